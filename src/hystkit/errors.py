@@ -1,0 +1,15 @@
+"""Errors hystkit raises for problems the user can fix (bad files, bad options, divergence)."""
+
+from __future__ import annotations
+
+
+class HystkitError(Exception):
+    """Base class: the CLI prints the message on one line and exits non-zero."""
+
+
+class InputError(HystkitError, ValueError):
+    """A data or model file cannot be used; the message names file, column and row."""
+
+
+class FitDivergedError(HystkitError, RuntimeError):
+    """An identification or a compensator run left the finite range."""
