@@ -13,3 +13,7 @@ class InputError(HystkitError, ValueError):
 
 class FitDivergedError(HystkitError, RuntimeError):
     """An identification or a compensator run left the finite range."""
+
+
+class OutputExistsError(HystkitError, FileExistsError):
+    """An output file exists and overwriting it was not asked for (``--force``)."""
