@@ -1,0 +1,320 @@
+"""Modified Power-Law (mPL) hysteresis model, ch. 5.3 of the reference document.
+
+Circuit (fig. 5.5): ``N`` cells, each a capacitor ``C = 1`` charged through a non-linear
+resistor whose current is a hyperbolic sine of its voltage (eq. 5.1); a linear output resistor
+``R = 1`` sums the weighted cell voltages (eq. 5.2)::
+
+    du_k/dt = f_k(e - u_k),          f_k(v) = I_Sk (exp(v/V_Tk) - exp(-v/V_Tk))    # eq. 5.1, 5.5
+    y       = w_0 e + sum_k w_k u_k - V_b                                           # eq. 5.2
+
+integrated with forward Euler (eq. 5.6). The state ``x`` is the vector of cell voltages ``u_k``.
+
+Stability limit (sec. 5.3.5, eq. 5.28-5.29). Forward Euler on a cell is stable only while
+``0 < f'(v) dt < 2``. Beyond the points ``x-``/``x+`` where the slope reaches the cap, ``f`` is
+continued by straight lines of the capped slope. eq. 5.29 in the document has two typos (the
+middle branch reads ``x- > x > x+`` and the lower branch uses ``x+``); the mathematically right
+form, used here, is ``f(x-) + s (x - x-)`` for ``x < x-`` and ``f(x) `` for ``x- <= x <= x+``.
+The default cap is ``f' dt <= 1`` rather than the marginal ``2``: then ``v -> v - f(v) dt`` is
+monotone and contracting, so every Euler step moves ``u_k`` towards the input without
+overshoot -- like the continuous RC cell -- and ``u_k`` stays inside the range of the input and
+the initial state *for any parameter set*. Any cap in ``(0, 2)`` keeps the model bounded.
+
+Everything here is pure: memory is the explicit state ``x`` passed in and returned.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import FitDivergedError
+from . import _mpl_kernels as kernels
+
+__all__ = [
+    "MplStructure",
+    "MplParams",
+    "simulate",
+    "simulate_reference",
+    "step",
+    "invert",
+    "invert_step",
+    "resistor_current",
+    "knee_voltage",
+]
+
+
+@dataclass(frozen=True)
+class MplStructure:
+    """What does not get fitted: cell count, sample time and the Euler slope cap.
+
+    Parameters
+    ----------
+    n_cells : int
+        Number of RC cells ``N`` (>= 1).
+    dt : float
+        Sample time of the recordings the model runs on [s].
+    slope_cap : float
+        Largest allowed ``f'(v) dt`` (eq. 5.28 requires < 2); 1 gives overshoot-free cells.
+    """
+
+    n_cells: int = 1
+    dt: float = 0.025
+    slope_cap: float = 1.0
+
+    def __post_init__(self) -> None:
+        if int(self.n_cells) != self.n_cells or self.n_cells < 1:
+            raise ValueError(f"n_cells must be a positive integer, got {self.n_cells!r}")
+        if not (np.isfinite(self.dt) and self.dt > 0):
+            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        if not 0 < self.slope_cap < 2:
+            raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step (eq. 5.28), "
+                             f"got {self.slope_cap!r}")
+
+    @property
+    def n_params(self) -> int:
+        """3N + 2 fitted parameters (sec. 5.3.2)."""
+        return 3 * self.n_cells + 2
+
+
+def _frozen(values, n: int, name: str) -> np.ndarray:
+    arr = np.array(values, dtype=float).reshape(-1)
+    if arr.shape != (n,):
+        raise ValueError(f"{name} must have {n} values, got {arr.shape[0]}")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class MplParams:
+    """Fitted quantities of an mPL model.
+
+    Parameters
+    ----------
+    i_s : array, shape (N,)
+        Saturation current ``I_S`` of each cell's resistor (> 0), eq. 5.1.
+    v_t : array, shape (N,)
+        Voltage scale ``V_T`` of each cell's resistor (> 0), eq. 5.1.
+    w : array, shape (N + 1,)
+        VCVS weights ``w_0 .. w_N``, eq. 5.2.
+    v_b : float
+        Bias voltage ``V_b``, eq. 5.2.
+
+    Notes
+    -----
+    The optimiser sees the vector ``[log G_1, log V_T1, ..., log G_N, log V_TN, w_0..w_N, V_b]``
+    with ``G_k = 2 I_Sk / V_Tk`` the small-signal conductance (the inverse time constant of the
+    cell). ``G`` and ``V_T`` are far less correlated than ``I_S`` and ``V_T``, and the logs keep
+    both positive.
+    """
+
+    i_s: np.ndarray
+    v_t: np.ndarray
+    w: np.ndarray
+    v_b: float = 0.0
+    n_cells: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        n = np.size(self.i_s)
+        object.__setattr__(self, "n_cells", int(n))
+        object.__setattr__(self, "i_s", _frozen(self.i_s, n, "i_s"))
+        object.__setattr__(self, "v_t", _frozen(self.v_t, n, "v_t"))
+        object.__setattr__(self, "w", _frozen(self.w, n + 1, "w"))
+        object.__setattr__(self, "v_b", float(self.v_b))
+        if np.any(self.i_s <= 0) or np.any(self.v_t <= 0):
+            raise ValueError("i_s and v_t must be positive (eq. 5.1)")
+
+    def to_vector(self) -> np.ndarray:
+        """Optimiser coordinates (see Notes of the class)."""
+        cells = np.column_stack([np.log(2 * self.i_s / self.v_t), np.log(self.v_t)]).reshape(-1)
+        return np.concatenate([cells, self.w, [self.v_b]])
+
+    @classmethod
+    def from_vector(cls, theta: np.ndarray, n_cells: int) -> MplParams:
+        """Inverse of :meth:`to_vector`."""
+        theta = np.asarray(theta, dtype=float)
+        cells = theta[: 2 * n_cells].reshape(n_cells, 2)
+        v_t = np.exp(cells[:, 1])
+        i_s = 0.5 * np.exp(cells[:, 0]) * v_t
+        return cls(i_s=i_s, v_t=v_t, w=theta[2 * n_cells: 3 * n_cells + 1],
+                   v_b=theta[3 * n_cells + 1])
+
+    def to_dict(self) -> dict:
+        return {"i_s": self.i_s.tolist(), "v_t": self.v_t.tolist(), "w": self.w.tolist(),
+                "v_b": self.v_b}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> MplParams:
+        return cls(i_s=d["i_s"], v_t=d["v_t"], w=d["w"], v_b=d["v_b"])
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, MplParams):
+            return NotImplemented
+        return bool(np.array_equal(self.to_vector(), other.to_vector()))
+
+    __hash__ = None
+
+
+def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:
+    """Voltage ``x+`` (= ``-x-``) beyond which each cell's resistor is a straight line.
+
+    Solves ``f'(x) = slope_cap / dt`` for the sinh resistor, ``f'(v) = G cosh(v / V_T)``;
+    zero when even the small-signal slope ``G`` exceeds the cap (the cell is then linear).
+    """
+    g = 2 * params.i_s / params.v_t
+    ratio = structure.slope_cap / (structure.dt * g)
+    return np.where(ratio > 1, params.v_t * np.arccosh(np.maximum(ratio, 1.0)), 0.0)
+
+
+def resistor_current(structure: MplStructure, params: MplParams, v: np.ndarray) -> np.ndarray:
+    """Limited cell-resistor currents ``f_k,lim(v)`` (eq. 5.1 with eq. 5.29, corrected).
+
+    Parameters
+    ----------
+    v : array, shape (..., N)
+        Voltage across each cell's resistor.
+
+    Returns
+    -------
+    array, shape (..., N)
+    """
+    v = np.asarray(v, dtype=float)
+    knee = knee_voltage(structure, params)
+    cap = structure.slope_cap / structure.dt
+    inside = np.abs(v) <= knee
+    v_in = np.clip(v, -knee, knee)
+    f_in = 2 * params.i_s * np.sinh(v_in / params.v_t)
+    return np.where(inside, f_in, f_in + cap * (v - v_in))
+
+
+def step(structure: MplStructure, params: MplParams, x: np.ndarray,
+         u: float) -> tuple[float, np.ndarray]:
+    """One sample of the forward model: output from the present state, then the Euler update.
+
+    Returns
+    -------
+    y : float
+        Model output ``w_0 u + sum w_k x_k - V_b`` (eq. 5.2).
+    x_next : array, shape (N,)
+        Cell voltages after ``dt`` (eq. 5.6).
+    """
+    x = np.asarray(x, dtype=float)
+    y = params.w[0] * u + params.w[1:] @ x - params.v_b
+    x_next = x + resistor_current(structure, params, u - x) * structure.dt
+    return float(y), x_next
+
+
+def invert_step(structure: MplStructure, params: MplParams, x: np.ndarray,
+                y: float) -> tuple[float, np.ndarray]:
+    """One sample of the analytical inverse (eq. 5.13-5.14, order of fig. 5.12).
+
+    The input estimate is solved from the output equation with the present state first, and
+    only then does the state advance with that estimate.
+    """
+    x = np.asarray(x, dtype=float)
+    u_hat = (y - params.w[1:] @ x + params.v_b) / params.w[0]
+    x_next = x + resistor_current(structure, params, u_hat - x) * structure.dt
+    return float(u_hat), x_next
+
+
+def _initial_state(n_cells: int, x0: np.ndarray | float | None, at_rest: float) -> np.ndarray:
+    if x0 is None:
+        return np.full(n_cells, float(at_rest))
+    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (n_cells,)).copy()
+    if not np.all(np.isfinite(x0)):
+        raise ValueError("x0 must be finite")
+    return x0
+
+
+def _check_input(u: np.ndarray, name: str) -> np.ndarray:
+    u = np.ascontiguousarray(u, dtype=float)
+    if u.ndim != 1 or u.size == 0:
+        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
+    if not np.all(np.isfinite(u)):
+        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
+    return u
+
+
+def simulate(structure: MplStructure, params: MplParams, u: np.ndarray,
+             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the forward model over an input sequence (compiled kernel).
+
+    Parameters
+    ----------
+    u : array, shape (n,)
+        Model input ``e`` sampled every ``structure.dt``.
+    x0 : array, shape (N,), float or None
+        Initial cell voltages. ``None`` starts at rest at the first input (``u_k = e_0``), the
+        synchronised start of eq. 2.21-2.22, instead of the document's zero state.
+
+    Returns
+    -------
+    y : array, shape (n,)
+    x_end : array, shape (N,)
+        State after the last sample; feeding it back as ``x0`` continues the run exactly.
+    """
+    _check_params(structure, params)
+    u = _check_input(u, "u")
+    x = _initial_state(structure.n_cells, x0, u[0])
+    knee = knee_voltage(structure, params)
+    return kernels.simulate(u, x, params.i_s, params.v_t, params.w, params.v_b, knee,
+                            structure.slope_cap / structure.dt, structure.dt)
+
+
+def simulate_reference(structure: MplStructure, params: MplParams, u: np.ndarray,
+                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    _check_params(structure, params)
+    u = _check_input(u, "u")
+    x = _initial_state(structure.n_cells, x0, u[0])
+    y = np.empty_like(u)
+    for n, u_n in enumerate(u):
+        y[n], x = step(structure, params, x, u_n)
+    return y, x
+
+
+def invert(structure: MplStructure, params: MplParams, y: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the analytical inverse (compensator) over an output sequence, eq. 5.13-5.14.
+
+    Parameters
+    ----------
+    y : array, shape (n,)
+        Measured model output (e.g. the sensor signal), sampled every ``structure.dt``.
+    x0 : array, shape (N,), float or None
+        Initial cell voltages; ``None`` starts at rest, ``u_k = e_0`` with
+        ``e_0 = (y_0 + V_b) / sum(w)``.
+
+    Returns
+    -------
+    u_hat : array, shape (n,)
+        Estimated input.
+    x_end : array, shape (N,)
+
+    Raises
+    ------
+    FitDivergedError
+        If the inverse leaves the finite range. Unlike the forward model, the inverse's
+        stability also depends on the weights (its cells see ``-(1 + w_k / w_0)`` times their own
+        voltage), so it is checked rather than guaranteed.
+    """
+    _check_params(structure, params)
+    y = _check_input(y, "y")
+    if params.w[0] == 0:
+        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
+    w_sum = params.w.sum()
+    rest = (y[0] + params.v_b) / w_sum if w_sum != 0 else 0.0
+    x = _initial_state(structure.n_cells, x0, rest)
+    knee = knee_voltage(structure, params)
+    u_hat, x_end, n_bad = kernels.invert(y, x, params.i_s, params.v_t, params.w, params.v_b,
+                                         knee, structure.slope_cap / structure.dt, structure.dt)
+    if n_bad >= 0:
+        raise FitDivergedError(
+            f"the inverse model diverged at sample {n_bad} of {y.size} (|u_hat| > 1e6 times the "
+            f"input range); the fitted weights make the compensator unstable on this data")
+    return u_hat, x_end
+
+
+def _check_params(structure: MplStructure, params: MplParams) -> None:
+    if params.n_cells != structure.n_cells:
+        raise ValueError(f"params have {params.n_cells} cells, structure has {structure.n_cells}")
