@@ -10,6 +10,7 @@ enter the output linearly) by linear least squares, so no start begins far off.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,7 +95,9 @@ def default_starts(structure: mpl.MplStructure) -> list[tuple[np.ndarray, np.nda
 
 def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
             starts: list[tuple[np.ndarray, np.ndarray]] | None = None,
-            max_nfev: int = 200) -> FitResult:
+            max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
+            accept: Callable[[mpl.MplParams], bool] | None = None,
+            accept_reason: str = "rejected by the acceptance test") -> FitResult:
     """Fit an mPL model mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9).
 
     Parameters
@@ -106,7 +109,13 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     starts : list of (i_s, v_t) pairs, optional
         Initial resistor shapes; the default is :func:`default_starts`.
     max_nfev : int
-        Residual-evaluation budget per start.
+        Residual-evaluation budget when polishing one start.
+    screen_nfev, n_polish : int
+        Every start first gets ``screen_nfev`` evaluations; the ``n_polish`` best are then run
+        to convergence.
+    accept : callable, optional
+        A candidate solution counts only if ``accept(params)`` is true (inverse mode uses it to
+        require a bounded inverse); ``accept_reason`` says why others were rejected.
 
     Raises
     ------
@@ -126,6 +135,7 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     upper = np.r_[np.tile([np.log(cap), _LOG_VT_BOUNDS[1]], n), np.full(n + 2, _W_BOUND)]
     starts = default_starts(structure) if starts is None else starts
     cache: dict = {}
+    n_polished = 0
 
     def run(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         key = theta.tobytes()
@@ -137,19 +147,40 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
                                                         cap, structure.dt)
         return cache[key]
 
+    def solve(theta0: np.ndarray, budget: int):
+        return least_squares(lambda th: run(th)[0] - y, theta0, jac=lambda th: run(th)[1],
+                             bounds=(lower, upper), method="trf", x_scale="jac",
+                             max_nfev=budget)
+
     t_start = time.perf_counter()
-    best, n_eval = None, 0
+    # Screen every start on a short budget, then polish the most promising ones: most starts
+    # settle into the same few basins, so full runs from all of them would repeat work.
+    screened, n_eval = [], 0
     for i_s, v_t in starts:
         theta0 = np.clip(_linear_init(structure, np.asarray(i_s, float), np.asarray(v_t, float),
                                       u, y).to_vector(), lower + 1e-9, upper - 1e-9)
-        sol = least_squares(lambda th: run(th)[0] - y, theta0, jac=lambda th: run(th)[1],
-                            bounds=(lower, upper), method="trf", x_scale="jac",
-                            max_nfev=max_nfev)
+        sol = solve(theta0, screen_nfev)
         n_eval += sol.nfev + sol.njev
-        if np.isfinite(sol.cost) and (best is None or sol.cost < best.cost):
+        if np.isfinite(sol.cost):
+            screened.append(sol)
+    screened.sort(key=lambda sol: sol.cost)
+    best, rejected = None, 0
+    for sol in screened:
+        if best is not None and n_polished >= n_polish:
+            break
+        if sol.status == 0:  # budget ran out: continue from where it stopped
+            sol = solve(sol.x, max_nfev)
+            n_eval += sol.nfev + sol.njev
+        if accept is not None and not accept(mpl.MplParams.from_vector(sol.x, n)):
+            rejected += 1
+            continue
+        n_polished += 1
+        if best is None or sol.cost < best.cost:
             best = sol
     if best is None:
-        raise FitDivergedError("the mPL fit diverged: no start gave a finite cost")
+        why = (f"all {rejected} candidate fits were rejected ({accept_reason})" if rejected
+               else "no start gave a finite cost")
+        raise FitDivergedError(f"the mPL fit failed: {why}")
     return FitResult(structure=structure, params=mpl.MplParams.from_vector(best.x, n),
                      cost=2.0 * float(best.cost), n_evaluations=int(n_eval),
                      seconds=time.perf_counter() - t_start, converged=bool(best.status > 0),

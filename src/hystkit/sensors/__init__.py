@@ -1,0 +1,5 @@
+"""Simulated sensors that produce the same recordings as the lab."""
+
+from ._virtual import VirtualSensor, simulate_experiment
+
+__all__ = ["VirtualSensor", "simulate_experiment"]

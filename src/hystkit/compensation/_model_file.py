@@ -1,0 +1,84 @@
+"""Compensator <-> JSON model file (schema ``hystkit.compensator``, version 1)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+from pathlib import Path
+
+from .. import __version__
+from ..errors import InputError
+from ..io import write_json
+from ..models import mpl
+from ._compensator import CENTERS, MODES, Compensator, LinearBaseline, Scaling
+
+__all__ = ["SCHEMA", "SCHEMA_VERSION", "save_compensator", "load_compensator",
+           "compensator_to_dict", "compensator_from_dict"]
+
+SCHEMA = "hystkit.compensator"
+SCHEMA_VERSION = 1
+
+
+def compensator_to_dict(comp: Compensator) -> dict:
+    """Plain-JSON form: model type, structure, parameters, normalisation, dt, baseline, fit."""
+    return {
+        "schema": SCHEMA,
+        "schema_version": SCHEMA_VERSION,
+        "hystkit_version": __version__,
+        "model": "mpl",
+        "mode": comp.mode,
+        "center": comp.center,
+        "dt": comp.structure.dt,
+        "structure": asdict(comp.structure),
+        "params": comp.params.to_dict(),
+        "normalisation": asdict(comp.scaling),
+        "baseline": asdict(comp.baseline),
+        "fit_seconds": comp.fit_info.get("fit_seconds"),
+        "fit": comp.fit_info,
+    }
+
+
+def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
+    """Inverse of :func:`compensator_to_dict`; InputError names what is wrong."""
+    if not isinstance(d, dict) or d.get("schema") != SCHEMA:
+        found = d.get("schema") if isinstance(d, dict) else type(d).__name__
+        raise InputError(f"{source}: not a hystkit compensator file (schema {found!r}, "
+                         f"expected {SCHEMA!r})")
+    if d.get("schema_version") != SCHEMA_VERSION:
+        raise InputError(f"{source}: schema_version {d.get('schema_version')!r} is not supported "
+                         f"(this hystkit reads version {SCHEMA_VERSION})")
+    try:
+        if d["model"] != "mpl":
+            raise InputError(f"{source}: key 'model': {d['model']!r} is not supported here")
+        if d["mode"] not in MODES or d["center"] not in CENTERS:
+            raise InputError(f"{source}: key 'mode'/'center': unknown value "
+                             f"{d['mode']!r}/{d['center']!r}")
+        return Compensator(structure=mpl.MplStructure(**d["structure"]),
+                           params=mpl.MplParams.from_dict(d["params"]), mode=d["mode"],
+                           center=d["center"], scaling=Scaling(**d["normalisation"]),
+                           baseline=LinearBaseline(**d["baseline"]), fit_info=d.get("fit", {}))
+    except KeyError as exc:
+        raise InputError(f"{source}: key {exc.args[0]!r} is missing") from None
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{source}: invalid model contents ({exc})") from None
+
+
+def save_compensator(comp: Compensator, path: str | Path, *, force: bool = False) -> Path:
+    """Write the model file; refuses to overwrite unless ``force``."""
+    return write_json(compensator_to_dict(comp), path, force=force)
+
+
+def load_compensator(path: str | Path) -> Compensator:
+    """Read a model file written by :func:`save_compensator`."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError(f"{path}: file not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read model file ({exc})") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path}: not JSON (line {exc.lineno}: {exc.msg})") from None
+    return compensator_from_dict(data, source=str(path))

@@ -1,0 +1,233 @@
+"""Goodness-of-fit, distortion and hysteresis metrics (thesis chapter 5)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+from scipy.integrate import trapezoid
+from scipy.signal import periodogram
+
+# Kaiser beta of MATLAB's ``sinad``: its side lobes (~ -350 dB) sit below double
+# precision, so no leakage escapes the main lobes of the DC and the fundamental.
+_KAISER_BETA = 38.0
+# First null of the Kaiser window's transform W(f) ~ sinh(sqrt(beta^2 - (pi*k)^2)) / sqrt(...),
+# k in bins: sqrt(beta^2 - (pi*k)^2) turns imaginary and first equals i*pi at
+# k0 = sqrt(1 + (beta/pi)^2) = 12.14 bins.  A tone's peak bin can be up to half a bin
+# off the true frequency, so its lobe spans peak +- (k0 + 0.5) -> 13 bins each side.
+# (Checked numerically: the zero-padded power spectrum of the window drops to the rounding
+# floor, ~1e-32 of its peak, exactly at 12.14 bins.)
+_LOBE_HALF_WIDTH = math.ceil(math.sqrt(1.0 + (_KAISER_BETA / math.pi) ** 2) + 0.5)
+# A reversal of x counts only after x came back by this fraction of its range,
+# so sensor noise and flat runs do not create spurious cycles.
+_REVERSAL_DEADBAND = 0.01
+
+
+def _as_signal(a: npt.ArrayLike, name: str) -> np.ndarray:
+    """Return `a` as a finite 1-D float array of at least 2 samples, else raise ValueError."""
+    arr = np.asarray(a, dtype=float)
+    if arr.ndim != 1:
+        raise ValueError(f"{name} must be 1-D, got shape {arr.shape}")
+    if arr.size < 2:
+        raise ValueError(f"{name} needs at least 2 samples, got {arr.size}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} contains NaN or infinite values")
+    return arr
+
+
+def _as_pair(
+    a: npt.ArrayLike, b: npt.ArrayLike, names: tuple[str, str]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Validate two signals with `_as_signal` and check that their lengths match."""
+    a_arr, b_arr = _as_signal(a, names[0]), _as_signal(b, names[1])
+    if a_arr.size != b_arr.size:
+        raise ValueError(
+            f"{names[0]} and {names[1]} differ in length ({a_arr.size} vs {b_arr.size})"
+        )
+    return a_arr, b_arr
+
+
+def _normalised_error(
+    y_true: npt.ArrayLike, y_pred: npt.ArrayLike, scale: float | None
+) -> np.ndarray:
+    """Return psi - psi_hat, both signals divided by `scale` (eq. 5.10), shape (n,)."""
+    t, p = _as_pair(y_true, y_pred, ("y_true", "y_pred"))
+    s = float(np.max(np.abs(t))) if scale is None else float(scale)
+    if not (math.isfinite(s) and s > 0.0):
+        raise ValueError(f"scale must be finite and > 0, got {s} (y_true all zero?)")
+    return (t - p) / s  # eq. 5.10
+
+
+def r2(y_true: npt.ArrayLike, y_pred: npt.ArrayLike) -> float:
+    """Ordinary coefficient of determination, ``1 - SS_res / SS_tot``.
+
+    Parameters
+    ----------
+    y_true, y_pred : array_like, shape (n,)
+        Measured and predicted signal, same (any) unit, n >= 2.
+
+    Returns
+    -------
+    float
+        Dimensionless; 1 for a perfect fit, 0 for predicting the mean, negative if worse.
+
+    Raises
+    ------
+    ValueError
+        On bad shapes or non-finite values, or if `y_true` is constant (SS_tot = 0).
+    """
+    t, p = _as_pair(y_true, y_pred, ("y_true", "y_pred"))
+    ss_tot = float(np.sum((t - t.mean()) ** 2))
+    # ss_tot can also underflow to 0 for a non-constant but tiny y_true.
+    if np.ptp(t) == 0.0 or ss_tot == 0.0:
+        raise ValueError("y_true is constant; R^2 is undefined")
+    ss_res = float(np.sum((t - p) ** 2))
+    return 1.0 - ss_res / ss_tot
+
+
+def e_rms_pct(y_true: npt.ArrayLike, y_pred: npt.ArrayLike, scale: float | None = None) -> float:
+    """Normalised RMS error in percent of `scale`, eq. 5.11.
+
+    Parameters
+    ----------
+    y_true, y_pred : array_like, shape (n,)
+        Measured and predicted signal, same unit, n >= 2.
+    scale : float, optional
+        Normalisation of eq. 5.10 in the unit of the signals; default ``max|y_true|``.
+
+    Returns
+    -------
+    float
+        ``100 * sqrt(mean((psi - psi_hat)**2))`` with ``psi = y_true / scale``, in %.
+    """
+    d = _normalised_error(y_true, y_pred, scale)
+    return 100.0 * math.sqrt(float(np.mean(d**2)))  # eq. 5.11
+
+
+def e_max_pct(y_true: npt.ArrayLike, y_pred: npt.ArrayLike, scale: float | None = None) -> float:
+    """Normalised maximum absolute error in percent of `scale`, eq. 5.11.
+
+    Parameters are those of `e_rms_pct`; returns ``100 * max|psi - psi_hat|`` in %.
+    """
+    d = _normalised_error(y_true, y_pred, scale)
+    return 100.0 * float(np.max(np.abs(d)))  # eq. 5.11
+
+
+def sinad_db(x: npt.ArrayLike, fs: float = 1.0) -> float:
+    """Signal to noise-and-distortion ratio of one signal, like MATLAB's ``sinad(x)``.
+
+    The one-sided modified periodogram with a Kaiser window (beta = 38) is split into
+    the DC main lobe (bins 0..13), the fundamental's main lobe (largest remaining peak
+    +- 13 bins; see `_LOBE_HALF_WIDTH`) and the rest, which is noise plus distortion.
+    Nothing is removed from `x` beforehand (no detrending).
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Sampled signal, any unit.  The fundamental should lie more than ~26 bins
+        (``26 * fs / n``) away from 0 Hz and fs/2, otherwise the lobes overlap.
+    fs : float, default 1.0
+        Sampling rate in Hz; the result does not depend on it.
+
+    Returns
+    -------
+    float
+        ``10 log10(P_fund / (P_total - P_dc - P_fund))`` in dB; ``inf`` if nothing is
+        left besides DC and fundamental.
+
+    Raises
+    ------
+    ValueError
+        On bad input, ``fs <= 0``, a constant `x`, or fewer samples than the lobes need.
+    """
+    sig = _as_signal(x, "x")
+    if not (math.isfinite(fs) and fs > 0.0):
+        raise ValueError(f"fs must be finite and > 0, got {fs}")
+    if np.ptp(sig) == 0.0:
+        raise ValueError("x is constant; it has no fundamental")
+    h = _LOBE_HALF_WIDTH
+    n_bins = sig.size // 2 + 1
+    if n_bins <= 3 * h + 2:  # DC lobe + a full fundamental lobe + at least one noise bin
+        raise ValueError(f"x has {sig.size} samples; sinad_db needs at least {6 * h + 4}")
+    # detrend=False: MATLAB removes nothing by hand; the DC lobe is excluded below instead.
+    _, pxx = periodogram(sig, fs=fs, window=("kaiser", _KAISER_BETA), detrend=False)
+    rest = np.ones(n_bins, dtype=bool)
+    rest[: h + 1] = False  # DC main lobe
+    k = h + 1 + int(np.argmax(pxx[h + 1 :]))  # fundamental = largest non-DC peak
+    lo, hi = max(k - h, h + 1), min(k + h, n_bins - 1)
+    rest[lo : hi + 1] = False
+    p_fund = float(np.sum(pxx[lo : hi + 1]))
+    # Summing the remaining bins equals P_total - P_dc - P_fund but cannot cancel to < 0.
+    p_noise = float(np.sum(pxx[rest]))
+    if p_noise == 0.0:
+        return math.inf
+    return 10.0 * math.log10(p_fund / p_noise)
+
+
+def _sweep_total(x: np.ndarray, deadband: float) -> float:
+    """Sum of the sweep heights of `x` between start, confirmed reversals and end.
+
+    A reversal is confirmed once `x` has moved back by more than `deadband` from its
+    running extremum (a hysteresis comparator), so noise and flat runs add nothing.
+    """
+    v = x[np.r_[True, np.diff(x) != 0.0]]  # collapse flat runs
+    # Only sign changes of the slope can be reversals; this keeps the loop short.
+    d = np.sign(np.diff(v))
+    v = np.r_[v[0], v[1:-1][d[1:] != d[:-1]], v[-1]]
+    turns = [v[0]]
+    direction, ext = 0, v[0]
+    for val in v[1:]:
+        if direction == 0:  # the first sweep's direction is unknown until x leaves the band
+            if abs(val - v[0]) > deadband:
+                direction, ext = (1 if val > v[0] else -1), val
+        elif direction * (val - ext) > 0.0:
+            ext = val  # still moving the same way
+        elif abs(val - ext) > deadband:
+            turns.append(ext)
+            direction, ext = -direction, val
+    turns.append(v[-1])
+    return float(np.sum(np.abs(np.diff(turns))))
+
+
+def loop_area(x: npt.ArrayLike, y: npt.ArrayLike) -> float:
+    """Normalised hysteresis loop area per input cycle in percent, eq. 5.15.
+
+    Both signals are scaled to [0, 1] (``x_hat = (x - min x) / (max x - min x)``,
+    likewise ``y_hat``) and the line integral along the recorded path,
+    ``A_hat = 100 / n_cycles * sum_i (y_hat[i] + y_hat[i+1]) / 2 * (x_hat[i+1] - x_hat[i])``
+    (trapezoid rule of ``oint y_hat dx_hat``), is returned.  Its sign gives the
+    orientation: clockwise in the (x_hat, y_hat) plane is positive, so an output that
+    lags the input (counter-clockwise) gives a negative value.  Monotone y(x) gives 0.
+
+    ``n_cycles = max(1, S / 2)``, where S is the summed height of the sweeps of x_hat
+    between its start, its reversals and its end: a full cycle sweeps the range up and
+    down (S = 2), whatever phase the record starts at.  For a record that starts and
+    ends mid-range this is ``n_reversals / 2``; unlike a plain reversal count it also
+    gives whole cycles for a record that starts at an extremum.  A reversal counts only
+    after x has come back by 1 % of its range, so noise and flat runs are ignored.
+    Records shorter than one cycle are normalised as one cycle.
+
+    Parameters
+    ----------
+    x, y : array_like, shape (n,)
+        Input (e.g. displacement) and output (e.g. sensor reading), any units, n >= 2.
+
+    Returns
+    -------
+    float
+        Signed loop area per cycle in % of the unit square; |A_hat| <= 100.
+
+    Raises
+    ------
+    ValueError
+        On bad input, or if x or y is constant (the normalisation is undefined).
+    """
+    xs, ys = _as_pair(x, y, ("x", "y"))
+    x_rng, y_rng = float(np.ptp(xs)), float(np.ptp(ys))
+    if x_rng == 0.0 or y_rng == 0.0:
+        raise ValueError("x and y must not be constant; the loop cannot be normalised")
+    x_hat = (xs - xs.min()) / x_rng
+    y_hat = (ys - ys.min()) / y_rng
+    n_cycles = max(1.0, _sweep_total(x_hat, _REVERSAL_DEADBAND) / 2.0)
+    return 100.0 / n_cycles * float(trapezoid(y_hat, x_hat))  # eq. 5.15

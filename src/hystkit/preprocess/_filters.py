@@ -1,0 +1,35 @@
+"""Filtering and resampling of recordings as in the document's lab pipeline (sec. 4.3.1)."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import signal
+
+__all__ = ["lowpass_zero_phase", "downsample"]
+
+
+def lowpass_zero_phase(x: np.ndarray, fs: float, cutoff: float = 20.0, order: int = 2,
+                       axis: int = -1) -> np.ndarray:
+    """Zero-phase Butterworth low-pass (forward-backward, ``filtfilt``), eq. 4.1.
+
+    Parameters
+    ----------
+    x : array
+        Signal(s) sampled at ``fs`` [Hz].
+    cutoff : float
+        -3 dB frequency of the one-way filter [Hz] (20 Hz in the document).
+    order : int
+        One-way order (2 in the document); the zero-phase result has twice the roll-off.
+    """
+    if not 0 < cutoff < fs / 2:
+        raise ValueError(f"cutoff {cutoff} Hz must lie between 0 and fs/2 = {fs / 2} Hz")
+    sos = signal.butter(order, cutoff, fs=fs, output="sos")
+    return signal.sosfiltfilt(sos, x, axis=axis)
+
+
+def downsample(x: np.ndarray, fs: float, fs_out: float, axis: int = -1) -> np.ndarray:
+    """Keep every ``fs / fs_out``-th sample (the caller low-passes first, as the lab does)."""
+    factor = fs / fs_out
+    if abs(factor - round(factor)) > 1e-9 or round(factor) < 1:
+        raise ValueError(f"fs = {fs} Hz is not an integer multiple of fs_out = {fs_out} Hz")
+    return np.take(x, np.arange(0, np.shape(x)[axis], int(round(factor))), axis=axis)

@@ -1,0 +1,96 @@
+"""Position excitations of the document's experiments (sec. 4.3, paper 9.2 sec. III), in mm."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import optimize, signal
+
+__all__ = ["sine", "decaying_sine", "exponential_chirp", "filtered_noise", "Experiment",
+           "EXPERIMENTS", "excitation"]
+
+
+def sine(t: np.ndarray, frequency: float = 0.5, amplitude: float = 3.0) -> np.ndarray:
+    """``amplitude * sin(2 pi f t)`` [mm]; the sine experiment is 0.5 Hz, 3 mm (eq. 9.14)."""
+    return amplitude * np.sin(2 * np.pi * frequency * np.asarray(t, dtype=float))
+
+
+def decaying_sine(t: np.ndarray, frequency: float = 0.5, start_amplitude: float = 2.0,
+                  end_amplitude: float = 0.1, duration: float = 200.0) -> np.ndarray:
+    """Sine whose amplitude falls exponentially from ``start`` to ``end`` over ``duration`` [mm].
+
+    The document's decay experiment: 0.5 Hz, 2 mm to 100 um over 200 s; its shrinking cycles are
+    minor loops inside the first, major one.
+    """
+    t = np.asarray(t, dtype=float)
+    envelope = start_amplitude * (end_amplitude / start_amplitude) ** (t / duration)
+    return envelope * np.sin(2 * np.pi * frequency * t)
+
+
+def exponential_chirp(t: np.ndarray, f0: float = 0.1, f1: float = 3.0, duration: float = 100.0,
+                      amplitude: float = 3.0) -> np.ndarray:
+    """Sine sweep whose frequency rises exponentially from ``f0`` to ``f1`` over ``duration``."""
+    return amplitude * signal.chirp(np.asarray(t, dtype=float), f0=f0, t1=duration, f1=f1,
+                                    method="logarithmic", phi=-90)
+
+
+def _fir_lowpass(fs: float, cutoff_3db: float, numtaps: int) -> np.ndarray:
+    """Windowed-sinc FIR whose gain is -3 dB at ``cutoff_3db``.
+
+    ``firwin``'s cut-off is the -6 dB point, so the design cut-off is solved for the stated
+    -3 dB point, as the document specifies its filter by it.
+    """
+    def gain_error(fc: float) -> float:
+        taps = signal.firwin(numtaps, fc, fs=fs)
+        _, h = signal.freqz(taps, worN=[cutoff_3db], fs=fs)
+        return abs(h[0]) - 1 / np.sqrt(2)
+
+    fc = optimize.brentq(gain_error, cutoff_3db, min(4 * cutoff_3db, 0.49 * fs), xtol=1e-6)
+    return signal.firwin(numtaps, fc, fs=fs)
+
+
+def filtered_noise(t: np.ndarray, seed: int, cutoff: float = 4.0, order: int = 500,
+                   amplitude: float = 3.0) -> np.ndarray:
+    """Gaussian noise through an ``order``-th order FIR low-pass (-3 dB at ``cutoff``) [mm].
+
+    Scaled so that max |x| equals ``amplitude``. The filter's start-up transient is discarded by
+    generating ``order`` extra samples first.
+    """
+    t = np.asarray(t, dtype=float)
+    fs = 1.0 / np.median(np.diff(t))
+    taps = _fir_lowpass(fs, cutoff, order + 1)
+    white = np.random.default_rng(seed).standard_normal(t.size + order)
+    x = signal.lfilter(taps, 1.0, white)[order:]
+    return amplitude * x / np.max(np.abs(x))
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """One of the document's excitation experiments: its duration and its trajectory."""
+
+    name: str
+    duration: float  # s
+    description: str
+    trajectory: Callable[[np.ndarray, int], np.ndarray]
+
+
+EXPERIMENTS: dict[str, Experiment] = {
+    "sine": Experiment("sine", 200.0, "sine 0.5 Hz, 3 mm", lambda t, seed: sine(t)),
+    "decay": Experiment("decay", 200.0, "0.5 Hz sine, 2 mm -> 100 um exponentially over 200 s",
+                        lambda t, seed: decaying_sine(t)),
+    "chirp": Experiment("chirp", 100.0, "exponential chirp 0.1 -> 3 Hz over 100 s, 3 mm",
+                        lambda t, seed: exponential_chirp(t)),
+    "noise": Experiment("noise", 200.0, "Gaussian noise, 500th-order FIR low-pass -3 dB at 4 Hz, "
+                        "peak 3 mm", lambda t, seed: filtered_noise(t, seed)),
+}
+
+
+def excitation(name: str, fs: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Time [s] and position [mm] of experiment ``name`` sampled at ``fs`` [Hz]."""
+    if name not in EXPERIMENTS:
+        raise ValueError(f"unknown excitation {name!r}; choose one of {sorted(EXPERIMENTS)}")
+    exp = EXPERIMENTS[name]
+    t = np.arange(int(round(exp.duration * fs))) / fs
+    return t, exp.trajectory(t, seed)
