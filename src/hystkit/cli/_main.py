@@ -9,8 +9,14 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from .. import __version__
-from ..compensation import (CENTERS, MODES, evaluate, fit_compensator, load_compensator,
-                            save_compensator)
+from ..compensation import (
+    CENTERS,
+    MODES,
+    evaluate,
+    fit_compensator,
+    load_compensator,
+    save_compensator,
+)
 from ..errors import HystkitError, OutputExistsError
 from ..io import read_recording, write_json, write_recording
 from ..sensors import simulate_experiment

@@ -2,8 +2,12 @@
 
 from ._compensator import CENTERS, MODES, Compensator, LinearBaseline, Scaling, fit_compensator
 from ._evaluate import evaluate
-from ._model_file import (compensator_from_dict, compensator_to_dict, load_compensator,
-                          save_compensator)
+from ._model_file import (
+                          compensator_from_dict,
+                          compensator_to_dict,
+                          load_compensator,
+                          save_compensator,
+)
 
 __all__ = ["CENTERS", "MODES", "Compensator", "LinearBaseline", "Scaling", "compensator_from_dict",
            "compensator_to_dict", "evaluate", "fit_compensator", "load_compensator",

@@ -27,7 +27,7 @@ from ..identification import FitResult, fit_mpl
 from ..io import Recording
 from ..models import mpl
 
-__all__ = ["Scaling", "LinearBaseline", "Compensator", "fit_compensator", "MODES", "CENTERS"]
+__all__ = ["CENTERS", "MODES", "Compensator", "LinearBaseline", "Scaling", "fit_compensator"]
 
 MODES = ("direct", "inverse")
 CENTERS = ("recording", "fit", "none")

@@ -12,8 +12,14 @@ from ..io import write_json
 from ..models import mpl
 from ._compensator import CENTERS, MODES, Compensator, LinearBaseline, Scaling
 
-__all__ = ["SCHEMA", "SCHEMA_VERSION", "save_compensator", "load_compensator",
-           "compensator_to_dict", "compensator_from_dict"]
+__all__ = [
+    "SCHEMA",
+    "SCHEMA_VERSION",
+    "compensator_from_dict",
+    "compensator_to_dict",
+    "load_compensator",
+    "save_compensator",
+]
 
 SCHEMA = "hystkit.compensator"
 SCHEMA_VERSION = 1

@@ -17,10 +17,10 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import FitDivergedError
-from ..models import mpl
 from ..models import _mpl_kernels as kernels
+from ..models import mpl
 
-__all__ = ["FitResult", "fit_mpl", "default_starts"]
+__all__ = ["FitResult", "default_starts", "fit_mpl"]
 
 # Bounds in optimiser coordinates (see MplParams.to_vector). |w| <= 100 mirrors the document's
 # weight-sum constraint of 10^2 (sec. 5.3.3).

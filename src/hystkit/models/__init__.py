@@ -3,4 +3,4 @@
 from . import mpl
 from .mpl import MplParams, MplStructure
 
-__all__ = ["mpl", "MplParams", "MplStructure"]
+__all__ = ["MplParams", "MplStructure", "mpl"]

@@ -32,15 +32,15 @@ from ..errors import FitDivergedError
 from . import _mpl_kernels as kernels
 
 __all__ = [
-    "MplStructure",
     "MplParams",
+    "MplStructure",
+    "invert",
+    "invert_step",
+    "knee_voltage",
+    "resistor_current",
     "simulate",
     "simulate_reference",
     "step",
-    "invert",
-    "invert_step",
-    "resistor_current",
-    "knee_voltage",
 ]
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal
 
-__all__ = ["lowpass_zero_phase", "downsample"]
+__all__ = ["downsample", "lowpass_zero_phase"]
 
 
 def lowpass_zero_phase(x: np.ndarray, fs: float, cutoff: float = 20.0, order: int = 2,
@@ -32,4 +32,4 @@ def downsample(x: np.ndarray, fs: float, fs_out: float, axis: int = -1) -> np.nd
     factor = fs / fs_out
     if abs(factor - round(factor)) > 1e-9 or round(factor) < 1:
         raise ValueError(f"fs = {fs} Hz is not an integer multiple of fs_out = {fs_out} Hz")
-    return np.take(x, np.arange(0, np.shape(x)[axis], int(round(factor))), axis=axis)
+    return np.take(x, np.arange(0, np.shape(x)[axis], round(factor)), axis=axis)

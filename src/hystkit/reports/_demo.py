@@ -14,7 +14,7 @@ from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
 from ._figures import plot_loops, plot_time_series
 
-__all__ = ["run_demo", "DOCUMENT_TABLE_5_5", "DEMO_FILES", "format_table"]
+__all__ = ["DEMO_FILES", "DOCUMENT_TABLE_5_5", "format_table", "run_demo"]
 
 # Table 5.5 / paper 9.2 table I: (model R², straight-line R²) on the document's lab data.
 DOCUMENT_TABLE_5_5 = {"sine": (0.990, 0.928), "chirp": (0.984, 0.945),

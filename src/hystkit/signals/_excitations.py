@@ -8,8 +8,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, signal
 
-__all__ = ["sine", "decaying_sine", "exponential_chirp", "filtered_noise", "Experiment",
-           "EXPERIMENTS", "excitation"]
+__all__ = [
+    "EXPERIMENTS",
+    "Experiment",
+    "decaying_sine",
+    "excitation",
+    "exponential_chirp",
+    "filtered_noise",
+    "sine",
+]
 
 
 def sine(t: np.ndarray, frequency: float = 0.5, amplitude: float = 3.0) -> np.ndarray:
@@ -92,5 +99,5 @@ def excitation(name: str, fs: float, seed: int = 0) -> tuple[np.ndarray, np.ndar
     if name not in EXPERIMENTS:
         raise ValueError(f"unknown excitation {name!r}; choose one of {sorted(EXPERIMENTS)}")
     exp = EXPERIMENTS[name]
-    t = np.arange(int(round(exp.duration * fs))) / fs
+    t = np.arange(round(exp.duration * fs)) / fs
     return t, exp.trajectory(t, seed)
