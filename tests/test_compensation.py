@@ -94,3 +94,15 @@ def test_constant_signal_cannot_be_fitted():
     rec = Recording(time=np.arange(100) * 0.025, sensor=np.ones(100), position=np.arange(100.0))
     with pytest.raises(InputError, match="column 'sensor' is constant"):
         fit_compensator(rec, 1)
+
+
+def test_estimator_contract(recordings):
+    from hystkit.compensation import CompensatorEstimator
+
+    fit_rec, val_rec = recordings["noise"]
+    est = CompensatorEstimator(n_cells=1)
+    assert not hasattr(est, "compensator_")
+    with pytest.raises(RuntimeError, match="not fitted"):
+        est.predict(val_rec)
+    assert est.fit(fit_rec) is est
+    assert est.score(val_rec) == pytest.approx(evaluate(est.compensator_, val_rec)["r2"])
