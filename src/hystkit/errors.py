@@ -17,3 +17,7 @@ class FitDivergedError(HystkitError, RuntimeError):
 
 class OutputExistsError(HystkitError, FileExistsError):
     """An output file exists and overwriting it was not asked for (``--force``)."""
+
+
+class OutputError(HystkitError, OSError):
+    """An output path cannot be written (its folder is a file, no permission, disk full)."""

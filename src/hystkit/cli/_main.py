@@ -17,22 +17,40 @@ from ..compensation import (
     load_compensator,
     save_compensator,
 )
-from ..errors import HystkitError, OutputExistsError
-from ..io import read_recording, write_json, write_recording
+from ..errors import HystkitError
+from ..io import check_output_path, read_recording, write_json, write_recording
 from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
 
 __all__ = ["main"]
 
 
-def _refuse_existing(path: Path, force: bool) -> None:
-    """Check before any work, so a refused run writes nothing and wastes no time."""
-    if path.exists() and not force:
-        raise OutputExistsError(f"{path} already exists; pass --force to overwrite it")
+class _UsageError(HystkitError):
+    """A command line argparse rejected; reported on one line like every other error."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # argparse would print the usage and call sys.exit(2)
+        raise _UsageError(f"{message} (see '{self.prog} --help')")
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {value}")
+    return value
+
+
+def _slope_cap(text: str) -> float:
+    value = float(text)
+    if not 0 < value < 2:
+        raise argparse.ArgumentTypeError(f"must lie in (0, 2) for a stable Euler step "
+                                         f"(eq. 5.28), got {value}")
+    return value
 
 
 def _simulate_sensor(args: argparse.Namespace) -> int:
-    _refuse_existing(args.out, args.force)
+    check_output_path(args.out, args.force)
     rec = simulate_experiment(args.excitation, seed=args.seed)
     write_recording(rec, args.out, force=args.force)
     print(f"wrote {args.out}: {EXPERIMENTS[args.excitation].description}, seed {args.seed}, "
@@ -41,7 +59,7 @@ def _simulate_sensor(args: argparse.Namespace) -> int:
 
 
 def _fit(args: argparse.Namespace) -> int:
-    _refuse_existing(args.out, args.force)
+    check_output_path(args.out, args.force)
     rec = read_recording(args.data)
     print(f"fitting mpl ({args.cells} cell(s), {args.mode} mode, centring: {args.center}) on "
           f"{args.data}: {rec.n_samples} samples at {rec.fs:g} Hz ...", flush=True)
@@ -59,7 +77,7 @@ def _fit(args: argparse.Namespace) -> int:
 
 
 def _compensate(args: argparse.Namespace) -> int:
-    _refuse_existing(args.out, args.force)
+    check_output_path(args.out, args.force)
     comp = load_compensator(args.model)
     rec = read_recording(args.data, need_position=False)
     estimate = comp.estimate(rec)
@@ -71,7 +89,7 @@ def _compensate(args: argparse.Namespace) -> int:
 
 def _evaluate(args: argparse.Namespace) -> int:
     if args.json is not None:
-        _refuse_existing(args.json, args.force)
+        check_output_path(args.json, args.force)
     comp = load_compensator(args.model)
     scores = evaluate(comp, read_recording(args.data))
     print(f"{args.data} with {args.model} (centring: {scores['center']}, "
@@ -112,7 +130,7 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="hystkit", description="Hysteresis compensation for "
+    parser = _Parser(prog="hystkit", description="Hysteresis compensation for "
                                      "lousy (3D-printed, soft) sensors.")
     parser.add_argument("--version", action="version", version=f"hystkit {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -126,14 +144,14 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("fit", help="fit a compensator to a recording")
     p.add_argument("data", type=Path, help="recording: time, position, sensor (CSV/Parquet/.mat)")
     p.add_argument("--model", choices=["mpl"], default="mpl")
-    p.add_argument("--cells", type=int, default=1, help="mPL cells N (3N+2 parameters)")
+    p.add_argument("--cells", type=_positive_int, default=1, help="mPL cells N (3N+2 parameters)")
     p.add_argument("--mode", choices=MODES, default="direct",
                    help="direct: fit sensor->position (paper 9.2); inverse: fit "
                         "position->sensor and invert it (paper 9.1)")
     p.add_argument("--center", choices=CENTERS, default="recording",
                    help="whose mean is removed: each recording's own (hides drift), the "
                         "fitting recording's, or none")
-    p.add_argument("--slope-cap", type=float, default=1.0,
+    p.add_argument("--slope-cap", type=_slope_cap, default=1.0,
                    help="Euler stability cap f'·dt of the cell resistors, in (0, 2)")
     p.add_argument("--out", type=Path, required=True, help="model JSON file to write")
     p.set_defaults(run=_fit)
@@ -152,7 +170,7 @@ def _parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("demo", help="the main job on the built-in virtual sensor")
     p.add_argument("--out", type=Path, help="output folder (default: a new timestamped one)")
-    p.add_argument("--cells", type=int, default=3,
+    p.add_argument("--cells", type=_positive_int, default=3,
                    help="mPL cells (default 3: 11 parameters, as the document's model)")
     p.set_defaults(run=_demo)
 
@@ -163,8 +181,8 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit code (0 success, 2 bad input or divergence)."""
-    args = _parser().parse_args(argv)
     try:
+        args = _parser().parse_args(argv)
         return args.run(args)
     except HystkitError as exc:
         print(f"hystkit: error: {exc}", file=sys.stderr)

@@ -66,6 +66,21 @@ class Compensator:
     baseline: LinearBaseline
     fit_info: dict = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        if self.params.n_cells != self.structure.n_cells:
+            raise ValueError(f"params have {self.params.n_cells} cells but the structure has "
+                             f"{self.structure.n_cells}")
+        if self.mode not in MODES or self.center not in CENTERS:
+            raise ValueError(f"unknown mode/center {self.mode!r}/{self.center!r}")
+        for name, value in vars(self.scaling).items():
+            ok = np.isfinite(value) and (value > 0 if name.endswith("scale") else True)
+            if not ok:
+                raise ValueError(f"normalisation {name} must be finite"
+                                 f"{' and positive' if name.endswith('scale') else ''}, "
+                                 f"got {value}")
+        if not (np.isfinite(self.baseline.slope) and np.isfinite(self.baseline.intercept)):
+            raise ValueError("baseline slope and intercept must be finite")
+
     def _normalised_sensor(self, sensor: np.ndarray) -> np.ndarray:
         offset = {"recording": np.mean(sensor), "fit": self.scaling.sensor_offset,
                   "none": 0.0}[self.center]

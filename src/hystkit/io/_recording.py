@@ -18,7 +18,7 @@ import pandas as pd
 from scipy.io import loadmat
 from scipy.io.matlab import MatReadError
 
-from hystkit.errors import InputError, OutputExistsError
+from hystkit.errors import InputError, OutputError, OutputExistsError
 
 _COLUMNS = ("time", "position", "sensor")  # also the column order of written files
 _MAX_STEP_DEVIATION = 0.01  # relative to the median step; beyond this we ask for resampling
@@ -335,12 +335,11 @@ def write_recording(
                              f"has {recording.n_samples} samples")
         columns[name] = values
     frame = pd.DataFrame(columns)
-    _refuse_overwrite(path, force)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if suffix == ".csv":
-        frame.to_csv(path, index=False)  # pandas writes floats as repr(): shortest round-trip
+    check_output_path(path, force)
+    if suffix == ".csv":  # pandas writes floats as repr(): the shortest exact round trip
+        _write_text_safely(path, lambda: frame.to_csv(path, index=False))
     else:
-        frame.to_parquet(path, index=False)
+        _write_text_safely(path, lambda: frame.to_parquet(path, index=False))
     return path
 
 
@@ -356,11 +355,10 @@ def write_json(obj: Any, path: str | os.PathLike[str], *, force: bool = False) -
         `path` exists and `force` is False.
     """
     path = Path(path)
-    _refuse_overwrite(path, force)
+    check_output_path(path, force)
     # Serialise before touching the disk so a bad object leaves no half-written file.
     text = json.dumps(obj, indent=2, allow_nan=False, default=_json_default) + "\n"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text, encoding="utf-8")
+    _write_text_safely(path, lambda: path.write_text(text, encoding="utf-8"))
     return path
 
 
@@ -372,6 +370,28 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"cannot write {type(value).__name__} as JSON")
 
 
-def _refuse_overwrite(path: Path, force: bool) -> None:
+def check_output_path(path: str | os.PathLike[str], force: bool = False) -> Path:
+    """Refuse an output path that exists (unless ``force``) or cannot be a file.
+
+    Callers run this before any work, so a refused run costs nothing and writes nothing.
+    """
+    path = Path(path)
     if path.exists() and not force:
         raise OutputExistsError(f"{path} already exists; pass --force to overwrite it")
+    if path.is_dir():
+        raise OutputError(f"{path} is a folder, not a file")
+    for parent in path.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise OutputError(f"{path}: cannot create it, {parent} is a file, not a folder")
+            break
+    return path
+
+
+def _write_text_safely(path: Path, write: Any) -> None:
+    """Create parent folders and write; OS failures become one-line OutputErrors."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write()
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None

@@ -78,7 +78,10 @@ class MplStructure:
 
 
 def _frozen(values, n: int, name: str) -> np.ndarray:
-    arr = np.array(values, dtype=float).reshape(-1)
+    try:
+        arr = np.array(values, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be numbers, got {values!r}") from None
     if arr.shape != (n,):
         raise ValueError(f"{name} must have {n} values, got {arr.shape[0]}")
     arr.setflags(write=False)
@@ -121,6 +124,11 @@ class MplParams:
         object.__setattr__(self, "v_t", _frozen(self.v_t, n, "v_t"))
         object.__setattr__(self, "w", _frozen(self.w, n + 1, "w"))
         object.__setattr__(self, "v_b", float(self.v_b))
+        for name in ("i_s", "v_t", "w"):
+            if not np.all(np.isfinite(getattr(self, name))):
+                raise ValueError(f"{name} must be finite, got {getattr(self, name).tolist()}")
+        if not np.isfinite(self.v_b):
+            raise ValueError(f"v_b must be finite, got {self.v_b}")
         if np.any(self.i_s <= 0) or np.any(self.v_t <= 0):
             raise ValueError("i_s and v_t must be positive (eq. 5.1)")
 

@@ -8,8 +8,7 @@ from pathlib import Path
 
 from .. import __version__
 from ..compensation import evaluate, fit_compensator
-from ..errors import OutputExistsError
-from ..io import write_json
+from ..io import check_output_path, write_json
 from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
 from ._figures import plot_loops, plot_time_series
@@ -49,9 +48,8 @@ def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
     ``time_series.png``. Checks every output path before writing any.
     """
     out = Path(out_dir)
-    existing = [str(out / f) for f in DEMO_FILES if (out / f).exists()]
-    if existing and not force:
-        raise OutputExistsError(f"{existing[0]} already exists; pass --force to overwrite it")
+    for name in DEMO_FILES:
+        check_output_path(out / name, force)
     t_start = time.perf_counter()
     recordings, compensators, metrics, shown = {}, {}, {}, {}
     for name in EXPERIMENTS:
@@ -74,6 +72,7 @@ def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
               "center": "recording", "fit_seed": FIT_SEED, "validation_seed": VALIDATION_SEED,
               "sensor": "VirtualSensor() defaults", "seconds": time.perf_counter() - t_start}
     write_json(config, out / "config.json", force=force)
+    # check_output_path has vetted these two; savefig has no overwrite guard of its own
     plot_loops(shown).savefig(out / "loops.png", dpi=110)
     plot_time_series(shown).savefig(out / "time_series.png", dpi=110)
     return {"metrics": metrics, "noise_trained": noise_trained, "config": config}
