@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
+from threadpoolctl import threadpool_limits
 
 from ..errors import FitDivergedError
 from ..models import _mpl_kernels as kernels
@@ -148,9 +149,12 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
         return cache[key]
 
     def solve(theta0: np.ndarray, budget: int):
-        return least_squares(lambda th: run(th)[0] - y, theta0, jac=lambda th: run(th)[1],
-                             bounds=(lower, upper), method="trf", x_scale="jac",
-                             max_nfev=budget)
+        # The solver's SVD of an (n x 3N+2) Jacobian is too small to gain from BLAS threads,
+        # and on a loaded machine threaded BLAS made fits 10-30x slower (benchmarks/README.md).
+        with threadpool_limits(limits=1, user_api="blas"):
+            return least_squares(lambda th: run(th)[0] - y, theta0, jac=lambda th: run(th)[1],
+                                 bounds=(lower, upper), method="trf", x_scale="jac",
+                                 max_nfev=budget)
 
     t_start = time.perf_counter()
     # Screen every start on a short budget, then polish the most promising ones: most starts

@@ -1,0 +1,417 @@
+"""Speed of hystkit's mPL forward model and of its fit, against references run in the same process.
+
+Run:  /tmp/venv/bin/python benchmarks/bench_mpl.py      (about a minute on 2 cores)
+
+Table 1 -- forward model cost in ns per sample per cell, for N = 1, 3, 10 cells on a
+100 000-sample normalised input (0.5 Hz sine plus white noise, max |u| = 1, dt = 0.025 s):
+
+* ``hystkit.models.mpl.simulate``: the numba kernel plus its Python wrapper (checks, knee),
+* the bare numba kernel ``_mpl_kernels.simulate`` (to show what the wrapper costs),
+* ``_c_reference.c``: the same loop in C, compiled now with ``cc -O2 -shared -fPIC`` (no
+  -ffast-math) and called through ctypes; its output must match hystkit's to ~1e-12,
+* ``simulate_reference``: the plain Python loop over ``step``, on 2 000 samples.
+
+Each figure is the *minimum* over 15 repeats of ``time.perf_counter`` around one call, after a
+warm-up call, with the variants interleaved within each repeat; the minimum is the least disturbed estimate of the cost of the work. The
+numba compile (or cache load) and the C compile are one-off costs, reported separately.
+
+Table 2 -- wall time of ``fit_mpl`` on the virtual sensor's sine fitting recording (8000
+samples, seed 1 as in the demo report), direct mode (input = normalised sensor, output =
+normalised position), N = 1, 2, 3, *median* of 3 runs after a warm-up, with the final SSE.
+Reference for N = 1: ``scipy.optimize.least_squares`` with a finite-difference ('2-point')
+Jacobian, from the same first start and bounds as ``fit_mpl``, with hystkit's compiled
+``simulate`` for the residuals.
+
+BLAS: unless OPENBLAS_NUM_THREADS is already set, this script sets it to 1 before numpy loads.
+The fit's linear algebra (scipy's SVD in least_squares) is on 8000 x <= 11 matrices, too small
+for threads to pay; on a 2-core machine with another process busy, OpenBLAS's two spinning
+threads made the same fit 10-30x slower and erratic (N = 3: 8-28 s instead of 0.8 s), while on
+an idle machine 1 and 2 threads timed alike. Export OPENBLAS_NUM_THREADS to measure another
+setting.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+if __name__ == "__main__":
+    # Must precede the first numpy import to take effect (see the module docstring).
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numba
+import numpy as np
+import scipy
+from scipy.optimize import least_squares
+
+import hystkit
+from hystkit.compensation._compensator import _centre_and_scale
+from hystkit.identification import _fit, default_starts, fit_mpl
+from hystkit.models import _mpl_kernels as kernels
+from hystkit.models import mpl
+from hystkit.sensors._virtual import simulate_experiment
+
+DT = 0.025
+SIM_CELLS = (1, 3, 10)
+SIM_SAMPLES = 100_000
+SIM_REPEATS = 15
+PY_SAMPLES = 2_000
+FIT_CELLS = (1, 2, 3)
+FIT_REPEATS = 3
+FIT_SEED = 1  # the demo report's fitting seed (hystkit.reports._demo.FIT_SEED)
+C_FLAGS = ("-O2", "-shared", "-fPIC")
+C_SOURCE = Path(__file__).with_name("_c_reference.c")
+
+
+# ----------------------------------------------------------------------------- machine
+
+def cpu_model() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def compiler_version(cc: str | None) -> str:
+    if cc is None:
+        return "none found"
+    out = subprocess.run([cc, "--version"], capture_output=True, text=True, check=False)
+    return out.stdout.splitlines()[0] if out.stdout else cc
+
+
+def print_machine(cc: str | None) -> None:
+    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    # Load average matters: other jobs on a 2-core box shift every number below.
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "n/a"
+    print("Machine")
+    print(f"  platform     {platform.platform()}")
+    print(f"  CPU          {cpu_model()}; os.cpu_count() = {os.cpu_count()}, usable = {usable}")
+    print(f"  load average {load} (1, 5, 15 min) at start")
+    print(f"  python       {platform.python_version()}; numpy {np.__version__}, "
+          f"numba {numba.__version__}, scipy {scipy.__version__}, "
+          f"hystkit {getattr(hystkit, '__version__', '?')}")
+    print(f"  C compiler   {compiler_version(cc)}")
+    print(f"  OPENBLAS_NUM_THREADS = {os.environ.get('OPENBLAS_NUM_THREADS', 'unset')}")
+    print()
+
+
+# ----------------------------------------------------------------------------- timing
+
+def interleaved_min(fns: dict, repeats: int) -> dict:
+    """Minimum seconds of one call of each ``fns[name]()`` over ``repeats`` rounds.
+
+    One untimed warm-up call each, then the variants take turns within every round, so a burst
+    of load from other processes hits all of them alike instead of skewing one column.
+    """
+    for fn in fns.values():
+        fn()
+    best = dict.fromkeys(fns, float("inf"))
+    for _ in range(repeats):
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            fn()
+            best[name] = min(best[name], time.perf_counter() - t0)
+    return best
+
+
+def first_call_seconds(fn) -> float:
+    t0 = time.perf_counter()
+    fn()
+    return time.perf_counter() - t0
+
+
+# ----------------------------------------------------------------------------- inputs
+
+def sim_input(n: int, seed: int = 0) -> np.ndarray:
+    """Normalised 0.5 Hz sine plus white noise, centred, max |u| = 1.
+
+    The noise gives sample-to-sample jumps large enough to push some cells past their knee,
+    so the linear continuation branch runs too, not only the sinh branch.
+    """
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * DT
+    u = np.sin(2 * np.pi * 0.5 * t) + 0.3 * rng.standard_normal(n)
+    u -= u.mean()
+    return u / np.max(np.abs(u))
+
+
+def sim_model(n_cells: int) -> tuple[mpl.MplStructure, mpl.MplParams]:
+    """i_s = 0.05, V_T spread 0.1 .. 0.3, all weights 0.5, V_b = 0.1.
+
+    V_T ~ 0.1 puts the knee at |v| ~ 0.44, reachable by the input's jumps; at V_T = 0.3 the
+    knee is at 1.64 and a normalised input would never leave the sinh region.
+    """
+    structure = mpl.MplStructure(n_cells=n_cells, dt=DT)
+    params = mpl.MplParams(i_s=np.full(n_cells, 0.05), v_t=np.geomspace(0.1, 0.3, n_cells),
+                           w=np.full(n_cells + 1, 0.5), v_b=0.1)
+    return structure, params
+
+
+def linear_branch_share(structure: mpl.MplStructure, params: mpl.MplParams,
+                        u: np.ndarray) -> float:
+    """Share of cell-samples that took the straight-line branch (|u - x_k| > knee_k).
+
+    Cells evolve independently given the input, so each cell's state trajectory is the output
+    of a one-cell model with w = [0, 1] and no bias.
+    """
+    knee = mpl.knee_voltage(structure, params)
+    one = mpl.MplStructure(n_cells=1, dt=structure.dt, slope_cap=structure.slope_cap)
+    hits = 0
+    for k in range(structure.n_cells):
+        cell = mpl.MplParams(i_s=params.i_s[k:k + 1], v_t=params.v_t[k:k + 1], w=[0.0, 1.0])
+        x, _ = mpl.simulate(one, cell, u)
+        hits += int(np.count_nonzero(np.abs(u - x) > knee[k]))
+    return hits / (u.size * structure.n_cells)
+
+
+# ----------------------------------------------------------------------------- C reference
+
+def build_c_reference(cc: str, workdir: str):
+    """Compile ``_c_reference.c`` into ``workdir``; return (ctypes function, compile seconds)."""
+    lib_path = Path(workdir) / "mpl_c_reference.so"
+    t0 = time.perf_counter()
+    subprocess.run([cc, *C_FLAGS, "-o", str(lib_path), str(C_SOURCE), "-lm"], check=True)
+    seconds = time.perf_counter() - t0
+    func = ctypes.CDLL(str(lib_path)).mpl_simulate
+    arr = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
+    func.argtypes = [arr, ctypes.c_int64, arr, ctypes.c_int64, arr, arr, arr, ctypes.c_double,
+                     arr, ctypes.c_double, ctypes.c_double, arr]
+    func.restype = None
+    return func, seconds
+
+
+def c_simulate(func, u: np.ndarray, x0: np.ndarray, i_s, v_t, w, v_b, knee, cap,
+               dt) -> tuple[np.ndarray, np.ndarray]:
+    """Same signature and allocations as the numba kernel (copies x0, allocates y)."""
+    x = x0.copy()
+    y = np.empty(u.size)
+    func(u, u.size, x, x.size, i_s, v_t, w, v_b, knee, cap, dt, y)
+    return y, x
+
+
+def kernel_args(structure: mpl.MplStructure, params: mpl.MplParams, u: np.ndarray) -> tuple:
+    """Arguments of ``_mpl_kernels.simulate`` exactly as ``mpl.simulate`` builds them."""
+    return (u, np.full(structure.n_cells, u[0]), params.i_s, params.v_t, params.w, params.v_b,
+            mpl.knee_voltage(structure, params), structure.slope_cap / structure.dt,
+            structure.dt)
+
+
+# ----------------------------------------------------------------------------- compile costs
+
+def numba_compile_seconds(dispatcher, args: tuple) -> tuple[float, float, str]:
+    """(first call of the package's dispatcher, cold compile of an uncached copy, cache note).
+
+    With ``cache=True`` the first call in a process usually loads machine code from
+    ``__pycache__``; compiling a fresh copy of the same Python function shows what a cold
+    cache (first install, changed source) costs.
+    """
+    first = first_call_seconds(lambda: dispatcher(*args))
+    stats = dispatcher.stats
+    note = ("loaded from numba's on-disk cache" if sum(stats.cache_hits.values())
+            else "compiled (cache miss)")
+    fresh = numba.njit(dispatcher.py_func)
+    cold = first_call_seconds(lambda: fresh(*args))
+    return first, cold, note
+
+
+def print_compile_costs(c_seconds: float | None) -> None:
+    structure, params = sim_model(1)
+    u = sim_input(1000)
+    sim = numba_compile_seconds(kernels.simulate, kernel_args(structure, params, u))
+    jac = numba_compile_seconds(kernels.simulate_with_jacobian, kernel_args(structure, params, u))
+    print("One-off costs (not included in the tables)")
+    for name, (first, cold, note) in (("simulate", sim), ("simulate_with_jacobian", jac)):
+        print(f"  numba {name:<23} first call {first * 1e3:8.1f} ms ({note}); "
+              f"cold compile {cold * 1e3:8.1f} ms")
+    if c_seconds is not None:
+        print(f"  C reference: cc {' '.join(C_FLAGS)}        {c_seconds * 1e3:8.1f} ms")
+    print()
+
+
+# ----------------------------------------------------------------------------- table 1
+
+def simulation_row(n_cells: int, c_func) -> dict:
+    structure, params = sim_model(n_cells)
+    u = sim_input(SIM_SAMPLES)
+    u_py = u[:PY_SAMPLES].copy()
+    args = kernel_args(structure, params, u)
+    per = 1e9 / (SIM_SAMPLES * n_cells)  # seconds per call -> ns per sample per cell
+
+    fns = {"hystkit": lambda: mpl.simulate(structure, params, u),
+           "kernel": lambda: kernels.simulate(*args),
+           "python": lambda: mpl.simulate_reference(structure, params, u_py)}
+    if c_func is not None:
+        fns["c"] = lambda: c_simulate(c_func, *args)
+    best = interleaved_min(fns, SIM_REPEATS)
+    row = {name: seconds * per for name, seconds in best.items()}
+    row["python"] = best["python"] * 1e9 / (PY_SAMPLES * n_cells)  # shorter input
+    row.update(n=n_cells, linear=linear_branch_share(structure, params, u))
+    if c_func is not None:
+        y_hk, x_hk = mpl.simulate(structure, params, u)
+        y_c, x_c = c_simulate(c_func, *args)
+        row["diff"] = max(float(np.max(np.abs(y_c - y_hk))), float(np.max(np.abs(x_c - x_hk))))
+    return row
+
+
+def print_simulation_table(c_func, cc: str | None) -> None:
+    rows = [simulation_row(n, c_func) for n in SIM_CELLS]
+    print(f"Table 1. mPL forward model, ns per sample per cell (min of {SIM_REPEATS} interleaved "
+          f"repeats after warm-up; {SIM_SAMPLES} samples, Python: {PY_SAMPLES} samples)")
+    if c_func is None:
+        print("  no C compiler found (cc, gcc, clang, $CC): C column skipped")
+    else:
+        print(f"  C = _c_reference.c, {Path(cc).name} {' '.join(C_FLAGS)} (no -ffast-math), "
+              f"via ctypes; max|diff| = max abs difference of C vs hystkit output and end state")
+    print("  linear % = share of cell-samples on the straight-line continuation beyond the knee")
+    head = (f"  {'N':>3} {'hystkit':>9} {'kernel':>9} {'C -O2':>9} {'Python':>10} "
+            f"{'hk / C':>8} {'Py / hk':>8} {'max|diff|':>10} {'linear %':>9}")
+    print(head)
+    print("  " + "-" * (len(head) - 2))
+    for r in rows:
+        c = f"{r['c']:9.2f}" if "c" in r else f"{'-':>9}"
+        ratio = f"{r['hystkit'] / r['c']:8.2f}" if "c" in r else f"{'-':>8}"
+        diff = f"{r['diff']:10.1e}" if "diff" in r else f"{'-':>10}"
+        print(f"  {r['n']:>3} {r['hystkit']:9.2f} {r['kernel']:9.2f} {c} {r['python']:10.0f} "
+              f"{ratio} {r['python'] / r['hystkit']:8.0f} {diff} {100 * r['linear']:9.2f}")
+    print("  hystkit = mpl.simulate (wrapper + numba kernel); kernel = _mpl_kernels.simulate "
+          "alone")
+    print()
+
+
+# ----------------------------------------------------------------------------- table 2
+
+def fit_data() -> tuple[np.ndarray, np.ndarray, float]:
+    """Direct mode: input = normalised sensor, output = normalised position (eq. 5.10)."""
+    rec = simulate_experiment("sine", FIT_SEED)
+    _, s, p = _centre_and_scale(rec, "recording")
+    return s, p, rec.dt
+
+
+def fit_bounds(structure: mpl.MplStructure) -> tuple[np.ndarray, np.ndarray]:
+    """The bounds ``fit_mpl`` builds internally (optimiser coordinates of MplParams)."""
+    n = structure.n_cells
+    cap = structure.slope_cap / structure.dt
+    lower = np.r_[np.tile([_fit._LOG_G_MIN, _fit._LOG_VT_BOUNDS[0]], n),
+                  np.full(n + 2, -_fit._W_BOUND)]
+    upper = np.r_[np.tile([np.log(cap), _fit._LOG_VT_BOUNDS[1]], n),
+                  np.full(n + 2, _fit._W_BOUND)]
+    return lower, upper
+
+
+def fd_reference_fit(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure) -> dict:
+    """least_squares('2-point') from fit_mpl's first start; residuals from mpl.simulate.
+
+    Same solver options as fit_mpl (trf, x_scale='jac', same bounds and theta0) except the
+    Jacobian and the budget (scipy's default); only one start, run to convergence.
+    """
+    lower, upper = fit_bounds(structure)
+    i_s, v_t = default_starts(structure)[0]
+    theta0 = np.clip(_fit._linear_init(structure, np.asarray(i_s, float),
+                                       np.asarray(v_t, float), u, y).to_vector(),
+                     lower + 1e-9, upper - 1e-9)
+    calls = [0]
+
+    def residuals(theta: np.ndarray) -> np.ndarray:
+        calls[0] += 1
+        params = mpl.MplParams.from_vector(theta, structure.n_cells)
+        return mpl.simulate(structure, params, u)[0] - y
+
+    t0 = time.perf_counter()
+    sol = least_squares(residuals, theta0, jac="2-point", bounds=(lower, upper), method="trf",
+                        x_scale="jac")
+    return {"seconds": time.perf_counter() - t0, "cost": 2.0 * float(sol.cost),
+            "runs": calls[0], "converged": sol.status > 0}
+
+
+def hystkit_fit(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure,
+                starts=None) -> dict:
+    t0 = time.perf_counter()
+    res = fit_mpl(u, y, structure, starts=starts)
+    return {"seconds": time.perf_counter() - t0, "cost": res.cost, "runs": res.n_evaluations,
+            "converged": res.converged}
+
+
+def repeated(fn, repeats: int) -> dict:
+    """Median wall time of ``repeats`` runs (plus min and max); cost etc. of the last run."""
+    runs = [fn() for _ in range(repeats)]
+    times = [r["seconds"] for r in runs]
+    return {**runs[-1], "seconds": statistics.median(times), "min": min(times),
+            "max": max(times)}
+
+
+def fit_line(label: str, r: dict) -> str:
+    return (f"  {label:<40} {r['seconds']:8.3f} {r['min']:7.3f}-{r['max']:<7.3f} "
+            f"{r['cost']:10.4f} {r['runs']:>6} {'yes' if r['converged'] else 'no':>5}")
+
+
+def print_fit_table() -> None:
+    u, y, dt = fit_data()
+    # Warm-up outside the timed runs: fit_mpl's first call would otherwise pay the kernel load.
+    hystkit_fit(u[:500], y[:500], mpl.MplStructure(n_cells=1, dt=dt))
+    print(f"Table 2. fit_mpl on the virtual sine fitting recording (seed {FIT_SEED}, "
+          f"{u.size} samples, dt = {dt:.3f} s), direct mode; wall time, median of "
+          f"{FIT_REPEATS} runs after warm-up")
+    print("  cost = SSE on the normalised data (eq. 5.9); runs: hystkit = FitResult.n_evaluations"
+          " (residual + exact-Jacobian evaluations), scipy FD = simulate calls incl. the FD"
+          " Jacobian's")
+    head = (f"  {'':<40} {'median s':>8} {'min-max s':>15} {'cost':>10} {'runs':>6} "
+            f"{'conv.':>5}")
+    print(head)
+    print("  " + "-" * (len(head) - 2))
+    results = {}
+    for n in FIT_CELLS:
+        structure = mpl.MplStructure(n_cells=n, dt=dt)
+        results[n] = repeated(lambda s=structure: hystkit_fit(u, y, s), FIT_REPEATS)
+        print(fit_line(f"hystkit fit_mpl, N = {n} (6 starts)", results[n]), flush=True)
+
+    structure = mpl.MplStructure(n_cells=1, dt=dt)
+    one = repeated(lambda: hystkit_fit(u, y, structure, starts=default_starts(structure)[:1]),
+                   FIT_REPEATS)
+    ref = repeated(lambda: fd_reference_fit(u, y, structure), FIT_REPEATS)
+    print()
+    print("  Reference, N = 1, same first start, theta0 and bounds:")
+    print(fit_line("hystkit fit_mpl, start [0] only", one))
+    print(fit_line("scipy least_squares '2-point' + simulate", ref))
+    print(f"  time ratio scipy-FD / hystkit: {ref['seconds'] / results[1]['seconds']:.2f}x vs the "
+          f"default 6-start fit, {ref['seconds'] / one['seconds']:.2f}x vs the same single start")
+    print("  Document's reference: MATLAB patternsearch took about 60 s on 6 cores (paper 9.2); "
+          "different data and machine, for scale only.")
+    print()
+
+
+# ----------------------------------------------------------------------------- main
+
+def find_compiler() -> str | None:
+    for name in (os.environ.get("CC"), "cc", "gcc", "clang"):
+        if name and shutil.which(name):
+            return shutil.which(name)
+    return None
+
+
+def main() -> int:
+    t_total = time.perf_counter()
+    cc = find_compiler()
+    print_machine(cc)
+    with tempfile.TemporaryDirectory(prefix="hystkit-bench-") as workdir:
+        c_func, c_seconds = build_c_reference(cc, workdir) if cc else (None, None)
+        # Compile costs first: the tables' warm-ups would otherwise hide the first call.
+        print_compile_costs(c_seconds)
+        print_simulation_table(c_func, cc)
+    print_fit_table()
+    print(f"Total benchmark time {time.perf_counter() - t_total:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
