@@ -111,6 +111,7 @@ def _fmt(x: float | None) -> str:
 
 
 def _demo(args: argparse.Namespace) -> int:
+    # Imported here so the other subcommands do not pay for loading matplotlib.
     from ..reports import DOCUMENT_TABLE_5_5, format_table, run_demo
 
     out = args.out or Path(f"hystkit-demo-{time.strftime('%Y%m%d-%H%M%S')}")
