@@ -1,182 +1,36 @@
-"""``hystkit`` command line: each subcommand parses, calls the library, writes, returns a code."""
+"""``hystkit`` command line: each subcommand parses, calls the library, writes, returns a code.
+
+Subcommands live in ``cmd_*.py`` modules beside this one, each with a ``register(sub)``
+function; they are found here so that adding a capability does not edit a shared file.
+"""
 
 from __future__ import annotations
 
-import argparse
+import importlib
+import pkgutil
 import sys
-import time
 from collections.abc import Sequence
-from pathlib import Path
 
 from .. import __version__
-from ..compensation import (
-    CENTERS,
-    MODES,
-    evaluate,
-    fit_compensator,
-    load_compensator,
-    save_compensator,
-)
 from ..errors import HystkitError
-from ..io import check_output_path, read_recording, write_json, write_recording
-from ..sensors import simulate_experiment
-from ..signals import EXPERIMENTS
+from ._common import Parser
 
 __all__ = ["main"]
 
 
-class _UsageError(HystkitError):
-    """A command line argparse rejected; reported on one line like every other error."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):  # argparse would print the usage and call sys.exit(2)
-        raise _UsageError(f"{message} (see '{self.prog} --help')")
-
-
-def _positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a positive integer, got {value}")
-    return value
-
-
-def _slope_cap(text: str) -> float:
-    value = float(text)
-    if not 0 < value < 2:
-        raise argparse.ArgumentTypeError(f"must lie in (0, 2) for a stable Euler step "
-                                         f"(eq. 5.28), got {value}")
-    return value
-
-
-def _simulate_sensor(args: argparse.Namespace) -> int:
-    check_output_path(args.out, args.force)
-    rec = simulate_experiment(args.excitation, seed=args.seed)
-    write_recording(rec, args.out, force=args.force)
-    print(f"wrote {args.out}: {EXPERIMENTS[args.excitation].description}, seed {args.seed}, "
-          f"{rec.n_samples} samples at {rec.fs:g} Hz")
-    return 0
-
-
-def _fit(args: argparse.Namespace) -> int:
-    check_output_path(args.out, args.force)
-    rec = read_recording(args.data)
-    print(f"fitting mpl ({args.cells} cell(s), {args.mode} mode, centring: {args.center}) on "
-          f"{args.data}: {rec.n_samples} samples at {rec.fs:g} Hz ...", flush=True)
-    comp = fit_compensator(rec, args.cells, mode=args.mode, center=args.center,
-                           slope_cap=args.slope_cap)
-    save_compensator(comp, args.out, force=args.force)
-    info = comp.fit_info
-    print(f"done in {info['fit_seconds']:.2f} s: SSE {info['cost']:.4g} (normalised), "
-          f"{'converged' if info['converged'] else 'NOT converged'} ({info['message']})")
-    p = comp.params
-    print(f"  I_S = {p.i_s.tolist()}, V_T = {p.v_t.tolist()}, w = {p.w.tolist()}, "
-          f"V_b = {p.v_b:.6g}")
-    print(f"wrote {args.out}")
-    return 0
-
-
-def _compensate(args: argparse.Namespace) -> int:
-    check_output_path(args.out, args.force)
-    comp = load_compensator(args.model)
-    rec = read_recording(args.data, need_position=False)
-    estimate = comp.estimate(rec)
-    write_recording(rec, args.out, extra={"position_estimate": estimate}, force=args.force)
-    print(f"wrote {args.out}: {rec.n_samples} samples with column 'position_estimate' [mm] "
-          f"(centring: {comp.center})")
-    return 0
-
-
-def _evaluate(args: argparse.Namespace) -> int:
-    if args.json is not None:
-        check_output_path(args.json, args.force)
-    comp = load_compensator(args.model)
-    scores = evaluate(comp, read_recording(args.data))
-    print(f"{args.data} with {args.model} (centring: {scores['center']}, "
-          f"{scores['n_samples']} samples)")
-    print(f"{'':<22}{'mPL':>10}{'straight line':>15}")
-    for key, label in (("r2", "R²"), ("e_rms_pct", "e_rms %"), ("e_max_pct", "e_max %"),
-                       ("sinad_db", "SINAD dB"), ("loop_area", "loop area %")):
-        a, b = scores[key], scores[f"linear_{key}"]
-        print(f"{label:<22}{_fmt(a):>10}{_fmt(b):>15}")
-    print(f"{'sensor loop area %':<22}{_fmt(scores['sensor_loop_area']):>10}")
-    if args.json is not None:
-        write_json(scores, args.json, force=args.force)
-        print(f"wrote {args.json}")
-    return 0
-
-
-def _fmt(x: float | None) -> str:
-    return "n/a" if x is None else f"{x:.4f}"
-
-
-def _demo(args: argparse.Namespace) -> int:
-    # Imported here so the other subcommands do not pay for loading matplotlib.
-    from ..reports import DOCUMENT_TABLE_5_5, format_table, run_demo
-
-    out = args.out or Path(f"hystkit-demo-{time.strftime('%Y%m%d-%H%M%S')}")
-    print(f"hystkit demo: virtual sensor, four experiments, {args.cells}-cell mPL compensator "
-          f"fitted on one recording and scored on another (direct mode, centring: recording)")
-    t0 = time.perf_counter()
-    result = run_demo(out, n_cells=args.cells, force=args.force)
-    print()
-    print(format_table(result["metrics"], "Validation (fit on seed 1, test on seed 2); cf. "
-                       "document table 5.5", DOCUMENT_TABLE_5_5))
-    print()
-    print(format_table(result["noise_trained"], "Compensator trained on noise, tested on each "
-                       "excitation (does compensation generalise?)"))
-    print(f"\nwrote {out}/: metrics.json, noise_trained.json, config.json, loops.png, "
-          f"time_series.png ({time.perf_counter() - t0:.1f} s)")
-    return 0
-
-
-def _parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="hystkit", description="Hysteresis compensation for "
-                                     "lousy (3D-printed, soft) sensors.")
+def _parser() -> Parser:
+    parser = Parser(prog="hystkit", description="Hysteresis compensation for lousy "
+                    "(3D-printed, soft) sensors.")
     parser.add_argument("--version", action="version", version=f"hystkit {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-
-    p = sub.add_parser("simulate-sensor", help="record an experiment on the virtual sensor")
-    p.add_argument("--excitation", choices=sorted(EXPERIMENTS), required=True)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", type=Path, required=True, help="CSV or Parquet file to write")
-    p.set_defaults(run=_simulate_sensor)
-
-    p = sub.add_parser("fit", help="fit a compensator to a recording")
-    p.add_argument("data", type=Path, help="recording: time, position, sensor (CSV/Parquet/.mat)")
-    p.add_argument("--model", choices=["mpl"], default="mpl")
-    p.add_argument("--cells", type=_positive_int, default=1, help="mPL cells N (3N+2 parameters)")
-    p.add_argument("--mode", choices=MODES, default="direct",
-                   help="direct: fit sensor->position (paper 9.2); inverse: fit "
-                        "position->sensor and invert it (paper 9.1)")
-    p.add_argument("--center", choices=CENTERS, default="recording",
-                   help="whose mean is removed: each recording's own (hides drift), the "
-                        "fitting recording's, or none")
-    p.add_argument("--slope-cap", type=_slope_cap, default=1.0,
-                   help="Euler stability cap f'·dt of the cell resistors, in (0, 2)")
-    p.add_argument("--out", type=Path, required=True, help="model JSON file to write")
-    p.set_defaults(run=_fit)
-
-    p = sub.add_parser("compensate", help="add a position_estimate column to a recording")
-    p.add_argument("model", type=Path)
-    p.add_argument("data", type=Path)
-    p.add_argument("--out", type=Path, required=True)
-    p.set_defaults(run=_compensate)
-
-    p = sub.add_parser("evaluate", help="score a compensator on a recording")
-    p.add_argument("model", type=Path)
-    p.add_argument("data", type=Path)
-    p.add_argument("--json", type=Path, help="also write the scores to this JSON file")
-    p.set_defaults(run=_evaluate)
-
-    p = sub.add_parser("demo", help="the main job on the built-in virtual sensor")
-    p.add_argument("--out", type=Path, help="output folder (default: a new timestamped one)")
-    p.add_argument("--cells", type=_positive_int, default=3,
-                   help="mPL cells (default 3: 11 parameters, as the document's model)")
-    p.set_defaults(run=_demo)
-
+    package = __name__.rpartition(".")[0]
+    for info in sorted(pkgutil.iter_modules(sys.modules[package].__path__), key=lambda m: m.name):
+        if info.name.startswith("cmd_"):
+            importlib.import_module(f"{package}.{info.name}").register(sub)
     for p in sub.choices.values():
-        p.add_argument("--force", action="store_true", help="overwrite existing output files")
+        if not any("--force" in a.option_strings for a in p._actions):
+            p.add_argument("--force", action="store_true",
+                           help="overwrite existing output files")
     return parser
 
 

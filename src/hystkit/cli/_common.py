@@ -1,0 +1,35 @@
+"""Pieces shared by the subcommand modules: the one-line-error parser and option types."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import HystkitError
+
+__all__ = ["Parser", "UsageError", "positive_int", "slope_cap"]
+
+
+class UsageError(HystkitError):
+    """A command line argparse rejected; reported on one line like every other error."""
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # argparse would print the usage and call sys.exit(2)
+        raise UsageError(f"{message} (see '{self.prog} --help')")
+
+
+def positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {value}")
+    return value
+
+
+def slope_cap(text: str) -> float:
+    value = float(text)
+    if not 0 < value < 2:
+        raise argparse.ArgumentTypeError(f"must lie in (0, 2) for a stable Euler step "
+                                         f"(eq. 5.28), got {value}")
+    return value
+
+
