@@ -213,7 +213,7 @@ def test_fit_prints_progress_and_result(data: dict[str, Path], tmp_path: Path,
     out = tmp_path / "m.json"
     code, stdout, err = _run(capsys, "fit", data["fit"], "--cells", 1, "--out", out)
     assert (code, err) == (0, "")
-    assert "1 cell(s), direct mode, centring: recording" in stdout
+    assert "fitting mpl (cells N (3N + 2 params): 1, direct mode, centring: recording)" in stdout
     assert f"wrote {out}" in stdout
     assert out.is_file()
 

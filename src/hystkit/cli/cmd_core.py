@@ -14,10 +14,11 @@ from ..compensation import (
     load_compensator,
     save_compensator,
 )
+from ..identification import FAMILIES, get_family
 from ..io import check_output_path, read_recording, write_json, write_recording
 from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
-from ._common import positive_int, slope_cap
+from ._common import UsageError, positive_int, slope_cap
 
 __all__ = ["register"]
 
@@ -33,18 +34,22 @@ def _simulate_sensor(args: argparse.Namespace) -> int:
 
 def _fit(args: argparse.Namespace) -> int:
     check_output_path(args.out, args.force)
+    family = get_family(args.model)
+    options = {} if args.slope_cap is None else {"slope_cap": args.slope_cap}
+    if options and args.model != "mpl":
+        raise UsageError(f"--slope-cap applies to the mpl model only, not {args.model!r}")
     rec = read_recording(args.data)
-    print(f"fitting mpl ({args.cells} cell(s), {args.mode} mode, centring: {args.center}) on "
-          f"{args.data}: {rec.n_samples} samples at {rec.fs:g} Hz ...", flush=True)
-    comp = fit_compensator(rec, args.cells, mode=args.mode, center=args.center,
-                           slope_cap=args.slope_cap)
+    size = family.default_size if args.cells is None else args.cells
+    print(f"fitting {args.model} ({family.size_help}: {size}, {args.mode} mode, centring: "
+          f"{args.center}) on {args.data}: {rec.n_samples} samples at {rec.fs:g} Hz ...",
+          flush=True)
+    comp = fit_compensator(rec, size, model=args.model, mode=args.mode, center=args.center,
+                           **options)
     save_compensator(comp, args.out, force=args.force)
     info = comp.fit_info
     print(f"done in {info['fit_seconds']:.2f} s: SSE {info['cost']:.4g} (normalised), "
           f"{'converged' if info['converged'] else 'NOT converged'} ({info['message']})")
-    p = comp.params
-    print(f"  I_S = {p.i_s.tolist()}, V_T = {p.v_t.tolist()}, w = {p.w.tolist()}, "
-          f"V_b = {p.v_b:.6g}")
+    print(f"  parameters: {comp.params.to_dict()}")
     print(f"wrote {args.out}")
     return 0
 
@@ -113,16 +118,21 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser("fit", help="fit a compensator to a recording")
     p.add_argument("data", type=Path, help="recording: time, position, sensor (CSV/Parquet/.mat)")
-    p.add_argument("--model", choices=["mpl"], default="mpl")
-    p.add_argument("--cells", type=positive_int, default=1, help="mPL cells N (3N+2 parameters)")
+    p.add_argument("--model", choices=sorted(FAMILIES), default="mpl",
+                   help="; ".join(f"{f.name}: {f.title}" for f in FAMILIES.values()))
+    p.add_argument("--cells", "--size", type=positive_int, default=None,
+                   help="model size: " + "; ".join(f"{f.name}: {f.size_help} (default "
+                                                    f"{f.default_size})"
+                                                    for f in FAMILIES.values()))
     p.add_argument("--mode", choices=MODES, default="direct",
                    help="direct: fit sensor->position (paper 9.2); inverse: fit "
                         "position->sensor and invert it (paper 9.1)")
     p.add_argument("--center", choices=CENTERS, default="recording",
                    help="whose mean is removed: each recording's own (hides drift), the "
                         "fitting recording's, or none")
-    p.add_argument("--slope-cap", type=slope_cap, default=1.0,
-                   help="Euler stability cap f'·dt of the cell resistors, in (0, 2)")
+    p.add_argument("--slope-cap", type=slope_cap, default=None,
+                   help="mpl only: Euler stability cap f'·dt of the cell resistors, in (0, 2) "
+                        "(default 1)")
     p.add_argument("--out", type=Path, required=True, help="model JSON file to write")
     p.set_defaults(run=_fit)
 

@@ -1,11 +1,12 @@
 """A fitted compensator: sensor signal in, position estimate out (sec. 5.3.4-5.3.6).
 
-Two ways to get one, both on the mPL model:
+Two ways to get one, for any registered model family (``hystkit.identification.FAMILIES``;
+the mPL by default):
 
-- ``direct`` (paper 9.2): fit the mPL structure from sensor to position; the model *is* the
+- ``direct`` (paper 9.2): fit the model from sensor to position; the model *is* the
   compensator.
-- ``inverse`` (paper 9.1): fit the forward model position -> sensor and run its analytical
-  inverse (eq. 5.13-5.14) on sensor data.
+- ``inverse`` (paper 9.1): fit the forward model position -> sensor and run its inverse
+  (for the mPL the analytical eq. 5.13-5.14) on sensor data; only for families with an inverse.
 
 Data pass through the same path at fit and at use: centring (``center``), scaling by the fitting
 recording's max |.| (eq. 5.10), the model, and back to mm. Centring choices:
@@ -19,13 +20,13 @@ recording's max |.| (eq. 5.10), the model, and back to mm. Centring choices:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from ..errors import FitDivergedError, InputError
-from ..identification import FitResult, fit_mpl
+from ..identification import FitResult, ModelFamily, get_family
 from ..io import Recording
-from ..models import mpl
 
 __all__ = ["CENTERS", "MODES", "Compensator", "LinearBaseline", "Scaling", "fit_compensator"]
 
@@ -56,22 +57,33 @@ class LinearBaseline:
 
 @dataclass(frozen=True, eq=False)
 class Compensator:
-    """Fitted mPL compensator with its data conventions; apply it with :meth:`estimate`."""
+    """Fitted compensator with its data conventions; apply it with :meth:`estimate`.
 
-    structure: mpl.MplStructure
-    params: mpl.MplParams
+    ``model`` names the family in the registry; ``structure`` and ``params`` are that family's
+    dataclasses.
+    """
+
+    structure: Any
+    params: Any
     mode: str
     center: str
     scaling: Scaling
     baseline: LinearBaseline
     fit_info: dict = field(default_factory=dict)
+    model: str = "mpl"
+
+    @property
+    def family(self) -> ModelFamily:
+        return get_family(self.model)
 
     def __post_init__(self) -> None:
-        if self.params.n_cells != self.structure.n_cells:
-            raise ValueError(f"params have {self.params.n_cells} cells but the structure has "
-                             f"{self.structure.n_cells}")
         if self.mode not in MODES or self.center not in CENTERS:
             raise ValueError(f"unknown mode/center {self.mode!r}/{self.center!r}")
+        if self.mode == "inverse" and self.family.invert is None:
+            raise ValueError(f"model {self.model!r} has no inverse "
+                             f"({self.family.no_inverse_reason})")
+        # A two-sample run makes the family check that structure and params belong together.
+        self.family.simulate(self.structure, self.params, np.zeros(2))
         for name, value in vars(self.scaling).items():
             ok = np.isfinite(value) and (value > 0 if name.endswith("scale") else True)
             if not ok:
@@ -115,10 +127,8 @@ class Compensator:
         """
         self.check_sampling(recording)
         s = self._normalised_sensor(recording.sensor)
-        if self.mode == "direct":
-            p, _ = mpl.simulate(self.structure, self.params, s)
-        else:
-            p, _ = mpl.invert(self.structure, self.params, s)
+        run = self.family.simulate if self.mode == "direct" else self.family.invert
+        p, _ = run(self.structure, self.params, s)
         return self._to_mm(p, position_mean)
 
     def estimate_linear(self, recording: Recording,
@@ -141,49 +151,57 @@ def _centre_and_scale(recording: Recording, center: str) -> tuple[Scaling, np.nd
     return scaling, s / scaling.sensor_scale, p / scaling.position_scale
 
 
-def _inverse_is_bounded(structure: mpl.MplStructure, params: mpl.MplParams,
+def _inverse_is_bounded(family: ModelFamily, structure: Any, params: Any,
                         s: np.ndarray) -> bool:
     try:
-        p_hat, _ = mpl.invert(structure, params, s)
+        p_hat, _ = family.invert(structure, params, s)
     except FitDivergedError:
         return False
     return bool(np.max(np.abs(p_hat)) < 10.0)  # normalised data: |p| <= 1 when it works
 
 
-def fit_compensator(recording: Recording, n_cells: int = 1, *, mode: str = "direct",
-                    center: str = "recording", slope_cap: float = 1.0) -> Compensator:
-    """Fit an mPL compensator and its straight-line baseline on one recording.
+def fit_compensator(recording: Recording, size: int | None = None, *, model: str = "mpl",
+                    mode: str = "direct", center: str = "recording",
+                    **structure_options: Any) -> Compensator:
+    """Fit a compensator and its straight-line baseline on one recording.
 
     Parameters
     ----------
     recording : Recording
         Fitting recording with ``time`` [s], ``position`` [mm] and ``sensor``.
-    n_cells : int
-        mPL cells N (3N + 2 parameters).
+    size : int, optional
+        The family's size knob (mPL: cells N, 3N + 2 parameters); default per family.
+    model : str
+        Registered model family (``hystkit.identification.FAMILIES``).
     mode : {"direct", "inverse"}
     center : {"recording", "fit", "none"}
         See the module docstring.
-    slope_cap : float
-        Euler slope cap of the cells' resistors, see :class:`~hystkit.models.MplStructure`.
+    **structure_options
+        Passed to the family's ``make_structure`` (mPL: ``slope_cap``).
     """
+    family = get_family(model)
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
     if center not in CENTERS:
         raise ValueError(f"center must be one of {CENTERS}, got {center!r}")
+    if mode == "inverse" and family.invert is None:
+        raise InputError(f"model {model!r} has no inverse ({family.no_inverse_reason}); "
+                         f"use --mode direct")
     if not recording.has_position():
         raise InputError(f"{recording.source}: column 'position' is needed to fit")
     scaling, s, p = _centre_and_scale(recording, center)
-    structure = mpl.MplStructure(n_cells=n_cells, dt=recording.dt, slope_cap=slope_cap)
+    structure = family.make_structure(recording.dt, family.default_size if size is None
+                                      else size, **structure_options)
     if mode == "direct":
-        result: FitResult = fit_mpl(s, p, structure)
+        result: FitResult = family.fit(s, p, structure)
     else:
         # The exact inverse of a discrete forward model can be unstable even when the model is
-        # not (its cells see a self-gain 1 + w_k / w_0); only keep fits whose inverse stays
-        # bounded on the training data.
-        result = fit_mpl(p, s, structure, accept=lambda params: _inverse_is_bounded(
-            structure, params, s), accept_reason="their inverse diverges on the training data; "
-                                                 "use --mode direct or fewer cells")
-
+        # not (for the mPL its cells see a self-gain 1 + w_k / w_0); only keep fits whose
+        # inverse stays bounded on the training data.
+        result = family.fit(p, s, structure, accept=lambda params: _inverse_is_bounded(
+            family, structure, params, s), accept_reason="their inverse diverges on the "
+                                                         "training data; use --mode direct or "
+                                                         "a smaller model")
     slope, intercept = np.polyfit(s, p, 1)
     info = {"cost": result.cost, "fit_seconds": result.seconds,
             "n_evaluations": result.n_evaluations, "converged": result.converged,
@@ -191,4 +209,4 @@ def fit_compensator(recording: Recording, n_cells: int = 1, *, mode: str = "dire
             "training_source": recording.source, "training_samples": recording.n_samples}
     return Compensator(structure=structure, params=result.params, mode=mode, center=center,
                        scaling=scaling, baseline=LinearBaseline(float(slope), float(intercept)),
-                       fit_info=info)
+                       fit_info=info, model=model)

@@ -8,8 +8,8 @@ from pathlib import Path
 
 from .. import __version__
 from ..errors import InputError
+from ..identification import FAMILIES
 from ..io import write_json
-from ..models import mpl
 from ._compensator import CENTERS, MODES, Compensator, LinearBaseline, Scaling
 
 __all__ = [
@@ -31,7 +31,7 @@ def compensator_to_dict(comp: Compensator) -> dict:
         "schema": SCHEMA,
         "schema_version": SCHEMA_VERSION,
         "hystkit_version": __version__,
-        "model": "mpl",
+        "model": comp.model,
         "mode": comp.mode,
         "center": comp.center,
         "dt": comp.structure.dt,
@@ -54,15 +54,18 @@ def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
         raise InputError(f"{source}: schema_version {d.get('schema_version')!r} is not supported "
                          f"(this hystkit reads version {SCHEMA_VERSION})")
     try:
-        if d["model"] != "mpl":
-            raise InputError(f"{source}: key 'model': {d['model']!r} is not supported here")
+        if d["model"] not in FAMILIES:
+            raise InputError(f"{source}: key 'model': {d['model']!r} is not a known model "
+                             f"({', '.join(sorted(FAMILIES))})")
         if d["mode"] not in MODES or d["center"] not in CENTERS:
             raise InputError(f"{source}: key 'mode'/'center': unknown value "
                              f"{d['mode']!r}/{d['center']!r}")
-        return Compensator(structure=mpl.MplStructure(**d["structure"]),
-                           params=mpl.MplParams.from_dict(d["params"]), mode=d["mode"],
+        family = FAMILIES[d["model"]]
+        return Compensator(structure=family.structure_type(**d["structure"]),
+                           params=family.params_type.from_dict(d["params"]), mode=d["mode"],
                            center=d["center"], scaling=Scaling(**d["normalisation"]),
-                           baseline=LinearBaseline(**d["baseline"]), fit_info=d.get("fit", {}))
+                           baseline=LinearBaseline(**d["baseline"]), fit_info=d.get("fit", {}),
+                           model=d["model"])
     except KeyError as exc:
         raise InputError(f"{source}: key {exc.args[0]!r} is missing") from None
     except (TypeError, ValueError) as exc:

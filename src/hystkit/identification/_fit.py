@@ -9,56 +9,22 @@ enter the output linearly) by linear least squares, so no start begins far off.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
-from threadpoolctl import threadpool_limits
 
-from ..errors import FitDivergedError
 from ..models import _mpl_kernels as kernels
 from ..models import mpl
+from ._least_squares import fit_multistart
+from ._result import FitResult
 
-__all__ = ["FitResult", "default_starts", "fit_mpl"]
+__all__ = ["default_starts", "fit_mpl"]
 
 # Bounds in optimiser coordinates (see MplParams.to_vector). |w| <= 100 mirrors the document's
 # weight-sum constraint of 10^2 (sec. 5.3.3).
 _LOG_VT_BOUNDS = (np.log(1e-3), np.log(1e3))
 _LOG_G_MIN = np.log(1e-4)
 _W_BOUND = 100.0
-
-
-@dataclass(frozen=True, eq=False)
-class FitResult:
-    """Outcome of :func:`fit_mpl`.
-
-    Attributes
-    ----------
-    structure, params
-        The fitted model.
-    cost : float
-        Sum of squared errors (eq. 5.9) on the data as given (normalised by the caller).
-    n_evaluations : int
-        Model runs over all starts (each Jacobian counts as one).
-    seconds : float
-        Wall time of the fit.
-    converged : bool
-        Whether the best start met a convergence tolerance (not merely its evaluation budget).
-    message : str
-        The solver's message for the best start.
-    n_starts : int
-    """
-
-    structure: mpl.MplStructure
-    params: mpl.MplParams
-    cost: float
-    n_evaluations: int
-    seconds: float
-    converged: bool
-    message: str
-    n_starts: int
 
 
 def _linear_init(structure: mpl.MplStructure, i_s: np.ndarray, v_t: np.ndarray,
@@ -136,9 +102,10 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     upper = np.r_[np.tile([np.log(cap), _LOG_VT_BOUNDS[1]], n), np.full(n + 2, _W_BOUND)]
     starts = default_starts(structure) if starts is None else starts
     cache: dict = {}
-    n_polished = 0
 
     def run(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        # least_squares asks for the residual and then the Jacobian at the same point: the
+        # sensitivity kernel yields both in one pass.
         key = theta.tobytes()
         if key not in cache:
             p = mpl.MplParams.from_vector(theta, n)
@@ -148,44 +115,10 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
                                                         cap, structure.dt)
         return cache[key]
 
-    def solve(theta0: np.ndarray, budget: int):
-        # The solver's SVD of an (n x 3N+2) Jacobian is too small to gain from BLAS threads,
-        # and on a loaded machine threaded BLAS made fits 10-30x slower (benchmarks/README.md).
-        with threadpool_limits(limits=1, user_api="blas"):
-            return least_squares(lambda th: run(th)[0] - y, theta0, jac=lambda th: run(th)[1],
-                                 bounds=(lower, upper), method="trf", x_scale="jac",
-                                 max_nfev=budget)
-
-    t_start = time.perf_counter()
-    # Screen every start on a short budget, then polish the most promising ones: most starts
-    # settle into the same few basins, so full runs from all of them would repeat work.
-    screened, n_eval = [], 0
-    for i_s, v_t in starts:
-        theta0 = np.clip(_linear_init(structure, np.asarray(i_s, float), np.asarray(v_t, float),
-                                      u, y).to_vector(), lower + 1e-9, upper - 1e-9)
-        sol = solve(theta0, screen_nfev)
-        n_eval += sol.nfev + sol.njev
-        if np.isfinite(sol.cost):
-            screened.append(sol)
-    screened.sort(key=lambda sol: sol.cost)
-    best, rejected = None, 0
-    for sol in screened:
-        if best is not None and n_polished >= n_polish:
-            break
-        if sol.status == 0:  # budget ran out: continue from where it stopped
-            sol = solve(sol.x, max_nfev)
-            n_eval += sol.nfev + sol.njev
-        if accept is not None and not accept(mpl.MplParams.from_vector(sol.x, n)):
-            rejected += 1
-            continue
-        n_polished += 1
-        if best is None or sol.cost < best.cost:
-            best = sol
-    if best is None:
-        why = (f"all {rejected} candidate fits were rejected ({accept_reason})" if rejected
-               else "no start gave a finite cost")
-        raise FitDivergedError(f"the mPL fit failed: {why}")
-    return FitResult(structure=structure, params=mpl.MplParams.from_vector(best.x, n),
-                     cost=2.0 * float(best.cost), n_evaluations=int(n_eval),
-                     seconds=time.perf_counter() - t_start, converged=bool(best.status > 0),
-                     message=str(best.message), n_starts=len(starts))
+    thetas = [_linear_init(structure, np.asarray(i_s, float), np.asarray(v_t, float), u,
+                           y).to_vector() for i_s, v_t in starts]
+    return fit_multistart(lambda th: run(th)[0] - y, thetas, (lower, upper),
+                          lambda th: mpl.MplParams.from_vector(th, n), structure,
+                          jac=lambda th: run(th)[1], max_nfev=max_nfev,
+                          screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
+                          accept_reason=accept_reason)

@@ -1,0 +1,93 @@
+"""Multi-start bounded least squares shared by the model families' fits (eq. 5.9)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+from threadpoolctl import threadpool_limits
+
+from ..errors import FitDivergedError
+from ._result import FitResult
+
+__all__ = ["fit_multistart"]
+
+
+def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
+                   starts: Sequence[np.ndarray],
+                   bounds: tuple[np.ndarray, np.ndarray],
+                   to_params: Callable[[np.ndarray], Any],
+                   structure: Any, *,
+                   jac: Callable[[np.ndarray], np.ndarray] | str = "2-point",
+                   max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
+                   accept: Callable[[Any], bool] | None = None,
+                   accept_reason: str = "rejected by the acceptance test") -> FitResult:
+    """Minimise ``sum(residual(theta)**2)`` from several starts; return the best as a FitResult.
+
+    Every start first gets ``screen_nfev`` evaluations; the ``n_polish`` cheapest are then run
+    to convergence (most starts fall into the same few basins, so polishing all of them would
+    repeat work). ``accept(params)`` can veto a candidate (e.g. an unstable inverse); vetoed
+    ones are skipped and counted.
+
+    Parameters
+    ----------
+    residual : callable
+        ``theta -> r`` (model output minus target), finite for every ``theta`` inside bounds.
+    starts : sequence of arrays
+        Initial ``theta`` vectors (clipped into the bounds).
+    bounds : (lower, upper)
+    to_params : callable
+        ``theta -> params`` of the model family.
+    jac : callable or "2-point"
+        Exact Jacobian if the family has one, else finite differences.
+
+    Raises
+    ------
+    FitDivergedError
+        If no start gives a finite cost, or every candidate is vetoed (the message says why).
+    """
+    lower, upper = (np.asarray(b, dtype=float) for b in bounds)
+    margin = 1e-9 * np.maximum(1.0, upper - lower)
+
+    def solve(theta0: np.ndarray, budget: int):
+        # BLAS threads do not pay on (n x n_params) problems, and under load they cost 10-30x
+        # (benchmarks/README.md).
+        with threadpool_limits(limits=1, user_api="blas"):
+            return least_squares(residual, theta0, jac=jac, bounds=(lower, upper),
+                                 method="trf", x_scale="jac", max_nfev=budget)
+
+    t_start = time.perf_counter()
+    screened, n_eval = [], 0
+    for theta0 in starts:
+        sol = solve(np.clip(np.asarray(theta0, dtype=float), lower + margin, upper - margin),
+                    screen_nfev)
+        n_eval += sol.nfev + (sol.njev or 0)
+        if np.isfinite(sol.cost):
+            screened.append(sol)
+    screened.sort(key=lambda sol: sol.cost)
+    best, rejected, n_polished = None, 0, 0
+    for sol in screened:
+        if best is not None and n_polished >= n_polish:
+            break
+        if sol.status == 0:  # budget ran out: continue from where it stopped
+            sol = solve(sol.x, max_nfev)
+            n_eval += sol.nfev + (sol.njev or 0)
+        if not np.isfinite(sol.cost):
+            continue
+        if accept is not None and not accept(to_params(sol.x)):
+            rejected += 1
+            continue
+        n_polished += 1
+        if best is None or sol.cost < best.cost:
+            best = sol
+    if best is None:
+        why = (f"all {rejected} candidate fits were rejected ({accept_reason})" if rejected
+               else "no start gave a finite cost")
+        raise FitDivergedError(f"the fit failed: {why}")
+    return FitResult(structure=structure, params=to_params(best.x), cost=2.0 * float(best.cost),
+                     n_evaluations=int(n_eval), seconds=time.perf_counter() - t_start,
+                     converged=bool(best.status > 0), message=str(best.message),
+                     n_starts=len(starts))
