@@ -1,0 +1,172 @@
+"""Every model family on the same recordings: ``hystkit compare`` and ``hystkit generalize``.
+
+The document chose its model by argument (table 2.1); here each family is fitted and scored on
+the same data, with table 2.1's properties measured on the fitted model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..compensation import evaluate, fit_compensator
+from ..compensation._compensator import _centre_and_scale
+from ..errors import HystkitError
+from ..identification import FAMILIES, get_family
+from ..io import Recording
+from ..metrics import e_max_pct, e_rms_pct, r2
+from ._properties import measure_properties
+
+__all__ = ["compare_models", "format_compare", "generalization_matrix", "plot_generalization"]
+
+
+def _forward_scores(name: str, size: int | None, fit_rec: Recording,
+                    val_rec: Recording) -> dict:
+    """Fit position -> sensor; score the forward prediction and the inverse on validation."""
+    family = get_family(name)
+    scaling, s_fit, p_fit = _centre_and_scale(fit_rec, "recording")
+    structure = family.make_structure(fit_rec.dt, structure_size(family, size))
+    result = family.fit(p_fit, s_fit, structure)
+    # validation data through the same conventions: own mean removed, fit recording's scales
+    s_val = (val_rec.sensor - val_rec.sensor.mean()) / scaling.sensor_scale
+    p_val = (val_rec.position - val_rec.position.mean()) / scaling.position_scale
+    s_hat, _ = family.simulate(structure, result.params, p_val)
+    out = {"size": structure_size(family, size), "size_help": family.size_help,
+           "n_params": _count_numbers(result.params.to_dict()), "fit_seconds": result.seconds, "converged": result.converged,
+           "r2_forward": r2(s_val, s_hat), "e_rms_pct": e_rms_pct(s_val, s_hat, scale=1.0),
+           "e_max_pct": e_max_pct(s_val, s_hat, scale=1.0)}
+    if family.invert is None:
+        out["r2_compensated"], out["compensated_note"] = None, family.no_inverse_reason
+    else:
+        try:
+            p_hat, _ = family.invert(structure, result.params, s_val)
+            out["r2_compensated"], out["compensated_note"] = r2(p_val, p_hat), ""
+        except HystkitError as exc:
+            out["r2_compensated"], out["compensated_note"] = None, f"inverse failed: {exc}"
+    out.update(measure_properties(family, structure, result.params))
+    return out
+
+
+def structure_size(family, size: int | None) -> int:
+    return family.default_size if size is None else size
+
+
+def _count_numbers(tree) -> int:
+    """Fitted numbers in a params dict (nested lists and scalars)."""
+    if isinstance(tree, dict):
+        return sum(_count_numbers(v) for v in tree.values())
+    if isinstance(tree, list | tuple):
+        return sum(_count_numbers(v) for v in tree)
+    return 1 if isinstance(tree, int | float) and not isinstance(tree, bool) else 0
+
+
+def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str] | None = None,
+                   sizes: Mapping[str, int] | None = None,
+                   progress: Callable[[str], None] = lambda _: None) -> dict:
+    """Fit every model on ``fit_rec`` and score it on ``val_rec``.
+
+    Returns
+    -------
+    dict
+        ``{model: {n_params, fit_seconds, r2_forward, r2_compensated (None if no inverse, with
+        compensated_note), r2_direct (a compensator fitted sensor -> position), linear_r2,
+        e_rms_pct, e_max_pct (forward, % of the normalised range), rate_dependent,
+        return_point_memory, minor_loops_close, ...}}``; a model whose fit fails has ``error``.
+    """
+    models = sorted(FAMILIES) if models is None else list(models)
+    table = {}
+    for name in models:
+        size = (sizes or {}).get(name)
+        progress(f"  {name}: fitting ...")
+        try:
+            entry = _forward_scores(name, size, fit_rec, val_rec)
+            direct = evaluate(fit_compensator(fit_rec, size, model=name), val_rec)
+            entry["r2_direct"], entry["linear_r2"] = direct["r2"], direct["linear_r2"]
+        except HystkitError as exc:
+            entry = {"error": str(exc)}
+        table[name] = entry
+    return table
+
+
+def generalization_matrix(recordings: Mapping[str, tuple[Recording, Recording]],
+                          models: Sequence[str], sizes: Mapping[str, int] | None = None,
+                          progress: Callable[[str], None] = lambda _: None) -> dict:
+    """Train a direct compensator on each excitation, test it on every excitation.
+
+    Returns
+    -------
+    dict
+        ``{model: {"r2": {train: {test: r2}}, "linear_r2": {train: {test: r2}}}}`` where a
+        failed fit or run gives None.
+    """
+    out = {}
+    for name in models:
+        size = (sizes or {}).get(name)
+        r2_model, r2_line = {}, {}
+        for train, (fit_rec, _) in recordings.items():
+            progress(f"  {name}: trained on {train}")
+            try:
+                comp = fit_compensator(fit_rec, size, model=name)
+            except HystkitError:
+                r2_model[train] = dict.fromkeys(recordings)
+                r2_line[train] = dict.fromkeys(recordings)
+                continue
+            r2_model[train], r2_line[train] = {}, {}
+            for test, (_, val_rec) in recordings.items():
+                try:
+                    scores = evaluate(comp, val_rec)
+                    r2_model[train][test], r2_line[train][test] = scores["r2"], \
+                        scores["linear_r2"]
+                except HystkitError:
+                    r2_model[train][test] = r2_line[train][test] = None
+        out[name] = {"r2": r2_model, "linear_r2": r2_line}
+    return out
+
+
+def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
+    """One heat map per model: rows = trained on, columns = tested on, colour = R²."""
+    fig = Figure(figsize=(3.6 * len(matrix), 3.4), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, len(matrix)))
+    for ax, (name, entry) in zip(axes, matrix.items()):
+        grid = entry["r2"]
+        names = list(grid)
+        values = np.array([[np.nan if grid[a][b] is None else grid[a][b] for b in names]
+                           for a in names])
+        image = ax.imshow(values, vmin=0.9, vmax=1.0, cmap="viridis")
+        for i in range(len(names)):
+            for j in range(len(names)):
+                text = "fail" if np.isnan(values[i, j]) else f"{values[i, j]:.3f}"
+                ax.text(j, i, text, ha="center", va="center", fontsize="small",
+                        color="w" if np.isnan(values[i, j]) or values[i, j] < 0.96 else "k")
+        ax.set(xticks=range(len(names)), xticklabels=names, yticks=range(len(names)),
+               yticklabels=names, xlabel="tested on", ylabel="trained on", title=name)
+    fig.colorbar(image, ax=list(axes), shrink=0.8, label="R²")
+    return fig
+
+
+def _fmt(x: float | None, spec: str = ".4f") -> str:
+    return "-" if x is None else format(x, spec)
+
+
+def _yes_no(flag: bool | None) -> str:
+    return "n/a" if flag is None else ("yes" if flag else "no")
+
+
+def format_compare(table: Mapping[str, dict]) -> str:
+    """Plain-text table of :func:`compare_models`' result."""
+    head = (f"{'model':<10}{'params':>7}{'fit s':>8}{'R² fwd':>8}{'R² inv':>8}{'R² dir':>8}"
+            f"{'line':>8}{'e_rms%':>8}{'e_max%':>8}  rate-dep  ret.point  minor")
+    lines = [head]
+    for name, m in table.items():
+        if "error" in m:
+            lines.append(f"{name:<10}  failed: {m['error']}")
+            continue
+        lines.append(
+            f"{name:<10}{_fmt(m['n_params'], 'd'):>7}{m['fit_seconds']:>8.2f}"
+            f"{_fmt(m['r2_forward']):>8}{_fmt(m['r2_compensated']):>8}{_fmt(m['r2_direct']):>8}"
+            f"{_fmt(m['linear_r2']):>8}{m['e_rms_pct']:>8.2f}{m['e_max_pct']:>8.2f}"
+            f"  {_yes_no(m['rate_dependent']):>8}  {_yes_no(m['return_point_memory']):>9}"
+            f"  {_yes_no(m['minor_loops_close']):>5}")
+    return "\n".join(lines)

@@ -1,0 +1,87 @@
+"""compare / generalize and the measured table 2.1 properties."""
+
+import json
+
+import numpy as np
+import pytest
+
+from hystkit.cli import main
+from hystkit.identification import ModelFamily
+from hystkit.reports._compare import compare_models, generalization_matrix
+from hystkit.reports._properties import measure_properties
+from hystkit.sensors import simulate_experiment
+
+
+def _family(simulate) -> ModelFamily:
+    return ModelFamily(name="toy", title="toy", structure_type=dict, params_type=dict,
+                       make_structure=lambda dt, size: None, simulate=simulate, fit=None)
+
+
+def _play(structure, params, u, x0=None, r=0.3):
+    y, out = 0.0 if x0 is None else x0, np.empty_like(u)
+    for i, v in enumerate(u):
+        y = max(v - r, min(v + r, y))
+        out[i] = y
+    return out, y
+
+
+def _lag(structure, params, u, x0=None, a=0.05):
+    x, out = u[0] if x0 is None else x0, np.empty_like(u)
+    for i, v in enumerate(u):
+        out[i] = x
+        x += a * (v - x)
+    return out, x
+
+
+def test_play_operator_is_rate_independent_with_return_point_memory():
+    props = measure_properties(_family(_play), None, None)
+    assert not props["rate_dependent"] and props["rate_difference"] < 1e-12
+    assert props["return_point_memory"] and props["minor_loops_close"]
+    assert props["major_loop_area_pct"] > 10  # a play of radius 0.3 on +-1: a fat loop
+
+
+def test_first_order_lag_is_rate_dependent_without_return_point_memory():
+    props = measure_properties(_family(_lag), None, None)
+    assert props["rate_dependent"]
+    assert props["return_point_memory"] is False  # the minor loop leaves a trace
+
+
+def test_static_map_has_no_loop_so_memory_is_undetermined():
+    props = measure_properties(_family(lambda s, p, u, x0=None: (np.tanh(u), None)), None, None)
+    assert not props["rate_dependent"]
+    assert props["return_point_memory"] is None and props["minor_loops_close"] is None
+
+
+@pytest.fixture(scope="module")
+def noise():
+    return simulate_experiment("noise", 1), simulate_experiment("noise", 2)
+
+
+def test_compare_mpl_on_the_virtual_sensor(noise):
+    table = compare_models(*noise, ["mpl"], {"mpl": 2})
+    m = table["mpl"]
+    assert m["n_params"] == 8  # 3N + 2
+    assert m["r2_forward"] > 0.95 and m["r2_direct"] > m["linear_r2"]
+    assert m["r2_compensated"] is None or m["r2_compensated"] > m["linear_r2"]
+
+
+def test_generalization_matrix_shape():
+    recs = {name: (simulate_experiment(name, 1), simulate_experiment(name, 2))
+            for name in ("sine", "noise")}
+    out = generalization_matrix(recs, ["mpl"])
+    grid = out["mpl"]["r2"]
+    assert set(grid) == {"sine", "noise"} and all(set(row) == {"sine", "noise"}
+                                                  for row in grid.values())
+    assert grid["noise"]["sine"] > out["mpl"]["linear_r2"]["noise"]["sine"]
+
+
+def test_compare_cli_writes_json(tmp_path, capsys):
+    f, v = tmp_path / "f.csv", tmp_path / "v.csv"
+    assert main(["simulate-sensor", "--excitation", "sine", "--seed", "1", "--out", str(f)]) == 0
+    assert main(["simulate-sensor", "--excitation", "sine", "--seed", "2", "--out", str(v)]) == 0
+    assert main(["compare", str(f), str(v), "--models", "mpl", "--out", str(tmp_path)]) == 0
+    table = json.loads((tmp_path / "compare.json").read_text())
+    assert {"n_params", "fit_seconds", "r2_forward", "r2_compensated", "e_rms_pct",
+            "e_max_pct"} <= set(table["mpl"])
+    assert main(["compare", str(f), str(v), "--models", "nope"]) == 2
+    assert "unknown model(s) nope" in capsys.readouterr().err
