@@ -1,0 +1,133 @@
+"""``hystkit datasets list|export``: the public hysteresis data sets (issue 4)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..datasets import (
+    DATASETS,
+    ROLES,
+    Dataset,
+    dataset_info,
+    list_excerpts,
+    load,
+    load_excerpt,
+    shared_data_status,
+)
+from ..errors import InputError
+from ..io import check_output_path, write_json, write_recording
+
+__all__ = ["register"]
+
+
+def _samples(counts: list[int]) -> str:
+    low, high = min(counts), max(counts)
+    return f"{low}" if low == high else f"{low}-{high}"
+
+
+def _rates(rates: list[float | None]) -> str:
+    known = sorted({r for r in rates if r is not None})
+    if not known:
+        return "no time axis"
+    return "/".join(f"{r:g}" for r in known) + " Hz"
+
+
+def _list(args: argparse.Namespace) -> int:
+    root, how = shared_data_status(args.root)
+    print(f"shared data: {root} ({how})" if root is not None else how)
+    if args.name is not None:
+        return _list_variants(args.name, root)
+    print(f"{'name':<24}{'runs':>5}  {'samples':<13}{'rate':<15}{'input -> output':<32}"
+          f"{'here':<6}licence")
+    for info in DATASETS.values():
+        here = "yes" if root is not None and (root / info.folder).is_dir() else "no"
+        io = f"{info.input_unit} -> {info.output_unit}"
+        print(f"{info.name:<24}{len(info.variants):>5}  "
+              f"{_samples([v.n_samples for v in info.variants]):<13}"
+              f"{_rates([v.fs for v in info.variants]):<15}{io:<32}{here:<6}{info.licence}")
+        print(f"{'':<4}{info.what}; {info.input_name} -> {info.output_name}"
+              + (f" (needs {info.requires})" if info.requires else ""))
+    shipped = {}
+    for spec in list_excerpts():
+        shipped.setdefault(spec.name, []).append(spec.variant)
+    for name, variants in shipped.items():
+        print(f"shipped excerpts (--excerpt, always available): {name}: {', '.join(variants)}")
+    print("details of one data set: hystkit datasets list NAME")
+    return 0
+
+
+def _list_variants(name: str, root: Path | None) -> int:
+    info = dataset_info(name)
+    print(f"{info.name}: {info.what}")
+    print(f"  input {info.input_name} [{info.input_unit}] -> output {info.output_name} "
+          f"[{info.output_unit}]; folder {info.folder}; licence {info.licence}")
+    print(f"{'variant':<24}{'split':<16}{'samples':>8}  {'rate':<14}description")
+    for v in info.variants:
+        mark = " (default)" if v.name == info.default_variant else ""
+        rate = "nominal" if v.fs is None else f"{v.fs:g} Hz"
+        print(f"{v.name:<24}{v.split or '-':<16}{v.n_samples:>8}  {rate:<14}{v.description}"
+              f"{mark}")
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    out = Path(args.out)
+    sidecar = out.with_name(out.name + ".json")
+    if out.suffix.lower() not in (".csv", ".parquet"):
+        raise InputError(f"{out}: cannot write file type {out.suffix or '(no suffix)'!r}; "
+                         "accepted: .csv, .parquet")
+    for path in (out, sidecar):  # refuse before reading anything
+        check_output_path(path, args.force)
+    ds: Dataset = (load_excerpt(args.name, args.variant) if args.excerpt
+                   else load(args.name, args.variant, root=args.root))
+    if args.segment is not None:
+        ds = ds.segment(args.segment)
+    rec = ds.to_recording(role=args.role)
+    write_recording(rec, out, extra=dict(ds.channels), force=args.force)
+    meta = {"exported_by": "hystkit datasets export", "role": args.role,
+            "segment": args.segment, "excerpt": args.excerpt, "columns": ds.columns(args.role),
+            "dataset": ds.metadata()}
+    write_json(meta, sidecar, force=args.force)
+    cols = ds.columns(args.role)
+    print(f"wrote {out}: {ds.label}{f' segment {args.segment}' if args.segment else ''}, "
+          f"{ds.n_samples} samples at {ds.fs:g} Hz")
+    for column, meaning in cols.items():
+        print(f"  {column:<22}{meaning}")
+    print(f"wrote {sidecar} (units, provenance, licence: {ds.provenance.licence})")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``datasets list`` and ``datasets export`` to the ``hystkit`` parser."""
+    p = sub.add_parser("datasets", help="public hysteresis data sets: list, export as a "
+                                        "recording")
+    # The parent gets a --force too (the CLI adds one to every top-level command); the child's
+    # default is SUPPRESS so that 'datasets --force export' is not reset to False by it.
+    p.add_argument("--force", action="store_true", help="overwrite existing output files")
+    actions = p.add_subparsers(dest="datasets_command", required=True)
+
+    q = actions.add_parser("list", help="the data sets (or the runs of one) and whether the "
+                                        "shared data are here")
+    q.add_argument("name", nargs="?", choices=list(DATASETS), help="list this data set's runs")
+    q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
+                                             "or a shared/data folder found above)")
+    q.set_defaults(run=_list)
+
+    q = actions.add_parser("export", help="write one run as a time, position, sensor "
+                                          "recording (CSV or Parquet) plus a .json sidecar")
+    q.add_argument("name", choices=list(DATASETS))
+    q.add_argument("--variant", help="the run (default: the data set's default; see "
+                                     "'hystkit datasets list NAME')")
+    q.add_argument("--segment", help="only this named segment of the run")
+    q.add_argument("--role", choices=ROLES, default="inverse",
+                   help="inverse (default): position = system input, sensor = output, so "
+                        "'hystkit fit' learns output -> input; forward: the other way round")
+    q.add_argument("--excerpt", action="store_true",
+                   help="use the excerpt shipped with hystkit instead of the shared data")
+    q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
+                                             "or a shared/data folder found above)")
+    q.add_argument("--out", type=Path, required=True, help="CSV or Parquet file to write")
+    q.add_argument("--force", action="store_true", default=argparse.SUPPRESS,
+                   help="overwrite existing output files")
+    q.set_defaults(run=_export)
