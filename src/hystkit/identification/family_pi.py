@@ -1,0 +1,191 @@
+"""The Kuhnen / modified Prandtl-Ishlinskii family (sec. 2.1.6) in the model registry, and its
+identification: one bounded linear least-squares solve (the document's "quadratic
+optimisation", sec. 2.2).
+
+Kuhnen's generalised error. The output ``y = S[H[x] + K[x] + b]`` is bilinear in the dead-zone
+and play weights, but the output-side error ``e = S^-1[y] - H[x] - K[x] - b`` is *linear* in
+all of them once the inverse superposition operator ``S^-1`` gets fixed thresholds ``d'_k`` in
+output units: ``k / (m + 1)`` of the largest and of the smallest output, ``k = 1 .. m``. The
+scale shared by ``S^-1`` and ``H + K`` is fixed by a unit slope of ``S^-1`` between ``d'_-1``
+and ``d'_1``. ``S`` (forward thresholds and weights) then follows by the inversion formula of
+:func:`hystkit.models.pi.inverse_superposition`, which is an involution.
+
+Constraints become bounds by a change of variables: the unknowns are the *slopes* the weights
+add up to (partial sums), so "partial sums > 0" (Kuhnen's invertibility condition) is a box.
+For ``S^-1`` these are its slopes between thresholds, ``>= MIN_SLOPE``. For ``H + K`` the creep
+weights are split, ``w_K = w+ - w-`` with ``w+, w- >= 0``, and the unknowns are
+``V_i = W_i - sum_j w-_j >= MIN_SLOPE`` with ``W_i = w_H0 + .. + w_Hi`` the slopes of the
+initial loading curve: every slope of ``H`` exceeds the total negative creep. In these
+variables ``H + K = sum_i V_i (p_i - p_{i+1}) + sum_j (w+_j z_j + w-_j (x - z_j))``, linear and
+box-bounded. The condition keeps the instantaneous operator invertible (``W~_i >= V_i``) and
+the inverse stable: for a branch of slope ``W`` the linearised model is ``G(q) = W + sum_j w_Kj
+c_j q / (q - 1 + c_j)``, and for ``|q| >= 1`` each creep term has a real part in
+``[c_j / (2 - c_j), 1]`` times its weight, so ``Re G >= W - sum_j w-_j > 0``: no zero of the
+model, no pole of the compensator, outside the unit circle. Creep of either sign stays possible
+-- a direct compensator (sensor -> position) needs negative creep weights, the inverse of the
+sensor's creep -- but not the large negative slow weights a free fit uses to chase slow drift,
+whose inverse diverges. A decreasing relation is fitted as an increasing one of ``-u``.
+
+``scipy.optimize.lsq_linear`` (BVLS, exact active set) solves the problem in one go. The split
+makes the matrix rank deficient (``x = sum_i (p_i - p_{i+1})``) and slopes beyond the input's
+travel are not excited at all, so a tiny ridge pulls every unknown towards a neutral value
+(slopes 1, creep and offset 0); it does not move well-determined weights measurably.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+from scipy.optimize import lsq_linear
+from threadpoolctl import threadpool_limits
+
+from ..errors import FitDivergedError
+from ..models import _pi_kernels as kernels
+from ..models import pi
+from ._registry import ModelFamily
+from ._result import FitResult
+
+__all__ = ["FAMILY", "fit_pi", "make_structure", "output_thresholds"]
+
+MIN_SLOPE = 0.01  # smallest loading-curve / S^-1 slope, in normalised units (slope 1 = linear)
+
+
+def output_thresholds(y: np.ndarray, n_deadzone: int) -> np.ndarray:
+    """Thresholds ``d'`` of ``S^-1``, shape (2 m + 1,): ``k / (m + 1)`` of the output's extremes.
+
+    Kuhnen spreads them equidistantly over the output range; a side without data (an output
+    that never changes sign) gets the mirror of the other side.
+    """
+    hi, lo = float(np.max(y)), float(np.min(y))
+    span = max(hi, -lo)
+    if span == 0:
+        raise ValueError("y is identically 0: there is no output range to place S^-1 in")
+    hi = hi if hi > 0 else span
+    lo = lo if lo < 0 else -span
+    k = np.arange(1, n_deadzone + 1) / (n_deadzone + 1)
+    return np.concatenate([lo * k[::-1], [0.0], hi * k])
+
+
+def _ramps(y: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Centre part of ``y`` (unit slope) and its part in each outer interval of ``d``."""
+    m = (d.size - 1) // 2
+    if m == 0:
+        return y.copy(), np.empty((y.size, 0))
+    edges_hi = np.append(d[m + 1:], np.inf)
+    edges_lo = np.insert(d[:m], 0, -np.inf)
+    up = np.clip(y[:, None] - edges_hi[None, :-1], 0.0, np.diff(edges_hi)[None, :])
+    down = np.clip(y[:, None] - edges_lo[None, 1:], -np.diff(edges_lo)[None, :], 0.0)
+    return np.clip(y, d[m - 1], d[m + 1]), np.hstack([up, down[:, ::-1]])
+
+
+def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
+           accept: Callable[[pi.PiParams], bool] | None = None,
+           accept_reason: str = "rejected by the acceptance test",
+           d_inv: np.ndarray | None = None, ridge: float = 1e-9) -> FitResult:
+    """Fit a modified PI model mapping ``u`` to ``y`` by Kuhnen's generalised error.
+
+    Parameters
+    ----------
+    u, y : array, shape (n,)
+        Model input and target output, sampled every ``structure.dt``, centred and normalised
+        (eq. 5.10) by the caller. The model starts at rest at ``u[0]`` (the default state).
+    structure : PiStructure
+    accept : callable, optional
+        Checked once on the solution; a veto raises FitDivergedError with ``accept_reason``.
+    d_inv : array, shape (2 n_deadzone + 1,), optional
+        Thresholds of ``S^-1`` in output units; default :func:`output_thresholds`.
+    ridge : float
+        Adds ``ridge * n * |theta - neutral|^2`` to the squared generalised error: a pull of
+        every unknown towards a neutral value (slopes 1, creep weights and offset 0) that is
+        ``ridge`` times the energy of a unit-variance regressor. The default 1e-9 only decides
+        what the data leave open.
+
+    Returns
+    -------
+    FitResult
+        ``cost`` is the output SSE (eq. 5.9) of the fitted model, not the generalised error.
+    """
+    t_start = time.perf_counter()
+    u = np.ascontiguousarray(u, dtype=float)
+    y = np.ascontiguousarray(y, dtype=float)
+    if u.shape != y.shape or u.ndim != 1 or u.size < 2:
+        raise ValueError(f"u and y must be 1-D, of equal length >= 2, got {u.shape}, {y.shape}")
+    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
+        raise ValueError("u and y must be finite")
+    n, n_k, m = structure.n_play, structure.n_creep, structure.n_deadzone
+    d_inv = output_thresholds(y, m) if d_inv is None else np.asarray(d_inv, dtype=float)
+    pi.PiParams(w_h=np.ones(n), w_s=np.ones(2 * m + 1), d_s=d_inv)  # validates d_inv
+    # A decreasing model is an increasing one of -u (plays and creep operators are odd).
+    polarity = 1.0 if np.cov(u, y)[0, 1] >= 0 else -1.0
+    x = polarity * u
+    plays, creep = kernels.regressors(x, np.full(n, x[0]), np.full(n_k, x[0]),
+                                      np.asarray(structure.play_thresholds),
+                                      structure.creep_gains)
+    # H + K = sum_i V_i (p_i - p_{i+1}) + sum_j (w+_j z_j + w-_j (x - z_j)) with p_0 = x,
+    # V_i = W_i - sum_j w-_j and w_K = w+ - w-.
+    loading = plays - np.hstack([plays[:, 1:], np.zeros((u.size, 1))])
+    centre, ramps = _ramps(y, d_inv)
+    a = np.hstack([loading, creep, x[:, None] - creep, np.ones((u.size, 1)), -ramps])
+    lower = np.r_[np.full(n, MIN_SLOPE), np.zeros(2 * n_k), -np.inf, np.full(2 * m, MIN_SLOPE)]
+    neutral = np.r_[np.ones(n), np.zeros(2 * n_k + 1), np.ones(2 * m)]
+    lam = np.sqrt(ridge * u.size)
+    a_aug = np.vstack([a, lam * np.eye(a.shape[1])])
+    t_aug = np.concatenate([centre, lam * neutral])
+    # BLAS threads do not pay on (n x ~30) problems and cost a lot under load.
+    with threadpool_limits(limits=1, user_api="blas"):
+        sol = lsq_linear(a_aug, t_aug, bounds=(lower, np.inf), method="bvls")
+    if not np.all(np.isfinite(sol.x)):
+        raise FitDivergedError(f"the fit failed: the linear solver returned non-finite "
+                               f"weights ({sol.message})")
+    params = _to_params(structure, sol.x, d_inv, polarity)
+    y_fit, _ = pi.simulate(structure, params, u)
+    if accept is not None and not accept(params):
+        raise FitDivergedError(f"the fit failed: the fitted model was rejected ({accept_reason})")
+    return FitResult(structure=structure, params=params, cost=float(np.sum((y_fit - y) ** 2)),
+                     n_evaluations=2, seconds=time.perf_counter() - t_start,
+                     converged=bool(sol.status > 0), message=str(sol.message), n_starts=1)
+
+
+def _to_params(structure: pi.PiStructure, theta: np.ndarray, d_inv: np.ndarray,
+               polarity: float) -> pi.PiParams:
+    """Optimiser unknowns (slopes, split creep weights) -> weights of the forward model."""
+    n, n_k, m = structure.n_play, structure.n_creep, structure.n_deadzone
+    w_up, w_down = theta[n:n + n_k], theta[n + n_k:n + 2 * n_k]
+    slopes = theta[:n] + w_down.sum()
+    s_up, s_down = theta[n + 2 * n_k + 1:n + 2 * n_k + 1 + m], theta[n + 2 * n_k + 1 + m:]
+    ws_inv = np.concatenate([np.diff(np.r_[1.0, s_down])[::-1], [1.0],
+                             np.diff(np.r_[1.0, s_up])])
+    d_s, w_s = pi.inverse_superposition(d_inv, ws_inv)
+    return pi.PiParams(w_h=polarity * np.diff(slopes, prepend=0.0), w_s=w_s, d_s=d_s,
+                       w_k=polarity * (w_up - w_down), b=theta[n + 2 * n_k])
+
+
+def make_structure(dt: float, size: int, *, n_deadzone: int = 2, n_creep: int = 4,
+                   r_max: float = 1.0, tau_min: float = 0.1) -> pi.PiStructure:
+    """``size`` evenly spread play thresholds and creep time constants a decade apart.
+
+    ``r_i = i r_max / size`` (i = 0 .. size - 1): Kuhnen's equidistant thresholds over the input
+    amplitude (``r_max = 1`` for data normalised to max |.| = 1, eq. 5.10). ``n_deadzone``
+    dead zones per side. ``a_j = 1 / (tau_min 10^j)`` (j = 0 .. n_creep - 1): by default time
+    constants 0.1, 1, 10 and 100 s, from 4 samples at 40 Hz to half a recording.
+    """
+    if int(size) != size or size < 1:
+        raise ValueError(f"size (play operators) must be a positive integer, got {size!r}")
+    if int(n_creep) != n_creep or n_creep < 0:
+        raise ValueError(f"n_creep must be a non-negative integer, got {n_creep!r}")
+    if not (r_max > 0 and tau_min > 0):
+        raise ValueError(f"r_max and tau_min must be positive, got {r_max!r}, {tau_min!r}")
+    return pi.PiStructure(play_thresholds=tuple(r_max * np.arange(size) / size),
+                          n_deadzone=n_deadzone,
+                          creep_rates=tuple(1.0 / (tau_min * 10.0 ** np.arange(n_creep))), dt=dt)
+
+
+FAMILY = ModelFamily(
+    name="pi", title="Kuhnen / modified Prandtl-Ishlinskii with creep (sec. 2.1.6, eq. 2.6-2.19)",
+    structure_type=pi.PiStructure, params_type=pi.PiParams, make_structure=make_structure,
+    simulate=pi.simulate, fit=fit_pi, invert=pi.invert,
+    size_help="play operators n (thresholds i/n, i < n; plus 2 x 2 dead zones, 4 creep "
+              "operators by default)",
+    default_size=10)

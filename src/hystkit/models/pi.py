@@ -1,0 +1,436 @@
+"""Kuhnen's modified Prandtl-Ishlinskii model with creep, sec. 2.1.6 of the reference document.
+
+Operators (eq. 2.6-2.15), for an input ``x`` sampled every ``dt``::
+
+    play      p_i(t) = max(x - r_i, min(x + r_i, p_i(t-)))       0 = r_0 < r_1 < ...   eq. 2.11
+    PI        H[x]   = sum_i w_Hi p_i                                                   eq. 2.7
+    creep     z_j(t) = z_j(t-) + c_j (x - z_j(t-)),  c_j = 1 - exp(-a_j dt)             eq. 2.14
+              K[x]   = sum_j w_Kj z_j
+    dead zone S_d(v) = max(v - d, 0) (d > 0),  v (d = 0),  min(v - d, 0) (d < 0)
+    output    y      = S[H[x] + K[x] + b] = sum_k w_Sk S_dk(H[x] + K[x] + b)            eq. 2.12
+
+The play recursion is exact for the input interpolated linearly between samples (only turning
+points matter: rate independence). Each creep operator is Kuhnen's linear creep operator
+``dz/dt = a (x - z)``, discretised exactly for an input held over the sample that ends at ``t``;
+eigenvalues a decade apart give a step response linear in ``log t`` (fig. 2.13).
+
+Deliberate readings of the document (details and reasons in ``docs/models/pi.md``): eq. 2.11's
+third argument is the previous output ``y``; the stray ``· i`` of eq. 2.14-2.15 is dropped;
+creep enters *inside* ``S`` (``S[H + K]``, eq. 2.15 prints ``S[H] + K``), which keeps
+Kuhnen's generalised-error identification linear with creep; the creep thresholds ``r_K`` are 0;
+eq. 2.19 swaps the operators -- the inverse is ``H^-1[S^-1[y]]``, dead zones first; an offset
+``b`` inside ``S`` (like ``V_b`` of eq. 5.2) absorbs the mean centred data leave.
+
+Inverse (eq. 2.19). A PI operator whose partial sums ``W_i = w_0 + .. + w_i`` are all positive
+is inverted by the PI operator with ``r'_i = sum_{j<=i} w_j (r_i - r_j)``, ``w'_0 = 1/w_0``,
+``w'_i = -w_i / (W_i W_{i-1})`` and play states ``q_i = W_i p_i + sum_{j>i} w_j p_j``; ``S``
+by the same formulas on each side of ``d = 0``. Within a sample ``K`` adds ``kappa x``
+(``kappa = sum_j w_Kj c_j``) plus a part the past fixed, and ``kappa x`` is a play of threshold
+0, so ``H~ = H + kappa x`` is again a PI operator: per sample the inverse solves exactly
+``H~[x] = S^-1[y] - b - sum_j w_Kj (1 - c_j) z_j`` (creep applied to the estimated input, no
+iteration), and ``compensator o model`` is the identity to rounding, with or without creep.
+
+State ``x = [p_0 .. p_{n-1}, z_1 .. z_m]`` (play outputs, creep states), for :func:`simulate`
+and :func:`invert` alike, so model and compensator can be synchronised.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import FitDivergedError
+from . import _pi_kernels as kernels
+
+__all__ = ["PiParams", "PiStructure", "deadzone", "inverse_pi",
+           "inverse_play_states", "inverse_superposition", "invert", "invert_step",
+           "not_invertible_reason", "play", "simulate", "simulate_reference", "step"]
+
+
+def _frozen(values, n: int, name: str) -> np.ndarray:
+    try:
+        arr = np.array(values, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be numbers, got {values!r}") from None
+    if n >= 0 and arr.shape != (n,):
+        raise ValueError(f"{name} must have {n} values, got {arr.shape[0]}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+    arr.setflags(write=False)
+    return arr
+
+
+def _float_tuple(values, name: str) -> tuple[float, ...]:
+    return tuple(_frozen(values, -1, name).tolist())
+
+
+@dataclass(frozen=True)
+class PiStructure:
+    """What does not get fitted: operator thresholds, creep eigenvalues and the sample time.
+
+    Parameters
+    ----------
+    play_thresholds : tuple of float
+        ``r_0 = 0 < r_1 < ...`` in input units (eq. 2.11); their number is the model size.
+    n_deadzone : int
+        One-sided dead-zone operators on *each* side of ``d = 0`` (eq. 2.12); 0 makes ``S``
+        linear. Their thresholds are fitted (they follow from the output range), so they live
+        in :class:`PiParams`.
+    creep_rates : tuple of float
+        Eigenvalues ``a_j`` [1/s] of the linear creep operators (eq. 2.14); empty for the
+        rate-independent model.
+    dt : float
+        Sample time [s].
+    """
+
+    play_thresholds: tuple[float, ...] = (0.0,)
+    n_deadzone: int = 0
+    creep_rates: tuple[float, ...] = ()
+    dt: float = 0.025
+
+    def __post_init__(self) -> None:
+        r = _float_tuple(self.play_thresholds, "play_thresholds")
+        object.__setattr__(self, "play_thresholds", r)
+        if r[0] != 0.0 or np.any(np.diff(r) <= 0):
+            raise ValueError(f"play_thresholds must start at 0 and increase strictly, got {r}")
+        rates = _float_tuple(self.creep_rates, "creep_rates")
+        object.__setattr__(self, "creep_rates", rates)
+        if any(a <= 0 for a in rates):
+            raise ValueError(f"creep_rates must be positive eigenvalues [1/s], got {rates}")
+        if int(self.n_deadzone) != self.n_deadzone or self.n_deadzone < 0:
+            raise ValueError(f"n_deadzone must be a non-negative integer, got {self.n_deadzone!r}")
+        if not (np.isfinite(self.dt) and self.dt > 0):
+            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+
+    @property
+    def n_play(self) -> int:
+        return len(self.play_thresholds)
+
+    @property
+    def n_creep(self) -> int:
+        return len(self.creep_rates)
+
+    @property
+    def creep_gains(self) -> np.ndarray:
+        """``c_j = 1 - exp(-a_j dt)``: the fraction of the gap a creep state closes per sample."""
+        return -np.expm1(-np.asarray(self.creep_rates, dtype=float) * self.dt)
+
+
+@dataclass(frozen=True, eq=False)
+class PiParams:
+    """Fitted quantities of a modified PI model.
+
+    Parameters
+    ----------
+    w_h : array, shape (n_play,)
+        Play weights ``w_H`` (eq. 2.7).
+    w_s : array, shape (2 n_deadzone + 1,)
+        Dead-zone weights ``w_S`` (eq. 2.12); the middle one belongs to ``d = 0``.
+    d_s : array, shape (2 n_deadzone + 1,)
+        Dead-zone thresholds ``d_-m < .. < d_0 = 0 < .. < d_m`` in units of ``H + K + b``.
+    w_k : array, shape (n_creep,)
+        Creep weights ``w_K`` (eq. 2.14).
+    b : float
+        Offset inside ``S``.
+    """
+
+    w_h: np.ndarray
+    w_s: np.ndarray = (1.0,)
+    d_s: np.ndarray = (0.0,)
+    w_k: np.ndarray = ()
+    b: float = 0.0
+    n_play: int = field(init=False)
+    n_deadzone: int = field(init=False)
+    n_creep: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "w_h", _frozen(self.w_h, -1, "w_h"))
+        object.__setattr__(self, "w_s", _frozen(self.w_s, -1, "w_s"))
+        object.__setattr__(self, "d_s", _frozen(self.d_s, self.w_s.size, "d_s"))
+        object.__setattr__(self, "w_k", _frozen(self.w_k, -1, "w_k"))
+        object.__setattr__(self, "b", float(self.b))
+        if not np.isfinite(self.b):
+            raise ValueError(f"b must be finite, got {self.b}")
+        m = (self.d_s.size - 1) // 2
+        if self.w_h.size < 1 or self.d_s.size % 2 == 0 or self.d_s[m] != 0.0 \
+                or np.any(np.diff(self.d_s) <= 0):
+            raise ValueError(f"need at least one play weight, and dead-zone thresholds that "
+                             f"increase strictly with 0 in the middle (eq. 2.12), got w_h "
+                             f"{self.w_h.tolist()}, d_s {self.d_s.tolist()}")
+        object.__setattr__(self, "n_play", int(self.w_h.size))
+        object.__setattr__(self, "n_deadzone", int(m))
+        object.__setattr__(self, "n_creep", int(self.w_k.size))
+
+    def to_dict(self) -> dict:
+        return {"w_h": self.w_h.tolist(), "w_s": self.w_s.tolist(), "d_s": self.d_s.tolist(),
+                "w_k": self.w_k.tolist(), "b": self.b}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> PiParams:
+        return cls(w_h=d["w_h"], w_s=d["w_s"], d_s=d["d_s"], w_k=d["w_k"], b=d["b"])
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, PiParams):
+            return NotImplemented
+        return all(np.array_equal(a, b) for a, b in zip(self.to_dict().values(),
+                                                        other.to_dict().values()))
+
+    __hash__ = None
+
+
+def play(x: np.ndarray | float, y_prev: np.ndarray | float,
+         r: np.ndarray | float) -> np.ndarray:
+    """Elementary play operator ``max(x - r, min(x + r, y_prev))`` (eq. 2.11)."""
+    return np.maximum(np.subtract(x, r), np.minimum(np.add(x, r), y_prev))
+
+
+def deadzone(v: np.ndarray | float, d: np.ndarray | float) -> np.ndarray:
+    """One-sided dead-zone operator ``S_d(v)`` (eq. 2.12); broadcasts over ``v`` and ``d``."""
+    v, d = np.broadcast_arrays(np.asarray(v, dtype=float), np.asarray(d, dtype=float))
+    return np.where(d > 0, np.maximum(v - d, 0.0), np.where(d < 0, np.minimum(v - d, 0.0), v))
+
+
+def inverse_pi(r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Thresholds and weights, shape (n,) each, of the inverse PI operator (eq. 2.19, Kuhnen).
+
+    For thresholds ``0 = r_0 < r_1 < ...`` and weights whose partial sums ``W_i`` (the slopes
+    of the initial loading curve between ``r_i`` and ``r_{i+1}``) are all positive:
+    ``r'_i = sum_{j<=i} w_j (r_i - r_j)`` (the loading curve at ``r_i``), ``w'_0 = 1 / w_0``,
+    ``w'_i = -w_i / (W_i W_{i-1})`` (slopes ``1 / W_i``).
+    """
+    r, w = np.asarray(r, dtype=float), np.asarray(w, dtype=float)
+    big_w = np.cumsum(w)
+    r_inv = np.concatenate([[0.0], np.cumsum(big_w[:-1] * np.diff(r))])
+    w_inv = np.diff(1.0 / big_w, prepend=0.0)
+    return r_inv, w_inv
+
+
+def inverse_superposition(d: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Thresholds and weights of the inverse superposition operator ``S^-1`` (eq. 2.19).
+
+    Each side of ``d_0 = 0`` is a PI-like initial loading curve: the inverse has thresholds
+    ``d'_k = S(d_k)`` and weights from the inverse slopes, as :func:`inverse_pi`. Needs the
+    partial sums ``w_0 + .. + w_k`` (k >= 0) and ``w_0 + .. + w_-k`` all positive.
+    """
+    d, w = np.asarray(d, dtype=float), np.asarray(w, dtype=float)
+    m = (d.size - 1) // 2
+    d_inv, w_inv = np.empty_like(d), np.empty_like(w)
+    for side in (slice(m, None), slice(m, None, -1)):  # centre outwards, each direction
+        d_inv[side], w_inv[side] = inverse_pi(np.abs(d[side]), w[side])
+    d_inv[:m] *= -1.0
+    return d_inv, w_inv
+
+
+def inverse_play_states(w: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """States ``q_i = W_i p_i + sum_{j>i} w_j p_j`` of the inverse plays that continue a PI
+    operator with weights ``w`` and play states ``p`` (both shape (n,))."""
+    w, p = np.asarray(w, dtype=float), np.asarray(p, dtype=float)
+    tail = np.concatenate([np.cumsum((w * p)[::-1])[::-1][1:], [0.0]])
+    return np.cumsum(w) * p + tail
+
+
+def _instantaneous_weights(structure: PiStructure, params: PiParams) -> np.ndarray:
+    """Play weights of ``H~ = H + kappa x``, the operator one sample of ``H + K`` applies."""
+    w = params.w_h.copy()
+    w[0] += params.w_k @ structure.creep_gains
+    return w
+
+
+def _superposition(params: PiParams, v: float) -> float:
+    return float(params.w_s @ deadzone(v, params.d_s))
+
+
+def step(structure: PiStructure, params: PiParams, x: np.ndarray,
+         u: float) -> tuple[float, np.ndarray]:
+    """One sample of the forward model (the readable reference of the kernel).
+
+    Returns
+    -------
+    y : float
+        ``S[H[u] + K[u] + b]`` with the states after this sample (eq. 2.12-2.15).
+    x_next : array, shape (n_play + n_creep,)
+    """
+    x = np.asarray(x, dtype=float)
+    p = play(u, x[: structure.n_play], np.asarray(structure.play_thresholds))
+    z = x[structure.n_play:] + structure.creep_gains * (u - x[structure.n_play:])
+    y = _superposition(params, params.w_h @ p + params.w_k @ z + params.b)
+    return y, np.concatenate([p, z])
+
+
+def invert_step(structure: PiStructure, params: PiParams, x: np.ndarray,
+                y: float) -> tuple[float, np.ndarray]:
+    """One sample of the inverse model on the forward state (the reference of the kernel).
+
+    The instantaneous operator ``H~`` is inverted with inverse plays built from the present
+    play states; the estimate then advances the forward state as :func:`step` would.
+    Needs an invertible model (see :func:`invert`).
+    """
+    x = np.asarray(x, dtype=float)
+    n, c = structure.n_play, structure.creep_gains
+    w_inst = _instantaneous_weights(structure, params)
+    sign = 1.0 if w_inst[0] > 0 else -1.0  # the polarity lives in H (S increases)
+    r_inv, w_inv = inverse_pi(np.asarray(structure.play_thresholds), sign * w_inst)
+    d_inv, ws_inv = inverse_superposition(params.d_s, params.w_s)
+    v = float(ws_inv @ deadzone(y, d_inv)) - params.b - params.w_k @ ((1 - c) * x[n:])
+    q = play(sign * v, inverse_play_states(sign * w_inst, x[:n]), r_inv)
+    u_hat = float(w_inv @ q)
+    return u_hat, step(structure, params, x, u_hat)[1]
+
+
+def _initial_state(structure: PiStructure, x0: np.ndarray | float | None,
+                   at_rest: float) -> np.ndarray:
+    n = structure.n_play + structure.n_creep
+    if x0 is None:
+        return np.full(n, float(at_rest))
+    try:
+        x0 = np.broadcast_to(np.asarray(x0, dtype=float), (n,)).copy()
+    except ValueError:
+        raise ValueError(f"x0 must be a float or have {n} values (plays, then creep states), "
+                         f"got shape {np.shape(x0)}") from None
+    if not np.all(np.isfinite(x0)):
+        raise ValueError("x0 must be finite")
+    return x0
+
+
+def _check_input(u: np.ndarray, name: str) -> np.ndarray:
+    u = np.ascontiguousarray(u, dtype=float)
+    if u.ndim != 1 or u.size == 0:
+        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
+    if not np.all(np.isfinite(u)):
+        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
+    return u
+
+
+def _check_params(structure: PiStructure, params: PiParams) -> None:
+    ours = (params.n_play, params.n_deadzone, params.n_creep)
+    theirs = (structure.n_play, structure.n_deadzone, structure.n_creep)
+    if ours != theirs:
+        raise ValueError(f"params have (plays, dead zones per side, creep operators) = {ours}, "
+                         f"the structure {theirs}")
+
+
+def simulate(structure: PiStructure, params: PiParams, u: np.ndarray,
+             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the forward model over an input sequence (compiled kernel).
+
+    Parameters
+    ----------
+    u : array, shape (n,)
+        Input sampled every ``structure.dt``.
+    x0 : array, shape (n_play + n_creep,), float or None
+        Initial play outputs then creep states. A float puts every state there; ``None``
+        starts at rest at the first input (all states ``= u[0]``), the state a decaying
+        oscillation about ``u[0]`` leaves behind (the demagnetised state, shifted).
+
+    Returns
+    -------
+    y : array, shape (n,)
+    x_end : array, shape (n_play + n_creep,)
+        State after the last sample; feeding it back as ``x0`` continues the run exactly.
+    """
+    _check_params(structure, params)
+    u = _check_input(u, "u")
+    x = _initial_state(structure, x0, u[0])
+    n = structure.n_play
+    y, p, z = kernels.simulate(u, x[:n].copy(), x[n:].copy(),
+                               np.asarray(structure.play_thresholds), params.w_h, params.d_s,
+                               params.w_s, structure.creep_gains, params.w_k, params.b)
+    return y, np.concatenate([p, z])
+
+
+def simulate_reference(structure: PiStructure, params: PiParams, u: np.ndarray,
+                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    _check_params(structure, params)
+    u = _check_input(u, "u")
+    x = _initial_state(structure, x0, u[0])
+    y = np.empty_like(u)
+    for n, u_n in enumerate(u):
+        y[n], x = step(structure, params, x, u_n)
+    return y, x
+
+
+def not_invertible_reason(structure: PiStructure, params: PiParams) -> str:
+    """Why the model has no inverse, or ``""`` if it has one.
+
+    The instantaneous play weights ``w~`` need partial sums of one sign (a strictly monotone
+    loading curve, either polarity) and the dead-zone weights partial sums that are positive
+    from ``d = 0`` outwards (an increasing ``S``).
+    """
+    _check_params(structure, params)
+    sums = np.cumsum(_instantaneous_weights(structure, params))
+    if not (np.all(sums > 0) or np.all(sums < 0)):
+        return (f"the partial sums of the instantaneous play weights {sums.tolist()} change "
+                f"sign or vanish, so H + K is not invertible (eq. 2.19)")
+    m = params.n_deadzone
+    for side in (params.w_s[m:], params.w_s[m::-1]):
+        if np.any(np.cumsum(side) <= 0):
+            return (f"the partial sums of the dead-zone weights {params.w_s.tolist()} are not "
+                    f"all positive from d = 0 outwards, so S is not invertible (eq. 2.19)")
+    return ""
+
+
+def invert(structure: PiStructure, params: PiParams, y: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the analytical inverse (compensator) over an output sequence (eq. 2.19 with creep).
+
+    Parameters
+    ----------
+    y : array, shape (n,)
+        Model output (e.g. the sensor signal), sampled every ``structure.dt``.
+    x0 : array, shape (n_play + n_creep,), float or None
+        Initial *forward* state (as for :func:`simulate`). ``None`` starts at rest at the
+        input ``u_0`` that gives ``y[0]`` at rest, ``u_0 = (S^-1(y_0) - b) / (sum w_H + sum
+        w_K)``. The inverse is exact when the play states are reachable ones (for example the
+        default, a float or any ``x_end``).
+
+    Returns
+    -------
+    u_hat : array, shape (n,)
+        Estimated input.
+    x_end : array, shape (n_play + n_creep,)
+        Forward state after the last sample (continues :func:`simulate` or :func:`invert`).
+
+    Raises
+    ------
+    FitDivergedError
+        If the model is not invertible (:func:`not_invertible_reason`) or the inverse leaves
+        the finite range (negative creep weights beyond what the fit's constraints allow).
+    """
+    reason = not_invertible_reason(structure, params)
+    if reason:
+        raise FitDivergedError(f"the model has no inverse: {reason}")
+    y = _check_input(y, "y")
+    n = structure.n_play
+    d_inv, ws_inv = inverse_superposition(params.d_s, params.w_s)
+    if x0 is None:
+        gain = params.w_h.sum() + params.w_k.sum()
+        if gain == 0:
+            raise FitDivergedError("the model's static gain sum(w_H) + sum(w_K) is 0: no input "
+                                   "is at rest at y[0]; pass x0")
+        rest = (float(ws_inv @ deadzone(y[0], d_inv)) - params.b) / gain
+    else:
+        rest = 0.0
+    x = _initial_state(structure, x0, rest)
+    w_inst = _instantaneous_weights(structure, params)
+    sign = 1.0 if w_inst[0] > 0 else -1.0
+    r_inv, w_inv = inverse_pi(np.asarray(structure.play_thresholds), sign * w_inst)
+    q0 = inverse_play_states(sign * w_inst, x[:n])
+    # The kernel inverts sign * H~; feeding it sign * (everything on the right-hand side) is
+    # the same as negating b, the creep weights and S^-1.
+    u_hat, q, z, n_bad = kernels.invert(y, q0, x[n:].copy(), r_inv, w_inv, d_inv,
+                                        sign * ws_inv, structure.creep_gains,
+                                        sign * params.w_k, sign * params.b)
+    if n_bad >= 0:
+        raise FitDivergedError(
+            f"the inverse model diverged at sample {n_bad} of {y.size} (|u_hat| > 1e6 times the "
+            f"output range); its creep weights make the compensator unstable on this data")
+    return u_hat, np.concatenate([_play_states_from_inverse(sign * w_inst, q), z])
+
+
+def _play_states_from_inverse(w: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`inverse_play_states`: ``q_i - q_{i+1} = W_i (p_i - p_{i+1})``."""
+    big_w = np.cumsum(w)
+    steps = np.append(-np.diff(q) / big_w[:-1], q[-1] / big_w[-1])
+    return np.cumsum(steps[::-1])[::-1]
