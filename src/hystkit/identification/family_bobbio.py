@@ -1,0 +1,104 @@
+"""The Bobbio-Marrucci family (sec. 2.1.4, eq. 2.5) in the model registry, and its fit.
+
+For fixed piston thresholds the output ``c_1 u + sum_k c_k F_k + b`` is linear in the spring
+compliances and the offset, so the fit is one non-negative least-squares solve (compliances
+>= 0, offset free) per candidate threshold set, and the best accepted set wins. The candidate
+sets place the play radii ``A_k = a_1 + .. + a_k-1`` of the springs on a grid up to a fraction
+``rho`` of the input's half-range, evenly or denser near zero.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+from scipy.optimize import nnls
+
+from ..errors import FitDivergedError
+from ..models import bobbio
+from ._registry import ModelFamily
+from ._result import FitResult
+
+__all__ = ["FAMILY", "candidate_thresholds", "fit_bobbio"]
+
+_RHO = (0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5)
+_SPACING = (1.0, 2.0)  # radius of spring k+1 grows like (k / (N - 1)) ** power
+
+
+def candidate_thresholds(structure: bobbio.BobbioStructure, u: np.ndarray) -> list[np.ndarray]:
+    """Threshold sets ``a`` (shape (N - 1,)) tried by :func:`fit_bobbio`."""
+    m = structure.n_springs - 1
+    if m == 0:
+        return [np.empty(0)]
+    half_range = max(0.5 * float(np.ptp(u)), 1e-12)
+    grid = np.arange(1, m + 1) / m
+    return [np.diff(rho * half_range * grid ** power, prepend=0.0)
+            for rho in _RHO for power in _SPACING]
+
+
+def _solve(u: np.ndarray, y: np.ndarray, structure: bobbio.BobbioStructure,
+           a: np.ndarray) -> tuple[bobbio.BobbioParams, float]:
+    """Best compliances >= 0 and offset for thresholds ``a``, and the SSE."""
+    probe = bobbio.BobbioParams(compliance=np.zeros(structure.n_springs), friction=a)
+    f, _ = bobbio.forces(structure, probe, u)
+    design = np.column_stack([u, f])
+    # the offset is free: eliminate it by centring, then solve the non-negative part
+    mean_x, mean_y = design.mean(axis=0), y.mean()
+    c, _ = nnls(design - mean_x, y - mean_y)
+    params = bobbio.BobbioParams(compliance=c, friction=a, offset=mean_y - mean_x @ c)
+    resid = design @ c + params.offset - y
+    return params, float(resid @ resid)
+
+
+def fit_bobbio(u: np.ndarray, y: np.ndarray, structure: bobbio.BobbioStructure, *,
+               thresholds: list[np.ndarray] | None = None,
+               accept: Callable[[bobbio.BobbioParams], bool] | None = None,
+               accept_reason: str = "rejected by the acceptance test") -> FitResult:
+    """Fit a Bobbio-Marrucci chain mapping applied force ``u`` to deformation ``y``.
+
+    Parameters
+    ----------
+    u, y : array, shape (n,)
+        Centred, normalised data (eq. 5.10).
+    thresholds : list of arrays, optional
+        Candidate threshold sets; default :func:`candidate_thresholds` (14 sets).
+    accept, accept_reason
+        Candidates with ``accept(params)`` false are skipped, cheapest first.
+
+    Raises
+    ------
+    FitDivergedError
+        If every candidate is vetoed.
+    """
+    t_start = time.perf_counter()
+    u = np.ascontiguousarray(u, dtype=float)
+    y = np.ascontiguousarray(y, dtype=float)
+    if u.shape != y.shape or u.ndim != 1:
+        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
+    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
+        raise ValueError("u and y must be finite")
+    sets = candidate_thresholds(structure, u) if thresholds is None else thresholds
+    fits = sorted((_solve(u, y, structure, np.asarray(a, dtype=float)) for a in sets),
+                  key=lambda fit: fit[1])
+    for n_rejected, (params, cost) in enumerate(fits):
+        if accept is None or accept(params):
+            return FitResult(structure=structure, params=params, cost=cost,
+                             n_evaluations=len(sets), seconds=time.perf_counter() - t_start,
+                             converged=True, message=f"best of {len(sets)} threshold sets "
+                             f"({n_rejected} better ones rejected), non-negative least "
+                             f"squares per set", n_starts=len(sets))
+    raise FitDivergedError(f"the fit failed: all {len(fits)} candidate fits were rejected "
+                           f"({accept_reason})")
+
+
+def _make_structure(dt: float, size: int) -> bobbio.BobbioStructure:
+    return bobbio.BobbioStructure(n_springs=size, dt=dt)
+
+
+FAMILY = ModelFamily(
+    name="bobbio", title="Bobbio-Marrucci springs and friction pistons (sec. 2.1.4, eq. 2.5)",
+    structure_type=bobbio.BobbioStructure, params_type=bobbio.BobbioParams,
+    make_structure=_make_structure, simulate=bobbio.simulate, fit=fit_bobbio,
+    invert=bobbio.invert, size_help="springs N, with N - 1 pistons (2N params)",
+    default_size=10)

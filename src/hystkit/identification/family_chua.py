@@ -1,0 +1,111 @@
+"""The Chua-Stromsmoe family (sec. 2.1.3, eq. 2.3) in the model registry, and its fit.
+
+The SSE (eq. 5.9) is minimised by bounded least squares (``fit_multistart``) over
+``ChuaParams.to_vector`` with finite-difference Jacobians: the model has 6 parameters per
+element and none enters the output linearly.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..models import chua
+from ._least_squares import fit_multistart
+from ._registry import ModelFamily
+from ._result import FitResult
+
+__all__ = ["FAMILY", "default_starts", "fit_chua"]
+
+# Bounds per element in optimiser coordinates, for data normalised to max |.| = 1 (eq. 5.10):
+# slopes and scales over four decades around 1, bands up to the whole half-range.
+_LOG_SLOPE = (np.log(1e-2), np.log(1e2))
+_LOG_SCALE = (np.log(1e-2), np.log(1e2))
+_LOG_VG = (np.log(1e-3), np.log(1e3))
+_DELTA = (0.0, 1.0)
+
+
+def _bounds(structure: chua.ChuaStructure) -> tuple[np.ndarray, np.ndarray]:
+    # Beyond the Euler cap g is a straight line of the capped slope, so a larger G changes
+    # nothing: 100 / dt is above the cap for any restoring slope >= 1e-2.
+    log_g = (np.log(1e-3), np.log(100.0 / structure.dt))
+    per = [_LOG_SLOPE, _LOG_SLOPE, _LOG_SCALE, log_g, _LOG_VG, _DELTA]
+    lower, upper = (np.tile([b[i] for b in per], structure.n_elements) for i in (0, 1))
+    return lower, upper
+
+
+def default_starts(structure: chua.ChuaStructure, gain: float) -> list[chua.ChuaParams]:
+    """Deterministic starts: linear restoring functions sharing the static ``gain`` (output per
+    input), element rates at 5 and 50 per cent of the Euler cap spread by 6x between elements,
+    with and without a dead band, strongly and mildly non-linear ``g``.
+    """
+    n = structure.n_elements
+    k = np.full(n, n / gain)
+    spread = 6.0 ** (np.arange(n) - (n - 1) / 2)
+    starts = []
+    for frac in (0.05, 0.5):
+        rate = np.minimum(frac * structure.slope_cap / structure.dt * spread,
+                          0.9 * structure.slope_cap / structure.dt)
+        for delta in (0.0, 0.1):
+            for v_g in (0.3, 3.0):
+                starts.append(chua.ChuaParams(k0=k, k_inf=k, y_s=np.full(n, 0.5), g=rate / k,
+                                              v_g=np.full(n, v_g), delta=np.full(n, delta)))
+    return starts
+
+
+def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
+             starts: list[chua.ChuaParams] | None = None, max_nfev: int = 100,
+             screen_nfev: int = 10, n_polish: int = 2,
+             accept: Callable[[chua.ChuaParams], bool] | None = None,
+             accept_reason: str = "rejected by the acceptance test") -> FitResult:
+    """Fit a Chua-Stromsmoe model mapping ``u`` to ``y`` (SSE, eq. 5.9).
+
+    Parameters
+    ----------
+    u, y : array, shape (n,)
+        Input and target, sampled every ``structure.dt``, centred and normalised (eq. 5.10).
+    starts : list of ChuaParams, optional
+        Default :func:`default_starts` (8 starts) with the least-squares static gain.
+    max_nfev, screen_nfev, n_polish : int
+        Passed to ``fit_multistart`` (iterations of the solver; each finite-difference
+        Jacobian costs another 6N model runs).
+    accept, accept_reason
+        Candidates for which ``accept(params)`` is false are skipped.
+
+    Raises
+    ------
+    FitDivergedError
+        If no start gives a finite cost or every candidate is vetoed.
+    """
+    u = np.ascontiguousarray(u, dtype=float)
+    y = np.ascontiguousarray(y, dtype=float)
+    if u.shape != y.shape or u.ndim != 1:
+        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
+    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
+        raise ValueError("u and y must be finite")
+    n = structure.n_elements
+    if starts is None:
+        # f and g increase, so the static gain is positive; a floor keeps k finite
+        gain = max(float(np.polyfit(u, y, 1)[0]), 0.05)
+        starts = default_starts(structure, gain)
+
+    def to_params(theta: np.ndarray) -> chua.ChuaParams:
+        return chua.ChuaParams.from_vector(theta, n)
+
+    return fit_multistart(lambda th: chua.simulate(structure, to_params(th), u)[0] - y,
+                          [p.to_vector() for p in starts], _bounds(structure), to_params,
+                          structure, max_nfev=max_nfev, screen_nfev=screen_nfev,
+                          n_polish=n_polish, accept=accept, accept_reason=accept_reason)
+
+
+def _make_structure(dt: float, size: int, slope_cap: float = 1.0) -> chua.ChuaStructure:
+    return chua.ChuaStructure(n_elements=size, dt=dt, slope_cap=slope_cap)
+
+
+FAMILY = ModelFamily(
+    name="chua", title="Chua-Stromsmoe, dy/dt = g(u - f(y)) (sec. 2.1.3, eq. 2.3)",
+    structure_type=chua.ChuaStructure, params_type=chua.ChuaParams,
+    make_structure=_make_structure, simulate=chua.simulate, fit=fit_chua, invert=chua.invert,
+    size_help="elements in series N, output the sum of their states (6N params; 1 = eq. 2.3)",
+    default_size=1)

@@ -1,0 +1,110 @@
+"""The PWL ladder family (Parodi-Storace-Cincotti, sec. 2.1.5) in the model registry, and its fit.
+
+The read-out weights and bias enter the output linearly, so the SSE (eq. 5.9) is minimised by
+variable projection: ``fit_multistart`` moves only the resistor parameters (per cell the dead
+band ``E_k`` and ``log G_k``), and every residual evaluation solves the weights and bias by
+linear least squares on the simulated capacitor voltages (finite-difference Jacobian).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..models import ladder
+from ._least_squares import fit_multistart
+from ._registry import ModelFamily
+from ._result import FitResult
+
+__all__ = ["FAMILY", "default_starts", "fit_ladder"]
+
+_BAND = (0.0, 1.5)  # normalised data (eq. 5.10): a band beyond the range never conducts
+_LOG_G_MIN = np.log(1e-3)
+_W_BOUND = 100.0  # as the mPL's |w| <= 100 (sec. 5.3.3)
+
+
+def default_starts(structure: ladder.LadderStructure) -> list[np.ndarray]:
+    """Deterministic starts ``[E_1, log G_1, ..]``: bands growing along the ladder (0, 0.05 or
+    0.2 of the range per cell) and conductances near the limit or 10 and 100 times slower.
+    """
+    n = structure.n_cells
+    g_max = ladder.conductance_limit(structure)
+    steps = np.arange(1, n + 1) / n
+    starts = []
+    for band in (0.0, 0.05, 0.2):
+        for frac in (0.9, 0.1, 0.01):
+            starts.append(np.column_stack([band * steps, np.full(n, np.log(frac * g_max))])
+                          .reshape(-1))
+    return starts
+
+
+def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, *,
+               starts: list[np.ndarray] | None = None, max_nfev: int = 100,
+               screen_nfev: int = 10, n_polish: int = 2,
+               accept: Callable[[ladder.LadderParams], bool] | None = None,
+               accept_reason: str = "rejected by the acceptance test") -> FitResult:
+    """Fit a PWL ladder mapping source voltage ``u`` to output ``y`` (SSE, eq. 5.9).
+
+    Parameters
+    ----------
+    u, y : array, shape (n,)
+        Centred, normalised data (eq. 5.10), sampled every ``structure.dt``.
+    starts : list of arrays, optional
+        Resistor parameters ``[E_1, log G_1, .., E_N, log G_N]``; default
+        :func:`default_starts` (9 starts).
+    max_nfev, screen_nfev, n_polish : int
+        Passed to ``fit_multistart``.
+    accept, accept_reason
+        Candidates with ``accept(params)`` false are skipped.
+
+    Raises
+    ------
+    FitDivergedError
+        If no start gives a finite cost or every candidate is vetoed.
+    """
+    u = np.ascontiguousarray(u, dtype=float)
+    y = np.ascontiguousarray(y, dtype=float)
+    if u.shape != y.shape or u.ndim != 1:
+        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
+    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
+        raise ValueError("u and y must be finite")
+    n = structure.n_cells
+    lower = np.tile([_BAND[0], _LOG_G_MIN], n)
+    upper = np.tile([_BAND[1], np.log(ladder.conductance_limit(structure))], n)
+    cache: dict = {}
+
+    def project(theta: np.ndarray) -> tuple[ladder.LadderParams, np.ndarray]:
+        # least_squares evaluates the same point again for the acceptance test and the result
+        key = theta.tobytes()
+        if key not in cache:
+            cells = theta.reshape(n, 2)
+            probe = ladder.LadderParams(band=cells[:, 0], conductance=np.exp(cells[:, 1]),
+                                        w=np.zeros(n + 1))
+            states, _ = ladder.states(structure, probe, u)
+            design = np.column_stack([u, states, -np.ones_like(u)])
+            coef = np.linalg.lstsq(design, y, rcond=None)[0]
+            coef[:-1] = np.clip(coef[:-1], -_W_BOUND, _W_BOUND)
+            params = ladder.LadderParams(band=probe.band, conductance=probe.conductance,
+                                         w=coef[:-1], v_b=coef[-1])
+            cache.clear()
+            cache[key] = params, design @ coef - y
+        return cache[key]
+
+    return fit_multistart(lambda th: project(th)[1],
+                          default_starts(structure) if starts is None else starts,
+                          (lower, upper), lambda th: project(th)[0], structure,
+                          max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
+                          accept=accept, accept_reason=accept_reason)
+
+
+def _make_structure(dt: float, size: int, slope_cap: float = 1.0) -> ladder.LadderStructure:
+    return ladder.LadderStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
+
+
+FAMILY = ModelFamily(
+    name="ladder", title="PWL ladder circuit, Parodi-Storace-Cincotti (sec. 2.1.5)",
+    structure_type=ladder.LadderStructure, params_type=ladder.LadderParams,
+    make_structure=_make_structure, simulate=ladder.simulate, fit=fit_ladder,
+    invert=ladder.invert, size_help="ladder sections N, a PWL resistor and a capacitor each "
+                                    "(3N + 2 params)", default_size=2)

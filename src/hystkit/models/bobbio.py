@@ -1,0 +1,255 @@
+"""Bobbio-Marrucci spring/piston chain, sec. 2.1.4 (fig. 2.6-2.8, eq. 2.5).
+
+Topology (fig. 2.6): the applied force ``F`` (the input ``u``) pulls the free end of a chain of
+``N`` linear springs; between spring ``k`` and spring ``k+1`` sits piston ``k``, held by Coulomb
+friction against a fixed floor; spring ``N`` ends at the wall. ``F_k`` is the force in spring
+``k`` (so ``F_1 = F``). Piston ``k`` feels ``F_k - F_k+1`` and sticks while
+
+    |F_k - F_k+1| <= a_k,            k = 1 .. N-1                                  (eq. 2.5)
+
+The output is the deformation of the spring sequence, ``Y = sum_k Y_k = sum_k c_k F_k`` with
+``c_k = 1 / k_k`` the compliance of spring ``k``, plus an offset ``b`` (the position reference).
+The document's eq. 2.5 runs to ``k = N``; with ``N - 1`` pistons it ends at ``N - 1``. Its
+``U_k`` ("forcing variables") are the spring forces ``F_k``, and its unit constants become the
+thresholds ``a_k`` and compliances ``c_k`` here.
+
+Quasi-static evolution, exact and event-free: velocity does not change the friction (sec.
+2.1.4), so the state after a sample depends only on the input values, not on their timing.
+Between samples the input moves monotonically; a piston starts sliding only when the one before
+it slides, and then sits at its threshold, so one pass from the loaded end inwards,
+
+    F_k+1 <- clip(F_k+1, F_k - a_k, F_k + a_k),      k = 1 .. N-1
+
+gives the new equilibrium. Each force is thus a play operator (eq. 2.11) of the previous one,
+and, play operators composing by adding their radii, ``F_k = H_{A_k}[F]`` with
+``A_k = a_1 + .. + a_k-1``: the chain is a Prandtl-Ishlinskii model with non-negative weights,
+rate-independent, with non-local memory (fig. 2.8) and wiping-out of minor loops.
+
+The state ``x`` is ``(F_2, .., F_N)``; ``F_1`` is the input itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import FitDivergedError
+from . import _circuit_kernels as kernels
+
+__all__ = [
+    "BobbioParams",
+    "BobbioStructure",
+    "forces",
+    "invert",
+    "simulate",
+    "simulate_reference",
+    "step",
+]
+
+
+@dataclass(frozen=True)
+class BobbioStructure:
+    """What does not get fitted.
+
+    Parameters
+    ----------
+    n_springs : int
+        Springs ``N`` (>= 1); there are ``N - 1`` pistons.
+    dt : float
+        Sample time [s]; the model is rate-independent and does not use it.
+    """
+
+    n_springs: int = 10
+    dt: float = 0.025
+
+    def __post_init__(self) -> None:
+        if int(self.n_springs) != self.n_springs or self.n_springs < 1:
+            raise ValueError(f"n_springs must be a positive integer, got {self.n_springs!r}")
+        if not (np.isfinite(self.dt) and self.dt > 0):
+            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+
+    @property
+    def n_params(self) -> int:
+        return 2 * self.n_springs
+
+
+def _frozen(values, n: int, name: str) -> np.ndarray:
+    try:
+        arr = np.array(values, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be numbers, got {values!r}") from None
+    if arr.shape != (n,):
+        raise ValueError(f"{name} must have {n} values, got {arr.size}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class BobbioParams:
+    """Spring compliances, piston thresholds and output offset.
+
+    Parameters
+    ----------
+    compliance : array, shape (N,)
+        ``c_k = 1 / k_k`` (>= 0; 0 is a rigid spring) [output units per input unit].
+    friction : array, shape (N - 1,)
+        Piston thresholds ``a_k`` (> 0) [input units], eq. 2.5.
+    offset : float
+        Output offset ``b``.
+    """
+
+    compliance: np.ndarray
+    friction: np.ndarray
+    offset: float = 0.0
+    n_springs: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        n = np.size(self.compliance)
+        object.__setattr__(self, "n_springs", int(n))
+        object.__setattr__(self, "compliance", _frozen(self.compliance, n, "compliance"))
+        object.__setattr__(self, "friction", _frozen(self.friction, n - 1, "friction"))
+        object.__setattr__(self, "offset", float(self.offset))
+        if not np.isfinite(self.offset):
+            raise ValueError(f"offset must be finite, got {self.offset}")
+        if np.any(self.compliance < 0):
+            raise ValueError("compliance must be >= 0 (springs have positive stiffness)")
+        if np.any(self.friction <= 0):
+            raise ValueError("friction thresholds a_k must be positive (eq. 2.5)")
+
+    @property
+    def radii(self) -> np.ndarray:
+        """Play radii ``A_k = a_1 + .. + a_k-1`` of the forces ``F_2 .. F_N``."""
+        return np.cumsum(self.friction)
+
+    def to_dict(self) -> dict:
+        return {"compliance": self.compliance.tolist(), "friction": self.friction.tolist(),
+                "offset": self.offset}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> BobbioParams:
+        return cls(compliance=d["compliance"], friction=d["friction"], offset=d["offset"])
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, BobbioParams):
+            return NotImplemented
+        return bool(np.array_equal(self.compliance, other.compliance)
+                    and np.array_equal(self.friction, other.friction)
+                    and self.offset == other.offset)
+
+    __hash__ = None
+
+
+def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
+         u: float) -> tuple[float, np.ndarray]:
+    """Apply force ``u``: project the spring forces onto eq. 2.5, then read the deformation."""
+    x_next = np.array(x, dtype=float)
+    prev = u
+    for k in range(x_next.size):
+        x_next[k] = min(max(x_next[k], prev - params.friction[k]), prev + params.friction[k])
+        prev = x_next[k]
+    y = params.compliance[0] * u + params.compliance[1:] @ x_next + params.offset
+    return float(y), x_next
+
+
+def _check(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
+           name: str) -> np.ndarray:
+    if params.n_springs != structure.n_springs:
+        raise ValueError(f"params have {params.n_springs} springs, structure has "
+                         f"{structure.n_springs}")
+    u = np.ascontiguousarray(u, dtype=float)
+    if u.ndim != 1 or u.size == 0:
+        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
+    if not np.all(np.isfinite(u)):
+        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
+    return u
+
+
+def _initial_state(n: int, x0: np.ndarray | float | None, at_rest: float) -> np.ndarray:
+    if x0 is None:
+        return np.full(n, float(at_rest))
+    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (n,)).copy()
+    if not np.all(np.isfinite(x0)):
+        raise ValueError("x0 must be finite")
+    return x0
+
+
+def forces(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Spring forces ``F_2 .. F_N`` after each sample, shape (n, N - 1), and the final state.
+
+    The output is linear in them: ``y = c_1 u + forces @ c[1:] + b`` (the fit uses this).
+    """
+    u = _check(structure, params, u, "u")
+    x = _initial_state(structure.n_springs - 1, x0, u[0])
+    return kernels.bobbio_forces(u, x, params.friction)
+
+
+def simulate(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
+             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Deformation ``Y`` for an applied-force sequence (compiled kernel).
+
+    Parameters
+    ----------
+    u : array, shape (n,)
+        Applied force, one value per sample (only the values matter, not ``dt``).
+    x0 : array, shape (N - 1,), float or None
+        Initial forces ``F_2 .. F_N``; any values obeying eq. 2.5 with ``F_1 = u_0`` are an
+        equilibrium, others are projected at the first sample. ``None`` starts at rest at the
+        first input, all springs carrying ``u_0`` and no piston loaded.
+
+    Returns
+    -------
+    y : array, shape (n,)
+    x_end : array, shape (N - 1,)
+    """
+    f, x_end = forces(structure, params, u, x0)
+    u = np.asarray(u, dtype=float)
+    return params.compliance[0] * u + f @ params.compliance[1:] + params.offset, x_end
+
+
+def simulate_reference(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
+                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Same as :func:`simulate`, as a plain loop over :func:`step`."""
+    u = _check(structure, params, u, "u")
+    x = _initial_state(structure.n_springs - 1, x0, u[0])
+    y = np.empty_like(u)
+    for n, u_n in enumerate(u):
+        y[n], x = step(structure, params, x, u_n)
+    return y, x
+
+
+def invert(structure: BobbioStructure, params: BobbioParams, y: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Applied force from the deformation: the chain under displacement control.
+
+    Given the state, ``Y(F)`` is continuous, piecewise linear and non-decreasing in ``F``:
+    slope ``c_1`` while piston 1 sticks, and each further piston that starts sliding adds its
+    spring's compliance. The inverse walks these segments (O(N) per sample, breakpoints
+    ``F_k +- A_k`` already sorted by eq. 2.5) and then updates the state like the forward model,
+    so ``simulate(invert(y)) == y``. If ``c_1 = 0`` and ``Y`` stays on a flat segment, the
+    middle of the band ``F_2 +- a_1`` is returned.
+
+    Parameters
+    ----------
+    y : array, shape (n,)
+    x0 : array, shape (N - 1,), float or None
+        ``None``: at rest at the force ``(y_0 - b) / sum(c)``.
+
+    Raises
+    ------
+    FitDivergedError
+        If no force gives the output (every compliance zero).
+    """
+    y = _check(structure, params, y, "y")
+    total = params.compliance.sum()
+    rest = (y[0] - params.offset) / total if total > 0 else 0.0
+    x = _initial_state(structure.n_springs - 1, x0, rest)
+    u_hat, x_end, n_bad = kernels.bobbio_invert(y, x, params.compliance, params.friction,
+                                                params.offset)
+    if n_bad >= 0:
+        raise FitDivergedError(f"no applied force gives the deformation at sample {n_bad} "
+                               f"(all compliances are zero)")
+    return u_hat, x_end

@@ -1,0 +1,341 @@
+"""Chua-Stromsmoe hysteresis model, sec. 2.1.3 (eq. 2.3-2.4) of the reference document.
+
+One element relates input ``u`` and output ``y`` by ``dy/dt = g(u - f(y))`` (eq. 2.3), with a
+restoring function ``f`` (energy storage; the i-lambda curve of Chua's iron-core inductor) and
+a dissipation function ``g`` (the v-i curve of its resistor). The forms used here::
+
+    f(y) = k_inf y + (k_0 - k_inf) y_s tanh(y / y_s)            odd, slope k_0 at 0, k_inf far
+    g(v) = G V_g sinh(d(v) / V_g),  d(v) = sign(v) max(|v| - delta, 0)
+
+``f`` is strictly increasing, onto and has slopes between ``k_0`` and ``k_inf`` (softening for
+``k_0 > k_inf``, stiffening otherwise), as eq. 2.3 requires. With ``delta = 0``, ``g`` is the
+document's strictly increasing dissipation function; the model then has local memory (the
+future depends on the past only through the present ``y``), loops that widen with frequency
+and, as the document says, no hysteresis at DC: slowly, ``y -> f^-1(u)``. A dead band
+``delta > 0`` is an extension: inside it the element does not move, so at DC it becomes the
+play operator ``y = f^-1(H_delta[u])`` (eq. 2.11) and keeps a rate-independent loop.
+Solved for the input, eq. 2.3 is the document's eq. 2.4, ``x = f(y) + g^-1(dy/dt)``, which
+names the input ``x`` (Chua and Stromsmoe's notation) where eq. 2.3 says ``u``; for a cosine
+``y`` and odd ``f``, ``g`` the two terms are the even and odd parts ``x_e``, ``x_o`` of the
+input. The identity holds exactly for every step of the discrete model below.
+
+``size`` elements in series (the flux linkages of inductors carrying one current add) give
+``y = sum_k y_k`` with one ``(f_k, g_k)`` per element; one element is eq. 2.3 itself.
+
+Discretisation: forward Euler ``y_k <- y_k + dt g_k(u_n - f_k(y_k))``, and the output at sample
+``n`` is the state *after* the step that uses ``u_n`` (eq. 2.3 has no feed-through, so this is
+what makes the inverse causal). Stability limit, as the mPL's (eq. 5.28-5.29): the step's
+slope is ``1 - dt g'(v) f'(y)`` and ``f' <= max(k_0, k_inf)``, so ``g`` is continued by a
+straight line beyond the knee where ``g' = slope_cap / (dt max(k_0, k_inf))``. With
+``slope_cap <= 1`` every step is monotone: ``y_k`` never overshoots its equilibrium and stays
+between ``f^-1(min u - delta)`` and ``f^-1(max u + delta)`` (or its start) for any parameters.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import FitDivergedError
+from . import _circuit_kernels as kernels
+
+__all__ = [
+    "ChuaParams",
+    "ChuaStructure",
+    "dissipation",
+    "invert",
+    "invert_step",
+    "restoring",
+    "restoring_inverse",
+    "simulate",
+    "simulate_reference",
+    "step",
+]
+
+_FIELDS = ("k0", "k_inf", "y_s", "g", "v_g", "delta")
+
+
+@dataclass(frozen=True)
+class ChuaStructure:
+    """What does not get fitted.
+
+    Parameters
+    ----------
+    n_elements : int
+        Elements in series (>= 1); 1 is eq. 2.3 itself.
+    dt : float
+        Sample time [s].
+    slope_cap : float
+        Largest allowed Euler slope ``dt g' f'`` (stable below 2; <= 1 gives no overshoot).
+    """
+
+    n_elements: int = 1
+    dt: float = 0.025
+    slope_cap: float = 1.0
+
+    def __post_init__(self) -> None:
+        if int(self.n_elements) != self.n_elements or self.n_elements < 1:
+            raise ValueError(f"n_elements must be a positive integer, got {self.n_elements!r}")
+        if not (np.isfinite(self.dt) and self.dt > 0):
+            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        if not 0 < self.slope_cap < 2:
+            raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step, "
+                             f"got {self.slope_cap!r}")
+
+    @property
+    def n_params(self) -> int:
+        return 6 * self.n_elements
+
+
+@dataclass(frozen=True, eq=False)
+class ChuaParams:
+    """Restoring and dissipation functions of each element, arrays of shape (N,).
+
+    Parameters
+    ----------
+    k0, k_inf : array
+        Slopes of ``f`` at 0 and far from 0 (> 0) [input units per output unit].
+    y_s : array
+        Output scale of the transition between the two slopes (> 0).
+    g : array
+        Slope ``G`` of ``g`` at the edge of its dead band (> 0) [output units per s per input
+        unit].
+    v_g : array
+        Input scale of the sinh in ``g`` (> 0); large means linear.
+    delta : array
+        Half-width of the dead band of ``g`` (>= 0); 0 is the document's model.
+
+    Notes
+    -----
+    The optimiser sees ``[log k0, log k_inf, log y_s, log g, log v_g, delta]`` per element.
+    """
+
+    k0: np.ndarray
+    k_inf: np.ndarray
+    y_s: np.ndarray
+    g: np.ndarray
+    v_g: np.ndarray
+    delta: np.ndarray
+    n_elements: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        n = np.size(self.k0)
+        object.__setattr__(self, "n_elements", int(n))
+        for name in _FIELDS:
+            try:
+                arr = np.array(getattr(self, name), dtype=float).reshape(-1)
+            except (TypeError, ValueError):
+                raise ValueError(f"{name} must be numbers, got {getattr(self, name)!r}") from None
+            if arr.shape != (n,):
+                raise ValueError(f"{name} must have {n} values, got {arr.size}")
+            if not np.all(np.isfinite(arr)):
+                raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        for name in _FIELDS[:5]:
+            if np.any(getattr(self, name) <= 0):
+                raise ValueError(f"{name} must be positive (f and g strictly increasing, eq. 2.3)")
+        if np.any(self.delta < 0):
+            raise ValueError("delta (dead band of g) must be >= 0")
+
+    def to_vector(self) -> np.ndarray:
+        cols = [np.log(getattr(self, name)) for name in _FIELDS[:5]] + [self.delta]
+        return np.column_stack(cols).reshape(-1)
+
+    @classmethod
+    def from_vector(cls, theta: np.ndarray, n_elements: int) -> ChuaParams:
+        t = np.asarray(theta, dtype=float).reshape(n_elements, 6)
+        return cls(*np.exp(t[:, :5]).T, delta=t[:, 5])
+
+    def to_dict(self) -> dict:
+        return {name: getattr(self, name).tolist() for name in _FIELDS}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> ChuaParams:
+        return cls(**{name: d[name] for name in _FIELDS})
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, ChuaParams):
+            return NotImplemented
+        return all(np.array_equal(getattr(self, n), getattr(other, n)) for n in _FIELDS)
+
+    __hash__ = None
+
+
+def _limits(structure: ChuaStructure, params: ChuaParams) -> tuple[np.ndarray, np.ndarray]:
+    """Per element: the cap on ``g'`` and the knee ``|v|`` beyond which ``g`` is straight."""
+    cap = structure.slope_cap / (structure.dt * np.maximum(params.k0, params.k_inf))
+    ratio = cap / params.g
+    knee = params.delta + np.where(ratio > 1, params.v_g * np.arccosh(np.maximum(ratio, 1.0)),
+                                   0.0)
+    return cap, knee
+
+
+def restoring(params: ChuaParams, y: np.ndarray) -> np.ndarray:
+    """``f_k(y_k)``; ``y`` of shape (..., N)."""
+    y = np.asarray(y, dtype=float)
+    return params.k_inf * y + (params.k0 - params.k_inf) * params.y_s * np.tanh(y / params.y_s)
+
+
+def restoring_inverse(params: ChuaParams, u: float) -> np.ndarray:
+    """``f_k^-1(u)`` for every element, shape (N,), by bisection to float resolution.
+
+    ``|f(y) - k_inf y| <= |k_0 - k_inf| y_s`` brackets the root.
+    """
+    return kernels.chua_restoring_inverse(float(u), params.k0, params.k_inf, params.y_s)
+
+
+def dissipation(structure: ChuaStructure, params: ChuaParams, v: np.ndarray) -> np.ndarray:
+    """Limited ``g_k(v_k)`` (dead band, sinh, straight line beyond the knee); shape (..., N)."""
+    v = np.asarray(v, dtype=float)
+    cap, knee = _limits(structure, params)
+    a = np.abs(v)
+    inner = np.clip(a, params.delta, knee) - params.delta
+    mag = params.g * params.v_g * np.sinh(inner / params.v_g) + cap * np.maximum(a - knee, 0.0)
+    return np.sign(v) * mag
+
+
+def step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
+         u: float) -> tuple[float, np.ndarray]:
+    """One Euler step with input ``u``; the output is the sum of the updated element states."""
+    x = np.asarray(x, dtype=float)
+    x_next = x + structure.dt * dissipation(structure, params, u - restoring(params, x))
+    return float(np.sum(x_next)), x_next
+
+
+def invert_step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
+                y: float) -> tuple[float, np.ndarray]:
+    """The input that makes :func:`step` return ``y``, and the state it leaves.
+
+    ``sum_k g_k(u - f_k(x_k)) = (y - sum_k x_k) / dt`` is solved by bisection (its left side is
+    non-decreasing in ``u``); where it is flat (no element moves, dead bands) the middle of the
+    flat interval is taken.
+    """
+    x = np.asarray(x, dtype=float)
+    fx = restoring(params, x)
+    r = (y - np.sum(x)) / structure.dt
+    cap, knee = _limits(structure, params)
+    n_el = x.size
+    brackets = [_g_inverse(r / n_el, params, cap, knee, upper) + fx for upper in (False, True)]
+    lo, hi = float(np.min(brackets[0])), float(np.max(brackets[1]))
+    ends = []
+    for first in (True, False):
+        a, b = lo, hi
+        while b - a > 1e-14 * (1.0 + abs(a) + abs(b)):
+            m = 0.5 * (a + b)
+            h = float(np.sum(dissipation(structure, params, m - fx)))
+            if h > r or (first and h == r):
+                b = m
+            else:
+                a = m
+        ends.append(b if first else a)
+    e = 0.5 * (ends[0] + ends[1])
+    return e, x + structure.dt * dissipation(structure, params, e - fx)
+
+
+def _g_inverse(r: float, params: ChuaParams, cap: np.ndarray, knee: np.ndarray,
+               upper: bool) -> np.ndarray:
+    if r == 0:
+        return params.delta if upper else -params.delta
+    g_knee = params.g * params.v_g * np.sinh((knee - params.delta) / params.v_g)
+    a = abs(r)
+    inside = params.delta + params.v_g * np.arcsinh(a / (params.g * params.v_g))
+    return np.sign(r) * np.where(a <= g_knee, inside, knee + (a - g_knee) / cap)
+
+
+def _check(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
+           name: str) -> np.ndarray:
+    if params.n_elements != structure.n_elements:
+        raise ValueError(f"params have {params.n_elements} elements, structure has "
+                         f"{structure.n_elements}")
+    u = np.ascontiguousarray(u, dtype=float)
+    if u.ndim != 1 or u.size == 0:
+        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
+    if not np.all(np.isfinite(u)):
+        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
+    return u
+
+
+def _initial_state(params: ChuaParams, x0: np.ndarray | float | None,
+                   u0: float) -> np.ndarray:
+    if x0 is None:
+        return restoring_inverse(params, u0)
+    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (params.n_elements,)).copy()
+    if not np.all(np.isfinite(x0)):
+        raise ValueError("x0 must be finite")
+    return x0
+
+
+def _kernel_args(structure: ChuaStructure, params: ChuaParams) -> tuple:
+    cap, knee = _limits(structure, params)
+    return (params.k0, params.k_inf, params.y_s, params.g, params.v_g, params.delta, knee, cap,
+            structure.dt)
+
+
+def simulate(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
+             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the model over an input sequence (compiled kernel).
+
+    Parameters
+    ----------
+    u : array, shape (n,)
+        Input sampled every ``structure.dt``.
+    x0 : array, shape (N,), float or None
+        Initial element outputs ``y_k``; ``None`` starts every element at rest at the first
+        input, ``y_k = f_k^-1(u_0)`` (``g = 0``).
+
+    Returns
+    -------
+    y : array, shape (n,)
+    x_end : array, shape (N,)
+        Element outputs after the last sample; feeding them back as ``x0`` continues the run.
+    """
+    u = _check(structure, params, u, "u")
+    x = _initial_state(params, x0, u[0])
+    return kernels.chua_simulate(u, x, *_kernel_args(structure, params))
+
+
+def simulate_reference(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
+                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Same as :func:`simulate`, as a plain loop over :func:`step`."""
+    u = _check(structure, params, u, "u")
+    x = _initial_state(params, x0, u[0])
+    y = np.empty_like(u)
+    for n, u_n in enumerate(u):
+        y[n], x = step(structure, params, x, u_n)
+    return y, x
+
+
+def invert(structure: ChuaStructure, params: ChuaParams, y: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Exact inverse of :func:`simulate`: the input sequence that produces ``y``.
+
+    Each sample solves the Euler step for its input by bisection (:func:`invert_step`), so
+    ``simulate(invert(y))`` returns ``y``. The input is unique wherever some element moves;
+    with dead bands and a constant output it is any point of the band, and the middle is
+    returned. The inverse amplifies output noise by ``1 / (dt g')``.
+
+    Parameters
+    ----------
+    y : array, shape (n,)
+    x0 : array, shape (N,), float or None
+        Initial element outputs; ``None`` splits ``y_0`` over the elements as their rest
+        state for a common input ``u`` with ``sum_k f_k^-1(u) = y_0``.
+
+    Raises
+    ------
+    FitDivergedError
+        If the input estimate leaves the finite range (|u| > 1e6 (1 + max |y|)).
+    """
+    y = _check(structure, params, y, "y")
+    if x0 is None:
+        x = restoring_inverse(params, kernels.chua_rest_input(y[0], params.k0, params.k_inf,
+                                                              params.y_s))
+    else:
+        x = _initial_state(params, x0, 0.0)
+    u_hat, x_end, n_bad = kernels.chua_invert(y, x, *_kernel_args(structure, params))
+    if n_bad >= 0:
+        raise FitDivergedError(f"the inverse Chua-Stromsmoe model diverged at sample {n_bad} "
+                               f"of {y.size}")
+    return u_hat, x_end

@@ -1,0 +1,268 @@
+"""PWL ladder circuit of Parodi, Storace and Cincotti, sec. 2.1.5 (fig. 2.10-2.11).
+
+The electrical transfer of the Bobbio-Marrucci chain (sec. 2.1.4): spring forces become
+capacitor voltages, pistons become piecewise-linear resistors whose dead band plays the
+friction threshold. Circuit: the source ``e`` (input) drives a ladder of ``N`` sections; section
+``k`` is a PWL resistor ``R_k`` from node ``k-1`` to node ``k`` (node 0 is the source) and a
+linear capacitor ``C = 1`` from node ``k`` to ground. With ``U_k`` the capacitor voltages::
+
+    i_k     = G_k d_k(U_k-1 - U_k),     d_k(v) = sign(v) max(|v| - E_k, 0)       (fig. 2.11)
+    dU_k/dt = i_k - i_k+1,              U_0 = e,  i_N+1 = 0
+    y       = w_0 e + sum_k w_k U_k - V_b
+
+Each resistor passes no current while ``|U_k-1 - U_k| <= E_k``: eq. 2.5 with ``U_k`` as the
+"forcing variables". For inputs slow compared with the resistors' time constants every node
+follows the play operator of the one before, ``U_k = H_{E_k}[U_k-1]`` (eq. 2.11), and the
+circuit becomes the rate-independent Bobbio-Marrucci chain with ``a_k = E_k`` (the document's
+table 2.1 lists the ladder as rate-independent); faster inputs add a lag, rate dependence. The read-out is the
+one of the Power-Law circuit that descends from this ladder (eq. 2.18, VCVS weights and bias)
+with the linear output resistor ``R = 1`` of the mPL (eq. 5.2), so ``y`` is the current through
+it; the document does not give the 1994 circuit's read-out. ``C = 1`` as in the mPL, since only
+``G / C`` matters once the weights are free.
+
+Discretisation: forward Euler at ``dt``, output from the present state first, then the update
+(as the mPL, fig. 5.12). Stability limit in the spirit of eq. 5.28-5.29: a node's Euler slope
+is ``1 - dt (G_k + G_k+1)`` where both resistors conduct, so each conductance is limited to
+``slope_cap / (2 dt)`` (the straight PWL branches simply get the capped slope). With
+``slope_cap <= 1`` the step is monotone in every node voltage, so all ``U_k`` stay between the
+extremes of the input and the initial state for any parameters.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import FitDivergedError
+from . import _circuit_kernels as kernels
+
+__all__ = [
+    "LadderParams",
+    "LadderStructure",
+    "conductance_limit",
+    "invert",
+    "simulate",
+    "simulate_reference",
+    "states",
+    "step",
+]
+
+
+@dataclass(frozen=True)
+class LadderStructure:
+    """What does not get fitted.
+
+    Parameters
+    ----------
+    n_cells : int
+        Ladder sections ``N`` (>= 1), each a PWL resistor and a capacitor.
+    dt : float
+        Sample time [s].
+    slope_cap : float
+        Largest allowed Euler slope ``dt (G_k + G_k+1)`` at a node (< 2; <= 1: no overshoot).
+    """
+
+    n_cells: int = 2
+    dt: float = 0.025
+    slope_cap: float = 1.0
+
+    def __post_init__(self) -> None:
+        if int(self.n_cells) != self.n_cells or self.n_cells < 1:
+            raise ValueError(f"n_cells must be a positive integer, got {self.n_cells!r}")
+        if not (np.isfinite(self.dt) and self.dt > 0):
+            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        if not 0 < self.slope_cap < 2:
+            raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step, "
+                             f"got {self.slope_cap!r}")
+
+    @property
+    def n_params(self) -> int:
+        return 3 * self.n_cells + 2
+
+
+def _frozen(values, n: int, name: str) -> np.ndarray:
+    try:
+        arr = np.array(values, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be numbers, got {values!r}") from None
+    if arr.shape != (n,):
+        raise ValueError(f"{name} must have {n} values, got {arr.size}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class LadderParams:
+    """Resistor characteristics and read-out weights.
+
+    Parameters
+    ----------
+    band : array, shape (N,)
+        Dead-band half-width ``E_k`` of each resistor (>= 0) [input units].
+    conductance : array, shape (N,)
+        Slope ``G_k`` of the straight branches (> 0) [1/s, with C = 1].
+    w : array, shape (N + 1,)
+        Read-out weights ``w_0 .. w_N`` (eq. 2.18).
+    v_b : float
+        Bias ``V_b`` (eq. 2.18).
+    """
+
+    band: np.ndarray
+    conductance: np.ndarray
+    w: np.ndarray
+    v_b: float = 0.0
+    n_cells: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        n = np.size(self.band)
+        object.__setattr__(self, "n_cells", int(n))
+        object.__setattr__(self, "band", _frozen(self.band, n, "band"))
+        object.__setattr__(self, "conductance", _frozen(self.conductance, n, "conductance"))
+        object.__setattr__(self, "w", _frozen(self.w, n + 1, "w"))
+        object.__setattr__(self, "v_b", float(self.v_b))
+        if not np.isfinite(self.v_b):
+            raise ValueError(f"v_b must be finite, got {self.v_b}")
+        if np.any(self.band < 0):
+            raise ValueError("band (resistor dead band E_k) must be >= 0")
+        if np.any(self.conductance <= 0):
+            raise ValueError("conductance must be positive")
+
+    def to_dict(self) -> dict:
+        return {"band": self.band.tolist(), "conductance": self.conductance.tolist(),
+                "w": self.w.tolist(), "v_b": self.v_b}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> LadderParams:
+        return cls(band=d["band"], conductance=d["conductance"], w=d["w"], v_b=d["v_b"])
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, LadderParams):
+            return NotImplemented
+        return bool(np.array_equal(self.band, other.band)
+                    and np.array_equal(self.conductance, other.conductance)
+                    and np.array_equal(self.w, other.w) and self.v_b == other.v_b)
+
+    __hash__ = None
+
+
+def conductance_limit(structure: LadderStructure) -> float:
+    """Largest effective ``G`` [1/s]: two conducting resistors at a node reach ``slope_cap``."""
+    return structure.slope_cap / (2.0 * structure.dt)
+
+
+def _effective_conductance(structure: LadderStructure, params: LadderParams) -> np.ndarray:
+    return np.minimum(params.conductance, conductance_limit(structure))
+
+
+def step(structure: LadderStructure, params: LadderParams, x: np.ndarray,
+         u: float) -> tuple[float, np.ndarray]:
+    """Output from the present capacitor voltages, then one Euler step with source ``u``."""
+    x = np.asarray(x, dtype=float)
+    y = params.w[0] * u + params.w[1:] @ x - params.v_b
+    v = np.concatenate([[u], x[:-1]]) - x
+    i = _effective_conductance(structure, params) * np.sign(v) * np.maximum(
+        np.abs(v) - params.band, 0.0)
+    return float(y), x + structure.dt * (i - np.append(i[1:], 0.0))
+
+
+def _check(structure: LadderStructure, params: LadderParams, u: np.ndarray,
+           name: str) -> np.ndarray:
+    if params.n_cells != structure.n_cells:
+        raise ValueError(f"params have {params.n_cells} cells, structure has "
+                         f"{structure.n_cells}")
+    u = np.ascontiguousarray(u, dtype=float)
+    if u.ndim != 1 or u.size == 0:
+        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
+    if not np.all(np.isfinite(u)):
+        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
+    return u
+
+
+def _initial_state(n: int, x0: np.ndarray | float | None, at_rest: float) -> np.ndarray:
+    if x0 is None:
+        return np.full(n, float(at_rest))
+    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (n,)).copy()
+    if not np.all(np.isfinite(x0)):
+        raise ValueError("x0 must be finite")
+    return x0
+
+
+def states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Capacitor voltages seen by each sample's output, shape (n, N), and the final state.
+
+    The output is linear in them: ``y = w_0 u + states @ w[1:] - V_b`` (the fit uses this).
+    """
+    u = _check(structure, params, u, "u")
+    x = _initial_state(structure.n_cells, x0, u[0])
+    return kernels.ladder_states(u, x, params.band, _effective_conductance(structure, params),
+                                 structure.dt)
+
+
+def simulate(structure: LadderStructure, params: LadderParams, u: np.ndarray,
+             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the circuit over a source-voltage sequence (compiled kernel).
+
+    Parameters
+    ----------
+    u : array, shape (n,)
+        Source voltage ``e`` sampled every ``structure.dt``.
+    x0 : array, shape (N,), float or None
+        Initial capacitor voltages; ``None`` starts at rest at the first input (``U_k = e_0``,
+        no current), the synchronised start of eq. 2.21-2.22.
+
+    Returns
+    -------
+    y : array, shape (n,)
+    x_end : array, shape (N,)
+    """
+    s, x_end = states(structure, params, u, x0)
+    u = np.asarray(u, dtype=float)
+    return params.w[0] * u + s @ params.w[1:] - params.v_b, x_end
+
+
+def simulate_reference(structure: LadderStructure, params: LadderParams, u: np.ndarray,
+                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Same as :func:`simulate`, as a plain loop over :func:`step`."""
+    u = _check(structure, params, u, "u")
+    x = _initial_state(structure.n_cells, x0, u[0])
+    y = np.empty_like(u)
+    for n, u_n in enumerate(u):
+        y[n], x = step(structure, params, x, u_n)
+    return y, x
+
+
+def invert(structure: LadderStructure, params: LadderParams, y: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Analytical inverse: ``e = (y + V_b - sum_k w_k U_k) / w_0``, then the state update.
+
+    The same construction as the mPL's eq. 5.13-5.14, in the order of fig. 5.12.
+
+    Parameters
+    ----------
+    y : array, shape (n,)
+    x0 : array, shape (N,), float or None
+        ``None``: at rest at ``e_0 = (y_0 + V_b) / sum(w)``.
+
+    Raises
+    ------
+    FitDivergedError
+        If ``w_0 = 0`` or the inverse leaves the finite range (its stability depends on the
+        weights, so it is checked, not guaranteed).
+    """
+    y = _check(structure, params, y, "y")
+    if params.w[0] == 0:
+        raise FitDivergedError("the ladder model has w_0 = 0, so it has no inverse")
+    w_sum = params.w.sum()
+    rest = (y[0] + params.v_b) / w_sum if w_sum != 0 else 0.0
+    x = _initial_state(structure.n_cells, x0, rest)
+    u_hat, x_end, n_bad = kernels.ladder_invert(y, x, params.band,
+                                                _effective_conductance(structure, params),
+                                                params.w, params.v_b, structure.dt)
+    if n_bad >= 0:
+        raise FitDivergedError(f"the inverse ladder model diverged at sample {n_bad} of "
+                               f"{y.size}; the weights make it unstable on this data")
+    return u_hat, x_end

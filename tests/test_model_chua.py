@@ -1,0 +1,232 @@
+"""Chua-Stromsmoe model (sec. 2.1.3, eq. 2.3-2.4): kernels, closed forms, local memory, fit."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+
+from hystkit.compensation import evaluate, fit_compensator
+from hystkit.errors import FitDivergedError
+from hystkit.identification import get_family
+from hystkit.identification.family_chua import fit_chua
+from hystkit.models import chua
+from hystkit.sensors import simulate_experiment
+
+DT = 0.025
+STRUCT2 = chua.ChuaStructure(n_elements=2, dt=DT)
+PARAMS2 = chua.ChuaParams(k0=[1.0, 2.0], k_inf=[3.0, 0.5], y_s=[0.3, 0.5], g=[5.0, 0.5],
+                          v_g=[0.2, 1.0], delta=[0.0, 0.1])
+
+
+def _input(n: int = 4000, seed: int = 0) -> np.ndarray:
+    t = np.arange(n) * DT
+    noise = np.random.default_rng(seed).standard_normal(n)
+    return np.sin(np.pi * t) * np.exp(-t / 80) + 0.3 * np.sin(2.3 * t) + 0.05 * noise
+
+
+def _linear(k: float, g: float, delta: float = 0.0) -> chua.ChuaParams:
+    # k0 = k_inf: f(y) = k y; a huge V_g makes sinh linear to ~1e-12 over |v| <= 1
+    return chua.ChuaParams(k0=[k], k_inf=[k], y_s=[1.0], g=[g], v_g=[1e6], delta=[delta])
+
+
+def test_kernel_matches_readable_reference():
+    u = _input()
+    y, x_end = chua.simulate(STRUCT2, PARAMS2, u)
+    y_ref, x_ref = chua.simulate_reference(STRUCT2, PARAMS2, u)
+    # same arithmetic in the same order; only tanh/sinh library calls may differ in the last bit
+    assert_allclose(y, y_ref, rtol=0, atol=1e-13)
+    assert_allclose(x_end, x_ref, rtol=0, atol=1e-13)
+
+
+def test_split_run_equals_whole_run():
+    u = _input()
+    y, x_end = chua.simulate(STRUCT2, PARAMS2, u)
+    y1, x1 = chua.simulate(STRUCT2, PARAMS2, u[:1234], x0=chua.restoring_inverse(PARAMS2, u[0]))
+    y2, x2 = chua.simulate(STRUCT2, PARAMS2, u[1234:], x0=x1)
+    np.testing.assert_array_equal(np.concatenate([y1, y2]), y)  # the state is all the memory
+    np.testing.assert_array_equal(x2, x_end)
+
+
+def test_linear_element_step_response_closed_form():
+    # f(y) = k y, g(v) = G v: y_n = (1 - (1 - G k dt)^(n+1)) / k (output after the step)
+    k, g = 2.0, 4.0
+    s = chua.ChuaStructure(dt=DT)
+    y, _ = chua.simulate(s, _linear(k, g), np.ones(100), x0=0.0)
+    n = np.arange(100)
+    assert_allclose(y, (1 - (1 - g * k * DT) ** (n + 1)) / k, rtol=1e-9)  # sinh ~ linear
+
+
+def test_fast_element_with_dead_band_is_the_play_operator():
+    # G beyond the Euler cap: beyond the band g is the capped line of slope 1 / dt, so one step
+    # lands on the band edge: y = max(u - delta, min(u + delta, y_prev)) (eq. 2.11), exactly.
+    delta = 0.2
+    u = _input(800)
+    y, _ = chua.simulate(chua.ChuaStructure(dt=DT), _linear(1.0, 1e4, delta), u, x0=0.0)
+    play, prev = np.empty_like(u), 0.0
+    for n, u_n in enumerate(u):
+        prev = max(u_n - delta, min(u_n + delta, prev))
+        play[n] = prev
+    assert_allclose(y, play, rtol=0, atol=1e-12)
+
+
+def test_eq_2_4_input_is_restoring_plus_inverse_dissipation():
+    # u = f(y) + g^-1(dy/dt) (eq. 2.4) holds for every Euler step, inside the knee
+    s = chua.ChuaStructure(dt=DT)
+    p = chua.ChuaParams(k0=[1.5], k_inf=[0.7], y_s=[0.4], g=[2.0], v_g=[0.3], delta=[0.0])
+    u = _input(2000)
+    x0 = chua.restoring_inverse(p, u[0])
+    y, _ = chua.simulate(s, p, u, x0=x0)
+    prev = np.concatenate([x0, y[:-1]])
+    rate = (y - prev) / DT
+    rebuilt = chua.restoring(p, prev[:, None])[:, 0] + 0.3 * np.arcsinh(rate / (2.0 * 0.3))
+    assert_allclose(rebuilt, u, rtol=0, atol=1e-12)
+
+
+def _loop_area(y: np.ndarray, u: np.ndarray) -> float:
+    """Area of the closed loop (y, u) over one period (cyclic trapezoid rule)."""
+    return abs(float(np.sum(0.5 * (np.roll(y, -1) + y) * (np.roll(u, -1) - u))))
+
+
+def test_loop_widens_with_frequency_and_vanishes_at_dc_without_dead_band():
+    """The document: loops grow with frequency; without a dead band there is no DC loop."""
+    s = chua.ChuaStructure(dt=DT)
+    k, g = 1.0, 2.0  # time constant 1 / (G k) = 0.5 s
+    areas = []
+    for period in (40000, 4000, 400, 80):
+        u = np.sin(2 * np.pi * np.arange(6 * period) / period)
+        y, _ = chua.simulate(s, _linear(k, g), u)
+        areas.append(_loop_area(y[-period:], u[-period:]))  # 5 periods: transient < 1e-8
+        # closed form: y_n = (1 - a) y_n-1 + G dt u_n with a = G k dt, a linear filter H; the
+        # cyclic trapezoid area of a sampled ellipse is pi |H| sin(-arg H) sin(w) / w
+        w = 2 * np.pi / period
+        h = g * DT / (1 - (1 - g * k * DT) * np.exp(-1j * w))
+        assert areas[-1] == pytest.approx(np.pi * abs(h) * np.sin(-np.angle(h)) * np.sin(w) / w,
+                                          rel=1e-6)
+    assert np.all(np.diff(areas) > 0)
+    assert areas[0] < 0.01  # ~ pi w tau: vanishes at DC
+
+
+def test_dead_band_keeps_a_loop_at_dc():
+    s = chua.ChuaStructure(dt=DT)
+    u = np.sin(2 * np.pi * np.arange(80000) / 40000)
+    y, _ = chua.simulate(s, _linear(1.0, 20.0, delta=0.1), u)
+    # the slow limit is the play of radius 0.1, whose loop is a parallelogram of area
+    # 4 delta (amplitude - delta) = 0.36; the lag outside the band adds about pi w tau = 1e-3
+    assert _loop_area(y[40000:], u[40000:]) == pytest.approx(4 * 0.1 * 0.9, rel=0.01)
+
+
+def test_half_wave_symmetry_of_odd_models():
+    # property 9 of Chua-Stromsmoe (sec. 2.1.3): odd f and g, u(t + T/2) = -u(t) => the
+    # periodic output has the same symmetry
+    t = np.arange(40 * 80)
+    u = 0.9 * np.sin(2 * np.pi * t / 80)
+    y, _ = chua.simulate(STRUCT2, PARAMS2, u)
+    last = y[-80:]
+    assert_allclose(last[40:], -last[:40], rtol=0, atol=1e-9)  # transient decayed over 39 T
+
+
+@settings(max_examples=60, deadline=None)
+@given(logs=st.lists(st.floats(-4, 4), min_size=5, max_size=5), delta=st.floats(0, 1),
+       cap=st.floats(0.05, 1.0), seed=st.integers(0, 1000))
+def test_stability_limit_bounds_any_parameter_set(logs, delta, cap, seed):
+    """With the slope cap <= 1 no step overshoots: y stays between f^-1(min u - delta),
+    f^-1(max u + delta) and its start, for any parameters."""
+    s = chua.ChuaStructure(dt=DT, slope_cap=cap)
+    p = chua.ChuaParams(*np.exp(np.array(logs))[:, None], delta=[delta])
+    rng = np.random.default_rng(seed)
+    u = 3 * rng.standard_normal(300)
+    x0 = rng.uniform(-5, 5, 1)
+    y, _ = chua.simulate(s, p, u, x0=x0)
+    lo = min(x0[0], chua.restoring_inverse(p, u.min() - delta)[0])
+    hi = max(x0[0], chua.restoring_inverse(p, u.max() + delta)[0])
+    span = 1e-9 * (1 + hi - lo)
+    assert np.all((y >= lo - span) & (y <= hi + span))
+
+
+def test_inverse_undoes_forward_to_machine_precision():
+    u = _input()
+    y, _ = chua.simulate(STRUCT2, PARAMS2, u)
+    u_hat, _ = chua.invert(STRUCT2, PARAMS2, y)
+    # element 1 has no dead band, so every step moves and fixes u; bisection to 1e-14
+    assert_allclose(u_hat, u, rtol=0, atol=1e-11)
+
+
+def test_inverse_kernel_matches_readable_step():
+    u = _input(300)
+    y, _ = chua.simulate(STRUCT2, PARAMS2, u)
+    x0 = chua.restoring_inverse(PARAMS2, u[0])
+    u_hat, x_end = chua.invert(STRUCT2, PARAMS2, y, x0=x0)
+    x, ref = x0, []
+    for y_n in y:
+        e, x = chua.invert_step(STRUCT2, PARAMS2, x, y_n)
+        ref.append(e)
+    assert_allclose(u_hat, ref, rtol=0, atol=1e-12)  # bisection tolerance 1e-14 (1 + |u|)
+    assert_allclose(x_end, x, rtol=0, atol=1e-12)
+
+
+def test_inverse_inside_the_dead_band_returns_its_middle():
+    p = _linear(2.0, 1.0, delta=0.3)
+    s = chua.ChuaStructure(dt=DT)
+    u_hat, _ = chua.invert(s, p, np.full(5, 0.25), x0=0.25)
+    assert_allclose(u_hat, 2.0 * 0.25, rtol=1e-13)  # f(y): the middle of [f(y) -+ delta]
+
+
+def test_recovers_known_parameters_from_noise_free_data():
+    truth = chua.ChuaParams(k0=[1.2], k_inf=[0.6], y_s=[0.4], g=[3.0], v_g=[0.5], delta=[0.1])
+    s = chua.ChuaStructure(dt=DT)
+    t = np.arange(8000) * DT
+    u = np.sin(np.pi * t) * np.exp(-t / 100) + 0.2 * np.sin(2.3 * t)
+    y, _ = chua.simulate(s, truth, u)
+    result = fit_chua(u, y, s)
+    assert result.converged
+    assert result.cost < 1e-20
+    # noise-free data: the optimum is the truth (finite-difference Jacobian: ~1e-8 relative)
+    assert_allclose(result.params.to_vector(), truth.to_vector(), rtol=1e-6, atol=1e-8)
+
+
+def test_acceptance_test_rejections_are_reported():
+    u = _input(1000)
+    with pytest.raises(FitDivergedError, match="rejected .no thanks."):
+        fit_chua(u, 0.5 * u, chua.ChuaStructure(dt=DT), starts=[_linear(2.0, 1.0)],
+                 max_nfev=3, screen_nfev=2, accept=lambda p: False, accept_reason="no thanks")
+
+
+def test_params_round_trips():
+    assert chua.ChuaParams.from_dict(PARAMS2.to_dict()) == PARAMS2
+    back = chua.ChuaParams.from_vector(PARAMS2.to_vector(), 2)
+    assert_allclose(back.to_vector(), PARAMS2.to_vector(), rtol=1e-15)
+    family = get_family("chua")
+    assert family.make_structure(DT, 2) == STRUCT2
+
+
+@pytest.mark.parametrize("kwargs", [{"n_elements": 0}, {"dt": -1.0}, {"slope_cap": 2.0}])
+def test_structure_rejects_bad_values(kwargs):
+    with pytest.raises(ValueError):
+        chua.ChuaStructure(**kwargs)
+
+
+@pytest.mark.parametrize("field, value", [("k0", [-1.0]), ("v_g", [0.0]), ("delta", [-0.1]),
+                                          ("g", [np.nan])])
+def test_params_reject_bad_values(field, value):
+    d = _linear(1.0, 1.0).to_dict() | {field: value}
+    with pytest.raises(ValueError):
+        chua.ChuaParams.from_dict(d)
+
+
+def test_simulate_rejects_nan_input():
+    u = _input(10)
+    u[3] = np.nan
+    with pytest.raises(ValueError, match="index 3"):
+        chua.simulate(STRUCT2, PARAMS2, u)
+
+
+@pytest.mark.parametrize("mode", ["direct", "inverse"])
+def test_compensator_on_the_virtual_sensor(mode):
+    comp = fit_compensator(simulate_experiment("sine", 1), model="chua", mode=mode)
+    scores = evaluate(comp, simulate_experiment("sine", 2))
+    assert np.isfinite(scores["r2"])
+    if mode == "inverse":
+        assert scores["r2"] > scores["linear_r2"]
+    # direct (sensor -> position) is not asserted to beat the line: an element whose f and g
+    # increase only lags its input, the opposite loop orientation (docs/models/circuits.md)
