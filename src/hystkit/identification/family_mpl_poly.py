@@ -1,0 +1,233 @@
+"""The polynomial mPL family (sec. 5.3.5, paper 9.2) in the model registry, and its fit.
+
+The paper ran MATLAB's patternsearch for 60 s from table I's start. Here the same SSE (eq. 5.9)
+goes to the shared multi-start trust-region least squares with the exact Jacobian (forward
+sensitivities through the Euler recursion and the limited cubic), from deterministic starts:
+table I of paper 9.2 as printed, and six "linear-output" starts whose cells are sinh-like
+cubics with time constants spread over decades and whose weights come from linear least
+squares (with ``g(z) = z`` the output is linear in ``w`` and ``V_b``).
+
+Only 4N + 4 of the 5N + 6 parameters are identifiable (:func:`canonical`). The solver
+works on all of them, as the paper did (trust-region steps are well defined on the rank-
+deficient Jacobian, and on the virtual sensor this took fewer evaluations than optimising in
+the gauge ``c_k0 = 0, w_0 = 1, V_b = 0``), and the result is mapped to the canonical
+representative, so a fitted model file is reproducible rather than one arbitrary point of an
+(N + 2)-dimensional valley of equivalent parameters. A fit whose ``w_0`` is exactly 0 (no
+canonical form) is returned as found.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import replace
+
+import numpy as np
+
+from ..errors import FitDivergedError
+from ..models import mpl_poly
+from ._least_squares import fit_multistart
+from ._registry import ModelFamily
+from ._result import FitResult
+
+__all__ = ["FAMILY", "PAPER_9_2_TABLE_I", "PAPER_9_2_TABLE_II", "canonical", "default_starts",
+           "fit_mpl_poly", "paper_9_2_params"]
+
+# Bounds in optimiser coordinates (MplPolyParams.to_vector). |w| <= 100 mirrors the document's
+# weight-sum constraint (sec. 5.3.3); the polynomial coefficients only need to stay finite.
+_COEF_BOUND = 1e3
+_LOG_C3_BOUNDS = (np.log(1e-6), np.log(1e4))
+_W_BOUND = 100.0
+
+#: Paper 9.2, table I (left): initial conditions, as printed (``f2``, ``f3`` enter squared and
+#: cubed, eq. 10); ``w0, w1, V_b`` from the text below table II.
+PAPER_9_2_TABLE_I: dict[str, float] = {
+    "f0": -1.0, "f1": 0.1, "f2": 0.1, "f3": 1.0, "g0": 0.1, "g1": 1.0, "g2": 0.1, "g3": 1.0,
+    "w0": 1.0, "w1": -1.0, "V_b": 0.01}
+
+#: Paper 9.2, table II: fitted weights of the four direct compensators (N = 1, 40 Hz,
+#: normalised sensor -> position), as printed; convert with :func:`paper_9_2_params`.
+PAPER_9_2_TABLE_II: dict[str, dict[str, float]] = {
+    "sine": {"f0": -2.516, "f1": -2.666, "f2": 1.975, "f3": 1.953, "g0": 0.100, "g1": 1.195,
+             "g2": 0.006, "g3": 0.475, "w0": 1.000, "w1": -0.492, "V_b": 0.135},
+    "chirp": {"f0": -0.469, "f1": -1.712, "f2": -2.228, "f3": 3.125, "g0": -0.369, "g1": 1.094,
+              "g2": 0.006, "g3": -0.384, "w0": 1.516, "w1": -0.531, "V_b": -0.537},
+    "decay": {"f0": -0.258, "f1": 0.663, "f2": -0.002, "f3": 0.008, "g0": -0.779, "g1": 1.320,
+              "g2": -0.002, "g3": -0.240, "w0": 0.984, "w1": -0.875, "V_b": -0.302},
+    "noise": {"f0": -4.719, "f1": 3.412, "f2": -1.244, "f3": 1.469, "g0": -0.119, "g1": 1.125,
+              "g2": 0.006, "g3": -0.259, "w0": 1.156, "w1": -0.406, "V_b": 0.010},
+}
+
+
+def paper_9_2_params(printed: Mapping[str, float]) -> mpl_poly.MplPolyParams:
+    """One-cell parameters from paper 9.2's printed values (a column of table I or II).
+
+    eq. 10 of the paper (eq. 5.16) applies ``f(x) = f0 + f1 x + f2^2 x^2 + f3^3 x^3`` to the
+    printed values, and the same form to ``g``: the squares and cubes are not typos (with them
+    every column is a working compensator, without them the chirp column is anti-correlated
+    with its input; docs/models/mpl_poly.md).
+    """
+    def cubic(p: str) -> list[float]:
+        return [printed[f"{p}0"], printed[f"{p}1"], printed[f"{p}2"] ** 2, printed[f"{p}3"] ** 3]
+
+    return mpl_poly.MplPolyParams(f=[cubic("f")], g=cubic("g"),
+                                  w=[printed["w0"], printed["w1"]], v_b=printed["V_b"])
+
+
+def canonical(structure: mpl_poly.MplPolyStructure,
+              params: mpl_poly.MplPolyParams) -> mpl_poly.MplPolyParams:
+    """The output-equivalent parameters whose cells rest at ``v* = 0``, with ``w_0 = 1`` and
+    ``V_b = 0``.
+
+    The 5N + 6 parameters are not all identifiable: shifting a cell's voltage
+    (``u_k -> u_k - gamma_k``, ``f_k(v) -> f_k(v - gamma_k)``; knees and rest points move
+    along) and an affine change of the output resistor's voltage (``z -> alpha z + beta``,
+    ``g`` re-expanded, ``w``, ``V_b`` rescaled) leave every input-output map, forward and
+    inverse, unchanged. Fixing these N + 2 directions leaves 4N + 4 identifiable parameters
+    (8 of the paper's 11 for N = 1). The representative chosen: every cell's rest voltage
+    (``mpl_poly.rest_voltages``) moved to 0, so that at rest ``u_k = e`` as in the sinh mPL
+    (then ``c_k0 = 0`` unless the rest point lies on a straight continuation), then
+    ``w_0 = 1``, ``V_b = 0``.
+
+    Raises
+    ------
+    ValueError
+        If ``w_0 = 0`` (no scale to fix it with).
+    """
+    if params.w[0] == 0:
+        raise ValueError("w_0 = 0: the canonical form fixes w_0 = 1")
+    shift = mpl_poly.rest_voltages(structure, params)
+    f = np.array([_compose(c, [r, 1.0]) for c, r in zip(params.f, shift, strict=True)])
+    knees = mpl_poly.knee_points(structure, params)
+    on_cubic = np.logical_or(not structure.limit, (knees[:, 0] < shift) & (shift < knees[:, 1]))
+    f[on_cubic, 0] = 0.0  # exactly, not to rounding
+    v_b = params.v_b + params.w[1:] @ shift
+    return mpl_poly.MplPolyParams(f=f, g=_compose(params.g, [-v_b, params.w[0]]),
+                                  w=params.w / params.w[0], v_b=0.0)
+
+
+def _compose(c: np.ndarray, inner: list[float]) -> np.ndarray:
+    """Coefficients of ``p(inner(x))`` for the cubic ``p`` and a linear ``inner``."""
+    coef = np.polynomial.Polynomial(c)(np.polynomial.Polynomial(inner)).coef
+    return np.pad(coef, (0, 4 - coef.size))
+
+
+def _make_structure(dt: float, size: int, slope_cap: float = 1.0,
+                    limit: bool = True) -> mpl_poly.MplPolyStructure:
+    return mpl_poly.MplPolyStructure(n_cells=size, dt=dt, slope_cap=slope_cap, limit=limit)
+
+
+def _table_i_start(n_cells: int) -> mpl_poly.MplPolyParams:
+    """Paper 9.2's table I start; extra cells copy its resistor with zero weight."""
+    p = paper_9_2_params(PAPER_9_2_TABLE_I)
+    return mpl_poly.MplPolyParams(f=np.repeat(p.f, n_cells, axis=0), g=p.g,
+                                  w=np.r_[p.w, np.zeros(n_cells - 1)], v_b=p.v_b)
+
+
+def default_starts(structure: mpl_poly.MplPolyStructure) -> list[np.ndarray]:
+    """Deterministic cell resistors ``f_k`` (shape (N, 4) each) for the linear-output starts.
+
+    ``f_k(v) = G_k (v + v^3 / (6 V^2))``, the cubic Taylor polynomial of the sinh mPL's
+    resistor: rates ``G_k`` at geometric spreads around 0.3, 3 and 30 % of the Euler cap, a
+    strongly (``V = 0.2``, the document's ``V_T`` start) and a mildly (``V = 2``) non-linear
+    shape, for data normalised to max |.| = 1 (eq. 5.10).
+    """
+    g_max = structure.slope_cap / structure.dt
+    k = np.arange(structure.n_cells)
+    starts = []
+    for v in (0.2, 2.0):
+        for frac in (0.003, 0.03, 0.3):
+            rate = np.minimum(g_max * frac * 6.0 ** (k - (structure.n_cells - 1) / 2),
+                              0.9 * g_max)
+            z = np.zeros_like(rate)
+            starts.append(np.column_stack([z, rate, z, rate / (6 * v * v)]))
+    return starts
+
+
+def _linear_output_start(structure: mpl_poly.MplPolyStructure, f: np.ndarray, u: np.ndarray,
+                         y: np.ndarray) -> mpl_poly.MplPolyParams | None:
+    """Given the cell resistors and ``g(z) = z``: weights and bias by linear least squares.
+    None if the cells diverge on ``u`` (possible only without the limit)."""
+    n = structure.n_cells
+    probe = mpl_poly.MplPolyParams(f=f, g=[0.0, 1.0, 0.0, 0.0], w=np.zeros(n + 1))
+    _, jac = mpl_poly.simulate_with_jacobian(structure, probe, u)
+    lin = jac[:, 4 * n + 4:]  # columns of w_0..w_N and V_b: [u, x_1..x_N, -1] as g' = 1
+    if not np.all(np.isfinite(lin)):
+        return None
+    coef = np.linalg.lstsq(lin, y, rcond=None)[0]
+    coef[:-1] = np.clip(coef[:-1], -0.9 * _W_BOUND, 0.9 * _W_BOUND)
+    return mpl_poly.MplPolyParams(f=f, g=probe.g, w=coef[:-1], v_b=coef[-1])
+
+
+def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStructure, *,
+                 max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
+                 accept: Callable[[mpl_poly.MplPolyParams], bool] | None = None,
+                 accept_reason: str = "rejected by the acceptance test") -> FitResult:
+    """Fit a polynomial mPL mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9).
+
+    Parameters
+    ----------
+    u, y : array, shape (n,)
+        Model input and target, sampled every ``structure.dt``, centred and normalised
+        (eq. 5.10) by the caller.
+    structure : MplPolyStructure
+        With ``limit=False`` trial points whose run diverges are rejected by the solver.
+    max_nfev, screen_nfev, n_polish : int
+        As :func:`hystkit.identification.fit_multistart`.
+    accept : callable, optional
+        A candidate counts only if ``accept(params)``; ``accept_reason`` says why others failed.
+
+    Raises
+    ------
+    FitDivergedError
+        If no start runs without diverging, none gives a finite cost, or all are vetoed.
+    """
+    u = np.ascontiguousarray(u, dtype=float)
+    y = np.ascontiguousarray(y, dtype=float)
+    if u.shape != y.shape or u.ndim != 1:
+        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
+    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
+        raise ValueError("u and y must be finite")
+    n = structure.n_cells
+    lower = np.r_[np.tile([-_COEF_BOUND] * 3 + [_LOG_C3_BOUNDS[0]], n),
+                  np.full(4, -_COEF_BOUND), np.full(n + 2, -_W_BOUND)]
+    upper = np.r_[np.tile([_COEF_BOUND] * 3 + [_LOG_C3_BOUNDS[1]], n),
+                  np.full(4, _COEF_BOUND), np.full(n + 2, _W_BOUND)]
+    cache: dict = {}
+
+    def to_params(theta: np.ndarray) -> mpl_poly.MplPolyParams:
+        return mpl_poly.MplPolyParams.from_vector(theta, n)
+
+    def run(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        # least_squares asks for the residual and then the Jacobian at the same point: the
+        # sensitivity kernel yields both in one pass. A diverged run is all NaN, which the
+        # trust-region solver treats as a rejected step.
+        key = theta.tobytes()
+        if key not in cache:
+            cache.clear()
+            cache[key] = mpl_poly.simulate_with_jacobian(structure, to_params(theta), u)
+        return cache[key]
+
+    candidates = [_table_i_start(n)] + [_linear_output_start(structure, f, u, y)
+                                        for f in default_starts(structure)]
+    # the solver needs a finite residual at each start
+    thetas = [p.to_vector() for p in candidates
+              if p is not None and np.all(np.isfinite(run(p.to_vector())[0]))]
+    if not thetas:
+        raise FitDivergedError("the fit failed: the model diverges on the training data from "
+                               "every start (use the stability limit)")
+    result = fit_multistart(lambda th: run(th)[0] - y, thetas, (lower, upper), to_params,
+                            structure, jac=lambda th: run(th)[1], max_nfev=max_nfev,
+                            screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
+                            accept_reason=accept_reason)
+    # the (N + 2)-dimensional valley of equivalent parameters (see the module docstring)
+    if result.params.w[0] == 0:
+        return result
+    return replace(result, params=canonical(structure, result.params))
+
+
+FAMILY = ModelFamily(
+    name="mpl-poly",
+    title="polynomial modified Power-Law, cubic resistors (sec. 5.3.5, eq. 5.16-5.17, 5.29)",
+    structure_type=mpl_poly.MplPolyStructure, params_type=mpl_poly.MplPolyParams,
+    make_structure=_make_structure, simulate=mpl_poly.simulate, fit=fit_mpl_poly,
+    invert=mpl_poly.invert, size_help="cells N (5N + 6 params)", default_size=1)

@@ -1,0 +1,218 @@
+"""Linearisation and discrete stability of the mPL families (sec. 5.3.5, eq. 5.18-5.28).
+
+For cells ``du_k/dt = f_k(e - u_k)`` and output ``i = g(z)``, ``z = w_0 e + sum w_k u_k - V_b``,
+the first-order Taylor expansion about an operating point ``(e_0, u_0)`` is, with the state
+augmented by a constant 1 (eq. 5.22) and in *absolute* coordinates::
+
+    du_k/dt = -f'_k u_k + f'_k e + o_k,   o_k = f_k(v_k0) - f'_k v_k0,   v_k0 = e_0 - u_k0
+    i       = g'_0 (w_0 e + sum w_k u_k) + g_0 - g'_0 (z_0 + V_b)
+
+with ``f_k, f'_k`` evaluated at ``v_k0 = e_0 - u_k0``. Corrections to the document:
+
+- eq. 5.19 evaluates ``f_k(u_k0 - e_0)``; the cell's argument is ``e - u`` (eq. 5.17), so it is
+  ``f_k(e_0 - u_k0)``.
+- eq. 5.18/5.23 use ``f_k0`` as the constant column and ``g_0 - g'_0 V_b`` as the output
+  constant; that is right only for ``e_0 = u_0 = 0``. The affine terms above are exact for any
+  operating point (the linear model reproduces the step at the point itself).
+- eq. 5.26 prints ``lambda = (1 - f'_k) dt``. Forward Euler gives ``A_d = I + A dt``, which is
+  upper triangular, so its eigenvalues are its diagonal: ``1 - f'_k dt`` for the cells and
+  **1** for the augmented constant state (its continuous eigenvalue is 0; it is a constant, not
+  a mode, and is left out of the stability test). The condition ``|1 - f'_k dt| < 1`` gives
+  eq. 5.28, ``0 < f'_k dt < 2``.
+
+Both the sinh mPL (``mpl``, linear output ``g(z) = z``) and the polynomial mPL (``mpl_poly``)
+go through :func:`linearise_cells`, which takes the cell-resistor current and slope functions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import mpl, mpl_poly
+
+__all__ = ["LinearModel", "discrete_eigenvalues", "knee_points", "linearise", "linearise_cells",
+           "resistor_slope", "stability_report"]
+
+Structure = mpl.MplStructure | mpl_poly.MplPolyStructure
+Params = mpl.MplParams | mpl_poly.MplPolyParams
+
+@dataclass(frozen=True, eq=False)
+class LinearModel:
+    """Augmented linear state space (eq. 5.23) of one operating point; state ``[u_1..u_N, 1]``.
+
+    Attributes
+    ----------
+    a : array, shape (N + 1, N + 1)
+    b : array, shape (N + 1,)
+    c : array, shape (N + 1,)
+    d : float
+    dt : float
+        Euler step [s] for :meth:`discrete`.
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    d: float
+    dt: float
+
+    def discrete(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """Forward-Euler discretisation (eq. 5.24, paper eq. 7): ``A_d = I + A dt``,
+        ``B_d = B dt``, ``C_d = C``, ``D_d = D``."""
+        return (np.eye(self.a.shape[0]) + self.a * self.dt, self.b * self.dt, self.c.copy(),
+                self.d)
+
+
+def linearise_cells(current: Callable[[np.ndarray], np.ndarray],
+                    slope: Callable[[np.ndarray], np.ndarray],
+                    output: Callable[[float], float], output_slope: Callable[[float], float],
+                    w: np.ndarray, v_b: float, e0: float, u0: np.ndarray,
+                    dt: float) -> LinearModel:
+    """Linearise cells ``du_k/dt = f_k(e - u_k)`` with output ``g(z)`` (eq. 5.18-5.23).
+
+    Parameters
+    ----------
+    current, slope : callable
+        ``v (N,) -> f_k(v_k) (N,)`` and ``-> f'_k(v_k) (N,)``: the (limited) cell resistors.
+    output, output_slope : callable
+        ``z -> g(z)`` and ``-> g'(z)``.
+    w : array, shape (N + 1,)
+    v_b : float
+    e0 : float
+        Input at the operating point.
+    u0 : array, shape (N,)
+        Cell voltages at the operating point.
+    dt : float
+        Sample time [s].
+    """
+    u0 = np.asarray(u0, dtype=float)
+    n = u0.size
+    v0 = e0 - u0
+    f0, df0 = np.asarray(current(v0), dtype=float), np.asarray(slope(v0), dtype=float)
+    z0 = w[0] * e0 + w[1:] @ u0 - v_b
+    g0, dg0 = float(output(z0)), float(output_slope(z0))
+    a = np.zeros((n + 1, n + 1))
+    a[:n, :n] = np.diag(-df0)
+    a[:n, n] = f0 - df0 * v0
+    c = np.r_[dg0 * w[1:], g0 - dg0 * (z0 + v_b)]
+    return LinearModel(a=a, b=np.r_[df0, 0.0], c=c, d=dg0 * w[0], dt=dt)
+
+
+def discrete_eigenvalues(model: LinearModel) -> np.ndarray:
+    """Eigenvalues of ``A_d = I + A dt``, shape (N + 1,): ``1 - f'_k dt`` per cell, then 1.
+
+    ``A_d`` is upper triangular (diagonal cells, constant column), so these are its diagonal.
+    The last one belongs to the augmented constant state (see the module docstring).
+    """
+    return np.diag(model.discrete()[0]).copy()
+
+
+def _mpl_slope(structure: mpl.MplStructure, params: mpl.MplParams,
+               v: np.ndarray) -> np.ndarray:
+    """Slope of the limited sinh resistor: ``G cosh(v / V_T)`` inside the knee, the cap beyond."""
+    v = np.asarray(v, dtype=float)
+    inside = np.abs(v) <= mpl.knee_voltage(structure, params)
+    g = 2 * params.i_s / params.v_t
+    v_in = np.where(inside, v, 0.0)
+    return np.where(inside, g * np.cosh(v_in / params.v_t), structure.slope_cap / structure.dt)
+
+
+def resistor_slope(structure: Structure, params: Params, v: np.ndarray) -> np.ndarray:
+    """Cell-resistor slopes ``f'_k,lim(v)``, shape (..., N), of an mpl or mpl-poly model."""
+    if isinstance(structure, mpl.MplStructure):
+        return _mpl_slope(structure, params, v)
+    return mpl_poly.resistor_slope(structure, params, v)
+
+
+def knee_points(structure: Structure, params: Params) -> np.ndarray:
+    """Knees ``x-, x+`` of each cell (shape (N, 2)) beyond which ``f'_k dt`` is capped."""
+    if isinstance(structure, mpl.MplStructure):
+        knee = mpl.knee_voltage(structure, params)
+        return np.column_stack([-knee, knee])
+    return mpl_poly.knee_points(structure, params)
+
+
+def linearise(structure: Structure, params: Params, e0: float, u0: np.ndarray) -> LinearModel:
+    """Linear model (eq. 5.23) of an mpl or mpl-poly model at input ``e0``, state ``u0`` (N,).
+
+    The sinh mPL has the linear output ``g(z) = z`` (``R = 1``, eq. 5.2).
+    """
+    if isinstance(structure, mpl.MplStructure):
+        return linearise_cells(lambda v: mpl.resistor_current(structure, params, v),
+                               lambda v: _mpl_slope(structure, params, v), lambda z: z,
+                               lambda z: 1.0, params.w, params.v_b, e0, u0, structure.dt)
+    if isinstance(structure, mpl_poly.MplPolyStructure):
+        return linearise_cells(lambda v: mpl_poly.resistor_current(structure, params, v),
+                               lambda v: mpl_poly.resistor_slope(structure, params, v),
+                               lambda z: mpl_poly.output_current(params, z),
+                               lambda z: mpl_poly.output_slope(params, z), params.w,
+                               params.v_b, e0, u0, structure.dt)
+    raise TypeError(f"linearise covers the mpl and mpl-poly families, not "
+                    f"{type(structure).__name__}")
+
+
+def _rest_points(structure: Structure, params: Params) -> list[np.ndarray]:
+    if isinstance(structure, mpl.MplStructure):
+        return [np.zeros(1)] * structure.n_cells  # the sinh resistor is odd and monotone
+    return mpl_poly.equilibria(structure, params)
+
+
+def stability_report(structure: Structure, params: Params, u: np.ndarray) -> dict:
+    """Where the linearised model is stable (eq. 5.28): rest points and a driven trajectory.
+
+    Operating points: every rest point of every cell (``f_k(v*) = 0``; ``u_k = e - v*`` for any
+    ``e``, so the cells' eigenvalues at rest do not depend on the input), and every sample of
+    the model run on ``u`` from its default start (the states the data actually visit).
+
+    Parameters
+    ----------
+    u : array, shape (n,)
+        Model input covering the training range (normalised data: about [-1, 1]).
+
+    Returns
+    -------
+    dict
+        Plain JSON: ``dt``, ``n_cells``, ``knees`` (N x [x-, x+]), ``rest`` (per cell: rest
+        voltages, ``f' dt`` and eigenvalues there), ``trajectory`` (sample count and per cell
+        the range of ``f' dt`` and of the eigenvalues), ``eigenvalue_min/max`` over all
+        points, ``n_points``, ``n_violations`` (points with ``f' dt`` outside (0, 2)) and
+        ``stable_everywhere``; the augmented constant state (eigenvalue 1) is not counted.
+    """
+    u = np.asarray(u, dtype=float)
+    dt = structure.dt
+    rest = []
+    slopes_rest = []
+    for k, v in enumerate(_rest_points(structure, params)):
+        probe = np.zeros((v.size, structure.n_cells))
+        probe[:, k] = v
+        s = resistor_slope(structure, params, probe)[:, k] * dt
+        slopes_rest.append(s)
+        rest.append({"v": v.tolist(), "slope_dt": s.tolist(), "eigenvalue": (1 - s).tolist()})
+    if isinstance(structure, mpl.MplStructure):
+        family, x = mpl, np.full(structure.n_cells, u[0])
+    else:
+        family, x = mpl_poly, u[0] - mpl_poly.rest_voltages(structure, params)
+    family.simulate(structure, params, u)  # FitDivergedError if the run diverges (no limit)
+    states = np.empty((u.size, structure.n_cells))
+    for n, u_n in enumerate(u):  # the states the run visits (an analysis, not a hot path)
+        states[n] = x
+        x = x + family.resistor_current(structure, params, u_n - x) * dt
+    slopes_traj = resistor_slope(structure, params, u[:, None] - states) * dt
+    everything = np.concatenate([np.concatenate(slopes_rest), slopes_traj.ravel()])
+    bad = (everything <= 0) | (everything >= 2)
+    return {
+        "dt": dt, "n_cells": structure.n_cells, "knees": knee_points(structure, params).tolist(),
+        "rest": rest,
+        "trajectory": {"n_samples": int(u.size),
+                       "slope_dt_min": slopes_traj.min(axis=0).tolist(),
+                       "slope_dt_max": slopes_traj.max(axis=0).tolist(),
+                       "eigenvalue_min": (1 - slopes_traj.max(axis=0)).tolist(),
+                       "eigenvalue_max": (1 - slopes_traj.min(axis=0)).tolist()},
+        "eigenvalue_min": float(1 - everything.max()),
+        "eigenvalue_max": float(1 - everything.min()),
+        "n_points": int(everything.size), "n_violations": int(bad.sum()),
+        "stable_everywhere": bool(not bad.any()),
+    }

@@ -1,0 +1,481 @@
+"""Polynomial modified Power-Law (mPL) model, sec. 5.3.5 and paper 9.2 of the reference document.
+
+``N`` cells, each a capacitor ``C = 1`` charged through a cubic resistor ``f_k``; a cubic output
+resistor ``g`` carries the output current (eq. 5.16-5.17)::
+
+    du_k/dt = f_k(e - u_k),      i = g(w_0 e + sum_k w_k u_k - V_b),
+    f_k(v) = c_k0 + c_k1 v + c_k2 v^2 + c_k3 v^3,   g(z) = g_0 + g_1 z + g_2 z^2 + g_3 z^3
+
+integrated with forward Euler (eq. 5.6). The state ``x`` is the vector of cell voltages ``u_k``.
+
+Decisions where the document is ambiguous or wrong, with the evidence, are in
+docs/models/mpl_poly.md; in short:
+
+- eq. 5.16's ``f2^2 x^2 + f3^3 x^3`` is the paper's parametrisation, not a typo. The model holds
+  the plain cubic coefficients ``c``; ``identification.family_mpl_poly.paper_9_2_params``
+  converts the paper's printed values (``c2 = f2^2``, ``c3 = f3^3``).
+- Per-cell ``f_k`` (eq. 5.17's subscript): with one shared ``f`` all cells would be equal.
+  ``5N + 6`` parameters, the paper's 11 for ``N = 1``; only ``4N + 4`` are identifiable.
+- ``c_k3 > 0`` is required: only then is the cell stable for large ``|v|`` (paper 9.2, sec.
+  II-C relies on it) and do the knees of eq. 5.29 exist on both sides (table II has it).
+- Stability limit (eq. 5.29, corrected, ``limit=True``): ``f`` on ``x- <= x <= x+`` and lines of
+  slope ``s = slope_cap / dt`` outside, ``f(x+) + s (x - x+)`` and ``f(x-) + s (x - x-)``, with
+  ``x-, x+`` the extreme solutions of ``f'(x) = s`` (both at the vertex of ``f'`` if ``f' >= s``
+  everywhere). Inside, ``f' <= 0`` is possible: such an equilibrium repels, the state settles
+  at an outer stable root and stays bounded; three real roots make the cell bistable.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..errors import FitDivergedError
+from . import _mpl_poly_kernels as kernels
+
+__all__ = [
+    "MplPolyParams", "MplPolyStructure", "equilibria", "invert", "invert_step", "knee_points",
+    "output_branch", "output_current", "output_slope", "resistor_current", "resistor_slope",
+    "rest_voltages", "simulate", "simulate_reference", "simulate_with_jacobian", "step",
+]
+
+
+@dataclass(frozen=True)
+class MplPolyStructure:
+    """What does not get fitted: cell count, sample time, Euler slope cap and the limit switch.
+
+    Parameters
+    ----------
+    n_cells : int
+        Number of RC cells ``N`` (>= 1).
+    dt : float
+        Sample time of the recordings the model runs on [s].
+    slope_cap : float
+        Largest allowed ``f'(v) dt`` outside the knees (eq. 5.28 requires < 2); 1 as the mPL.
+    limit : bool
+        Apply the stability limit eq. 5.29; ``False`` runs the raw cubic (may diverge).
+    """
+
+    n_cells: int = 1
+    dt: float = 0.025
+    slope_cap: float = 1.0
+    limit: bool = True
+
+    def __post_init__(self) -> None:
+        if int(self.n_cells) != self.n_cells or self.n_cells < 1:
+            raise ValueError(f"n_cells must be a positive integer, got {self.n_cells!r}")
+        if not (np.isfinite(self.dt) and self.dt > 0):
+            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        if not 0 < self.slope_cap < 2:
+            raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step (eq. 5.28), "
+                             f"got {self.slope_cap!r}")
+        if not isinstance(self.limit, bool):
+            raise TypeError(f"limit must be true or false, got {self.limit!r}")
+
+    @property
+    def n_params(self) -> int:
+        """``5N + 6`` fitted parameters (11 for the paper's N = 1)."""
+        return 5 * self.n_cells + 6
+
+
+def _frozen(values, shape: tuple[int, ...] | None, name: str) -> np.ndarray:
+    try:
+        arr = np.array(values, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be numbers, got {values!r}") from None
+    if shape is not None and arr.shape != shape:
+        raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class MplPolyParams:
+    """Fitted quantities of a polynomial mPL model.
+
+    Parameters
+    ----------
+    f : array, shape (N, 4)
+        Cubic coefficients ``c0..c3`` of each cell resistor, ``c3 > 0`` (eq. 5.16).
+    g : array, shape (4,)
+        Cubic coefficients of the output resistor (eq. 5.16-5.17).
+    w : array, shape (N + 1,)
+        VCVS weights ``w_0 .. w_N``.
+    v_b : float
+        Bias voltage ``V_b``.
+
+    Notes
+    -----
+    The optimiser sees ``[c_k0, c_k1, c_k2, log c_k3 (per cell), g_0..g_3, w_0..w_N, V_b]``.
+    """
+
+    f: np.ndarray
+    g: np.ndarray
+    w: np.ndarray
+    v_b: float = 0.0
+    n_cells: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        shape = np.shape(_frozen(self.f, None, "f"))
+        if len(shape) != 2 or shape[0] < 1 or shape[1] != 4:
+            raise ValueError(f"f must have shape (N, 4), one row per cell, got {shape}")
+        n = shape[0]
+        object.__setattr__(self, "n_cells", int(n))
+        object.__setattr__(self, "f", _frozen(self.f, (n, 4), "f"))
+        object.__setattr__(self, "g", _frozen(self.g, (4,), "g"))
+        object.__setattr__(self, "w", _frozen(self.w, (n + 1,), "w"))
+        object.__setattr__(self, "v_b", float(self.v_b))
+        if not np.isfinite(self.v_b):
+            raise ValueError(f"v_b must be finite, got {self.v_b}")
+        if np.any(self.f[:, 3] <= 0):
+            raise ValueError("the cubic coefficient of every cell resistor must be positive "
+                             "(stable for large |v|, sec. 5.3.5)")
+
+    def to_vector(self) -> np.ndarray:
+        """Optimiser coordinates (see Notes of the class)."""
+        cells = np.column_stack([self.f[:, :3], np.log(self.f[:, 3])]).reshape(-1)
+        return np.concatenate([cells, self.g, self.w, [self.v_b]])
+
+    @classmethod
+    def from_vector(cls, theta: np.ndarray, n_cells: int) -> MplPolyParams:
+        """Inverse of :meth:`to_vector`."""
+        theta = np.asarray(theta, dtype=float)
+        cells = theta[: 4 * n_cells].reshape(n_cells, 4)
+        f = np.column_stack([cells[:, :3], np.exp(cells[:, 3])])
+        rest = theta[4 * n_cells:]
+        return cls(f=f, g=rest[:4], w=rest[4: n_cells + 5], v_b=rest[n_cells + 5])
+
+    def to_dict(self) -> dict:
+        return {"f": self.f.tolist(), "g": self.g.tolist(), "w": self.w.tolist(),
+                "v_b": self.v_b}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> MplPolyParams:
+        return cls(f=d["f"], g=d["g"], w=d["w"], v_b=d["v_b"])
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, MplPolyParams):
+            return NotImplemented
+        return bool(np.array_equal(self.to_vector(), other.to_vector()))
+
+    __hash__ = None
+
+
+def knee_points(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarray:
+    """Knees ``x-, x+`` of each cell, shape (N, 2): the extreme solutions of ``f'(x) = s``.
+
+    ``s = slope_cap / dt``. With ``c3 > 0`` ``f'`` is an upward parabola, so ``f' > s`` exactly
+    outside the knees; when it never drops to ``s`` both knees sit at its vertex.
+    """
+    s = structure.slope_cap / structure.dt
+    c1, c2, c3 = params.f[:, 1], params.f[:, 2], params.f[:, 3]
+    vertex = -c2 / (3 * c3)
+    half_width = np.sqrt(np.maximum(c2 * c2 - 3 * c3 * (c1 - s), 0.0)) / (3 * c3)
+    return np.column_stack([vertex - half_width, vertex + half_width])
+
+
+def _cubic(c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return (c[..., 0] + x * (c[..., 1] + x * (c[..., 2] + x * c[..., 3])),
+            c[..., 1] + x * (2 * c[..., 2] + 3 * c[..., 3] * x))
+
+
+def _resistor(structure: MplPolyStructure, params: MplPolyParams,
+              v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    v = np.asarray(v, dtype=float)
+    f, df = _cubic(params.f, v)
+    if not structure.limit:
+        return f, df
+    knees = knee_points(structure, params)
+    s = structure.slope_cap / structure.dt
+    x_b = np.where(v >= knees[:, 1], knees[:, 1], knees[:, 0])
+    outside = (v >= knees[:, 1]) | (v <= knees[:, 0])
+    return (np.where(outside, _cubic(params.f, x_b)[0] + s * (v - x_b), f),
+            np.where(outside, s, df))
+
+
+def resistor_current(structure: MplPolyStructure, params: MplPolyParams,
+                     v: np.ndarray) -> np.ndarray:
+    """Cell currents ``f_k,lim(v)`` (eq. 5.16 with 5.29 when ``structure.limit``).
+
+    Parameters
+    ----------
+    v : array, shape (..., N)
+        Voltage across each cell's resistor.
+    """
+    return _resistor(structure, params, v)[0]
+
+
+def resistor_slope(structure: MplPolyStructure, params: MplPolyParams,
+                   v: np.ndarray) -> np.ndarray:
+    """Slopes ``f'_k,lim(v)``, shape (..., N): the cells' rates in eq. 5.20 and 5.26."""
+    return _resistor(structure, params, v)[1]
+
+
+def output_current(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
+    """Output resistor current ``g(z)`` (eq. 5.17)."""
+    return _cubic(params.g, np.asarray(z, dtype=float))[0]
+
+
+def output_slope(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
+    """Output resistor slope ``g'(z)`` (``g'_0`` of eq. 5.19)."""
+    return _cubic(params.g, np.asarray(z, dtype=float))[1]
+
+
+def equilibria(structure: MplPolyStructure, params: MplPolyParams) -> list[np.ndarray]:
+    """Every rest voltage ``v*`` with ``f_k,lim(v*) = 0`` of each cell, ascending.
+
+    At rest ``u_k = e - v*``: the rest voltage does not depend on the input.
+    """
+    knees = knee_points(structure, params)
+    s = structure.slope_cap / structure.dt
+    out = []
+    for k, c in enumerate(params.f):
+        roots = np.roots(c[::-1])
+        v = roots[np.abs(roots.imag) <= 1e-9 * (1 + np.abs(roots))].real
+        if structure.limit:
+            xm, xp = knees[k]
+            v = list(v[(v > xm) & (v < xp)])
+            f_m, f_p = _cubic(c, np.array([xm, xp]))[0]
+            # roots on the straight continuations (the two coincide in a one-line cell)
+            v += [xp - f_p / s] if f_p <= 0 else []
+            v += [xm - f_m / s] if f_m >= 0 else []
+        out.append(np.unique(np.asarray(v, dtype=float)))
+    return out
+
+
+def rest_voltages(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarray:
+    """Default start: each cell at a stable rest voltage (``f' > 0``), shape (N,).
+
+    A cubic with ``c3 > 0`` always has one (its largest root). When there are two (a bistable
+    cell) the one nearer the cubic's inflection point ``-c2 / (3 c3)`` is taken (the lower on a
+    tie): unlike "nearest to 0" this does not depend on how the cell voltage is offset, so
+    equivalent parameters (``identification.family_mpl_poly.canonical``) start in the same
+    state.
+    """
+    out = np.empty(params.n_cells)
+    centre = -params.f[:, 2] / (3 * params.f[:, 3])
+    for k, v in enumerate(equilibria(structure, params)):
+        probe = np.zeros((v.size, params.n_cells))
+        probe[:, k] = v
+        slope = resistor_slope(structure, params, probe)[:, k]
+        stable = v[slope > 0] if np.any(slope > 0) else v
+        out[k] = stable[np.argmin(np.abs(stable - centre[k]))]
+    return out
+
+
+def output_branch(structure: MplPolyStructure,
+                  params: MplPolyParams) -> tuple[float, float, float]:
+    """The monotone branch of ``g`` used by :func:`invert`: ``(lo, hi, sign)``.
+
+    The branch contains ``z_rest = -sum w_k v*_k - V_b``, the output resistor's voltage when
+    the model rests at ``e = 0`` (the centre of centred, normalised data); it is the largest
+    interval around it where ``g'`` keeps its sign (bounds at the roots of ``g'``, ``+-inf``
+    where there are none). Defined this way it is the same branch for all equivalent parameters
+    (``identification.family_mpl_poly.canonical``).
+
+    Raises
+    ------
+    FitDivergedError
+        If ``g'(z_rest) = 0`` (no monotone branch through the operating point).
+    """
+    z_rest = -params.w[1:] @ rest_voltages(structure, params) - params.v_b
+    slope = float(output_slope(params, z_rest))
+    if slope == 0:
+        raise FitDivergedError(f"the output resistor has g'(z) = 0 at the rest point "
+                               f"z = {z_rest:.4g}, so it is not invertible there")
+    roots = np.roots([3 * params.g[3], 2 * params.g[2], params.g[1]])
+    roots = roots[np.abs(roots.imag) <= 1e-12 * np.abs(roots)].real
+    lo = max(roots[roots < z_rest], default=-np.inf)
+    hi = min(roots[roots > z_rest], default=np.inf)
+    return float(lo), float(hi), float(np.sign(slope))
+
+
+def step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarray,
+         u: float) -> tuple[float, np.ndarray]:
+    """One sample of the forward model: output from the present state, then the Euler update.
+
+    Returns
+    -------
+    y : float
+        ``g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17).
+    x_next : array, shape (N,)
+        Cell voltages after ``dt`` (eq. 5.6 with eq. 5.16).
+    """
+    x = np.asarray(x, dtype=float)
+    y = output_current(params, params.w[0] * u + params.w[1:] @ x - params.v_b)
+    return float(y), x + resistor_current(structure, params, u - x) * structure.dt
+
+
+def invert_step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarray,
+                y: float) -> tuple[float, np.ndarray]:
+    """One sample of the inverse: ``z = g^-1(y)`` on :func:`output_branch`, the input from the
+    output equation with the present state (as eq. 5.13), then the state update (fig. 5.12)."""
+    x = np.asarray(x, dtype=float)
+    lo, hi, _ = output_branch(structure, params)
+    a = lo if np.isfinite(lo) else -1e15
+    b = hi if np.isfinite(hi) else 1e15
+    z = brentq(lambda z: output_current(params, z) - y, a, b, xtol=1e-15, rtol=1e-15)
+    e = (z - params.w[1:] @ x + params.v_b) / params.w[0]
+    return float(e), x + resistor_current(structure, params, e - x) * structure.dt
+
+
+def _check(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
+           name: str) -> np.ndarray:
+    if params.n_cells != structure.n_cells:
+        raise ValueError(f"params have {params.n_cells} cells, structure has {structure.n_cells}")
+    u = np.ascontiguousarray(u, dtype=float)
+    if u.ndim != 1 or u.size == 0:
+        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
+    if not np.all(np.isfinite(u)):
+        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
+    return u
+
+
+def _start(structure: MplPolyStructure, params: MplPolyParams, x0, e0: float) -> np.ndarray:
+    if x0 is None:
+        return e0 - rest_voltages(structure, params)
+    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (structure.n_cells,)).copy()
+    if not np.all(np.isfinite(x0)):
+        raise ValueError("x0 must be finite")
+    return x0
+
+
+def _kernel_args(structure: MplPolyStructure, params: MplPolyParams) -> tuple:
+    return (np.ascontiguousarray(params.f), knee_points(structure, params),
+            structure.slope_cap / structure.dt, structure.limit, np.ascontiguousarray(params.g))
+
+
+def _bound(structure: MplPolyStructure, *arrays: np.ndarray) -> float:
+    """Divergence threshold of the forward run. With the limit the cells are provably bounded
+    (however large a wild cubic makes them), so only non-finite values count; without it, far
+    beyond anything a bounded run on these data reaches."""
+    if structure.limit:
+        return np.inf
+    return 1e6 * (1.0 + max(float(np.max(np.abs(a))) for a in arrays))
+
+
+def simulate(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
+             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the forward model over an input sequence (compiled kernel).
+
+    Parameters
+    ----------
+    u : array, shape (n,)
+        Model input ``e`` sampled every ``structure.dt``.
+    x0 : array, shape (N,), float or None
+        Initial cell voltages; ``None`` starts at rest at the first input,
+        ``u_k = e_0 - v*_k`` with ``v*_k`` from :func:`rest_voltages`.
+
+    Returns
+    -------
+    y : array, shape (n,)
+    x_end : array, shape (N,)
+        State after the last sample; feeding it back as ``x0`` continues the run exactly.
+
+    Raises
+    ------
+    FitDivergedError
+        If a cell voltage leaves the finite range (only possible with ``limit=False``).
+    """
+    u = _check(structure, params, u, "u")
+    x = _start(structure, params, x0, u[0])
+    y, x_end, n_bad = kernels.simulate(u, x, *_kernel_args(structure, params), params.w,
+                                       params.v_b, structure.dt, _bound(structure, u, x))
+    if n_bad >= 0:
+        raise FitDivergedError(f"the model diverged at sample {n_bad} of {u.size} (a cell "
+                               f"voltage exceeded 1e6 times the input range or overflowed); "
+                               f"without the stability limit (eq. 5.29) forward Euler is "
+                               f"unstable here")
+    return y, x_end
+
+
+def simulate_reference(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
+                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Same as :func:`simulate` for bounded runs, as a plain loop over :func:`step`."""
+    u = _check(structure, params, u, "u")
+    x = _start(structure, params, x0, u[0])
+    y = np.empty_like(u)
+    for n, u_n in enumerate(u):
+        y[n], x = step(structure, params, x, u_n)
+    return y, x
+
+
+def simulate_with_jacobian(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
+                           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Forward output and its exact Jacobian ``dy/dtheta``, shape (n, 5N + 6), columns in the
+    order of :meth:`MplPolyParams.to_vector`. The rest start (``x0=None``) moves with the
+    parameters: ``du_k(0)/dtheta = (df_k/dtheta)(v*) / f'_k(v*)``. Non-finite on divergence."""
+    u = _check(structure, params, u, "u")
+    x = _start(structure, params, x0, u[0])
+    fc, knees, s, limit, gc = _kernel_args(structure, params)
+    sens0 = np.zeros((structure.n_cells, 4))
+    if x0 is None:
+        v_rest = u[0] - x
+        slope = resistor_slope(structure, params, v_rest)
+        for k in range(structure.n_cells):
+            sens0[k] = kernels.cell_gradient(v_rest[k], fc[k], knees[k, 0], knees[k, 1], s,
+                                             limit) / slope[k]
+    y, jac, n_bad = kernels.simulate_with_jacobian(u, x, sens0, fc, knees, s, limit, gc,
+                                                   params.w, params.v_b, structure.dt,
+                                                   _bound(structure, u, x))
+    if n_bad >= 0:
+        y[:], jac[:] = np.nan, np.nan
+    return y, jac
+
+
+def invert(structure: MplPolyStructure, params: MplPolyParams, y: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the inverse model (compensator) over an output sequence.
+
+    Per sample: ``z = g^-1(y_n)`` on the monotone branch of :func:`output_branch` (safeguarded
+    Newton), ``e = (z - sum w_k u_k + V_b) / w_0`` with the present state, then the state update.
+
+    Parameters
+    ----------
+    y : array, shape (n,)
+        Model output (e.g. the sensor signal), sampled every ``structure.dt``.
+    x0 : array, shape (N,), float or None
+        ``None`` starts at rest: ``u_k = e_0 - v*_k`` with ``e_0`` solving the output equation
+        at rest, ``e_0 = (z_0 + sum w_k v*_k + V_b) / sum w`` (``e_0 = 0`` if ``sum w = 0``).
+
+    Returns
+    -------
+    u_hat : array, shape (n,)
+    x_end : array, shape (N,)
+
+    Raises
+    ------
+    FitDivergedError
+        If ``w_0 = 0``, ``g' = 0`` at the rest point, a sample lies outside the range of
+        ``g``'s monotone branch (then no inverse exists for it), or the estimate leaves the
+        finite range (the inverse dynamics are not guaranteed stable).
+    """
+    y = _check(structure, params, y, "y")
+    if params.w[0] == 0:
+        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
+    lo, hi, sign = output_branch(structure, params)
+    v_rest = rest_voltages(structure, params)
+    centre = -params.w[1:] @ v_rest - params.v_b  # z at rest at e = 0, inside the branch
+    if x0 is None:
+        z0, ok = kernels.solve_output(y[0], params.g, lo, hi, sign, centre)
+        w_sum = params.w.sum()
+        e0 = (z0 + params.w[1:] @ v_rest + params.v_b) / w_sum if ok and w_sum != 0 else 0.0
+        x = e0 - v_rest
+    else:
+        x = _start(structure, params, x0, 0.0)
+    e_hat, x_end, n_bad, why = kernels.invert(y, x, *_kernel_args(structure, params), lo, hi,
+                                              sign, centre, params.w, params.v_b, structure.dt,
+                                              1e6 * (1.0 + np.max(np.abs(y)) + np.max(np.abs(x))))
+    if why == 1:
+        raise FitDivergedError(
+            f"the inverse failed at sample {n_bad} of {y.size}: output {y[n_bad]:.4g} is outside "
+            f"the range of the output resistor g on its monotone branch [{lo:.4g}, {hi:.4g}]")
+    if why == 2:
+        raise FitDivergedError(
+            f"the inverse model diverged at sample {n_bad} of {y.size} (|e_hat| > 1e6 times the "
+            f"output range); the fitted weights make the compensator unstable on this data")
+    return e_hat, x_end
