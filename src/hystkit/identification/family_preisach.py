@@ -1,0 +1,252 @@
+"""The classical Preisach family (sec. 2.1.1, appendix 9.3-9.5) in the model registry.
+
+Identification from first-order reversal curves (appendix 9.4, eq. 9.4):
+:func:`everett_from_forcs`. Without FORCs, :func:`fit_preisach` (the family's fit): the
+output is linear in the cell masses of the grid (``y = Phi @ m + y_0``, ``Phi`` from
+:func:`hystkit.models.preisach.cell_regressors`), so the SSE of eq. 5.9 is minimised by one
+bounded linear least-squares solve (``scipy.optimize.lsq_linear``, BVLS) per loop orientation:
+
+- counter-clockwise loops (the output lags the input, e.g. position -> sensor): all masses
+  ``>= 0``, i.e. ``mu >= 0``: monotone branches and an exact inverse;
+- clockwise loops (the inverse of such a hysteresis, e.g. sensor -> position): off-diagonal
+  masses ``<= 0``, diagonal (zero-width, reversible) masses ``>= 0``. A non-negative Preisach
+  weight cannot make clockwise loops at all, so a direct compensator needs this sign.
+
+``orientation="auto"`` (default) solves both and keeps the lower SSE. Cells that the data
+never switch independently are not determined by the SSE alone; a smoothness penalty fixes
+them::
+
+    minimise  ||Phi m + y_0 - y||^2 + smoothing * n * sum_{neighbour cells} (rho_a - rho_b)^2
+
+with ``rho`` the density (mass per area on the grid squares, per length along the diagonal
+segments): a discrete integral of ``|grad mu|^2``, nearly independent of the grid size, per
+sample. ``smoothing = 0`` gives plain bounded least squares.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from scipy.interpolate import LinearNDInterpolator
+from scipy.optimize import lsq_linear
+from threadpoolctl import threadpool_limits
+
+from ..errors import FitDivergedError
+from ..models import preisach
+from ._registry import ModelFamily
+from ._result import FitResult
+
+__all__ = ["FAMILY", "ORIENTATIONS", "check_data", "everett_from_forcs", "fit_oriented", "fit_preisach",
+           "smoothness_rows", "solve_regularised"]
+
+
+def check_data(u: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """1-D, equal length, finite; returned as contiguous float arrays."""
+    u = np.ascontiguousarray(u, dtype=float)
+    y = np.ascontiguousarray(y, dtype=float)
+    if u.shape != y.shape or u.ndim != 1 or u.size < 2:
+        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
+    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
+        raise ValueError("u and y must be finite")
+    return u, y
+
+
+def smoothness_rows(levels: int) -> np.ndarray:
+    """Penalty rows ``D`` with ``||D m||^2 = sum (rho_a - rho_b)^2`` over neighbouring cells.
+
+    Squares (density ``m / h^2``) neighbour squares, diagonal segments (density ``m / h``,
+    weighted by ``h^-1/2`` for the 1-D integral) neighbour diagonal segments; ``h`` is the grid
+    step. Columns follow ``np.tril_indices(levels - 1)``.
+
+    Returns
+    -------
+    array, shape (n_pairs, L (L - 1) / 2)
+    """
+    h = 2.0 / (levels - 1)
+    rows, cols = np.tril_indices(levels - 1)
+    index = {(i, j): k for k, (i, j) in enumerate(zip(rows, cols))}
+    pairs, scales = [], []
+    for (i, j), k in index.items():
+        if j < i:
+            for nb in ((i + 1, j), (i, j + 1)):
+                if nb in index and nb[1] < nb[0]:
+                    pairs.append((k, index[nb]))
+                    scales.append(h ** -2)
+        elif (i + 1, i + 1) in index:
+            pairs.append((k, index[(i + 1, i + 1)]))
+            scales.append(h ** -1.5)
+    d = np.zeros((len(pairs), rows.size))
+    for r, ((a, b), scale) in enumerate(zip(pairs, scales)):
+        d[r, a], d[r, b] = scale, -scale
+    return d
+
+
+def solve_regularised(a: np.ndarray, y: np.ndarray, penalty: np.ndarray,
+                      nonneg: np.ndarray) -> tuple[np.ndarray, str, bool]:
+    """``argmin ||a x - y||^2 + ||penalty x||^2`` with ``x[nonneg] >= 0``.
+
+    The stacked problem is first reduced to its triangular QR factor (``||a x - y||^2`` equals
+    ``||R x - Q^T y||^2`` plus a constant), so the bounded solver works on a square problem
+    whatever the number of samples.
+
+    Returns
+    -------
+    x : array, shape (p,)
+    message : str
+    success : bool
+    """
+    with threadpool_limits(limits=1, user_api="blas"):
+        stacked = np.vstack([np.column_stack([a, y]),
+                             np.column_stack([penalty, np.zeros(penalty.shape[0])])])
+        r = np.linalg.qr(stacked, mode="r")
+        p = a.shape[1]
+        lower = np.where(nonneg, 0.0, -np.inf)
+        sol = lsq_linear(r[:p, :p], r[:p, p], bounds=(lower, np.inf), method="bvls",
+                         tol=1e-12)
+    x = sol.x.copy()
+    x[nonneg] = np.maximum(x[nonneg], 0.0)  # bvls may leave -0.0 or -1e-17 at the bound
+    return x, str(sol.message), bool(sol.success)
+
+
+ORIENTATIONS = {"counterclockwise": (1.0,), "clockwise": (-1.0,), "auto": (1.0, -1.0)}
+
+
+def fit_oriented(a: np.ndarray, y: np.ndarray, penalty: np.ndarray, hysteretic: np.ndarray,
+                 nonneg: np.ndarray, orientation: str, to_params: Callable[[np.ndarray], Any],
+                 structure: Any, accept: Callable[[Any], bool] | None,
+                 accept_reason: str) -> FitResult:
+    """Solve the linear fit for each loop orientation; return the cheapest accepted one.
+
+    The columns ``hysteretic`` (off-diagonal Preisach cells) get the orientation's sign
+    before the solve, so ``x[nonneg] >= 0`` means non-negative weights for counter-clockwise
+    loops and non-positive ones for clockwise loops; see the module docstring.
+    """
+    t_start = time.perf_counter()
+    candidates = []
+    for sign in ORIENTATIONS[orientation]:
+        flip = np.where(hysteretic, sign, 1.0)
+        coef, message, success = solve_regularised(a * flip, y, penalty * flip, nonneg)
+        coef *= flip
+        candidates.append((float(np.sum((a @ coef - y) ** 2)), sign, coef, message, success))
+    candidates.sort(key=lambda cand: cand[0])
+    rejected = 0
+    for cost, sign, coef, message, success in candidates:
+        params = to_params(coef)
+        if accept is not None and not accept(params):
+            rejected += 1
+            continue
+        loops = "counter-clockwise" if sign > 0 else "clockwise"
+        return FitResult(structure=structure, params=params, cost=cost, n_evaluations=1,
+                         seconds=time.perf_counter() - t_start, converged=success,
+                         message=f"{loops} loops; {message}", n_starts=len(candidates))
+    raise FitDivergedError(f"the fit failed: all {rejected} least-squares solutions were "
+                           f"rejected ({accept_reason})")
+
+
+def fit_preisach(u: np.ndarray, y: np.ndarray, structure: preisach.PreisachStructure, *,
+                 accept: Callable[[preisach.PreisachParams], bool] | None = None,
+                 accept_reason: str = "rejected by the acceptance test") -> FitResult:
+    """Fit the classical Preisach model mapping ``u`` to ``y`` (linear least squares, eq. 5.9).
+
+    Parameters
+    ----------
+    u, y : array, shape (n,)
+        Model input and target output, centred and normalised (eq. 5.10) by the caller; the
+        model starts in its default (demagnetised) state, as :func:`preisach.simulate` does.
+    structure : PreisachStructure
+        ``levels`` sets the grid, ``smoothing`` the penalty and ``orientation`` the sign of
+        the hysteretic weights (module docstring).
+    accept : callable, optional
+        Checked on each solution (one per orientation tried), cheapest first; vetoed ones are
+        skipped.
+
+    Raises
+    ------
+    FitDivergedError
+        If ``accept`` rejects every solution (with ``accept_reason``).
+    """
+    u, y = check_data(u, y)
+    levels = structure.levels
+    phi = preisach.cell_regressors(levels, u, capacity=structure.capacity)
+    # beyond [-1, 1] the slope F(1, -1) is the total mass: every cell carries the extension
+    phi += (u - np.clip(u, -1.0, 1.0))[:, None]
+    a = np.column_stack([phi, np.ones(u.size)])
+    d = smoothness_rows(levels) * np.sqrt(structure.smoothing * u.size)
+    penalty = np.column_stack([d, np.zeros(d.shape[0])])  # the offset is not penalised
+    rows, cols = np.tril_indices(levels - 1)
+    hysteretic = np.r_[rows != cols, False]
+    nonneg = np.r_[np.ones(rows.size, bool), False]
+
+    def to_params(coef: np.ndarray) -> preisach.PreisachParams:
+        masses = np.zeros((levels - 1, levels - 1))
+        masses[rows, cols] = coef[:-1]
+        return preisach.PreisachParams.from_masses(masses, offset=coef[-1])
+
+    return fit_oriented(a, y, penalty, hysteretic, nonneg, structure.orientation, to_params,
+                        structure, accept, accept_reason)
+
+
+def everett_from_forcs(alphas: np.ndarray, betas: np.ndarray, y: np.ndarray,
+                       levels: int | None = None) -> preisach.PreisachParams:
+    """Identify the model from first-order reversal curves (eq. 9.4, appendix 9.4).
+
+    FORC ``i`` starts in negative saturation, rises to ``alphas[i]`` (the limiting ascending
+    branch, ``f_alpha``) and falls through ``betas[j] <= alphas[i]``, giving
+    ``y[i, j] = f_{alpha_i beta_j}``. Then ``F(alpha, beta) = (f_alpha - f_alpha beta) / 2``
+    (eq. 9.4), with ``f_alpha`` read where ``beta = alpha``, and ``y_0`` is the mean of the
+    FORC from 1 at its two ends, ``(f+ + f-) / 2``. ``F`` is resampled onto the model's grid by
+    piecewise-linear interpolation over the measured points (exact at shared nodes).
+
+    Parameters
+    ----------
+    alphas : array, shape (n_a,)
+        Reversal inputs, strictly increasing, including -1 and 1.
+    betas : array, shape (n_b,)
+        Measuring inputs, strictly increasing; must contain every alpha.
+    y : array, shape (n_a, n_b)
+        FORC outputs; entries with ``betas[j] > alphas[i]`` are ignored.
+    levels : int, optional
+        Model grid levels; default ``n_a``.
+    """
+    alphas, betas = np.asarray(alphas, dtype=float), np.asarray(betas, dtype=float)
+    y = np.asarray(y, dtype=float)
+    if y.shape != (alphas.size, betas.size):
+        raise ValueError(f"y must have shape {(alphas.size, betas.size)}, got {y.shape}")
+    if np.any(np.diff(alphas) <= 0) or np.any(np.diff(betas) <= 0):
+        raise ValueError("alphas and betas must be strictly increasing")
+    if alphas[0] != -1.0 or alphas[-1] != 1.0 or betas[0] != -1.0:
+        raise ValueError("the FORCs must cover the input range: alphas from -1 to 1, betas "
+                         "from -1")
+    start = np.searchsorted(betas, alphas)
+    if np.any(start >= betas.size) or np.any(betas[np.minimum(start, betas.size - 1)]
+                                             != alphas):
+        raise ValueError("betas must contain every alpha (each FORC's first point)")
+    ia, ib = np.nonzero(betas[None, :] <= alphas[:, None])
+    values = 0.5 * (y[ia, start[ia]] - y[ia, ib])  # eq. 9.4
+    if not np.all(np.isfinite(values)):
+        raise ValueError("y must be finite where betas <= alphas")
+    points = np.column_stack([alphas[ia], betas[ib]])
+    levels = alphas.size if levels is None else int(levels)
+    h = preisach.grid(levels)
+    na, nb = np.tril_indices(levels, -1)
+    e = np.zeros((levels, levels))
+    e[na, nb] = LinearNDInterpolator(points, values)(h[na], h[nb])
+    offset = 0.5 * (y[-1, start[-1]] + y[-1, 0])
+    return preisach.PreisachParams(everett=e, offset=offset)
+
+
+def _make_structure(dt: float, size: int, **options: Any) -> preisach.PreisachStructure:
+    return preisach.PreisachStructure(levels=size, dt=dt, **options)
+
+
+FAMILY = ModelFamily(
+    name="preisach", title="classical Preisach, Everett function on a grid (sec. 2.1.1, "
+                           "eq. 2.1, 9.4-9.13)",
+    structure_type=preisach.PreisachStructure, params_type=preisach.PreisachParams,
+    make_structure=_make_structure, simulate=preisach.simulate, fit=fit_preisach,
+    invert=preisach.invert,
+    size_help="grid levels L over the normalised input (L (L - 1) / 2 Preisach cells)",
+    default_size=20)
