@@ -127,8 +127,12 @@ def generalization_matrix(recordings: Mapping[str, tuple[Recording, Recording]],
 
 def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
     """One heat map per model: rows = trained on, columns = tested on, colour = R²."""
-    fig = Figure(figsize=(3.6 * len(matrix), 3.4), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(1, len(matrix)))
+    n_cols = min(3, len(matrix))
+    n_rows = -(-len(matrix) // n_cols)
+    fig = Figure(figsize=(3.6 * n_cols, 3.2 * n_rows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(n_rows, n_cols)).ravel()
+    for ax in axes[len(matrix):]:
+        ax.set_axis_off()
     for ax, (name, entry) in zip(axes, matrix.items()):
         grid = entry["r2"]
         names = list(grid)
@@ -142,7 +146,7 @@ def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
                         color="w" if np.isnan(values[i, j]) or values[i, j] < 0.96 else "k")
         ax.set(xticks=range(len(names)), xticklabels=names, yticks=range(len(names)),
                yticklabels=names, xlabel="tested on", ylabel="trained on", title=name)
-    fig.colorbar(image, ax=list(axes), shrink=0.8, label="R²")
+    fig.colorbar(image, ax=list(axes[:len(matrix)]), shrink=0.8, label="R² (clipped at 0.9)")
     return fig
 
 
@@ -169,4 +173,6 @@ def format_compare(table: Mapping[str, dict]) -> str:
             f"{_fmt(m['linear_r2']):>8}{m['e_rms_pct']:>8.2f}{m['e_max_pct']:>8.2f}"
             f"  {_yes_no(m['rate_dependent']):>8}  {_yes_no(m['return_point_memory']):>9}"
             f"  {_yes_no(m['minor_loops_close']):>5}")
-    return "\n".join(lines)
+    notes = [f"  {name}: no R² inv: {m['compensated_note']}" for name, m in table.items()
+             if "error" not in m and m["r2_compensated"] is None]
+    return "\n".join(lines + (["why some R² inv are missing:"] + notes if notes else []))
