@@ -1,0 +1,252 @@
+"""``hystkit control``: the document's closed-loop experiments (ch. 7) on fitted sensor models."""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import re
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from ..compensation import load_compensator
+from ..control import (
+    EXPERIMENTS,
+    MASS,
+    PID,
+    SCHEMES,
+    TRAININGS,
+    DisturbanceObserver,
+    Plant,
+    SensorModels,
+    bode_data,
+    build_loop,
+    compensator_block,
+    design_dob,
+    experiment_cases,
+    fit_sensor_models,
+    loop_margins,
+    plot_bode,
+    plot_cases,
+    plot_response,
+    run_experiment,
+    tune_pid,
+)
+from ..io import check_output_path, read_recording, write_json
+from ..signals import EXPERIMENTS as EXCITATIONS
+from ._common import UsageError, positive_int
+
+__all__ = ["register"]
+
+# eq. 7.6 (scheme a) and eq. 7.8 (scheme b): the document's plant errors on the eq. 7.3 sine
+DOCUMENT_SINE = {"direct": {"e_p_max": 6.94e-4, "e_p_mean": -1.543e-4, "source": "eq. 7.6"},
+                 "weighting": {"e_p_max": 1.86e-4, "e_p_mean": -2.29e-5, "source": "eq. 7.8"}}
+
+
+def _positive_float(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be positive, got {text}")
+    return value
+
+
+@functools.lru_cache(maxsize=4)
+def _models(training: str, excitation: str, sensor_cells: int, model_cells: int | None,
+            sensor_data: Path | None = None, training_data: Path | None = None) -> SensorModels:
+    # In-memory only, per process (repeated main() calls in one session, e.g. tests); nothing
+    # is cached on disk, so every command line fits its models afresh (about 2 s).
+    return fit_sensor_models(
+        training=training, training_excitation=excitation, sensor_cells=sensor_cells,
+        model_cells=model_cells,
+        sensor_recording=None if sensor_data is None else read_recording(sensor_data),
+        training_recording=None if training_data is None else read_recording(training_data))
+
+
+def _slug(label: str) -> str:
+    return re.sub(r"[^0-9A-Za-z.]+", "_", label).strip("_")
+
+
+def _outputs(args: argparse.Namespace, out: Path) -> list[Path]:
+    names = []
+    if args.experiment:
+        names += ["metrics.json", "config.json"]
+        labels = [c.label for c in experiment_cases(args.experiment)]
+        names += (["response.png"] if len(labels) == 1
+                  else ["cases.png"] + [f"case_{_slug(x)}.png" for x in labels])
+    else:
+        names += ["analysis.json", "config.json"]
+    if args.bode:
+        names.append("bode.png")
+    return [out / n for n in names]
+
+
+def _loop(args: argparse.Namespace, models: SensorModels):
+    """The configured loop; a library ValueError here is a bad option combination."""
+    try:
+        plant = Plant(args.mass, args.u_max)
+        pid = None if args.pid is None else PID(args.pid[0], args.pid[1], args.pid[2])
+        loop = build_loop(args.scheme, models, pid=pid, plant=plant,
+                          zero_at_start=not args.no_zero)
+        if args.tune is not None:
+            pid = tune_pid(args.tune[0], args.tune[1], loop=loop)
+        pid = replace(pid or loop.pid, tf=args.tf, anti_windup=args.anti_windup)
+        loop = replace(loop, pid=pid)
+        if args.dob:
+            dob = (design_dob(loop) if args.dob_hz is None
+                   else DisturbanceObserver(args.dob_hz))
+            loop = replace(loop, dob=dob)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    return loop
+
+
+def _fmt(x) -> str:
+    return "n/a" if x is None else f"{x:.3g}"
+
+
+def _control(args: argparse.Namespace) -> int:
+    if not (args.experiment or args.bode):
+        raise UsageError("give --experiment NAME and/or --bode (see 'hystkit control --help')")
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    out = args.out or Path(f"hystkit-control-{args.scheme}-{args.experiment or 'bode'}-{stamp}")
+    paths = _outputs(args, out)
+    for path in paths:  # refuse before any work
+        check_output_path(path, args.force)
+    t_start = time.perf_counter()
+    models = _models(args.training, args.training_excitation, args.sensor_cells,
+                     args.model_cells, args.sensor_data, args.training_data)
+    if args.compensator is not None:
+        models = replace(models, compensator=compensator_block(load_compensator(
+            args.compensator), name="S_m^comp"), info={**models.info,
+                                                      "compensator_file": str(args.compensator)})
+    t_fit = time.perf_counter() - t_start
+    loop = _loop(args, models)
+    margins = loop_margins(loop)
+    dob = f"{loop.dob.f_q:.3g} Hz" if loop.dob else "off"
+    print(f"hystkit control: scheme {args.scheme}"
+          + (f", experiment {args.experiment}" if args.experiment else "")
+          + f", DOB {dob}; sensor models in "
+          f"{t_fit:.1f} s (S_r: {models.info['sensor_source']}; compensator and S_m: "
+          f"{models.info['training_source']})")
+    p = loop.pid
+    print(f"PID Kp = {p.kp:.4g}, Ti = {p.ti:.4g} s, Td = {p.td:.4g} s, Tf = {p.tf:.3g} s; "
+          f"linearised at rest: crossover {_fmt(margins.crossover_hz)} Hz, phase margin "
+          f"{_fmt(margins.phase_margin_deg)} deg, gain margin "
+          f"{_fmt(margins.gain_margin_db) if margins.gain_margin_db is not None else 'inf'} dB,"
+          f" closed loop "
+          + ("stable" if margins.closed_loop_stable else
+             f"UNSTABLE (max |pole| {margins.max_pole_radius:.10f}: grows e-fold in "
+             f"{margins.growth_time_s:.3g} s)"))
+    config = {
+        "hystkit_version": __version__, "scheme": args.scheme, "experiment": args.experiment,
+        "ts": loop.ts, "mass": loop.plant.mass, "u_max": loop.plant.u_max
+        if np.isfinite(loop.plant.u_max) else None,
+        "pid": {"kp": p.kp, "ti": p.ti if np.isfinite(p.ti) else None, "td": p.td, "tf": p.tf,
+                "anti_windup": p.anti_windup,
+                "source": "--pid" if args.pid else "--tune" if args.tune else "document"},
+        "dob_f_q": loop.dob.f_q if loop.dob else None, "zeroed_at_start": not args.no_zero,
+        "sensor_gain_m_per_unit": loop.sensor_gain, "models": models.info,
+        "sensor_fit": models.sensor.info, "compensator_fit": models.compensator.info,
+        "model_fit": models.model.info, "fit_seconds": t_fit}
+    out.mkdir(parents=True, exist_ok=True)
+    linear = {"operating_point": "rest (t = 0)", **margins.to_dict()}
+    if args.experiment:
+        result = run_experiment(args.experiment, loop)
+        metrics = {**result.metrics(), "linear": linear}
+        if args.experiment == "sine":
+            metrics["document"] = DOCUMENT_SINE[args.scheme]
+        _print_table(metrics)
+        write_json(metrics, out / "metrics.json", force=args.force)
+        title = f"scheme {args.scheme}, {args.experiment}"
+        if len(result.cases) == 1:
+            plot_response(next(iter(result.cases.values())), title).savefig(
+                out / "response.png", dpi=110)
+        else:
+            plot_cases(result).savefig(out / "cases.png", dpi=110)
+            for label, resp in result.cases.items():
+                plot_response(resp, f"{title}: {label}").savefig(
+                    out / f"case_{_slug(label)}.png", dpi=110)
+    else:
+        write_json({"scheme": args.scheme, "linear": linear}, out / "analysis.json",
+                   force=args.force)
+    if args.bode:
+        f, mag, phase = bode_data(loop)
+        plot_bode(f, mag, phase, margins, f"scheme {args.scheme}: linearised open loop at "
+                  f"rest, cut at the plant input").savefig(out / "bode.png", dpi=110)
+    config["seconds"] = time.perf_counter() - t_start
+    write_json(config, out / "config.json", force=args.force)
+    print(f"wrote {out}/: {', '.join(x.name for x in paths)} "
+          f"({config['seconds']:.1f} s)")
+    return 0
+
+
+def _print_table(metrics: dict) -> None:
+    print(f"{'case':<14}{'e_p,max [m]':>12}{'e_p,mean [m]':>14}{'e_p,rms [m]':>13}"
+          f"{'tracking rms':>14}{'bounded':>9}{'sim [ms]':>10}")
+    for label, m in metrics["cases"].items():
+        row = (f"{label:<14}{_fmt(m.get('e_p_max')):>12}{_fmt(m.get('e_p_mean')):>14}"
+               f"{_fmt(m.get('e_p_rms')):>13}{_fmt(m.get('tracking_rms')):>14}"
+               f"{'yes' if m['bounded'] else 'NO':>9}{m['seconds'] * 1e3:>10.2f}")
+        if "e_p_max_during" in m:
+            row += (f"  |e_p| max 2.0-2.2 s {_fmt(m['e_p_max_during'])} m, "
+                    f"after 2.5 s {_fmt(m['e_p_max_after'])} m")
+        if not m["bounded"]:
+            row += f"  stopped at t = {m['stop_time']:.3f} s: {m['stop_reason']}"
+        print(row)
+    if "document" in metrics:
+        d = metrics["document"]
+        print(f"document ({d['source']}): e_p,max {d['e_p_max']:.3g} m, e_p,mean "
+              f"{d['e_p_mean']:.4g} m")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``hystkit control`` to the ``hystkit`` parser."""
+    p = sub.add_parser("control", help="closed-loop position control with a hysteretic "
+                       "sensor: the document's ch. 7 experiments")
+    p.add_argument("--scheme", choices=SCHEMES, required=True,
+                   help="direct: e = r - compensator(s) (fig. 7.1); weighting: "
+                        "e = g_s (S_m(r) - s) (fig. 7.8)")
+    p.add_argument("--experiment", choices=EXPERIMENTS,
+                   help="sine (eq. 7.3), frequency / amplitude sweeps, cubic trajectory, "
+                        "output disturbance steps")
+    p.add_argument("--bode", action="store_true",
+                   help="write bode.png: the linearised open loop at rest (alone: "
+                        "analysis.json)")
+    p.add_argument("--dob", action="store_true", help="add the disturbance observer (sec. 7.4)")
+    p.add_argument("--dob-hz", type=_positive_float,
+                   help="Q-filter bandwidth [Hz] (default: chosen by design_dob)")
+    p.add_argument("--pid", nargs=3, type=float, metavar=("KP", "TI", "TD"),
+                   help="PID gains (default: the document's for the scheme)")
+    p.add_argument("--tune", nargs=2, type=float, metavar=("FC_HZ", "PM_DEG"),
+                   help="tune the PID for this crossover and phase margin on the linearised "
+                        "loop")
+    p.add_argument("--tf", type=float, default=0.0,
+                   help="derivative filter time constant [s] (default 0: eq. 7.2)")
+    p.add_argument("--anti-windup", action="store_true",
+                   help="conditional integration while the force saturates (needs --u-max)")
+    p.add_argument("--mass", type=_positive_float, default=MASS, help="moving mass [kg]")
+    p.add_argument("--u-max", type=_positive_float, default=np.inf,
+                   help="actuator force limit [N] (default none)")
+    p.add_argument("--training", choices=TRAININGS, default="recording",
+                   help="compensator / S_m data: a virtual-sensor recording (default) or "
+                        "S_r's own response to the sine (the document's protocol)")
+    p.add_argument("--training-excitation", choices=sorted(EXCITATIONS), default="sine",
+                   help="excitation of the training recording (default sine, 0.5 Hz 3 mm)")
+    p.add_argument("--sensor-data", type=Path,
+                   help="recording (time, position, sensor) to fit S_r on instead of the "
+                        "virtual sensor's noise run")
+    p.add_argument("--training-data", type=Path,
+                   help="recording to fit the compensator and S_m on instead of the virtual "
+                        "sensor's")
+    p.add_argument("--compensator", type=Path,
+                   help="use this compensator model file (from 'hystkit fit') in the loop")
+    p.add_argument("--sensor-cells", type=positive_int, default=3, help="mPL cells of S_r")
+    p.add_argument("--model-cells", type=positive_int,
+                   help="mPL cells of compensator and S_m (default 3; 1 with --training loop)")
+    p.add_argument("--no-zero", action="store_true",
+                   help="do not zero the estimates on the sensor's rest reading at start")
+    p.add_argument("--out", type=Path, help="output folder (default: a new timestamped one)")
+    p.set_defaults(run=_control)

@@ -1,0 +1,280 @@
+"""Linear analysis of the loop (fig. 7.4, 7.9): linearised open loop, Bode, margins, tuning.
+
+The loop is linearised at an operating point (a :class:`LoopState`; default: at rest, the
+document's "t = 0"): the plant and PID are linear already, each mPL block is linearised as in
+paper 9.2 eq. 2-7 (:meth:`SensorBlock.linearise`), and the DOB is its extended-state observer.
+The open loop is cut at the plant input: ``L(z) = -v / u_p`` with ``u_p`` the force entering the
+plant and ``v`` the force the controller (with DOB) returns, so the closed loop is
+``feedback(L, 1)``. Margins and crossover come from python-control's ``stability_margins``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import control
+import numpy as np
+from scipy.optimize import brentq
+
+from ._blocks import (
+    PID,
+    TS,
+    DisturbanceObserver,
+    Plant,
+    extended_input,
+    extended_matrices,
+    plant_matrices,
+)
+from ._loop import ControlLoop, LoopState, rest_state
+
+__all__ = ["LoopMargins", "bode_data", "design_dob", "loop_margins", "open_loop", "tune_pid"]
+
+
+def _ss(a, b, c, d, ts, inputs, outputs, name) -> control.StateSpace:
+    n = np.size(a) and np.atleast_2d(a).shape[0]
+    n_in = 1 if isinstance(inputs, str) else len(inputs)
+    a = np.reshape(np.asarray(a, dtype=float), (n, n))
+    b = np.reshape(np.asarray(b, dtype=float), (n, n_in))
+    c = np.reshape(np.asarray(c, dtype=float), (1, n))
+    d = np.reshape(np.asarray(d, dtype=float), (1, n_in))
+    return control.ss(a, b, c, d, ts, inputs=inputs, outputs=outputs, name=name)
+
+
+def _block_ss(block, x, u_in, ts, inputs, outputs, name) -> control.StateSpace:
+    a, b, c, d = block.linearise(x, u_in, ts)
+    return _ss(a, b, c, d, ts, inputs, outputs, name)
+
+
+def open_loop(loop: ControlLoop, state: LoopState | None = None) -> control.StateSpace:
+    """Linearised open loop ``L(z)`` cut at the plant input (discrete, ``dt = loop.ts``).
+
+    Parameters
+    ----------
+    state : LoopState, optional
+        Operating point; default :func:`rest_state` at ``r = 0``. The sensor blocks'
+        slopes are taken at their state and at the inputs that state implies (the plant
+        position, then the sensor's output).
+    """
+    state = rest_state(loop) if state is None else state
+    ts = loop.ts
+    a, b, c = plant_matrices(loop.plant.mass, ts)
+    blocks = [_ss(a, b, c, 0.0, ts, "u_p", "y", "plant")]
+    y0 = float(state.plant[0])
+    blocks.append(_block_ss(loop.sensor, state.sensor, y0, ts, "y", "s", "sensor"))
+    s0, _ = loop.sensor.step(state.sensor, y0, ts)
+    if loop.scheme == "direct" or loop.dob is not None:  # else y_hat is not fed back
+        blocks.append(_block_ss(loop.compensator, state.compensator, s0, ts, "s", "y_hat",
+                                "compensator"))
+    if loop.scheme == "direct":
+        blocks.append(control.summing_junction(["-y_hat"], "e", name="error"))
+    else:
+        blocks.append(_ss([], [], [], -loop.sensor_gain, ts, "s", "e", "error"))
+    num, den = loop.pid.transfer_coefficients(ts)
+    pid = control.tf2ss(control.tf(num, den, ts))
+    blocks.append(_ss(pid.A, pid.B, pid.C, pid.D, ts, "e", "u_c", "pid"))
+    if loop.dob is None:
+        blocks.append(control.summing_junction(["u_c"], "v", name="force"))
+    else:
+        a_e, c_e = extended_matrices(loop.mass_n, ts)
+        gain = loop.dob.observer_gain(loop.mass_n, ts)
+        b_e = extended_input(loop.mass_n, ts)
+        blocks.append(_ss(a_e - np.outer(gain, c_e), np.column_stack([gain, b_e]),
+                          [0.0, 0.0, 1.0], [[0.0, 0.0]], ts, ["y_hat", "v"], "d_hat", "dob"))
+        blocks.append(control.summing_junction(["u_c", "-d_hat"], "v", name="force"))
+    sys = control.interconnect(blocks, inplist=["u_p"], outlist=["v"], name="open_loop")
+    return control.ss(sys.A, sys.B, -sys.C, -sys.D, ts, inputs="u_p", outputs="v",
+                      name="L")
+
+
+@dataclass(frozen=True)
+class LoopMargins:
+    """Crossover and stability margins of the linearised loop.
+
+    Attributes
+    ----------
+    crossover_hz : float or None
+        Gain-crossover frequency ``|L| = 1`` [Hz] (None if ``|L|`` never crosses 1).
+    phase_margin_deg : float or None
+    gain_margin_db : float or None
+        None when the phase never crosses -180 deg (infinite gain margin).
+    phase_crossover_hz : float or None
+    closed_loop_stable : bool
+        All poles of ``feedback(L, 1)`` strictly inside the unit circle.
+    max_pole_radius : float
+    growth_time_s : float or None
+        For an unstable loop, the e-folding time ``Ts / ln max|pole|`` [s] of its fastest
+        growing mode: a slow drift (hours) and a blow-up (milliseconds) both count as unstable.
+    """
+
+    crossover_hz: float | None
+    phase_margin_deg: float | None
+    gain_margin_db: float | None
+    phase_crossover_hz: float | None
+    closed_loop_stable: bool
+    max_pole_radius: float
+    growth_time_s: float | None = None
+
+    def to_dict(self) -> dict:
+        return dict(vars(self))
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if np.isfinite(x) else None
+
+
+def _grid(ts: float, f_min: float = 1e-3, n: int = 4000) -> np.ndarray:
+    return np.geomspace(f_min, 0.999 * 0.5 / ts, n)
+
+
+def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargins:
+    """Margins of :func:`open_loop` and closed-loop stability of the linearised loop.
+
+    The crossover is the highest frequency with ``|L| = 1`` and the phase margin is
+    ``180 + arg L`` there; the gain margin is ``-|L|`` in dB at the first phase crossing
+    (``arg L = -180`` mod 360) above the crossover. Crossings are found on a 4000-point log grid
+    (1 mHz to Nyquist) and refined by root finding on the exact frequency response.
+    python-control's ``stability_margins`` is not used: the loop's three poles at ``z = 1``
+    (plant and integrator) make its polynomial method fall back to a grid that returns
+    spurious low-frequency crossings.
+    """
+    lsys = open_loop(loop, state)
+    poles = np.linalg.eigvals(control.feedback(lsys, 1).A)
+    radius = float(np.max(np.abs(poles))) if poles.size else 0.0
+
+    def h(f: float) -> complex:
+        return complex(np.asarray(lsys(np.exp(2j * np.pi * f * loop.ts))).reshape(-1)[0])
+
+    f = _grid(loop.ts)
+    resp = np.asarray(control.frequency_response(lsys, 2 * np.pi * f).complex).reshape(-1)
+    log_mag = np.log(np.abs(resp))
+    cross = np.nonzero(np.sign(log_mag[:-1]) != np.sign(log_mag[1:]))[0]
+    f_c = pm = gm = f_pc = None
+    if cross.size:
+        i = cross[-1]
+        f_c = brentq(lambda x: np.log(abs(h(x))), f[i], f[i + 1], xtol=1e-12 * f[i])
+        pm = float(np.degrees(np.angle(-h(f_c))))
+        # phase crossings: Im(-L) changes sign while Re(-L) > 0, i.e. arg L = -180 mod 360
+        im = (-resp).imag
+        above = [j for j in np.nonzero(np.sign(im[:-1]) != np.sign(im[1:]))[0]
+                 if f[j] >= f_c and (-resp[j]).real < 0]
+        if above:
+            j = above[0]
+            f_pc = brentq(lambda x: (-h(x)).imag, f[j], f[j + 1], xtol=1e-12 * f[j])
+            gm = float(-20 * np.log10(abs(h(f_pc))))
+    return LoopMargins(crossover_hz=f_c, phase_margin_deg=pm, gain_margin_db=gm,
+                       phase_crossover_hz=f_pc, closed_loop_stable=radius < 1.0,
+                       max_pole_radius=radius,
+                       growth_time_s=None if radius < 1.0 else float(loop.ts / np.log(radius)))
+
+
+def bode_data(loop: ControlLoop, state: LoopState | None = None,
+              f: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Frequency [Hz], magnitude [dB] and unwrapped phase [deg] of :func:`open_loop`.
+
+    Default grid: 400 log-spaced points from 0.05 Hz to 0.95 of the Nyquist frequency. The
+    unwrapped phase is shifted by whole turns so that it lies in (-360, 0] where ``|L|`` is
+    closest to 1 (the crossover reads as ``-180 + phase margin``).
+    """
+    if f is None:
+        f = np.geomspace(0.05, 0.95 * 0.5 / loop.ts, 400)
+    resp = control.frequency_response(open_loop(loop, state), 2 * np.pi * np.asarray(f))
+    h = np.asarray(resp.complex).reshape(-1)
+    phase = np.degrees(np.unwrap(np.angle(h)))
+    phase -= 360.0 * np.ceil(phase[np.argmin(np.abs(np.log(np.abs(h))))] / 360.0)
+    return f, 20 * np.log10(np.abs(h)), phase
+
+
+def _response(num, den, z):
+    return np.polyval(num, z) / np.polyval(den, z)
+
+
+def tune_pid(f_c: float, phase_margin: float = 60.0, *, loop: ControlLoop | None = None,
+             plant: Plant | None = None, ts: float = TS, ti_over_td: float = 4.0,
+             tf_over_td: float = 0.0) -> PID:
+    """Eq. 7.2 PID whose loop crosses over at ``f_c`` [Hz] with ``phase_margin`` [deg].
+
+    The loop tuned is ``C(z) G(z)``. Without ``loop``, ``G`` is the exact ZOH plant alone: the
+    linear loop the document tunes on (sec. 7.2). With ``loop``, ``G`` is that loop's
+    linearised open loop at rest with ``C = 1`` and no DOB -- plant, sensor, compensator or the
+    scheme (b) sensor gain included -- so the target holds for the loop as simulated (at rest).
+    With ``Ti = ti_over_td * Td`` (4: a double real zero in continuous time) and
+    ``Tf = tf_over_td * Td``, ``Td`` is solved so that ``arg C G = -180 + phase_margin`` at
+    ``f_c`` (the PID's phase rises monotonically with ``Td``), then ``Kp`` so that
+    ``|C G| = 1`` there. Check the result with :func:`loop_margins`: a path with its own
+    dynamics can add crossings elsewhere.
+
+    Raises
+    ------
+    ValueError
+        If no ``Td`` gives that much phase (the PID's lead stays below 90 deg).
+    """
+    z = np.exp(2j * np.pi * f_c * (ts if loop is None else loop.ts))
+    if loop is None:
+        plant = Plant() if plant is None else plant
+        a, b, c = plant_matrices(plant.mass, ts)
+        g = complex(c @ np.linalg.solve(z * np.eye(2) - a, b))
+    else:
+        ts = loop.ts
+        unit = open_loop(replace(loop, pid=PID(kp=1.0), dob=None))
+        g = complex(np.asarray(unit(z)).reshape(-1)[0])
+    phase_g = np.angle(g)
+    if phase_g > 0:  # the double integrator sits at -180 deg: keep its branch
+        phase_g -= 2 * np.pi
+    need = -np.pi + np.radians(phase_margin) - phase_g
+
+    def pid_for(td: float, kp: float = 1.0) -> PID:
+        return PID(kp=kp, ti=ti_over_td * td, td=td, tf=tf_over_td * td)
+
+    def mismatch(log_td: float) -> float:
+        return float(np.angle(_response(*pid_for(np.exp(log_td)).transfer_coefficients(ts), z))
+                     - need)
+
+    lo, hi = np.log(1e-3 / (2 * np.pi * f_c)), np.log(1e3 / (2 * np.pi * f_c))
+    if not (mismatch(lo) < 0 < mismatch(hi)):
+        raise ValueError(f"a PID of this form cannot give {phase_margin} deg of phase margin at "
+                         f"{f_c} Hz (it needs {np.degrees(need):.1f} deg of lead)")
+    td = float(np.exp(brentq(mismatch, lo, hi, xtol=1e-12)))
+    gain = abs(_response(*pid_for(td).transfer_coefficients(ts), z) * g)
+    return pid_for(td, 1.0 / gain)
+
+
+DOB_CANDIDATES_HZ = tuple(float(f) for f in np.round(np.geomspace(1.0, 200.0, 24), 3))
+
+
+def design_dob(loop: ControlLoop, *, min_phase_margin: float = 30.0,
+               min_gain_margin_db: float = 6.0, candidates_hz=DOB_CANDIDATES_HZ,
+               state: LoopState | None = None) -> DisturbanceObserver:
+    """Choose the Q-filter bandwidth: the highest candidate that keeps the margins.
+
+    Steps 1-2 of the procedure are fixed by :class:`DisturbanceObserver` (nominal plant, binomial
+    ``Q = 1 / (tau s + 1)^3``). Step 3: for each candidate ``f_q`` (default 24 log-spaced values, 1-200 Hz, the
+    top a fifth of the Nyquist frequency) the loop with that DOB is linearised at ``state``,
+    sensor and compensator included, and the highest ``f_q`` is kept whose loop has at least
+    ``min_phase_margin`` [deg] and ``min_gain_margin_db`` [dB] and no closed-loop pole further
+    out than the loop without the DOB (or than the unit circle, whichever is larger): the DOB
+    must not destabilise. A higher bandwidth rejects more disturbance but feeds more of the
+    sensor-compensator mismatch back into the plant.
+
+    Raises
+    ------
+    ValueError
+        If no candidate keeps the margins.
+    """
+    base = loop_margins(replace(loop, dob=None), state)
+    limit = max(1.0, base.max_pole_radius) + 1e-12
+    best = None
+    for f_q in candidates_hz:
+        dob = DisturbanceObserver(float(f_q), loop.nominal_mass)
+        m = loop_margins(_with_dob(loop, dob), state)
+        ok = (m.max_pole_radius <= limit
+              and (m.phase_margin_deg is None or m.phase_margin_deg >= min_phase_margin)
+              and (m.gain_margin_db is None or m.gain_margin_db >= min_gain_margin_db))
+        if ok:
+            best = dob
+    if best is None:
+        raise ValueError("no Q-filter bandwidth keeps the required margins on this loop")
+    return best
+
+
+def _with_dob(loop: ControlLoop, dob: DisturbanceObserver) -> ControlLoop:
+    return replace(loop, dob=dob)

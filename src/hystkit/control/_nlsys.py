@@ -1,0 +1,168 @@
+"""python-control adapters: hystkit models and loops as discrete-time ``nlsys`` objects.
+
+For users who build and simulate systems in python-control: :func:`as_nlsys` wraps one
+model, :func:`loop_nlsys` the whole loop of a :class:`ControlLoop` (same equations as the
+compiled kernel, one Python call per block per step -- correct, and about a thousand times
+slower; see ``benchmarks/bench_control.py``). State is python-control's, so these inherit its
+explicit-state semantics (``initial_state`` in, ``states`` out).
+"""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+
+from ..compensation import Compensator
+from ..models import mpl
+from ._blocks import TS, plant_matrices
+from ._loop import ControlLoop, LoopState, rest_state
+from ._sensors import SensorBlock, compensator_block
+
+__all__ = ["as_nlsys", "loop_initial_state", "loop_nlsys"]
+
+Model = SensorBlock | Compensator | tuple[mpl.MplStructure, mpl.MplParams]
+
+
+def _as_block(model: Model) -> SensorBlock:
+    if isinstance(model, SensorBlock):
+        return model
+    if isinstance(model, Compensator):
+        return compensator_block(model)
+    if isinstance(model, tuple) and len(model) == 2:
+        return SensorBlock(model[0], model[1], name="mpl")
+    raise TypeError(f"expected a SensorBlock, a Compensator or (MplStructure, MplParams), got "
+                    f"{type(model).__name__}")
+
+
+def as_nlsys(model: Model, dt: float = TS, *, name: str | None = None, input: str = "u",
+             output: str = "y") -> control.NonlinearIOSystem:
+    """A hystkit model as a discrete-time python-control ``nlsys`` (sample time ``dt``).
+
+    Parameters
+    ----------
+    model : SensorBlock, Compensator or (MplStructure, MplParams)
+        A bare ``(structure, params)`` pair runs in normalised units; the others in their
+        physical units (a compensator: sensor in, position [m] out).
+    dt : float
+        Sample time [s]; the model is re-stepped at it (see :mod:`hystkit.control`).
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        States ``<name>_x0 ..`` (normalised cell voltages), one input and one output, with the
+        model's direct feedthrough (``w_0``) in the output function.
+    """
+    block = _as_block(model)
+    name = block.name if name is None else name
+    p = block.params
+    knee = mpl.knee_voltage(block.at(dt), p)
+    cap = block.structure.slope_cap / dt
+    w0, w, v_b = p.w[0], p.w[1:], p.v_b
+
+    def current(v):
+        v_in = np.clip(v, -knee, knee)
+        return 2 * p.i_s * np.sinh(v_in / p.v_t) + cap * (v - v_in)  # eq. 5.29, corrected
+
+    def drive_and_out(x, u):
+        v = (u[0] - block.in_offset) / block.in_scale
+        if block.inverse:
+            drive = (v + v_b - w @ x) / w0  # eq. 5.13
+            return drive, drive
+        return v, w0 * v + w @ x - v_b  # eq. 5.2
+
+    def update(t, x, u, params):
+        drive, _ = drive_and_out(x, u)
+        return x + current(drive - x) * dt
+
+    def out(t, x, u, params):
+        return np.array([block.out_scale * drive_and_out(x, u)[1] + block.out_offset])
+
+    return control.nlsys(update, out, inputs=[input], outputs=[output],
+                         states=[f"{name}_x{k}" for k in range(p.n_cells)], dt=dt, name=name)
+
+
+def _plant(loop: ControlLoop) -> control.NonlinearIOSystem:
+    ts = loop.ts
+    _, b, _ = plant_matrices(loop.plant.mass, ts)
+
+    def update(t, x, u, params):
+        force = u[0] + u[1]
+        return np.array([x[0] + ts * x[1] + b[0] * force, x[1] + b[1] * force])
+
+    def out(t, x, u, params):
+        return np.array([x[0] + u[2]])
+
+    return control.nlsys(update, out, inputs=["u", "d_in", "d_out"], outputs=["y"],
+                         states=["position", "velocity"], dt=ts, name="plant")
+
+
+def _controller(loop: ControlLoop) -> control.NonlinearIOSystem:
+    """PID (eq. 7.2) + force limit + plant estimate (fig. 7.11) + DOB, as in the kernel."""
+    ts, p = loop.ts, loop.pid
+    _, b_n, _ = plant_matrices(loop.mass_n, ts)
+    ki = ts / p.ti if np.isfinite(p.ti) else 0.0
+    gain = None if loop.dob is None else loop.dob.observer_gain(loop.mass_n, ts)
+
+    def force(x, e):
+        d = (p.tf * x[2] + p.td * (e - x[1])) / (p.tf + ts)
+        wanted = p.kp * (e + x[0] + d) - (x[7] if gain is not None else 0.0)
+        return d, wanted, float(np.clip(wanted, -loop.plant.u_max, loop.plant.u_max))
+
+    def update(t, x, u, params):
+        e, y_hat = u[0], u[1]
+        d, wanted, f = force(x, e)
+        frozen = p.anti_windup and f != wanted and p.kp * e * wanted > 0
+        nxt = np.array([x[0] + (0.0 if frozen else ki * e), e, d,
+                        x[3] + ts * x[4] + b_n[0] * f, x[4] + b_n[1] * f, x[5], x[6], x[7]])
+        if gain is not None:
+            innov = y_hat - x[5]
+            nxt[5:] = [x[5] + ts * x[6] + b_n[0] * (f + x[7]) + gain[0] * innov,
+                       x[6] + b_n[1] * (f + x[7]) + gain[1] * innov, x[7] + gain[2] * innov]
+        return nxt
+
+    def out(t, x, u, params):
+        return np.array([force(x, u[0])[2], x[3]])
+
+    return control.nlsys(update, out, inputs=["e", "y_hat"], outputs=["u", "y_hat_plant"],
+                         states=["integral", "e_prev", "derivative", "est_position",
+                                 "est_velocity", "dob_position", "dob_velocity", "dob_force"],
+                         dt=ts, name="controller")
+
+
+def loop_nlsys(loop: ControlLoop) -> control.InterconnectedSystem:
+    """The whole loop as one python-control system.
+
+    Inputs ``r`` [m], ``d_in`` [N], ``d_out`` [m]; outputs ``y, s, y_hat, e, u, y_hat_plant``
+    and, with ``S_m``, ``s_hat`` (``y_hat`` is 0 without a compensator). State order: plant,
+    S_r, compensator, S_m, controller; :func:`loop_initial_state` builds it from a
+    :class:`LoopState`.
+    """
+    ts = loop.ts
+    systems = [_plant(loop), as_nlsys(loop.sensor, ts, name="S_r", input="y", output="s")]
+    if loop.compensator is not None:
+        systems.append(as_nlsys(loop.compensator, ts, name="comp", input="s", output="y_hat"))
+    else:
+        systems.append(control.nlsys(None, lambda t, x, u, p: np.array([0.0]), inputs=["s"],
+                                     outputs=["y_hat"], dt=ts, name="comp"))
+    if loop.model is not None:
+        systems.append(as_nlsys(loop.model, ts, name="S_m", input="r", output="s_hat"))
+    if loop.scheme == "direct":
+        systems.append(control.summing_junction(["r", "-y_hat"], "e", name="error"))
+    else:
+        g = loop.sensor_gain
+        systems.append(control.nlsys(None, lambda t, x, u, p: np.array([g * (u[0] - u[1])]),
+                                     inputs=["s_hat", "s"], outputs=["e"], dt=ts,
+                                     name="error"))
+    systems.append(_controller(loop))
+    outputs = ["y", "s", "y_hat", "e", "u", "y_hat_plant"]
+    return control.interconnect(systems, inplist=["r", "d_in", "d_out"],
+                                outlist=outputs + (["s_hat"] if loop.model is not None else []),
+                                name="loop", dt=ts)
+
+
+def loop_initial_state(loop: ControlLoop, state: LoopState | None = None,
+                       r0: float = 0.0) -> np.ndarray:
+    """:class:`LoopState` (default: at rest at ``r0``) in :func:`loop_nlsys` state order."""
+    state = rest_state(loop, r0) if state is None else state
+    return np.concatenate([state.plant, state.sensor, state.compensator, state.model,
+                           state.pid, state.estimate, state.dob])
