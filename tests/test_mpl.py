@@ -79,7 +79,7 @@ def test_cell_that_is_too_fast_everywhere_becomes_linear_at_the_cap():
     p = mpl.MplParams(i_s=[100.0], v_t=[0.1], w=[0.0, 1.0])  # G = 2000 /s > 1/dt = 40 /s
     assert mpl.knee_voltage(s, p)[0] == 0.0
     # slope cap 1: the cell reaches any input in exactly one step (deadbeat, no overshoot)
-    y, x_end = mpl.simulate(s, p, np.array([0.7, 0.7, 0.7]), x0=0.0)
+    y, _x_end = mpl.simulate(s, p, np.array([0.7, 0.7, 0.7]), x0=0.0)
     assert_allclose(y, [0.0, 0.7, 0.7], atol=1e-15)
 
 
@@ -115,7 +115,7 @@ def test_without_the_limit_euler_diverges():
     assert not np.isfinite(x) or abs(x) > 1e6
     s = mpl.MplStructure(n_cells=1, dt=DT)
     p = mpl.MplParams(i_s=[i_s], v_t=[v_t], w=[0.0, 1.0])
-    y, x_end = mpl.simulate(s, p, np.full(20, u), x0=0.0)
+    _y, x_end = mpl.simulate(s, p, np.full(20, u), x0=0.0)
     assert 0.0 <= x_end[0] <= u
 
 
@@ -182,7 +182,7 @@ def test_params_vector_round_trip():
     assert mpl.MplParams.from_dict(PARAMS2.to_dict()) == PARAMS2
 
 
-@pytest.mark.parametrize("kwargs", [dict(n_cells=0), dict(dt=0.0), dict(slope_cap=2.0)])
+@pytest.mark.parametrize("kwargs", [{"n_cells": 0}, {"dt": 0.0}, {"slope_cap": 2.0}])
 def test_structure_rejects_bad_values(kwargs):
     with pytest.raises(ValueError):
         mpl.MplStructure(**kwargs)
