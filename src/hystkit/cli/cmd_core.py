@@ -19,13 +19,16 @@ from ..io import check_output_path, read_recording, write_json, write_recording
 from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
 from ._common import UsageError, positive_int, slope_cap
+from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_from_args
 
 __all__ = ["register"]
 
 
 def _simulate_sensor(args: argparse.Namespace) -> int:
+    if args.raw:
+        return run_raw_simulation(args)
     check_output_path(args.out, args.force)
-    rec = simulate_experiment(args.excitation, seed=args.seed)
+    rec = simulate_experiment(args.excitation, seed=args.seed, sensor=sensor_from_args(args))
     write_recording(rec, args.out, force=args.force)
     print(f"wrote {args.out}: {EXPERIMENTS[args.excitation].description}, seed {args.seed}, "
           f"{rec.n_samples} samples at {rec.fs:g} Hz")
@@ -72,7 +75,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     scores = evaluate(comp, read_recording(args.data))
     print(f"{args.data} with {args.model} (centring: {scores['center']}, "
           f"{scores['n_samples']} samples)")
-    print(f"{'':<22}{'mPL':>10}{'straight line':>15}")
+    print(f"{'':<22}{comp.model:>10}{'straight line':>15}")
     for key, label in (("r2", "R²"), ("e_rms_pct", "e_rms %"), ("e_max_pct", "e_max %"),
                        ("sinad_db", "SINAD dB"), ("loop_area", "loop area %")):
         a, b = scores[key], scores[f"linear_{key}"]
@@ -96,16 +99,34 @@ def _demo(args: argparse.Namespace) -> int:
     print(f"hystkit demo: virtual sensor, four experiments, {args.cells}-cell mPL compensator "
           f"fitted on one recording and scored on another (direct mode, centring: recording)")
     t0 = time.perf_counter()
-    result = run_demo(out, n_cells=args.cells, force=args.force)
+    result = run_demo(out, n_cells=args.cells, force=args.force, raw=args.raw)
     print()
     print(format_table(result["metrics"], "Validation (fit on seed 1, test on seed 2); cf. "
                        "document table 5.5", DOCUMENT_TABLE_5_5))
     print()
     print(format_table(result["noise_trained"], "Compensator trained on noise, tested on each "
                        "excitation (does compensation generalise?)"))
+    raw = result.get("raw_path")
+    if raw is not None:
+        _print_raw_path(raw)
     print(f"\nwrote {out}/: metrics.json, noise_trained.json, config.json, loops.png, "
-          f"time_series.png ({time.perf_counter() - t0:.1f} s)")
+          f"time_series.png{', raw_path.json' if raw else ''} "
+          f"({time.perf_counter() - t0:.1f} s)")
     return 0
+
+
+def _print_raw_path(raw: dict) -> None:
+    from ..reports import format_table  # lazily, as in _demo
+
+    print()
+    print(format_table({f"{raw['excitation']} raw": raw["metrics"]},
+                       f"Raw path: scope files at {raw['scope_rate_hz']:g} Hz -> preprocess -> "
+                       f"fit -> evaluate (cf. the {raw['excitation']} row above)"))
+    trip = raw["round_trip"]["validation"]
+    print(f"  decoded vs true: position max error {trip['position_max_error_um']:.2f} um "
+          f"({trip['position_max_error_counts']:.2f} counts), dR/R rms error "
+          f"{trip['sensor_rms_error']:.1e}, {trip['n_illegal']} illegal of {trip['n_edges']} "
+          f"encoder transitions")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -114,6 +135,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--excitation", choices=sorted(EXPERIMENTS), required=True)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", type=Path, required=True, help="CSV or Parquet file to write")
+    add_simulation_options(p)
     p.set_defaults(run=_simulate_sensor)
 
     p = sub.add_parser("fit", help="fit a compensator to a recording")
@@ -152,5 +174,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, help="output folder (default: a new timestamped one)")
     p.add_argument("--cells", type=positive_int, default=3,
                    help="mPL cells (default 3: 11 parameters, as the document's model)")
+    p.add_argument("--raw", action="store_true",
+                   help="also run the lab chain on raw scope files: simulate-sensor --raw -> "
+                        "preprocess -> fit -> evaluate (sine, 50 kHz; about 10 s more)")
     p.set_defaults(run=_demo)
 

@@ -1,5 +1,12 @@
-"""Reading, validating and writing recordings; JSON result files."""
+"""Reading, validating and writing recordings; JSON result files; raw scope recordings."""
 
+from hystkit.io._raw import RAW_COLUMNS, RawChunk, RawFormat, RawReader, RawWriter, open_raw
+from hystkit.io._raw_config import (
+    CONFIG_KEYS,
+    find_raw_config,
+    read_raw_config,
+    write_raw_config,
+)
 from hystkit.io._recording import (
                                   Recording,
                                   check_output_path,
@@ -8,4 +15,6 @@ from hystkit.io._recording import (
                                   write_recording,
 )
 
-__all__ = ["Recording", "check_output_path", "read_recording", "write_json", "write_recording"]
+__all__ = ["CONFIG_KEYS", "RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter",
+           "Recording", "check_output_path", "find_raw_config", "open_raw", "read_raw_config",
+           "read_recording", "write_json", "write_raw_config", "write_recording"]

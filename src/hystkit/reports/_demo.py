@@ -2,25 +2,35 @@
 
 from __future__ import annotations
 
+import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 from .. import __version__
 from ..compensation import evaluate, fit_compensator
 from ..io import check_output_path, write_json
-from ..sensors import simulate_experiment
+from ..preprocess import PreprocessSettings, preprocess_raw
+from ..sensors import ScopeSettings, simulate_experiment, simulate_raw
 from ..signals import EXPERIMENTS
 from ._figures import plot_loops, plot_time_series
 
-__all__ = ["DEMO_FILES", "DOCUMENT_TABLE_5_5", "format_table", "run_demo"]
+__all__ = ["DEMO_FILES", "DOCUMENT_TABLE_5_5", "RAW_DEMO_FILES", "RAW_SCOPE_RATE", "format_table",
+           "run_demo", "run_raw_path"]
 
 # Table 5.5 / paper 9.2 table I: (model R², straight-line R²) on the document's lab data.
 DOCUMENT_TABLE_5_5 = {"sine": (0.990, 0.928), "chirp": (0.984, 0.945),
                       "decay": (0.987, 0.710), "noise": (0.958, 0.882)}
 DEMO_FILES = ("metrics.json", "noise_trained.json", "config.json", "loops.png",
               "time_series.png")
+RAW_DEMO_FILES = ("raw_path.json",)  # written too with raw=True
 FIT_SEED, VALIDATION_SEED = 1, 2
+# The raw path's scope rate: low enough to keep the demo fast (10 M samples per channel and
+# recording), high enough for every encoder state to last 25 samples. The lab used 2 and
+# 6.25 MHz; `hystkit simulate-sensor --raw --scope-rate 6.25e6` and the benchmark run those.
+RAW_SCOPE_RATE = 50e3
 
 
 def format_table(metrics: dict, title: str, reference: dict | None = None) -> str:
@@ -39,16 +49,17 @@ def format_table(metrics: dict, title: str, reference: dict | None = None) -> st
 
 
 def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
-             progress: Callable[[str], None] = print) -> dict:
+             progress: Callable[[str], None] = print, raw: bool = False) -> dict:
     """Simulate the four experiments, fit on each fitting recording, score on its validation one.
 
     Writes ``metrics.json`` (per excitation, the keys of :func:`~hystkit.compensation.evaluate`),
     ``noise_trained.json`` (the noise-trained compensator scored on every excitation: does
     compensation generalise?), ``config.json`` and the figures ``loops.png``,
-    ``time_series.png``. Checks every output path before writing any.
+    ``time_series.png``; with `raw`, also ``raw_path.json`` from :func:`run_raw_path` (the
+    returned dict then has a ``raw_path`` key). Checks every output path before writing any.
     """
     out = Path(out_dir)
-    for name in DEMO_FILES:
+    for name in DEMO_FILES + (RAW_DEMO_FILES if raw else ()):
         check_output_path(out / name, force)
     t_start = time.perf_counter()
     recordings, compensators, metrics, shown = {}, {}, {}, {}
@@ -65,9 +76,12 @@ def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
                  f"{comp.structure.n_params} parameters)")
     noise_trained = {name: evaluate(compensators["noise"], rec)
                      for name, rec in recordings.items()}
+    raw_path = run_raw_path(n_cells, progress=progress) if raw else None
     out.mkdir(parents=True, exist_ok=True)
     write_json(metrics, out / "metrics.json", force=force)
     write_json(noise_trained, out / "noise_trained.json", force=force)
+    if raw_path is not None:
+        write_json(raw_path, out / "raw_path.json", force=force)
     config = {"hystkit_version": __version__, "n_cells": n_cells, "mode": "direct",
               "center": "recording", "fit_seed": FIT_SEED, "validation_seed": VALIDATION_SEED,
               "sensor": "VirtualSensor() defaults", "seconds": time.perf_counter() - t_start}
@@ -75,4 +89,49 @@ def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
     # check_output_path has vetted these two; savefig has no overwrite guard of its own
     plot_loops(shown).savefig(out / "loops.png", dpi=110)
     plot_time_series(shown).savefig(out / "time_series.png", dpi=110)
-    return {"metrics": metrics, "noise_trained": noise_trained, "config": config}
+    result = {"metrics": metrics, "noise_trained": noise_trained, "config": config}
+    return result if raw_path is None else {**result, "raw_path": raw_path}
+
+
+def run_raw_path(n_cells: int = 3, *, excitation: str = "sine", scope_rate: float = RAW_SCOPE_RATE,
+                 progress: Callable[[str], None] = print) -> dict:
+    """The lab's whole chain on the virtual sensor: raw scope files -> preprocess -> fit -> score.
+
+    Writes the fitting and validation recordings of `excitation` as raw scope files (bridge
+    voltages and the merged encoder signal at `scope_rate`) to a temporary folder, preprocesses
+    them (eq. 4.2-4.5, encoder decoding, 20 Hz zero-phase filter, 40 Hz), fits the compensator
+    on one and scores it on the other, and compares the decoded position and dR/R with the
+    simulator's truth.
+
+    Returns
+    -------
+    dict
+        ``metrics`` (the keys of :func:`~hystkit.compensation.evaluate`), ``round_trip``
+        (maximum position error [um] and [counts], dR/R error, illegal transitions) and
+        ``preprocess`` (the validation recording's report).
+    """
+    t_start = time.perf_counter()
+    recordings, round_trip, reports = {}, {}, {}
+    with tempfile.TemporaryDirectory(prefix="hystkit-raw-") as folder:
+        for role, seed in (("fit", FIT_SEED), ("validation", VALIDATION_SEED)):
+            path = Path(folder) / f"{excitation}_{seed}.parquet"
+            truth = simulate_raw(path, excitation, seed, scope=ScopeSettings(fs=scope_rate))
+            result = preprocess_raw(path, PreprocessSettings(r_bridge=ScopeSettings.r_bridge,
+                                                             v_supply=ScopeSettings.v_supply))
+            ref, rec = truth.recording(), result.recording
+            position_error = float(np.max(np.abs(rec.position - ref.position)))
+            round_trip[role] = {
+                "position_max_error_um": 1e3 * position_error,
+                "position_max_error_counts": position_error / truth.encoder_mm,
+                "sensor_max_error": float(np.max(np.abs(rec.sensor - ref.sensor))),
+                "sensor_rms_error": float(np.sqrt(np.mean((rec.sensor - ref.sensor) ** 2))),
+                "n_illegal": result.report.n_illegal, "n_edges": result.report.n_edges}
+            recordings[role], reports[role] = rec, result.report.to_dict()
+    comp = fit_compensator(recordings["fit"], n_cells)
+    metrics = evaluate(comp, recordings["validation"])
+    progress(f"  raw path: {excitation} at {scope_rate:g} Hz, "
+             f"{reports['fit']['n_samples']} samples per channel and recording, preprocessed "
+             f"and fitted in {time.perf_counter() - t_start:.2f} s")
+    return {"excitation": excitation, "scope_rate_hz": scope_rate, "n_cells": n_cells,
+            "metrics": metrics, "round_trip": round_trip, "preprocess": reports["validation"],
+            "seconds": time.perf_counter() - t_start}

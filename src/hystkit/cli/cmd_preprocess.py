@@ -1,0 +1,277 @@
+"""``hystkit preprocess``: raw scope recording -> 40 Hz recording; raw mode of simulate-sensor.
+
+Settings come from, in increasing priority: the defaults, the TOML file stored next to the raw
+file (same stem, ``.toml``) or given with ``--config``, and the command-line options.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+import warnings
+from pathlib import Path
+from typing import Any
+
+from ..errors import HystkitError
+from ..io import (
+    CONFIG_KEYS,
+    RawFormat,
+    check_output_path,
+    find_raw_config,
+    read_raw_config,
+    write_json,
+    write_recording,
+)
+from ..preprocess import PreprocessSettings, RawDataWarning, parse_states, preprocess_raw
+from ..sensors import ScopeSettings, VirtualSensor, simulate_raw, with_asymmetry
+from ..signals import EXPERIMENTS
+
+__all__ = ["add_simulation_options", "register", "run_raw_simulation", "sensor_from_args"]
+
+
+class SettingsError(HystkitError, ValueError):
+    """Options or a settings file with values preprocessing cannot use."""
+
+
+def _positive(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text}")
+    return value
+
+
+def _non_negative(text: str) -> float:
+    value = float(text)
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {text}")
+    return value
+
+
+def _count(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got {text}")
+    return value
+
+
+def _levels(text: str) -> tuple[float, ...]:
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be four comma-separated voltages, got {text!r}")
+    if len(values) != 4:
+        raise argparse.ArgumentTypeError(f"must be four comma-separated voltages, got {text!r}")
+    return values
+
+
+def _states(text: str) -> str:
+    try:
+        parse_states(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+# Option dest -> settings key (the same names as the TOML keys).
+_OPTIONS = ("r_bridge", "v_supply", "um_per_count", "position_offset_mm", "fs_out", "cutoff",
+            "order", "fs", "encoder_states", "encoder_levels", "encoder_dwell_us",
+            "illegal", "remove_mean", "normalise", "chunk_size", "time_unit")
+
+
+def _settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawFormat, Path | None]:
+    """Merge defaults, the settings file and the options; return what preprocessing needs."""
+    config_path = args.config if args.config is not None else find_raw_config(args.raw)
+    values: dict[str, Any] = read_raw_config(config_path) if config_path is not None else {}
+    values.pop("simulation", None)
+    for key in _OPTIONS:
+        option = getattr(args, key, None)
+        if option is not None and option is not False:
+            values[key] = option
+    where = f"settings from {config_path} and the options" if config_path else "options"
+    for key in ("r_bridge", "v_supply"):
+        if key not in values:
+            flag = "--" + key.replace("_", "-")
+            raise SettingsError(f"{args.raw}: the bridge {CONFIG_KEYS[key][1]} is not known: "
+                                f"pass {flag} or set {key} in a settings file "
+                                f"({Path(args.raw).with_suffix('.toml')})")
+    fmt_keys = {"fs", "n_samples", "time_unit", "skip_rows", "columns"}
+    try:
+        fmt = RawFormat(columns=tuple(values.get("columns", {}).items()),
+                        **{k: values[k] for k in fmt_keys - {"columns"} if k in values})
+        kwargs = {k: v for k, v in values.items() if k not in fmt_keys}
+        if "encoder_states" in kwargs:
+            kwargs["encoder_states"] = parse_states(kwargs["encoder_states"])
+        if "encoder_levels" in kwargs:
+            kwargs["encoder_levels"] = tuple(float(v) for v in kwargs["encoder_levels"])
+        settings = PreprocessSettings(**kwargs)
+    except (TypeError, ValueError) as exc:
+        raise SettingsError(f"{where}: {exc}") from None
+    return settings, fmt, config_path
+
+
+def _preprocess(args: argparse.Namespace) -> int:
+    report_path = args.report if args.report is not None else args.out.with_suffix(".json")
+    if report_path == args.out:
+        raise SettingsError(f"--report {report_path} is the data output file")
+    check_output_path(args.out, args.force)
+    check_output_path(report_path, args.force)
+    settings, fmt, config_path = _settings(args)
+    print(f"preprocessing {args.raw}" + (f" with settings from {config_path}" if config_path
+                                          else "") + " ...", flush=True)
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RawDataWarning)
+        result = preprocess_raw(args.raw, settings, fmt, progress=True)
+    rep = result.report
+    print(f"  {rep.n_samples} samples at {rep.fs:.6g} Hz ({rep.duration_s:.6g} s), "
+          f"{rep.encoder_kind} encoder, decimated by {round(rep.fs / rep.fs_mid)} to "
+          f"{rep.fs_mid:.6g} Hz, zero-phase Butterworth (order {settings.order}, "
+          f"{settings.cutoff:g} Hz), {settings.fs_out:g} Hz out")
+    levels = ", ".join(f"{v:.4g}" for v in rep.encoder_levels)
+    print(f"  encoder: levels {levels} V; {rep.n_edges} state changes, {rep.n_illegal} illegal "
+          f"double transition(s), {rep.n_rejected} short excursion(s) rejected "
+          f"(dwell {rep.encoder_dwell_samples} samples)")
+    print(f"  gauges: R1 = {rep.r1_mean_ohm:.6g} Ohm, R2 = {rep.r2_mean_ohm:.6g} Ohm, "
+          f"symmetry 2(R1-R2)/(R1+R2) = {rep.symmetry:.4f}")
+    for warning in caught:
+        if issubclass(warning.category, RawDataWarning):
+            print(f"hystkit: warning: {warning.message}", file=sys.stderr)
+        else:
+            warnings.warn_explicit(warning.message, warning.category, warning.filename,
+                                   warning.lineno)
+    write_recording(result.recording, args.out, extra=result.extra, force=args.force)
+    seconds = time.perf_counter() - t0
+    write_json({"report": rep.to_dict(), "settings": {k: _plain(v) for k, v in
+                                                      vars(settings).items()},
+                "format": {k: _plain(v) for k, v in vars(fmt).items()},
+                "config_file": None if config_path is None else str(config_path)},
+               report_path, force=args.force)
+    print(f"wrote {args.out}: {rep.n_out} samples at {rep.fs_out:g} Hz (time, position [mm], "
+          f"sensor = dR1/R1 - dR2/R2, r1, r2 [Ohm], dr1, dr2) and {report_path} "
+          f"({seconds:.1f} s, {rep.n_samples / seconds / 1e6:.3g} M samples/s per channel)")
+    return 0
+
+
+def _plain(value: Any) -> Any:
+    return list(value) if isinstance(value, tuple) else value
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``preprocess`` to the ``hystkit`` parser."""
+    p = sub.add_parser("preprocess", help="raw scope recording (v1, v2, encoder) -> position "
+                       "and dR/R at 40 Hz")
+    p.add_argument("raw", type=Path, help="raw recording: time, v1, v2 and encoder or "
+                   "enc_a/enc_b (CSV, Parquet or .mat)")
+    p.add_argument("--out", type=Path, required=True, help="CSV or Parquet file to write")
+    p.add_argument("--report", type=Path, help="JSON report (default: --out with .json)")
+    p.add_argument("--config", type=Path, help="TOML settings (default: the raw file's stem "
+                   "with .toml, if it exists)")
+    p.add_argument("--r-bridge", type=_positive, metavar="OHM", help="bridge resistor (eq. 4.2)")
+    p.add_argument("--v-supply", type=_positive, metavar="V", help="bridge supply V0 (eq. 4.2)")
+    p.add_argument("--um-per-count", type=_positive, metavar="UM",
+                   help="encoder resolution (default 5; eq. 9.16 calibrates 5.1)")
+    p.add_argument("--position-offset", dest="position_offset_mm", type=float, metavar="MM",
+                   help="added to the position, which counts from the first sample (default 0)")
+    p.add_argument("--fs-out", type=_positive, metavar="HZ", help="output rate (default 40)")
+    p.add_argument("--cutoff", type=_positive, metavar="HZ",
+                   help="zero-phase Butterworth cut-off (default 20, eq. 4.1)")
+    p.add_argument("--order", type=int, metavar="N", help="Butterworth order (default 2)")
+    p.add_argument("--fs", type=_positive, metavar="HZ",
+                   help="scope sample rate: needed without a time column, checked against one")
+    p.add_argument("--time-unit", choices=["s", "ms", "us", "ns"],
+                   help="unit of the time column (default s)")
+    p.add_argument("--encoder-states", type=_states, metavar="AB,AB,AB,AB",
+                   help="A/B states of the merged levels, ascending (default 00,01,10,11)")
+    p.add_argument("--encoder-levels", type=_levels, metavar="V,V,V,V",
+                   help="the four merged levels (default: found in the data)")
+    p.add_argument("--encoder-dwell", dest="encoder_dwell_us", type=_positive, metavar="US",
+                   help="a new encoder level must last this long (default 4 us, >= 2 samples)")
+    p.add_argument("--illegal", choices=["continue", "hold"],
+                   help="a double transition adds 2 counts in the direction of travel "
+                        "(continue, default) or nothing (hold); both are counted and reported")
+    p.add_argument("--remove-mean", action="store_true", help="subtract the mean of position "
+                   "and sensor")
+    p.add_argument("--normalise", action="store_true",
+                   help="divide position and sensor by their max |.| (eq. 5.10)")
+    p.add_argument("--chunk-size", type=int, metavar="N",
+                   help="samples per chunk (default 262144); memory grows with it")
+    p.set_defaults(run=_preprocess)
+
+
+# --------------------------------------------------------------------------- simulate-sensor
+
+
+def add_simulation_options(p: argparse.ArgumentParser) -> None:
+    """simulate-sensor options for the sensor (both modes) and the raw mode."""
+    p.add_argument("--age-hours", type=_non_negative, metavar="H",
+                   help="hours since printing: the resistance still settles (sec. 3.5.1; "
+                        "default 48)")
+    p.add_argument("--asymmetry", type=float, metavar="S",
+                   help="gauge symmetry 2(R1-R2)/(R1+R2) of the base resistances "
+                        "(default 0.35: 22.4 / 15.7 kOhm)")
+    p.add_argument("--raw", action="store_true",
+                   help="write the raw scope recording (time, v1, v2, encoder) and its .toml "
+                        "settings instead of the 40 Hz recording")
+    p.add_argument("--scope-rate", type=_positive, metavar="HZ",
+                   help="raw: scope sample rate (default 1e6; the document: 1.98e6, 6.25e6)")
+    p.add_argument("--duration", type=_positive, metavar="S",
+                   help="raw: only the first S seconds of the experiment")
+    p.add_argument("--encoder", choices=["merged", "ab"],
+                   help="raw: one merged 4-level channel (default) or enc_a, enc_b")
+    p.add_argument("--r-bridge", type=_positive, metavar="OHM",
+                   help="raw: bridge resistor (default 10000)")
+    p.add_argument("--v-supply", type=_positive, metavar="V", help="raw: bridge supply "
+                   "(default 2)")
+    p.add_argument("--glitches", type=_count, metavar="N",
+                   help="raw: hide N encoder states (each an illegal double transition)")
+    p.add_argument("--truth", type=Path, metavar="FILE",
+                   help="raw: also write the exact position and dR/R at 40 Hz here")
+
+
+_RAW_ONLY = ("scope_rate", "duration", "encoder", "r_bridge", "v_supply", "glitches", "truth")
+
+
+def sensor_from_args(args: argparse.Namespace) -> VirtualSensor:
+    """The virtual sensor with the --age-hours / --asymmetry options applied."""
+    if not args.raw:
+        used = [f"--{k.replace('_', '-')}" for k in _RAW_ONLY if getattr(args, k) is not None]
+        if used:
+            raise SettingsError(f"{', '.join(used)} only apply with --raw")
+    try:
+        return with_asymmetry(VirtualSensor(), args.asymmetry, args.age_hours)
+    except ValueError as exc:
+        raise SettingsError(str(exc)) from None
+
+
+def run_raw_simulation(args: argparse.Namespace) -> int:
+    """simulate-sensor --raw: write the raw file, its settings and optionally the truth."""
+    config = args.out.with_suffix(".toml")
+    for path in (args.out, config) + ((args.truth,) if args.truth else ()):
+        check_output_path(path, args.force)
+    sensor = sensor_from_args(args)
+    defaults = ScopeSettings()
+    scope = ScopeSettings(
+        fs=args.scope_rate or defaults.fs, r_bridge=args.r_bridge or defaults.r_bridge,
+        v_supply=args.v_supply or defaults.v_supply, encoder_mode=args.encoder or "merged",
+        n_missed_states=args.glitches or 0)
+    t0 = time.perf_counter()
+    try:
+        truth = simulate_raw(args.out, args.excitation, args.seed, sensor=sensor, scope=scope,
+                             duration=args.duration, force=args.force)
+    except ValueError as exc:
+        if isinstance(exc, HystkitError):
+            raise
+        raise SettingsError(str(exc)) from None
+    print(f"wrote {args.out}: raw scope recording of the virtual sensor, "
+          f"{EXPERIMENTS[args.excitation].description}, seed {args.seed}, {truth.n_samples} "
+          f"samples at {scope.fs:.6g} Hz ({truth.n_samples / scope.fs:.6g} s), "
+          f"{scope.encoder_mode} encoder, {len(truth.missed)} hidden encoder state(s) "
+          f"({time.perf_counter() - t0:.1f} s)")
+    print(f"wrote {config}: R_br = {scope.r_bridge:g} Ohm, V0 = {scope.v_supply:g} V, "
+          f"fs = {scope.fs:.6g} Hz; 'hystkit preprocess {args.out}' reads it")
+    if args.truth:
+        write_recording(truth.recording(), args.truth, force=args.force)
+        print(f"wrote {args.truth}: the exact position [mm] and dR1/R1 - dR2/R2 at 40 Hz")
+    return 0
+

@@ -1,0 +1,115 @@
+"""Settings of a raw recording in a small TOML file stored next to the data.
+
+The file has the data file's stem (``run1.parquet`` -> ``run1.toml``), flat keys
+(:data:`CONFIG_KEYS`) and optional tables ``columns`` (file column names) and ``simulation``
+(free-form notes). ``hystkit preprocess`` reads it; command-line options override it.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hystkit.errors import InputError
+
+from ._recording import _write_text_safely, check_output_path
+
+__all__ = ["CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_config"]
+
+# key: (type(s), meaning). Read by read_raw_config; used by hystkit.preprocess and the CLI.
+CONFIG_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
+    "r_bridge": ((int, float), "bridge resistor R_br [Ohm] (eq. 4.2)"),
+    "v_supply": ((int, float), "bridge supply V0 [V] (eq. 4.2)"),
+    "um_per_count": ((int, float), "encoder resolution [um per count] (5 in the document)"),
+    "position_offset_mm": ((int, float), "added to the position [mm] (eq. 9.16: -0.0656)"),
+    "fs_out": ((int, float), "output sample rate [Hz]"),
+    "cutoff": ((int, float), "zero-phase Butterworth cut-off [Hz] (eq. 4.1)"),
+    "order": ((int,), "Butterworth order (one way)"),
+    "fs": ((int, float), "scope sample rate [Hz]; checked against the time column"),
+    "n_samples": ((int,), "samples per channel; a shorter file is reported as truncated"),
+    "encoder_states": ((str, list), "A/B states of the merged levels, ascending: 00,01,10,11"),
+    "encoder_levels": ((list,), "the four merged encoder levels [V], ascending"),
+    "encoder_dwell_us": ((int, float), "a new encoder level must last this long [us]"),
+    "illegal": ((str,), "double transitions add 2 counts ('continue') or none ('hold')"),
+    "remove_mean": ((bool,), "subtract the mean of position and sensor"),
+    "normalise": ((bool,), "divide position and sensor by their max |.| (eq. 5.10)"),
+    "chunk_size": ((int,), "rows per chunk"),
+    "time_unit": ((str,), "unit of the time column: s, ms, us or ns"),
+    "skip_rows": ((int,), "CSV: lines to skip after the header (e.g. a units line)"),
+    "columns": ((dict,), "file column names, e.g. {v1 = 'Channel A', time = 'Time'}"),
+    "simulation": ((dict,), "free-form notes written by simulate-sensor (ignored)"),
+}
+
+
+
+def find_raw_config(data_path: str | os.PathLike[str]) -> Path | None:
+    """The settings file stored next to a raw recording (same stem, ``.toml``), if present."""
+    candidate = Path(data_path).with_suffix(".toml")
+    return candidate if candidate.is_file() else None
+
+
+def read_raw_config(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """Read a raw recording's TOML settings; keys and types as in :data:`CONFIG_KEYS`.
+
+    Raises
+    ------
+    InputError
+        Unreadable or invalid TOML, an unknown key (a typo would otherwise be ignored), or a
+        value of the wrong type. Ranges are checked by the code that uses the values.
+    """
+    path = Path(path)
+    try:
+        with path.open("rb") as handle:
+            values = tomllib.load(handle)
+    except FileNotFoundError as exc:
+        raise InputError(f"{path}: config file not found") from exc
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: invalid TOML ({exc})") from exc
+    for key, value in values.items():
+        if key not in CONFIG_KEYS:
+            raise InputError(f"{path}: unknown key {key!r}; known keys: "
+                             f"{', '.join(CONFIG_KEYS)}")
+        types = CONFIG_KEYS[key][0]
+        ok = isinstance(value, types) and not (isinstance(value, bool) and bool not in types)
+        if not ok:
+            raise InputError(f"{path}: key {key!r} must be "
+                             f"{' or '.join(t.__name__ for t in types)}, got {value!r}")
+    return values
+
+
+def write_raw_config(path: str | os.PathLike[str], values: dict[str, Any], *,
+                     comment: str = "", force: bool = False) -> Path:
+    """Write flat settings (numbers, strings, booleans, lists, one level of tables) as TOML."""
+    path = Path(path)
+    check_output_path(path, force)
+    lines = [f"# {line}" for line in comment.splitlines()]
+    tables = {k: v for k, v in values.items() if isinstance(v, dict)}
+    lines += [f"{k} = {_toml_value(v)}" for k, v in values.items() if k not in tables]
+    for name, table in tables.items():
+        lines += ["", f"[{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
+    text = "\n".join(lines) + "\n"
+    _write_text_safely(path, lambda: path.write_text(text, encoding="utf-8"))
+    return path
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | np.integer):
+        return str(int(value))
+    if isinstance(value, float | np.floating):
+        if not math.isfinite(value):
+            raise ValueError(f"cannot write {value} to TOML settings")
+        return repr(float(value))
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"cannot write {type(value).__name__} to TOML settings")
+
+

@@ -1,0 +1,458 @@
+"""From a raw scope recording to a fit-ready 40 Hz recording, in one streaming pass.
+
+The document's MATLAB post-processing (sec. 4.3.1-4.3.2, appendix 9.7-9.8) as a pipeline whose
+memory is bounded by the chunk size, not the recording length:
+
+1. read a chunk (:func:`hystkit.io.open_raw`: CSV, Parquet, .mat);
+2. bridge voltages -> gauge resistances R1, R2 at the scope rate (eq. 4.3), after checking
+   ``0 < V_m < V0`` and counting samples stuck at a channel's extreme (clipping);
+3. encoder -> counts (level survey, debounce, quadrature state machine: :mod:`._encoder`);
+4. R1, R2 and the count go through stateful FIR decimation stages (:mod:`._decimate`) to an
+   intermediate rate ``fs_mid`` of about ``mid_factor * fs_out`` (400 Hz by default);
+5. on that small signal, the document's zero-phase Butterworth (eq. 4.1; 2nd order, 20 Hz),
+   then every ``fs_mid / fs_out``-th sample (or linear interpolation onto the ``fs_out`` grid
+   when the rates are not integer multiples);
+6. position [mm] = counts * um_per_count / 1000 + offset, relative to the first sample;
+   dR/R per gauge about its mean (eq. 4.4-4.5), the differential output dR1/R1 - dR2/R2 and the
+   gauge symmetry 2 (R1 - R2) / (R1 + R2); optional mean removal and normalisation (eq. 5.10).
+
+Converting to resistance before filtering (not after) keeps the non-linear eq. 4.3 from
+biasing the result with the scope noise. Unless the levels are given, the encoder column is
+first surveyed from the start until all four levels have been seen (usually within the first
+chunk; at worst the column is read twice). A reader thread decodes the next chunk while the
+current one is processed.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import queue
+import sys
+import threading
+import time as _time
+import warnings
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from tqdm import tqdm
+
+from ..io import Recording
+from ..io._raw import RawChunk, RawFormat, RawReader, open_raw
+from ._bridge import bridge_kernel, clipped_channels, gauge_symmetry
+from ._decimate import (
+    Decimator,
+    decimator_flush,
+    decimator_init,
+    decimator_step,
+    design_chain,
+)
+from ._encoder import (
+    DEFAULT_STATES,
+    EncoderSettings,
+    EncoderState,
+    ab_to_code,
+    decode_flush,
+    decode_step,
+    encoder_init,
+)
+from ._filters import lowpass_zero_phase
+from ._levels import LevelSurvey
+
+__all__ = ["PreprocessReport", "PreprocessResult", "PreprocessSettings", "RawDataWarning",
+           "preprocess_raw"]
+
+
+class RawDataWarning(UserWarning):
+    """Raw data that were processed but deserve a look (clipping, illegal transitions)."""
+
+
+@dataclass(frozen=True)
+class PreprocessSettings:
+    """Settings of :func:`preprocess_raw` (SI units unless noted).
+
+    Parameters
+    ----------
+    r_bridge, v_supply : float
+        Bridge resistor R_br [Ohm] and supply V0 [V] of eq. 4.2 (no defaults: the document used
+        10 kOhm / 2 V and 560 Ohm / 1 V, and a wrong value silently scales dR/R).
+    um_per_count : float
+        Encoder resolution [um] (5; eq. 9.16 calibrates it to 5.1).
+    position_offset_mm : float
+        Added to the position [mm] (the encoder counts from the first sample).
+    fs_out, cutoff, order
+        Output rate [Hz], Butterworth cut-off [Hz] (<= fs_out / 2) and one-way order.
+    encoder_states : tuple of 4 int
+        A/B code ``2 A + B`` of the merged levels in ascending order.
+    encoder_levels : tuple of 4 float, optional
+        The merged levels [V]; found in the data when None.
+    encoder_dwell_us : float
+        A new encoder level must persist this long [us] (at least 2 samples).
+    illegal : {"continue", "hold"}
+        Counts added by a double transition: 2 in the last direction, or none.
+    max_illegal_fraction : float
+        Above this share of illegal state changes (and 10 of them) the position is refused.
+    remove_mean, normalise : bool
+        Subtract the mean of position and sensor; divide them by their max |.| (eq. 5.10).
+    chunk_size : int
+        Samples per chunk (2**18); memory is about 200 bytes per chunk sample. Larger chunks
+        are no faster: they fall out of the CPU caches between the passes over a chunk.
+    mid_factor : int
+        The intermediate rate is about ``mid_factor * fs_out``.
+    """
+
+    r_bridge: float
+    v_supply: float
+    um_per_count: float = 5.0
+    position_offset_mm: float = 0.0
+    fs_out: float = 40.0
+    cutoff: float = 20.0
+    order: int = 2
+    encoder_states: tuple[int, int, int, int] = DEFAULT_STATES
+    encoder_levels: tuple[float, ...] | None = None
+    encoder_dwell_us: float = 4.0
+    illegal: str = "continue"
+    max_illegal_fraction: float = 0.01
+    remove_mean: bool = False
+    normalise: bool = False
+    chunk_size: int = 1 << 18
+    mid_factor: int = 10
+
+    def __post_init__(self) -> None:
+        for name in ("r_bridge", "v_supply", "um_per_count", "fs_out", "cutoff",
+                     "encoder_dwell_us"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a positive number, got {value!r}")
+        if self.cutoff > self.fs_out / 2:
+            raise ValueError(f"cutoff {self.cutoff:g} Hz is above fs_out / 2 = "
+                             f"{self.fs_out / 2:g} Hz: the output would alias")
+        if self.order < 1 or self.chunk_size < 2 or self.mid_factor < 4:
+            raise ValueError("order must be >= 1, chunk_size >= 2 and mid_factor >= 4")
+        if not 0 <= self.max_illegal_fraction <= 1:
+            raise ValueError("max_illegal_fraction must lie in [0, 1]")
+        EncoderSettings(states=self.encoder_states, illegal=self.illegal)  # validates both
+        if self.encoder_levels is not None and (
+                len(self.encoder_levels) != 4 or not np.all(np.diff(self.encoder_levels) > 0)):
+            raise ValueError(f"encoder_levels must be four ascending voltages, "
+                             f"got {self.encoder_levels}")
+
+
+@dataclass(frozen=True)
+class PreprocessReport:
+    """What :func:`preprocess_raw` found; every field is a plain number, string or list."""
+
+    source: str
+    n_samples: int
+    fs: float
+    duration_s: float
+    fs_mid: float
+    fs_out: float
+    n_out: int
+    decimation: list[list[int]]
+    encoder_kind: str
+    encoder_levels: list[float]
+    encoder_levels_end: list[float]
+    encoder_dwell_samples: int
+    n_edges: int
+    n_illegal: int
+    first_illegal_s: float | None
+    n_rejected: int
+    r1_mean_ohm: float
+    r2_mean_ohm: float
+    symmetry: float
+    clipped: dict[str, int]
+    warnings: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict:
+        """The report as a JSON-ready dict."""
+        return asdict(self)
+
+
+@dataclass(frozen=True, eq=False)
+class PreprocessResult:
+    """Output of :func:`preprocess_raw`.
+
+    ``recording``: time [s], position [mm], sensor dR1/R1 - dR2/R2 [-] at ``fs_out``;
+    ``extra``: ``r1``, ``r2`` [Ohm] and ``dr1``, ``dr2`` [-] on the same time grid;
+    ``report``: counts, levels, symmetry and warnings.
+    """
+
+    recording: Recording
+    extra: dict[str, np.ndarray]
+    report: PreprocessReport
+
+
+def preprocess_raw(path: str | os.PathLike[str], settings: PreprocessSettings,
+                   fmt: RawFormat | None = None, *, progress: bool = False) -> PreprocessResult:
+    """Turn a raw scope recording into position and dR/R at ``settings.fs_out``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Raw recording (``.csv``, ``.parquet``, ``.mat``); see :mod:`hystkit.io`.
+    settings : PreprocessSettings
+    fmt : RawFormat, optional
+        Column names, time unit and metadata (``fs``, ``n_samples``) of the file.
+    progress : bool
+        Show a progress bar on stderr (only on a terminal).
+
+    Returns
+    -------
+    PreprocessResult
+
+    Raises
+    ------
+    InputError
+        Unreadable, truncated or inconsistent file; bridge voltage outside (0, V0); a flat
+        encoder, fewer or more than four merged levels; too many illegal transitions; a
+        recording too short for the filters. Named by file, column and row.
+
+    Warns
+    -----
+    RawDataWarning
+        A channel that looks clipped, or illegal encoder transitions (with their count).
+    """
+    t_start = _time.perf_counter()
+    reader = open_raw(path, fmt, settings.chunk_size)
+    fs = reader.fs
+    factor = max(1, round(fs / (settings.mid_factor * settings.fs_out)))
+    fs_mid = fs / factor
+    if fs_mid < 4 * settings.fs_out or settings.cutoff >= fs_mid / 2:
+        raise reader.fail(f"sample rate {fs:.6g} Hz is too low for fs_out = "
+                          f"{settings.fs_out:g} Hz (need at least {4 * settings.fs_out:g} Hz)")
+    chain = design_chain(fs, factor, min(2 * settings.cutoff, fs_mid / 4))
+    dwell = max(2, math.ceil(settings.encoder_dwell_us * 1e-6 * fs - 1e-9))
+    enc_settings, levels, logic = _encoder_setup(reader, settings, dwell)
+    enc_state = encoder_init(levels)
+
+    # R and the count run through separate decimator states: each stream's output k is centred
+    # on raw sample k * factor however far the stream has got, so the few samples the decoder
+    # holds back (pending its dwell decision) need no re-alignment.
+    r_states = [decimator_init(stage, 2) for stage in chain]
+    c_states = [decimator_init(stage, 1) for stage in chain]
+    mid_r: list[np.ndarray] = []
+    mid_c: list[np.ndarray] = []
+    extremes = np.array([-np.inf, 0, np.inf, 0] * 2, dtype=float)
+    t0 = 0.0
+    bar = tqdm(total=reader.n_samples, unit="sample", unit_scale=True, file=sys.stderr,
+               disable=None if progress else True, mininterval=0.5, desc="preprocess")
+    for chunk in _prefetch(reader.chunks()):
+        if chunk.start == 0 and chunk.time is not None:
+            t0 = float(chunk.time[0])
+        r, bad, extremes = bridge_kernel(chunk.v1, chunk.v2, float(settings.r_bridge),
+                                          float(settings.v_supply), extremes)
+        for g in range(2):
+            if bad[g] >= 0:
+                _raise_bridge(reader, g, chunk, int(bad[g]), settings.v_supply)
+        x = chunk.encoder if logic is None else ab_to_code(chunk.enc_a, chunk.enc_b, *logic)
+        counts, enc_state = decode_step(enc_settings, enc_state, x)
+        mid_r.append(_run_chain(chain, r_states, r))
+        mid_c.append(_run_chain(chain, c_states, counts[np.newaxis].astype(float)))
+        bar.update(chunk.n)
+    bar.close()
+    mid_c.append(_run_chain(chain, c_states, decode_flush(enc_state)[np.newaxis].astype(float)))
+    mid_r.append(_flush_chain(chain, r_states, 2))
+    mid_c.append(_flush_chain(chain, c_states, 1))
+    mid = np.vstack([np.concatenate(mid_r, axis=1), np.concatenate(mid_c, axis=1)])
+    return _finish(reader, settings, mid, t0, reader.fs, factor, chain, enc_settings, enc_state,
+                   levels, logic, extremes, reader.n_samples or 0, t_start)
+
+
+# --------------------------------------------------------------------------- pieces
+
+
+def _encoder_setup(reader: RawReader, settings: PreprocessSettings, dwell: int
+                   ) -> tuple[EncoderSettings, np.ndarray, tuple[float, float] | None]:
+    """Decoder settings, starting levels and, for logic channels, their thresholds [V]."""
+    if reader.encoder_kind == "ab":
+        thresholds = tuple(_logic_threshold(reader, c) for c in ("enc_a", "enc_b"))
+        # Codes 2A + B are decoded as four fixed levels 0..3 in code order.
+        return (EncoderSettings(states=(0, 1, 2, 3), dwell=dwell, illegal=settings.illegal,
+                                track_block=0),
+                np.arange(4.0), thresholds)  # type: ignore[return-value]
+    enc = EncoderSettings(states=settings.encoder_states, dwell=dwell, illegal=settings.illegal)
+    if settings.encoder_levels is not None:
+        return enc, np.asarray(settings.encoder_levels, dtype=float), None
+    survey = LevelSurvey()
+    for chunk in reader.chunks(columns=("encoder",)):
+        survey = survey.add(chunk.encoder)
+        if survey.n_levels >= 4 and min(c[3] for c in survey.clusters) >= 100:
+            break
+    _check_levels(reader, "encoder", survey, 4)
+    return enc, survey.centres, None
+
+
+def _logic_threshold(reader: RawReader, column: str) -> float:
+    survey = LevelSurvey()
+    for chunk in reader.chunks(columns=(column,)):
+        survey = survey.add(getattr(chunk, column))
+        if survey.n_levels >= 2 and min(c[3] for c in survey.clusters) >= 100:
+            break
+    _check_levels(reader, column, survey, 2)
+    return float(survey.centres.mean())
+
+
+def _check_levels(reader: RawReader, column: str, survey: LevelSurvey, wanted: int) -> None:
+    found = ", ".join(f"{c:.4g}" for c in survey.centres)
+    if survey.n_levels <= 1:
+        lo, hi = survey.clusters[0][1], survey.clusters[0][2]
+        raise reader.fail(f"flat: one level ({found} V, range {lo:.4g} to {hi:.4g} V) in "
+                          f"{survey.n_samples} samples, so no encoder edges and no position; "
+                          "is the encoder connected and did the actuator move?", column)
+    if survey.n_levels < wanted:
+        raise reader.fail(f"only {survey.n_levels} of {wanted} levels found ({found} V) in the "
+                          "whole recording; the actuator never visited all A/B states or this "
+                          "is not the encoder" + (", give --encoder-levels"
+                                                  if wanted == 4 else ""), column)
+    if survey.n_levels > wanted:
+        raise reader.fail(f"{survey.n_levels} distinct levels ({found} V) where {wanted} were "
+                          "expected; is this the " + ("merged encoder signal"
+                                                      if wanted == 4 else "logic channel")
+                          + "? (give --encoder-levels to skip the search)", column)
+
+
+def _raise_bridge(reader: RawReader, g: int, chunk: RawChunk, i: int, v_supply: float) -> None:
+    v = (chunk.v1, chunk.v2)[g][i]
+    raise reader.fail(f"bridge voltage {v:.6g} V outside (0, V0 = {v_supply:g} V), where "
+                      "R_S = R_br (V0 - V_m) / V_m (eq. 4.3) is undefined; check the channel, "
+                      "its polarity and --v-supply", f"v{g + 1}", chunk.start + i)
+
+
+def _prefetch(chunks: Iterator[RawChunk]) -> Iterator[RawChunk]:
+    """Read the next chunk in a thread while this one is processed (parsing and decoding
+    release the GIL, as do the numba kernels), so two cores share the work."""
+    done = object()
+    box: queue.Queue = queue.Queue(maxsize=1)
+    stop = threading.Event()
+
+    def put(item: object) -> bool:
+        while not stop.is_set():
+            try:
+                box.put(item, timeout=0.1)
+                return True
+            except queue.Full:
+                continue
+        return False  # the consumer has gone
+
+    def work() -> None:
+        try:
+            for item in chunks:
+                if not put(item):
+                    return
+            put(done)
+        except Exception as exc:  # noqa: BLE001 -- handed to the consumer, raised there
+            put(exc)
+
+    thread = threading.Thread(target=work, daemon=True, name="hystkit-raw-reader")
+    thread.start()
+    try:
+        while True:
+            item = box.get()
+            if item is done:
+                return
+            if isinstance(item, Exception):
+                raise item
+            yield item
+    finally:
+        stop.set()
+        thread.join(timeout=5)
+
+
+def _run_chain(chain: tuple[Decimator, ...], states: list, x: np.ndarray) -> np.ndarray:
+    for i, stage in enumerate(chain):
+        x, states[i] = decimator_step(stage, states[i], x)
+    return x
+
+
+def _flush_chain(chain: tuple[Decimator, ...], states: list, n_rows: int) -> np.ndarray:
+    """Flush stage by stage: each stage's tail runs through the stages after it."""
+    tail = np.zeros((n_rows, 0))
+    for i, stage in enumerate(chain):
+        if tail.shape[1]:
+            tail, states[i] = decimator_step(stage, states[i], tail)
+        tail = np.concatenate([tail, decimator_flush(stage, states[i])], axis=1)
+    return tail
+
+
+def _finish(reader: RawReader, settings: PreprocessSettings, mid: np.ndarray, t0: float,
+            fs: float, factor: int, chain: tuple[Decimator, ...], enc: EncoderSettings,
+            state: EncoderState, levels: np.ndarray, logic: tuple | None, extremes: np.ndarray,
+            n: int, t_start: float) -> PreprocessResult:
+    fs_mid = fs / factor
+    notes = []
+    n_illegal, n_edges = state.n_illegal, state.n_edges
+    first_illegal = None if state.first_illegal < 0 else t0 + state.first_illegal / fs
+    if n_illegal >= 10 and n_illegal > settings.max_illegal_fraction * n_edges:
+        raise reader.fail(f"{n_illegal} of {n_edges} state changes are illegal double "
+                          f"transitions (first at t = {first_illegal:.6g} s): the position "
+                          "cannot be trusted; the sample rate may be too low for the motion, "
+                          "or the encoder levels, --encoder-states or --encoder-dwell wrong",
+                          "encoder" if logic is None else "enc_a")
+    if n_illegal:
+        policy = ("added 2 counts in the direction of travel" if enc.illegal == "continue"
+                  else "added nothing")
+        notes.append(f"{reader.source}: encoder: {n_illegal} illegal double transition(s) of "
+                     f"{n_edges} state changes (first at t = {first_illegal:.6g} s); "
+                     f"{policy} for each, so the position may be off by up to "
+                     f"{2 * n_illegal} counts ({2 * n_illegal * settings.um_per_count:g} um)")
+    if n_edges == 0:  # only possible with given levels; the survey refuses a flat channel
+        notes.append(f"{reader.source}: encoder: no state change in {n} samples, so the "
+                     "position is constant: a flat encoder channel, or wrong --encoder-levels?")
+    clipped = clipped_channels(extremes, n)
+    for key, (count, value) in clipped.items():
+        column, side = key.split("_")
+        notes.append(f"{reader.source}: column {column!r}: {count} samples "
+                     f"({100 * count / n:.3g} %) sit exactly at the channel's {side}imum "
+                     f"{value:.6g} V: the scope channel looks clipped, and dR/R is wrong there")
+    for note in notes:
+        warnings.warn(note, RawDataWarning, stacklevel=3)
+
+    try:
+        smooth = lowpass_zero_phase(mid, fs_mid, settings.cutoff, settings.order)
+    except ValueError as exc:
+        raise reader.fail(f"recording too short for the {settings.cutoff:g} Hz filter "
+                          f"({mid.shape[1]} samples at {fs_mid:.6g} Hz; {exc})") from exc
+    ratio = fs_mid / settings.fs_out
+    if abs(ratio - round(ratio)) < 1e-6 * ratio:
+        out = smooth[:, ::round(ratio)]
+        # The nominal grid: fs estimated from float time stamps is off by ~1e-12, which would
+        # only print as 0.025000000000000612.
+        t = t0 + np.arange(out.shape[1]) / settings.fs_out
+    else:
+        t_mid = np.arange(mid.shape[1]) / fs_mid
+        t = np.arange(math.floor(t_mid[-1] * settings.fs_out + 1e-9) + 1) / settings.fs_out
+        out = np.vstack([np.interp(t, t_mid, row) for row in smooth])
+        t = t0 + t
+    r1, r2, counts = out
+    if out.shape[1] < 2:
+        raise reader.fail(f"recording too short: {n} samples give {out.shape[1]} output sample(s)")
+    dr1, dr2 = (r1 - r1.mean()) / r1.mean(), (r2 - r2.mean()) / r2.mean()  # eq. 4.4-4.5
+    position = counts * settings.um_per_count * 1e-3 + settings.position_offset_mm
+    sensor = dr1 - dr2
+    if settings.remove_mean:
+        position, sensor = position - position.mean(), sensor - sensor.mean()
+    if settings.normalise:
+        position = position / _max_abs(position)
+        sensor = sensor / _max_abs(sensor)
+    recording = Recording(time=t, sensor=sensor, position=position, source=reader.source)
+    report = PreprocessReport(
+        source=reader.source, n_samples=n, fs=fs, duration_s=n / fs, fs_mid=fs_mid,
+        fs_out=settings.fs_out, n_out=int(t.size),
+        decimation=[[s.factor, int(s.taps.size)] for s in chain],
+        encoder_kind=reader.encoder_kind, encoder_levels=[float(v) for v in levels],
+        encoder_levels_end=[float(v) for v in state.levels],
+        encoder_dwell_samples=enc.dwell, n_edges=n_edges, n_illegal=n_illegal,
+        first_illegal_s=first_illegal, n_rejected=state.n_rejected,
+        r1_mean_ohm=float(r1.mean()), r2_mean_ohm=float(r2.mean()),
+        symmetry=gauge_symmetry(r1, r2), clipped={k: c for k, (c, _) in clipped.items()},
+        warnings=notes,
+        seconds=_time.perf_counter() - t_start)
+    return PreprocessResult(recording, {"r1": r1, "r2": r2, "dr1": dr1, "dr2": dr2}, report)
+
+
+def _max_abs(x: np.ndarray) -> float:
+    peak = float(np.max(np.abs(x)))
+    return peak if peak > 0 else 1.0

@@ -1,0 +1,305 @@
+"""Raw mode of the virtual sensor: what the oscilloscope would have saved.
+
+The :class:`~hystkit.sensors.VirtualSensor` runs at its internal rate (400 Hz) for the whole
+experiment; its position and gauge resistances are then evaluated at the scope rate with a
+cubic spline (the trajectories have no content above 4 Hz and the resistance noise is a
+400 Hz-sampled process, so the spline adds nothing the decimation would keep). From them:
+
+* ``v1``, ``v2``: the half-bridge voltages across the bridge resistor (eq. 4.2) plus white
+  scope noise;
+* ``encoder``: the merged A/B signal of sec. 4.2.1. The hex buffer drives A through
+  R_d1 = 1 kOhm and B through R_d2 = 2 kOhm into one node loaded by the scope, which gives the
+  four levels of ``(2A + B)/3`` of the logic swing, slightly unequal because of the buffer's
+  output resistance and logic-low voltage; the logic supply drifts slowly, edges have a finite
+  time constant (samples caught mid-edge), and there is white noise. ``enc_a``/``enc_b`` instead
+  give the two logic channels.
+
+The file is written chunk by chunk (blocks of 2**20 samples, each with its own noise seed), so
+memory does not grow with the recording and the file does not depend on any chunk size. A
+settings file with the same stem (``.toml``) records R_br, V0, fs and the sample count, so
+``hystkit preprocess`` needs no options. Faults can be injected to test the decoder: missed
+encoder states (each an illegal double transition) and one-sample spikes.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+from numba import njit
+from scipy.interpolate import CubicSpline
+
+from ..io import RawWriter, Recording, check_output_path, write_raw_config
+from ..preprocess import (
+    DEFAULT_STATES,
+    bridge_voltage,
+    code_to_ab,
+    count_to_code,
+    downsample,
+    lowpass_zero_phase,
+)
+from ..signals import EXPERIMENTS, excitation
+from ._virtual import VirtualSensor
+
+__all__ = ["RawTruth", "ScopeSettings", "merged_levels", "simulate_raw", "with_asymmetry"]
+
+_BLOCK = 1 << 20  # samples per written block and per noise seed
+
+
+@dataclass(frozen=True)
+class ScopeSettings:
+    """The lab's instruments in the raw simulation (SI units).
+
+    Defaults: the Picoscope set-up of sec. 4.3.1 (R_br = 10 kOhm, V0 = 2 V) at 1 MHz, 0.5 mV
+    RMS scope noise, a 5 V hex buffer (4.8 V high, 0.1 V low, 30 Ohm) driving the 1 kOhm / 2 kOhm
+    merger into the scope's 1 MOhm, 20 mV noise on the merged channel, 0.5 us edges, 1 %
+    logic-supply drift over 100 s.
+    """
+
+    fs: float = 1e6
+    r_bridge: float = 10e3
+    v_supply: float = 2.0
+    bridge_noise_v: float = 0.5e-3
+    encoder_mode: str = "merged"
+    logic_high: float = 4.8
+    logic_low: float = 0.1
+    r_d1: float = 1e3
+    r_d2: float = 2e3
+    r_buffer: float = 30.0
+    r_scope: float = 1e6
+    encoder_noise_v: float = 0.02
+    edge_tau: float = 0.5e-6
+    supply_drift: float = 0.01
+    drift_period: float = 100.0
+    n_missed_states: int = 0
+    n_spikes: int = 0
+
+    def __post_init__(self) -> None:
+        if self.encoder_mode not in ("merged", "ab"):
+            raise ValueError(f"encoder_mode must be 'merged' or 'ab', got {self.encoder_mode!r}")
+        for name in ("fs", "r_bridge", "v_supply", "r_d1", "r_d2", "r_scope", "drift_period"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
+        if min(self.bridge_noise_v, self.encoder_noise_v, self.edge_tau, self.r_buffer,
+               self.supply_drift, self.n_missed_states, self.n_spikes) < 0:
+            raise ValueError("noise, edge time, drift and fault counts must be >= 0")
+
+
+def merged_levels(scope: ScopeSettings, supply_scale: float = 1.0) -> np.ndarray:
+    """Merged encoder voltage [V] of A/B codes 0..3 (``2 A + B``): the divider of sec. 4.2.1."""
+    g_a, g_b = 1 / (scope.r_d1 + scope.r_buffer), 1 / (scope.r_d2 + scope.r_buffer)
+    a, b = code_to_ab(np.arange(4))
+    v_a = np.where(a, scope.logic_high, scope.logic_low) * supply_scale
+    v_b = np.where(b, scope.logic_high, scope.logic_low) * supply_scale
+    return (v_a * g_a + v_b * g_b) / (g_a + g_b + 1 / scope.r_scope)
+
+
+def with_asymmetry(sensor: VirtualSensor, asymmetry: float | None = None,
+                   age_hours: float | None = None) -> VirtualSensor:
+    """`sensor` with gauge symmetry ``2 (R1 - R2)/(R1 + R2)`` = `asymmetry` of the base
+    resistances (their mean kept) and/or another time since printing [h] (sec. 3.5.1)."""
+    if asymmetry is not None:
+        if not -2 < asymmetry < 2:
+            raise ValueError(f"asymmetry must lie in (-2, 2), got {asymmetry}")
+        mean = 0.5 * sum(sensor.base_resistance)
+        sensor = replace(sensor, base_resistance=(mean * (1 + asymmetry / 2),
+                                                  mean * (1 - asymmetry / 2)))
+    if age_hours is not None:
+        if age_hours < 0:
+            raise ValueError(f"age_hours must be >= 0, got {age_hours}")
+        sensor = replace(sensor, age_hours=age_hours)
+    return sensor
+
+
+@dataclass(frozen=True, eq=False)
+class RawTruth:
+    """What the raw file encodes, at the sensor's internal rate.
+
+    ``time`` [s], ``position`` [mm] and ``resistance`` (2, n) [Ohm] of gauges R1, R2, before
+    scope noise; ``fs_internal`` [Hz]; ``count0`` the encoder count at the first sample;
+    ``encoder_mm`` per count; ``n_samples`` and ``fs`` of the raw file; ``missed`` (time [s],
+    hidden count) of each injected missed state; ``spikes`` their sample indices.
+    """
+
+    time: np.ndarray
+    position: np.ndarray
+    resistance: np.ndarray
+    fs_internal: float
+    count0: int
+    encoder_mm: float
+    n_samples: int
+    fs: float
+    missed: np.ndarray
+    spikes: np.ndarray
+
+    def counts(self, start: int = 0, stop: int | None = None) -> np.ndarray:
+        """True encoder counts relative to the first sample, for raw samples start..stop-1."""
+        stop = self.n_samples if stop is None else stop
+        x = _spline_at(self._coefficients(self.position[np.newaxis]), self.fs_internal,
+                       np.arange(start, stop) / self.fs)[0]
+        return np.round(x / self.encoder_mm).astype(np.int64) - self.count0
+
+    def recording(self, cutoff: float = 20.0, fs_out: float = 40.0) -> Recording:
+        """The truth through the document's chain (eq. 4.1, 4.4-4.5) at `fs_out`: exact
+        position [mm] relative to the start and dR1/R1 - dR2/R2, as preprocessing should give."""
+        rows = np.vstack([self.position - self.count0 * self.encoder_mm, self.resistance])
+        filtered = lowpass_zero_phase(rows, self.fs_internal, cutoff)
+        position, r1, r2 = downsample(filtered, self.fs_internal, fs_out)
+        t = downsample(self.time, self.fs_internal, fs_out)
+        sensor = (r1 - r1.mean()) / r1.mean() - (r2 - r2.mean()) / r2.mean()
+        return Recording(time=t, position=position, sensor=sensor, source="<raw truth>")
+
+    def _coefficients(self, rows: np.ndarray) -> np.ndarray:
+        return np.stack([CubicSpline(self.time, r).c for r in rows])
+
+
+def simulate_raw(path: str | os.PathLike[str], name: str, seed: int = 0, *,
+                 sensor: VirtualSensor | None = None, scope: ScopeSettings | None = None,
+                 duration: float | None = None, force: bool = False) -> RawTruth:
+    """Write the raw scope recording of experiment `name` on the virtual sensor.
+
+    Parameters
+    ----------
+    path : str or path-like
+        ``.csv`` or ``.parquet``; the settings go to the same stem with ``.toml``.
+    name : str
+        Excitation (sine, decay, chirp, noise).
+    seed : int
+        Seeds the sensor (as :func:`simulate_experiment`) and the scope noise.
+    sensor, scope : optional
+        Virtual sensor and instrument settings (defaults when None).
+    duration : float, optional
+        Keep only the first `duration` seconds of the experiment.
+    force : bool
+        Overwrite existing files.
+
+    Returns
+    -------
+    RawTruth
+    """
+    sensor = VirtualSensor() if sensor is None else sensor
+    scope = ScopeSettings() if scope is None else scope
+    path = Path(path)
+    config_path = path.with_suffix(".toml")
+    for p in (path, config_path):
+        check_output_path(p, force)
+    t, x = excitation(name, sensor.fs_internal, seed)
+    if duration is not None:
+        if not 0 < duration:
+            raise ValueError(f"duration must be positive, got {duration}")
+        keep = t <= duration + 1e-12
+        t, x = t[keep], x[keep]
+    if t.size < 8:
+        raise ValueError("duration too short: fewer than 8 internal samples")
+    rng = np.random.default_rng(seed)
+    r = sensor.resistances(x, t, rng)  # same draws as VirtualSensor.record for this seed
+    n = int(np.floor(t[-1] * scope.fs + 1e-9)) + 1
+    coef = np.stack([CubicSpline(t, row).c for row in (x, r[0], r[1])])
+    step = sensor.encoder_mm
+    count0 = int(np.round(x[0] / step))
+    fault_rng = np.random.default_rng([seed, 0xFA17])
+    missed = _choose_missed(t, x, step, scope.n_missed_states, fault_rng)
+    # Spikes after the first 1 % of samples, so the first sample (it sets the state) is clean.
+    spikes = np.sort(n // 100 + fault_rng.choice(n - n // 100, scope.n_spikes, replace=False)) \
+        if scope.n_spikes else np.zeros(0, dtype=np.int64)
+    columns = ("time", "v1", "v2") + (("encoder",) if scope.encoder_mode == "merged"
+                                      else ("enc_a", "enc_b"))
+    edge_state = np.zeros(1 if scope.encoder_mode == "merged" else 2) + np.nan
+    a_edge = np.exp(-1.0 / (scope.fs * scope.edge_tau)) if scope.edge_tau > 0 else 0.0
+    with RawWriter(path, columns, force=force) as writer:
+        for b, start in enumerate(range(0, n, _BLOCK)):
+            ts = np.arange(start, min(n, start + _BLOCK)) / scope.fs
+            noise = np.random.default_rng([seed, 0x5C0E, b])
+            pos, r1, r2 = _spline_at(coef, sensor.fs_internal, ts)
+            counts = np.round(pos / step).astype(np.int64)
+            codes = count_to_code(counts)
+            for t_missed, hidden, direction in missed:
+                hide = (counts == hidden) & (np.abs(ts - t_missed) < 0.5 / sensor.fs_internal)
+                codes[hide] = count_to_code(np.array([hidden - direction]))[0]
+            chunk = {"time": ts}
+            for g, rg in enumerate((r1, r2)):
+                chunk[f"v{g + 1}"] = (bridge_voltage(rg, scope.r_bridge, scope.v_supply)
+                                      + scope.bridge_noise_v * noise.standard_normal(ts.size))
+            scale = 1 + scope.supply_drift * np.sin(2 * np.pi * ts / scope.drift_period)
+            local = spikes[(spikes >= start) & (spikes < start + ts.size)] - start
+            if scope.encoder_mode == "merged":
+                ideal = np.take_along_axis(
+                    merged_levels(scope)[np.newaxis], codes[np.newaxis], 1)[0] * scale
+                signals = [ideal]
+            else:
+                signals = [np.where(bit, scope.logic_high, scope.logic_low) * scale
+                           for bit in code_to_ab(codes)]
+            for j, (col, ideal) in enumerate(zip(columns[3:], signals)):
+                shaped = _one_pole(ideal, a_edge, edge_state[j])
+                edge_state[j] = shaped[-1]
+                if local.size and j == 0:  # spikes: one sample jumps to another level
+                    shaped[local] = ideal[local] + np.where(ideal[local] > ideal.mean(), -1, 1) \
+                        * 0.6 * (scope.logic_high - scope.logic_low)
+                chunk[col] = shaped + scope.encoder_noise_v * noise.standard_normal(ts.size)
+            writer.write(**chunk)
+    um = sensor.encoder_mm * 1e3
+    config = {"r_bridge": scope.r_bridge, "v_supply": scope.v_supply, "fs": scope.fs,
+              "n_samples": n, "um_per_count": um}
+    if scope.encoder_mode == "merged":
+        config["encoder_states"] = [format(q, "02b") for q in DEFAULT_STATES]
+    notes = {"excitation": name, "seed": seed, "duration_s": float(t[-1]),
+             "bridge_noise_v": scope.bridge_noise_v, "encoder_noise_v": scope.encoder_noise_v,
+             "edge_tau_s": scope.edge_tau, "supply_drift": scope.supply_drift,
+             "missed_states": len(missed), "spikes": int(spikes.size),
+             "age_hours": sensor.age_hours,
+             "base_resistance_ohm": [float(v) for v in sensor.base_resistance]}
+    comment = (f"hystkit raw recording: virtual sensor, {EXPERIMENTS[name].description}\n"
+               f"read by 'hystkit preprocess {path.name}'")
+    write_raw_config(config_path, {**config, "simulation": notes}, comment=comment, force=force)
+    return RawTruth(time=t, position=x, resistance=r, fs_internal=sensor.fs_internal,
+                    count0=count0, encoder_mm=step, n_samples=n, fs=scope.fs,
+                    missed=np.array([(m[0], m[1]) for m in missed]).reshape(-1, 2),
+                    spikes=spikes)
+
+
+def _choose_missed(t: np.ndarray, x: np.ndarray, step: float, n_missed: int,
+                   rng: np.random.Generator) -> list[tuple[float, int, int]]:
+    """Internal steps in which the position moves monotonically over >= 3 counts; in each, the
+    first count passed is hidden. Returns (centre time [s], hidden count, direction)."""
+    if n_missed == 0:
+        return []
+    counts = np.round(x / step).astype(np.int64)
+    dx = np.diff(counts)
+    velocity = np.gradient(x)
+    ok = (np.abs(dx) >= 3) & (np.sign(velocity[:-1]) == np.sign(dx)) \
+        & (np.sign(velocity[1:]) == np.sign(dx))
+    candidates = np.flatnonzero(ok)[2:]
+    if candidates.size < n_missed:
+        raise ValueError(f"cannot inject {n_missed} missed states: only {candidates.size} "
+                         "places move fast enough (use a longer or faster excitation)")
+    chosen = np.sort(rng.choice(candidates, n_missed, replace=False))
+    return [(0.5 * (t[i] + t[i + 1]), int(counts[i] + np.sign(dx[i])), int(np.sign(dx[i])))
+            for i in chosen]
+
+
+@njit(cache=True)
+def _spline_at(coef, fs_internal, ts):
+    """Evaluate cubic splines (rows of CubicSpline.c stacked) on a uniform knot grid at `ts`."""
+    n_rows, _, n_knots = coef.shape
+    out = np.empty((n_rows, ts.size))
+    h = 1.0 / fs_internal
+    for j in range(ts.size):
+        i = min(int(ts[j] * fs_internal), n_knots - 1)
+        dx = ts[j] - i * h
+        for r in range(n_rows):
+            out[r, j] = ((coef[r, 0, i] * dx + coef[r, 1, i]) * dx + coef[r, 2, i]) * dx \
+                + coef[r, 3, i]
+    return out
+
+
+@njit(cache=True)
+def _one_pole(u, a, y0):
+    """First-order lag ``y[n] = a y[n-1] + (1 - a) u[n]`` from state y0 (NaN: start at u[0])."""
+    y = np.empty_like(u)
+    prev = u[0] if np.isnan(y0) else y0
+    for n in range(u.size):
+        prev = a * prev + (1.0 - a) * u[n]
+        y[n] = prev
+    return y
