@@ -106,3 +106,13 @@ def test_estimator_contract(recordings):
         est.predict(val_rec)
     assert est.fit(fit_rec) is est
     assert est.score(val_rec) == pytest.approx(evaluate(est.compensator_, val_rec)["r2"])
+
+
+def test_constant_estimate_has_no_loop_area(recordings):
+    """A compensator that outputs a constant is a (bad) result, not a crash: area undefined."""
+    fit_rec, val_rec = recordings["sine"]
+    comp = fit_compensator(fit_rec, 1)
+    flat = type(comp)(**{**comp.__dict__, "params": type(comp.params)(
+        i_s=comp.params.i_s, v_t=comp.params.v_t, w=[0.0, 0.0], v_b=0.0)})
+    scores = evaluate(flat, val_rec)
+    assert scores["loop_area"] is None and scores["r2"] < 0.01

@@ -40,9 +40,14 @@ def evaluate(compensator: Compensator, recording: Recording) -> dict:
         scores[f"{prefix}e_rms_pct"] = e_rms_pct(position, guess, scale=scale)
         scores[f"{prefix}e_max_pct"] = e_max_pct(position, guess, scale=scale)
         scores[f"{prefix}sinad_db"] = _sinad_or_none(guess, recording.fs)
-        scores[f"{prefix}loop_area"] = loop_area(position, guess)
-    scores["sensor_loop_area"] = loop_area(position, recording.sensor)
+        scores[f"{prefix}loop_area"] = _loop_area_or_none(position, guess)
+    scores["sensor_loop_area"] = _loop_area_or_none(position, recording.sensor)
     return scores
+
+
+def _loop_area_or_none(x: np.ndarray, y: np.ndarray) -> float | None:
+    """eq. 5.15 normalises by the range of y: undefined (None) for a constant estimate."""
+    return None if np.ptp(y) == 0 else loop_area(x, y)
 
 
 def _sinad_or_none(x: np.ndarray, fs: float) -> float | None:

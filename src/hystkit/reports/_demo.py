@@ -41,7 +41,7 @@ def format_table(metrics: dict, title: str, reference: dict | None = None) -> st
     lines = [title, head]
     for name, m in metrics.items():
         row = (f"{name:<11}{m['r2']:>9.4f}{m['linear_r2']:>9.4f}{m['e_rms_pct']:>9.2f}"
-               f"{m['loop_area']:>13.2f}")
+               f"{'-' if m['loop_area'] is None else format(m['loop_area'], '.2f'):>13}")
         if reference and name in reference:
             row += f"{reference[name][0]:>15.3f} / {reference[name][1]:.3f}"
         lines.append(row)
