@@ -18,6 +18,7 @@ from ..control import (
     MASS,
     PID,
     SCHEMES,
+    TABLE_II_SENSORS,
     TRAININGS,
     DisturbanceObserver,
     Plant,
@@ -33,6 +34,7 @@ from ..control import (
     plot_cases,
     plot_response,
     run_experiment,
+    table_ii_sensor,
     tune_pid,
 )
 from ..io import check_output_path, read_recording, write_json
@@ -55,10 +57,12 @@ def _positive_float(text: str) -> float:
 
 @functools.lru_cache(maxsize=4)
 def _models(training: str, excitation: str, sensor_cells: int, model_cells: int | None,
-            sensor_data: Path | None = None, training_data: Path | None = None) -> SensorModels:
+            sensor_data: Path | None = None, training_data: Path | None = None,
+            sensor: str = "virtual") -> SensorModels:
     # In-memory only, per process (repeated main() calls in one session, e.g. tests); nothing
     # is cached on disk, so every command line fits its models afresh (about 2 s).
     return fit_sensor_models(
+        sensor=None if sensor == "virtual" else table_ii_sensor(sensor.removeprefix("table-ii-")),
         training=training, training_excitation=excitation, sensor_cells=sensor_cells,
         model_cells=model_cells,
         sensor_recording=None if sensor_data is None else read_recording(sensor_data),
@@ -115,9 +119,13 @@ def _control(args: argparse.Namespace) -> int:
     paths = _outputs(args, out)
     for path in paths:  # refuse before any work
         check_output_path(path, args.force)
+    if args.sensor != "virtual" and args.sensor_data is not None:
+        raise UsageError("--sensor-data fits S_r on a recording; it cannot be combined with "
+                         f"--sensor {args.sensor}")
+    training = args.training or ("recording" if args.sensor == "virtual" else "loop")
     t_start = time.perf_counter()
-    models = _models(args.training, args.training_excitation, args.sensor_cells,
-                     args.model_cells, args.sensor_data, args.training_data)
+    models = _models(training, args.training_excitation, args.sensor_cells,
+                     args.model_cells, args.sensor_data, args.training_data, args.sensor)
     if args.compensator is not None:
         models = replace(models, compensator=compensator_block(load_compensator(
             args.compensator), name="S_m^comp"), info={**models.info,
@@ -141,7 +149,7 @@ def _control(args: argparse.Namespace) -> int:
              f"UNSTABLE (max |pole| {margins.max_pole_radius:.10f}: grows e-fold in "
              f"{margins.growth_time_s:.3g} s)"))
     config = {
-        "hystkit_version": __version__, "scheme": args.scheme, "experiment": args.experiment,
+        "hystkit_version": __version__, "scheme": args.scheme, "sensor": args.sensor, "experiment": args.experiment,
         "ts": loop.ts, "mass": loop.plant.mass, "u_max": loop.plant.u_max
         if np.isfinite(loop.plant.u_max) else None,
         "pid": {"kp": p.kp, "ti": p.ti if np.isfinite(p.ti) else None, "td": p.td, "tf": p.tf,
@@ -230,9 +238,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mass", type=_positive_float, default=MASS, help="moving mass [kg]")
     p.add_argument("--u-max", type=_positive_float, default=np.inf,
                    help="actuator force limit [N] (default none)")
-    p.add_argument("--training", choices=TRAININGS, default="recording",
-                   help="compensator / S_m data: a virtual-sensor recording (default) or "
-                        "S_r's own response to the sine (the document's protocol)")
+    p.add_argument("--sensor", choices=("virtual", *TABLE_II_SENSORS), default="virtual",
+                   help="S_r: an mPL fitted on the virtual sensor's noise run (default) or a "
+                        "column of paper 9.2's table II run as a sensor (its inverse; "
+                        "table-ii-noise is the document's S_r, fig. 7.2)")
+    p.add_argument("--training", choices=TRAININGS, default=None,
+                   help="compensator / S_m data: a virtual-sensor recording (default with "
+                        "--sensor virtual) or S_r's own response to the sine (the document's "
+                        "protocol; default with a table-II sensor)")
     p.add_argument("--training-excitation", choices=sorted(EXCITATIONS), default="sine",
                    help="excitation of the training recording (default sine, 0.5 Hz 3 mm)")
     p.add_argument("--sensor-data", type=Path,
@@ -242,7 +255,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="recording to fit the compensator and S_m on instead of the virtual "
                         "sensor's")
     p.add_argument("--compensator", type=Path,
-                   help="use this compensator model file (from 'hystkit fit') in the loop")
+                   help="use this compensator model file (from 'hystkit fit', family mpl or "
+                        "mpl-poly, direct or inverse mode) in the loop")
     p.add_argument("--sensor-cells", type=positive_int, default=3, help="mPL cells of S_r")
     p.add_argument("--model-cells", type=positive_int,
                    help="mPL cells of compensator and S_m (default 3; 1 with --training loop)")

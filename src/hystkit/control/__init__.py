@@ -43,6 +43,7 @@ from ._loop import (
 )
 from ._nlsys import as_nlsys, loop_initial_state, loop_nlsys
 from ._plots import plot_bode, plot_cases, plot_response
+from ._poly import TABLE_II_SENSORS
 from ._sensors import (
     TRAININGS,
     SensorBlock,
@@ -52,6 +53,7 @@ from ._sensors import (
     fit_sensor_models,
     forward_block,
     linear_block,
+    table_ii_sensor,
 )
 
 __all__ = [
@@ -64,6 +66,7 @@ __all__ = [
     "MASS",
     "PID",
     "SCHEMES",
+    "TABLE_II_SENSORS",
     "TRAININGS",
     "TS",
     "Case",
@@ -100,6 +103,7 @@ __all__ = [
     "simulate_loop",
     "simulate_loop_reference",
     "sine_reference",
+    "table_ii_sensor",
     "tare",
     "tune_pid",
 ]

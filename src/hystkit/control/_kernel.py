@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit
 
 from ..models._mpl_kernels import _current
+from ..models._mpl_poly_kernels import _cell, _cubic, solve_output
 from ._sensors import BLOCK_HEADER
 
 N_FIXED = 10
@@ -29,17 +30,54 @@ STOP_REASONS = {1: "plant position non-finite or beyond the position limit",
                 3: "sensor, model or compensator signal non-finite"}
 
 
+@njit(cache=True)
+def _poly_block(blk, x, xn, off, u):
+    """Polynomial mPL step in normalised units (layout: ``_poly.pack_body``).
+
+    Forward: ``y = g(w0 u + sum w_k x_k - V_b)`` (eq. 5.17), cells driven by ``u``. Inverse:
+    ``z = g^-1(u)`` on the rest branch (safeguarded Newton, as ``mpl_poly.invert``), ``u_hat =
+    (z - sum w_k x_k + V_b) / w0``, cells driven by ``u_hat``; NaN if ``u`` is outside the
+    branch's range (the loop then stops).
+    """
+    n = int(blk[0])
+    h = BLOCK_HEADER
+    limit = blk[h] != 0.0
+    ig, i_f = h + 5, h + 9
+    ik, iw = i_f + 4 * n, i_f + 6 * n
+    if blk[1] == 0.0:
+        z = blk[iw] * u - blk[2]
+        for k in range(n):
+            z += blk[iw + 1 + k] * x[off + k]
+        out, _ = _cubic(blk[ig], blk[ig + 1], blk[ig + 2], blk[ig + 3], z)
+        drive = u
+    else:
+        z, ok = solve_output(u, blk[ig:ig + 4], blk[h + 1], blk[h + 2], blk[h + 3], blk[h + 4])
+        acc = z + blk[2]
+        for k in range(n):
+            acc -= blk[iw + 1 + k] * x[off + k]
+        out = acc / blk[iw] if ok else np.nan
+        drive = out
+    for k in range(n):
+        f, _ = _cell(drive - x[off + k], blk[i_f + 4 * k:i_f + 4 * k + 4], blk[ik + 2 * k],
+                     blk[ik + 2 * k + 1], blk[3], limit)
+        xn[off + k] = x[off + k] + f * blk[4]
+    return out
+
+
 @njit(cache=True, inline="always")
 def _block(blk, x, xn, off, u_in):
     """One mPL block step: output from ``x``, next cell states written to ``xn``.
 
     Forward: ``y = w0 u + sum w_k x_k - V_b`` (eq. 5.2), cells driven by ``u``. Inverse:
     ``u_hat = (y + V_b - sum w_k x_k) / w0`` (eq. 5.13), cells driven by ``u_hat`` (fig. 5.12).
+    The polynomial mPL (``blk[9] == 1``) is :func:`_poly_block`.
     """
     n = int(blk[0])
     h = BLOCK_HEADER
     iw = h + 3 * n
     u = blk[5] * u_in + blk[6]
+    if blk[9] != 0.0:
+        return blk[7] * _poly_block(blk, x, xn, off, u) + blk[8]
     if blk[1] == 0.0:
         acc = blk[iw] * u - blk[2]
         for k in range(n):

@@ -54,6 +54,16 @@ def as_nlsys(model: Model, dt: float = TS, *, name: str | None = None, input: st
     """
     block = _as_block(model)
     name = block.name if name is None else name
+    if block.is_poly:  # the readable block step, as the plain-Python reference loop
+        def update_poly(t, x, u, params):
+            return block.step(x, u[0], dt)[1]
+
+        def out_poly(t, x, u, params):
+            return np.array([block.step(x, u[0], dt)[0]])
+
+        return control.nlsys(update_poly, out_poly, inputs=[input], outputs=[output],
+                             states=[f"{name}_x{k}" for k in range(block.n_cells)], dt=dt,
+                             name=name)
     p = block.params
     knee = mpl.knee_voltage(block.at(dt), p)
     cap = block.structure.slope_cap / dt

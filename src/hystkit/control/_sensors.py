@@ -32,8 +32,9 @@ from ..errors import InputError
 from ..identification import fit_mpl
 from ..io import Recording
 from ..models import _mpl_kernels as mpl_kernels
-from ..models import mpl
+from ..models import mpl, mpl_poly
 from ..sensors import simulate_experiment
+from . import _poly
 
 __all__ = [
     "BLOCK_HEADER",
@@ -45,12 +46,14 @@ __all__ = [
     "fit_sensor_models",
     "forward_block",
     "linear_block",
+    "table_ii_sensor",
 ]
 
-BLOCK_HEADER = 9
+BLOCK_HEADER = 10
 """Packed block layout for the kernel: ``[n, inverse, v_b, cap, dt, a_in, b_in, a_out, b_out,
-i_s (n), v_t (n), knee (n), w (n + 1)]``; the affine maps are ``u_norm = a_in u + b_in`` and
-``out = a_out y_norm + b_out``."""
+kind, ...]``; the affine maps are ``u_norm = a_in u + b_in`` and ``out = a_out y_norm + b_out``.
+``kind`` 0, the sinh mPL: ``i_s (n), v_t (n), knee (n), w (n + 1)`` follow; ``kind`` 1, the
+polynomial mPL: the body of :func:`hystkit.control._poly.pack_body`."""
 
 MM = 1e-3  # recordings hold position in mm; the loop works in metres
 
@@ -61,9 +64,10 @@ class SensorBlock:
 
     Parameters
     ----------
-    structure : MplStructure
+    structure : MplStructure or MplPolyStructure
         As fitted (its ``dt`` is the fitting sample time; the loop re-runs it at ``Ts``).
-    params : MplParams
+    params : MplParams or MplPolyParams
+        The sinh mPL (eq. 5.2) or the polynomial mPL (eq. 5.16-5.17, :mod:`._poly`).
     inverse : bool
         Run the analytical inverse (eq. 5.13-5.14) instead of the model itself (a compensator
         fitted in inverse mode).
@@ -76,8 +80,8 @@ class SensorBlock:
         Provenance: training source, fit cost and R^2 (free-form, JSON-safe).
     """
 
-    structure: mpl.MplStructure
-    params: mpl.MplParams
+    structure: mpl.MplStructure | mpl_poly.MplPolyStructure
+    params: mpl.MplParams | mpl_poly.MplPolyParams
     inverse: bool = False
     in_offset: float = 0.0
     in_scale: float = 1.0
@@ -87,6 +91,8 @@ class SensorBlock:
     info: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        if self.is_poly != isinstance(self.structure, mpl_poly.MplPolyStructure):
+            raise ValueError("structure and params belong to different model families")
         if self.params.n_cells != self.structure.n_cells:
             raise ValueError(f"params have {self.params.n_cells} cells, structure has "
                              f"{self.structure.n_cells}")
@@ -102,8 +108,16 @@ class SensorBlock:
     def n_cells(self) -> int:
         return self.structure.n_cells
 
-    def at(self, dt: float) -> mpl.MplStructure:
-        """The model's structure re-stepped at ``dt`` (same cells and slope cap)."""
+    @property
+    def is_poly(self) -> bool:
+        """True for the polynomial mPL (``mpl-poly``), False for the sinh mPL."""
+        return isinstance(self.params, mpl_poly.MplPolyParams)
+
+    def at(self, dt: float):
+        """The model's structure re-stepped at ``dt`` (same cells, slope cap and limit)."""
+        if self.is_poly:
+            return mpl_poly.MplPolyStructure(self.structure.n_cells, dt,
+                                             self.structure.slope_cap, self.structure.limit)
         return mpl.MplStructure(self.structure.n_cells, dt, self.structure.slope_cap)
 
     def rest_state(self, u_in: float) -> np.ndarray:
@@ -113,6 +127,8 @@ class SensorBlock:
         estimate, and at rest ``u_hat = (y + V_b) / sum(w)``, as :func:`mpl.invert` starts.
         """
         v = (u_in - self.in_offset) / self.in_scale
+        if self.is_poly:
+            return _poly.rest_state(self.structure, self.params, self.inverse, float(v))
         if self.inverse:
             w_sum = float(np.sum(self.params.w))
             v = (v + self.params.v_b) / w_sum if w_sum != 0 else 0.0
@@ -122,7 +138,9 @@ class SensorBlock:
         """One sample (readable reference): output from the present state, then the update."""
         u = (u_in - self.in_offset) / self.in_scale
         structure = self.at(dt)
-        if self.inverse:
+        if self.is_poly:
+            y, x_next = _poly.step(structure, self.params, self.inverse, x, u)
+        elif self.inverse:
             y, x_next = mpl.invert_step(structure, self.params, x, u)
         else:
             y, x_next = mpl.step(structure, self.params, x, u)
@@ -140,19 +158,24 @@ class SensorBlock:
         u_in = np.asarray(u_in, dtype=float)
         x0 = self.rest_state(float(u_in[0])) if x0 is None else x0
         u = (u_in - self.in_offset) / self.in_scale
-        run = mpl.invert if self.inverse else mpl.simulate
-        y, x_end = run(self.at(dt), self.params, u, x0)
+        if self.is_poly:
+            y, x_end = _poly.simulate(self.at(dt), self.params, self.inverse, u, x0)
+        else:
+            run = mpl.invert if self.inverse else mpl.simulate
+            y, x_end = run(self.at(dt), self.params, u, x0)
         return self.out_scale * y + self.out_offset, x_end
 
     def pack(self, dt: float) -> np.ndarray:
         """Flat float64 array for the compiled loop (layout :data:`BLOCK_HEADER`)."""
         s = self.at(dt)
         p = self.params
+        header = [p.n_cells, float(self.inverse), p.v_b, s.slope_cap / dt, dt,
+                  1.0 / self.in_scale, -self.in_offset / self.in_scale, self.out_scale,
+                  self.out_offset, float(self.is_poly)]
+        if self.is_poly:
+            return np.concatenate([header, _poly.pack_body(s, p)]).astype(np.float64)
         knee = mpl.knee_voltage(s, p)
-        return np.concatenate([
-            [p.n_cells, float(self.inverse), p.v_b, s.slope_cap / dt, dt,
-             1.0 / self.in_scale, -self.in_offset / self.in_scale, self.out_scale,
-             self.out_offset], p.i_s, p.v_t, knee, p.w]).astype(np.float64)
+        return np.concatenate([header, p.i_s, p.v_t, knee, p.w]).astype(np.float64)
 
     def linearise(self, x: np.ndarray, u_in: float,
                   dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -164,6 +187,10 @@ class SensorBlock:
         """
         x = np.asarray(x, dtype=float)
         u = (u_in - self.in_offset) / self.in_scale
+        if self.is_poly:
+            a, b, c, d = _poly.linearise(self.at(dt), self.params, self.inverse, x, u)
+            return (a, b / self.in_scale, self.out_scale * c,
+                    self.out_scale * d / self.in_scale)
         p = self.params
         s = self.at(dt)
         knee = mpl.knee_voltage(s, p)
@@ -289,7 +316,8 @@ def fit_sensor_models(*, training: str = "recording", sensor_cells: int = 3,
                       model_cells: int | None = None, sensor_seed: int = 1,
                       training_seed: int = 2, training_excitation: str = "sine",
                       sensor_recording: Recording | None = None,
-                      training_recording: Recording | None = None) -> SensorModels:
+                      training_recording: Recording | None = None,
+                      sensor: SensorBlock | None = None) -> SensorModels:
     """Fit ``S_r``, the compensator and ``S_m`` as the document's ch. 7 does (about 2 s).
 
     ``S_r`` is a forward mPL fitted on the sensor recording (default: the virtual sensor's noise
@@ -317,6 +345,9 @@ def fit_sensor_models(*, training: str = "recording", sensor_cells: int = 3,
         1 for ``loop``).
     sensor_recording, training_recording : Recording, optional
         Use these instead of the virtual sensor's.
+    sensor : SensorBlock, optional
+        A ready ``S_r`` (e.g. :func:`table_ii_sensor`) instead of a fit; its ``fit_dt`` is the
+        rate of the ``loop`` training run.
 
     Raises
     ------
@@ -326,9 +357,13 @@ def fit_sensor_models(*, training: str = "recording", sensor_cells: int = 3,
     if training not in TRAININGS:
         raise ValueError(f"training must be one of {TRAININGS}, got {training!r}")
     model_cells = (3 if training == "recording" else 1) if model_cells is None else model_cells
-    rec_r = simulate_experiment("noise", sensor_seed) if sensor_recording is None \
-        else sensor_recording
-    s_r = fit_forward_sensor(rec_r, sensor_cells, name="S_r")
+    if sensor is not None:
+        s_r, sensor_source = sensor, sensor.info.get("source", sensor.name)
+        sensor_cells = sensor.n_cells
+    else:
+        rec_r = simulate_experiment("noise", sensor_seed) if sensor_recording is None \
+            else sensor_recording
+        s_r, sensor_source = fit_forward_sensor(rec_r, sensor_cells, name="S_r"), rec_r.source
     if training_recording is not None:
         rec_t = training_recording
     elif training == "recording":
@@ -349,8 +384,18 @@ def fit_sensor_models(*, training: str = "recording", sensor_cells: int = 3,
             raise InputError(f"S_m reproduces S_r exactly (max difference {gap:.1e}): identical "
                              f"models make an unrealistic identity (sec. 6.2.2); use fewer "
                              f"model cells than the sensor's {sensor_cells}")
-    info = {"training": training, "sensor_source": rec_r.source,
+    info = {"training": training, "sensor_source": sensor_source,
             "training_source": rec_t.source, "sensor_cells": sensor_cells,
             "model_cells": model_cells}
     return SensorModels(s_r, compensator_block(comp, name="S_m^comp"), s_m,
                         s_m.info["m_per_sensor_unit"], info)
+
+
+def table_ii_sensor(column: str = "noise") -> SensorBlock:
+    """Paper 9.2's table II ``column`` as ``S_r``: the inverse of that sensor -> position fit.
+
+    Position [m] in (normalised by the assumed 3 mm), the paper's normalised sensor out (spans
+    about +-1 on full-range motion). See :func:`hystkit.control._poly.table_ii_block` and
+    docs/control.md section 2.
+    """
+    return _poly.table_ii_block(column)
