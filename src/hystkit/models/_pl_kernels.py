@@ -1,0 +1,110 @@
+"""Compiled hot loops of the Power-Law model; ``pl.py`` holds the readable reference and checks.
+
+All arrays are float64 and already validated by the caller. Per cell ``k`` (0-based here, cell
+``k + 1`` of the document) ``thr[k] = (k + 1) V_T`` is the threshold of eq. 2.16 and ``knee[k]``
+(<= ``thr[k]``) the voltage where the power law hands over to the straight branch of slope
+``g_lin`` (see ``pl.py``). ``brk`` holds the M + 1 breakpoints of the output basis (eq. 2.17).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def _current(v, i_t, thr, knee, power, g_lin):
+    """Cell resistor current: odd power law inside the knee (eq. 2.16), straight line outside."""
+    a = abs(v)
+    s = 1.0 if v >= 0 else -1.0
+    scale = i_t / (power - 1.0)
+    if a <= knee:
+        return s * scale * (a / thr) ** power
+    return s * (scale * (knee / thr) ** power + g_lin * (a - knee))
+
+
+@njit(cache=True, inline="always")
+def _f_inverse(u, brk, a):
+    """``i = f^-1(u)`` for the increasing PWL ``f = sum a_j phi_j`` with ``f(0) = 0`` (eq. 2.18)."""
+    m = a.size
+    # f at the left end of each segment, accumulated from i = 0 (phi_j(0) = 0)
+    j0 = 0
+    while j0 < m - 1 and brk[j0 + 1] <= 0.0:
+        j0 += 1
+    # walk right or left from the segment that holds i = 0
+    j, f_left, i_left = j0, 0.0, 0.0
+    if u >= 0.0:
+        while j < m - 1 and f_left + a[j] * (brk[j + 1] - i_left) < u:
+            f_left += a[j] * (brk[j + 1] - i_left)
+            i_left = brk[j + 1]
+            j += 1
+        return i_left + (u - f_left) / a[j]
+    while j > 0 and f_left - a[j] * (i_left - brk[j]) > u:
+        f_left -= a[j] * (i_left - brk[j])
+        i_left = brk[j]
+        j -= 1
+    return i_left + (u - f_left) / a[j]
+
+
+@njit(cache=True, inline="always")
+def _f(i, brk, a):
+    """``u = f(i) = sum_j a_j phi_j(i)`` with ``phi_j(i) = clip(i, b_j-1, b_j) - clip(0, ...)``,
+    the outermost segments unbounded (eq. 2.17)."""
+    m = a.size
+    total = 0.0
+    for j in range(m):
+        lo = -np.inf if j == 0 else brk[j]
+        hi = np.inf if j == m - 1 else brk[j + 1]
+        total += a[j] * (min(max(i, lo), hi) - min(max(0.0, lo), hi))
+    return total
+
+
+@njit(cache=True)
+def states(u, x0, i_t, thr, knee, power, g_lin, dt):
+    """Cell voltages seen at each sample (before that sample's update), shape (n, N)."""
+    n_cells = x0.size
+    x = x0.copy()
+    out = np.empty((u.size, n_cells))
+    for n in range(u.size):
+        for k in range(n_cells):
+            out[n, k] = x[k]
+            x[k] += _current(u[n] - x[k], i_t, thr[k], knee[k], power, g_lin) * dt
+    return out, x
+
+
+@njit(cache=True)
+def simulate(u, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
+    n_cells = x0.size
+    x = x0.copy()
+    y = np.empty(u.size)
+    for n in range(u.size):
+        acc = w[0] * u[n] - v_b
+        for k in range(n_cells):
+            acc += w[k + 1] * x[k]
+        y[n] = _f_inverse(acc, brk, a)
+        for k in range(n_cells):
+            x[k] += _current(u[n] - x[k], i_t, thr[k], knee[k], power, g_lin) * dt
+    return y, x
+
+
+@njit(cache=True)
+def invert(y, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
+    """Inverse model (eq. 2.20 after ``u = f(i)``): output first, then the state update.
+
+    Returns the index of the first sample that left the finite range, or -1.
+    """
+    n_cells = x0.size
+    x = x0.copy()
+    e_hat = np.empty(y.size)
+    bound = 1e6 * (1.0 + np.max(np.abs(y)))
+    for n in range(y.size):
+        acc = _f(y[n], brk, a) + v_b
+        for k in range(n_cells):
+            acc -= w[k + 1] * x[k]
+        e = acc / w[0]
+        if not abs(e) < bound:
+            return e_hat, x, n
+        e_hat[n] = e
+        for k in range(n_cells):
+            x[k] += _current(e - x[k], i_t, thr[k], knee[k], power, g_lin) * dt
+    return e_hat, x, -1

@@ -1,0 +1,365 @@
+"""Power-Law (PL) model of hysteresis and creep as published (Biggio, Oliveri, Stellino, Parodi,
+Storace), sec. 2.1.7 of the reference document, eq. 2.16-2.18 and table 5.1.
+
+Sub-circuit (a): ``N`` cells, each a capacitor ``C = 1`` charged from the source ``e`` through a
+non-linear resistor ``d_k``; sub-circuit (b): VCVS weights, a bias and a non-linear output
+resistor ``u = f(i)``::
+
+    du_k/dt = d_k(e - u_k)                                                  # KCL, C = 1
+    d_k(v)  = I_T / (p - 1) sign(v) |v / (k V_T)|^p        for |v| <= k V_T  # eq. 2.16
+            = d_k(k V_T) sign(v) + G (|v| - k V_T) sign(v) beyond            # straight branch
+    u       = w_0 e + sum_k w_k u_k - V_b                                   # eq. 2.18
+    f(i)    = sum_j a_j phi_j(i)                                            # eq. 2.17
+    y = i   = f^-1(u)                                                       # model output
+
+Readings of the text (documented in docs/models/pl.md):
+
+* eq. 2.16 writes ``(u_k / k V_t)^p`` with "p odd"; the odd extension ``sign(v) |v|^p`` is used so
+  that any real ``p > 1`` (the toolbox's p = 20 of table 5.1 included) gives an odd, increasing
+  resistor. The voltage is the resistor's, ``e - u_k`` (eq. 5.5 of the mPL descendant).
+* The thresholds ``k V_T`` grow linearly with the cell index (the driving points of fig. 2.17b).
+  Outside them the characteristic is "linear": its slope ``G`` is the steepest one forward Euler
+  tolerates, ``G = slope_cap / dt`` -- the discrete stand-in for the near-vertical branches of
+  the PWL ladder resistor (fig. 2.11), so that a cell driven beyond its threshold follows the
+  input within a sample (play-operator hysteresis, eq. 2.11) and creeps inside it.
+* Stability (eq. 5.28-5.29 of the mPL, applied here): where the power law's own slope would
+  exceed ``G`` (below the threshold, for a large ``I_T``), the straight branch starts earlier, at
+  the knee where the slopes are equal. With ``slope_cap <= 1`` each Euler step is monotone and
+  contracting, so every ``u_k`` stays within the range of the input and the initial state.
+* eq. 2.17 writes ``phi_j(t)``; the basis functions are functions of the current ``i``. They are
+  the M "segment ramps" of a uniform partition of [-1, 1] (normalised data, eq. 5.10):
+  ``phi_j(i) = clip(i, b_j-1, b_j) - clip(0, b_j-1, b_j)``, the outermost two unbounded. So
+  ``f`` is the continuous PWL function through ``f(0) = 0`` whose slope on segment ``j`` is
+  ``a_j``; ``a_j > 0`` makes it strictly increasing, and ``f^-1`` exists in closed form.
+
+The state ``x`` is the vector of capacitor voltages ``u_k``. Everything here is pure.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import FitDivergedError
+from . import _pl_kernels as kernels
+
+__all__ = [
+    "PlParams",
+    "PlStructure",
+    "basis_breakpoints",
+    "invert",
+    "output_resistor",
+    "output_resistor_inverse",
+    "resistor_current",
+    "simulate",
+    "simulate_reference",
+    "states",
+    "step",
+]
+
+
+@dataclass(frozen=True)
+class PlStructure:
+    """Structural (not least-squares) parameters: N, p, M, S of the exhaustive search, and dt.
+
+    Parameters
+    ----------
+    n_cells : int
+        Cells ``N`` (>= 1).
+    power : float
+        Exponent ``p`` (> 1) of the cell resistors' middle part, eq. 2.16.
+    n_basis : int
+        Number ``M`` (>= 1) of PWL basis functions of the output resistor, eq. 2.17.
+    smoothing : float
+        ``S`` (>= 0): weight of the penalty on slope changes of ``f`` between neighbouring basis
+        segments in the weight fit (per sample, relative to the mean squared equation error);
+        it has no effect on simulation. Table 5.1 uses 0.001.
+    dt : float
+        Sample time [s].
+    slope_cap : float
+        ``G dt`` of the straight branches, the largest Euler slope (< 2, eq. 5.28; 1: no overshoot).
+    """
+
+    n_cells: int = 1
+    power: float = 21.0
+    n_basis: int = 1
+    smoothing: float = 0.001
+    dt: float = 0.025
+    slope_cap: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("n_cells", "n_basis"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or int(value) != value or value < 1:
+                raise ValueError(f"{name} must be a positive integer, got {value!r}")
+        if not (np.isfinite(self.power) and self.power > 1):
+            raise ValueError(f"power p must be > 1 (eq. 2.16 divides by p - 1), got {self.power!r}")
+        if not (np.isfinite(self.smoothing) and self.smoothing >= 0):
+            raise ValueError(f"smoothing S must be >= 0, got {self.smoothing!r}")
+        if not (np.isfinite(self.dt) and self.dt > 0):
+            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        if not 0 < self.slope_cap < 2:
+            raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step (eq. 5.28), "
+                             f"got {self.slope_cap!r}")
+
+    @property
+    def n_params(self) -> int:
+        """Parameters as table 5.1 counts them: w_0..w_N, V_b, a_1..a_M, I_T, V_T (N + M + 4).
+
+        One of them is redundant: scaling ``w``, ``V_b`` and ``a`` together leaves ``i`` unchanged;
+        the fit fixes the mean slope of ``f`` to 1.
+        """
+        return self.n_cells + self.n_basis + 4
+
+
+def _frozen(values, n: int, name: str) -> np.ndarray:
+    try:
+        arr = np.array(values, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be numbers, got {values!r}") from None
+    if arr.shape != (n,):
+        raise ValueError(f"{name} must have {n} values, got {arr.size}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class PlParams:
+    """Least-squares parameters of a PL model.
+
+    Parameters
+    ----------
+    i_t : float
+        Current ``I_T`` (> 0) of eq. 2.16 [1/s with C = 1 and normalised voltages].
+    v_t : float
+        Threshold step ``V_T`` (> 0); cell ``k`` has its threshold at ``k V_T``.
+    w : array, shape (N + 1,)
+        VCVS weights ``w_0 .. w_N``, eq. 2.18.
+    v_b : float
+        Bias ``V_b``, eq. 2.18.
+    a : array, shape (M,)
+        Slopes ``a_j`` (> 0) of the output resistor on its M segments, eq. 2.17.
+    """
+
+    i_t: float
+    v_t: float
+    w: np.ndarray
+    v_b: float = 0.0
+    a: np.ndarray = (1.0,)
+    n_cells: int = field(init=False)
+    n_basis: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "n_cells", int(np.size(self.w)) - 1)
+        object.__setattr__(self, "n_basis", int(np.size(self.a)))
+        if self.n_cells < 1 or self.n_basis < 1:
+            raise ValueError("w needs N + 1 >= 2 values and a at least one")
+        object.__setattr__(self, "w", _frozen(self.w, self.n_cells + 1, "w"))
+        object.__setattr__(self, "a", _frozen(self.a, self.n_basis, "a"))
+        for name in ("i_t", "v_t", "v_b"):
+            value = float(getattr(self, name))
+            if not np.isfinite(value):
+                raise ValueError(f"{name} must be finite, got {value}")
+            object.__setattr__(self, name, value)
+        if self.i_t <= 0 or self.v_t <= 0:
+            raise ValueError("i_t and v_t must be positive (eq. 2.16)")
+        if np.any(self.a <= 0):
+            raise ValueError("the output resistor slopes a_j must be positive (f invertible)")
+
+    def to_dict(self) -> dict:
+        return {"i_t": self.i_t, "v_t": self.v_t, "w": self.w.tolist(), "v_b": self.v_b,
+                "a": self.a.tolist()}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> PlParams:
+        return cls(i_t=d["i_t"], v_t=d["v_t"], w=d["w"], v_b=d["v_b"], a=d["a"])
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, PlParams):
+            return NotImplemented
+        return self.to_dict() == other.to_dict()
+
+    __hash__ = None
+
+
+def basis_breakpoints(n_basis: int) -> np.ndarray:
+    """Breakpoints ``b_0 .. b_M`` of the output basis: M equal segments of [-1, 1], eq. 2.17."""
+    return np.linspace(-1.0, 1.0, n_basis + 1)
+
+
+def _cells(structure: PlStructure, params: PlParams) -> tuple[np.ndarray, np.ndarray, float]:
+    """Thresholds ``k V_T``, knees (where the power law's slope reaches G) and G."""
+    g_lin = structure.slope_cap / structure.dt
+    p = structure.power
+    thr = params.v_t * np.arange(1, structure.n_cells + 1)
+    # d'(v) = p I_T / ((p - 1) thr) (v / thr)^(p - 1) = G  at  v = knee
+    knee = thr * (g_lin * (p - 1) * thr / (p * params.i_t)) ** (1.0 / (p - 1))
+    return thr, np.minimum(knee, thr), g_lin
+
+
+def resistor_current(structure: PlStructure, params: PlParams, v: np.ndarray) -> np.ndarray:
+    """Cell-resistor currents ``d_k(v)`` (eq. 2.16 with the straight branches).
+
+    Parameters
+    ----------
+    v : array, shape (..., N)
+        Voltage across each cell's resistor.
+
+    Returns
+    -------
+    array, shape (..., N)
+    """
+    v = np.asarray(v, dtype=float)
+    thr, knee, g_lin = _cells(structure, params)
+    a = np.abs(v)
+    scale = params.i_t / (structure.power - 1)
+    inside = scale * (np.minimum(a, knee) / thr) ** structure.power
+    return np.sign(v) * (inside + g_lin * np.maximum(a - knee, 0.0))
+
+
+def output_resistor(params: PlParams, i: np.ndarray) -> np.ndarray:
+    """``u = f(i) = sum_j a_j phi_j(i)`` (eq. 2.17), shape of ``i``."""
+    i = np.asarray(i, dtype=float)
+    brk = basis_breakpoints(params.n_basis)
+    lo = np.r_[-np.inf, brk[1:-1]]
+    hi = np.r_[brk[1:-1], np.inf]
+    phi = np.clip(i[..., None], lo, hi) - np.clip(0.0, lo, hi)
+    return phi @ params.a
+
+
+def output_resistor_inverse(params: PlParams, u: np.ndarray) -> np.ndarray:
+    """``i = f^-1(u)`` (eq. 2.18), exact: ``f`` is PWL and strictly increasing."""
+    u = np.asarray(u, dtype=float)
+    if params.n_basis == 1:
+        return u / params.a[0]
+    knots = basis_breakpoints(params.n_basis)[1:-1]
+    f_knots = output_resistor(params, knots)
+    seg = np.searchsorted(f_knots, u)  # segment j holds f values between f(b_j-1) and f(b_j)
+    ref = np.maximum(seg - 1, 0)  # a knot on segment j: its left end, or b_1 for the first
+    return knots[ref] + (u - f_knots[ref]) / params.a[seg]
+
+
+def step(structure: PlStructure, params: PlParams, x: np.ndarray,
+         e: float) -> tuple[float, np.ndarray]:
+    """One sample: output ``i = f^-1(w_0 e + sum w_k u_k - V_b)`` from the present state
+    (eq. 2.18), then the forward-Euler update of the cell voltages.
+
+    Returns
+    -------
+    y : float
+    x_next : array, shape (N,)
+    """
+    x = np.asarray(x, dtype=float)
+    u = params.w[0] * e + params.w[1:] @ x - params.v_b
+    y = float(output_resistor_inverse(params, u))
+    return y, x + resistor_current(structure, params, e - x) * structure.dt
+
+
+def _initial_state(n_cells: int, x0: np.ndarray | float | None, at_rest: float) -> np.ndarray:
+    if x0 is None:
+        return np.full(n_cells, float(at_rest))
+    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (n_cells,)).copy()
+    if not np.all(np.isfinite(x0)):
+        raise ValueError("x0 must be finite")
+    return x0
+
+
+def _check(structure: PlStructure, params: PlParams, u: np.ndarray, name: str) -> np.ndarray:
+    if params.n_cells != structure.n_cells or params.n_basis != structure.n_basis:
+        raise ValueError(f"params have N = {params.n_cells}, M = {params.n_basis}; the structure "
+                         f"has N = {structure.n_cells}, M = {structure.n_basis}")
+    u = np.ascontiguousarray(u, dtype=float)
+    if u.ndim != 1 or u.size == 0:
+        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
+    if not np.all(np.isfinite(u)):
+        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
+    return u
+
+
+def _kernel_args(structure: PlStructure, params: PlParams) -> tuple:
+    thr, knee, g_lin = _cells(structure, params)
+    return params.i_t, thr, knee, float(structure.power), g_lin, structure.dt
+
+
+def simulate(structure: PlStructure, params: PlParams, u: np.ndarray,
+             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the forward model (compiled kernel).
+
+    Parameters
+    ----------
+    u : array, shape (n,)
+        Source voltage ``e`` every ``structure.dt``.
+    x0 : array, shape (N,), float or None
+        Initial capacitor voltages; ``None`` starts at rest at the first input (``u_k = e_0``).
+
+    Returns
+    -------
+    y : array, shape (n,)
+        Output current ``i``.
+    x_end : array, shape (N,)
+        State after the last sample; passing it as ``x0`` continues the run exactly.
+    """
+    u = _check(structure, params, u, "u")
+    x = _initial_state(structure.n_cells, x0, u[0])
+    return kernels.simulate(u, x, *_kernel_args(structure, params), params.w, params.v_b,
+                            basis_breakpoints(structure.n_basis), params.a)
+
+
+def simulate_reference(structure: PlStructure, params: PlParams, u: np.ndarray,
+                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    u = _check(structure, params, u, "u")
+    x = _initial_state(structure.n_cells, x0, u[0])
+    y = np.empty_like(u)
+    for n, e in enumerate(u):
+        y[n], x = step(structure, params, x, e)
+    return y, x
+
+
+def states(structure: PlStructure, params: PlParams, u: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Capacitor voltages at every sample, shape (n, N), and the final state (weights unused)."""
+    u = _check(structure, params, u, "u")
+    x = _initial_state(structure.n_cells, x0, u[0])
+    return kernels.states(u, x, *_kernel_args(structure, params))
+
+
+def invert(structure: PlStructure, params: PlParams, y: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Analytical inverse (compensator): ``u = f(i)`` (closed form, eq. 2.17), then eq. 2.20
+    ``e = (u + V_b - sum w_k u_k) / w_0`` from the present state, then the cell update.
+
+    Parameters
+    ----------
+    y : array, shape (n,)
+        Output current ``i`` every ``structure.dt``.
+    x0 : array, shape (N,), float or None
+        Initial capacitor voltages; ``None``: at rest, ``u_k = e_0 = (f(i_0) + V_b) / sum(w)``.
+
+    Returns
+    -------
+    e_hat : array, shape (n,)
+    x_end : array, shape (N,)
+
+    Raises
+    ------
+    FitDivergedError
+        If ``w_0 = 0`` or the inverse leaves the finite range (its cells see the estimate, whose
+        feedback through ``-w_k / w_0`` is not stable for every weight set).
+    """
+    y = _check(structure, params, y, "y")
+    if params.w[0] == 0:
+        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 2.20)")
+    w_sum = params.w.sum()
+    rest = (float(output_resistor(params, y[0])) + params.v_b) / w_sum if w_sum != 0 else 0.0
+    x = _initial_state(structure.n_cells, x0, rest)
+    e_hat, x_end, n_bad = kernels.invert(y, x, *_kernel_args(structure, params), params.w,
+                                         params.v_b, basis_breakpoints(structure.n_basis),
+                                         params.a)
+    if n_bad >= 0:
+        raise FitDivergedError(f"the inverse PL model diverged at sample {n_bad} of {y.size}; "
+                               f"the fitted weights make the compensator unstable on this data")
+    return e_hat, x_end
