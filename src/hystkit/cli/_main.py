@@ -7,6 +7,7 @@ function; they are found here so that adding a capability does not edit a shared
 from __future__ import annotations
 
 import importlib
+import os
 import pkgutil
 import sys
 from collections.abc import Sequence
@@ -42,6 +43,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except HystkitError as exc:
         print(f"hystkit: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # The reader went away (`hystkit ... | head`): not our error. Point stdout at devnull so
+        # the interpreter's final flush does not raise again (Python docs, signal module).
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
 
 
 if __name__ == "__main__":
