@@ -15,7 +15,7 @@ import numpy as np
 
 from ..models import _mpl_kernels as kernels
 from ..models import mpl
-from ._least_squares import fit_multistart
+from ._least_squares import check_fit_data, fit_multistart
 from ._result import FitResult
 
 __all__ = ["default_starts", "fit_mpl"]
@@ -89,12 +89,7 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     FitDivergedError
         If no start gives a finite cost.
     """
-    u = np.ascontiguousarray(u, dtype=float)
-    y = np.ascontiguousarray(y, dtype=float)
-    if u.shape != y.shape or u.ndim != 1:
-        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
-    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
-        raise ValueError("u and y must be finite")
+    u, y = check_fit_data(u, y)
     n = structure.n_cells
     cap = structure.slope_cap / structure.dt
     x0 = np.full(n, u[0])

@@ -13,7 +13,30 @@ from threadpoolctl import threadpool_limits
 from ..errors import FitDivergedError
 from ._result import FitResult
 
-__all__ = ["fit_multistart"]
+__all__ = ["check_fit_data", "fit_multistart"]
+
+
+def check_fit_data(u: np.ndarray, y: np.ndarray,
+                   min_size: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Fit data ``u``, ``y`` as contiguous float arrays: 1-D, of equal length, finite.
+
+    Parameters
+    ----------
+    min_size : int
+        Fewest samples accepted (a shorter pair is reported like a length mismatch).
+
+    Raises
+    ------
+    ValueError
+        If the arrays are not 1-D, differ in length, are too short or hold NaN or inf.
+    """
+    u = np.ascontiguousarray(u, dtype=float)
+    y = np.ascontiguousarray(y, dtype=float)
+    if u.shape != y.shape or u.ndim != 1 or u.size < min_size:
+        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
+    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
+        raise ValueError("u and y must be finite")
+    return u, y
 
 
 def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],

@@ -17,6 +17,7 @@ from scipy.optimize import nnls
 
 from ..errors import FitDivergedError
 from ..models import bobbio
+from ._least_squares import check_fit_data
 from ._registry import ModelFamily
 from ._result import FitResult
 
@@ -72,12 +73,7 @@ def fit_bobbio(u: np.ndarray, y: np.ndarray, structure: bobbio.BobbioStructure, 
         If every candidate is vetoed.
     """
     t_start = time.perf_counter()
-    u = np.ascontiguousarray(u, dtype=float)
-    y = np.ascontiguousarray(y, dtype=float)
-    if u.shape != y.shape or u.ndim != 1:
-        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
-    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
-        raise ValueError("u and y must be finite")
+    u, y = check_fit_data(u, y)
     sets = candidate_thresholds(structure, u) if thresholds is None else thresholds
     fits = sorted((_solve(u, y, structure, np.asarray(a, dtype=float)) for a in sets),
                   key=lambda fit: fit[1])

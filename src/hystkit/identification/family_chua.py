@@ -12,7 +12,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..models import chua
-from ._least_squares import fit_multistart
+from ._least_squares import check_fit_data, fit_multistart
 from ._registry import ModelFamily
 from ._result import FitResult
 
@@ -78,12 +78,7 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
     FitDivergedError
         If no start gives a finite cost or every candidate is vetoed.
     """
-    u = np.ascontiguousarray(u, dtype=float)
-    y = np.ascontiguousarray(y, dtype=float)
-    if u.shape != y.shape or u.ndim != 1:
-        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
-    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
-        raise ValueError("u and y must be finite")
+    u, y = check_fit_data(u, y)
     n = structure.n_elements
     if starts is None:
         # f and g increase, so the static gain is positive; a floor keeps k finite

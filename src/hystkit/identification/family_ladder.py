@@ -13,7 +13,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..models import ladder
-from ._least_squares import fit_multistart
+from ._least_squares import check_fit_data, fit_multistart
 from ._registry import ModelFamily
 from ._result import FitResult
 
@@ -63,12 +63,7 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
     FitDivergedError
         If no start gives a finite cost or every candidate is vetoed.
     """
-    u = np.ascontiguousarray(u, dtype=float)
-    y = np.ascontiguousarray(y, dtype=float)
-    if u.shape != y.shape or u.ndim != 1:
-        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
-    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
-        raise ValueError("u and y must be finite")
+    u, y = check_fit_data(u, y)
     n = structure.n_cells
     lower = np.tile([_BAND[0], _LOG_G_MIN], n)
     upper = np.tile([_BAND[1], np.log(ladder.conductance_limit(structure))], n)

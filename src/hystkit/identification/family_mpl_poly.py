@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import FitDivergedError
 from ..models import mpl_poly
-from ._least_squares import fit_multistart
+from ._least_squares import check_fit_data, fit_multistart
 from ._registry import ModelFamily
 from ._result import FitResult
 
@@ -181,12 +181,7 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
     FitDivergedError
         If no start runs without diverging, none gives a finite cost, or all are vetoed.
     """
-    u = np.ascontiguousarray(u, dtype=float)
-    y = np.ascontiguousarray(y, dtype=float)
-    if u.shape != y.shape or u.ndim != 1:
-        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
-    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
-        raise ValueError("u and y must be finite")
+    u, y = check_fit_data(u, y)
     n = structure.n_cells
     lower = np.r_[np.tile([-_COEF_BOUND] * 3 + [_LOG_C3_BOUNDS[0]], n),
                   np.full(4, -_COEF_BOUND), np.full(n + 2, -_W_BOUND)]

@@ -31,7 +31,7 @@ from scipy.optimize import lsq_linear
 
 from ..metrics import e_max_pct, e_rms_pct
 from ..models import pl
-from ._least_squares import fit_multistart
+from ._least_squares import check_fit_data, fit_multistart
 from ._registry import ModelFamily
 from ._result import FitResult
 
@@ -126,12 +126,7 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
     FitDivergedError
         If no start gives a finite cost or every candidate is vetoed.
     """
-    u = np.ascontiguousarray(u, dtype=float)
-    y = np.ascontiguousarray(y, dtype=float)
-    if u.shape != y.shape or u.ndim != 1:
-        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
-    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
-        raise ValueError("u and y must be finite")
+    u, y = check_fit_data(u, y)
     cache: dict = {}
 
     def project(theta: np.ndarray) -> tuple[pl.PlParams, np.ndarray]:

@@ -36,6 +36,7 @@ from threadpoolctl import threadpool_limits
 
 from ..errors import FitDivergedError
 from ..models import preisach
+from ._least_squares import check_fit_data
 from ._registry import ModelFamily
 from ._result import FitResult
 
@@ -45,13 +46,7 @@ __all__ = ["FAMILY", "ORIENTATIONS", "check_data", "everett_from_forcs", "fit_or
 
 def check_data(u: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """1-D, equal length, finite; returned as contiguous float arrays."""
-    u = np.ascontiguousarray(u, dtype=float)
-    y = np.ascontiguousarray(y, dtype=float)
-    if u.shape != y.shape or u.ndim != 1 or u.size < 2:
-        raise ValueError(f"u and y must be 1-D and of equal length, got {u.shape} and {y.shape}")
-    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
-        raise ValueError("u and y must be finite")
-    return u, y
+    return check_fit_data(u, y, min_size=2)
 
 
 def smoothness_rows(levels: int) -> np.ndarray:

@@ -36,6 +36,14 @@ import numpy as np
 
 from ..errors import FitDivergedError
 from . import _circuit_kernels as kernels
+from ._validation import (
+    check_dt,
+    check_positive_int,
+    check_signal,
+    check_size,
+    frozen_array,
+    initial_state,
+)
 
 __all__ = [
     "BobbioParams",
@@ -64,27 +72,12 @@ class BobbioStructure:
     dt: float = 0.025
 
     def __post_init__(self) -> None:
-        if int(self.n_springs) != self.n_springs or self.n_springs < 1:
-            raise ValueError(f"n_springs must be a positive integer, got {self.n_springs!r}")
-        if not (np.isfinite(self.dt) and self.dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        check_positive_int(self.n_springs, "n_springs")
+        check_dt(self.dt)
 
     @property
     def n_params(self) -> int:
         return 2 * self.n_springs
-
-
-def _frozen(values, n: int, name: str) -> np.ndarray:
-    try:
-        arr = np.array(values, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be numbers, got {values!r}") from None
-    if arr.shape != (n,):
-        raise ValueError(f"{name} must have {n} values, got {arr.size}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,8 +102,8 @@ class BobbioParams:
     def __post_init__(self) -> None:
         n = np.size(self.compliance)
         object.__setattr__(self, "n_springs", int(n))
-        object.__setattr__(self, "compliance", _frozen(self.compliance, n, "compliance"))
-        object.__setattr__(self, "friction", _frozen(self.friction, n - 1, "friction"))
+        object.__setattr__(self, "compliance", frozen_array(self.compliance, n, "compliance"))
+        object.__setattr__(self, "friction", frozen_array(self.friction, n - 1, "friction"))
         object.__setattr__(self, "offset", float(self.offset))
         if not np.isfinite(self.offset):
             raise ValueError(f"offset must be finite, got {self.offset}")
@@ -156,24 +149,8 @@ def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
 
 def _check(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
            name: str) -> np.ndarray:
-    if params.n_springs != structure.n_springs:
-        raise ValueError(f"params have {params.n_springs} springs, structure has "
-                         f"{structure.n_springs}")
-    u = np.ascontiguousarray(u, dtype=float)
-    if u.ndim != 1 or u.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
-    if not np.all(np.isfinite(u)):
-        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
-    return u
-
-
-def _initial_state(n: int, x0: np.ndarray | float | None, at_rest: float) -> np.ndarray:
-    if x0 is None:
-        return np.full(n, float(at_rest))
-    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (n,)).copy()
-    if not np.all(np.isfinite(x0)):
-        raise ValueError("x0 must be finite")
-    return x0
+    check_size(params.n_springs, structure.n_springs, "springs")
+    return check_signal(u, name)
 
 
 def forces(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
@@ -183,7 +160,7 @@ def forces(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
     The output is linear in them: ``y = c_1 u + forces @ c[1:] + b`` (the fit uses this).
     """
     u = _check(structure, params, u, "u")
-    x = _initial_state(structure.n_springs - 1, x0, u[0])
+    x = initial_state(structure.n_springs - 1, x0, u[0])
     return kernels.bobbio_forces(u, x, params.friction)
 
 
@@ -214,7 +191,7 @@ def simulate_reference(structure: BobbioStructure, params: BobbioParams, u: np.n
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step`."""
     u = _check(structure, params, u, "u")
-    x = _initial_state(structure.n_springs - 1, x0, u[0])
+    x = initial_state(structure.n_springs - 1, x0, u[0])
     y = np.empty_like(u)
     for n, u_n in enumerate(u):
         y[n], x = step(structure, params, x, u_n)
@@ -246,7 +223,7 @@ def invert(structure: BobbioStructure, params: BobbioParams, y: np.ndarray,
     y = _check(structure, params, y, "y")
     total = params.compliance.sum()
     rest = (y[0] - params.offset) / total if total > 0 else 0.0
-    x = _initial_state(structure.n_springs - 1, x0, rest)
+    x = initial_state(structure.n_springs - 1, x0, rest)
     u_hat, x_end, n_bad = kernels.bobbio_invert(y, x, params.compliance, params.friction,
                                                 params.offset)
     if n_bad >= 0:

@@ -50,6 +50,7 @@ from scipy.signal import resample_poly
 
 from ..errors import FitDivergedError
 from . import _boucwen_kernels as kernels
+from ._validation import check_dt, check_signal
 
 __all__ = [
     "BENCHMARK_PARAMS",
@@ -91,8 +92,7 @@ class BoucWenStructure:
     start: str = "rest"
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.dt) and self.dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        check_dt(self.dt)
         if int(self.substeps) != self.substeps or self.substeps < 1:
             raise ValueError(f"substeps must be a positive integer, got {self.substeps!r}")
         if self.input_hold not in HOLDS:
@@ -258,15 +258,6 @@ def step(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
     return float(s[0]), np.append(s, u)
 
 
-def _check_input(u: np.ndarray) -> np.ndarray:
-    u = np.ascontiguousarray(u, dtype=float)
-    if u.ndim != 1 or u.size == 0:
-        raise ValueError(f"u must be a non-empty 1-D array, got shape {u.shape}")
-    if not np.all(np.isfinite(u)):
-        raise ValueError(f"u contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
-    return u
-
-
 def initial_state(structure: BoucWenStructure, params: BoucWenParams,
                   u0: float) -> np.ndarray:
     """``(y, y', z, u0)`` at the first sample of a run without ``x0`` (``structure.start``)."""
@@ -310,7 +301,7 @@ def simulate_states(structure: BoucWenStructure, params: BoucWenParams, u: np.nd
     FitDivergedError
         If the integration leaves the finite range (RK4 step too long for the parameters).
     """
-    u = _check_input(u)
+    u = check_signal(u, "u")
     x, fresh = _initial_state(structure, params, x0, u[0])
     states, x_end, n_bad = kernels.simulate(u, x, fresh, params.as_array(), structure.dt,
                                             structure.substeps,
@@ -340,7 +331,7 @@ def simulate(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
 def simulate_reference(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
                        x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
-    u = _check_input(u)
+    u = check_signal(u, "u")
     x, fresh = _initial_state(structure, params, x0, u[0])
     y = np.empty_like(u)
     for n, u_n in enumerate(u):
@@ -368,7 +359,7 @@ def bandlimited_upsample(u: np.ndarray, factor: int, periodic: bool) -> np.ndarr
     array, shape (n * factor,)
         ``out[factor * i] == u[i]`` up to round-off (periodic) or the filter's accuracy.
     """
-    u = _check_input(u)
+    u = check_signal(u, "u")
     if int(factor) != factor or factor < 1:
         raise ValueError(f"factor must be a positive integer, got {factor!r}")
     if factor == 1:

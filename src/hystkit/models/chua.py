@@ -39,6 +39,15 @@ import numpy as np
 
 from ..errors import FitDivergedError
 from . import _circuit_kernels as kernels
+from ._validation import (
+    broadcast_state,
+    check_dt,
+    check_positive_int,
+    check_signal,
+    check_size,
+    check_slope_cap,
+    frozen_array,
+)
 
 __all__ = [
     "ChuaParams",
@@ -75,13 +84,9 @@ class ChuaStructure:
     slope_cap: float = 1.0
 
     def __post_init__(self) -> None:
-        if int(self.n_elements) != self.n_elements or self.n_elements < 1:
-            raise ValueError(f"n_elements must be a positive integer, got {self.n_elements!r}")
-        if not (np.isfinite(self.dt) and self.dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
-        if not 0 < self.slope_cap < 2:
-            raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step, "
-                             f"got {self.slope_cap!r}")
+        check_positive_int(self.n_elements, "n_elements")
+        check_dt(self.dt)
+        check_slope_cap(self.slope_cap)
 
     @property
     def n_params(self) -> int:
@@ -123,16 +128,7 @@ class ChuaParams:
         n = np.size(self.k0)
         object.__setattr__(self, "n_elements", int(n))
         for name in _FIELDS:
-            try:
-                arr = np.array(getattr(self, name), dtype=float).reshape(-1)
-            except (TypeError, ValueError):
-                raise ValueError(f"{name} must be numbers, got {getattr(self, name)!r}") from None
-            if arr.shape != (n,):
-                raise ValueError(f"{name} must have {n} values, got {arr.size}")
-            if not np.all(np.isfinite(arr)):
-                raise ValueError(f"{name} must be finite, got {arr.tolist()}")
-            arr.setflags(write=False)
-            object.__setattr__(self, name, arr)
+            object.__setattr__(self, name, frozen_array(getattr(self, name), n, name))
         for name in _FIELDS[:5]:
             if np.any(getattr(self, name) <= 0):
                 raise ValueError(f"{name} must be positive (f and g strictly increasing, eq. 2.3)")
@@ -246,25 +242,15 @@ def _g_inverse(r: float, params: ChuaParams, cap: np.ndarray, knee: np.ndarray,
 
 def _check(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
            name: str) -> np.ndarray:
-    if params.n_elements != structure.n_elements:
-        raise ValueError(f"params have {params.n_elements} elements, structure has "
-                         f"{structure.n_elements}")
-    u = np.ascontiguousarray(u, dtype=float)
-    if u.ndim != 1 or u.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
-    if not np.all(np.isfinite(u)):
-        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
-    return u
+    check_size(params.n_elements, structure.n_elements, "elements")
+    return check_signal(u, name)
 
 
 def _initial_state(params: ChuaParams, x0: np.ndarray | float | None,
                    u0: float) -> np.ndarray:
     if x0 is None:
         return restoring_inverse(params, u0)
-    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (params.n_elements,)).copy()
-    if not np.all(np.isfinite(x0)):
-        raise ValueError("x0 must be finite")
-    return x0
+    return broadcast_state(x0, params.n_elements)
 
 
 def _kernel_args(structure: ChuaStructure, params: ChuaParams) -> tuple:

@@ -38,6 +38,7 @@ from numpy.polynomial import Polynomial
 
 from ..errors import FitDivergedError
 from . import _preisach_kernels as kernels
+from ._validation import check_signal
 from .preisach import (
     INVERT_TOL,
     PreisachParams,
@@ -218,11 +219,7 @@ def _check(structure: GPreisachStructure, params: GPreisachParams, v: np.ndarray
     if params.levels != structure.levels or params.nu.size != structure.degree + 1:
         raise ValueError(f"params (levels {params.levels}, {params.nu.size} nu) do not match "
                          f"the structure (levels {structure.levels}, degree {structure.degree})")
-    v = np.ascontiguousarray(v, dtype=float)
-    if v.ndim != 1 or v.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {v.shape}")
-    if not np.all(np.isfinite(v)):
-        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(v)))}")
+    v = check_signal(v, name)
     x = demagnetised_state(structure.levels - 1) if x0 is None else x0
     return v, check_state(x, structure.capacity)
 

@@ -36,6 +36,15 @@ import numpy as np
 
 from ..errors import FitDivergedError
 from . import _circuit_kernels as kernels
+from ._validation import (
+    check_dt,
+    check_positive_int,
+    check_signal,
+    check_size,
+    check_slope_cap,
+    frozen_array,
+    initial_state,
+)
 
 __all__ = [
     "LadderParams",
@@ -68,30 +77,13 @@ class LadderStructure:
     slope_cap: float = 1.0
 
     def __post_init__(self) -> None:
-        if int(self.n_cells) != self.n_cells or self.n_cells < 1:
-            raise ValueError(f"n_cells must be a positive integer, got {self.n_cells!r}")
-        if not (np.isfinite(self.dt) and self.dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
-        if not 0 < self.slope_cap < 2:
-            raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step, "
-                             f"got {self.slope_cap!r}")
+        check_positive_int(self.n_cells, "n_cells")
+        check_dt(self.dt)
+        check_slope_cap(self.slope_cap)
 
     @property
     def n_params(self) -> int:
         return 3 * self.n_cells + 2
-
-
-def _frozen(values, n: int, name: str) -> np.ndarray:
-    try:
-        arr = np.array(values, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be numbers, got {values!r}") from None
-    if arr.shape != (n,):
-        raise ValueError(f"{name} must have {n} values, got {arr.size}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,9 +111,9 @@ class LadderParams:
     def __post_init__(self) -> None:
         n = np.size(self.band)
         object.__setattr__(self, "n_cells", int(n))
-        object.__setattr__(self, "band", _frozen(self.band, n, "band"))
-        object.__setattr__(self, "conductance", _frozen(self.conductance, n, "conductance"))
-        object.__setattr__(self, "w", _frozen(self.w, n + 1, "w"))
+        object.__setattr__(self, "band", frozen_array(self.band, n, "band"))
+        object.__setattr__(self, "conductance", frozen_array(self.conductance, n, "conductance"))
+        object.__setattr__(self, "w", frozen_array(self.w, n + 1, "w"))
         object.__setattr__(self, "v_b", float(self.v_b))
         if not np.isfinite(self.v_b):
             raise ValueError(f"v_b must be finite, got {self.v_b}")
@@ -170,24 +162,8 @@ def step(structure: LadderStructure, params: LadderParams, x: np.ndarray,
 
 def _check(structure: LadderStructure, params: LadderParams, u: np.ndarray,
            name: str) -> np.ndarray:
-    if params.n_cells != structure.n_cells:
-        raise ValueError(f"params have {params.n_cells} cells, structure has "
-                         f"{structure.n_cells}")
-    u = np.ascontiguousarray(u, dtype=float)
-    if u.ndim != 1 or u.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
-    if not np.all(np.isfinite(u)):
-        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
-    return u
-
-
-def _initial_state(n: int, x0: np.ndarray | float | None, at_rest: float) -> np.ndarray:
-    if x0 is None:
-        return np.full(n, float(at_rest))
-    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (n,)).copy()
-    if not np.all(np.isfinite(x0)):
-        raise ValueError("x0 must be finite")
-    return x0
+    check_size(params.n_cells, structure.n_cells, "cells")
+    return check_signal(u, name)
 
 
 def states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
@@ -197,7 +173,7 @@ def states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
     The output is linear in them: ``y = w_0 u + states @ w[1:] - V_b`` (the fit uses this).
     """
     u = _check(structure, params, u, "u")
-    x = _initial_state(structure.n_cells, x0, u[0])
+    x = initial_state(structure.n_cells, x0, u[0])
     return kernels.ladder_states(u, x, params.band, _effective_conductance(structure, params),
                                  structure.dt)
 
@@ -228,7 +204,7 @@ def simulate_reference(structure: LadderStructure, params: LadderParams, u: np.n
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step`."""
     u = _check(structure, params, u, "u")
-    x = _initial_state(structure.n_cells, x0, u[0])
+    x = initial_state(structure.n_cells, x0, u[0])
     y = np.empty_like(u)
     for n, u_n in enumerate(u):
         y[n], x = step(structure, params, x, u_n)
@@ -258,7 +234,7 @@ def invert(structure: LadderStructure, params: LadderParams, y: np.ndarray,
         raise FitDivergedError("the ladder model has w_0 = 0, so it has no inverse")
     w_sum = params.w.sum()
     rest = (y[0] + params.v_b) / w_sum if w_sum != 0 else 0.0
-    x = _initial_state(structure.n_cells, x0, rest)
+    x = initial_state(structure.n_cells, x0, rest)
     u_hat, x_end, n_bad = kernels.ladder_invert(y, x, params.band,
                                                 _effective_conductance(structure, params),
                                                 params.w, params.v_b, structure.dt)

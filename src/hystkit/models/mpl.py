@@ -30,6 +30,15 @@ import numpy as np
 
 from ..errors import FitDivergedError
 from . import _mpl_kernels as kernels
+from ._validation import (
+    check_dt,
+    check_positive_int,
+    check_signal,
+    check_size,
+    check_slope_cap,
+    frozen_array,
+    initial_state,
+)
 
 __all__ = [
     "MplParams",
@@ -63,29 +72,14 @@ class MplStructure:
     slope_cap: float = 1.0
 
     def __post_init__(self) -> None:
-        if int(self.n_cells) != self.n_cells or self.n_cells < 1:
-            raise ValueError(f"n_cells must be a positive integer, got {self.n_cells!r}")
-        if not (np.isfinite(self.dt) and self.dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
-        if not 0 < self.slope_cap < 2:
-            raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step (eq. 5.28), "
-                             f"got {self.slope_cap!r}")
+        check_positive_int(self.n_cells, "n_cells")
+        check_dt(self.dt)
+        check_slope_cap(self.slope_cap)
 
     @property
     def n_params(self) -> int:
         """3N + 2 fitted parameters (sec. 5.3.2)."""
         return 3 * self.n_cells + 2
-
-
-def _frozen(values, n: int, name: str) -> np.ndarray:
-    try:
-        arr = np.array(values, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be numbers, got {values!r}") from None
-    if arr.shape != (n,):
-        raise ValueError(f"{name} must have {n} values, got {arr.shape[0]}")
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,13 +114,10 @@ class MplParams:
     def __post_init__(self) -> None:
         n = np.size(self.i_s)
         object.__setattr__(self, "n_cells", int(n))
-        object.__setattr__(self, "i_s", _frozen(self.i_s, n, "i_s"))
-        object.__setattr__(self, "v_t", _frozen(self.v_t, n, "v_t"))
-        object.__setattr__(self, "w", _frozen(self.w, n + 1, "w"))
+        object.__setattr__(self, "i_s", frozen_array(self.i_s, n, "i_s"))
+        object.__setattr__(self, "v_t", frozen_array(self.v_t, n, "v_t"))
+        object.__setattr__(self, "w", frozen_array(self.w, n + 1, "w"))
         object.__setattr__(self, "v_b", float(self.v_b))
-        for name in ("i_s", "v_t", "w"):
-            if not np.all(np.isfinite(getattr(self, name))):
-                raise ValueError(f"{name} must be finite, got {getattr(self, name).tolist()}")
         if not np.isfinite(self.v_b):
             raise ValueError(f"v_b must be finite, got {self.v_b}")
         if np.any(self.i_s <= 0) or np.any(self.v_t <= 0):
@@ -225,24 +216,6 @@ def invert_step(structure: MplStructure, params: MplParams, x: np.ndarray,
     return float(u_hat), x_next
 
 
-def _initial_state(n_cells: int, x0: np.ndarray | float | None, at_rest: float) -> np.ndarray:
-    if x0 is None:
-        return np.full(n_cells, float(at_rest))
-    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (n_cells,)).copy()
-    if not np.all(np.isfinite(x0)):
-        raise ValueError("x0 must be finite")
-    return x0
-
-
-def _check_input(u: np.ndarray, name: str) -> np.ndarray:
-    u = np.ascontiguousarray(u, dtype=float)
-    if u.ndim != 1 or u.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
-    if not np.all(np.isfinite(u)):
-        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
-    return u
-
-
 def simulate(structure: MplStructure, params: MplParams, u: np.ndarray,
              x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Run the forward model over an input sequence (compiled kernel).
@@ -262,8 +235,8 @@ def simulate(structure: MplStructure, params: MplParams, u: np.ndarray,
         State after the last sample; feeding it back as ``x0`` continues the run exactly.
     """
     _check_params(structure, params)
-    u = _check_input(u, "u")
-    x = _initial_state(structure.n_cells, x0, u[0])
+    u = check_signal(u, "u")
+    x = initial_state(structure.n_cells, x0, u[0])
     knee = knee_voltage(structure, params)
     return kernels.simulate(u, x, params.i_s, params.v_t, params.w, params.v_b, knee,
                             structure.slope_cap / structure.dt, structure.dt)
@@ -273,8 +246,8 @@ def simulate_reference(structure: MplStructure, params: MplParams, u: np.ndarray
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
     _check_params(structure, params)
-    u = _check_input(u, "u")
-    x = _initial_state(structure.n_cells, x0, u[0])
+    u = check_signal(u, "u")
+    x = initial_state(structure.n_cells, x0, u[0])
     y = np.empty_like(u)
     for n, u_n in enumerate(u):
         y[n], x = step(structure, params, x, u_n)
@@ -307,12 +280,12 @@ def invert(structure: MplStructure, params: MplParams, y: np.ndarray,
         voltage), so it is checked rather than guaranteed.
     """
     _check_params(structure, params)
-    y = _check_input(y, "y")
+    y = check_signal(y, "y")
     if params.w[0] == 0:
         raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
     w_sum = params.w.sum()
     rest = (y[0] + params.v_b) / w_sum if w_sum != 0 else 0.0
-    x = _initial_state(structure.n_cells, x0, rest)
+    x = initial_state(structure.n_cells, x0, rest)
     knee = knee_voltage(structure, params)
     u_hat, x_end, n_bad = kernels.invert(y, x, params.i_s, params.v_t, params.w, params.v_b,
                                          knee, structure.slope_cap / structure.dt, structure.dt)
@@ -324,5 +297,4 @@ def invert(structure: MplStructure, params: MplParams, y: np.ndarray,
 
 
 def _check_params(structure: MplStructure, params: MplParams) -> None:
-    if params.n_cells != structure.n_cells:
-        raise ValueError(f"params have {params.n_cells} cells, structure has {structure.n_cells}")
+    check_size(params.n_cells, structure.n_cells, "cells")

@@ -34,6 +34,15 @@ from scipy.optimize import brentq
 
 from ..errors import FitDivergedError
 from . import _mpl_poly_kernels as kernels
+from ._validation import (
+    broadcast_state,
+    check_dt,
+    check_positive_int,
+    check_signal,
+    check_size,
+    check_slope_cap,
+    frozen_shaped,
+)
 
 __all__ = [
     "MplPolyParams", "MplPolyStructure", "equilibria", "invert", "invert_step", "knee_points",
@@ -64,13 +73,9 @@ class MplPolyStructure:
     limit: bool = True
 
     def __post_init__(self) -> None:
-        if int(self.n_cells) != self.n_cells or self.n_cells < 1:
-            raise ValueError(f"n_cells must be a positive integer, got {self.n_cells!r}")
-        if not (np.isfinite(self.dt) and self.dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
-        if not 0 < self.slope_cap < 2:
-            raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step (eq. 5.28), "
-                             f"got {self.slope_cap!r}")
+        check_positive_int(self.n_cells, "n_cells")
+        check_dt(self.dt)
+        check_slope_cap(self.slope_cap)
         if not isinstance(self.limit, bool):
             raise TypeError(f"limit must be true or false, got {self.limit!r}")
 
@@ -78,19 +83,6 @@ class MplPolyStructure:
     def n_params(self) -> int:
         """``5N + 6`` fitted parameters (11 for the paper's N = 1)."""
         return 5 * self.n_cells + 6
-
-
-def _frozen(values, shape: tuple[int, ...] | None, name: str) -> np.ndarray:
-    try:
-        arr = np.array(values, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be numbers, got {values!r}") from None
-    if shape is not None and arr.shape != shape:
-        raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,14 +112,14 @@ class MplPolyParams:
     n_cells: int = field(init=False)
 
     def __post_init__(self) -> None:
-        shape = np.shape(_frozen(self.f, None, "f"))
+        shape = np.shape(frozen_shaped(self.f, None, "f"))
         if len(shape) != 2 or shape[0] < 1 or shape[1] != 4:
             raise ValueError(f"f must have shape (N, 4), one row per cell, got {shape}")
         n = shape[0]
         object.__setattr__(self, "n_cells", int(n))
-        object.__setattr__(self, "f", _frozen(self.f, (n, 4), "f"))
-        object.__setattr__(self, "g", _frozen(self.g, (4,), "g"))
-        object.__setattr__(self, "w", _frozen(self.w, (n + 1,), "w"))
+        object.__setattr__(self, "f", frozen_shaped(self.f, (n, 4), "f"))
+        object.__setattr__(self, "g", frozen_shaped(self.g, (4,), "g"))
+        object.__setattr__(self, "w", frozen_shaped(self.w, (n + 1,), "w"))
         object.__setattr__(self, "v_b", float(self.v_b))
         if not np.isfinite(self.v_b):
             raise ValueError(f"v_b must be finite, got {self.v_b}")
@@ -325,23 +317,14 @@ def invert_step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarra
 
 def _check(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
            name: str) -> np.ndarray:
-    if params.n_cells != structure.n_cells:
-        raise ValueError(f"params have {params.n_cells} cells, structure has {structure.n_cells}")
-    u = np.ascontiguousarray(u, dtype=float)
-    if u.ndim != 1 or u.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
-    if not np.all(np.isfinite(u)):
-        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
-    return u
+    check_size(params.n_cells, structure.n_cells, "cells")
+    return check_signal(u, name)
 
 
 def _start(structure: MplPolyStructure, params: MplPolyParams, x0, e0: float) -> np.ndarray:
     if x0 is None:
         return e0 - rest_voltages(structure, params)
-    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (structure.n_cells,)).copy()
-    if not np.all(np.isfinite(x0)):
-        raise ValueError("x0 must be finite")
-    return x0
+    return broadcast_state(x0, structure.n_cells)
 
 
 def _kernel_args(structure: MplPolyStructure, params: MplPolyParams) -> tuple:

@@ -42,27 +42,20 @@ import numpy as np
 
 from ..errors import FitDivergedError
 from . import _pi_kernels as kernels
+from ._validation import (
+    check_dt,
+    check_signal,
+    frozen_array,
+    initial_state,
+)
 
 __all__ = ["PiParams", "PiStructure", "deadzone", "inverse_pi",
            "inverse_play_states", "inverse_superposition", "invert", "invert_step",
            "not_invertible_reason", "play", "simulate", "simulate_reference", "step"]
 
 
-def _frozen(values, n: int, name: str) -> np.ndarray:
-    try:
-        arr = np.array(values, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be numbers, got {values!r}") from None
-    if n >= 0 and arr.shape != (n,):
-        raise ValueError(f"{name} must have {n} values, got {arr.shape[0]}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
-    arr.setflags(write=False)
-    return arr
-
-
 def _float_tuple(values, name: str) -> tuple[float, ...]:
-    return tuple(_frozen(values, -1, name).tolist())
+    return tuple(frozen_array(values, None, name).tolist())
 
 
 @dataclass(frozen=True)
@@ -100,8 +93,7 @@ class PiStructure:
             raise ValueError(f"creep_rates must be positive eigenvalues [1/s], got {rates}")
         if int(self.n_deadzone) != self.n_deadzone or self.n_deadzone < 0:
             raise ValueError(f"n_deadzone must be a non-negative integer, got {self.n_deadzone!r}")
-        if not (np.isfinite(self.dt) and self.dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        check_dt(self.dt)
 
     @property
     def n_play(self) -> int:
@@ -145,10 +137,10 @@ class PiParams:
     n_creep: int = field(init=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "w_h", _frozen(self.w_h, -1, "w_h"))
-        object.__setattr__(self, "w_s", _frozen(self.w_s, -1, "w_s"))
-        object.__setattr__(self, "d_s", _frozen(self.d_s, self.w_s.size, "d_s"))
-        object.__setattr__(self, "w_k", _frozen(self.w_k, -1, "w_k"))
+        object.__setattr__(self, "w_h", frozen_array(self.w_h, None, "w_h"))
+        object.__setattr__(self, "w_s", frozen_array(self.w_s, None, "w_s"))
+        object.__setattr__(self, "d_s", frozen_array(self.d_s, self.w_s.size, "d_s"))
+        object.__setattr__(self, "w_k", frozen_array(self.w_k, None, "w_k"))
         object.__setattr__(self, "b", float(self.b))
         if not np.isfinite(self.b):
             raise ValueError(f"b must be finite, got {self.b}")
@@ -280,26 +272,8 @@ def invert_step(structure: PiStructure, params: PiParams, x: np.ndarray,
 
 def _initial_state(structure: PiStructure, x0: np.ndarray | float | None,
                    at_rest: float) -> np.ndarray:
-    n = structure.n_play + structure.n_creep
-    if x0 is None:
-        return np.full(n, float(at_rest))
-    try:
-        x0 = np.broadcast_to(np.asarray(x0, dtype=float), (n,)).copy()
-    except ValueError:
-        raise ValueError(f"x0 must be a float or have {n} values (plays, then creep states), "
-                         f"got shape {np.shape(x0)}") from None
-    if not np.all(np.isfinite(x0)):
-        raise ValueError("x0 must be finite")
-    return x0
-
-
-def _check_input(u: np.ndarray, name: str) -> np.ndarray:
-    u = np.ascontiguousarray(u, dtype=float)
-    if u.ndim != 1 or u.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
-    if not np.all(np.isfinite(u)):
-        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
-    return u
+    return initial_state(structure.n_play + structure.n_creep, x0, at_rest,
+                         layout="plays, then creep states")
 
 
 def _check_params(structure: PiStructure, params: PiParams) -> None:
@@ -330,7 +304,7 @@ def simulate(structure: PiStructure, params: PiParams, u: np.ndarray,
         State after the last sample; feeding it back as ``x0`` continues the run exactly.
     """
     _check_params(structure, params)
-    u = _check_input(u, "u")
+    u = check_signal(u, "u")
     x = _initial_state(structure, x0, u[0])
     n = structure.n_play
     y, p, z = kernels.simulate(u, x[:n].copy(), x[n:].copy(),
@@ -343,7 +317,7 @@ def simulate_reference(structure: PiStructure, params: PiParams, u: np.ndarray,
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
     _check_params(structure, params)
-    u = _check_input(u, "u")
+    u = check_signal(u, "u")
     x = _initial_state(structure, x0, u[0])
     y = np.empty_like(u)
     for n, u_n in enumerate(u):
@@ -401,7 +375,7 @@ def invert(structure: PiStructure, params: PiParams, y: np.ndarray,
     reason = not_invertible_reason(structure, params)
     if reason:
         raise FitDivergedError(f"the model has no inverse: {reason}")
-    y = _check_input(y, "y")
+    y = check_signal(y, "y")
     n = structure.n_play
     d_inv, ws_inv = inverse_superposition(params.d_s, params.w_s)
     if x0 is None:

@@ -43,6 +43,13 @@ import numpy as np
 
 from ..errors import FitDivergedError
 from . import _pl_kernels as kernels
+from ._validation import (
+    check_dt,
+    check_signal,
+    check_slope_cap,
+    frozen_array,
+    initial_state,
+)
 
 __all__ = [
     "PlParams",
@@ -97,11 +104,8 @@ class PlStructure:
             raise ValueError(f"power p must be > 1 (eq. 2.16 divides by p - 1), got {self.power!r}")
         if not (np.isfinite(self.smoothing) and self.smoothing >= 0):
             raise ValueError(f"smoothing S must be >= 0, got {self.smoothing!r}")
-        if not (np.isfinite(self.dt) and self.dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
-        if not 0 < self.slope_cap < 2:
-            raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step (eq. 5.28), "
-                             f"got {self.slope_cap!r}")
+        check_dt(self.dt)
+        check_slope_cap(self.slope_cap)
 
     @property
     def n_params(self) -> int:
@@ -111,19 +115,6 @@ class PlStructure:
         the fit fixes the mean slope of ``f`` to 1.
         """
         return self.n_cells + self.n_basis + 4
-
-
-def _frozen(values, n: int, name: str) -> np.ndarray:
-    try:
-        arr = np.array(values, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be numbers, got {values!r}") from None
-    if arr.shape != (n,):
-        raise ValueError(f"{name} must have {n} values, got {arr.size}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True, eq=False)
@@ -157,8 +148,8 @@ class PlParams:
         object.__setattr__(self, "n_basis", int(np.size(self.a)))
         if self.n_cells < 1 or self.n_basis < 1:
             raise ValueError("w needs N + 1 >= 2 values and a at least one")
-        object.__setattr__(self, "w", _frozen(self.w, self.n_cells + 1, "w"))
-        object.__setattr__(self, "a", _frozen(self.a, self.n_basis, "a"))
+        object.__setattr__(self, "w", frozen_array(self.w, self.n_cells + 1, "w"))
+        object.__setattr__(self, "a", frozen_array(self.a, self.n_basis, "a"))
         for name in ("i_t", "v_t", "v_b"):
             value = float(getattr(self, name))
             if not np.isfinite(value):
@@ -258,25 +249,11 @@ def step(structure: PlStructure, params: PlParams, x: np.ndarray,
     return y, x + resistor_current(structure, params, e - x) * structure.dt
 
 
-def _initial_state(n_cells: int, x0: np.ndarray | float | None, at_rest: float) -> np.ndarray:
-    if x0 is None:
-        return np.full(n_cells, float(at_rest))
-    x0 = np.broadcast_to(np.asarray(x0, dtype=float), (n_cells,)).copy()
-    if not np.all(np.isfinite(x0)):
-        raise ValueError("x0 must be finite")
-    return x0
-
-
 def _check(structure: PlStructure, params: PlParams, u: np.ndarray, name: str) -> np.ndarray:
     if params.n_cells != structure.n_cells or params.n_basis != structure.n_basis:
         raise ValueError(f"params have N = {params.n_cells}, M = {params.n_basis}; the structure "
                          f"has N = {structure.n_cells}, M = {structure.n_basis}")
-    u = np.ascontiguousarray(u, dtype=float)
-    if u.ndim != 1 or u.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
-    if not np.all(np.isfinite(u)):
-        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
-    return u
+    return check_signal(u, name)
 
 
 def _kernel_args(structure: PlStructure, params: PlParams) -> tuple:
@@ -303,7 +280,7 @@ def simulate(structure: PlStructure, params: PlParams, u: np.ndarray,
         State after the last sample; passing it as ``x0`` continues the run exactly.
     """
     u = _check(structure, params, u, "u")
-    x = _initial_state(structure.n_cells, x0, u[0])
+    x = initial_state(structure.n_cells, x0, u[0])
     return kernels.simulate(u, x, *_kernel_args(structure, params), params.w, params.v_b,
                             basis_breakpoints(structure.n_basis), params.a)
 
@@ -312,7 +289,7 @@ def simulate_reference(structure: PlStructure, params: PlParams, u: np.ndarray,
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
     u = _check(structure, params, u, "u")
-    x = _initial_state(structure.n_cells, x0, u[0])
+    x = initial_state(structure.n_cells, x0, u[0])
     y = np.empty_like(u)
     for n, e in enumerate(u):
         y[n], x = step(structure, params, x, e)
@@ -323,7 +300,7 @@ def states(structure: PlStructure, params: PlParams, u: np.ndarray,
            x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Capacitor voltages at every sample, shape (n, N), and the final state (weights unused)."""
     u = _check(structure, params, u, "u")
-    x = _initial_state(structure.n_cells, x0, u[0])
+    x = initial_state(structure.n_cells, x0, u[0])
     return kernels.states(u, x, *_kernel_args(structure, params))
 
 
@@ -355,7 +332,7 @@ def invert(structure: PlStructure, params: PlParams, y: np.ndarray,
         raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 2.20)")
     w_sum = params.w.sum()
     rest = (float(output_resistor(params, y[0])) + params.v_b) / w_sum if w_sum != 0 else 0.0
-    x = _initial_state(structure.n_cells, x0, rest)
+    x = initial_state(structure.n_cells, x0, rest)
     e_hat, x_end, n_bad = kernels.invert(y, x, *_kernel_args(structure, params), params.w,
                                          params.v_b, basis_breakpoints(structure.n_basis),
                                          params.a)

@@ -49,6 +49,7 @@ import numpy as np
 
 from ..errors import FitDivergedError
 from . import _preisach_kernels as kernels
+from ._validation import check_dt, check_signal, check_size
 
 __all__ = [
     "PreisachParams",
@@ -103,8 +104,7 @@ class PreisachStructure:
     def __post_init__(self) -> None:
         if int(self.levels) != self.levels or self.levels < 2:
             raise ValueError(f"levels must be an integer >= 2, got {self.levels!r}")
-        if not (np.isfinite(self.dt) and self.dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        check_dt(self.dt)
         if int(self.capacity) != self.capacity or self.capacity < 2 * self.levels + 2:
             raise ValueError(f"capacity must be an integer >= 2 * levels + 2 = "
                              f"{2 * self.levels + 2}, got {self.capacity!r}")
@@ -305,13 +305,8 @@ def step(structure: PreisachStructure, params: PreisachParams, x: np.ndarray,
 
 def _check(structure: PreisachStructure, params: PreisachParams, v: np.ndarray, name: str,
            x0: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    if params.levels != structure.levels:
-        raise ValueError(f"params have {params.levels} levels, structure has {structure.levels}")
-    v = np.ascontiguousarray(v, dtype=float)
-    if v.ndim != 1 or v.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-D array, got shape {v.shape}")
-    if not np.all(np.isfinite(v)):
-        raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(v)))}")
+    check_size(params.levels, structure.levels, "levels")
+    v = check_signal(v, name)
     x = demagnetised_state(structure.levels - 1) if x0 is None else x0
     return v, check_state(x, structure.capacity)
 
