@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from pathlib import Path
 
@@ -65,7 +66,16 @@ def _compensate(args: argparse.Namespace) -> int:
     write_recording(rec, args.out, extra={"position_estimate": estimate}, force=args.force)
     print(f"wrote {args.out}: {rec.n_samples} samples with column 'position_estimate' [mm] "
           f"(centring: {comp.center})")
+    _warn_if_extrapolating(comp.extrapolated_fraction(rec), args.data)
     return 0
+
+
+def _warn_if_extrapolating(fraction: float | None, data: Path) -> None:
+    """Say so when the compensator runs outside the sensor range it was trained on."""
+    if fraction:
+        print(f"hystkit: warning: {data}: {100 * fraction:.1f} % of the samples lie outside the "
+              f"sensor range the compensator was trained on; its estimate there is an "
+              f"extrapolation", file=sys.stderr)
 
 
 def _evaluate(args: argparse.Namespace) -> int:
@@ -73,6 +83,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         check_output_path(args.json, args.force)
     comp = load_compensator(args.model)
     scores = evaluate(comp, read_recording(args.data))
+    _warn_if_extrapolating(scores["extrapolated_fraction"], args.data)
     print(f"{args.data} with {args.model} (centring: {scores['center']}, "
           f"{scores['n_samples']} samples)")
     print(f"{'':<22}{comp.model:>10}{'straight line':>15}")

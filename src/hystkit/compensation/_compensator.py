@@ -71,6 +71,7 @@ class Compensator:
     baseline: LinearBaseline
     fit_info: dict = field(default_factory=dict)
     model: str = "mpl"
+    training_range: tuple[float, float] | None = None
 
     @property
     def family(self) -> ModelFamily:
@@ -92,6 +93,12 @@ class Compensator:
                                  f"got {value}")
         if not (np.isfinite(self.baseline.slope) and np.isfinite(self.baseline.intercept)):
             raise ValueError("baseline slope and intercept must be finite")
+        if self.training_range is not None:
+            lo, hi = (float(v) for v in self.training_range)
+            if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
+                raise ValueError(f"training_range must be two finite numbers, low <= high, got "
+                                 f"{self.training_range!r}")
+            object.__setattr__(self, "training_range", (lo, hi))
 
     def _normalised_sensor(self, sensor: np.ndarray) -> np.ndarray:
         offset = {"recording": np.mean(sensor), "fit": self.scaling.sensor_offset,
@@ -130,6 +137,21 @@ class Compensator:
         run = self.family.simulate if self.mode == "direct" else self.family.invert
         p, _ = run(self.structure, self.params, s)
         return self._to_mm(p, position_mean)
+
+    def extrapolated_fraction(self, recording: Recording, margin: float = 0.05) -> float | None:
+        """Share of samples whose sensor value lies outside the range seen in training.
+
+        The range (normalised units) is widened by ``margin`` of its width on each side; None if
+        the compensator does not know its training range (files from before it was stored).
+        Beyond that range every model extrapolates, and the generalisation matrix shows how
+        badly that can end.
+        """
+        if self.training_range is None:
+            return None
+        lo, hi = self.training_range
+        pad = margin * (hi - lo)
+        s = self._normalised_sensor(recording.sensor)
+        return float(np.mean((s < lo - pad) | (s > hi + pad)))
 
     def estimate_linear(self, recording: Recording,
                         position_mean: float | None = None) -> np.ndarray:
@@ -207,6 +229,7 @@ def fit_compensator(recording: Recording, size: int | None = None, *, model: str
             "n_evaluations": result.n_evaluations, "converged": result.converged,
             "message": result.message, "n_starts": result.n_starts,
             "training_source": recording.source, "training_samples": recording.n_samples}
-    return Compensator(structure=structure, params=result.params, mode=mode, center=center,
+    return Compensator(training_range=(float(s.min()), float(s.max())),
+                       structure=structure, params=result.params, mode=mode, center=center,
                        scaling=scaling, baseline=LinearBaseline(float(slope), float(intercept)),
                        fit_info=info, model=model)

@@ -25,7 +25,8 @@ def evaluate(compensator: Compensator, recording: Recording) -> dict:
     -------
     dict
         ``r2, e_rms_pct, e_max_pct, sinad_db, loop_area`` of the compensator, the same with a
-        ``linear_`` prefix for the baseline line, ``sensor_loop_area``, ``n_samples``, ``center``.
+        ``linear_`` prefix for the baseline line, ``sensor_loop_area``, ``n_samples``, ``center``,
+        ``extrapolated_fraction`` (share of samples outside the sensor range seen in training).
     """
     if not recording.has_position():
         raise InputError(f"{recording.source}: column 'position' is needed to evaluate")
@@ -34,7 +35,8 @@ def evaluate(compensator: Compensator, recording: Recording) -> dict:
     estimate = compensator.estimate(recording, position_mean=mean)
     linear = compensator.estimate_linear(recording, position_mean=mean)
     scale = compensator.scaling.position_scale
-    scores = {"n_samples": recording.n_samples, "center": compensator.center}
+    scores = {"n_samples": recording.n_samples, "center": compensator.center,
+              "extrapolated_fraction": compensator.extrapolated_fraction(recording)}
     for prefix, guess in (("", estimate), ("linear_", linear)):
         scores[f"{prefix}r2"] = r2(position, guess)
         scores[f"{prefix}e_rms_pct"] = e_rms_pct(position, guess, scale=scale)

@@ -41,6 +41,8 @@ def compensator_to_dict(comp: Compensator) -> dict:
         "baseline": asdict(comp.baseline),
         "fit_seconds": comp.fit_info.get("fit_seconds"),
         "fit": comp.fit_info,
+        "training_range": (None if comp.training_range is None
+                           else list(comp.training_range)),
     }
 
 
@@ -65,6 +67,8 @@ def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
                            params=family.params_type.from_dict(d["params"]), mode=d["mode"],
                            center=d["center"], scaling=Scaling(**d["normalisation"]),
                            baseline=LinearBaseline(**d["baseline"]), fit_info=d.get("fit", {}),
+                           training_range=(None if d.get("training_range") is None
+                                           else tuple(d["training_range"])),
                            model=d["model"])
     except KeyError as exc:
         raise InputError(f"{source}: key {exc.args[0]!r} is missing") from None
