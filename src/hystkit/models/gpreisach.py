@@ -38,14 +38,12 @@ from numpy.polynomial import Polynomial
 
 from ..errors import FitDivergedError
 from . import _preisach_kernels as kernels
-from ._validation import check_signal
 from .preisach import (
     INVERT_TOL,
     PreisachParams,
     PreisachStructure,
     antisymmetric,
-    check_state,
-    demagnetised_state,
+    prepare_run,
     staircase_terms,
     update_staircase,
 )
@@ -219,9 +217,7 @@ def _check(structure: GPreisachStructure, params: GPreisachParams, v: np.ndarray
     if params.levels != structure.levels or params.nu.size != structure.degree + 1:
         raise ValueError(f"params (levels {params.levels}, {params.nu.size} nu) do not match "
                          f"the structure (levels {structure.levels}, degree {structure.degree})")
-    v = check_signal(v, name)
-    x = demagnetised_state(structure.levels - 1) if x0 is None else x0
-    return v, check_state(x, structure.capacity)
+    return prepare_run(structure, v, name, x0)
 
 
 def simulate(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarray,

@@ -306,6 +306,16 @@ def step(structure: PreisachStructure, params: PreisachParams, x: np.ndarray,
 def _check(structure: PreisachStructure, params: PreisachParams, v: np.ndarray, name: str,
            x0: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     check_size(params.levels, structure.levels, "levels")
+    return prepare_run(structure, v, name, x0)
+
+
+def prepare_run(structure, v: np.ndarray, name: str,
+                x0: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """Checked input and start state (demagnetised if ``x0`` is None) for a staircase model.
+
+    Shared with the generalised model, whose structure has the same ``levels`` and
+    ``capacity``.
+    """
     v = check_signal(v, name)
     x = demagnetised_state(structure.levels - 1) if x0 is None else x0
     return v, check_state(x, structure.capacity)
