@@ -5,8 +5,8 @@ import pytest
 from numpy.testing import assert_allclose
 
 from hystkit.errors import FitDivergedError
-from hystkit.identification import fit_mpl
 from hystkit.models import mpl
+from hystkit.models.mpl import fit_mpl
 
 DT = 0.025
 

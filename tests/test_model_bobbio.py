@@ -12,9 +12,8 @@ from scipy.optimize import brentq
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification import get_family
 from hystkit.identification.family_bobbio import candidate_thresholds, fit_bobbio
-from hystkit.models import bobbio
+from hystkit.models import bobbio, get_family
 from hystkit.sensors import simulate_experiment
 
 STRUCT = bobbio.BobbioStructure(n_springs=5)

@@ -13,9 +13,9 @@ from scipy.io import loadmat
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError, InputError
-from hystkit.identification import get_family
 from hystkit.identification.family_boucwen import fit_boucwen
 from hystkit.models import boucwen as bw
+from hystkit.models import get_family
 from hystkit.sensors import simulate_experiment
 
 DT = 0.01

@@ -8,9 +8,8 @@ from numpy.testing import assert_allclose
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification import get_family
 from hystkit.identification.family_chua import fit_chua
-from hystkit.models import chua
+from hystkit.models import chua, get_family
 from hystkit.sensors import simulate_experiment
 
 DT = 0.025

@@ -9,9 +9,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification import get_family
 from hystkit.identification.family_ladder import fit_ladder
-from hystkit.models import bobbio, ladder
+from hystkit.models import bobbio, get_family, ladder
 from hystkit.sensors import simulate_experiment
 
 DT = 0.025

@@ -15,13 +15,13 @@ from hystkit.compensation import (
     fit_compensator,
 )
 from hystkit.errors import FitDivergedError
-from hystkit.identification import FAMILIES
 from hystkit.identification.family_mpl_poly import (
     PAPER_9_2_TABLE_II,
     canonical,
     fit_mpl_poly,
     paper_9_2_params,
 )
+from hystkit.models import FAMILIES
 from hystkit.models import mpl_poly as mp
 from hystkit.models._linearise import stability_report
 from hystkit.sensors import simulate_experiment

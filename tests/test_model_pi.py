@@ -12,9 +12,8 @@ from numpy.testing import assert_allclose
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification import FAMILIES
 from hystkit.identification.family_pi import MIN_SLOPE, fit_pi
-from hystkit.models import pi
+from hystkit.models import FAMILIES, pi
 from hystkit.sensors import simulate_experiment
 
 DT = 0.025

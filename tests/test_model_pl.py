@@ -10,10 +10,9 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from hystkit.cli._main import main
 from hystkit.compensation import evaluate, fit_compensator
-from hystkit.identification import get_family
 from hystkit.identification.family_pl import fit_pl, format_search_table, structural_search
 from hystkit.io import write_recording
-from hystkit.models import pl
+from hystkit.models import get_family, pl
 from hystkit.sensors import simulate_experiment
 
 DT = 0.025

@@ -18,8 +18,8 @@ from hystkit.compensation import (
     fit_compensator,
 )
 from hystkit.errors import FitDivergedError
-from hystkit.identification import get_family
 from hystkit.identification.family_preisach import everett_from_forcs, fit_preisach
+from hystkit.models import get_family
 from hystkit.models import preisach as P
 from hystkit.sensors import simulate_experiment
 

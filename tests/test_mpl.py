@@ -7,8 +7,8 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from hystkit.errors import FitDivergedError
-from hystkit.models import _mpl_kernels as kernels
 from hystkit.models import mpl
+from hystkit.models.mpl import kernels
 
 DT = 0.025
 

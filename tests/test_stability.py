@@ -4,7 +4,6 @@ stability``."""
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
 
 import numpy as np
 import pytest
@@ -13,7 +12,6 @@ from numpy.testing import assert_allclose
 from hystkit.cli import main
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification import FAMILIES, ModelFamily
 from hystkit.identification.family_mpl_poly import PAPER_9_2_TABLE_II, paper_9_2_params
 from hystkit.io import write_recording
 from hystkit.models import _linearise as lin
@@ -186,35 +184,6 @@ def test_cli_uses_a_recording_as_the_probe(model_files, capsys):
     assert f"driven by {model_files['recording']}" in stdout
 
 
-@dataclass(frozen=True)
-class _DummyStructure:
-    dt: float = DT
-
-
-@dataclass(frozen=True)
-class _DummyParams:
-    def to_dict(self) -> dict:
-        return {}
-
-    @classmethod
-    def from_dict(cls, d: dict) -> _DummyParams:
-        return cls()
-
-
-def test_cli_refuses_other_families_in_one_line(model_files, tmp_path, capsys, monkeypatch):
-    dummy = ModelFamily(name="dummy", title="identity", structure_type=_DummyStructure,
-                        params_type=_DummyParams,
-                        make_structure=lambda dt, size: _DummyStructure(dt),
-                        simulate=lambda s, p, u, x0=None: (np.asarray(u, float), np.zeros(0)),
-                        fit=lambda *a, **k: None, no_inverse_reason="identity")
-    monkeypatch.setitem(FAMILIES, "dummy", dummy)
-    data = json.loads(model_files["mpl"].read_text())
-    data.update(model="dummy", structure={"dt": DT}, params={})
-    path = tmp_path / "dummy.json"
-    path.write_text(json.dumps(data))
-    code, stdout, stderr = _run(capsys, "stability", path)
-    assert code == 2 and stdout == ""
-    lines = stderr.splitlines()
-    assert len(lines) == 1 and "covers the mpl and mpl-poly families, not 'dummy'" in lines[0]
+def test_cli_missing_model_file_is_one_line(tmp_path, capsys):
     code, _, stderr = _run(capsys, "stability", tmp_path / "missing.json")
     assert code == 2 and "file not found" in stderr

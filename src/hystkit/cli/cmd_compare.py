@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..identification import FAMILIES
 from ..io import check_output_path, read_recording, write_json
+from ..models import FAMILIES
 from ._common import UsageError
 
 __all__ = ["register"]

@@ -15,8 +15,8 @@ from ..compensation import (
     load_compensator,
     save_compensator,
 )
-from ..identification import FAMILIES, get_family
 from ..io import check_output_path, read_recording, write_json, write_recording
+from ..models import FAMILIES, get_family
 from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
 from ._common import UsageError, positive_int, slope_cap

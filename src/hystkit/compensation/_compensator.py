@@ -1,6 +1,6 @@
 """A fitted compensator: sensor signal in, position estimate out (sec. 5.3.4-5.3.6).
 
-Two ways to get one, for any registered model family (``hystkit.identification.FAMILIES``;
+Two ways to get one, for any registered model family (``hystkit.models.FAMILIES``;
 the mPL by default):
 
 - ``direct`` (paper 9.2): fit the model from sensor to position; the model *is* the
@@ -25,8 +25,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import FitDivergedError, InputError
-from ..identification import FitResult, ModelFamily, get_family
+from ..identification import FitResult
 from ..io import Recording
+from ..models import Family, get_family
 
 __all__ = ["CENTERS", "MODES", "Compensator", "LinearBaseline", "Scaling", "fit_compensator"]
 
@@ -74,7 +75,7 @@ class Compensator:
     training_range: tuple[float, float] | None = None
 
     @property
-    def family(self) -> ModelFamily:
+    def family(self) -> Family:
         return get_family(self.model)
 
     def __post_init__(self) -> None:
@@ -173,7 +174,7 @@ def _centre_and_scale(recording: Recording, center: str) -> tuple[Scaling, np.nd
     return scaling, s / scaling.sensor_scale, p / scaling.position_scale
 
 
-def _inverse_is_bounded(family: ModelFamily, structure: Any, params: Any,
+def _inverse_is_bounded(family: Family, structure: Any, params: Any,
                         s: np.ndarray) -> bool:
     try:
         p_hat, _ = family.invert(structure, params, s)
@@ -194,7 +195,7 @@ def fit_compensator(recording: Recording, size: int | None = None, *, model: str
     size : int, optional
         The family's size knob (mPL: cells N, 3N + 2 parameters); default per family.
     model : str
-        Registered model family (``hystkit.identification.FAMILIES``).
+        Registered model family (``hystkit.models.FAMILIES``).
     mode : {"direct", "inverse"}
     center : {"recording", "fit", "none"}
         See the module docstring.

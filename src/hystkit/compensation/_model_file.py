@@ -8,8 +8,8 @@ from pathlib import Path
 
 from .. import __version__
 from ..errors import InputError
-from ..identification import FAMILIES
 from ..io import write_json
+from ..models import FAMILIES
 from ._compensator import CENTERS, MODES, Compensator, LinearBaseline, Scaling
 
 __all__ = [

@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..models._mpl_kernels import _current
 from ..models._mpl_poly_kernels import _cell, _cubic, solve_output
+from ..models.mpl.kernels import current as _current
 from ._sensors import BLOCK_HEADER
 
 N_FIXED = 10

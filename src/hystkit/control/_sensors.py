@@ -29,10 +29,10 @@ import numpy as np
 
 from ..compensation import Compensator, Scaling, fit_compensator
 from ..errors import InputError
-from ..identification import fit_mpl
 from ..io import Recording
-from ..models import _mpl_kernels as mpl_kernels
 from ..models import mpl, mpl_poly
+from ..models.mpl import fit_mpl
+from ..models.mpl import kernels as mpl_kernels
 from ..sensors import simulate_experiment
 from . import _poly
 
@@ -196,7 +196,7 @@ class SensorBlock:
         knee = mpl.knee_voltage(s, p)
         w, w0 = p.w[1:], p.w[0]
         drive = (u + p.v_b - w @ x) / w0 if self.inverse else u
-        slope = np.array([mpl_kernels._current(drive - x[k], p.i_s[k], p.v_t[k], knee[k],
+        slope = np.array([mpl_kernels.current(drive - x[k], p.i_s[k], p.v_t[k], knee[k],
                                                s.slope_cap / dt)[1] for k in range(p.n_cells)])
         g = slope * dt
         if self.inverse:

@@ -1,9 +1,10 @@
-"""Parameter identification: least-squares fits of hysteresis models to recordings."""
+"""Parameter identification machinery shared by every model family (no family lives here).
 
-from ._fit import default_starts, fit_mpl
-from ._least_squares import fit_multistart
-from ._registry import FAMILIES, ModelFamily, get_family
+Each family's own fit is in its folder, ``hystkit.models.<family>``; the registry of families is
+:mod:`hystkit.models`.
+"""
+
+from ._least_squares import check_fit_data, fit_multistart
 from ._result import FitResult
 
-__all__ = ["FAMILIES", "FitResult", "ModelFamily", "default_starts", "fit_mpl", "fit_multistart",
-           "get_family"]
+__all__ = ["FitResult", "check_fit_data", "fit_multistart"]

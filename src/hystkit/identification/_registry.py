@@ -1,4 +1,4 @@
-"""Model families behind one interface: simulate, fit, invert (where one exists).
+"""TRANSITIONAL: the first registry's family record, until every family has its folder.
 
 A family is a module ``family_<name>.py`` in this folder exporting ``FAMILY``, a
 :class:`ModelFamily`; the registry finds them, so adding a model edits no shared file.
@@ -6,19 +6,15 @@ A family is a module ``family_<name>.py`` in this folder exporting ``FAMILY``, a
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
 from ._result import FitResult
 
-__all__ = ["FAMILIES", "ModelFamily", "get_family"]
+__all__ = ["ModelFamily"]
 
 
 @dataclass(frozen=True)
@@ -58,25 +54,3 @@ class ModelFamily:
     no_inverse_reason: str = ""
     size_help: str = "model size"
     default_size: int = 1
-
-
-def _discover() -> dict[str, ModelFamily]:
-    package = __name__.rpartition(".")[0]
-    families = {}
-    for info in sorted(pkgutil.iter_modules(sys.modules[package].__path__), key=lambda m: m.name):
-        if info.name.startswith("family_"):
-            family = importlib.import_module(f"{package}.{info.name}").FAMILY
-            families[family.name] = family
-    return families
-
-
-FAMILIES: dict[str, ModelFamily] = _discover()
-
-
-def get_family(name: str) -> ModelFamily:
-    """The registered family ``name``; InputError listing the known ones otherwise."""
-    try:
-        return FAMILIES[name]
-    except KeyError:
-        raise InputError(f"unknown model {name!r}; known models: {', '.join(sorted(FAMILIES))}")\
-            from None

@@ -1,7 +1,12 @@
-"""Hysteresis models. Each module holds one model family with pure, explicit-state functions."""
+"""Hysteresis models: the family protocol, the registry, and one folder per model family.
 
-from . import bobbio, boucwen, chua, gpreisach, ladder, mpl, mpl_poly, pi, pl, preisach
-from .mpl import MplParams, MplStructure
+``from hystkit.models import get_family`` gives a family by its CLI name; ``FAMILIES`` maps
+every registered name to its family. See :mod:`hystkit.models._protocol` for what a family
+provides and how to add one.
+"""
 
-__all__ = ["MplParams", "MplStructure", "bobbio", "boucwen", "chua", "gpreisach", "ladder", "mpl",
-           "mpl_poly", "pi", "pl", "preisach"]
+from ._protocol import Block, Family, Record, numerical_linearisation
+from ._registry import FAMILIES, get_family, register, unregister
+
+__all__ = ["FAMILIES", "Block", "Family", "Record", "get_family", "numerical_linearisation",
+           "register", "unregister"]

@@ -14,9 +14,9 @@ from matplotlib.figure import Figure
 from ..compensation import evaluate, fit_compensator
 from ..compensation._compensator import _centre_and_scale
 from ..errors import HystkitError
-from ..identification import FAMILIES, get_family
 from ..io import Recording
 from ..metrics import e_max_pct, e_rms_pct, r2
+from ..models import FAMILIES, get_family
 from ._properties import measure_properties
 
 __all__ = ["compare_models", "format_compare", "generalization_matrix", "plot_generalization"]

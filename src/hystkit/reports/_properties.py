@@ -26,8 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from ..identification import ModelFamily
 from ..metrics import loop_area
+from ..models import Family
 
 __all__ = ["measure_properties"]
 
@@ -48,7 +48,7 @@ def _range(y: np.ndarray) -> float:
     return float(np.ptp(y)) or 1.0
 
 
-def measure_properties(family: ModelFamily, structure: Any, params: Any) -> dict:
+def measure_properties(family: Family, structure: Any, params: Any) -> dict:
     """Measure rate dependence, return-point memory and minor-loop closure of a fitted model.
 
     Returns

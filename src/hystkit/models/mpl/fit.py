@@ -13,10 +13,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..models import _mpl_kernels as kernels
-from ..models import mpl
-from ._least_squares import check_fit_data, fit_multistart
-from ._result import FitResult
+from ...identification import FitResult, check_fit_data, fit_multistart
+from . import kernels
+from . import model as mpl
 
 __all__ = ["default_starts", "fit_mpl"]
 

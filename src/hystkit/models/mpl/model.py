@@ -28,9 +28,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FitDivergedError
-from . import _mpl_kernels as kernels
-from ._validation import (
+from ...errors import FitDivergedError
+from .._protocol import Record
+from .._validation import (
     check_dt,
     check_positive_int,
     check_signal,
@@ -39,6 +39,7 @@ from ._validation import (
     frozen_array,
     initial_state,
 )
+from . import kernels
 
 __all__ = [
     "MplParams",
@@ -54,7 +55,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class MplStructure:
+class MplStructure(Record):
     """What does not get fitted: cell count, sample time and the Euler slope cap.
 
     Parameters
@@ -83,7 +84,7 @@ class MplStructure:
 
 
 @dataclass(frozen=True, eq=False)
-class MplParams:
+class MplParams(Record):
     """Fitted quantities of an mPL model.
 
     Parameters
@@ -137,21 +138,6 @@ class MplParams:
         i_s = 0.5 * np.exp(cells[:, 0]) * v_t
         return cls(i_s=i_s, v_t=v_t, w=theta[2 * n_cells: 3 * n_cells + 1],
                    v_b=theta[3 * n_cells + 1])
-
-    def to_dict(self) -> dict:
-        return {"i_s": self.i_s.tolist(), "v_t": self.v_t.tolist(), "w": self.w.tolist(),
-                "v_b": self.v_b}
-
-    @classmethod
-    def from_dict(cls, d: dict) -> MplParams:
-        return cls(i_s=d["i_s"], v_t=d["v_t"], w=d["w"], v_b=d["v_b"])
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, MplParams):
-            return NotImplemented
-        return bool(np.array_equal(self.to_vector(), other.to_vector()))
-
-    __hash__ = None
 
 
 def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:

@@ -1,7 +1,7 @@
-"""Compiled hot loops of the mPL model; ``mpl.py`` holds the readable reference and the checks.
+"""Compiled hot loops of the mPL model; ``model.py`` holds the readable reference and the checks.
 
 All arrays are float64 and already validated by the caller. ``knee`` is the per-cell voltage
-beyond which the resistor is linear with slope ``cap`` (eq. 5.29, see ``mpl.py``).
+beyond which the resistor is linear with slope ``cap`` (eq. 5.29, see ``model.py``).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from numba import njit
 
 
 @njit(cache=True, inline="always")
-def _current(v, i_s, v_t, knee, cap):
+def current(v, i_s, v_t, knee, cap):
     """Limited sinh resistor current and its slope at ``v``."""
     if abs(v) <= knee:
         return 2.0 * i_s * np.sinh(v / v_t), 2.0 * i_s / v_t * np.cosh(v / v_t)
@@ -30,7 +30,7 @@ def simulate(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
             acc += w[k + 1] * x[k]
         y[n] = acc
         for k in range(n_cells):
-            f, _ = _current(u[n] - x[k], i_s[k], v_t[k], knee[k], cap)
+            f, _ = current(u[n] - x[k], i_s[k], v_t[k], knee[k], cap)
             x[k] += f * dt
     return y, x
 
@@ -54,7 +54,7 @@ def invert(y, x0, i_s, v_t, w, v_b, knee, cap, dt):
             return u_hat, x, n
         u_hat[n] = e
         for k in range(n_cells):
-            f, _ = _current(e - x[k], i_s[k], v_t[k], knee[k], cap)
+            f, _ = current(e - x[k], i_s[k], v_t[k], knee[k], cap)
             x[k] += f * dt
     return u_hat, x, -1
 
@@ -85,7 +85,7 @@ def simulate_with_jacobian(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
         jac[n, 3 * n_cells + 1] = -1.0
         for k in range(n_cells):
             v = u[n] - x[k]
-            f, slope = _current(v, i_s[k], v_t[k], knee[k], cap)
+            f, slope = current(v, i_s[k], v_t[k], knee[k], cap)
             if abs(v) <= knee[k]:
                 d_log_g = f
                 d_log_vt = f - v * slope
@@ -98,3 +98,37 @@ def simulate_with_jacobian(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
             sens[k, 1] += (d_log_vt - slope * sens[k, 1]) * dt
             x[k] += f * dt
     return y, jac
+
+
+# Loop blocks (protocol in ``hystkit.models._protocol``): body = [n, v_b, cap, dt,
+# i_s (n), v_t (n), knee (n), w (n + 1)].
+
+@njit(cache=True)
+def block_forward(body, x, xn, off, u):
+    """``y = w_0 u + sum w_k x_k - V_b`` (eq. 5.2), then the cells driven by ``u`` (eq. 5.6)."""
+    n = int(body[0])
+    iw = 4 + 3 * n
+    acc = body[iw] * u - body[1]
+    for k in range(n):
+        acc += body[iw + 1 + k] * x[off + k]
+    for k in range(n):
+        f, _ = current(u - x[off + k], body[4 + k], body[4 + n + k], body[4 + 2 * n + k],
+                       body[2])
+        xn[off + k] = x[off + k] + f * body[3]
+    return acc
+
+
+@njit(cache=True)
+def block_inverse(body, x, xn, off, y):
+    """``u_hat = (y + V_b - sum w_k x_k) / w_0`` (eq. 5.13), cells driven by ``u_hat``."""
+    n = int(body[0])
+    iw = 4 + 3 * n
+    acc = y + body[1]
+    for k in range(n):
+        acc -= body[iw + 1 + k] * x[off + k]
+    u_hat = acc / body[iw]
+    for k in range(n):
+        f, _ = current(u_hat - x[off + k], body[4 + k], body[4 + n + k], body[4 + 2 * n + k],
+                       body[2])
+        xn[off + k] = x[off + k] + f * body[3]
+    return u_hat

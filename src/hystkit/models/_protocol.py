@@ -1,0 +1,250 @@
+"""The family protocol: what every hysteresis model family provides, in one place.
+
+A *family* (mPL, Preisach, PI, ...) is one folder ``hystkit/models/<family>/`` whose
+``__init__`` exports ``FAMILY``, an instance of a :class:`Family` subclass. Generic code (fit,
+compensator, compare, control loop, stability, python-control adapter) talks to families only
+through this protocol, so adding a family is one new folder and no edit elsewhere.
+
+Conventions, shared by every family:
+
+- **Explicit state.** A model's memory is a float64 vector ``x`` passed in and returned; nothing
+  is kept in objects. ``step`` gives the output from the *present* state and then the next
+  state, so ``simulate`` over a split run continued from ``x_end`` equals the whole run.
+- **Structure and parameters.** ``Structure`` holds what is not fitted (sizes, sample time
+  ``dt``, integration limits); ``Params`` holds the fitted quantities. Both are frozen
+  dataclasses deriving from :class:`Record`, which gives JSON round trips and equality once.
+- **Normalised units.** Fits and the compensator work on data centred and scaled to max |.| = 1
+  (eq. 5.10); a family's documented parameter domain is stated for those units.
+- **Inverse.** ``invert`` / ``invert_step`` are ``None`` for a family without an inverse, and
+  ``no_inverse_reason`` says why.
+- **Compiled block.** :meth:`Family.block` returns a numba function with the signature
+  ``step(body, x, xn, off, u) -> out`` and the flat float64 ``body`` it reads: the output from
+  ``x[off:off + n_state]``, the next state written to ``xn[off:off + n_state]``. The closed
+  loop calls these for every slot, so any family runs compiled in any slot.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from typing import Any, ClassVar, NamedTuple
+
+import numpy as np
+
+__all__ = ["Block", "Family", "Record", "numerical_linearisation"]
+
+
+class Record:
+    """Mixin for a family's frozen ``Structure`` / ``Params`` dataclasses.
+
+    ``to_dict`` gives JSON-safe values (arrays and tuples as lists), ``from_dict`` rebuilds from
+    the ``__init__`` fields, ``==`` compares every ``__init__`` field (arrays element-wise).
+    Derived fields (``field(init=False)``) are left out of all three. Declare array-holding
+    classes ``@dataclass(frozen=True, eq=False)`` so that this ``==`` is used; a structure of
+    scalars and tuples may keep the dataclass's own ``==`` and hash.
+    """
+
+    @classmethod
+    def _init_fields(cls) -> list[str]:
+        return [f.name for f in dataclasses.fields(cls) if f.init]
+
+    def to_dict(self) -> dict:
+        return {name: _jsonable(getattr(self, name)) for name in self._init_fields()}
+
+    @classmethod
+    def from_dict(cls, d: dict):
+        missing = [name for name in cls._init_fields() if name not in d
+                   and _required(cls, name)]
+        if missing:
+            raise KeyError(f"{cls.__name__} needs {', '.join(missing)}")
+        return cls(**{name: d[name] for name in cls._init_fields() if name in d})
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        return all(_same(getattr(self, name), getattr(other, name))
+                   for name in self._init_fields())
+
+    __hash__ = None
+
+
+def _required(cls: type, name: str) -> bool:
+    f = next(f for f in dataclasses.fields(cls) if f.name == name)
+    return f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, tuple | list):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, np.ndarray | list | tuple) or isinstance(b, np.ndarray | list | tuple):
+        a, b = np.asarray(a), np.asarray(b)
+        return a.shape == b.shape and bool(np.array_equal(a, b))
+    return bool(a == b)
+
+
+class Block(NamedTuple):
+    """A model compiled for the closed loop (see the module docstring).
+
+    Attributes
+    ----------
+    step : numba dispatcher
+        ``step(body, x, xn, off, u) -> out``.
+    body : array
+        Flat float64 parameters the step reads.
+    n_state : int
+        Length of the block's slice of the loop state.
+    """
+
+    step: Callable[..., float]
+    body: np.ndarray
+    n_state: int
+
+
+class Family(ABC):
+    """One hysteresis model family. Subclass it once per family; export an instance as FAMILY.
+
+    Class attributes
+    ----------------
+    name : str
+        CLI name (``hystkit fit --model NAME``).
+    title : str
+        Human name with the reference document's section.
+    size_help : str
+        What the size knob means (cells, operators, grid levels ...).
+    default_size : int
+    docs : str
+        Path of the family's page under ``docs/``.
+    Structure, Params : type
+        The family's frozen dataclasses (both derive from :class:`Record`).
+    no_inverse_reason : str
+        Empty when the family has an inverse; otherwise why not (``invert`` is then None).
+    """
+
+    name: ClassVar[str]
+    title: ClassVar[str]
+    size_help: ClassVar[str] = "model size"
+    default_size: ClassVar[int] = 1
+    docs: ClassVar[str] = ""
+    Structure: ClassVar[type]
+    Params: ClassVar[type]
+    no_inverse_reason: ClassVar[str] = ""
+
+    # A family with an inverse overrides both with methods:
+    #   invert(structure, params, y, x0=None) -> (u_hat, x_end)
+    #   invert_step(structure, params, x, y) -> (u_hat, x_next)
+    invert: ClassVar[Callable[..., tuple[np.ndarray, np.ndarray]] | None] = None
+    invert_step: ClassVar[Callable[..., tuple[float, np.ndarray]] | None] = None
+
+    # Older names, kept so that code written against the first registry keeps working.
+    @property
+    def structure_type(self) -> type:
+        return self.Structure
+
+    @property
+    def params_type(self) -> type:
+        return self.Params
+
+    @property
+    def has_inverse(self) -> bool:
+        return self.invert is not None
+
+    def __repr__(self) -> str:
+        return f"<hystkit model family {self.name!r}>"
+
+    # -- structure --------------------------------------------------------------------------
+
+    @abstractmethod
+    def make_structure(self, dt: float, size: int, **options: Any) -> Any:
+        """``(dt [s], size, **options) -> Structure``; ``size`` is the family's size knob."""
+
+    def at(self, structure: Any, dt: float) -> Any:
+        """The same model at sample time ``dt`` (the loop's ``Ts``).
+
+        The default replaces ``dt``, right for a model that is a discretised ODE whose
+        parameters do not depend on the step. A family for which that is wrong overrides this
+        or raises ``ValueError`` saying why.
+        """
+        return dataclasses.replace(structure, dt=float(dt))
+
+    def n_params(self, structure: Any, params: Any) -> int:
+        """Number of fitted numbers (for information criteria)."""
+        return int(sum(np.size(v) for v in params.to_dict().values()))
+
+    # -- running ----------------------------------------------------------------------------
+
+    @abstractmethod
+    def rest_state(self, structure: Any, params: Any, value: float,
+                   inverse: bool = False) -> np.ndarray:
+        """State at rest under a constant input ``value`` (forward) or output (``inverse``)."""
+
+    @abstractmethod
+    def step(self, structure: Any, params: Any, x: np.ndarray,
+             u: float) -> tuple[float, np.ndarray]:
+        """One sample: output from the present state, then the next state (readable)."""
+
+    @abstractmethod
+    def simulate(self, structure: Any, params: Any, u: np.ndarray,
+                 x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Run over ``u`` (compiled); ``x0=None`` starts at rest at ``u[0]``."""
+
+    # -- identification ---------------------------------------------------------------------
+
+    @abstractmethod
+    def fit(self, u: np.ndarray, y: np.ndarray, structure: Any, *,
+            accept: Callable[[Any], bool] | None = None,
+            accept_reason: str = "rejected by the acceptance test", **options: Any) -> Any:
+        """Fit ``u -> y`` (centred, normalised data) and return a ``FitResult``."""
+
+    # -- loop -------------------------------------------------------------------------------
+
+    @abstractmethod
+    def block(self, structure: Any, params: Any, inverse: bool = False) -> Block:
+        """The model (or its inverse) compiled for the closed loop, at ``structure.dt``."""
+
+    def linearise(self, structure: Any, params: Any, x: np.ndarray, u: float,
+                  inverse: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """Discrete linearisation ``(A, B, C, D)`` of one step at state ``x`` and input ``u``.
+
+        The default differentiates :meth:`step` (or ``invert_step``) numerically; families
+        with an analytical form override it and test that the two agree.
+        """
+        run = self.invert_step if inverse else self.step
+        if run is None:
+            raise ValueError(f"model {self.name!r} has no inverse ({self.no_inverse_reason})")
+        return numerical_linearisation(lambda xx, uu: run(structure, params, xx, uu), x, u)
+
+
+def numerical_linearisation(step: Callable[[np.ndarray, float], tuple[float, np.ndarray]],
+                            x: np.ndarray, u: float,
+                            rel_step: float = 1e-6) -> tuple[np.ndarray, np.ndarray,
+                                                             np.ndarray, float]:
+    """``(A, B, C, D)`` of ``(y, x+) = step(x, u)`` by central differences.
+
+    The step is ``rel_step`` times ``max(1, |value|)`` per coordinate; a piecewise model
+    linearised exactly on a kink gets the mean of its two slopes.
+    """
+    x = np.array(x, dtype=float)
+    n = x.size
+    a = np.empty((n, n))
+    c = np.empty(n)
+    for k in range(n):
+        h = rel_step * max(1.0, abs(x[k]))
+        xp, xm = x.copy(), x.copy()
+        xp[k] += h
+        xm[k] -= h
+        (yp, xnp), (ym, xnm) = step(xp, u), step(xm, u)
+        a[:, k] = (np.asarray(xnp) - np.asarray(xnm)) / (2 * h)
+        c[k] = (yp - ym) / (2 * h)
+    h = rel_step * max(1.0, abs(u))
+    (yp, xnp), (ym, xnm) = step(x, u + h), step(x, u - h)
+    b = (np.asarray(xnp) - np.asarray(xnm)) / (2 * h)
+    return a, b, c, float((yp - ym) / (2 * h))

@@ -1,0 +1,73 @@
+"""The modified Power-Law family (sec. 5.3.1, eq. 5.1-5.6) behind the family protocol."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._protocol import Block, Family
+from . import kernels
+from . import model as mpl
+from .fit import fit_mpl
+
+__all__ = ["MplFamily"]
+
+
+class MplFamily(Family):
+    name = "mpl"
+    title = "modified Power-Law, sinh resistors (sec. 5.3.1, eq. 5.1-5.6)"
+    size_help = "cells N (3N + 2 params)"
+    default_size = 1
+    docs = "docs/models/mpl.md"
+    Structure = mpl.MplStructure
+    Params = mpl.MplParams
+
+    def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> mpl.MplStructure:
+        return mpl.MplStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
+
+    def rest_state(self, structure, params, value, inverse=False):
+        # Forward: each cell equals its drive. Inverse: the drive is the input estimate, at rest
+        # (y + V_b) / sum(w), as mpl.invert starts.
+        if inverse:
+            w_sum = float(np.sum(params.w))
+            value = (value + params.v_b) / w_sum if w_sum != 0 else 0.0
+        return np.full(structure.n_cells, float(value))
+
+    def step(self, structure, params, x, u):
+        return mpl.step(structure, params, x, u)
+
+    def simulate(self, structure, params, u, x0=None):
+        return mpl.simulate(structure, params, u, x0)
+
+    def invert(self, structure, params, y, x0=None):
+        return mpl.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return mpl.invert_step(structure, params, x, y)
+
+    def fit(self, u, y, structure, *, accept=None,
+            accept_reason="rejected by the acceptance test", **options):
+        return fit_mpl(u, y, structure, accept=accept, accept_reason=accept_reason, **options)
+
+    def block(self, structure, params, inverse=False):
+        body = np.concatenate([[params.n_cells, params.v_b, structure.slope_cap / structure.dt,
+                                structure.dt], params.i_s, params.v_t,
+                               mpl.knee_voltage(structure, params), params.w])
+        step = kernels.block_inverse if inverse else kernels.block_forward
+        return Block(step, np.ascontiguousarray(body, dtype=np.float64), structure.n_cells)
+
+    def linearise(self, structure, params, x, u, inverse=False):
+        """Paper 9.2 eq. 2-7: each cell ``x+ = x + f(v) dt`` becomes
+        ``dx+ = (1 - f' dt) dx + f' dt d(drive)``, ``f'`` the slope of the limited resistor
+        (eq. 5.29) at the operating point; the inverse's drive ``(u - w.x + V_b) / w_0`` feeds
+        back into every cell."""
+        x = np.asarray(x, dtype=float)
+        knee = mpl.knee_voltage(structure, params)
+        cap = structure.slope_cap / structure.dt
+        w, w0 = params.w[1:], params.w[0]
+        drive = (u + params.v_b - w @ x) / w0 if inverse else u
+        slope = np.array([kernels.current(drive - x[k], params.i_s[k], params.v_t[k], knee[k],
+                                          cap)[1] for k in range(structure.n_cells)])
+        g = slope * structure.dt
+        if inverse:
+            return np.diag(1.0 - g) - np.outer(g, w) / w0, g / w0, -w / w0, 1.0 / w0
+        return np.diag(1.0 - g), g, w.copy(), float(w0)
