@@ -18,7 +18,6 @@ from ..control import (
     MASS,
     PID,
     SCHEMES,
-    TABLE_II_SENSORS,
     TRAININGS,
     DisturbanceObserver,
     Plant,
@@ -34,10 +33,13 @@ from ..control import (
     plot_cases,
     plot_response,
     run_experiment,
+    sensor_block,
     table_ii_sensor,
+    table_ii_sensors,
     tune_pid,
 )
 from ..io import check_output_path, read_recording, write_json
+from ..models import FAMILIES
 from ..signals import EXPERIMENTS as EXCITATIONS
 from ._common import UsageError, positive_int
 
@@ -55,16 +57,39 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _sensor(sensor: str):
+    """``S_r`` from ``--sensor``: None (fit on the virtual sensor), a table-II column, or a
+    model file run position -> sensor."""
+    if sensor == "virtual":
+        return None
+    if sensor.startswith("table-ii-"):
+        column = sensor.removeprefix("table-ii-")
+        if column not in table_ii_sensors():
+            raise UsageError(f"--sensor {sensor}: paper 9.2's table II has columns "
+                             f"{', '.join(table_ii_sensors())}")
+        return table_ii_sensor(column)
+    return _file_block(sensor_block, Path(sensor), "S_r", "--sensor")
+
+
+def _file_block(make, path: Path, name: str, option: str):
+    """A model file as a loop block; a family that cannot serve in that slot is one line."""
+    try:
+        return make(load_compensator(path), name=name)
+    except ValueError as exc:
+        raise UsageError(f"{option} {path}: {exc}") from None
+
+
 @functools.lru_cache(maxsize=4)
-def _models(training: str, excitation: str, sensor_cells: int, model_cells: int | None,
+def _models(training: str, excitation: str, sensor_size: int | None, model_size: int | None,
             sensor_data: Path | None = None, training_data: Path | None = None,
-            sensor: str = "virtual") -> SensorModels:
+            sensor: str = "virtual", sensor_model: str = "mpl",
+            model: str = "mpl") -> SensorModels:
     # In-memory only, per process (repeated main() calls in one session, e.g. tests); nothing
     # is cached on disk, so every command line fits its models afresh (about 2 s).
     return fit_sensor_models(
-        sensor=None if sensor == "virtual" else table_ii_sensor(sensor.removeprefix("table-ii-")),
-        training=training, training_excitation=excitation, sensor_cells=sensor_cells,
-        model_cells=model_cells,
+        sensor=_sensor(sensor), training=training, training_excitation=excitation,
+        sensor_cells=sensor_size, model_cells=model_size, sensor_model=sensor_model,
+        model=model,
         sensor_recording=None if sensor_data is None else read_recording(sensor_data),
         training_recording=None if training_data is None else read_recording(training_data))
 
@@ -102,6 +127,7 @@ def _loop(args: argparse.Namespace, models: SensorModels):
             dob = (design_dob(loop) if args.dob_hz is None
                    else DisturbanceObserver(args.dob_hz))
             loop = replace(loop, dob=dob)
+        loop.kernel_arguments()  # every block at the loop's Ts, or the family's refusal
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     return loop
@@ -124,12 +150,17 @@ def _control(args: argparse.Namespace) -> int:
                          f"--sensor {args.sensor}")
     training = args.training or ("recording" if args.sensor == "virtual" else "loop")
     t_start = time.perf_counter()
-    models = _models(training, args.training_excitation, args.sensor_cells,
-                     args.model_cells, args.sensor_data, args.training_data, args.sensor)
+    models = _models(training, args.training_excitation, args.sensor_size,
+                     args.model_size, args.sensor_data, args.training_data, args.sensor,
+                     args.sensor_model, args.model)
     if args.compensator is not None:
-        models = replace(models, compensator=compensator_block(load_compensator(
-            args.compensator), name="S_m^comp"), info={**models.info,
-                                                      "compensator_file": str(args.compensator)})
+        models = replace(models, compensator=_file_block(
+            compensator_block, args.compensator, "S_m^comp", "--compensator"),
+            info={**models.info, "compensator_file": str(args.compensator)})
+    if args.model_file is not None:
+        models = replace(models, model=_file_block(sensor_block, args.model_file, "S_m",
+                                                   "--model-file"),
+                         info={**models.info, "model_file": str(args.model_file)})
     t_fit = time.perf_counter() - t_start
     loop = _loop(args, models)
     margins = loop_margins(loop)
@@ -238,10 +269,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mass", type=_positive_float, default=MASS, help="moving mass [kg]")
     p.add_argument("--u-max", type=_positive_float, default=np.inf,
                    help="actuator force limit [N] (default none)")
-    p.add_argument("--sensor", choices=("virtual", *TABLE_II_SENSORS), default="virtual",
-                   help="S_r: an mPL fitted on the virtual sensor's noise run (default) or a "
-                        "column of paper 9.2's table II run as a sensor (its inverse; "
-                        "table-ii-noise is the document's S_r, fig. 7.2)")
+    p.add_argument("--sensor", default="virtual", metavar="virtual|table-ii-COLUMN|MODEL.json",
+                   help="S_r: a model (family --sensor-model) fitted on the virtual sensor's "
+                        "noise run (default); a column of paper 9.2's table II run as a sensor "
+                        "(its inverse; table-ii-noise is the document's S_r, fig. 7.2); or a "
+                        "model file of any family run position -> sensor (an inverse-mode file "
+                        "as is, a direct-mode file through its family's inverse)")
+    families = sorted(FAMILIES)
+    p.add_argument("--sensor-model", choices=families, default="mpl",
+                   help="family of the fitted S_r (default mpl)")
+    p.add_argument("--model", choices=families, default="mpl",
+                   help="family of the fitted compensator and S_m (default mpl)")
     p.add_argument("--training", choices=TRAININGS, default=None,
                    help="compensator / S_m data: a virtual-sensor recording (default with "
                         "--sensor virtual) or S_r's own response to the sine (the document's "
@@ -255,11 +293,17 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="recording to fit the compensator and S_m on instead of the virtual "
                         "sensor's")
     p.add_argument("--compensator", type=Path,
-                   help="use this compensator model file (from 'hystkit fit', family mpl or "
-                        "mpl-poly, direct or inverse mode) in the loop")
-    p.add_argument("--sensor-cells", type=positive_int, default=3, help="mPL cells of S_r")
-    p.add_argument("--model-cells", type=positive_int,
-                   help="mPL cells of compensator and S_m (default 3; 1 with --training loop)")
+                   help="use this model file (from 'hystkit fit', any family, direct or "
+                        "inverse mode) as the compensator")
+    p.add_argument("--model-file", type=Path,
+                   help="use this model file as S_m of scheme (b), run position -> sensor "
+                        "like --sensor MODEL.json")
+    p.add_argument("--sensor-size", "--sensor-cells", type=positive_int, dest="sensor_size",
+                   help="size of the fitted S_r (mPL cells; default 3 for mpl, else the "
+                        "family's default)")
+    p.add_argument("--model-size", "--model-cells", type=positive_int, dest="model_size",
+                   help="size of the fitted compensator and S_m (mPL: 3, or 1 with "
+                        "--training loop; else the family's default)")
     p.add_argument("--no-zero", action="store_true",
                    help="do not zero the estimates on the sensor's rest reading at start")
     p.add_argument("--out", type=Path, help="output folder (default: a new timestamped one)")

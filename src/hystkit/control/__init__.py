@@ -43,7 +43,6 @@ from ._loop import (
 )
 from ._nlsys import as_nlsys, loop_initial_state, loop_nlsys
 from ._plots import plot_bode, plot_cases, plot_response
-from ._poly import TABLE_II_SENSORS
 from ._sensors import (
     TRAININGS,
     SensorBlock,
@@ -53,7 +52,9 @@ from ._sensors import (
     fit_sensor_models,
     forward_block,
     linear_block,
+    sensor_block,
     table_ii_sensor,
+    table_ii_sensors,
 )
 
 __all__ = [
@@ -66,7 +67,6 @@ __all__ = [
     "MASS",
     "PID",
     "SCHEMES",
-    "TABLE_II_SENSORS",
     "TRAININGS",
     "TS",
     "Case",
@@ -99,11 +99,13 @@ __all__ = [
     "plot_cases",
     "plot_response",
     "rest_state",
+    "sensor_block",
     "run_experiment",
     "simulate_loop",
     "simulate_loop_reference",
     "sine_reference",
     "table_ii_sensor",
+    "table_ii_sensors",
     "tare",
     "tune_pid",
 ]

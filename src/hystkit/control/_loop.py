@@ -96,10 +96,10 @@ class ControlLoop:
         return self.plant.mass if self.nominal_mass is None else self.nominal_mass
 
     def sizes(self) -> tuple[int, int, int]:
-        """Cell counts of S_r, compensator, S_m (0 if absent)."""
-        return (self.sensor.n_cells,
-                0 if self.compensator is None else self.compensator.n_cells,
-                0 if self.model is None else self.model.n_cells)
+        """State lengths of S_r, compensator, S_m (0 if absent)."""
+        return (self.sensor.n_state,
+                0 if self.compensator is None else self.compensator.n_state,
+                0 if self.model is None else self.model.n_state)
 
     def kernel_arguments(self) -> tuple:
         """Packed constant arguments of :func:`_kernel.run` after ``x0``."""
@@ -111,11 +111,14 @@ class ControlLoop:
                         float(p.anti_windup), self.sensor_gain])
         dob = (np.zeros(4) if self.dob is None
                else np.r_[1.0, self.dob.observer_gain(self.mass_n, self.ts)])
-        empty = np.empty(0)
-        return (self.scheme == "direct", plant, pid, dob, float(self.y_limit),
-                self.sensor.pack(self.ts),
-                empty if self.compensator is None else self.compensator.pack(self.ts),
-                empty if self.model is None else self.model.pack(self.ts))
+        absent = (_kernel.identity_step, np.array([1.0, 0.0, 1.0, 0.0]), np.empty(0))
+        slots = [self.sensor.pack(self.ts),
+                 absent if self.compensator is None else self.compensator.pack(self.ts),
+                 absent if self.model is None else self.model.pack(self.ts)]
+        sizes = np.array([*self.sizes(), self.compensator is not None, self.model is not None],
+                         dtype=np.int64)
+        return (self.scheme == "direct", plant, pid, dob, float(self.y_limit), sizes,
+                *(item for slot in slots for item in slot))
 
 
 @dataclass(frozen=True, eq=False)
@@ -128,7 +131,7 @@ class LoopState:
     pid : (3,) integral term, previous error, derivative term (eq. 7.2)
     estimate : (2,) nominal-plant position and velocity (fig. 7.11)
     dob : (3,) observer estimates of position, velocity, input force [N]
-    sensor, compensator, model : (N,) cell voltages of S_r, compensator, S_m (normalised)
+    sensor, compensator, model : states of S_r, compensator, S_m (normalised units)
     """
 
     plant: np.ndarray

@@ -13,14 +13,14 @@ import control
 import numpy as np
 
 from ..compensation import Compensator
-from ..models import mpl
+from ..models import family_of
 from ._blocks import TS, plant_matrices
 from ._loop import ControlLoop, LoopState, rest_state
 from ._sensors import SensorBlock, compensator_block
 
 __all__ = ["as_nlsys", "loop_initial_state", "loop_nlsys"]
 
-Model = SensorBlock | Compensator | tuple[mpl.MplStructure, mpl.MplParams]
+Model = SensorBlock | Compensator | tuple
 
 
 def _as_block(model: Model) -> SensorBlock:
@@ -29,66 +29,42 @@ def _as_block(model: Model) -> SensorBlock:
     if isinstance(model, Compensator):
         return compensator_block(model)
     if isinstance(model, tuple) and len(model) == 2:
-        return SensorBlock(model[0], model[1], name="mpl")
-    raise TypeError(f"expected a SensorBlock, a Compensator or (MplStructure, MplParams), got "
-                    f"{type(model).__name__}")
+        return SensorBlock(model[0], model[1], name=family_of(model[0]).name)
+    raise TypeError(f"expected a SensorBlock, a Compensator or (structure, params) of a "
+                    f"registered family, got {type(model).__name__}")
 
 
 def as_nlsys(model: Model, dt: float = TS, *, name: str | None = None, input: str = "u",
              output: str = "y") -> control.NonlinearIOSystem:
-    """A hystkit model as a discrete-time python-control ``nlsys`` (sample time ``dt``).
+    """A hystkit model of any family as a discrete-time python-control ``nlsys`` (step ``dt``).
 
     Parameters
     ----------
-    model : SensorBlock, Compensator or (MplStructure, MplParams)
+    model : SensorBlock, Compensator or (structure, params)
         A bare ``(structure, params)`` pair runs in normalised units; the others in their
         physical units (a compensator: sensor in, position [m] out).
     dt : float
-        Sample time [s]; the model is re-stepped at it (see :mod:`hystkit.control`).
+        Sample time [s]; the model is re-stepped at it (``family.at``).
 
     Returns
     -------
     control.NonlinearIOSystem
-        States ``<name>_x0 ..`` (normalised cell voltages), one input and one output, with the
-        model's direct feedthrough (``w_0``) in the output function.
+        States ``<name>_x0 ..`` (the family's normalised state), one input and one output; the
+        update and output functions are the family's readable ``step`` (or ``invert_step``),
+        the same the plain-Python reference loop runs.
     """
     block = _as_block(model)
     name = block.name if name is None else name
-    if block.is_poly:  # the readable block step, as the plain-Python reference loop
-        def update_poly(t, x, u, params):
-            return block.step(x, u[0], dt)[1]
-
-        def out_poly(t, x, u, params):
-            return np.array([block.step(x, u[0], dt)[0]])
-
-        return control.nlsys(update_poly, out_poly, inputs=[input], outputs=[output],
-                             states=[f"{name}_x{k}" for k in range(block.n_cells)], dt=dt,
-                             name=name)
-    p = block.params
-    knee = mpl.knee_voltage(block.at(dt), p)
-    cap = block.structure.slope_cap / dt
-    w0, w, v_b = p.w[0], p.w[1:], p.v_b
-
-    def current(v):
-        v_in = np.clip(v, -knee, knee)
-        return 2 * p.i_s * np.sinh(v_in / p.v_t) + cap * (v - v_in)  # eq. 5.29, corrected
-
-    def drive_and_out(x, u):
-        v = (u[0] - block.in_offset) / block.in_scale
-        if block.inverse:
-            drive = (v + v_b - w @ x) / w0  # eq. 5.13
-            return drive, drive
-        return v, w0 * v + w @ x - v_b  # eq. 5.2
 
     def update(t, x, u, params):
-        drive, _ = drive_and_out(x, u)
-        return x + current(drive - x) * dt
+        return block.step(x, u[0], dt)[1]
 
     def out(t, x, u, params):
-        return np.array([block.out_scale * drive_and_out(x, u)[1] + block.out_offset])
+        return np.array([block.step(x, u[0], dt)[0]])
 
     return control.nlsys(update, out, inputs=[input], outputs=[output],
-                         states=[f"{name}_x{k}" for k in range(p.n_cells)], dt=dt, name=name)
+                         states=[f"{name}_x{k}" for k in range(block.n_state)], dt=dt,
+                         name=name)
 
 
 def _plant(loop: ControlLoop) -> control.NonlinearIOSystem:

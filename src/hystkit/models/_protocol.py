@@ -175,6 +175,11 @@ class Family(ABC):
         """
         return dataclasses.replace(structure, dt=float(dt))
 
+    def presets(self) -> dict[str, tuple[Any, Any, dict]]:
+        """Named published parameter sets: ``name -> (structure, params, info)``; ``info`` says
+        where the values come from. Default: none."""
+        return {}
+
     def n_params(self, structure: Any, params: Any) -> int:
         """Number of fitted numbers (for information criteria)."""
         return int(sum(np.size(v) for v in params.to_dict().values()))

@@ -16,7 +16,7 @@ from importlib.metadata import entry_points
 from ..errors import InputError
 from ._protocol import Family
 
-__all__ = ["FAMILIES", "get_family", "register", "unregister"]
+__all__ = ["FAMILIES", "family_of", "get_family", "register", "unregister"]
 
 _PACKAGE = __name__.rpartition(".")[0]
 _found: dict[str, Family] | None = None
@@ -73,6 +73,15 @@ def get_family(name: str) -> Family:
     except KeyError:
         raise InputError(f"unknown model {name!r}; known models: "
                          f"{', '.join(sorted(families))}") from None
+
+
+def family_of(structure: object) -> Family:
+    """The registered family whose ``Structure`` ``structure`` is; TypeError otherwise."""
+    for family in _families().values():
+        if isinstance(structure, family.Structure):
+            return family
+    raise TypeError(f"{type(structure).__name__} is not the structure of a registered model "
+                    f"family")
 
 
 class _Families(Mapping[str, Family]):

@@ -12,7 +12,7 @@ from numpy.testing import assert_allclose
 from hystkit.cli import main
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification.family_mpl_poly import PAPER_9_2_TABLE_II, paper_9_2_params
+from hystkit.models.mpl_poly import PAPER_9_2_TABLE_II, paper_9_2_params
 from hystkit.io import write_recording
 from hystkit.models import _linearise as lin
 from hystkit.models import mpl, mpl_poly

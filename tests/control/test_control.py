@@ -262,7 +262,7 @@ def test_linearisation_matches_finite_differences(models, which):
     else:
         block = getattr(models, which)
     u0 = 0.02 if which == "compensator" else 1e-3
-    x0 = block.rest_state(u0) + 0.05 * np.arange(block.n_cells)
+    x0 = block.rest_state(u0) + 0.05 * np.arange(block.n_state)
     a, b, c, d = block.linearise(x0, u0, TS)
     h_u = 1e-7 * block.in_scale
     y_p, x_p = block.step(x0, u0 + h_u, TS)
@@ -271,8 +271,8 @@ def test_linearisation_matches_finite_differences(models, which):
     # central differences: O(h^2) truncation, round-off ~ eps |x| / h relative to max |b|
     assert_allclose((x_p - x_m) / (2 * h_u), b, rtol=1e-5, atol=1e-6 * np.max(np.abs(b)))
     assert_allclose((y_p - y_m) / (2 * h_u), d, rtol=1e-5)
-    for k in range(block.n_cells):
-        dx = np.zeros(block.n_cells)
+    for k in range(block.n_state):
+        dx = np.zeros(block.n_state)
         dx[k] = 1e-7
         y_p, x_p = block.step(x0 + dx, u0, TS)
         y_m, x_m = block.step(x0 - dx, u0, TS)
