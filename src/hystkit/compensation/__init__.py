@@ -1,15 +1,25 @@
 """Compensators: fitted models that turn a sensor signal into a position estimate."""
 
-from ._compensator import CENTERS, MODES, Compensator, LinearBaseline, Scaling, fit_compensator
+from ._centring import (
+    CENTERS,
+    DEFAULT_CENTER,
+    DEPLOYABLE_CENTERS,
+    ORACLE_CENTER,
+    center_label,
+)
+from ._compensator import MODES, Compensator
+from ._conventions import LinearBaseline, Scaling, prepare_training_data
 from ._estimator import CompensatorEstimator
 from ._evaluate import evaluate
+from ._fitting import fit_compensator
 from ._model_file import (
-                          compensator_from_dict,
-                          compensator_to_dict,
-                          load_compensator,
-                          save_compensator,
+    compensator_from_dict,
+    compensator_to_dict,
+    load_compensator,
+    save_compensator,
 )
 
-__all__ = ["CENTERS", "MODES", "Compensator", "CompensatorEstimator", "LinearBaseline", "Scaling", "compensator_from_dict",
-           "compensator_to_dict", "evaluate", "fit_compensator", "load_compensator",
-           "save_compensator"]
+__all__ = ["CENTERS", "DEFAULT_CENTER", "DEPLOYABLE_CENTERS", "MODES", "ORACLE_CENTER",
+           "Compensator", "CompensatorEstimator", "LinearBaseline", "Scaling", "center_label",
+           "compensator_from_dict", "compensator_to_dict", "evaluate", "fit_compensator",
+           "load_compensator", "prepare_training_data", "save_compensator"]

@@ -8,52 +8,40 @@ the mPL by default):
 - ``inverse`` (paper 9.1): fit the forward model position -> sensor and run its inverse
   (for the mPL the analytical eq. 5.13-5.14) on sensor data; only for families with an inverse.
 
-Data pass through the same path at fit and at use: centring (``center``), scaling by the fitting
-recording's max |.| (eq. 5.10), the model, and back to mm. Centring choices:
-
-- ``recording`` (paper 9.2, default): each recording's own mean is removed from its sensor
-  signal and, for evaluation, its position; this hides offset drift between recordings.
-- ``fit``: the fitting recording's means are removed from every recording (honest about drift).
-- ``none``: no offsets at all.
+Data pass through the same path at fit and at use: the sensor offset of the centring mode
+(:mod:`._centring`; deployable by default), the stored polarity (the sensor is flipped so that
+it rises with position, for every family), scaling by the fitting data's max |.| (eq. 5.10), the
+model, and back to mm.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from ..errors import FitDivergedError, InputError
-from ..identification import FitResult
 from ..io import Recording
 from ..models import Family, get_family
+from ._centring import (
+    CENTERS,
+    DEFAULT_TARE_SECONDS,
+    DEFAULT_TRACK_SECONDS,
+    ORACLE_CENTER,
+    sensor_level,
+)
+from ._conventions import LinearBaseline, Scaling, _centre_and_scale  # noqa: F401  (benchmarks import it from here)
 
-__all__ = ["CENTERS", "MODES", "Compensator", "LinearBaseline", "Scaling", "fit_compensator"]
+__all__ = ["MODES", "POSITION_MARGIN", "SENSOR_MARGIN", "Compensator", "LinearBaseline",
+           "Scaling"]
 
 MODES = ("direct", "inverse")
-CENTERS = ("recording", "fit", "none")
-
-
-@dataclass(frozen=True)
-class Scaling:
-    """Offsets and scales of the fitting recording (eq. 5.10), sensor units and mm."""
-
-    sensor_offset: float
-    sensor_scale: float
-    position_offset: float
-    position_scale: float
-
-
-@dataclass(frozen=True)
-class LinearBaseline:
-    """Least-squares straight line position(sensor) in normalised units (MATLAB polyfit)."""
-
-    slope: float
-    intercept: float
-
-    def __call__(self, s: np.ndarray) -> np.ndarray:
-        return self.slope * s + self.intercept
+# Use-time guards: a sensor sample is "outside" beyond this share of the training sensor range
+# on either side, an estimate beyond this share of the training position range.
+SENSOR_MARGIN = 0.05
+POSITION_MARGIN = 0.10
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,7 +49,10 @@ class Compensator:
     """Fitted compensator with its data conventions; apply it with :meth:`estimate`.
 
     ``model`` names the family in the registry; ``structure`` and ``params`` are that family's
-    dataclasses.
+    dataclasses. ``polarity`` (+1 or -1) multiplies the offset-free sensor so that it rises with
+    position. ``sensor_reference`` is the training data's sensor level for ``tare`` / ``track``;
+    ``rest_position`` [mm] the training position during the tare window; ``position_range``
+    [mm] the training position range (use-time guard).
     """
 
     structure: Any
@@ -73,6 +64,12 @@ class Compensator:
     fit_info: dict = field(default_factory=dict)
     model: str = "mpl"
     training_range: tuple[float, float] | None = None
+    polarity: float = 1.0
+    tare_seconds: float = DEFAULT_TARE_SECONDS
+    track_seconds: float = DEFAULT_TRACK_SECONDS
+    sensor_reference: float = 0.0
+    rest_position: float | None = None
+    position_range: tuple[float, float] | None = None
 
     @property
     def family(self) -> Family:
@@ -94,143 +91,146 @@ class Compensator:
                                  f"got {value}")
         if not (np.isfinite(self.baseline.slope) and np.isfinite(self.baseline.intercept)):
             raise ValueError("baseline slope and intercept must be finite")
-        if self.training_range is not None:
-            lo, hi = (float(v) for v in self.training_range)
-            if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
-                raise ValueError(f"training_range must be two finite numbers, low <= high, got "
-                                 f"{self.training_range!r}")
-            object.__setattr__(self, "training_range", (lo, hi))
+        if self.polarity not in (1.0, -1.0):
+            raise ValueError(f"polarity must be +1 or -1, got {self.polarity!r}")
+        if not (self.tare_seconds > 0 and self.track_seconds > 0):
+            raise ValueError("tare_seconds and track_seconds must be positive")
+        for name in ("training_range", "position_range"):
+            value = getattr(self, name)
+            if value is not None:
+                lo, hi = (float(v) for v in value)
+                if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
+                    raise ValueError(f"{name} must be two finite numbers, low <= high, got "
+                                     f"{value!r}")
+                object.__setattr__(self, name, (lo, hi))
 
-    def _normalised_sensor(self, sensor: np.ndarray) -> np.ndarray:
-        offset = {"recording": np.mean(sensor), "fit": self.scaling.sensor_offset,
-                  "none": 0.0}[self.center]
-        return (np.asarray(sensor, dtype=float) - offset) / self.scaling.sensor_scale
+    # -- the data path ---------------------------------------------------------------------
 
-    def _to_mm(self, p: np.ndarray, position_mean: float | None) -> np.ndarray:
+    def sensor_offset(self, sensor: np.ndarray) -> np.ndarray | float:
+        """Offset removed from a recording's sensor signal (per sample for tare / track)."""
         if self.center == "none":
-            offset = 0.0
-        elif self.center == "recording" and position_mean is not None:
-            offset = position_mean
-        else:
-            offset = self.scaling.position_offset
-        return p * self.scaling.position_scale + offset
+            return 0.0
+        if self.center == ORACLE_CENTER:
+            return float(np.mean(sensor))
+        level = sensor_level(self.center, sensor, self.structure.dt,
+                             tare_seconds=self.tare_seconds, track_seconds=self.track_seconds)
+        if level is None:  # fit
+            return self.scaling.sensor_offset
+        return self.scaling.sensor_offset + level - self.sensor_reference
+
+    def normalised_sensor(self, sensor: np.ndarray) -> np.ndarray:
+        """The model's sensor input: offset removed, flipped by ``polarity``, scaled."""
+        s = np.asarray(sensor, dtype=float)
+        return self.polarity * (s - self.sensor_offset(s)) / self.scaling.sensor_scale
+
+    def position_offset(self, position_mean: float | None = None,
+                        rest_position: float | None = None) -> float:
+        """Offset [mm] added to the normalised estimate.
+
+        ``position_mean`` is used only by the oracle centring (the recording's true mean);
+        ``rest_position`` only by ``tare`` (where the device rests during the tare window, if
+        not where it rested in training).
+        """
+        if self.center == "none":
+            return 0.0
+        if self.center == ORACLE_CENTER and position_mean is not None:
+            return position_mean
+        offset = self.scaling.position_offset
+        if self.center == "tare" and rest_position is not None and self.rest_position is not None:
+            offset += rest_position - self.rest_position
+        return offset
 
     def check_sampling(self, recording: Recording) -> None:
         """The model's Euler step is tied to ``dt``: refuse recordings sampled otherwise."""
         if abs(recording.dt - self.structure.dt) > 0.01 * self.structure.dt:
-                raise InputError(
+            raise InputError(
                 f"{recording.source}: column 'time': sampled every {recording.dt:.6g} s, but the "
                 f"model was fitted at {self.structure.dt:.6g} s; resample the recording first")
 
-    def estimate(self, recording: Recording, position_mean: float | None = None) -> np.ndarray:
+    def estimate(self, recording: Recording, position_mean: float | None = None, *,
+                 rest_position: float | None = None) -> np.ndarray:
         """Position estimate [mm] from the recording's sensor signal.
 
-        Parameters
-        ----------
-        recording : Recording
-            Needs ``time`` and ``sensor``; sampled at the model's ``dt``.
-        position_mean : float, optional
-            With ``center="recording"`` the estimate is only known up to the recording's mean
-            position; pass it (evaluation does) or the fitting recording's mean is used.
+        With every centring but ``recording`` (oracle) the estimate at sample k uses sensor
+        samples <= k and the model file only; ``position_mean`` is ignored then.
+
+        Raises
+        ------
+        FitDivergedError
+            If the model's output is not finite (it is never returned).
         """
         self.check_sampling(recording)
-        s = self._normalised_sensor(recording.sensor)
+        s = self.normalised_sensor(recording.sensor)
         run = self.family.simulate if self.mode == "direct" else self.family.invert
         p, _ = run(self.structure, self.params, s)
-        return self._to_mm(p, position_mean)
+        estimate = p * self.scaling.position_scale + self.position_offset(position_mean,
+                                                                           rest_position)
+        bad = np.flatnonzero(~np.isfinite(estimate))
+        if bad.size:
+            raise FitDivergedError(
+                f"{recording.source}: column 'sensor', sample {bad[0]}: the {self.model} "
+                f"compensator's estimate is not finite there ({bad.size} such samples)")
+        return estimate
 
-    def extrapolated_fraction(self, recording: Recording, margin: float = 0.05) -> float | None:
-        """Share of samples whose sensor value lies outside the range seen in training.
+    def estimate_linear(self, recording: Recording, position_mean: float | None = None, *,
+                        rest_position: float | None = None) -> np.ndarray:
+        """Position [mm] from the stored straight-line baseline, same conventions."""
+        s = self.normalised_sensor(recording.sensor)
+        return (self.baseline(s) * self.scaling.position_scale
+                + self.position_offset(position_mean, rest_position))
 
-        The range (normalised units) is widened by ``margin`` of its width on each side; None if
-        the compensator does not know its training range (files from before it was stored).
-        Beyond that range every model extrapolates, and the generalisation matrix shows how
-        badly that can end.
+    def oracle(self) -> Compensator:
+        """The same model under the paper's protocol (``recording`` centring): an oracle."""
+        return replace(self, center=ORACLE_CENTER)
+
+    # -- use-time guards ------------------------------------------------------------------
+
+    def sensor_outside(self, recording: Recording,
+                       margin: float = SENSOR_MARGIN) -> np.ndarray | None:
+        """Mask of samples whose normalised sensor lies outside the training range.
+
+        The range is widened by ``margin`` of its width on each side; None if the compensator
+        does not know it (files from before it was stored).
         """
         if self.training_range is None:
             return None
         lo, hi = self.training_range
         pad = margin * (hi - lo)
-        s = self._normalised_sensor(recording.sensor)
-        return float(np.mean((s < lo - pad) | (s > hi + pad)))
+        s = self.normalised_sensor(recording.sensor)
+        return (s < lo - pad) | (s > hi + pad)
 
-    def estimate_linear(self, recording: Recording,
-                        position_mean: float | None = None) -> np.ndarray:
-        """Position [mm] from the stored straight-line baseline, same conventions."""
-        return self._to_mm(self.baseline(self._normalised_sensor(recording.sensor)),
-                           position_mean)
+    def estimate_outside(self, estimate: np.ndarray,
+                         margin: float = POSITION_MARGIN) -> np.ndarray | None:
+        """Mask of estimates [mm] beyond the training position range widened by ``margin``."""
+        if self.position_range is None:
+            return None
+        lo, hi = self.position_range
+        pad = margin * (hi - lo)
+        offset = self.position_offset() - self.scaling.position_offset
+        return (estimate < lo + offset - pad) | (estimate > hi + offset + pad)
 
-
-def _centre_and_scale(recording: Recording, center: str) -> tuple[Scaling, np.ndarray,
-                                                                  np.ndarray]:
-    s_off = float(np.mean(recording.sensor)) if center != "none" else 0.0
-    p_off = float(np.mean(recording.position)) if center != "none" else 0.0
-    s = recording.sensor - s_off
-    p = recording.position - p_off
-    scaling = Scaling(s_off, float(np.max(np.abs(s))), p_off, float(np.max(np.abs(p))))
-    if scaling.sensor_scale == 0 or scaling.position_scale == 0:
-        column = "sensor" if scaling.sensor_scale == 0 else "position"
-        raise InputError(f"{recording.source}: column '{column}' is constant; nothing to fit")
-    return scaling, s / scaling.sensor_scale, p / scaling.position_scale
+    def extrapolated_fraction(self, recording: Recording,
+                              margin: float = SENSOR_MARGIN) -> float | None:
+        """Share of samples whose sensor value lies outside the range seen in training."""
+        mask = self.sensor_outside(recording, margin)
+        return None if mask is None else float(np.mean(mask))
 
 
-def _inverse_is_bounded(family: Family, structure: Any, params: Any,
-                        s: np.ndarray) -> bool:
+def check_training_data(recordings: Sequence[Recording]) -> None:
+    """Every fitting recording needs a position column and the same sampling step."""
+    for rec in recordings:
+        if not rec.has_position():
+            raise InputError(f"{rec.source}: column 'position' is needed to fit")
+        if abs(rec.dt - recordings[0].dt) > 0.01 * recordings[0].dt:
+            raise InputError(f"{rec.source}: column 'time': sampled every {rec.dt:.6g} s, but "
+                             f"{recordings[0].source} every {recordings[0].dt:.6g} s; fit "
+                             f"recordings must share one rate")
+
+
+def inverse_is_bounded(family: Any, structure: Any, params: Any, s: np.ndarray) -> bool:
+    """Whether a candidate's inverse stays bounded on normalised training data."""
     try:
         p_hat, _ = family.invert(structure, params, s)
     except FitDivergedError:
         return False
     return bool(np.max(np.abs(p_hat)) < 10.0)  # normalised data: |p| <= 1 when it works
-
-
-def fit_compensator(recording: Recording, size: int | None = None, *, model: str = "mpl",
-                    mode: str = "direct", center: str = "recording",
-                    **structure_options: Any) -> Compensator:
-    """Fit a compensator and its straight-line baseline on one recording.
-
-    Parameters
-    ----------
-    recording : Recording
-        Fitting recording with ``time`` [s], ``position`` [mm] and ``sensor``.
-    size : int, optional
-        The family's size knob (mPL: cells N, 3N + 2 parameters); default per family.
-    model : str
-        Registered model family (``hystkit.models.FAMILIES``).
-    mode : {"direct", "inverse"}
-    center : {"recording", "fit", "none"}
-        See the module docstring.
-    **structure_options
-        Passed to the family's ``make_structure`` (mPL: ``slope_cap``).
-    """
-    family = get_family(model)
-    if mode not in MODES:
-        raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
-    if center not in CENTERS:
-        raise ValueError(f"center must be one of {CENTERS}, got {center!r}")
-    if mode == "inverse" and family.invert is None:
-        raise InputError(f"model {model!r} has no inverse ({family.no_inverse_reason}); "
-                         f"use --mode direct")
-    if not recording.has_position():
-        raise InputError(f"{recording.source}: column 'position' is needed to fit")
-    scaling, s, p = _centre_and_scale(recording, center)
-    structure = family.make_structure(recording.dt, family.default_size if size is None
-                                      else size, **structure_options)
-    if mode == "direct":
-        result: FitResult = family.fit(s, p, structure)
-    else:
-        # The exact inverse of a discrete forward model can be unstable even when the model is
-        # not (for the mPL its cells see a self-gain 1 + w_k / w_0); only keep fits whose
-        # inverse stays bounded on the training data.
-        result = family.fit(p, s, structure, accept=lambda params: _inverse_is_bounded(
-            family, structure, params, s), accept_reason="their inverse diverges on the "
-                                                         "training data; use --mode direct or "
-                                                         "a smaller model")
-    slope, intercept = np.polyfit(s, p, 1)
-    info = {"cost": result.cost, "fit_seconds": result.seconds,
-            "n_evaluations": result.n_evaluations, "converged": result.converged,
-            "message": result.message, "n_starts": result.n_starts,
-            "training_source": recording.source, "training_samples": recording.n_samples}
-    return Compensator(training_range=(float(s.min()), float(s.max())),
-                       structure=structure, params=result.params, mode=mode, center=center,
-                       scaling=scaling, baseline=LinearBaseline(float(slope), float(intercept)),
-                       fit_info=info, model=model)

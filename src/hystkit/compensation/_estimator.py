@@ -6,7 +6,9 @@ import numpy as np
 
 from ..io import Recording
 from ..metrics import r2
-from ._compensator import Compensator, fit_compensator
+from ._centring import DEFAULT_CENTER, ORACLE_CENTER
+from ._compensator import Compensator
+from ._fitting import fit_compensator
 
 __all__ = ["CompensatorEstimator"]
 
@@ -18,7 +20,7 @@ class CompensatorEstimator:
     ``compensator_`` (a :class:`Compensator`, which can be saved and applied on its own).
     """
 
-    def __init__(self, n_cells: int = 1, mode: str = "direct", center: str = "recording",
+    def __init__(self, n_cells: int = 1, mode: str = "direct", center: str = DEFAULT_CENTER,
                  slope_cap: float = 1.0) -> None:
         self.n_cells = n_cells
         self.mode = mode
@@ -41,7 +43,7 @@ class CompensatorEstimator:
         return self._fitted().estimate(recording)
 
     def score(self, recording: Recording) -> float:
-        """R² of the estimate against the recording's position, with the evaluation centring."""
+        """R² of the estimate against the recording's position, with the fitted centring."""
         comp = self._fitted()
-        mean = float(recording.position.mean()) if comp.center == "recording" else None
+        mean = float(recording.position.mean()) if comp.center == ORACLE_CENTER else None
         return r2(recording.position, comp.estimate(recording, position_mean=mean))

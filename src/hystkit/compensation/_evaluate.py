@@ -1,4 +1,10 @@
-"""Scores of a compensator on a recording (sec. 5.3.3-5.3.6): the numbers of table 5.5."""
+"""Scores of a compensator on a recording (sec. 5.3.3-5.3.6): the numbers of table 5.5.
+
+Every score comes twice: the *deployable* one, with the compensator's own centring (the
+estimate at sample k uses sensor samples <= k and the model file), and the *oracle* one with
+the paper's protocol (``recording`` centring: the recording's own sensor mean is removed and its
+true mean position added back), which a compensator in use can never have.
+"""
 
 from __future__ import annotations
 
@@ -7,43 +13,68 @@ import numpy as np
 from ..errors import InputError
 from ..io import Recording
 from ..metrics import e_max_pct, e_rms_pct, loop_area, r2, sinad_db
-from ._compensator import Compensator
+from ._centring import ORACLE_CENTER, center_label
+from ._compensator import POSITION_MARGIN, SENSOR_MARGIN, Compensator
 
-__all__ = ["evaluate"]
+__all__ = ["SCORE_KEYS", "evaluate", "use_flags"]
+
+SCORE_KEYS = ("r2", "e_rms_pct", "e_max_pct", "sinad_db", "loop_area")
 
 
-def evaluate(compensator: Compensator, recording: Recording) -> dict:
+def use_flags(compensator: Compensator, recording: Recording,
+              estimate: np.ndarray) -> dict[str, np.ndarray | None]:
+    """Per-sample use-time guards: sensor outside the training range, estimate outside the
+    training position range (margins ``SENSOR_MARGIN`` / ``POSITION_MARGIN``)."""
+    return {"sensor_outside": compensator.sensor_outside(recording),
+            "estimate_outside": compensator.estimate_outside(estimate)}
+
+
+def _scores(position: np.ndarray, guess: np.ndarray, scale: float, fs: float) -> dict:
+    return {"r2": r2(position, guess), "e_rms_pct": e_rms_pct(position, guess, scale=scale),
+            "e_max_pct": e_max_pct(position, guess, scale=scale),
+            "sinad_db": _sinad_or_none(guess, fs), "loop_area": _loop_area_or_none(position,
+                                                                                  guess)}
+
+
+def evaluate(compensator: Compensator, recording: Recording, *,
+             rest_position: float | None = None) -> dict:
     """Compare the compensated and the straight-line position with the measured one.
 
-    With ``center="recording"`` the measured position is centred on its own mean, as in
-    paper 9.2; the errors in per cent are relative to the fitting recording's max |position|
-    (eq. 5.10-5.11). ``loop_area`` is the normalised loop area (eq. 5.15) of the estimate
-    against the measured position (0 for a perfect compensator); ``sensor_loop_area`` is that
-    of the raw sensor, for comparison.
+    Errors in per cent are relative to the fitting data's max |position| (eq. 5.10-5.11).
+    ``loop_area`` is the normalised loop area (eq. 5.15) of the estimate against the measured
+    position (0 for a perfect compensator); ``sensor_loop_area`` is that of the raw sensor.
 
     Returns
     -------
     dict
-        ``r2, e_rms_pct, e_max_pct, sinad_db, loop_area`` of the compensator, the same with a
-        ``linear_`` prefix for the baseline line, ``sensor_loop_area``, ``n_samples``, ``center``,
-        ``extrapolated_fraction`` (share of samples outside the sensor range seen in training).
+        ``r2, e_rms_pct, e_max_pct, sinad_db, loop_area`` of the compensator with its own
+        (deployable, unless it was fitted with the oracle) centring, named in ``center``; the same
+        with a ``linear_`` prefix for the straight line; the same with an ``_oracle`` suffix
+        under the paper's protocol (``center_oracle``); ``sensor_loop_area``, ``n_samples``,
+        ``extrapolated_fraction``, ``n_sensor_outside`` / ``n_estimate_outside`` (use-time
+        guards, None if the model file predates them) with their margins.
     """
     if not recording.has_position():
         raise InputError(f"{recording.source}: column 'position' is needed to evaluate")
-    position = recording.position
-    mean = float(np.mean(position)) if compensator.center == "recording" else None
-    estimate = compensator.estimate(recording, position_mean=mean)
-    linear = compensator.estimate_linear(recording, position_mean=mean)
-    scale = compensator.scaling.position_scale
-    scores = {"n_samples": recording.n_samples, "center": compensator.center,
-              "extrapolated_fraction": compensator.extrapolated_fraction(recording)}
-    for prefix, guess in (("", estimate), ("linear_", linear)):
-        scores[f"{prefix}r2"] = r2(position, guess)
-        scores[f"{prefix}e_rms_pct"] = e_rms_pct(position, guess, scale=scale)
-        scores[f"{prefix}e_max_pct"] = e_max_pct(position, guess, scale=scale)
-        scores[f"{prefix}sinad_db"] = _sinad_or_none(guess, recording.fs)
-        scores[f"{prefix}loop_area"] = _loop_area_or_none(position, guess)
+    position, scale = recording.position, compensator.scaling.position_scale
+    scores = {"n_samples": recording.n_samples, "center": center_label(compensator.center),
+              "center_oracle": center_label(ORACLE_CENTER)}
+    runs = (("", compensator), ("_oracle", compensator.oracle()))
+    estimate = None
+    for suffix, comp in runs:
+        mean = float(np.mean(position)) if comp.center == ORACLE_CENTER else None
+        guess = comp.estimate(recording, mean, rest_position=rest_position)
+        line = comp.estimate_linear(recording, mean, rest_position=rest_position)
+        estimate = guess if estimate is None else estimate
+        for prefix, values in (("", guess), ("linear_", line)):
+            for key, value in _scores(position, values, scale, recording.fs).items():
+                scores[f"{prefix}{key}{suffix}"] = value
     scores["sensor_loop_area"] = _loop_area_or_none(position, recording.sensor)
+    flags = use_flags(compensator, recording, estimate)
+    scores["extrapolated_fraction"] = compensator.extrapolated_fraction(recording)
+    for name, mask in flags.items():
+        scores[f"n_{name}"] = None if mask is None else int(np.sum(mask))
+    scores["sensor_margin"], scores["position_margin"] = SENSOR_MARGIN, POSITION_MARGIN
     return scores
 
 

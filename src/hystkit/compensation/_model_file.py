@@ -1,4 +1,11 @@
-"""Compensator <-> JSON model file (schema ``hystkit.compensator``, version 1)."""
+"""Compensator <-> JSON model file (schema ``hystkit.compensator``, version 1).
+
+Keys added since the first files (``polarity``, ``tare_seconds``, ``track_seconds``,
+``sensor_reference``, ``rest_position``, ``position_range``) are optional when reading, with the
+behaviour of the files that lacked them: polarity +1, no position-range guard. A file with
+``center: recording`` (the old default) still loads and runs the paper's protocol, which removes
+each recording's own sensor mean: it is an oracle (not causal) and is labelled so.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +17,9 @@ from .. import __version__
 from ..errors import InputError
 from ..io import write_json
 from ..models import FAMILIES
-from ._compensator import CENTERS, MODES, Compensator, LinearBaseline, Scaling
+from ._centring import CENTERS
+from ._compensator import MODES, Compensator
+from ._conventions import LinearBaseline, Scaling
 
 __all__ = [
     "SCHEMA",
@@ -43,6 +52,13 @@ def compensator_to_dict(comp: Compensator) -> dict:
         "fit": comp.fit_info,
         "training_range": (None if comp.training_range is None
                            else list(comp.training_range)),
+        "position_range": (None if comp.position_range is None
+                           else list(comp.position_range)),
+        "polarity": comp.polarity,
+        "tare_seconds": comp.tare_seconds,
+        "track_seconds": comp.track_seconds,
+        "sensor_reference": comp.sensor_reference,
+        "rest_position": comp.rest_position,
     }
 
 
@@ -67,13 +83,23 @@ def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
                            params=family.params_type.from_dict(d["params"]), mode=d["mode"],
                            center=d["center"], scaling=Scaling(**d["normalisation"]),
                            baseline=LinearBaseline(**d["baseline"]), fit_info=d.get("fit", {}),
-                           training_range=(None if d.get("training_range") is None
-                                           else tuple(d["training_range"])),
-                           model=d["model"])
+                           training_range=_pair_or_none(d.get("training_range")),
+                           position_range=_pair_or_none(d.get("position_range")),
+                           model=d["model"], **_optional(d))
     except KeyError as exc:
         raise InputError(f"{source}: key {exc.args[0]!r} is missing") from None
     except (TypeError, ValueError) as exc:
         raise InputError(f"{source}: invalid model contents ({exc})") from None
+
+
+def _pair_or_none(value) -> tuple | None:
+    return None if value is None else tuple(value)
+
+
+def _optional(d: dict) -> dict:
+    """Keys newer than the first model files, only when present (older files keep defaults)."""
+    keys = ("polarity", "tare_seconds", "track_seconds", "sensor_reference", "rest_position")
+    return {k: (float(d[k]) if d[k] is not None else None) for k in keys if k in d}
 
 
 def save_compensator(comp: Compensator, path: str | Path, *, force: bool = False) -> Path:

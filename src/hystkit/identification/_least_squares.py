@@ -113,4 +113,5 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
     return FitResult(structure=structure, params=to_params(best.x), cost=2.0 * float(best.cost),
                      n_evaluations=int(n_eval), seconds=time.perf_counter() - t_start,
                      converged=bool(best.status > 0), message=str(best.message),
-                     n_starts=len(starts))
+                     n_starts=len(starts), theta=np.array(best.x),
+                     bounds=(lower, upper))

@@ -27,6 +27,10 @@ class FitResult:
     message : str
         The solver's message for the best start.
     n_starts : int
+    theta : array or None
+        The optimum in optimiser coordinates, when the fit used a bounded solver.
+    bounds : (lower, upper) or None
+        That solver's bounds, so reports can flag parameters sitting on one.
     """
 
     structure: Any
@@ -37,3 +41,5 @@ class FitResult:
     converged: bool
     message: str
     n_starts: int
+    theta: Any = None
+    bounds: Any = None

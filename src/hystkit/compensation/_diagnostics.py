@@ -1,0 +1,109 @@
+"""Fit-time guards: is a fitted compensator worth more than its straight line?
+
+A least-squares solver reports "converged" for a model that collapsed to a constant, for one
+whose parameters sit on their bounds and for one worse than a straight line. These checks look
+at the fitted model itself, for any family, and give the fit a ``status`` that says so.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ..identification import FitResult
+from ..metrics import r2
+from ._param_vector import flatten_params
+
+__all__ = ["BOUND_TOLERANCE", "COLLAPSE_RATIO", "MIN_SAMPLES_PER_PARAM", "bound_flags",
+           "fit_status", "standard_errors"]
+
+# A fit needs at least this many samples per fitted number (with fewer, the residual has too
+# few degrees of freedom for the noise level, hence for standard errors).
+MIN_SAMPLES_PER_PARAM = 2
+# An estimate whose standard deviation is below this share of the target's is a constant.
+COLLAPSE_RATIO = 1e-3
+# A parameter within this share of its bound interval of a bound is "on the bound".
+BOUND_TOLERANCE = 1e-4
+
+
+def standard_errors(residual: Callable[[np.ndarray], np.ndarray], params: Any,
+                    n_data: int) -> dict:
+    """Standard errors of the float parameters from a finite-difference Jacobian at the optimum.
+
+    ``residual(params)`` is the model-minus-target vector of the fit; the covariance is
+    ``s^2 (J^T J)^-1`` with ``s^2 = SSE / (n - p)`` (Gauss-Newton). Parameters the data do not
+    determine (``J^T J`` numerically singular) get ``inf``.
+
+    Returns
+    -------
+    dict
+        ``values`` and ``standard_errors`` (flat, the order of ``params.to_dict()``'s float
+        entries), ``relative`` (SE / |value|), ``condition_number`` of ``J^T J``.
+    """
+    theta, rebuild = flatten_params(params)
+    r0 = residual(rebuild(theta))
+    steps = 1e-6 * np.maximum(np.abs(theta), 1e-3)
+    jac = np.empty((r0.size, theta.size))
+    for j, h in enumerate(steps):
+        shifted = theta.copy()
+        shifted[j] += h
+        jac[:, j] = (residual(rebuild(shifted)) - r0) / h
+    dof = max(n_data - theta.size, 1)
+    sigma2 = float(r0 @ r0) / dof
+    _u, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    determined = sv > sv[0] * 1e-8 if sv.size and sv[0] > 0 else np.zeros(sv.size, bool)
+    inv_sv2 = np.where(determined, 1.0 / np.where(determined, sv, 1.0) ** 2, 0.0)
+    variance = sigma2 * np.einsum("kj,k,kj->j", vt, inv_sv2, vt)
+    # A parameter with weight in an undetermined direction has no finite standard error.
+    blind = np.abs(vt[~determined]).max(axis=0) > 1e-6 if (~determined).any() \
+        else np.zeros(theta.size, bool)
+    se = np.where(blind, np.inf, np.sqrt(np.maximum(variance, 0.0)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = np.where(theta != 0, se / np.abs(theta), np.inf)
+    cond = float((sv[0] / sv[-1]) ** 2) if sv.size and sv[-1] > 0 else float("inf")
+    return {"values": theta.tolist(), "standard_errors": _finite_or_none(se),
+            "relative": _finite_or_none(rel), "condition_number": _finite_or_none(cond)}
+
+
+def _finite_or_none(x):
+    """JSON has no inf: an undetermined standard error is written as null."""
+    if np.ndim(x) == 0:
+        return float(x) if np.isfinite(x) else None
+    return [float(v) if np.isfinite(v) else None for v in np.asarray(x)]
+
+
+def bound_flags(result: FitResult) -> list[int] | None:
+    """Indices of optimiser coordinates on or near a bound; None when the fit did not say."""
+    theta, bounds = getattr(result, "theta", None), getattr(result, "bounds", None)
+    if theta is None or bounds is None:
+        return None
+    lower, upper = (np.asarray(b, dtype=float) for b in bounds)
+    width = np.where(np.isfinite(upper - lower), upper - lower, 1.0)
+    tol = BOUND_TOLERANCE * np.maximum(width, 1e-12)
+    near = (np.isfinite(lower) & (theta - lower <= tol)) | \
+        (np.isfinite(upper) & (upper - theta <= tol))
+    return [int(i) for i in np.flatnonzero(near)]
+
+
+def fit_status(estimate: np.ndarray, target: np.ndarray, line: np.ndarray,
+               on_bounds: list[int] | None, converged: bool) -> tuple[str, str]:
+    """``(status, message)`` of a fit from its training estimate and the straight line's.
+
+    Status is the first that applies: ``collapsed`` (estimate constant), ``worse_than_line``
+    (training R² below the line's), ``on_bounds``, ``not_converged``, else ``ok``.
+    """
+    r2_model, r2_line = r2(target, estimate), r2(target, line)
+    if np.std(estimate) < COLLAPSE_RATIO * np.std(target):
+        return "collapsed", (f"the fitted model is constant (std of its estimate "
+                             f"{np.std(estimate):.3g} against {np.std(target):.3g} of the target)")
+    if r2_model < r2_line:
+        return "worse_than_line", (f"training R² {r2_model:.4f} is below the straight line's "
+                                   f"{r2_line:.4f}")
+    if on_bounds:
+        return "on_bounds", (f"{len(on_bounds)} parameter(s) on a bound of the search "
+                             f"(optimiser coordinates {on_bounds})")
+    if not converged:
+        return "not_converged", "the solver stopped on its evaluation budget"
+    return "ok", f"training R² {r2_model:.4f} (straight line {r2_line:.4f})"

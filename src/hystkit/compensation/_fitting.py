@@ -1,0 +1,191 @@
+"""Fit a compensator on one or several recordings, with its fit-time guards.
+
+Several recordings are fitted jointly: each is centred by its own tare / tracker, and each runs
+from its own rest state. The family fits the concatenated data (its fit takes one sequence);
+then a generic least-squares polish over the family's float parameters (``to_dict``) fits the
+per-recording simulations, so the joins between recordings carry no state.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..errors import HystkitError, InputError
+from ..identification import FitResult
+from ..io import Recording
+from ..metrics import r2
+from ..models import Family, get_family
+from ._centring import (
+    CENTERS,
+    DEFAULT_CENTER,
+    DEFAULT_TARE_SECONDS,
+    DEFAULT_TRACK_SECONDS,
+)
+from ._compensator import MODES, Compensator, check_training_data, inverse_is_bounded
+from ._conventions import LinearBaseline, prepare_training_data
+from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status, standard_errors
+from ._param_vector import flatten_params, simulate_segments
+
+__all__ = ["MIN_SAMPLES", "fit_compensator"]
+
+# Fewer samples than this cannot describe a loop at all; checked before any fit runs.
+MIN_SAMPLES = 20
+# The joint polish differentiates numerically, one model run per parameter: above this many
+# parameters (Preisach grids) it is skipped and the concatenated fit is kept.
+MAX_POLISH_PARAMS = 40
+# Residual of a parameter vector outside the family's domain (the polish has no bounds).
+_OUTSIDE = 1e3
+
+
+def _check_sample_count(recordings: Sequence[Recording]) -> None:
+    n = sum(r.n_samples for r in recordings)
+    if n < MIN_SAMPLES:
+        raise InputError(f"{recordings[0].source}: column 'position': {n} samples; a fit needs "
+                         f"at least {MIN_SAMPLES}")
+
+
+def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.ndarray],
+                    targets: list[np.ndarray]) -> tuple[Any, str]:
+    """Refit the float parameters on per-recording simulations (generic, finite differences)."""
+    theta0, rebuild = flatten_params(params)
+    if theta0.size > MAX_POLISH_PARAMS:
+        return params, (f"{theta0.size} parameters: fitted on the concatenated recordings, "
+                        f"joint polish skipped (more than {MAX_POLISH_PARAMS})")
+    target = np.concatenate(targets)
+
+    def residual(theta: np.ndarray) -> np.ndarray:
+        try:
+            r = simulate_segments(run, structure, rebuild(theta), inputs) - target
+        except (ValueError, HystkitError):
+            return np.full(target.size, _OUTSIDE)
+        return r if np.all(np.isfinite(r)) else np.full(target.size, _OUTSIDE)
+
+    sol = least_squares(residual, theta0, method="trf", x_scale="jac", max_nfev=100)
+    start_cost = 0.5 * float(np.sum(residual(theta0) ** 2))
+    if sol.cost < start_cost:
+        return rebuild(sol.x), f"joint polish over {len(inputs)} recordings: {sol.message}"
+    return params, "joint polish found nothing better than the concatenated fit"
+
+
+def _count_params(params: Any) -> int:
+    return int(sum(np.size(v) for v in params.to_dict().values()
+                   if np.asarray(v).dtype.kind in "fi"))
+
+
+def fit_compensator(recordings: Recording | Sequence[Recording], size: int | None = None, *,
+                    model: str = "mpl", mode: str = "direct", center: str = DEFAULT_CENTER,
+                    tare_seconds: float = DEFAULT_TARE_SECONDS,
+                    track_seconds: float = DEFAULT_TRACK_SECONDS, diagnose: bool = True,
+                    **structure_options: Any) -> Compensator:
+    """Fit a compensator and its straight-line baseline on one or several recordings.
+
+    Parameters
+    ----------
+    recordings : Recording or sequence of Recording
+        Fitting recordings with ``time`` [s], ``position`` [mm] and ``sensor``, one rate.
+    size : int, optional
+        The family's size knob (mPL: cells N, 3N + 2 parameters); default per family.
+    model : str
+        Registered model family (``hystkit.models.FAMILIES``).
+    mode : {"direct", "inverse"}
+    center : {"fit", "tare", "track", "recording", "none"}
+        See :mod:`hystkit.compensation._centring`; ``recording`` is the oracle protocol.
+    tare_seconds, track_seconds : float
+        Tare window and drift-tracker time constant [s], stored in the model.
+    diagnose : bool
+        Compute parameter standard errors (one model run per parameter).
+    **structure_options
+        Passed to the family's ``make_structure`` (mPL: ``slope_cap``).
+
+    The fit's ``status`` in ``fit_info`` is ``ok`` only if the model is not constant, beats the
+    straight line on the training data, has no parameter on a bound and converged.
+    """
+    recs = [recordings] if isinstance(recordings, Recording) else list(recordings)
+    if not recs:
+        raise InputError("no fitting recording given")
+    family = get_family(model)
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
+    if center not in CENTERS:
+        raise ValueError(f"center must be one of {CENTERS}, got {center!r}")
+    if mode == "inverse" and family.invert is None:
+        raise InputError(f"model {model!r} has no inverse ({family.no_inverse_reason}); "
+                         f"use --mode direct")
+    check_training_data(recs)
+    _check_sample_count(recs)
+    conventions, s_list, p_list = prepare_training_data(
+        recs, center, tare_seconds=tare_seconds, track_seconds=track_seconds)
+    s, p = np.concatenate(s_list), np.concatenate(p_list)
+    structure = family.make_structure(recs[0].dt, family.default_size if size is None
+                                      else size, **structure_options)
+    inputs, targets = (s_list, p_list) if mode == "direct" else (p_list, s_list)
+    result = _fit_family(family, structure, mode, s, p)
+    params, joint_note = result.params, ""
+    if len(recs) > 1:
+        params, joint_note = _polish_jointly(family.simulate, structure, params, inputs, targets)
+    n_params = _count_params(params)
+    if s.size < MIN_SAMPLES_PER_PARAM * n_params:
+        raise InputError(f"{recs[0].source}: column 'position': {s.size} samples for "
+                         f"{n_params} parameters of {model}; a fit needs at least "
+                         f"{MIN_SAMPLES_PER_PARAM} samples per parameter")
+    slope, intercept = np.polyfit(s, p, 1)
+    baseline = LinearBaseline(float(slope), float(intercept))
+    comp = Compensator(structure=structure, params=params, mode=mode, center=center,
+                       baseline=baseline, model=model, tare_seconds=tare_seconds,
+                       track_seconds=track_seconds, training_range=(float(s.min()),
+                                                                    float(s.max())),
+                       position_range=(float(min(r.position.min() for r in recs)),
+                                       float(max(r.position.max() for r in recs))),
+                       **conventions)
+    info = _fit_info(comp, result, recs, s_list, p_list, inputs, targets, diagnose)
+    info["n_params"], info["joint_fit"] = n_params, joint_note or None
+    object.__setattr__(comp, "fit_info", info)
+    return comp
+
+
+def _fit_family(family: Family, structure: Any, mode: str, s: np.ndarray,
+                p: np.ndarray) -> FitResult:
+    if mode == "direct":
+        return family.fit(s, p, structure)
+    # The exact inverse of a discrete forward model can be unstable even when the model is
+    # not (for the mPL its cells see a self-gain 1 + w_k / w_0); only keep fits whose inverse
+    # stays bounded on the training data.
+    return family.fit(p, s, structure, accept=lambda params: inverse_is_bounded(
+        family, structure, params, s), accept_reason="their inverse diverges on the training "
+                                                     "data; use --mode direct or a smaller model")
+
+
+def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording],
+              s_list: list[np.ndarray], p_list: list[np.ndarray], inputs: list[np.ndarray],
+              targets: list[np.ndarray], diagnose: bool) -> dict:
+    """The solver's report plus the guards: status, training R², bounds, AIC/BIC, SEs."""
+    family, structure = comp.family, comp.structure
+    run = family.simulate if comp.mode == "direct" else family.invert
+    p = np.concatenate(p_list)
+    estimate = simulate_segments(run, structure, comp.params, s_list)
+    line = comp.baseline(np.concatenate(s_list))
+    on_bounds = bound_flags(result) if len(recs) == 1 else None
+    status, message = fit_status(estimate, p, line, on_bounds, result.converged)
+    n = p.size
+    forward = simulate_segments(family.simulate, structure, comp.params, inputs)
+    sse = float(np.sum((forward - np.concatenate(targets)) ** 2))
+    k = _count_params(comp.params)
+    log_term = n * np.log(max(sse, 1e-300) / n)
+    info = {"cost": sse, "fit_seconds": result.seconds, "n_evaluations": result.n_evaluations,
+            "converged": result.converged, "message": result.message,
+            "n_starts": result.n_starts, "training_source": recs[0].source,
+            "training_sources": [r.source for r in recs],
+            "training_samples": int(n), "status": status, "status_message": message,
+            "training_r2": r2(p, estimate), "training_linear_r2": r2(p, line),
+            "on_bounds": on_bounds, "aic": float(log_term + 2 * k),
+            "bic": float(log_term + k * np.log(n))}
+    if diagnose:
+        target = np.concatenate(targets)
+        info["standard_errors"] = standard_errors(
+            lambda params: simulate_segments(family.simulate, structure, params, inputs) - target,
+            comp.params, n)
+    return info
