@@ -1,33 +1,41 @@
-"""Speed of hystkit's closed-loop simulation against python-control and a plain Python loop.
+"""Speed of hystkit's closed-loop simulation: against the loop before the family protocol, with
+other families' blocks, and against python-control and a plain Python loop.
 
-Run:  /tmp/venv/bin/python benchmarks/bench_control.py      (about a minute on 2 cores)
+Run:  python benchmarks/bench_control.py      (about two minutes on 2 cores)
 
 The loop is the document's 5 s closed loop (ch. 7): r = 3 mm sin(pi t) (eq. 7.3), Ts = 5.04e-4 s,
 so 9921 steps, plant 1 / (m s^2) (exact ZOH), the eq. 7.2 PID with the document's gains, the
-"real" sensor S_r (3-cell mPL fitted on the virtual sensor's noise run) and the compensator
-(3-cell mPL, direct mode, fitted on its sine run) -- scheme (a); scheme (b) adds S_m (3 cells).
-Variants, all on the same ControlLoop and the same reference:
+"real" sensor S_r (3-cell mPL fitted on the virtual sensor's noise run) and a compensator fitted
+on its sine run (direct mode) -- scheme (a); scheme (b) adds S_m.
 
-* ``hystkit``: ``hystkit.control.simulate_loop`` (validating wrapper + one numba kernel call),
-* ``kernel``: the bare kernel ``_kernel.run`` with pre-packed arguments,
-* ``Python``: ``simulate_loop_reference``, the readable plain-Python loop over block steps,
-* ``python-control``: ``control.input_output_response`` on ``hystkit.control.loop_nlsys(loop)``
-  (a discrete-time interconnection of ``nlsys`` blocks with the same equations).
+Table 1 (protocol cost). ``hystkit`` is today's kernel, one numba specialisation per combination
+of the blocks' step functions; ``before`` is the kernel of commit 411a485 (before the family
+protocol: mPL and polynomial-mPL blocks hard-wired, ``inline="always"``), rebuilt from git into a
+temporary folder and fed the same blocks in its own packing. Both are called with pre-packed
+arguments; A and B alternate (A B A B ...) so bursts of load hit both alike; medians of the
+repeats and the median of the paired ratios are reported.
 
-Each variant's output is compared with hystkit's (max |y difference|, metres) to show they do
-the same work. hystkit and the kernel: minimum of 15 interleaved repeats after a warm-up call;
-the Python loop: minimum of 3; python-control: one run per scheme (about 10 s each). The numba
-compile (or on-disk cache load) and the model fits are one-off costs, reported separately.
+Table 2 (families and references). ``simulate_loop`` with a 3-cell mPL, a 10-operator PI and a
+20-level Preisach compensator (S_r stays the mPL); ``Python``: ``simulate_loop_reference``, the
+readable loop over block steps; ``python-control``: ``control.input_output_response`` on
+``hystkit.control.loop_nlsys(loop)`` with the mPL loop. Every variant's plant position is compared
+with hystkit's (max |y difference|, metres) to show they do the same work.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 import platform
+import statistics
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 
 if __name__ == "__main__":
-    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # as bench_mpl.py: small fits, no threads
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # small fits, no threads
 
 import control
 import numba
@@ -35,18 +43,23 @@ import numpy as np
 
 import hystkit
 from hystkit import control as hc
+from hystkit.compensation import fit_compensator
 from hystkit.control import _kernel
+from hystkit.models import mpl
+from hystkit.sensors import simulate_experiment
 
 SECONDS = 5.0
-REPEATS = 15
+REPEATS = 21
 PY_REPEATS = 3
+BEFORE = "411a485"  # the last commit before the family protocol
+REPO = Path(__file__).resolve().parents[1]
 
 
 def machine() -> None:
-    load = ", ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "n/a"
-    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     print("Machine")
-    print(f"  platform     {platform.platform()}; cpus {os.cpu_count()} (usable {usable})")
+    print(f"  platform     {platform.platform()}; cpus {os.cpu_count()} "
+          f"(usable {len(os.sched_getaffinity(0))})")
     print(f"  load average {load} (1, 5, 15 min) at start")
     print(f"  python       {platform.python_version()}; numpy {np.__version__}, numba "
           f"{numba.__version__}, python-control {control.__version__}, hystkit "
@@ -54,14 +67,103 @@ def machine() -> None:
     print()
 
 
-def best_of(fn, repeats: int) -> float:
-    fn()
-    best = float("inf")
-    for _ in range(repeats):
+def old_kernel(folder: Path):
+    """The pre-protocol loop kernel as a stand-alone package ``before_protocol`` in ``folder``."""
+    pkg = folder / "before_protocol"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    for name in ("_mpl_kernels", "_mpl_poly_kernels"):
+        text = subprocess.run(["git", "show", f"{BEFORE}:src/hystkit/models/{name}.py"],
+                              cwd=REPO, check=True, capture_output=True, text=True).stdout
+        (pkg / f"{name}.py").write_text(text)
+    text = subprocess.run(["git", "show", f"{BEFORE}:src/hystkit/control/_kernel.py"], cwd=REPO,
+                          check=True, capture_output=True, text=True).stdout
+    text = (text.replace("from ..models._mpl_kernels", "from ._mpl_kernels")
+            .replace("from ..models._mpl_poly_kernels", "from ._mpl_poly_kernels")
+            .replace("from ._sensors import BLOCK_HEADER", "BLOCK_HEADER = 10"))
+    (pkg / "_kernel.py").write_text(text)
+    sys.path.insert(0, str(folder))
+    return importlib.import_module("before_protocol._kernel")
+
+
+def old_pack(block: hc.SensorBlock, dt: float) -> np.ndarray:
+    """An mPL block in the pre-protocol layout: header of 10, then i_s, v_t, knee, w."""
+    s, p = block.at(dt), block.params
+    header = [p.n_cells, float(block.inverse), p.v_b, s.slope_cap / dt, dt,
+              1.0 / block.in_scale, -block.in_offset / block.in_scale, block.out_scale,
+              block.out_offset, 0.0]
+    return np.concatenate([header, p.i_s, p.v_t, mpl.knee_voltage(s, p), p.w])
+
+
+def protocol_cost(models: hc.SensorModels, r: np.ndarray, old) -> list[tuple]:
+    rows = []
+    zeros = np.zeros(r.size)
+    for scheme in hc.SCHEMES:
+        loop = hc.build_loop(scheme, models)
+        x0 = hc.rest_state(loop, float(r[0])).to_vector()
+        args = loop.kernel_arguments()
+        direct, plant, pid, dob, y_limit = args[:5]
+        blocks = [old_pack(b, loop.ts) if b is not None else np.empty(0)
+                  for b in (loop.sensor, loop.compensator, loop.model)]
+
+        def new(args=args, x0=x0):
+            return _kernel.run(r, zeros, zeros, zeros, x0, *args)
+
+        def before(x0=x0, plant=plant, pid=pid, dob=dob, direct=direct, y_limit=y_limit,
+                   blocks=blocks):
+            return old.run(r, zeros, zeros, zeros, x0, direct, plant, pid, dob, y_limit,
+                           *blocks)
+
+        diff = float(np.max(np.abs(new()[0][0] - before()[0][0])))
+        times = {"hystkit": [], "before": []}
+        for _ in range(REPEATS):
+            for name, fn in (("hystkit", new), ("before", before)):
+                t0 = time.perf_counter()
+                fn()
+                times[name].append(time.perf_counter() - t0)
+        ratios = [a / b for a, b in zip(times["hystkit"], times["before"], strict=True)]
+        rows.append((scheme, statistics.median(times["before"]),
+                     statistics.median(times["hystkit"]), statistics.median(ratios), diff))
+    return rows
+
+
+def family_rows(r: np.ndarray, models: hc.SensorModels) -> list[tuple]:
+    rows = []
+    sine = simulate_experiment("sine", 2)
+    for family, size in (("mpl", 3), ("pi", 10), ("preisach", 20)):
+        comp = fit_compensator(sine, size, model=family, mode="direct", center="fit")
+        loop = hc.build_loop("direct", hc.SensorModels(
+            models.sensor, hc.compensator_block(comp), models.model, models.sensor_gain))
         t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
+        fast = hc.simulate_loop(loop, r[:10])
+        t_compile = time.perf_counter() - t0
+        fast = hc.simulate_loop(loop, r)
+        times = []
+        for _ in range(REPEATS):
+            t0 = time.perf_counter()
+            hc.simulate_loop(loop, r)
+            times.append(time.perf_counter() - t0)
+        t_fast = statistics.median(times)
+        rows.append((family, "hystkit", t_fast, 0.0, 1.0, t_compile))
+        slow_times = []
+        for _ in range(PY_REPEATS):
+            t0 = time.perf_counter()
+            slow = hc.simulate_loop_reference(loop, r)
+            slow_times.append(time.perf_counter() - t0)
+        t_slow = statistics.median(slow_times)
+        rows.append((family, "Python", t_slow, float(np.max(np.abs(slow.y - fast.y))),
+                     t_slow / t_fast, None))
+        if family == "mpl":
+            sys_ = hc.loop_nlsys(loop)
+            x0 = hc.loop_initial_state(loop, r0=float(r[0]))
+            zeros = np.zeros(r.size)
+            t0 = time.perf_counter()
+            pc = control.input_output_response(sys_, np.arange(r.size) * hc.TS,
+                                               [r, zeros, zeros], x0)
+            t_pc = time.perf_counter() - t0
+            rows.append((family, "python-control", t_pc,
+                         float(np.max(np.abs(pc.outputs[0] - fast.y))), t_pc / t_fast, None))
+    return rows
 
 
 def main() -> None:
@@ -72,59 +174,31 @@ def main() -> None:
     t_fit = time.perf_counter() - t0
     n = round(SECONDS / hc.TS)
     r = hc.sine_reference(n)
-    rows = []
-    t0 = time.perf_counter()
-    hc.simulate_loop(hc.build_loop("direct", models), r[:10])
-    t_first = time.perf_counter() - t0
-    for scheme in hc.SCHEMES:
-        loop = hc.build_loop(scheme, models)
-        fast = hc.simulate_loop(loop, r)
-        state = hc.rest_state(loop, float(r[0])).to_vector()
-        args = loop.kernel_arguments()
-        zeros = np.zeros(n)
-
-        def kernel(loop=loop, state=state, args=args, zeros=zeros):
-            return _kernel.run(r, zeros, zeros, zeros, state, *args)
-
-        times = {"hystkit": float("inf"), "kernel": float("inf")}
-        for fn in (lambda loop=loop: hc.simulate_loop(loop, r), kernel):
-            fn()
-        for _ in range(REPEATS):  # interleaved, so bursts of load hit both alike
-            for name, fn in (("hystkit", lambda loop=loop: hc.simulate_loop(loop, r)),
-                             ("kernel", kernel)):
-                t0 = time.perf_counter()
-                fn()
-                times[name] = min(times[name], time.perf_counter() - t0)
-        slow = hc.simulate_loop_reference(loop, r)
-        times["Python"] = best_of(lambda loop=loop: hc.simulate_loop_reference(loop, r),
-                                  PY_REPEATS - 1)
-        sys = hc.loop_nlsys(loop)
-        x0 = hc.loop_initial_state(loop, r0=float(r[0]))
-        t_axis = np.arange(n) * hc.TS
+    with tempfile.TemporaryDirectory() as folder:
+        old = old_kernel(Path(folder))
         t0 = time.perf_counter()
-        pc = control.input_output_response(sys, t_axis, [r, zeros, zeros], x0)
-        times["python-control"] = time.perf_counter() - t0
-        kernel_y = kernel()[0][0]
-        diffs = {"hystkit": 0.0, "kernel": float(np.max(np.abs(kernel_y - fast.y))),
-                 "Python": float(np.max(np.abs(slow.y - fast.y))),
-                 "python-control": float(np.max(np.abs(pc.outputs[0] - fast.y)))}
-        for name in ("hystkit", "kernel", "Python", "python-control"):
-            rows.append((scheme, name, times[name], diffs[name], times[name] / times["hystkit"]))
-
-    print("One-off costs (not in the table)")
-    print(f"  fit_sensor_models (S_r, compensator, S_m; 3 cells each)  {t_fit:8.2f} s")
-    print(f"  first simulate_loop call (numba compile or cache load)   {t_first * 1e3:8.1f} ms")
+        proto = protocol_cost(models, r, old)
+        t_proto = time.perf_counter() - t0
+    fam = family_rows(r, models)
+    print(f"One-off: fit_sensor_models (3 cells each) {t_fit:.2f} s; table 1 incl. compiles "
+          f"{t_proto:.1f} s")
     print()
-    print(f"Table. {SECONDS:g} s closed loop, {n} steps at Ts = {hc.TS} s, r = 3 mm sin(pi t); "
-          f"S_r and compensator 3-cell mPL (+ S_m for weighting)")
-    print("  hystkit/kernel: min of 15 interleaved repeats after warm-up; Python: min of 3; "
-          "python-control: 1 run")
-    print(f"  {'scheme':<10}{'variant':<16}{'ms / run':>12}{'us / step':>11}{'x hystkit':>11}"
+    print(f"Table 1. {SECONDS:g} s loop, {n} steps, mPL blocks (3 cells): kernel before the "
+          f"protocol ({BEFORE}) vs today's; medians of {REPEATS} A/B pairs")
+    print(f"  {'scheme':<10}{'before ms':>11}{'hystkit ms':>12}{'ratio (median of pairs)':>25}"
           f"{'max|y diff| m':>15}")
-    print("  " + "-" * 73)
-    for scheme, name, seconds, diff, ratio in rows:
-        print(f"  {scheme:<10}{name:<16}{seconds * 1e3:>12.2f}{seconds / n * 1e6:>11.3f}"
-              f"{ratio:>11.1f}{diff:>15.1e}")
+    for scheme, t_old, t_new, ratio, diff in proto:
+        print(f"  {scheme:<10}{t_old * 1e3:>11.2f}{t_new * 1e3:>12.2f}{ratio:>25.3f}"
+              f"{diff:>15.1e}")
+    print()
+    print(f"Table 2. scheme (a), S_r 3-cell mPL, compensator of each family; hystkit: median of "
+          f"{REPEATS}, Python: median of {PY_REPEATS}, python-control: 1 run")
+    print(f"  {'compensator':<13}{'variant':<16}{'ms / run':>11}{'us / step':>11}"
+          f"{'x hystkit':>11}{'max|y diff| m':>15}{'compile s':>11}")
+    for family, name, seconds, diff, ratio, compile_s in fam:
+        c = f"{compile_s:.2f}" if compile_s is not None else ""
+        print(f"  {family:<13}{name:<16}{seconds * 1e3:>11.2f}{seconds / n * 1e6:>11.3f}"
+              f"{ratio:>11.1f}{diff:>15.1e}{c:>11}")
     print()
     print(f"Total benchmark time {time.perf_counter() - t_total:.1f} s")
 

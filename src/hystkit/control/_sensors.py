@@ -101,7 +101,7 @@ class SensorBlock:
             return
         family = family_of(self.structure)
         if not isinstance(self.params, family.Params):
-            raise ValueError(f"params of type {type(self.params).__name__} do not belong to "
+            raise TypeError(f"params of type {type(self.params).__name__} do not belong to "
                              f"the {family.name} family")
         if self.inverse and not family.has_inverse:
             raise ValueError(f"{self.name}: model {family.name!r} has no inverse "
