@@ -12,8 +12,7 @@ Decisions where the document is ambiguous or wrong, with the evidence, are in
 docs/models/mpl_poly.md; in short:
 
 - eq. 5.16's ``f2^2 x^2 + f3^3 x^3`` is the paper's parametrisation, not a typo. The model holds
-  the plain cubic coefficients ``c``; ``identification.family_mpl_poly.paper_9_2_params``
-  converts the paper's printed values (``c2 = f2^2``, ``c3 = f3^3``).
+  the plain cubic coefficients ``c``; ``presets.paper_9_2_params`` converts the paper's printed values (``c2 = f2^2``, ``c3 = f3^3``).
 - Per-cell ``f_k`` (eq. 5.17's subscript): with one shared ``f`` all cells would be equal.
   ``5N + 6`` parameters, the paper's 11 for ``N = 1``; only ``4N + 4`` are identifiable.
 - ``c_k3 > 0`` is required: only then is the cell stable for large ``|v|`` (paper 9.2, sec.
@@ -32,9 +31,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from ..errors import FitDivergedError
-from . import _mpl_poly_kernels as kernels
-from ._validation import (
+from ...errors import FitDivergedError
+from .._protocol import Record
+from .._validation import (
     broadcast_state,
     check_dt,
     check_positive_int,
@@ -43,16 +42,32 @@ from ._validation import (
     check_slope_cap,
     frozen_shaped,
 )
+from . import kernels
 
 __all__ = [
-    "MplPolyParams", "MplPolyStructure", "equilibria", "invert", "invert_step", "knee_points",
-    "output_branch", "output_current", "output_slope", "resistor_current", "resistor_slope",
-    "rest_voltages", "simulate", "simulate_reference", "simulate_with_jacobian", "step",
+    "MplPolyParams",
+    "MplPolyStructure",
+    "equilibria",
+    "inverse_branch",
+    "invert",
+    "invert_step",
+    "knee_points",
+    "output_branch",
+    "output_current",
+    "output_slope",
+    "resistor_current",
+    "resistor_slope",
+    "rest_state",
+    "rest_voltages",
+    "simulate",
+    "simulate_reference",
+    "simulate_with_jacobian",
+    "step",
 ]
 
 
 @dataclass(frozen=True)
-class MplPolyStructure:
+class MplPolyStructure(Record):
     """What does not get fitted: cell count, sample time, Euler slope cap and the limit switch.
 
     Parameters
@@ -86,7 +101,7 @@ class MplPolyStructure:
 
 
 @dataclass(frozen=True, eq=False)
-class MplPolyParams:
+class MplPolyParams(Record):
     """Fitted quantities of a polynomial mPL model.
 
     Parameters
@@ -140,21 +155,6 @@ class MplPolyParams:
         f = np.column_stack([cells[:, :3], np.exp(cells[:, 3])])
         rest = theta[4 * n_cells:]
         return cls(f=f, g=rest[:4], w=rest[4: n_cells + 5], v_b=rest[n_cells + 5])
-
-    def to_dict(self) -> dict:
-        return {"f": self.f.tolist(), "g": self.g.tolist(), "w": self.w.tolist(),
-                "v_b": self.v_b}
-
-    @classmethod
-    def from_dict(cls, d: dict) -> MplPolyParams:
-        return cls(f=d["f"], g=d["g"], w=d["w"], v_b=d["v_b"])
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, MplPolyParams):
-            return NotImplemented
-        return bool(np.array_equal(self.to_vector(), other.to_vector()))
-
-    __hash__ = None
 
 
 def knee_points(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarray:
@@ -245,8 +245,7 @@ def rest_voltages(structure: MplPolyStructure, params: MplPolyParams) -> np.ndar
     A cubic with ``c3 > 0`` always has one (its largest root). When there are two (a bistable
     cell) the one nearer the cubic's inflection point ``-c2 / (3 c3)`` is taken (the lower on a
     tie): unlike "nearest to 0" this does not depend on how the cell voltage is offset, so
-    equivalent parameters (``identification.family_mpl_poly.canonical``) start in the same
-    state.
+    equivalent parameters (``fit.canonical``) start in the same state.
     """
     out = np.empty(params.n_cells)
     centre = -params.f[:, 2] / (3 * params.f[:, 3])
@@ -267,7 +266,7 @@ def output_branch(structure: MplPolyStructure,
     the model rests at ``e = 0`` (the centre of centred, normalised data); it is the largest
     interval around it where ``g'`` keeps its sign (bounds at the roots of ``g'``, ``+-inf``
     where there are none). Defined this way it is the same branch for all equivalent parameters
-    (``identification.family_mpl_poly.canonical``).
+    (``fit.canonical``).
 
     Raises
     ------
@@ -285,6 +284,37 @@ def output_branch(structure: MplPolyStructure,
     hi = min(roots[roots > z_rest], default=np.inf)
     return float(lo), float(hi), float(np.sign(slope))
 
+
+
+def inverse_branch(structure: MplPolyStructure,
+                   params: MplPolyParams) -> tuple[float, float, float, float]:
+    """``(lo, hi, sign, centre)``: :func:`output_branch` and the rest point ``z_rest`` inside it,
+    where the inverse's Newton search starts widening its bracket (the arguments of
+    ``kernels.solve_output``). Raises as :func:`output_branch`."""
+    lo, hi, sign = output_branch(structure, params)
+    centre = -params.w[1:] @ rest_voltages(structure, params) - params.v_b
+    return lo, hi, sign, float(centre)
+
+
+def rest_state(structure: MplPolyStructure, params: MplPolyParams, value: float,
+               inverse: bool = False) -> np.ndarray:
+    """Cells at rest, ``u_k = e - v*_k`` (:func:`rest_voltages`), shape (N,).
+
+    Forward: ``e`` is the constant input ``value``. Inverse (``value`` a constant output):
+    ``e_0 = (z_0 + sum w_k v*_k + V_b) / sum w`` with ``g(z_0) = value`` on the branch, the
+    input at which the model rests with that output; ``e_0 = 0`` if ``value`` is outside the
+    branch's range or ``sum w = 0``. :func:`simulate` / :func:`invert` start here for
+    ``x0=None``.
+    """
+    v_rest = rest_voltages(structure, params)
+    if not inverse:
+        return float(value) - v_rest
+    lo, hi, sign, centre = inverse_branch(structure, params)
+    z0, ok = kernels.solve_output(float(value), np.ascontiguousarray(params.g), lo, hi, sign,
+                                  centre)
+    w_sum = params.w.sum()
+    e0 = (z0 + params.w[1:] @ v_rest + params.v_b) / w_sum if ok and w_sum != 0 else 0.0
+    return e0 - v_rest
 
 def step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
@@ -323,7 +353,7 @@ def _check(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
 
 def _start(structure: MplPolyStructure, params: MplPolyParams, x0, e0: float) -> np.ndarray:
     if x0 is None:
-        return e0 - rest_voltages(structure, params)
+        return rest_state(structure, params, e0)
     return broadcast_state(x0, structure.n_cells)
 
 
@@ -440,14 +470,9 @@ def invert(structure: MplPolyStructure, params: MplPolyParams, y: np.ndarray,
     y = _check(structure, params, y, "y")
     if params.w[0] == 0:
         raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
-    lo, hi, sign = output_branch(structure, params)
-    v_rest = rest_voltages(structure, params)
-    centre = -params.w[1:] @ v_rest - params.v_b  # z at rest at e = 0, inside the branch
+    lo, hi, sign, centre = inverse_branch(structure, params)
     if x0 is None:
-        z0, ok = kernels.solve_output(y[0], params.g, lo, hi, sign, centre)
-        w_sum = params.w.sum()
-        e0 = (z0 + params.w[1:] @ v_rest + params.v_b) / w_sum if ok and w_sum != 0 else 0.0
-        x = e0 - v_rest
+        x = rest_state(structure, params, y[0], inverse=True)
     else:
         x = _start(structure, params, x0, 0.0)
     e_hat, x_end, n_bad, why = kernels.invert(y, x, *_kernel_args(structure, params), lo, hi,

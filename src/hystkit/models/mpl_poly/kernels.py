@@ -1,4 +1,4 @@
-"""Compiled hot loops of the polynomial mPL; ``mpl_poly.py`` holds the reference and the checks.
+"""Compiled hot loops of the polynomial mPL; ``model.py`` holds the reference and the checks.
 
 All arrays are float64 and validated by the caller. ``fc`` (N, 4) holds each cell resistor's
 cubic coefficients ``c0..c3``, ``knees`` (N, 2) its points ``x-, x+`` where ``f' = s``
@@ -184,3 +184,51 @@ def invert(y, x0, fc, knees, s, limit, gc, lo, hi, sign, centre, w, v_b, dt, bou
             f, _ = _cell(e - x[k], fc[k], knees[k, 0], knees[k, 1], s, limit)
             x[k] += f * dt
     return e_hat, x, -1, 0
+
+
+# Loop blocks (protocol in ``hystkit.models._protocol``): body = [n, v_b, s, dt, limit,
+# lo, hi, sign, centre, g0..g3, fc (N x 4, row-major), knees (N x 2), w (N + 1)]; ``lo, hi,
+# sign, centre`` (``model.inverse_branch``) are read by the inverse only.
+_IG = 9  # first output-resistor coefficient
+_IF = 13  # first cell coefficient
+
+
+@njit(cache=True, inline="always")
+def _block_cells(body, x, xn, off, drive):
+    """The cells' Euler update (eq. 5.6 with eq. 5.16, 5.29) driven by ``drive``."""
+    n = int(body[0])
+    ik = _IF + 4 * n
+    limit = body[4] != 0.0
+    for k in range(n):
+        f, _ = _cell(drive - x[off + k], body[_IF + 4 * k:_IF + 4 * k + 4], body[ik + 2 * k],
+                     body[ik + 2 * k + 1], body[2], limit)
+        xn[off + k] = x[off + k] + f * body[3]
+
+
+@njit(cache=True)
+def block_forward(body, x, xn, off, u):
+    """``y = g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17), then the cells driven by ``u``."""
+    n = int(body[0])
+    iw = _IF + 6 * n
+    z = body[iw] * u - body[1]
+    for k in range(n):
+        z += body[iw + 1 + k] * x[off + k]
+    y, _ = _cubic(body[_IG], body[_IG + 1], body[_IG + 2], body[_IG + 3], z)
+    _block_cells(body, x, xn, off, u)
+    return y
+
+
+@njit(cache=True)
+def block_inverse(body, x, xn, off, y):
+    """``z = g^-1(y)`` on the rest branch (as :func:`invert`), ``u_hat = (z - sum w_k x_k +
+    V_b) / w_0``, cells driven by ``u_hat``. NaN (output and state) when ``y`` is outside the
+    branch's range: no input gives that output, and the loop stops on it."""
+    n = int(body[0])
+    iw = _IF + 6 * n
+    z, ok = solve_output(y, body[_IG:_IG + 4], body[5], body[6], body[7], body[8])
+    acc = z + body[1]
+    for k in range(n):
+        acc -= body[iw + 1 + k] * x[off + k]
+    u_hat = acc / body[iw] if ok else np.nan
+    _block_cells(body, x, xn, off, u_hat)
+    return u_hat

@@ -1,4 +1,4 @@
-"""The polynomial mPL family (sec. 5.3.5, paper 9.2) in the model registry, and its fit.
+"""Least-squares identification of the polynomial mPL (sec. 5.3.5, paper 9.2).
 
 The paper ran MATLAB's patternsearch for 60 s from table I's start. Here the same SSE (eq. 5.9)
 goes to the shared multi-start trust-region least squares with the exact Jacobian (forward
@@ -18,59 +18,23 @@ canonical form) is returned as found.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
 
-from ..errors import FitDivergedError
-from ..models import mpl_poly
-from ._least_squares import check_fit_data, fit_multistart
-from ._registry import ModelFamily
-from ._result import FitResult
+from ...errors import FitDivergedError
+from ...identification import FitResult, check_fit_data, fit_multistart
+from . import model as mpl_poly
+from .presets import PAPER_9_2_TABLE_I, paper_9_2_params
 
-__all__ = ["FAMILY", "PAPER_9_2_TABLE_I", "PAPER_9_2_TABLE_II", "canonical", "default_starts",
-           "fit_mpl_poly", "paper_9_2_params"]
+__all__ = ["canonical", "default_starts", "fit_mpl_poly"]
 
 # Bounds in optimiser coordinates (MplPolyParams.to_vector). |w| <= 100 mirrors the document's
 # weight-sum constraint (sec. 5.3.3); the polynomial coefficients only need to stay finite.
 _COEF_BOUND = 1e3
 _LOG_C3_BOUNDS = (np.log(1e-6), np.log(1e4))
 _W_BOUND = 100.0
-
-#: Paper 9.2, table I (left): initial conditions, as printed (``f2``, ``f3`` enter squared and
-#: cubed, eq. 10); ``w0, w1, V_b`` from the text below table II.
-PAPER_9_2_TABLE_I: dict[str, float] = {
-    "f0": -1.0, "f1": 0.1, "f2": 0.1, "f3": 1.0, "g0": 0.1, "g1": 1.0, "g2": 0.1, "g3": 1.0,
-    "w0": 1.0, "w1": -1.0, "V_b": 0.01}
-
-#: Paper 9.2, table II: fitted weights of the four direct compensators (N = 1, 40 Hz,
-#: normalised sensor -> position), as printed; convert with :func:`paper_9_2_params`.
-PAPER_9_2_TABLE_II: dict[str, dict[str, float]] = {
-    "sine": {"f0": -2.516, "f1": -2.666, "f2": 1.975, "f3": 1.953, "g0": 0.100, "g1": 1.195,
-             "g2": 0.006, "g3": 0.475, "w0": 1.000, "w1": -0.492, "V_b": 0.135},
-    "chirp": {"f0": -0.469, "f1": -1.712, "f2": -2.228, "f3": 3.125, "g0": -0.369, "g1": 1.094,
-              "g2": 0.006, "g3": -0.384, "w0": 1.516, "w1": -0.531, "V_b": -0.537},
-    "decay": {"f0": -0.258, "f1": 0.663, "f2": -0.002, "f3": 0.008, "g0": -0.779, "g1": 1.320,
-              "g2": -0.002, "g3": -0.240, "w0": 0.984, "w1": -0.875, "V_b": -0.302},
-    "noise": {"f0": -4.719, "f1": 3.412, "f2": -1.244, "f3": 1.469, "g0": -0.119, "g1": 1.125,
-              "g2": 0.006, "g3": -0.259, "w0": 1.156, "w1": -0.406, "V_b": 0.010},
-}
-
-
-def paper_9_2_params(printed: Mapping[str, float]) -> mpl_poly.MplPolyParams:
-    """One-cell parameters from paper 9.2's printed values (a column of table I or II).
-
-    eq. 10 of the paper (eq. 5.16) applies ``f(x) = f0 + f1 x + f2^2 x^2 + f3^3 x^3`` to the
-    printed values, and the same form to ``g``: the squares and cubes are not typos (with them
-    every column is a working compensator, without them the chirp column is anti-correlated
-    with its input; docs/models/mpl_poly.md).
-    """
-    def cubic(p: str) -> list[float]:
-        return [printed[f"{p}0"], printed[f"{p}1"], printed[f"{p}2"] ** 2, printed[f"{p}3"] ** 3]
-
-    return mpl_poly.MplPolyParams(f=[cubic("f")], g=cubic("g"),
-                                  w=[printed["w0"], printed["w1"]], v_b=printed["V_b"])
 
 
 def canonical(structure: mpl_poly.MplPolyStructure,
@@ -109,11 +73,6 @@ def _compose(c: np.ndarray, inner: list[float]) -> np.ndarray:
     """Coefficients of ``p(inner(x))`` for the cubic ``p`` and a linear ``inner``."""
     coef = np.polynomial.Polynomial(c)(np.polynomial.Polynomial(inner)).coef
     return np.pad(coef, (0, 4 - coef.size))
-
-
-def _make_structure(dt: float, size: int, slope_cap: float = 1.0,
-                    limit: bool = True) -> mpl_poly.MplPolyStructure:
-    return mpl_poly.MplPolyStructure(n_cells=size, dt=dt, slope_cap=slope_cap, limit=limit)
 
 
 def _table_i_start(n_cells: int) -> mpl_poly.MplPolyParams:
@@ -219,10 +178,3 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
         return result
     return replace(result, params=canonical(structure, result.params))
 
-
-FAMILY = ModelFamily(
-    name="mpl-poly",
-    title="polynomial modified Power-Law, cubic resistors (sec. 5.3.5, eq. 5.16-5.17, 5.29)",
-    structure_type=mpl_poly.MplPolyStructure, params_type=mpl_poly.MplPolyParams,
-    make_structure=_make_structure, simulate=mpl_poly.simulate, fit=fit_mpl_poly,
-    invert=mpl_poly.invert, size_help="cells N (5N + 6 params)", default_size=1)

@@ -1,0 +1,109 @@
+"""The polynomial mPL family (sec. 5.3.5, eq. 5.16-5.17, 5.29; paper 9.2) behind the protocol."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import FitDivergedError
+from .._protocol import Block, Family
+from . import kernels
+from . import model as mpl_poly
+from .fit import fit_mpl_poly
+from .presets import PAPER_9_2_TABLE_II, paper_9_2_params
+
+__all__ = ["MplPolyFamily"]
+
+
+class MplPolyFamily(Family):
+    name = "mpl-poly"
+    title = "polynomial modified Power-Law, cubic resistors (sec. 5.3.5, eq. 5.16-5.17, 5.29)"
+    size_help = "cells N (5N + 6 params)"
+    default_size = 1
+    docs = "docs/models/mpl_poly.md"
+    Structure = mpl_poly.MplPolyStructure
+    Params = mpl_poly.MplPolyParams
+
+    def make_structure(self, dt: float, size: int, slope_cap: float = 1.0,
+                       limit: bool = True) -> mpl_poly.MplPolyStructure:
+        return mpl_poly.MplPolyStructure(n_cells=size, dt=dt, slope_cap=slope_cap, limit=limit)
+
+    def at(self, structure, dt):
+        """Same cells, slope cap and limit at ``dt``. The cubics are rates of a continuous ODE
+        (``du_k/dt = f_k``), so they do not depend on the step; only the Euler limit does, and
+        the knees (``f' = slope_cap / dt``) follow ``dt`` because they are computed from it."""
+        return super().at(structure, dt)
+
+    def presets(self):
+        """Paper 9.2's table II columns: direct compensators (sensor -> position) fitted on
+        normalised 40 Hz data, N = 1, as printed (``f2^2``, ``f3^3``)."""
+        structure = mpl_poly.MplPolyStructure(n_cells=1, dt=0.025)
+        return {f"table-ii-{name}": (structure, paper_9_2_params(printed),
+                                     {"source": f"paper 9.2 table II, {name} column (as "
+                                                "printed, f2^2, f3^3)",
+                                      "direction": "sensor -> position", "fit_dt": 0.025})
+                for name, printed in PAPER_9_2_TABLE_II.items()}
+
+    def rest_state(self, structure, params, value, inverse=False):
+        return mpl_poly.rest_state(structure, params, value, inverse)
+
+    def step(self, structure, params, x, u):
+        return mpl_poly.step(structure, params, x, u)
+
+    def simulate(self, structure, params, u, x0=None):
+        return mpl_poly.simulate(structure, params, u, x0)
+
+    def invert(self, structure, params, y, x0=None):
+        return mpl_poly.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        """As :func:`model.invert_step`; NaN input estimate and state when ``y`` is outside
+        the range of ``g``'s branch (no input gives it), as the compiled block."""
+        lo, hi, sign, centre = mpl_poly.inverse_branch(structure, params)
+        if not kernels.solve_output(float(y), np.ascontiguousarray(params.g), lo, hi, sign,
+                                    centre)[1]:
+            return np.nan, np.full(np.size(x), np.nan)
+        return mpl_poly.invert_step(structure, params, x, y)
+
+    def fit(self, u, y, structure, *, accept=None,
+            accept_reason="rejected by the acceptance test", **options):
+        return fit_mpl_poly(u, y, structure, accept=accept, accept_reason=accept_reason,
+                            **options)
+
+    def block(self, structure, params, inverse=False):
+        if inverse:
+            if params.w[0] == 0:
+                raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
+            branch = mpl_poly.inverse_branch(structure, params)
+        else:  # the forward model needs no branch (g may have none through the rest point)
+            branch = (-np.inf, np.inf, 0.0, 0.0)
+        body = np.concatenate([[params.n_cells, params.v_b, structure.slope_cap / structure.dt,
+                                structure.dt, float(structure.limit)], branch, params.g,
+                               params.f.reshape(-1),
+                               mpl_poly.knee_points(structure, params).reshape(-1), params.w])
+        step = kernels.block_inverse if inverse else kernels.block_forward
+        return Block(step, np.ascontiguousarray(body, dtype=np.float64), structure.n_cells)
+
+    def linearise(self, structure, params, x, u, inverse=False):
+        """Paper 9.2 eq. 2-7. Forward: ``dx+ = (1 - f' dt) dx + f' dt du``,
+        ``dy = g'(z) (w_0 du + w . dx)``. Inverse: ``dz = dy / g'(z)``,
+        ``de = (dz - w . dx) / w_0``, the cells driven by ``e``. ``f'`` is the slope of the
+        limited cubic (eq. 5.29) at the operating point."""
+        x = np.asarray(x, dtype=float)
+        w0, w = params.w[0], params.w[1:]
+        if inverse:
+            lo, hi, sign, centre = mpl_poly.inverse_branch(structure, params)
+            z, ok = kernels.solve_output(float(u), np.ascontiguousarray(params.g), lo, hi, sign,
+                                         centre)
+            if not ok:
+                raise ValueError(f"output {u:.4g} is outside the range of g's branch: the "
+                                 f"inverse is not defined there")
+            drive = (z - w @ x + params.v_b) / w0
+        else:
+            drive = u
+            z = w0 * u + w @ x - params.v_b
+        dg = float(mpl_poly.output_slope(params, z))
+        g = mpl_poly.resistor_slope(structure, params, drive - x) * structure.dt
+        if inverse:
+            return (np.diag(1.0 - g) - np.outer(g, w) / w0, g / (w0 * dg), -w / w0,
+                    float(1.0 / (w0 * dg)))
+        return np.diag(1.0 - g), g, dg * w, float(dg * w0)
