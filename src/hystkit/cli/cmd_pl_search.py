@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..identification.family_pl import DEFAULT_GRID, format_search_table, structural_search
 from ..io import check_output_path, read_recording, write_json
+from ..models.pl import DEFAULT_GRID, format_search_table, structural_search
 
 __all__ = ["register"]
 

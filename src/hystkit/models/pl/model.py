@@ -41,24 +41,30 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FitDivergedError
-from . import _pl_kernels as kernels
-from ._validation import (
+from ...errors import FitDivergedError
+from .._protocol import Record
+from .._validation import (
     check_dt,
     check_signal,
     check_slope_cap,
     frozen_array,
     initial_state,
 )
+from . import kernels
 
 __all__ = [
     "PlParams",
     "PlStructure",
     "basis_breakpoints",
     "invert",
+    "invert_step",
+    "kernel_args",
     "output_resistor",
     "output_resistor_inverse",
+    "output_resistor_slope",
     "resistor_current",
+    "resistor_slope",
+    "rest_state",
     "simulate",
     "simulate_reference",
     "states",
@@ -67,7 +73,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class PlStructure:
+class PlStructure(Record):
     """Structural (not least-squares) parameters: N, p, M, S of the exhaustive search, and dt.
 
     Parameters
@@ -118,7 +124,7 @@ class PlStructure:
 
 
 @dataclass(frozen=True, eq=False)
-class PlParams:
+class PlParams(Record):
     """Least-squares parameters of a PL model.
 
     Parameters
@@ -160,21 +166,6 @@ class PlParams:
         if np.any(self.a <= 0):
             raise ValueError("the output resistor slopes a_j must be positive (f invertible)")
 
-    def to_dict(self) -> dict:
-        return {"i_t": self.i_t, "v_t": self.v_t, "w": self.w.tolist(), "v_b": self.v_b,
-                "a": self.a.tolist()}
-
-    @classmethod
-    def from_dict(cls, d: dict) -> PlParams:
-        return cls(i_t=d["i_t"], v_t=d["v_t"], w=d["w"], v_b=d["v_b"], a=d["a"])
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, PlParams):
-            return NotImplemented
-        return self.to_dict() == other.to_dict()
-
-    __hash__ = None
-
 
 def basis_breakpoints(n_basis: int) -> np.ndarray:
     """Breakpoints ``b_0 .. b_M`` of the output basis: M equal segments of [-1, 1], eq. 2.17."""
@@ -211,6 +202,15 @@ def resistor_current(structure: PlStructure, params: PlParams, v: np.ndarray) ->
     return np.sign(v) * (inside + g_lin * np.maximum(a - knee, 0.0))
 
 
+def resistor_slope(structure: PlStructure, params: PlParams, v: np.ndarray) -> np.ndarray:
+    """Slopes ``d'_k(v)``, shape (..., N): ``p I_T / ((p - 1) k V_T) |v / k V_T|^(p - 1)``
+    inside the knee, ``G`` on the straight branches (the cells' rates in a linearisation)."""
+    v = np.asarray(v, dtype=float)
+    thr, knee, g_lin = _cells(structure, params)
+    p = structure.power
+    inside = p * params.i_t / ((p - 1) * thr) * (np.abs(v) / thr) ** (p - 1)
+    return np.where(np.abs(v) <= knee, inside, g_lin)
+
 def output_resistor(params: PlParams, i: np.ndarray) -> np.ndarray:
     """``u = f(i) = sum_j a_j phi_j(i)`` (eq. 2.17), shape of ``i``."""
     i = np.asarray(i, dtype=float)
@@ -233,6 +233,28 @@ def output_resistor_inverse(params: PlParams, u: np.ndarray) -> np.ndarray:
     return knots[ref] + (u - f_knots[ref]) / params.a[seg]
 
 
+def output_resistor_slope(params: PlParams, i: np.ndarray) -> np.ndarray:
+    """``f'(i)``: the slope ``a_j`` of the segment holding ``i`` (the left one at a breakpoint
+    inside, as the outermost segments extend to infinity)."""
+    i = np.asarray(i, dtype=float)
+    seg = np.searchsorted(basis_breakpoints(params.n_basis)[1:-1], i)
+    return params.a[seg]
+
+
+def rest_state(structure: PlStructure, params: PlParams, value: float,
+               inverse: bool = False) -> np.ndarray:
+    """Cells at rest, each equal to the source (``d_k(0) = 0``), shape (N,).
+
+    Forward: the source is the constant input ``value``. Inverse (``value`` a constant output
+    current): ``e_0 = (f(value) + V_b) / sum w`` (0 if ``sum w = 0``), the source at which the
+    model rests with that output. :func:`simulate` / :func:`invert` start here for ``x0=None``.
+    """
+    if inverse:
+        w_sum = params.w.sum()
+        u = float(output_resistor(params, value))
+        value = (u + params.v_b) / w_sum if w_sum != 0 else 0.0
+    return np.full(structure.n_cells, float(value))
+
 def step(structure: PlStructure, params: PlParams, x: np.ndarray,
          e: float) -> tuple[float, np.ndarray]:
     """One sample: output ``i = f^-1(w_0 e + sum w_k u_k - V_b)`` from the present state
@@ -249,6 +271,14 @@ def step(structure: PlStructure, params: PlParams, x: np.ndarray,
     return y, x + resistor_current(structure, params, e - x) * structure.dt
 
 
+def invert_step(structure: PlStructure, params: PlParams, x: np.ndarray,
+                y: float) -> tuple[float, np.ndarray]:
+    """One sample of the inverse: ``u = f(i)`` (eq. 2.17), ``e = (u + V_b - sum w_k u_k) / w_0``
+    from the present state (eq. 2.20), then the cell update driven by ``e``."""
+    x = np.asarray(x, dtype=float)
+    e = (float(output_resistor(params, y)) + params.v_b - params.w[1:] @ x) / params.w[0]
+    return e, x + resistor_current(structure, params, e - x) * structure.dt
+
 def _check(structure: PlStructure, params: PlParams, u: np.ndarray, name: str) -> np.ndarray:
     if params.n_cells != structure.n_cells or params.n_basis != structure.n_basis:
         raise ValueError(f"params have N = {params.n_cells}, M = {params.n_basis}; the structure "
@@ -256,7 +286,8 @@ def _check(structure: PlStructure, params: PlParams, u: np.ndarray, name: str) -
     return check_signal(u, name)
 
 
-def _kernel_args(structure: PlStructure, params: PlParams) -> tuple:
+def kernel_args(structure: PlStructure, params: PlParams) -> tuple:
+    """``(I_T, thresholds, knees, p, G, dt)``: the cell arguments of the compiled kernels."""
     thr, knee, g_lin = _cells(structure, params)
     return params.i_t, thr, knee, float(structure.power), g_lin, structure.dt
 
@@ -280,8 +311,8 @@ def simulate(structure: PlStructure, params: PlParams, u: np.ndarray,
         State after the last sample; passing it as ``x0`` continues the run exactly.
     """
     u = _check(structure, params, u, "u")
-    x = initial_state(structure.n_cells, x0, u[0])
-    return kernels.simulate(u, x, *_kernel_args(structure, params), params.w, params.v_b,
+    x = initial_state(structure.n_cells, x0, u[0])  # = rest_state(..., u[0]) for x0=None
+    return kernels.simulate(u, x, *kernel_args(structure, params), params.w, params.v_b,
                             basis_breakpoints(structure.n_basis), params.a)
 
 
@@ -301,7 +332,7 @@ def states(structure: PlStructure, params: PlParams, u: np.ndarray,
     """Capacitor voltages at every sample, shape (n, N), and the final state (weights unused)."""
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
-    return kernels.states(u, x, *_kernel_args(structure, params))
+    return kernels.states(u, x, *kernel_args(structure, params))
 
 
 def invert(structure: PlStructure, params: PlParams, y: np.ndarray,
@@ -330,10 +361,11 @@ def invert(structure: PlStructure, params: PlParams, y: np.ndarray,
     y = _check(structure, params, y, "y")
     if params.w[0] == 0:
         raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 2.20)")
-    w_sum = params.w.sum()
-    rest = (float(output_resistor(params, y[0])) + params.v_b) / w_sum if w_sum != 0 else 0.0
-    x = initial_state(structure.n_cells, x0, rest)
-    e_hat, x_end, n_bad = kernels.invert(y, x, *_kernel_args(structure, params), params.w,
+    if x0 is None:
+        x = rest_state(structure, params, y[0], inverse=True)
+    else:
+        x = initial_state(structure.n_cells, x0, 0.0)
+    e_hat, x_end, n_bad = kernels.invert(y, x, *kernel_args(structure, params), params.w,
                                          params.v_b, basis_breakpoints(structure.n_basis),
                                          params.a)
     if n_bad >= 0:

@@ -1,9 +1,9 @@
-"""Compiled hot loops of the Power-Law model; ``pl.py`` holds the readable reference and checks.
+"""Compiled hot loops of the Power-Law model; ``model.py`` holds the readable reference.
 
 All arrays are float64 and already validated by the caller. Per cell ``k`` (0-based here, cell
 ``k + 1`` of the document) ``thr[k] = (k + 1) V_T`` is the threshold of eq. 2.16 and ``knee[k]``
 (<= ``thr[k]``) the voltage where the power law hands over to the straight branch of slope
-``g_lin`` (see ``pl.py``). ``brk`` holds the M + 1 breakpoints of the output basis (eq. 2.17).
+``g_lin`` (see ``model.py``). ``brk`` holds the M + 1 breakpoints of the output basis (eq. 2.17).
 """
 
 from __future__ import annotations
@@ -108,3 +108,48 @@ def invert(y, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
         for k in range(n_cells):
             x[k] += _current(e - x[k], i_t, thr[k], knee[k], power, g_lin) * dt
     return e_hat, x, -1
+
+
+# Loop blocks (protocol in ``hystkit.models._protocol``): body = [n, m, i_t, power, g_lin, dt,
+# v_b, thr (N), knee (N), w (N + 1), brk (M + 1), a (M)].
+
+@njit(cache=True, inline="always")
+def _block_cells(body, x, xn, off, drive):
+    """The cells' Euler update driven by ``drive`` (eq. 2.16 with the straight branches)."""
+    n = int(body[0])
+    for k in range(n):
+        xn[off + k] = x[off + k] + _current(drive - x[off + k], body[2], body[7 + k],
+                                            body[7 + n + k], body[3], body[4]) * body[5]
+
+
+@njit(cache=True, inline="always")
+def _block_output_basis(body):
+    """Slices of ``body``: the weights ``w``, the breakpoints and the slopes ``a``."""
+    n, m = int(body[0]), int(body[1])
+    iw = 7 + 2 * n
+    ib = iw + n + 1
+    return body[iw:ib], body[ib:ib + m + 1], body[ib + m + 1:ib + 2 * m + 1]
+
+
+@njit(cache=True)
+def block_forward(body, x, xn, off, u):
+    """``i = f^-1(w_0 e + sum w_k u_k - V_b)`` (eq. 2.18), then the cells driven by ``e``."""
+    w, brk, a = _block_output_basis(body)
+    acc = w[0] * u - body[6]
+    for k in range(w.size - 1):
+        acc += w[k + 1] * x[off + k]
+    y = _f_inverse(acc, brk, a)
+    _block_cells(body, x, xn, off, u)
+    return y
+
+
+@njit(cache=True)
+def block_inverse(body, x, xn, off, y):
+    """``e = (f(i) + V_b - sum w_k u_k) / w_0`` (eq. 2.17, 2.20), the cells driven by ``e``."""
+    w, brk, a = _block_output_basis(body)
+    acc = _f(y, brk, a) + body[6]
+    for k in range(w.size - 1):
+        acc -= w[k + 1] * x[off + k]
+    e = acc / w[0]
+    _block_cells(body, x, xn, off, e)
+    return e

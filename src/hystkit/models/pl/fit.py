@@ -1,5 +1,5 @@
-"""The Power-Law family as published (sec. 2.1.7, eq. 2.16-2.18) in the model registry, its
-weight fit and the exhaustive structural search over N, p, M, S (sec. 2.2, table 5.1).
+"""Identification of the Power-Law model as published (sec. 2.1.7, eq. 2.16-2.18) for a fixed
+structure; the structural search over N, p, M, S (table 5.1) is in ``search.py``.
 
 Fit for a fixed structure. The document (sec. 2.2) obtains the weights by "minimizing the
 constrained quadratic cost function" of its ref. [15]. The cost is quadratic because it is
@@ -16,36 +16,25 @@ equation error is solved by bounded linear least squares, with
 The two resistor parameters ``I_T`` and ``V_T`` enter non-linearly; ``fit_multistart`` moves
 them (log coordinates) with the output error ``f^-1(...) - y`` (eq. 5.9) as its residual, the
 weights being re-solved at every evaluation (variable projection). N, p, M and S are not
-fitted by least squares: :func:`structural_search` tries every combination of a grid.
+fitted by least squares: ``search.structural_search`` tries every combination of a grid.
 """
 
 from __future__ import annotations
 
-import itertools
-import time
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import asdict
+from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from ..metrics import e_max_pct, e_rms_pct
-from ..models import pl
-from ._least_squares import check_fit_data, fit_multistart
-from ._registry import ModelFamily
-from ._result import FitResult
+from ...identification import FitResult, check_fit_data, fit_multistart
+from . import model as pl
 
-__all__ = ["DEFAULT_GRID", "FAMILY", "fit_pl", "format_search_table", "structural_search"]
+__all__ = ["default_starts", "fit_pl", "solve_weights"]
 
 _W_BOUND = 100.0
 _A_MIN = 0.05
 _LOG_VT = (np.log(1e-3), np.log(2.0))  # thresholds beyond N * 2 never matter on [-1, 1] data
 _LOG_IT = (np.log(1e-6), np.log(1e4))
-
-#: Default grid of :func:`structural_search` (16 structures, < ~30 s on 8000 samples).
-DEFAULT_GRID: dict[str, tuple] = {"n": (1, 2, 5, 10), "p": (5.0, 21.0), "m": (1, 5),
-                                  "s": (0.001,)}
-
 
 def solve_weights(structure: pl.PlStructure, x: np.ndarray, u: np.ndarray,
                   y: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -149,75 +138,3 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
                           (lower, upper), lambda th: project(th)[0], structure,
                           max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
                           accept=accept, accept_reason=accept_reason)
-
-
-def structural_search(u: np.ndarray, y: np.ndarray, dt: float,
-                      grid: Mapping[str, Sequence] | None = None,
-                      slope_cap: float = 1.0) -> list[dict]:
-    """Exhaustive search over N, p, M, S (sec. 2.2, table 5.1): fit every combination.
-
-    Parameters
-    ----------
-    u, y : array, shape (n,)
-        Model input and output every ``dt`` [s]; centred on their means and scaled to
-        max |.| = 1 here (eq. 5.10), so the errors are those of eq. 5.11 on normalised data.
-    grid : mapping with keys "n", "p", "m", "s", optional
-        Values to try for each structural parameter; :data:`DEFAULT_GRID` fills missing keys.
-
-    Returns
-    -------
-    list of dict
-        One row per combination, in grid order: ``n_cells, power, n_basis, smoothing,
-        n_params, e_rms_pct, e_max_pct, seconds``, and ``structure`` / ``params`` (dicts).
-    """
-    grid = {**DEFAULT_GRID, **(grid or {})}
-    u = np.asarray(u, dtype=float) - np.mean(u)
-    y = np.asarray(y, dtype=float) - np.mean(y)
-    u, y = u / np.max(np.abs(u)), y / np.max(np.abs(y))
-    rows = []
-    for n, p, m, s in itertools.product(grid["n"], grid["p"], grid["m"], grid["s"]):
-        structure = pl.PlStructure(n_cells=int(n), power=float(p), n_basis=int(m),
-                                   smoothing=float(s), dt=dt, slope_cap=slope_cap)
-        t0 = time.perf_counter()
-        result = fit_pl(u, y, structure)
-        seconds = time.perf_counter() - t0
-        y_hat = pl.simulate(structure, result.params, u)[0]
-        rows.append({"n_cells": structure.n_cells, "power": structure.power,
-                     "n_basis": structure.n_basis, "smoothing": structure.smoothing,
-                     "n_params": structure.n_params, "e_rms_pct": e_rms_pct(y, y_hat, 1.0),
-                     "e_max_pct": e_max_pct(y, y_hat, 1.0), "seconds": seconds,
-                     "structure": asdict(structure),
-                     "params": result.params.to_dict()})
-    return rows
-
-
-def format_search_table(rows: Sequence[dict], best_only_per_n: bool = False) -> str:
-    """The search result laid out like table 5.1 (one line per structure, or the best per N)."""
-    if best_only_per_n:
-        best: dict[int, dict] = {}
-        for r in rows:
-            if r["n_cells"] not in best or r["e_rms_pct"] < best[r["n_cells"]]["e_rms_pct"]:
-                best[r["n_cells"]] = r
-        rows = [best[n] for n in sorted(best)]
-    head = (f"{'Model':<10} {'Cells (N)':>9} {'No. pars':>8} {'e_rms %':>8} {'e_max %':>8} "
-            f"{'M':>3} {'S':>7} {'p':>5} {'fit s':>6}")
-    lines = [head, "-" * len(head)]
-    for r in rows:
-        lines.append(f"{'Power-Law':<10} {r['n_cells']:>9d} {r['n_params']:>8d} "
-                     f"{r['e_rms_pct']:>8.3f} {r['e_max_pct']:>8.3f} {r['n_basis']:>3d} "
-                     f"{r['smoothing']:>7g} {r['power']:>5g} {r['seconds']:>6.2f}")
-    return "\n".join(lines)
-
-
-def _make_structure(dt: float, size: int, power: float = 21.0, n_basis: int = 1,
-                    smoothing: float = 0.001, slope_cap: float = 1.0) -> pl.PlStructure:
-    return pl.PlStructure(n_cells=size, power=power, n_basis=n_basis, smoothing=smoothing,
-                          dt=dt, slope_cap=slope_cap)
-
-
-FAMILY = ModelFamily(
-    name="pl", title="Power-Law model as published, Biggio et al. (sec. 2.1.7, eq. 2.16-2.18)",
-    structure_type=pl.PlStructure, params_type=pl.PlParams, make_structure=_make_structure,
-    simulate=pl.simulate, fit=fit_pl, invert=pl.invert,
-    size_help="cells N (N + M + 4 params; p, M, S via options or 'hystkit pl-search')",
-    default_size=1)

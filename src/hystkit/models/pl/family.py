@@ -1,0 +1,85 @@
+"""The Power-Law family as published (sec. 2.1.7, eq. 2.16-2.18) behind the family protocol."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import FitDivergedError
+from .._protocol import Block, Family
+from . import kernels
+from . import model as pl
+from .fit import fit_pl
+
+__all__ = ["PlFamily"]
+
+
+class PlFamily(Family):
+    name = "pl"
+    title = "Power-Law model as published, Biggio et al. (sec. 2.1.7, eq. 2.16-2.18)"
+    size_help = "cells N (N + M + 4 params; p, M, S via options or 'hystkit pl-search')"
+    default_size = 1
+    docs = "docs/models/pl.md"
+    Structure = pl.PlStructure
+    Params = pl.PlParams
+
+    def make_structure(self, dt: float, size: int, power: float = 21.0, n_basis: int = 1,
+                       smoothing: float = 0.001, slope_cap: float = 1.0) -> pl.PlStructure:
+        return pl.PlStructure(n_cells=size, power=power, n_basis=n_basis, smoothing=smoothing,
+                              dt=dt, slope_cap=slope_cap)
+
+    def at(self, structure, dt):
+        """Same N, p, M, S and slope cap at ``dt``. ``I_T``, ``V_T`` are rates and voltages of
+        the continuous cells (``du_k/dt = d_k``), so they stay; the straight branches' slope
+        ``G = slope_cap / dt`` is the Euler limit and follows ``dt``, so a cell driven beyond
+        its threshold still follows the input within one sample (the play-operator part), and
+        the knees are recomputed from it."""
+        return super().at(structure, dt)
+
+    def rest_state(self, structure, params, value, inverse=False):
+        return pl.rest_state(structure, params, value, inverse)
+
+    def step(self, structure, params, x, u):
+        return pl.step(structure, params, x, u)
+
+    def simulate(self, structure, params, u, x0=None):
+        return pl.simulate(structure, params, u, x0)
+
+    def invert(self, structure, params, y, x0=None):
+        return pl.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return pl.invert_step(structure, params, x, y)
+
+    def fit(self, u, y, structure, *, accept=None,
+            accept_reason="rejected by the acceptance test", **options):
+        return fit_pl(u, y, structure, accept=accept, accept_reason=accept_reason, **options)
+
+    def block(self, structure, params, inverse=False):
+        if inverse and params.w[0] == 0:
+            raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 2.20)")
+        i_t, thr, knee, power, g_lin, dt = pl.kernel_args(structure, params)
+        body = np.concatenate([[params.n_cells, params.n_basis, i_t, power, g_lin, dt,
+                                params.v_b], thr, knee, params.w,
+                               pl.basis_breakpoints(params.n_basis), params.a])
+        step = kernels.block_inverse if inverse else kernels.block_forward
+        return Block(step, np.ascontiguousarray(body, dtype=np.float64), structure.n_cells)
+
+    def linearise(self, structure, params, x, u, inverse=False):
+        """Each cell ``x+ = x + d(drive - x) dt`` gives ``dx+ = (1 - d' dt) dx + d' dt
+        d(drive)``, ``d'`` the slope of the cell resistor (power law or straight branch).
+        Forward: ``di = (w_0 de + w . dx) / f'(i)``; inverse: ``de = (f'(i) di - w . dx) / w_0``,
+        the cells driven by ``e``. ``f'`` is the slope ``a_j`` of the output resistor's segment
+        (on a breakpoint the left one; the numerical default would average the two)."""
+        x = np.asarray(x, dtype=float)
+        w0, w = params.w[0], params.w[1:]
+        if inverse:
+            a = float(pl.output_resistor_slope(params, u))
+            drive = pl.invert_step(structure, params, x, u)[0]
+        else:
+            i = pl.output_resistor_inverse(params, w0 * u + w @ x - params.v_b)
+            a = float(pl.output_resistor_slope(params, i))
+            drive = u
+        g = pl.resistor_slope(structure, params, drive - x) * structure.dt
+        if inverse:
+            return np.diag(1.0 - g) - np.outer(g, w) / w0, g * a / w0, -w / w0, a / w0
+        return np.diag(1.0 - g), g, w / a, float(w0 / a)
