@@ -12,14 +12,18 @@ from numpy.testing import assert_allclose
 from hystkit.cli import main
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.models.mpl_poly import PAPER_9_2_TABLE_II, paper_9_2_params
 from hystkit.io import write_recording
-from hystkit.models import _linearise as lin
-from hystkit.models import mpl, mpl_poly
+from hystkit.models import _cells, family_of, mpl, mpl_poly
+from hystkit.models.mpl_poly import PAPER_9_2_TABLE_II, paper_9_2_params
 from hystkit.sensors import simulate_experiment
 from hystkit.signals import exponential_chirp
 
 DT = 0.025
+
+
+def _cells_of(structure, params) -> _cells.Cells:
+    return family_of(structure).cells(structure, params)
+
 POLY = (mpl_poly.MplPolyStructure(n_cells=2, dt=DT),
         mpl_poly.MplPolyParams(f=[[0.05, 1.5, 0.4, 2.0], [-0.1, 8.0, 1.0, 300.0]],
                                g=[0.02, 0.9, 0.05, 0.1], w=[1.2, -0.4, -0.3], v_b=0.03))
@@ -36,11 +40,11 @@ POINTS = [(0.3, np.array([0.3, 0.3])), (0.5, np.array([0.1, 0.45])),
 def test_discrete_eigenvalues_are_one_minus_slope_dt_and_one(family, point):
     (structure, params), _ = FAMILY_MODULES[family]
     e0, u0 = POINTS[point]
-    model = lin.linearise(structure, params, e0, u0)
+    model = _cells.linearise(_cells_of(structure, params), e0, u0)
     a_d = model.discrete()[0]
-    slope = lin.resistor_slope(structure, params, e0 - u0)
+    slope = _cells_of(structure, params).slope(e0 - u0)
     closed = np.r_[1 - slope * DT, 1.0]  # eq. 5.26 corrected: 1 - f'dt; the constant state: 1
-    assert_allclose(lin.discrete_eigenvalues(model), closed, rtol=0, atol=1e-15)
+    assert_allclose(_cells.discrete_eigenvalues(model), closed, rtol=0, atol=1e-15)
     # numpy agrees (A_d is triangular, so its eigenvalues are exact up to rounding)
     assert_allclose(np.sort(np.linalg.eigvals(a_d).real), np.sort(closed), rtol=0, atol=1e-12)
     # continuous A: -f'_k and 0 for the constant state
@@ -53,7 +57,7 @@ def test_discrete_eigenvalues_are_one_minus_slope_dt_and_one(family, point):
 def test_linear_model_is_the_jacobian_of_the_step_map(family, point):
     (structure, params), module = FAMILY_MODULES[family]
     e0, u0 = POINTS[point]
-    a_d, b_d, c_d, d_d = lin.linearise(structure, params, e0, u0).discrete()
+    a_d, b_d, c_d, d_d = _cells.linearise(_cells_of(structure, params), e0, u0).discrete()
     y0, x1 = module.step(structure, params, u0, e0)
     # affine, not only linear: the model reproduces the step at the operating point itself
     assert_allclose(a_d[:2] @ np.r_[u0, 1.0] + b_d[:2] * e0, x1, rtol=0, atol=1e-13)
@@ -83,7 +87,7 @@ def test_the_documents_eq_5_26_is_not_the_eigenvalue():
     s = mpl_poly.MplPolyStructure(n_cells=1, dt=DT)
     p = mpl_poly.MplPolyParams(f=[[0.0, 2.0, 0.0, 1e-9]], g=[0.0, 1.0, 0.0, 0.0],
                                w=[1.0, -1.0])
-    model = lin.linearise(s, p, 0.0, np.zeros(1))
+    model = _cells.linearise(_cells_of(s, p), 0.0, np.zeros(1))
     eig = np.sort(np.linalg.eigvals(model.discrete()[0]).real)
     assert_allclose(eig, [1 - 2.0 * DT, 1.0], atol=1e-12)
     assert not np.any(np.isclose(eig, (1 - 2.0) * DT)) and not np.any(np.isclose(eig, 0.0))
@@ -96,7 +100,7 @@ def test_criterion_eq_5_28_predicts_perturbation_growth(slope_dt, stable):
     s = mpl_poly.MplPolyStructure(n_cells=1, dt=DT, limit=False)
     p = mpl_poly.MplPolyParams(f=[[0.0, slope_dt / DT, 0.0, 1e-300]], g=[0.0, 1.0, 0.0, 0.0],
                                w=[0.0, 1.0])
-    lam = lin.discrete_eigenvalues(lin.linearise(s, p, 0.0, np.zeros(1)))[0]
+    lam = _cells.discrete_eigenvalues(_cells.linearise(_cells_of(s, p), 0.0, np.zeros(1)))[0]
     y, _ = mpl_poly.simulate(s, p, np.zeros(40), x0=1e-3)
     assert_allclose(y, 1e-3 * lam ** np.arange(40), rtol=1e-12)
     assert (abs(lam) < 1) == stable == (0 < slope_dt < 2)
@@ -109,14 +113,14 @@ def test_sinh_slope_matches_finite_differences_inside_and_beyond_the_knee():
     h = 1e-7
     fd = (mpl.resistor_current(structure, params, v + h)
           - mpl.resistor_current(structure, params, v - h)) / (2 * h)
-    assert_allclose(lin.resistor_slope(structure, params, v), fd, rtol=1e-6)
-    assert_allclose(lin.resistor_slope(structure, params, v)[1], 1 / DT)  # the cap
+    assert_allclose(_cells_of(structure, params).slope(v), fd, rtol=1e-6)
+    assert_allclose(_cells_of(structure, params).slope(v)[1], 1 / DT)  # the cap
 
 
 def test_report_of_a_limited_model_is_stable_everywhere():
     structure, params = POLY
     u = exponential_chirp(np.arange(4000) * DT, amplitude=1.0)
-    report = lin.stability_report(structure, params, u)
+    report = _cells.cell_report(_cells_of(structure, params), u)
     assert report["stable_everywhere"] and report["n_violations"] == 0
     assert report["n_points"] == 4000 * 2 + 2  # two cells, one rest point each
     assert_allclose(report["knees"], mpl_poly.knee_points(structure, params))
@@ -129,7 +133,7 @@ def test_report_flags_the_repelling_middle_rest_point_of_a_bistable_cell():
     s = mpl_poly.MplPolyStructure(n_cells=1, dt=DT)
     p = mpl_poly.MplPolyParams(f=[[0.0, -4.0, 0.0, 4.0]], g=[0.0, 1.0, 0.0, 0.0],
                                w=[1.0, -1.0])
-    report = lin.stability_report(s, p, np.zeros(100))
+    report = _cells.cell_report(_cells_of(s, p), np.zeros(100))
     rest = report["rest"][0]
     assert_allclose(rest["v"], [-1.0, 0.0, 1.0], atol=1e-12)
     assert_allclose(rest["eigenvalue"], [1 - 8 * DT, 1 + 4 * DT, 1 - 8 * DT], atol=1e-12)
@@ -140,8 +144,8 @@ def test_report_refuses_a_diverging_unlimited_model():
     p = paper_9_2_params(PAPER_9_2_TABLE_II["chirp"])
     fast = exponential_chirp(np.arange(4000) * DT, f1=10.0, amplitude=1.0)
     with pytest.raises(FitDivergedError):
-        lin.stability_report(mpl_poly.MplPolyStructure(limit=False), p, fast)
-    assert lin.stability_report(mpl_poly.MplPolyStructure(), p, fast)["n_points"] == 4001
+        _cells.cell_report(_cells_of(mpl_poly.MplPolyStructure(limit=False), p), fast)
+    assert _cells.cell_report(_cells_of(mpl_poly.MplPolyStructure(), p), fast)["n_points"] == 4001
 
 
 # --------------------------------------------------------------------------- CLI

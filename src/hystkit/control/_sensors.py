@@ -247,6 +247,12 @@ def _offsets(compensator: Compensator) -> tuple[float, float]:
                                                             sc.position_offset)
 
 
+def _sensor_scale(compensator: Compensator) -> float:
+    """Sensor units per normalised unit, signed: the model sees the sensor flipped by the
+    file's ``polarity`` (a sensor that falls with position)."""
+    return compensator.scaling.sensor_scale * compensator.polarity
+
+
 def _file_info(compensator: Compensator, direction: str) -> dict:
     info = {k: v for k, v in compensator.fit_info.items()
             if isinstance(v, str | int | float | bool)}
@@ -260,11 +266,10 @@ def compensator_block(compensator: Compensator, *, name: str = "compensator") ->
     Direct mode runs the fitted model; inverse mode runs the inverse of the forward model it
     holds. Offsets: see :func:`_offsets`.
     """
-    sc = compensator.scaling
     s_off, p_off = _offsets(compensator)
     return SensorBlock(compensator.structure, compensator.params,
-                       compensator.mode == "inverse", s_off, sc.sensor_scale,
-                       p_off * MM, sc.position_scale * MM, name=name,
+                       compensator.mode == "inverse", s_off, _sensor_scale(compensator),
+                       p_off * MM, compensator.scaling.position_scale * MM, name=name,
                        info=_file_info(compensator, "sensor -> position"))
 
 
@@ -275,11 +280,11 @@ def sensor_block(compensator: Compensator, *, name: str = "S_r") -> SensorBlock:
     direct-mode file holds sensor -> position: it runs backwards through its family's inverse,
     and a family without one is refused with the reason (``ValueError``).
     """
-    sc = compensator.scaling
     s_off, p_off = _offsets(compensator)
     return SensorBlock(compensator.structure, compensator.params,
-                       compensator.mode == "direct", p_off * MM, sc.position_scale * MM,
-                       s_off, sc.sensor_scale, name=name,
+                       compensator.mode == "direct", p_off * MM,
+                       compensator.scaling.position_scale * MM, s_off,
+                       _sensor_scale(compensator), name=name,
                        info=_file_info(compensator, "position -> sensor"))
 
 

@@ -7,6 +7,7 @@ provides and how to add one.
 
 from ._protocol import Block, Family, Record, numerical_linearisation
 from ._registry import FAMILIES, family_of, get_family, register, unregister
+from ._stability import stability_report
 
 __all__ = ["FAMILIES", "Block", "Family", "Record", "family_of", "get_family",
-           "numerical_linearisation", "register", "unregister"]
+           "numerical_linearisation", "register", "stability_report", "unregister"]

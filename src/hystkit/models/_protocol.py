@@ -228,6 +228,13 @@ class Family(ABC):
         return numerical_linearisation(lambda xx, uu: run(structure, params, xx, uu), x, u)
 
 
+    def stability_details(self, structure: Any, params: Any, u: np.ndarray) -> dict | None:
+        """Family-specific stability facts beyond the generic eigenvalue scan of
+        :func:`hystkit.models.stability_report` (the mPL families: eq. 5.28 per cell, knees,
+        rest points); None when the family has none."""
+        return None
+
+
 def numerical_linearisation(step: Callable[[np.ndarray, float], tuple[float, np.ndarray]],
                             x: np.ndarray, u: float,
                             rel_step: float = 1e-6) -> tuple[np.ndarray, np.ndarray,

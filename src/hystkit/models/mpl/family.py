@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._cells import Cells, cell_report
 from .._protocol import Block, Family
 from . import kernels
 from . import model as mpl
@@ -71,3 +72,24 @@ class MplFamily(Family):
         if inverse:
             return np.diag(1.0 - g) - np.outer(g, w) / w0, g / w0, -w / w0, 1.0 / w0
         return np.diag(1.0 - g), g, w.copy(), float(w0)
+
+    def cells(self, structure, params) -> Cells:
+        """The model as the eq. 5.18-5.28 analysis sees it (linear output ``g(z) = z``)."""
+        knee = mpl.knee_voltage(structure, params)
+        cap = structure.slope_cap / structure.dt
+        g = 2 * params.i_s / params.v_t
+
+        def slope(v):  # G cosh(v / V_T) inside the knee, the cap beyond
+            v = np.asarray(v, dtype=float)
+            inside = np.abs(v) <= knee
+            return np.where(inside, g * np.cosh(np.where(inside, v, 0.0) / params.v_t), cap)
+
+        return Cells(current=lambda v: mpl.resistor_current(structure, params, v), slope=slope,
+                     output=lambda z: z, output_slope=lambda z: 1.0, w=params.w,
+                     v_b=params.v_b, dt=structure.dt, knees=np.column_stack([-knee, knee]),
+                     rest_points=[np.zeros(1)] * structure.n_cells,  # sinh: odd, monotone
+                     start=lambda e0: np.full(structure.n_cells, e0),
+                     check=lambda u: mpl.simulate(structure, params, u))
+
+    def stability_details(self, structure, params, u):
+        return cell_report(self.cells(structure, params), u)

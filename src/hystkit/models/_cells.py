@@ -21,7 +21,8 @@ with ``f_k, f'_k`` evaluated at ``v_k0 = e_0 - u_k0``. Corrections to the docume
   eq. 5.28, ``0 < f'_k dt < 2``.
 
 Both the sinh mPL (``mpl``, linear output ``g(z) = z``) and the polynomial mPL (``mpl_poly``)
-go through :func:`linearise_cells`, which takes the cell-resistor current and slope functions.
+describe themselves as :class:`Cells` (their families' ``cells`` method); everything here works
+on that description and imports no family.
 """
 
 from __future__ import annotations
@@ -31,13 +32,49 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import mpl, mpl_poly
+__all__ = ["Cells", "LinearModel", "cell_report", "discrete_eigenvalues", "linearise",
+           "linearise_cells"]
 
-__all__ = ["LinearModel", "discrete_eigenvalues", "knee_points", "linearise", "linearise_cells",
-           "resistor_slope", "stability_report"]
 
-Structure = mpl.MplStructure | mpl_poly.MplPolyStructure
-Params = mpl.MplParams | mpl_poly.MplPolyParams
+@dataclass(frozen=True, eq=False)
+class Cells:
+    """An RC-cell model as the analysis of eq. 5.18-5.28 sees it.
+
+    Attributes
+    ----------
+    current, slope : callable
+        ``v (..., N) -> f_k,lim(v_k)`` and ``-> f'_k,lim(v_k)``: the limited cell resistors.
+    output, output_slope : callable
+        ``z -> g(z)`` and ``-> g'(z)`` (the sinh mPL: ``z`` and 1).
+    w : array, shape (N + 1,)
+    v_b : float
+    dt : float
+    knees : array, shape (N, 2)
+        ``x-, x+`` of each cell beyond which ``f'_k dt`` is capped.
+    rest_points : list of arrays
+        Per cell, the voltages where ``f_k = 0``.
+    start : callable
+        ``e_0 -> u (N,)``: the state the model starts in for a first input ``e_0``.
+    check : callable
+        ``u -> None``: runs the model on ``u``; raises FitDivergedError if it diverges.
+    """
+
+    current: Callable[[np.ndarray], np.ndarray]
+    slope: Callable[[np.ndarray], np.ndarray]
+    output: Callable[[float], float]
+    output_slope: Callable[[float], float]
+    w: np.ndarray
+    v_b: float
+    dt: float
+    knees: np.ndarray
+    rest_points: list
+    start: Callable[[float], np.ndarray]
+    check: Callable[[np.ndarray], None]
+
+    @property
+    def n_cells(self) -> int:
+        return int(np.size(self.w)) - 1
+
 
 @dataclass(frozen=True, eq=False)
 class LinearModel:
@@ -110,57 +147,13 @@ def discrete_eigenvalues(model: LinearModel) -> np.ndarray:
     return np.diag(model.discrete()[0]).copy()
 
 
-def _mpl_slope(structure: mpl.MplStructure, params: mpl.MplParams,
-               v: np.ndarray) -> np.ndarray:
-    """Slope of the limited sinh resistor: ``G cosh(v / V_T)`` inside the knee, the cap beyond."""
-    v = np.asarray(v, dtype=float)
-    inside = np.abs(v) <= mpl.knee_voltage(structure, params)
-    g = 2 * params.i_s / params.v_t
-    v_in = np.where(inside, v, 0.0)
-    return np.where(inside, g * np.cosh(v_in / params.v_t), structure.slope_cap / structure.dt)
+def linearise(cells: Cells, e0: float, u0: np.ndarray) -> LinearModel:
+    """Linear model (eq. 5.23) at input ``e0``, state ``u0`` (N,)."""
+    return linearise_cells(cells.current, cells.slope, cells.output, cells.output_slope,
+                           cells.w, cells.v_b, e0, u0, cells.dt)
 
 
-def resistor_slope(structure: Structure, params: Params, v: np.ndarray) -> np.ndarray:
-    """Cell-resistor slopes ``f'_k,lim(v)``, shape (..., N), of an mpl or mpl-poly model."""
-    if isinstance(structure, mpl.MplStructure):
-        return _mpl_slope(structure, params, v)
-    return mpl_poly.resistor_slope(structure, params, v)
-
-
-def knee_points(structure: Structure, params: Params) -> np.ndarray:
-    """Knees ``x-, x+`` of each cell (shape (N, 2)) beyond which ``f'_k dt`` is capped."""
-    if isinstance(structure, mpl.MplStructure):
-        knee = mpl.knee_voltage(structure, params)
-        return np.column_stack([-knee, knee])
-    return mpl_poly.knee_points(structure, params)
-
-
-def linearise(structure: Structure, params: Params, e0: float, u0: np.ndarray) -> LinearModel:
-    """Linear model (eq. 5.23) of an mpl or mpl-poly model at input ``e0``, state ``u0`` (N,).
-
-    The sinh mPL has the linear output ``g(z) = z`` (``R = 1``, eq. 5.2).
-    """
-    if isinstance(structure, mpl.MplStructure):
-        return linearise_cells(lambda v: mpl.resistor_current(structure, params, v),
-                               lambda v: _mpl_slope(structure, params, v), lambda z: z,
-                               lambda z: 1.0, params.w, params.v_b, e0, u0, structure.dt)
-    if isinstance(structure, mpl_poly.MplPolyStructure):
-        return linearise_cells(lambda v: mpl_poly.resistor_current(structure, params, v),
-                               lambda v: mpl_poly.resistor_slope(structure, params, v),
-                               lambda z: mpl_poly.output_current(params, z),
-                               lambda z: mpl_poly.output_slope(params, z), params.w,
-                               params.v_b, e0, u0, structure.dt)
-    raise TypeError(f"linearise covers the mpl and mpl-poly families, not "
-                    f"{type(structure).__name__}")
-
-
-def _rest_points(structure: Structure, params: Params) -> list[np.ndarray]:
-    if isinstance(structure, mpl.MplStructure):
-        return [np.zeros(1)] * structure.n_cells  # the sinh resistor is odd and monotone
-    return mpl_poly.equilibria(structure, params)
-
-
-def stability_report(structure: Structure, params: Params, u: np.ndarray) -> dict:
+def cell_report(cells: Cells, u: np.ndarray) -> dict:
     """Where the linearised model is stable (eq. 5.28): rest points and a driven trajectory.
 
     Operating points: every rest point of every cell (``f_k(v*) = 0``; ``u_k = e - v*`` for any
@@ -182,30 +175,26 @@ def stability_report(structure: Structure, params: Params, u: np.ndarray) -> dic
         ``stable_everywhere``; the augmented constant state (eigenvalue 1) is not counted.
     """
     u = np.asarray(u, dtype=float)
-    dt = structure.dt
+    dt, n = cells.dt, cells.n_cells
     rest = []
     slopes_rest = []
-    for k, v in enumerate(_rest_points(structure, params)):
-        probe = np.zeros((v.size, structure.n_cells))
+    for k, v in enumerate(cells.rest_points):
+        probe = np.zeros((v.size, n))
         probe[:, k] = v
-        s = resistor_slope(structure, params, probe)[:, k] * dt
+        s = cells.slope(probe)[:, k] * dt
         slopes_rest.append(s)
         rest.append({"v": v.tolist(), "slope_dt": s.tolist(), "eigenvalue": (1 - s).tolist()})
-    if isinstance(structure, mpl.MplStructure):
-        family, x = mpl, np.full(structure.n_cells, u[0])
-    else:
-        family, x = mpl_poly, u[0] - mpl_poly.rest_voltages(structure, params)
-    family.simulate(structure, params, u)  # FitDivergedError if the run diverges (no limit)
-    states = np.empty((u.size, structure.n_cells))
-    for n, u_n in enumerate(u):  # the states the run visits (an analysis, not a hot path)
-        states[n] = x
-        x = x + family.resistor_current(structure, params, u_n - x) * dt
-    slopes_traj = resistor_slope(structure, params, u[:, None] - states) * dt
+    cells.check(u)  # FitDivergedError if the run diverges (no limit)
+    x = cells.start(float(u[0]))
+    states = np.empty((u.size, n))
+    for i, u_i in enumerate(u):  # the states the run visits (an analysis, not a hot path)
+        states[i] = x
+        x = x + cells.current(u_i - x) * dt
+    slopes_traj = cells.slope(u[:, None] - states) * dt
     everything = np.concatenate([np.concatenate(slopes_rest), slopes_traj.ravel()])
     bad = (everything <= 0) | (everything >= 2)
     return {
-        "dt": dt, "n_cells": structure.n_cells, "knees": knee_points(structure, params).tolist(),
-        "rest": rest,
+        "dt": dt, "n_cells": n, "knees": np.asarray(cells.knees).tolist(), "rest": rest,
         "trajectory": {"n_samples": int(u.size),
                        "slope_dt_min": slopes_traj.min(axis=0).tolist(),
                        "slope_dt_max": slopes_traj.max(axis=0).tolist(),

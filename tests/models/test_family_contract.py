@@ -1,0 +1,175 @@
+"""The family protocol's contract, checked on every registered family alike.
+
+Each family gets a fitted example (its default size, direct mode: sensor -> position on the
+virtual sensor's noise run, normalised as the compensator does) and must then honour the
+invariants every generic piece relies on. Family-specific property tests stay with the family
+(``tests/models/<family>/``).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from hystkit.models import FAMILIES, Family, get_family, numerical_linearisation
+from hystkit.sensors import simulate_experiment
+
+NAMES = sorted(FAMILIES)
+N_FIT = 1600  # 40 s at 40 Hz: enough to excite every family, short enough for a quick fit
+
+
+@functools.cache
+def _data() -> tuple[float, np.ndarray, np.ndarray]:
+    rec = simulate_experiment("noise", 1)
+    s = rec.sensor[:N_FIT] - rec.sensor[:N_FIT].mean()
+    p = rec.position[:N_FIT] - rec.position[:N_FIT].mean()
+    return rec.dt, s / np.max(np.abs(s)), p / np.max(np.abs(p))
+
+
+@functools.cache
+def _example(name: str):
+    """A fitted (structure, params) of the family, and its input signal."""
+    family = get_family(name)
+    dt, s, p = _data()
+    structure = family.make_structure(dt, family.default_size)
+    return structure, family.fit(s, p, structure).params, s
+
+
+def _probe(n: int = 300, seed: int = 0) -> np.ndarray:
+    """A smooth random input inside the training range, with reversals."""
+    rng = np.random.default_rng(seed)
+    return 0.8 * np.sin(np.cumsum(rng.uniform(0.0, 0.15, n)) + 0.3) * np.linspace(1, 0.5, n)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_family_declares_the_protocol(name):
+    family = get_family(name)
+    assert isinstance(family, Family) and family.name == name
+    assert family.title and family.size_help and family.default_size >= 1
+    assert (family.invert is None) == bool(family.no_inverse_reason)
+    assert (family.invert is None) == (family.invert_step is None)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_params_and_structure_round_trip_through_json(name):
+    family = get_family(name)
+    structure, params, _ = _example(name)
+    again = family.Params.from_dict(json.loads(json.dumps(params.to_dict())))
+    assert again == params and not (again != params)
+    assert family.Structure.from_dict(json.loads(json.dumps(structure.to_dict()))) == structure
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_split_run_equals_whole_run(name):
+    family = get_family(name)
+    structure, params, _ = _example(name)
+    u = _probe()
+    y, x_end = family.simulate(structure, params, u)
+    y1, x_mid = family.simulate(structure, params, u[:137])
+    y2, x_end2 = family.simulate(structure, params, u[137:], x_mid)
+    assert_allclose(np.r_[y1, y2], y, rtol=0, atol=1e-12)
+    assert_allclose(x_end2, x_end, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_compiled_run_equals_the_readable_steps_from_rest(name):
+    family = get_family(name)
+    structure, params, _ = _example(name)
+    u = _probe(200, seed=1)
+    y, _ = family.simulate(structure, params, u)
+    x = family.rest_state(structure, params, float(u[0]))
+    for k, u_k in enumerate(u):
+        y_k, x = family.step(structure, params, x, u_k)
+        assert y_k == pytest.approx(y[k], abs=1e-10), k
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("inverse", [False, True])
+def test_loop_block_equals_the_readable_step(name, inverse):
+    family = get_family(name)
+    if inverse and not family.has_inverse:
+        pytest.skip(f"{name} has no inverse: {family.no_inverse_reason}")
+    structure, params, _ = _example(name)
+    block = family.block(structure, params, inverse)
+    step = family.invert_step if inverse else family.step
+    u = _probe(250, seed=2)
+    if inverse:  # drive the inverse with outputs the model can produce
+        u, _ = family.simulate(structure, params, u)
+    x = family.rest_state(structure, params, float(u[0]), inverse)
+    assert np.size(x) == block.n_state
+    off = 3  # the block's slice sits anywhere in the loop state
+    state = np.zeros(off + block.n_state + 2)
+    state[off:off + block.n_state] = x
+    for k, u_k in enumerate(u):
+        nxt = state.copy()
+        out = block.step(block.body, state, nxt, off, u_k)
+        ref, x = step(structure, params, x, u_k)
+        assert out == pytest.approx(ref, abs=1e-10), k
+        assert_allclose(nxt[off:off + block.n_state], x, rtol=0, atol=1e-10)
+        assert_allclose(np.r_[nxt[:off], nxt[off + block.n_state:]], 0.0)  # nothing else
+        state = nxt
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_rest_state_is_a_fixed_point(name):
+    family = get_family(name)
+    structure, params, _ = _example(name)
+    for value in (-0.5, 0.0, 0.7):
+        x = family.rest_state(structure, params, value)
+        _, x_next = family.step(structure, params, x, value)
+        assert_allclose(x_next, x, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_inverse_undoes_the_model(name):
+    family = get_family(name)
+    if not family.has_inverse:
+        pytest.skip(f"{name} has no inverse: {family.no_inverse_reason}")
+    structure, params, _ = _example(name)
+    u = _probe(300, seed=3)
+    y, _ = family.simulate(structure, params, u)
+    u_hat, _ = family.invert(structure, params, y)
+    assert_allclose(u_hat, u, rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_at_keeps_the_model_at_its_own_step_and_round_trips(name):
+    family = get_family(name)
+    structure, params, _ = _example(name)
+    assert family.at(structure, structure.dt) == structure
+    try:
+        finer = family.at(structure, structure.dt / 8)
+    except ValueError as exc:  # a clear refusal is allowed, with the reason
+        assert str(exc)
+        return
+    assert finer.dt == pytest.approx(structure.dt / 8)
+    assert family.at(finer, structure.dt) == structure
+    y, _ = family.simulate(finer, params, np.repeat(_probe(100, seed=4), 8))
+    assert np.all(np.isfinite(y))
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("inverse", [False, True])
+def test_linearisation_matches_the_numerical_one(name, inverse):
+    family = get_family(name)
+    if inverse and not family.has_inverse:
+        pytest.skip(f"{name} has no inverse: {family.no_inverse_reason}")
+    structure, params, _ = _example(name)
+    step = family.invert_step if inverse else family.step
+    u = _probe(120, seed=5)
+    if inverse:
+        u, _ = family.simulate(structure, params, u)
+    x = family.rest_state(structure, params, float(u[0]), inverse)
+    for k, u_k in enumerate(u):
+        if k % 40 == 39:
+            got = family.linearise(structure, params, x, u_k, inverse)
+            ref = numerical_linearisation(lambda xx, uu: step(structure, params, xx, uu), x,
+                                          u_k)
+            for a, b in zip(got, ref, strict=True):
+                assert_allclose(np.asarray(a, float), np.asarray(b, float), rtol=1e-5,
+                                atol=1e-7)
+        _, x = step(structure, params, x, u_k)
