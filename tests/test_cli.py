@@ -201,7 +201,7 @@ def test_fit_writes_model_json(data: dict[str, Path]) -> None:
     assert MODEL_KEYS <= set(model)
     assert model["schema"] == "hystkit.compensator"
     assert model["schema_version"] == 1
-    assert (model["model"], model["mode"], model["center"]) == ("mpl", "direct", "recording")
+    assert (model["model"], model["mode"], model["center"]) == ("mpl", "direct", "fit")
     assert model["dt"] == pytest.approx(0.025)
     assert model["structure"]["n_cells"] == 1
     assert len(model["params"]["i_s"]) == 1 and len(model["params"]["w"]) == 2
@@ -213,7 +213,8 @@ def test_fit_prints_progress_and_result(data: dict[str, Path], tmp_path: Path,
     out = tmp_path / "m.json"
     code, stdout, err = _run(capsys, "fit", data["fit"], "--cells", 1, "--out", out)
     assert (code, err) == (0, "")
-    assert "fitting mpl (cells N (3N + 2 params): 1, direct mode, centring: recording)" in stdout
+    assert "fitting mpl (cells N (3N + 2 params): 1, direct mode, centring: fit)" in stdout
+    assert "status: ok" in stdout
     assert f"wrote {out}" in stdout
     assert out.is_file()
 
@@ -237,7 +238,8 @@ def test_compensate_needs_no_position_column(data: dict[str, Path], tmp_path: Pa
     out = tmp_path / "out.csv"
     code, _, err = _run(capsys, "compensate", data["model"], rec, "--out", out)
     assert (code, err) == (0, "")
-    assert list(pd.read_csv(out).columns) == ["time", "sensor", "position_estimate"]
+    assert list(pd.read_csv(out).columns) == ["time", "sensor", "position_estimate",
+                                              "sensor_outside", "estimate_outside"]
 
 
 def _evaluate_json(capsys: pytest.CaptureFixture[str], model: Path, rec: Path,
@@ -254,7 +256,7 @@ def test_evaluate_writes_scores_and_beats_the_line(data: dict[str, Path], tmp_pa
     assert EVALUATE_KEYS <= set(scores)
     assert scores["n_samples"] == N_SAMPLES
     assert scores["r2"] > scores["linear_r2"]  # the hysteresis model beats a straight line
-    assert "straight line" in stdout and "centring: recording" in stdout
+    assert "line oracle" in stdout and "deployable centring: fit" in stdout
     assert f"wrote {out}" in stdout
 
 

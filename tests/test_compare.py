@@ -66,9 +66,9 @@ def test_compare_mpl_on_the_virtual_sensor(noise):
 
 
 def test_generalization_matrix_shape():
-    recs = {name: (simulate_experiment(name, 1), simulate_experiment(name, 2))
-            for name in ("sine", "noise")}
-    out = generalization_matrix(recs, ["mpl"])
+    names = ("sine", "noise")
+    out = generalization_matrix({n: simulate_experiment(n, 1) for n in names},
+                                {n: simulate_experiment(n, 2) for n in names}, ["mpl"])
     grid = out["mpl"]["r2"]
     assert set(grid) == {"sine", "noise"} and all(set(row) == {"sine", "noise"}
                                                   for row in grid.values())

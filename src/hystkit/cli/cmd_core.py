@@ -9,12 +9,18 @@ from pathlib import Path
 
 from ..compensation import (
     CENTERS,
+    DEFAULT_CENTER,
     MODES,
+    ORACLE_CENTER,
+    center_label,
     evaluate,
     fit_compensator,
     load_compensator,
     save_compensator,
 )
+from ..compensation._centring import DEFAULT_TARE_SECONDS, DEFAULT_TRACK_SECONDS
+from ..compensation._compensator import POSITION_MARGIN, SENSOR_MARGIN
+from ..compensation._evaluate import use_flags
 from ..io import check_output_path, read_recording, write_json, write_recording
 from ..models import FAMILIES, get_family
 from ..sensors import simulate_experiment
@@ -22,7 +28,11 @@ from ..signals import EXPERIMENTS
 from ._common import UsageError, positive_int, slope_cap
 from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_from_args
 
-__all__ = ["register"]
+__all__ = ["GUARD_EXIT", "register"]
+
+# Exit code of a fit that ran but failed its guards (collapsed, worse than the line, on bounds,
+# not converged); 2 is kept for errors that stop a command.
+GUARD_EXIT = 3
 
 
 def _simulate_sensor(args: argparse.Namespace) -> int:
@@ -42,60 +52,113 @@ def _fit(args: argparse.Namespace) -> int:
     options = {} if args.slope_cap is None else {"slope_cap": args.slope_cap}
     if options and args.model != "mpl":
         raise UsageError(f"--slope-cap applies to the mpl model only, not {args.model!r}")
-    rec = read_recording(args.data)
+    recs = [read_recording(path) for path in args.data]
     size = family.default_size if args.cells is None else args.cells
     print(f"fitting {args.model} ({family.size_help}: {size}, {args.mode} mode, centring: "
-          f"{args.center}) on {args.data}: {rec.n_samples} samples at {rec.fs:g} Hz ...",
-          flush=True)
-    comp = fit_compensator(rec, size, model=args.model, mode=args.mode, center=args.center,
+          f"{center_label(args.center)}) on {', '.join(map(str, args.data))}: "
+          f"{sum(r.n_samples for r in recs)} samples at {recs[0].fs:g} Hz ...", flush=True)
+    comp = fit_compensator(recs, size, model=args.model, mode=args.mode, center=args.center,
+                           tare_seconds=args.tare_seconds, track_seconds=args.track_seconds,
                            **options)
     save_compensator(comp, args.out, force=args.force)
     info = comp.fit_info
-    print(f"done in {info['fit_seconds']:.2f} s: SSE {info['cost']:.4g} (normalised), "
-          f"{'converged' if info['converged'] else 'NOT converged'} ({info['message']})")
+    print(f"done in {info['fit_seconds']:.2f} s: SSE {info['cost']:.4g} (normalised), solver: "
+          f"{info['message']}")
     print(f"  parameters: {comp.params.to_dict()}")
+    _print_standard_errors(info.get("standard_errors"))
+    print(f"  training R² {info['training_r2']:.4f}, straight line {info['training_linear_r2']:.4f}"
+          f"; AIC {info['aic']:.1f}, BIC {info['bic']:.1f}; sensor polarity {comp.polarity:+g}")
+    if info.get("joint_fit"):
+        print(f"  {info['joint_fit']}")
     print(f"wrote {args.out}")
+    if info["status"] != "ok":
+        print(f"hystkit: fit {info['status'].replace('_', ' ')}: {info['status_message']}; the "
+              f"model was written for inspection, do not use it as a compensator",
+              file=sys.stderr)
+        return GUARD_EXIT
+    print(f"  status: ok ({info['status_message']})")
     return 0
+
+
+def _print_standard_errors(se: dict | None) -> None:
+    if not se:
+        return
+    rel = [r for r in se["relative"] if r is not None]
+    n_blind = sum(r is None for r in se["standard_errors"])
+    worst = f"largest relative SE {max(rel):.3g}" if rel else "no finite SE"
+    print(f"  standard errors (Gauss-Newton, finite-difference Jacobian): {worst}"
+          f"{f'; {n_blind} parameter(s) not determined by the data' if n_blind else ''}")
 
 
 def _compensate(args: argparse.Namespace) -> int:
     check_output_path(args.out, args.force)
     comp = load_compensator(args.model)
+    _warn_if_oracle(comp.center, args.model)
     rec = read_recording(args.data, need_position=False)
-    estimate = comp.estimate(rec)
-    write_recording(rec, args.out, extra={"position_estimate": estimate}, force=args.force)
+    estimate = comp.estimate(rec, rest_position=args.rest_position)
+    flags = use_flags(comp, rec, estimate)
+    extra = {"position_estimate": estimate}
+    extra.update({name: mask.astype(int) for name, mask in flags.items() if mask is not None})
+    write_recording(rec, args.out, extra=extra, force=args.force)
     print(f"wrote {args.out}: {rec.n_samples} samples with column 'position_estimate' [mm] "
-          f"(centring: {comp.center})")
-    _warn_if_extrapolating(comp.extrapolated_fraction(rec), args.data)
+          f"(centring: {center_label(comp.center)}) and the flag columns "
+          f"{', '.join(n for n, m in flags.items() if m is not None) or '(none: old model file)'}")
+    _warn_if_outside(flags, args.data)
     return 0
 
 
-def _warn_if_extrapolating(fraction: float | None, data: Path) -> None:
-    """Say so when the compensator runs outside the sensor range it was trained on."""
-    if fraction:
-        print(f"hystkit: warning: {data}: {100 * fraction:.1f} % of the samples lie outside the "
-              f"sensor range the compensator was trained on; its estimate there is an "
+def _warn_if_oracle(center: str, path: Path) -> None:
+    if center == ORACLE_CENTER:
+        print(f"hystkit: warning: {path} was fitted with centring 'recording' (the paper's "
+              f"protocol): it removes each recording's own sensor mean, which needs the whole "
+              f"recording; refit with --center fit, tare or track for a causal compensator",
+              file=sys.stderr)
+
+
+def _warn_if_outside(flags: dict, data: Path) -> None:
+    """Say so when the compensator runs outside what it was trained on."""
+    mask = flags["sensor_outside"]
+    if mask is not None and mask.any():
+        print(f"hystkit: warning: {data}: {int(mask.sum())} sample(s) "
+              f"({100 * mask.mean():.1f} %) lie outside the sensor range the compensator was "
+              f"trained on (+{100 * SENSOR_MARGIN:g} % margin); its estimate there is an "
               f"extrapolation", file=sys.stderr)
+    mask = flags["estimate_outside"]
+    if mask is not None and mask.any():
+        print(f"hystkit: warning: {data}: {int(mask.sum())} estimate(s) "
+              f"({100 * mask.mean():.1f} %) lie outside the training position range "
+              f"(+{100 * POSITION_MARGIN:g} % margin)", file=sys.stderr)
 
 
 def _evaluate(args: argparse.Namespace) -> int:
     if args.json is not None:
         check_output_path(args.json, args.force)
     comp = load_compensator(args.model)
-    scores = evaluate(comp, read_recording(args.data))
-    _warn_if_extrapolating(scores["extrapolated_fraction"], args.data)
-    print(f"{args.data} with {args.model} (centring: {scores['center']}, "
-          f"{scores['n_samples']} samples)")
-    print(f"{'':<22}{comp.model:>10}{'straight line':>15}")
+    _warn_if_oracle(comp.center, args.model)
+    rec = read_recording(args.data)
+    scores = evaluate(comp, rec, rest_position=args.rest_position)
+    _warn_if_outside(use_flags(comp, rec, comp.estimate(rec, rest_position=args.rest_position)),
+                     args.data)
+    print(f"{args.data} with {args.model} ({scores['n_samples']} samples); deployable centring: "
+          f"{scores['center']}, oracle: {scores['center_oracle']}")
+    print(f"{'':<20}{comp.model:>12}{'line':>10}{comp.model + ' oracle':>16}{'line oracle':>13}")
     for key, label in (("r2", "R²"), ("e_rms_pct", "e_rms %"), ("e_max_pct", "e_max %"),
                        ("sinad_db", "SINAD dB"), ("loop_area", "loop area %")):
-        a, b = scores[key], scores[f"linear_{key}"]
-        print(f"{label:<22}{_fmt(a):>10}{_fmt(b):>15}")
-    print(f"{'sensor loop area %':<22}{_fmt(scores['sensor_loop_area']):>10}")
+        values = (scores[key], scores[f"linear_{key}"], scores[f"{key}_oracle"],
+                  scores[f"linear_{key}_oracle"])
+        print(f"{label:<20}" + "".join(f"{_fmt(v):>{w}}" for v, w in zip(values,
+                                                                        (12, 10, 16, 13))))
+    print(f"{'sensor loop area %':<20}{_fmt(scores['sensor_loop_area']):>12}")
+    print(f"outside training: {_count(scores['n_sensor_outside'])} sensor samples, "
+          f"{_count(scores['n_estimate_outside'])} estimates")
     if args.json is not None:
         write_json(scores, args.json, force=args.force)
         print(f"wrote {args.json}")
     return 0
+
+
+def _count(n: int | None) -> str:
+    return "unknown (old model file)" if n is None else str(n)
 
 
 def _fmt(x: float | None) -> str:
@@ -108,7 +171,8 @@ def _demo(args: argparse.Namespace) -> int:
 
     out = args.out or Path(f"hystkit-demo-{time.strftime('%Y%m%d-%H%M%S')}")
     print(f"hystkit demo: virtual sensor, four experiments, {args.cells}-cell mPL compensator "
-          f"fitted on one recording and scored on another (direct mode, centring: recording)")
+          f"fitted on one recording and scored on another (direct mode, deployable centring: "
+          f"{DEFAULT_CENTER}; the paper's oracle centring beside it)")
     t0 = time.perf_counter()
     result = run_demo(out, n_cells=args.cells, force=args.force, raw=args.raw)
     print()
@@ -140,6 +204,34 @@ def _print_raw_path(raw: dict) -> None:
           f"encoder transitions")
 
 
+def positive_float(text: str) -> float:
+    value = float(text)
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text}")
+    return value
+
+
+def _add_centring_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--center", choices=CENTERS, default=DEFAULT_CENTER,
+                   help="sensor offset: fit = the training offsets (default); tare = the level "
+                        "of the first --tare-seconds of each recording, device at rest; track = "
+                        "a causal low-pass drift tracker (time constant --track-seconds); "
+                        "recording = ORACLE, the paper's protocol (whole-recording mean, not "
+                        "causal); none")
+    p.add_argument("--tare-seconds", type=positive_float, default=DEFAULT_TARE_SECONDS,
+                   help=f"tare window at the start of each recording [s] (default "
+                        f"{DEFAULT_TARE_SECONDS:g})")
+    p.add_argument("--track-seconds", type=positive_float, default=DEFAULT_TRACK_SECONDS,
+                   help=f"drift-tracker time constant [s] (default {DEFAULT_TRACK_SECONDS:g}); "
+                        f"slower sensor content than ~1/(2 pi T) is taken for drift")
+
+
+def _add_rest_position(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--rest-position", type=float, default=None,
+                   help="tare centring: position [mm] during the tare window (default: where "
+                        "the device rested in training)")
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add this module's subcommands to the ``hystkit`` parser."""
     p = sub.add_parser("simulate-sensor", help="record an experiment on the virtual sensor")
@@ -150,7 +242,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=_simulate_sensor)
 
     p = sub.add_parser("fit", help="fit a compensator to a recording")
-    p.add_argument("data", type=Path, help="recording: time, position, sensor (CSV/Parquet/.mat)")
+    p.add_argument("data", type=Path, nargs="+",
+                   help="recording(s): time, position, sensor (CSV/Parquet/.mat); several are "
+                        "fitted jointly, each with its own initial state and tare")
     p.add_argument("--model", choices=sorted(FAMILIES), default="mpl",
                    help="; ".join(f"{f.name}: {f.title}" for f in FAMILIES.values()))
     p.add_argument("--cells", "--size", type=positive_int, default=None,
@@ -160,18 +254,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mode", choices=MODES, default="direct",
                    help="direct: fit sensor->position (paper 9.2); inverse: fit "
                         "position->sensor and invert it (paper 9.1)")
-    p.add_argument("--center", choices=CENTERS, default="recording",
-                   help="whose mean is removed: each recording's own (hides drift), the "
-                        "fitting recording's, or none")
+    _add_centring_options(p)
     p.add_argument("--slope-cap", type=slope_cap, default=None,
                    help="mpl only: Euler stability cap f'·dt of the cell resistors, in (0, 2) "
                         "(default 1)")
     p.add_argument("--out", type=Path, required=True, help="model JSON file to write")
     p.set_defaults(run=_fit)
 
-    p = sub.add_parser("compensate", help="add a position_estimate column to a recording")
+    p = sub.add_parser("compensate", help="add a position_estimate column (and flags) to a "
+                                          "recording")
     p.add_argument("model", type=Path)
     p.add_argument("data", type=Path)
+    _add_rest_position(p)
     p.add_argument("--out", type=Path, required=True)
     p.set_defaults(run=_compensate)
 
@@ -179,6 +273,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("model", type=Path)
     p.add_argument("data", type=Path)
     p.add_argument("--json", type=Path, help="also write the scores to this JSON file")
+    _add_rest_position(p)
     p.set_defaults(run=_evaluate)
 
     p = sub.add_parser("demo", help="the main job on the built-in virtual sensor")

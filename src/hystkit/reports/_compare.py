@@ -22,30 +22,49 @@ from ._properties import measure_properties
 __all__ = ["compare_models", "format_compare", "generalization_matrix", "plot_generalization"]
 
 
+# What a failing family can raise: our own errors, and the numerical ones of a fit gone
+# degenerate (e.g. a collapsed model whose properties cannot be measured).
+FAMILY_FAILURES = (HystkitError, ValueError, ArithmeticError, np.linalg.LinAlgError)
+
+
 def _forward_scores(name: str, size: int | None, fit_rec: Recording,
                     val_rec: Recording) -> dict:
-    """Fit position -> sensor; score the forward prediction and the inverse on validation."""
+    """Fit position -> sensor; score the forward prediction and the inverse on validation.
+
+    The inverse is scored twice: deployable (the fitting recording's offsets) and oracle (the
+    validation recording's own means, the paper's protocol).
+    """
     family = get_family(name)
-    scaling, s_fit, p_fit = _centre_and_scale(fit_rec, "recording")
+    scaling, s_fit, p_fit = _centre_and_scale(fit_rec, "fit")
     structure = family.make_structure(fit_rec.dt, structure_size(family, size))
     result = family.fit(p_fit, s_fit, structure)
-    # validation data through the same conventions: own mean removed, fit recording's scales
-    s_val = (val_rec.sensor - val_rec.sensor.mean()) / scaling.sensor_scale
-    p_val = (val_rec.position - val_rec.position.mean()) / scaling.position_scale
-    s_hat, _ = family.simulate(structure, result.params, p_val)
+    offsets = {"": (scaling.sensor_offset, scaling.position_offset),
+               "_oracle": (val_rec.sensor.mean(), val_rec.position.mean())}
     out = {"size": structure_size(family, size), "size_help": family.size_help,
-           "n_params": _count_numbers(result.params.to_dict()), "fit_seconds": result.seconds, "converged": result.converged,
-           "r2_forward": r2(s_val, s_hat), "e_rms_pct": e_rms_pct(s_val, s_hat, scale=1.0),
-           "e_max_pct": e_max_pct(s_val, s_hat, scale=1.0)}
-    if family.invert is None:
-        out["r2_compensated"], out["compensated_note"] = None, family.no_inverse_reason
-    else:
+           "n_params": _count_numbers(result.params.to_dict()), "fit_seconds": result.seconds,
+           "converged": result.converged, "compensated_note": ""}
+    for suffix, (s_off, p_off) in offsets.items():
+        s_val = (val_rec.sensor - s_off) / scaling.sensor_scale
+        p_val = (val_rec.position - p_off) / scaling.position_scale
+        s_hat, _ = family.simulate(structure, result.params, p_val)
+        out[f"r2_forward{suffix}"] = r2(s_val, s_hat)
+        if suffix == "":
+            out["e_rms_pct"] = e_rms_pct(s_val, s_hat, scale=1.0)
+            out["e_max_pct"] = e_max_pct(s_val, s_hat, scale=1.0)
+        out[f"r2_compensated{suffix}"] = None
+        if family.invert is None:
+            out["compensated_note"] = family.no_inverse_reason
+            continue
         try:
             p_hat, _ = family.invert(structure, result.params, s_val)
-            out["r2_compensated"], out["compensated_note"] = r2(p_val, p_hat), ""
+            out[f"r2_compensated{suffix}"] = r2(p_val, p_hat)
         except HystkitError as exc:
-            out["r2_compensated"], out["compensated_note"] = None, f"inverse failed: {exc}"
-    out.update(measure_properties(family, structure, result.params))
+            out["compensated_note"] = f"inverse failed: {exc}"
+    try:
+        out.update(measure_properties(family, structure, result.params))
+    except FAMILY_FAILURES as exc:
+        out.update(rate_dependent=None, return_point_memory=None, minor_loops_close=None,
+                   properties_note=f"not measurable: {exc}")
     return out
 
 
@@ -72,8 +91,10 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
     dict
         ``{model: {n_params, fit_seconds, r2_forward, r2_compensated (None if no inverse, with
         compensated_note), r2_direct (a compensator fitted sensor -> position), linear_r2,
+        the same four with an ``_oracle`` suffix (paper's protocol), center, direct_status,
         e_rms_pct, e_max_pct (forward, % of the normalised range), rate_dependent,
-        return_point_memory, minor_loops_close, ...}}``; a model whose fit fails has ``error``.
+        return_point_memory, minor_loops_close, ...}}``; a model whose fit fails has ``error``
+        (the others are still scored).
     """
     models = sorted(FAMILIES) if models is None else list(models)
     table = {}
@@ -82,46 +103,55 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
         progress(f"  {name}: fitting ...")
         try:
             entry = _forward_scores(name, size, fit_rec, val_rec)
-            direct = evaluate(fit_compensator(fit_rec, size, model=name), val_rec)
-            entry["r2_direct"], entry["linear_r2"] = direct["r2"], direct["linear_r2"]
-        except HystkitError as exc:
-            entry = {"error": str(exc)}
+            comp = fit_compensator(fit_rec, size, model=name, diagnose=False)
+            direct = evaluate(comp, val_rec)
+            entry["center"], entry["direct_status"] = direct["center"], comp.fit_info["status"]
+            for suffix in ("", "_oracle"):
+                entry[f"r2_direct{suffix}"] = direct[f"r2{suffix}"]
+                entry[f"linear_r2{suffix}"] = direct[f"linear_r2{suffix}"]
+        except FAMILY_FAILURES as exc:
+            entry = {"error": f"{type(exc).__name__}: {exc}"}
         table[name] = entry
     return table
 
 
-def generalization_matrix(recordings: Mapping[str, tuple[Recording, Recording]],
+def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Recording],
                           models: Sequence[str], sizes: Mapping[str, int] | None = None,
                           progress: Callable[[str], None] = lambda _: None) -> dict:
-    """Train a direct compensator on each excitation, test it on every excitation.
+    """Train a direct compensator on each training recording, test it on every test recording.
 
     Returns
     -------
     dict
-        ``{model: {"r2": {train: {test: r2}}, "linear_r2": {train: {test: r2}}}}`` where a
-        failed fit or run gives None.
+        ``{model: {"r2", "r2_oracle", "linear_r2": {train: {test: value}}, "errors": {train:
+        reason}}}``: deployable and oracle R²; a failed fit or run gives None and its reason.
     """
     out = {}
     for name in models:
         size = (sizes or {}).get(name)
-        r2_model, r2_line = {}, {}
-        for train, (fit_rec, _) in recordings.items():
-            progress(f"  {name}: trained on {train}")
+        grids = {key: {} for key in ("r2", "r2_oracle", "linear_r2")}
+        errors = {}
+        for train_name, fit_rec in train.items():
+            progress(f"  {name}: trained on {train_name}")
+            for grid in grids.values():
+                grid[train_name] = dict.fromkeys(test)
             try:
-                comp = fit_compensator(fit_rec, size, model=name)
-            except HystkitError:
-                r2_model[train] = dict.fromkeys(recordings)
-                r2_line[train] = dict.fromkeys(recordings)
+                comp = fit_compensator(fit_rec, size, model=name, diagnose=False)
+            except FAMILY_FAILURES as exc:
+                errors[train_name] = f"fit: {exc}"
                 continue
-            r2_model[train], r2_line[train] = {}, {}
-            for test, (_, val_rec) in recordings.items():
+            if comp.fit_info["status"] != "ok":
+                errors[train_name] = f"fit {comp.fit_info['status']}: " \
+                                     f"{comp.fit_info['status_message']}"
+            for test_name, val_rec in test.items():
                 try:
                     scores = evaluate(comp, val_rec)
-                    r2_model[train][test], r2_line[train][test] = scores["r2"], \
-                        scores["linear_r2"]
-                except HystkitError:
-                    r2_model[train][test] = r2_line[train][test] = None
-        out[name] = {"r2": r2_model, "linear_r2": r2_line}
+                except FAMILY_FAILURES as exc:
+                    errors[f"{train_name} -> {test_name}"] = str(exc)
+                    continue
+                for key, grid in grids.items():
+                    grid[train_name][test_name] = scores[key]
+        out[name] = {**grids, "errors": errors}
     return out
 
 
@@ -135,17 +165,19 @@ def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
         ax.set_axis_off()
     for ax, (name, entry) in zip(axes, matrix.items()):
         grid = entry["r2"]
-        names = list(grid)
+        rows = list(grid)
+        names = list(next(iter(grid.values()))) if grid else []
         values = np.array([[np.nan if grid[a][b] is None else grid[a][b] for b in names]
-                           for a in names])
+                           for a in rows])
         image = ax.imshow(values, vmin=0.9, vmax=1.0, cmap="viridis")
-        for i in range(len(names)):
+        for i in range(len(rows)):
             for j in range(len(names)):
                 text = "fail" if np.isnan(values[i, j]) else f"{values[i, j]:.3f}"
                 ax.text(j, i, text, ha="center", va="center", fontsize="small",
                         color="w" if np.isnan(values[i, j]) or values[i, j] < 0.96 else "k")
-        ax.set(xticks=range(len(names)), xticklabels=names, yticks=range(len(names)),
-               yticklabels=names, xlabel="tested on", ylabel="trained on", title=name)
+        ax.set(xticks=range(len(names)), xticklabels=names, yticks=range(len(rows)),
+               yticklabels=rows, xlabel="tested on", ylabel="trained on",
+               title=f"{name} (deployable R²)")
     fig.colorbar(image, ax=list(axes[:len(matrix)]), shrink=0.8, label="R² (clipped at 0.9)")
     return fig
 
@@ -159,20 +191,23 @@ def _yes_no(flag: bool | None) -> str:
 
 
 def format_compare(table: Mapping[str, dict]) -> str:
-    """Plain-text table of :func:`compare_models`' result."""
-    head = (f"{'model':<10}{'params':>7}{'fit s':>8}{'R² fwd':>8}{'R² inv':>8}{'R² dir':>8}"
-            f"{'line':>8}{'e_rms%':>8}{'e_max%':>8}  rate-dep  ret.point  minor")
+    """Plain-text table of :func:`compare_models`' result: deployable, then oracle scores."""
+    head = (f"{'model':<10}{'params':>7}{'fit s':>7}{'R² fwd':>8}{'R² inv':>8}{'R² dir':>8}"
+            f"{'line':>8} | oracle:{'R² inv':>8}{'R² dir':>8}{'line':>8}{'e_rms%':>8}"
+            f"  rate-dep  ret.point  minor  direct fit")
     lines = [head]
     for name, m in table.items():
         if "error" in m:
-            lines.append(f"{name:<10}  failed: {m['error']}")
+            lines.append(f"{name:<10}  FAILED: {m['error']}")
             continue
         lines.append(
-            f"{name:<10}{_fmt(m['n_params'], 'd'):>7}{m['fit_seconds']:>8.2f}"
+            f"{name:<10}{_fmt(m['n_params'], 'd'):>7}{m['fit_seconds']:>7.2f}"
             f"{_fmt(m['r2_forward']):>8}{_fmt(m['r2_compensated']):>8}{_fmt(m['r2_direct']):>8}"
-            f"{_fmt(m['linear_r2']):>8}{m['e_rms_pct']:>8.2f}{m['e_max_pct']:>8.2f}"
+            f"{_fmt(m['linear_r2']):>8} |        {_fmt(m['r2_compensated_oracle']):>8}"
+            f"{_fmt(m['r2_direct_oracle']):>8}{_fmt(m['linear_r2_oracle']):>8}"
+            f"{m['e_rms_pct']:>8.2f}"
             f"  {_yes_no(m['rate_dependent']):>8}  {_yes_no(m['return_point_memory']):>9}"
-            f"  {_yes_no(m['minor_loops_close']):>5}")
+            f"  {_yes_no(m['minor_loops_close']):>5}  {m['direct_status']}")
     notes = [f"  {name}: no R² inv: {m['compensated_note']}" for name, m in table.items()
              if "error" not in m and m["r2_compensated"] is None]
     return "\n".join(lines + (["why some R² inv are missing:"] + notes if notes else []))
