@@ -17,7 +17,6 @@ from hystkit.compensation import (
 from hystkit.errors import FitDivergedError
 from hystkit.models import FAMILIES
 from hystkit.models import mpl_poly as mp
-from hystkit.models._linearise import stability_report
 from hystkit.models.mpl_poly import (
     PAPER_9_2_TABLE_II,
     canonical,
@@ -389,7 +388,7 @@ def test_paper_9_2_claim_on_the_virtual_chirp(virtual):
     limited = fit_compensator(fit_rec, model="mpl-poly")
     unlimited = fit_compensator(fit_rec, model="mpl-poly", limit=False)
     s_fit = (fit_rec.sensor - fit_rec.sensor.mean()) / limited.scaling.sensor_scale
-    report = stability_report(limited.structure, limited.params, s_fit)
+    report = mp.FAMILY.stability_details(limited.structure, limited.params, s_fit)
     assert report["trajectory"]["slope_dt_max"][0] < 0.7 < limited.structure.slope_cap
     assert unlimited.params == limited.params  # the limit never acted during the fit
     scores = evaluate(limited, val_rec)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._cells import Cells, cell_report
 from .._protocol import Block, Family
 from . import kernels
 from . import model as mpl_poly
@@ -107,3 +108,19 @@ class MplPolyFamily(Family):
             return (np.diag(1.0 - g) - np.outer(g, w) / w0, g / (w0 * dg), -w / w0,
                     float(1.0 / (w0 * dg)))
         return np.diag(1.0 - g), g, dg * w, float(dg * w0)
+
+    def cells(self, structure, params) -> Cells:
+        """The model as the eq. 5.18-5.28 analysis sees it (cubic output ``g``)."""
+        return Cells(current=lambda v: mpl_poly.resistor_current(structure, params, v),
+                     slope=lambda v: mpl_poly.resistor_slope(structure, params, v),
+                     output=lambda z: mpl_poly.output_current(params, z),
+                     output_slope=lambda z: mpl_poly.output_slope(params, z), w=params.w,
+                     v_b=params.v_b, dt=structure.dt,
+                     knees=mpl_poly.knee_points(structure, params),
+                     rest_points=mpl_poly.equilibria(structure, params),
+                     start=lambda e0: mpl_poly.rest_state(structure, params, e0),
+                     check=lambda u: mpl_poly.simulate(structure, params, u))
+
+    def stability_details(self, structure, params, u):
+        """eq. 5.28 per cell at every rest point and along a run on ``u`` (``_cells``)."""
+        return cell_report(self.cells(structure, params), u)
