@@ -173,12 +173,18 @@ def test_cli_prints_and_writes_the_analysis(model_files, model, tmp_path, capsys
     out = tmp_path / "stability.json"
     code, stdout, stderr = _run(capsys, "stability", model_files[model], "--json", out)
     assert code == 0, stderr
-    assert f": {model}, 1 cell(s)" in stdout
+    assert f": {model} (" in stdout and "1 state(s)" in stdout
     assert "knees x- = " in stdout and "augmented constant state has eigenvalue 1" in stdout
     assert "0 < f'·dt < 2 everywhere (eq. 5.28): yes" in stdout
+    assert "eigenvalues of A: stable" in stdout
     report = json.loads(out.read_text())
     assert report["model"] == model and report["stable_everywhere"] is True
-    assert len(report["knees"]) == 1 and report["trajectory"]["n_samples"] == 4000
+    details = report["details"]
+    assert details["stable_everywhere"] is True
+    assert len(details["knees"]) == 1 and details["trajectory"]["n_samples"] == 4000
+    # one cell: the generic eigenvalue scan and eq. 5.26 agree on the largest |1 - f' dt|
+    assert report["radius_max"] == pytest.approx(
+        max(abs(details["eigenvalue_min"]), abs(details["eigenvalue_max"])), rel=1e-6)
 
 
 def test_cli_uses_a_recording_as_the_probe(model_files, capsys):

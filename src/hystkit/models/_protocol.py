@@ -84,6 +84,14 @@ def _jsonable(value: Any) -> Any:
     return value
 
 
+def _count_numbers(value: Any) -> int:
+    if isinstance(value, dict):
+        return sum(_count_numbers(v) for v in value.values())
+    if isinstance(value, list | tuple):
+        return sum(_count_numbers(v) for v in value)
+    return int(isinstance(value, int | float) and not isinstance(value, bool))
+
+
 def _same(a: Any, b: Any) -> bool:
     if isinstance(a, np.ndarray | list | tuple) or isinstance(b, np.ndarray | list | tuple):
         a, b = np.asarray(a), np.asarray(b)
@@ -181,8 +189,9 @@ class Family(ABC):
         return {}
 
     def n_params(self, structure: Any, params: Any) -> int:
-        """Number of fitted numbers (for information criteria)."""
-        return int(sum(np.size(v) for v in params.to_dict().values()))
+        """Number of fitted numbers (for information criteria): every number in
+        ``params.to_dict()``, nested lists included. Override when some are fixed."""
+        return _count_numbers(params.to_dict())
 
     # -- running ----------------------------------------------------------------------------
 

@@ -39,7 +39,7 @@ from hystkit.errors import InputError
 from hystkit.io import Recording, read_recording
 
 MM = "piezo_micromanipulator"
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "piezo_micromanipulator.py"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "piezo_micromanipulator.py"
 
 
 # --------------------------------------------------------------------------- helpers
