@@ -75,6 +75,11 @@ class SensorBlock:
     name : str
     info : dict
         Provenance: training source, fit cost and R^2 (free-form, JSON-safe).
+    model_family : Family, optional
+        The family to run ``structure`` with; default the registered family whose
+        ``Structure`` it is. A model that is not a fittable family (e.g. the virtual sensor's
+        physics, :mod:`hystkit.sensors`) passes an object with the protocol's running methods
+        (``rest_state``, ``step``, ``simulate``, ``at``, ``block``, ``linearise``).
     """
 
     structure: Any
@@ -86,6 +91,7 @@ class SensorBlock:
     out_scale: float = 1.0
     name: str = "model"
     info: dict = field(default_factory=dict)
+    model_family: Any = None
 
     def __post_init__(self) -> None:
         for key in ("in_offset", "in_scale", "out_offset", "out_scale"):
@@ -99,7 +105,7 @@ class SensorBlock:
             if self.inverse:
                 raise ValueError("the ideal linear block has no inverse mode")
             return
-        family = family_of(self.structure)
+        family = self.family
         if not isinstance(self.params, family.Params):
             raise TypeError(f"params of type {type(self.params).__name__} do not belong to "
                              f"the {family.name} family")
@@ -113,7 +119,9 @@ class SensorBlock:
     @property
     def family(self) -> Family | None:
         """The model's family; None for the ideal linear block."""
-        return None if self.structure is None else family_of(self.structure)
+        if self.structure is None:
+            return None
+        return self.model_family if self.model_family is not None else family_of(self.structure)
 
     @property
     def n_state(self) -> int:
