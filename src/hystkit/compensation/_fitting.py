@@ -72,8 +72,8 @@ def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.
 
 
 def _count_params(params: Any) -> int:
-    return int(sum(np.size(v) for v in params.to_dict().values()
-                   if np.asarray(v).dtype.kind in "fi"))
+    """Fitted numbers: the float entries (integers in a params dict are structural)."""
+    return int(flatten_params(params)[0].size)
 
 
 def fit_compensator(recordings: Recording | Sequence[Recording], size: int | None = None, *,

@@ -7,7 +7,7 @@ entries are structural (counts, flags), so they are kept fixed.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numpy as np
@@ -15,24 +15,31 @@ import numpy as np
 __all__ = ["flatten_params", "simulate_segments"]
 
 
+def _floats(tree: Any) -> list[float]:
+    """Float leaves of a nested dict / list tree, depth first (lists may be ragged)."""
+    if isinstance(tree, dict):
+        return [x for v in tree.values() for x in _floats(v)]
+    if isinstance(tree, list | tuple):
+        return [x for v in tree for x in _floats(v)]
+    return [float(tree)] if isinstance(tree, float) else []
+
+
+def _replace_floats(tree: Any, values: Iterator[float]) -> Any:
+    if isinstance(tree, dict):
+        return {k: _replace_floats(v, values) for k, v in tree.items()}
+    if isinstance(tree, list | tuple):
+        return [_replace_floats(v, values) for v in tree]
+    return float(next(values)) if isinstance(tree, float) else tree
+
+
 def flatten_params(params: Any) -> tuple[np.ndarray, Callable[[np.ndarray], Any]]:
     """``(theta, rebuild)``: the float entries of ``params.to_dict()`` and their inverse."""
     d = params.to_dict()
-    keys = [k for k, v in d.items()
-            if np.asarray(v).dtype.kind == "f" and np.asarray(v).size > 0]
-    shapes = [np.shape(d[k]) for k in keys]
-    sizes = [int(np.prod(s)) for s in shapes]
-    theta = np.concatenate([np.ravel(np.asarray(d[k], dtype=float)) for k in keys]) \
-        if keys else np.zeros(0)
+    theta = np.array(_floats(d), dtype=float)
     cls = type(params)
 
     def rebuild(vector: np.ndarray) -> Any:
-        out, start = dict(d), 0
-        for key, shape, size in zip(keys, shapes, sizes, strict=True):
-            values = np.asarray(vector[start:start + size], dtype=float).reshape(shape)
-            out[key] = values.tolist() if shape else float(values)
-            start += size
-        return cls.from_dict(out)
+        return cls.from_dict(_replace_floats(d, iter(np.asarray(vector, dtype=float))))
 
     return theta, rebuild
 

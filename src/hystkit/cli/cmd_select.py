@@ -1,0 +1,92 @@
+"""``hystkit select``: choose family x size x mode by cross-validation on training data."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from ..compensation import CENTERS, DEFAULT_CENTER, save_compensator
+from ..io import check_output_path, read_recording, write_json
+from ._common import UsageError, positive_int
+from .cmd_compare import _models
+from .cmd_core import GUARD_EXIT
+
+__all__ = ["register"]
+
+SELECTION_FILES = ("selection.json", "selection.csv", "selection.png")
+
+
+def _centers(text: str) -> list[str]:
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    unknown = [n for n in names if n not in CENTERS]
+    if unknown or not names:
+        raise UsageError(f"--centers: unknown centring(s) {', '.join(unknown) or '(none)'}; "
+                         f"known: {', '.join(CENTERS)}")
+    return names
+
+
+def _select(args: argparse.Namespace) -> int:
+    import pandas as pd  # only this command needs it and matplotlib
+
+    from ..reports._select import candidates, plot_selection, select_model
+
+    check_output_path(args.out, args.force)
+    report = args.report or args.out.with_name(args.out.stem + "-selection")
+    for name in SELECTION_FILES:
+        check_output_path(report / name, args.force)
+    recs = [read_recording(path) for path in args.data]
+    cands = candidates(_models(args.models), _centers(args.centers))
+    t0 = time.perf_counter()
+    print(f"selecting among {len(cands)} candidates on {', '.join(map(str, args.data))} "
+          f"(deployable held-out R², "
+          f"{'leave-one-recording-out' if len(recs) > 1 else 'blocked time folds'})")
+    result = select_model(recs, cands, jobs=args.jobs, progress=print)
+    rows = result["ranking"]
+    print(f"{'candidate':<32}{'cv R²':>8}{'min':>8}{'oracle':>8}{'line':>8}{'params':>7}"
+          f"{'AIC':>10}{'BIC':>10}  guards")
+    for r in rows:
+        if "error" in r:
+            print(f"{r['candidate']:<32}  FAILED: {r['error']}")
+            continue
+        print(f"{r['candidate']:<32}{r['cv_r2']:>8.4f}{r['cv_r2_min']:>8.4f}"
+              f"{r['cv_r2_oracle']:>8.4f}{r['cv_linear_r2']:>8.4f}{r['n_params']:>7d}"
+              f"{r['aic']:>10.0f}{r['bic']:>10.0f}  {r['guard_failed'] or 'ok'}")
+    report.mkdir(parents=True, exist_ok=True)
+    summary = {"winner": result["winner"], "folds": result["folds"], "ranking": rows,
+               "seconds": time.perf_counter() - t0, "model_file": str(args.out)}
+    write_json(summary, report / "selection.json", force=args.force)
+    pd.DataFrame([{k: v for k, v in r.items() if k != "fold_status"} for r in rows]).to_csv(
+        report / "selection.csv", index=False)
+    plot_selection(rows).savefig(report / "selection.png", dpi=110)
+    print(f"wrote {report / 'selection.json'}, .csv, .png ({summary['seconds']:.1f} s)")
+    if result["winner"] is None:
+        print("hystkit: no candidate passed its guards; no model written", file=sys.stderr)
+        return GUARD_EXIT
+    save_compensator(result["compensator"], args.out, force=args.force)
+    w = result["winner"]
+    print(f"winner: {w['candidate']} (held-out deployable R² {w['cv_r2']:.4f}, oracle "
+          f"{w['cv_r2_oracle']:.4f}, line {w['cv_linear_r2']:.4f}); wrote {args.out}")
+    failed = [r["candidate"] for r in rows if "error" in r]
+    if failed:
+        print(f"hystkit: {len(failed)} candidate(s) failed: {', '.join(failed)}",
+              file=sys.stderr)
+        return GUARD_EXIT
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``select``."""
+    p = sub.add_parser("select", help="choose model family, size and mode by cross-validation "
+                                      "on training recordings")
+    p.add_argument("data", type=Path, nargs="+", help="training recording(s), one rate")
+    p.add_argument("--out", type=Path, required=True, help="model JSON file of the winner")
+    p.add_argument("--report", type=Path,
+                   help="folder for selection.json/.csv/.png (default: OUT's name + -selection)")
+    p.add_argument("--models", help="comma-separated families (default: all)")
+    p.add_argument("--centers", default=DEFAULT_CENTER,
+                   help=f"comma-separated centrings to try (default {DEFAULT_CENTER})")
+    p.add_argument("--jobs", type=positive_int, default=1,
+                   help="worker processes for the candidates (default 1)")
+    p.set_defaults(run=_select)

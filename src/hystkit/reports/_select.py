@@ -1,0 +1,167 @@
+"""``hystkit select``: family x size x mode (x centring) by cross-validation on training data.
+
+Only the training recordings are used: leave-one-recording-out when there are several, blocked
+time folds otherwise (each fold trains on the other blocks as separate recordings, so no state
+crosses a gap). The score is the *deployable* held-out R²; AIC / BIC of the fold fits are shown
+beside it, and a candidate whose fit fails its guards in any fold (collapsed, worse than the
+line) is ranked after every candidate that passes.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..compensation import DEFAULT_CENTER, evaluate, fit_compensator
+from ..io import Recording
+from ..models import FAMILIES, get_family
+from ._compare import FAMILY_FAILURES
+
+__all__ = ["Candidate", "candidates", "folds", "plot_selection", "select_model"]
+
+N_TIME_FOLDS = 3
+# Guard failures that disqualify a candidate; "on_bounds" / "not_converged" are only reported.
+_DISQUALIFYING = ("collapsed", "worse_than_line")
+
+
+@dataclass(frozen=True)
+class Candidate:
+    model: str
+    size: int
+    mode: str
+    center: str
+
+    @property
+    def label(self) -> str:
+        return f"{self.model}:{self.size}:{self.mode}:{self.center}"
+
+
+def candidates(models: Sequence[str] | None = None, centers: Sequence[str] = (DEFAULT_CENTER,),
+               extra_sizes: dict[str, Sequence[int]] | None = None) -> list[Candidate]:
+    """Every family at its default size (and ``extra_sizes``), direct and, where one exists,
+    inverse mode, for each centring."""
+    extra = {"mpl": (1, 3)} if extra_sizes is None else extra_sizes
+    out = []
+    for name in sorted(FAMILIES) if models is None else models:
+        family = get_family(name)
+        sizes = sorted({family.default_size, *extra.get(name, ())})
+        modes = ("direct", "inverse") if family.invert is not None else ("direct",)
+        out += [Candidate(name, size, mode, center) for center in centers for size in sizes
+                for mode in modes]
+    return out
+
+
+def folds(recordings: Sequence[Recording]) -> list[tuple[list[Recording], Recording]]:
+    """(training recordings, held-out recording) pairs; see the module docstring."""
+    if len(recordings) > 1:
+        return [([r for j, r in enumerate(recordings) if j != i], held)
+                for i, held in enumerate(recordings)]
+    rec = recordings[0]
+    edges = np.linspace(0, rec.n_samples, N_TIME_FOLDS + 1).astype(int)
+    blocks = [_block(rec, a, b, k) for k, (a, b) in enumerate(itertools.pairwise(edges))]
+    return [([b for j, b in enumerate(blocks) if j != i], held) for i, held in enumerate(blocks)]
+
+
+def _block(rec: Recording, start: int, stop: int, k: int) -> Recording:
+    return Recording(time=rec.time[start:stop] - rec.time[start], sensor=rec.sensor[start:stop],
+                     position=rec.position[start:stop], source=f"{rec.source}[block {k + 1}]")
+
+
+def _score_candidate(args: tuple[Candidate, list, dict]) -> dict:
+    """Cross-validate one candidate (a top-level function, so worker processes can run it)."""
+    cand, pairs, options = args
+    scores, oracle, line, aic, bic, statuses = [], [], [], [], [], []
+    try:
+        for train, held in pairs:
+            comp = fit_compensator(train, cand.size, model=cand.model, mode=cand.mode,
+                                   center=cand.center, diagnose=False, **options)
+            s = evaluate(comp, held)
+            scores.append(s["r2"])
+            oracle.append(s["r2_oracle"])
+            line.append(s["linear_r2"])
+            aic.append(comp.fit_info["aic"])
+            bic.append(comp.fit_info["bic"])
+            statuses.append(comp.fit_info["status"])
+            n_params = comp.fit_info["n_params"]
+    except FAMILY_FAILURES as exc:
+        return {**_describe(cand), "error": f"{type(exc).__name__}: {exc}"}
+    bad = sorted({st for st in statuses if st in _DISQUALIFYING})
+    return {**_describe(cand), "cv_r2": float(np.mean(scores)), "cv_r2_min": float(min(scores)),
+            "cv_r2_oracle": float(np.mean(oracle)), "cv_linear_r2": float(np.mean(line)),
+            "n_params": n_params, "aic": float(np.mean(aic)), "bic": float(np.mean(bic)),
+            "fold_status": statuses, "guard_failed": ", ".join(bad) or None}
+
+
+def _describe(cand: Candidate) -> dict:
+    return {"candidate": cand.label, "model": cand.model, "size": cand.size, "mode": cand.mode,
+            "center": cand.center}
+
+
+def _rank_key(row: dict) -> tuple:
+    if "error" in row:
+        return (2, 0.0)
+    return (1 if row["guard_failed"] else 0, -row["cv_r2"])
+
+
+def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
+                 jobs: int = 1, progress: Callable[[str], None] = lambda _: None,
+                 **options) -> dict:
+    """Rank candidates by cross-validated deployable R²; refit the winner on all recordings.
+
+    Returns
+    -------
+    dict
+        ``ranking`` (rows of candidate, cv_r2, cv_r2_min, cv_r2_oracle, cv_linear_r2, n_params,
+        aic, bic, fold_status, guard_failed, or error), ``folds`` (descriptions), ``winner``
+        (its row) and ``compensator`` (fitted on all recordings), or ``winner`` None when
+        every candidate failed.
+    """
+    pairs = folds(recordings)
+    work = [(c, pairs, options) for c in cands]
+    progress(f"  {len(cands)} candidates x {len(pairs)} folds"
+             f"{f' on {jobs} processes' if jobs > 1 else ''} ...")
+    if jobs > 1:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            rows = list(pool.map(_score_candidate, work))
+    else:
+        rows = [_score_candidate(w) for w in work]
+    rows.sort(key=_rank_key)
+    out = {"folds": [{"train": [r.source for r in train], "test": held.source}
+                     for train, held in pairs], "ranking": rows, "winner": None,
+           "compensator": None}
+    for row in rows:
+        if "error" in row or row["guard_failed"]:
+            continue
+        try:
+            out["compensator"] = fit_compensator(list(recordings), row["size"],
+                                                 model=row["model"], mode=row["mode"],
+                                                 center=row["center"], **options)
+        except FAMILY_FAILURES as exc:
+            row["error_final"] = str(exc)
+            continue
+        out["winner"] = row
+        break
+    return out
+
+
+def plot_selection(ranking: Sequence[dict]) -> Figure:
+    """Held-out deployable R² per candidate (oracle and straight line as markers)."""
+    rows = [r for r in ranking if "error" not in r]
+    fig = Figure(figsize=(7, 0.3 * len(rows) + 1.5), layout="constrained")
+    ax = fig.subplots()
+    y = np.arange(len(rows))[::-1]
+    clip = lambda v: max(v, -0.5)
+    ax.barh(y, [clip(r["cv_r2"]) for r in rows],
+            color=["tab:gray" if r["guard_failed"] else "tab:blue" for r in rows],
+            label="deployable R² (mean over folds)")
+    ax.plot([clip(r["cv_r2_oracle"]) for r in rows], y, "k|", ms=10, label="oracle R²")
+    ax.plot([clip(r["cv_linear_r2"]) for r in rows], y, "rx", label="straight line")
+    ax.set(yticks=y, yticklabels=[r["candidate"] for r in rows], xlabel="held-out R²",
+           xlim=(min(0.0, *(clip(r["cv_r2"]) for r in rows)) if rows else 0.0, 1.0))
+    ax.legend(loc="lower left", fontsize="small")
+    return fig
