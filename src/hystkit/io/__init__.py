@@ -1,18 +1,18 @@
 """Reading, validating and writing recordings; JSON result files; raw scope recordings."""
 
-from hystkit.io._raw import RAW_COLUMNS, RawChunk, RawFormat, RawReader, RawWriter, open_raw
-from hystkit.io._raw_config import (
+from ._raw import RAW_COLUMNS, RawChunk, RawFormat, RawReader, RawWriter, open_raw
+from ._raw_config import (
     CONFIG_KEYS,
     find_raw_config,
     read_raw_config,
     write_raw_config,
 )
-from hystkit.io._recording import (
-                                  Recording,
-                                  check_output_path,
-                                  read_recording,
-                                  write_json,
-                                  write_recording,
+from ._recording import (
+    Recording,
+    check_output_path,
+    read_recording,
+    write_json,
+    write_recording,
 )
 
 __all__ = ["CONFIG_KEYS", "RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter",

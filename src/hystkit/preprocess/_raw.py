@@ -38,8 +38,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from tqdm import tqdm
 
-from ..io import Recording
-from ..io._raw import RawChunk, RawFormat, RawReader, open_raw
+from ..io import RawChunk, RawFormat, RawReader, Recording, open_raw
 from ._bridge import bridge_kernel, clipped_channels, gauge_symmetry
 from ._decimate import (
     Decimator,
