@@ -28,6 +28,7 @@ from __future__ import annotations
 import dataclasses
 from abc import ABC, abstractmethod
 from collections.abc import Callable
+from types import ModuleType
 from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
@@ -146,11 +147,29 @@ class Family(ABC):
     Params: ClassVar[type]
     no_inverse_reason: ClassVar[str] = ""
 
-    # A family with an inverse overrides both with methods:
+    model: ClassVar[ModuleType | None] = None
+    """The module of the family's pure functions. ``rest_state``, ``step``, ``simulate`` and,
+    for a family with an inverse, ``invert`` / ``invert_step`` default to its functions of the
+    same names and signatures (``rest_state(structure, params, value, inverse)``)."""
+
+    # None when the family has no inverse; otherwise methods
     #   invert(structure, params, y, x0=None) -> (u_hat, x_end)
     #   invert_step(structure, params, x, y) -> (u_hat, x_next)
+    # taken from ``model`` unless the family defines them.
     invert: ClassVar[Callable[..., tuple[np.ndarray, np.ndarray]] | None] = None
     invert_step: ClassVar[Callable[..., tuple[float, np.ndarray]] | None] = None
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        module = cls.__dict__.get("model")
+        if module is None or cls.no_inverse_reason:
+            return
+        if "invert" not in cls.__dict__ and hasattr(module, "invert"):
+            cls.invert = lambda self, structure, params, y, x0=None: module.invert(
+                structure, params, y, x0)
+        if "invert_step" not in cls.__dict__ and hasattr(module, "invert_step"):
+            cls.invert_step = lambda self, structure, params, x, y: module.invert_step(
+                structure, params, x, y)
 
     # Older names, kept so that code written against the first registry keeps working.
     @property
@@ -195,20 +214,26 @@ class Family(ABC):
 
     # -- running ----------------------------------------------------------------------------
 
-    @abstractmethod
     def rest_state(self, structure: Any, params: Any, value: float,
                    inverse: bool = False) -> np.ndarray:
         """State at rest under a constant input ``value`` (forward) or output (``inverse``)."""
+        return self._module("rest_state").rest_state(structure, params, value, inverse)
 
-    @abstractmethod
     def step(self, structure: Any, params: Any, x: np.ndarray,
              u: float) -> tuple[float, np.ndarray]:
         """One sample: output from the present state, then the next state (readable)."""
+        return self._module("step").step(structure, params, x, u)
 
-    @abstractmethod
     def simulate(self, structure: Any, params: Any, u: np.ndarray,
                  x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Run over ``u`` (compiled); ``x0=None`` starts at rest at ``u[0]``."""
+        return self._module("simulate").simulate(structure, params, u, x0)
+
+    def _module(self, what: str) -> ModuleType:
+        if self.model is None:
+            raise NotImplementedError(f"family {self.name!r} defines no {what} and no model "
+                                      f"module to take it from")
+        return self.model
 
     # -- identification ---------------------------------------------------------------------
 

@@ -21,6 +21,7 @@ class MplFamily(Family):
     docs = "docs/models/mpl.md"
     Structure = mpl.MplStructure
     Params = mpl.MplParams
+    model = mpl  # step, simulate, invert, invert_step
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> mpl.MplStructure:
         return mpl.MplStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
@@ -32,18 +33,6 @@ class MplFamily(Family):
             w_sum = float(np.sum(params.w))
             value = (value + params.v_b) / w_sum if w_sum != 0 else 0.0
         return np.full(structure.n_cells, float(value))
-
-    def step(self, structure, params, x, u):
-        return mpl.step(structure, params, x, u)
-
-    def simulate(self, structure, params, u, x0=None):
-        return mpl.simulate(structure, params, u, x0)
-
-    def invert(self, structure, params, y, x0=None):
-        return mpl.invert(structure, params, y, x0)
-
-    def invert_step(self, structure, params, x, y):
-        return mpl.invert_step(structure, params, x, y)
 
     def fit(self, u, y, structure, *, accept=None,
             accept_reason="rejected by the acceptance test", **options):
