@@ -102,7 +102,9 @@ def _generalize(args: argparse.Namespace) -> int:
                 print(f"{train_name[:11]:<12}" + "".join(
                     f"{'fail' if v is None else f'{v:.4f}':>12}" for v in row.values()))
         for where_, reason in entry["errors"].items():
-            print(f"  {name} {where_}: {reason}")
+            print(f"  {name} {where_}: FAILED: {reason}")
+        for where_, reason in entry["notes"].items():
+            print(f"  {name} {where_}: note: {reason}")
         if entry["errors"]:
             failed.append(name)
     write_json(matrix, out / "generalize.json", force=args.force)

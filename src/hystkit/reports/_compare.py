@@ -25,6 +25,8 @@ __all__ = ["compare_models", "format_compare", "generalization_matrix", "plot_ge
 # What a failing family can raise: our own errors, and the numerical ones of a fit gone
 # degenerate (e.g. a collapsed model whose properties cannot be measured).
 FAMILY_FAILURES = (HystkitError, ValueError, ArithmeticError, np.linalg.LinAlgError)
+# Fit statuses (compensation guards) that make a model unusable, not merely suspicious.
+DISQUALIFYING = ("collapsed", "worse_than_line")
 
 
 def _forward_scores(name: str, size: int | None, fit_rec: Recording,
@@ -124,13 +126,15 @@ def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Rec
     -------
     dict
         ``{model: {"r2", "r2_oracle", "linear_r2": {train: {test: value}}, "errors": {train:
-        reason}}}``: deployable and oracle R²; a failed fit or run gives None and its reason.
+        reason}, "notes": {train: reason}}}``: deployable and oracle R²; a failed fit or run
+        gives None and its reason in ``errors``, as does a collapsed fit or one worse than its
+        line (its scores are kept); parameters on bounds or an exhausted budget are ``notes``.
     """
     out = {}
     for name in models:
         size = (sizes or {}).get(name)
         grids = {key: {} for key in ("r2", "r2_oracle", "linear_r2")}
-        errors = {}
+        errors, notes = {}, {}
         for train_name, fit_rec in train.items():
             progress(f"  {name}: trained on {train_name}")
             for grid in grids.values():
@@ -140,9 +144,11 @@ def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Rec
             except FAMILY_FAILURES as exc:
                 errors[train_name] = f"fit: {exc}"
                 continue
-            if comp.fit_info["status"] != "ok":
-                errors[train_name] = f"fit {comp.fit_info['status']}: " \
-                                     f"{comp.fit_info['status_message']}"
+            status = comp.fit_info["status"]
+            if status != "ok":
+                # collapsed / worse than the line disqualify the row; bounds and budget are notes
+                target = errors if status in DISQUALIFYING else notes
+                target[train_name] = f"fit {status}: {comp.fit_info['status_message']}"
             for test_name, val_rec in test.items():
                 try:
                     scores = evaluate(comp, val_rec)
@@ -151,7 +157,7 @@ def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Rec
                     continue
                 for key, grid in grids.items():
                     grid[train_name][test_name] = scores[key]
-        out[name] = {**grids, "errors": errors}
+        out[name] = {**grids, "errors": errors, "notes": notes}
     return out
 
 

@@ -20,13 +20,11 @@ from matplotlib.figure import Figure
 from ..compensation import DEFAULT_CENTER, evaluate, fit_compensator
 from ..io import Recording
 from ..models import FAMILIES, get_family
-from ._compare import FAMILY_FAILURES
+from ._compare import DISQUALIFYING, FAMILY_FAILURES
 
 __all__ = ["Candidate", "candidates", "folds", "plot_selection", "select_model"]
 
 N_TIME_FOLDS = 3
-# Guard failures that disqualify a candidate; "on_bounds" / "not_converged" are only reported.
-_DISQUALIFYING = ("collapsed", "worse_than_line")
 
 
 @dataclass(frozen=True)
@@ -90,7 +88,7 @@ def _score_candidate(args: tuple[Candidate, list, dict]) -> dict:
             n_params = comp.fit_info["n_params"]
     except FAMILY_FAILURES as exc:
         return {**_describe(cand), "error": f"{type(exc).__name__}: {exc}"}
-    bad = sorted({st for st in statuses if st in _DISQUALIFYING})
+    bad = sorted({st for st in statuses if st in DISQUALIFYING})
     return {**_describe(cand), "cv_r2": float(np.mean(scores)), "cv_r2_min": float(min(scores)),
             "cv_r2_oracle": float(np.mean(oracle)), "cv_linear_r2": float(np.mean(line)),
             "n_params": n_params, "aic": float(np.mean(aic)), "bic": float(np.mean(bic)),
