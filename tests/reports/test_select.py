@@ -8,6 +8,7 @@ import pytest
 from hystkit.cli import main
 from hystkit.compensation import evaluate, fit_compensator, load_compensator
 from hystkit.compensation._param_vector import flatten_params
+from hystkit.io import Recording
 from hystkit.models import FAMILIES
 from hystkit.reports._select import folds
 from hystkit.sensors import simulate_experiment
@@ -63,3 +64,13 @@ def test_select_writes_the_winner_and_its_table(tmp_path, capsys):
     assert main(["select", str(data), "--models", "mpl", "--out", str(out), "--report",
                  str(report)]) == 2  # exists: needs --force
     capsys.readouterr()
+
+
+def test_a_rest_block_trains_but_is_not_scored():
+    rec = simulate_experiment("sine", 1)
+    still = rec.position.copy()
+    still[: rec.n_samples // 3 + 1] = 0.0  # the first block is at rest
+    pairs = folds([Recording(time=rec.time, sensor=rec.sensor, position=still)])
+    assert len(pairs) == 2
+    assert all(np.ptp(held.position) > 0 for _, held in pairs)
+    assert all(len(train) == 2 for train, _ in pairs)
