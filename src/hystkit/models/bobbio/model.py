@@ -34,9 +34,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FitDivergedError
-from . import _circuit_kernels as kernels
-from ._validation import (
+from ...errors import FitDivergedError
+from .._protocol import Record
+from .._validation import (
     check_dt,
     check_positive_int,
     check_signal,
@@ -44,12 +44,15 @@ from ._validation import (
     frozen_array,
     initial_state,
 )
+from . import kernels
 
 __all__ = [
     "BobbioParams",
     "BobbioStructure",
     "forces",
     "invert",
+    "invert_step",
+    "rest_state",
     "simulate",
     "simulate_reference",
     "step",
@@ -57,7 +60,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class BobbioStructure:
+class BobbioStructure(Record):
     """What does not get fitted.
 
     Parameters
@@ -81,7 +84,7 @@ class BobbioStructure:
 
 
 @dataclass(frozen=True, eq=False)
-class BobbioParams:
+class BobbioParams(Record):
     """Spring compliances, piston thresholds and output offset.
 
     Parameters
@@ -117,23 +120,6 @@ class BobbioParams:
         """Play radii ``A_k = a_1 + .. + a_k-1`` of the forces ``F_2 .. F_N``."""
         return np.cumsum(self.friction)
 
-    def to_dict(self) -> dict:
-        return {"compliance": self.compliance.tolist(), "friction": self.friction.tolist(),
-                "offset": self.offset}
-
-    @classmethod
-    def from_dict(cls, d: dict) -> BobbioParams:
-        return cls(compliance=d["compliance"], friction=d["friction"], offset=d["offset"])
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, BobbioParams):
-            return NotImplemented
-        return bool(np.array_equal(self.compliance, other.compliance)
-                    and np.array_equal(self.friction, other.friction)
-                    and self.offset == other.offset)
-
-    __hash__ = None
-
 
 def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
@@ -145,6 +131,30 @@ def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
         prev = x_next[k]
     y = params.compliance[0] * u + params.compliance[1:] @ x_next + params.offset
     return float(y), x_next
+
+
+def invert_step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
+                y: float) -> tuple[float, np.ndarray]:
+    """One sample of :func:`invert`: the force that gives ``y`` from the forces ``x``, and the
+    forces it leaves; NaN (and a NaN state) where no force gives ``y``, as the loop block."""
+    x = np.array(x, dtype=float)
+    x_next = x.copy()
+    f = kernels.invert_sample(x, x_next, 0, float(y), params.compliance, params.friction,
+                              params.offset)
+    return float(f), np.full_like(x, np.nan) if np.isnan(f) else x_next
+
+
+def _rest_force(params: BobbioParams, y: float) -> float:
+    total = params.compliance.sum()
+    return (y - params.offset) / total if total > 0 else 0.0
+
+
+def rest_state(params: BobbioParams, value: float, inverse: bool = False) -> np.ndarray:
+    """Every spring carrying the force ``value`` (``inverse``: the force ``(value - b) / sum(c)``
+    that gives the deformation ``value``), no piston loaded: the start of ``simulate`` /
+    ``invert`` with ``x0=None``."""
+    force = _rest_force(params, value) if inverse else float(value)
+    return np.full(params.n_springs - 1, force)
 
 
 def _check(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
@@ -161,7 +171,7 @@ def forces(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
     """
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_springs - 1, x0, u[0])
-    return kernels.bobbio_forces(u, x, params.friction)
+    return kernels.forces(u, x, params.friction)
 
 
 def simulate(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
@@ -221,10 +231,8 @@ def invert(structure: BobbioStructure, params: BobbioParams, y: np.ndarray,
         If no force gives the output (every compliance zero).
     """
     y = _check(structure, params, y, "y")
-    total = params.compliance.sum()
-    rest = (y[0] - params.offset) / total if total > 0 else 0.0
-    x = initial_state(structure.n_springs - 1, x0, rest)
-    u_hat, x_end, n_bad = kernels.bobbio_invert(y, x, params.compliance, params.friction,
+    x = initial_state(structure.n_springs - 1, x0, _rest_force(params, y[0]))
+    u_hat, x_end, n_bad = kernels.invert(y, x, params.compliance, params.friction,
                                                 params.offset)
     if n_bad >= 0:
         raise FitDivergedError(f"no applied force gives the deformation at sample {n_bad} "

@@ -12,8 +12,8 @@ from scipy.optimize import brentq
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification.family_bobbio import candidate_thresholds, fit_bobbio
-from hystkit.models import bobbio, get_family
+from hystkit.models import bobbio, get_family, numerical_linearisation
+from hystkit.models.bobbio import candidate_thresholds, fit_bobbio
 from hystkit.sensors import simulate_experiment
 
 STRUCT = bobbio.BobbioStructure(n_springs=5)
@@ -227,3 +227,129 @@ def test_compensator_on_the_virtual_sensor():
     # the wrong loop orientation (test above): every hysteretic compliance is zero and the
     # fit is the least-squares line, the same as the baseline up to rounding
     assert direct["r2"] == pytest.approx(direct["linear_r2"], abs=1e-9)
+
+
+# --- the family protocol: loop blocks, rest states, at(dt), records, linearisation ---------
+
+FAMILY = get_family("bobbio")
+# a state the chain reaches (eq. 2.5 holds with F_1 = 0.1), piston 1 off its threshold
+X_MEMORY = bobbio.simulate(STRUCT, PARAMS, _ramps(0.0, 1.5, -0.6, 0.2, 0.1))[1]
+# eq. 2.5 strictly inside for F_1 = 0.1: no piston on its threshold, the step is smooth here
+X_INSIDE = np.array([0.12, 0.05, -0.1, 0.0])
+
+
+def _drive(run, x0, signal, off=None):
+    """Run ``run`` sample by sample: a compiled block (``off`` = its slice's offset inside a
+    larger loop state whose neighbours must stay untouched) or a step function."""
+    x, out, states = np.asarray(x0, float), [], []
+    for v in signal:
+        if off is None:
+            y, x = run(x, v)
+        else:
+            big = np.full(off + x.size + 2, 7.0)
+            big[off:off + x.size] = x
+            xn = big.copy()
+            y = run.step(run.body, big, xn, off, v)
+            assert np.all(xn[:off] == 7.0) and np.all(xn[off + x.size:] == 7.0)
+            x = xn[off:off + x.size]
+        out.append(y)
+        states.append(x)
+    return np.array(out), np.array(states)
+
+
+@pytest.mark.parametrize("inverse", [False, True])
+def test_block_equals_step_from_a_non_rest_state(inverse):
+    rng = np.random.default_rng(4)
+    x0 = X_MEMORY
+    signal = np.cumsum(0.15 * rng.standard_normal(400))
+    if inverse:
+        signal = bobbio.simulate(STRUCT, PARAMS, signal, x0=x0)[0] + 0.01 * rng.standard_normal(400)
+    run = FAMILY.invert_step if inverse else FAMILY.step
+    blk = FAMILY.block(STRUCT, PARAMS, inverse)
+    assert blk.n_state == 4
+    out_blk, x_blk = _drive(blk, x0, signal, off=2)
+    out_ref, x_ref = _drive(lambda x, v: run(STRUCT, PARAMS, x, v), x0, signal)
+    assert np.all(np.isfinite(out_ref))
+    assert_allclose(out_blk, out_ref, rtol=0, atol=1e-12)
+    assert_allclose(x_blk, x_ref, rtol=0, atol=1e-12)
+    assert np.ptp(x_ref[:, -1]) > 0.5  # the last piston slides, memory is exercised
+
+
+def test_inverse_without_any_compliance_is_nan_in_block_and_step():
+    rigid = bobbio.BobbioParams(compliance=np.zeros(3), friction=[0.1, 0.2])
+    s = bobbio.BobbioStructure(n_springs=3)
+    u_blk, x_blk = _drive(FAMILY.block(s, rigid, True), [0.0, 0.0], [0.5], off=1)
+    u_ref, x_ref = _drive(lambda x, v: FAMILY.invert_step(s, rigid, x, v), [0.0, 0.0], [0.5])
+    assert np.isnan(u_blk[0]) and np.isnan(u_ref[0])
+    assert np.all(np.isnan(x_blk)) and np.all(np.isnan(x_ref))
+    with pytest.raises(FitDivergedError):
+        bobbio.invert(s, rigid, np.array([0.0, 0.5]), x0=0.0)
+
+
+@pytest.mark.parametrize("value", [-0.8, 0.0, 0.35])
+def test_rest_state_is_the_start_of_runs_and_a_fixed_point(value):
+    x_fwd = FAMILY.rest_state(STRUCT, PARAMS, value)
+    y, x_next = FAMILY.step(STRUCT, PARAMS, x_fwd, value)
+    assert_array_equal(x_next, x_fwd)
+    assert bobbio.simulate(STRUCT, PARAMS, np.full(3, value))[0] == pytest.approx([y] * 3)
+    x_inv = FAMILY.rest_state(STRUCT, PARAMS, value, inverse=True)
+    u_hat, x_next = FAMILY.invert_step(STRUCT, PARAMS, x_inv, value)
+    assert_allclose(x_next, x_inv, rtol=0, atol=1e-12)
+    assert FAMILY.step(STRUCT, PARAMS, x_inv, u_hat)[0] == pytest.approx(value, abs=1e-12)
+    assert_allclose(bobbio.invert(STRUCT, PARAMS, np.full(3, value))[0], u_hat, atol=1e-12)
+
+
+def test_at_any_dt_is_the_same_rate_independent_model():
+    u = _input(500)
+    y, _ = FAMILY.simulate(STRUCT, PARAMS, u)
+    for dt in (0.001, 0.025, 0.4):
+        other = FAMILY.at(STRUCT, dt)
+        assert other.dt == dt and other.n_springs == STRUCT.n_springs
+        assert_array_equal(FAMILY.simulate(other, PARAMS, u)[0], y)
+
+
+def test_records_round_trip_and_old_model_files_load():
+    import json
+
+    d = PARAMS.to_dict()
+    assert bobbio.BobbioParams.from_dict(json.loads(json.dumps(d))) == PARAMS
+    assert bobbio.BobbioStructure.from_dict(STRUCT.to_dict()) == STRUCT
+    old = {"compliance": [0.5, 0.2, 0.1, 0.3, 0.4], "friction": [0.1, 0.15, 0.2, 0.25],
+           "offset": 0.1}  # as written by hystkit before the move
+    assert d == old and bobbio.BobbioParams.from_dict(old) == PARAMS
+    old_structure = {"n_springs": 5, "dt": 0.025}  # asdict(structure)
+    assert STRUCT.to_dict() == old_structure
+    assert bobbio.BobbioStructure(**old_structure) == STRUCT
+    assert PARAMS != bobbio.BobbioParams.from_dict({**old, "offset": 0.2})
+
+
+def test_analytical_linearisation_matches_numerical():
+    x = X_INSIDE
+    assert_array_equal(FAMILY.step(STRUCT, PARAMS, x, 0.1)[1], x)
+    for u in (0.05, 0.45, -1.2, 0.15):  # sticking, partly sliding, all sliding, sticking
+        exact = FAMILY.linearise(STRUCT, PARAMS, x, u)
+        approx = numerical_linearisation(lambda xx, uu: FAMILY.step(STRUCT, PARAMS, xx, uu),
+                                         x, u, rel_step=1e-7)
+        for e, a in zip(exact, approx):
+            assert_allclose(e, a, rtol=1e-6, atol=1e-8)
+
+
+def test_inverse_linearisation_is_the_derivative_along_the_motion():
+    x = X_INSIDE
+
+    def run(xx, yy):
+        return FAMILY.invert_step(STRUCT, PARAMS, xx, yy)
+
+    y_stick = FAMILY.step(STRUCT, PARAMS, x, 0.05)[0]  # piston 1 holds: interior, smooth
+    y_slide = FAMILY.step(STRUCT, PARAMS, x, 0.45)[0]  # pistons slide, loading upwards
+    for y, one_sided in ((y_stick, False), (y_slide, True)):
+        a, b, c, d = FAMILY.linearise(STRUCT, PARAMS, x, y, inverse=True)
+        h = 1e-7
+        if one_sided:  # a further rise in y continues the motion, from the same state
+            (u1, x1), (u0, x0) = run(x, y + h), run(x, y)
+            assert_allclose(d, (u1 - u0) / h, rtol=1e-5)
+            assert_allclose(b, (x1 - x0) / h, rtol=1e-5, atol=1e-8)
+        else:
+            num = numerical_linearisation(run, x, y)
+            for e, n in zip((a, b, c, d), num):
+                assert_allclose(e, n, rtol=1e-6, atol=1e-8)

@@ -1,4 +1,4 @@
-"""The Bobbio-Marrucci family (sec. 2.1.4, eq. 2.5) in the model registry, and its fit.
+"""Identification of the Bobbio-Marrucci chain (sec. 2.1.4, eq. 2.5).
 
 For fixed piston thresholds the output ``c_1 u + sum_k c_k F_k + b`` is linear in the spring
 compliances and the offset, so the fit is one non-negative least-squares solve (compliances
@@ -15,13 +15,11 @@ from collections.abc import Callable
 import numpy as np
 from scipy.optimize import nnls
 
-from ..errors import FitDivergedError
-from ..models import bobbio
-from ._least_squares import check_fit_data
-from ._registry import ModelFamily
-from ._result import FitResult
+from ...errors import FitDivergedError
+from ...identification import FitResult, check_fit_data
+from . import model as bobbio
 
-__all__ = ["FAMILY", "candidate_thresholds", "fit_bobbio"]
+__all__ = ["candidate_thresholds", "fit_bobbio"]
 
 _RHO = (0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5)
 _SPACING = (1.0, 2.0)  # radius of spring k+1 grows like (k / (N - 1)) ** power
@@ -87,14 +85,3 @@ def fit_bobbio(u: np.ndarray, y: np.ndarray, structure: bobbio.BobbioStructure, 
     raise FitDivergedError(f"the fit failed: all {len(fits)} candidate fits were rejected "
                            f"({accept_reason})")
 
-
-def _make_structure(dt: float, size: int) -> bobbio.BobbioStructure:
-    return bobbio.BobbioStructure(n_springs=size, dt=dt)
-
-
-FAMILY = ModelFamily(
-    name="bobbio", title="Bobbio-Marrucci springs and friction pistons (sec. 2.1.4, eq. 2.5)",
-    structure_type=bobbio.BobbioStructure, params_type=bobbio.BobbioParams,
-    make_structure=_make_structure, simulate=bobbio.simulate, fit=fit_bobbio,
-    invert=bobbio.invert, size_help="springs N, with N - 1 pistons (2N params)",
-    default_size=10)

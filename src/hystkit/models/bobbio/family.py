@@ -1,0 +1,84 @@
+"""The Bobbio-Marrucci family (sec. 2.1.4, eq. 2.5) behind the family protocol."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._protocol import Block, Family
+from . import kernels
+from . import model as bobbio
+from .fit import fit_bobbio
+
+__all__ = ["BobbioFamily"]
+
+
+class BobbioFamily(Family):
+    name = "bobbio"
+    title = "Bobbio-Marrucci springs and friction pistons (sec. 2.1.4, eq. 2.5)"
+    size_help = "springs N, with N - 1 pistons (2N params)"
+    default_size = 10
+    docs = "docs/models/circuits.md"
+    Structure = bobbio.BobbioStructure
+    Params = bobbio.BobbioParams
+
+    def make_structure(self, dt: float, size: int) -> bobbio.BobbioStructure:
+        return bobbio.BobbioStructure(n_springs=size, dt=dt)
+
+    def at(self, structure, dt):
+        """The chain is rate-independent (only the input values matter, not their timing), so
+        the same model runs at any ``dt``; only the recorded ``dt`` changes."""
+        return super().at(structure, dt)
+
+    def rest_state(self, structure, params, value, inverse=False):
+        return bobbio.rest_state(params, value, inverse)
+
+    def step(self, structure, params, x, u):
+        return bobbio.step(structure, params, x, u)
+
+    def simulate(self, structure, params, u, x0=None):
+        return bobbio.simulate(structure, params, u, x0)
+
+    def invert(self, structure, params, y, x0=None):
+        return bobbio.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return bobbio.invert_step(structure, params, x, y)
+
+    def fit(self, u, y, structure, *, accept=None,
+            accept_reason="rejected by the acceptance test", **options):
+        return fit_bobbio(u, y, structure, accept=accept, accept_reason=accept_reason,
+                          **options)
+
+    def block(self, structure, params, inverse=False):
+        body = np.concatenate([[params.n_springs, params.offset], params.compliance,
+                               params.friction])
+        step = kernels.block_inverse if inverse else kernels.block_forward
+        return Block(step, np.ascontiguousarray(body, dtype=np.float64),
+                     structure.n_springs - 1)
+
+    def linearise(self, structure, params, x, u, inverse=False):
+        """A sliding piston passes the force before it on (``dF_k+1 = dF_k``), a sticking one
+        keeps its own (``dF_k+1 = dF_k+1``); ``y = c_1 u + sum c_k F_k + b``. The inverse solves
+        that output for ``u`` at the operating point's force, ``du = (dy - C dx) / D``: the
+        derivative along the motion the chain is making there (where ``D = 0``, a flat
+        segment, the numerical default is used). A piston exactly on its threshold (where
+        sliding stopped) is a kink; it counts as sticking."""
+        x = np.asarray(x, dtype=float)
+        m = x.size
+        u_op = bobbio.invert_step(structure, params, x, u)[0] if inverse else u
+        # rows of d(x+) / d(x, u): column m is the input
+        rows = np.zeros((m, m + 1))
+        prev_row, prev = np.eye(1, m + 1, m)[0], u_op
+        for k in range(m):
+            a = params.friction[k]
+            sliding = x[k] < prev - a or x[k] > prev + a
+            rows[k] = prev_row if sliding else np.eye(1, m + 1, k)[0]
+            prev_row, prev = rows[k], min(max(x[k], prev - a), prev + a)
+        a_mat, b = rows[:, :m], rows[:, m]
+        c = params.compliance[1:] @ a_mat
+        d = float(params.compliance[0] + params.compliance[1:] @ b)
+        if not inverse:
+            return a_mat, b, c, d
+        if d == 0:
+            return super().linearise(structure, params, x, u, inverse=True)
+        return a_mat - np.outer(b, c) / d, b / d, -c / d, 1.0 / d
