@@ -1,4 +1,4 @@
-"""The PWL ladder family (Parodi-Storace-Cincotti, sec. 2.1.5) in the model registry, and its fit.
+"""Identification of the PWL ladder circuit (Parodi-Storace-Cincotti, sec. 2.1.5).
 
 The read-out weights and bias enter the output linearly, so the SSE (eq. 5.9) is minimised by
 variable projection: ``fit_multistart`` moves only the resistor parameters (per cell the dead
@@ -12,12 +12,10 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..models import ladder
-from ._least_squares import check_fit_data, fit_multistart
-from ._registry import ModelFamily
-from ._result import FitResult
+from ...identification import FitResult, check_fit_data, fit_multistart
+from . import model as ladder
 
-__all__ = ["FAMILY", "default_starts", "fit_ladder"]
+__all__ = ["default_starts", "fit_ladder"]
 
 _BAND = (0.0, 1.5)  # normalised data (eq. 5.10): a band beyond the range never conducts
 _LOG_G_MIN = np.log(1e-3)
@@ -92,14 +90,3 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
                           max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
                           accept=accept, accept_reason=accept_reason)
 
-
-def _make_structure(dt: float, size: int, slope_cap: float = 1.0) -> ladder.LadderStructure:
-    return ladder.LadderStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
-
-
-FAMILY = ModelFamily(
-    name="ladder", title="PWL ladder circuit, Parodi-Storace-Cincotti (sec. 2.1.5)",
-    structure_type=ladder.LadderStructure, params_type=ladder.LadderParams,
-    make_structure=_make_structure, simulate=ladder.simulate, fit=fit_ladder,
-    invert=ladder.invert, size_help="ladder sections N, a PWL resistor and a capacitor each "
-                                    "(3N + 2 params)", default_size=2)

@@ -9,8 +9,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification.family_ladder import fit_ladder
-from hystkit.models import bobbio, get_family, ladder
+from hystkit.models import bobbio, get_family, ladder, numerical_linearisation
+from hystkit.models.ladder import fit_ladder
 from hystkit.sensors import simulate_experiment
 
 DT = 0.025
@@ -169,3 +169,126 @@ def test_compensator_on_the_virtual_sensor(mode, size):
     comp = fit_compensator(simulate_experiment("sine", 1), size, model="ladder", mode=mode)
     scores = evaluate(comp, simulate_experiment("sine", 2))
     assert scores["r2"] > scores["linear_r2"]
+
+
+# --- the family protocol: loop blocks, rest states, at(dt), records, linearisation ---------
+
+FAMILY = get_family("ladder")
+
+
+def _drive(run, x0, signal, off=None):
+    """Run ``run`` sample by sample: a compiled block (``off`` = its slice's offset inside a
+    larger loop state whose neighbours must stay untouched) or a step function."""
+    x, out, states = np.asarray(x0, float), [], []
+    for v in signal:
+        if off is None:
+            y, x = run(x, v)
+        else:
+            big = np.full(off + x.size + 2, 7.0)
+            big[off:off + x.size] = x
+            xn = big.copy()
+            y = run.step(run.body, big, xn, off, v)
+            assert np.all(xn[:off] == 7.0) and np.all(xn[off + x.size:] == 7.0)
+            x = xn[off:off + x.size]
+        out.append(y)
+        states.append(x)
+    return np.array(out), np.array(states)
+
+
+@pytest.mark.parametrize("inverse", [False, True])
+def test_block_equals_step_from_a_non_rest_state(inverse):
+    rng = np.random.default_rng(5)
+    x0 = np.array([0.6, -0.4, 0.3])
+    signal = np.convolve(1.5 * rng.standard_normal(400), np.ones(4) / 4, "same")
+    run = FAMILY.invert_step if inverse else FAMILY.step
+    blk = FAMILY.block(STRUCT3, PARAMS3, inverse)
+    assert blk.n_state == 3
+    out_blk, x_blk = _drive(blk, x0, signal, off=1)
+    out_ref, x_ref = _drive(lambda x, v: run(STRUCT3, PARAMS3, x, v), x0, signal)
+    assert np.all(np.isfinite(out_ref))
+    assert_allclose(out_blk, out_ref, rtol=0, atol=1e-12)
+    assert_allclose(x_blk, x_ref, rtol=0, atol=1e-12)
+    assert np.ptp(x_ref[:, 2]) > 0.2  # the last section conducts now and then
+
+
+def test_inverse_block_refuses_without_w0():
+    p = ladder.LadderParams(band=[0.1], conductance=[1.0], w=[0.0, 1.0])
+    with pytest.raises(FitDivergedError, match="w_0 = 0"):
+        FAMILY.block(ladder.LadderStructure(n_cells=1), p, inverse=True)
+
+
+@pytest.mark.parametrize("value", [-0.7, 0.0, 0.45])
+def test_rest_state_is_the_start_of_runs_and_a_fixed_point(value):
+    x_fwd = FAMILY.rest_state(STRUCT3, PARAMS3, value)
+    y, x_next = FAMILY.step(STRUCT3, PARAMS3, x_fwd, value)
+    assert_array_equal(x_next, x_fwd)
+    assert_allclose(ladder.simulate(STRUCT3, PARAMS3, np.full(3, value))[0], y, atol=1e-15)
+    x_inv = FAMILY.rest_state(STRUCT3, PARAMS3, value, inverse=True)
+    u_hat, x_next = FAMILY.invert_step(STRUCT3, PARAMS3, x_inv, value)
+    assert_allclose(x_next, x_inv, rtol=0, atol=1e-12)
+    assert_allclose(ladder.invert(STRUCT3, PARAMS3, np.full(3, value))[0], u_hat, atol=1e-12)
+
+
+def test_at_finer_dt_keeps_the_effective_conductances():
+    g = ladder.effective_conductance(STRUCT3, PARAMS3)
+    assert g[1] < PARAMS3.conductance[1]  # the limit binds at the fitted dt
+    for factor in (0.5, 0.2, 0.05):
+        fine = FAMILY.at(STRUCT3, DT * factor)
+        assert fine.dt == DT * factor
+        assert_allclose(ladder.effective_conductance(fine, PARAMS3), g, rtol=1e-12)
+        assert ladder.conductance_limit(fine) == pytest.approx(ladder.conductance_limit(STRUCT3))
+        assert FAMILY.at(fine, DT) == STRUCT3  # and back
+    assert FAMILY.at(STRUCT3, DT) == STRUCT3
+
+
+def test_at_coarser_dt_saturates_the_cap_and_stays_monotone():
+    half = ladder.LadderStructure(n_cells=3, dt=DT, slope_cap=0.5)
+    same = FAMILY.at(half, 2 * DT)
+    assert same.slope_cap == pytest.approx(1.0)
+    assert ladder.conductance_limit(same) == pytest.approx(ladder.conductance_limit(half))
+    coarse = FAMILY.at(STRUCT3, 4 * DT)
+    assert coarse.slope_cap == 1.0
+    assert ladder.conductance_limit(coarse) == pytest.approx(ladder.conductance_limit(STRUCT3) / 4)
+    # monotone Euler step: the voltages stay inside the range of input and start
+    states = ladder.states(coarse, PARAMS3, np.ones(300), x0=[0.0, -0.5, 0.5])[0]
+    assert np.all(states >= -0.5 - 1e-12) and np.all(states <= 1.0 + 1e-12)
+
+
+def test_at_finer_dt_converges_to_the_same_circuit():
+    u = _input(400)
+    t = np.arange(u.size) * DT
+    ref, _ = FAMILY.simulate(FAMILY.at(STRUCT3, DT / 32), PARAMS3,
+                             np.interp(np.arange(u.size * 32) * DT / 32, t, u))
+    gaps = []
+    for k in (2, 4, 8):
+        y_k, _ = FAMILY.simulate(FAMILY.at(STRUCT3, DT / k), PARAMS3,
+                                 np.interp(np.arange(u.size * k) * DT / k, t, u))
+        gaps.append(np.max(np.abs(y_k[::k] - ref[::32])))
+    assert gaps[0] > gaps[1] > gaps[2]  # forward Euler: first order in the step
+    assert gaps[2] < 0.6 * gaps[1] < 0.36 * gaps[0]
+
+
+def test_records_round_trip_and_old_model_files_load():
+    import json
+
+    d = PARAMS3.to_dict()
+    assert ladder.LadderParams.from_dict(json.loads(json.dumps(d))) == PARAMS3
+    assert ladder.LadderStructure.from_dict(STRUCT3.to_dict()) == STRUCT3
+    old = {"band": [0.1, 0.0, 0.2], "conductance": [5.0, 100.0, 1.0],
+           "w": [0.8, 0.3, -0.2, 0.4], "v_b": 0.1}  # as written by hystkit before the move
+    assert d == old and ladder.LadderParams.from_dict(old) == PARAMS3
+    old_structure = {"n_cells": 3, "dt": DT, "slope_cap": 1.0}  # asdict(structure)
+    assert STRUCT3.to_dict() == old_structure
+    assert ladder.LadderStructure(**old_structure) == STRUCT3
+    assert PARAMS3 != ladder.LadderParams.from_dict({**old, "v_b": 0.2})
+
+
+@pytest.mark.parametrize("inverse", [False, True])
+def test_analytical_linearisation_matches_numerical(inverse):
+    run = FAMILY.invert_step if inverse else FAMILY.step
+    for x, u in (([0.3, 0.05, -0.3], 0.7), ([0.1, 0.12, 0.0], 0.15), ([0.0, 0.4, 0.1], -0.5)):
+        exact = FAMILY.linearise(STRUCT3, PARAMS3, x, u, inverse)
+        approx = numerical_linearisation(lambda xx, uu: run(STRUCT3, PARAMS3, xx, uu),
+                                         np.array(x), u)
+        for e, a in zip(exact, approx):
+            assert_allclose(e, a, rtol=1e-6, atol=1e-8)

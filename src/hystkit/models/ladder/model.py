@@ -34,9 +34,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FitDivergedError
-from . import _circuit_kernels as kernels
-from ._validation import (
+from ...errors import FitDivergedError
+from .._protocol import Record
+from .._validation import (
     check_dt,
     check_positive_int,
     check_signal,
@@ -45,12 +45,16 @@ from ._validation import (
     frozen_array,
     initial_state,
 )
+from . import kernels
 
 __all__ = [
     "LadderParams",
     "LadderStructure",
     "conductance_limit",
+    "effective_conductance",
     "invert",
+    "invert_step",
+    "rest_state",
     "simulate",
     "simulate_reference",
     "states",
@@ -59,7 +63,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class LadderStructure:
+class LadderStructure(Record):
     """What does not get fitted.
 
     Parameters
@@ -87,7 +91,7 @@ class LadderStructure:
 
 
 @dataclass(frozen=True, eq=False)
-class LadderParams:
+class LadderParams(Record):
     """Resistor characteristics and read-out weights.
 
     Parameters
@@ -122,30 +126,14 @@ class LadderParams:
         if np.any(self.conductance <= 0):
             raise ValueError("conductance must be positive")
 
-    def to_dict(self) -> dict:
-        return {"band": self.band.tolist(), "conductance": self.conductance.tolist(),
-                "w": self.w.tolist(), "v_b": self.v_b}
-
-    @classmethod
-    def from_dict(cls, d: dict) -> LadderParams:
-        return cls(band=d["band"], conductance=d["conductance"], w=d["w"], v_b=d["v_b"])
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, LadderParams):
-            return NotImplemented
-        return bool(np.array_equal(self.band, other.band)
-                    and np.array_equal(self.conductance, other.conductance)
-                    and np.array_equal(self.w, other.w) and self.v_b == other.v_b)
-
-    __hash__ = None
-
 
 def conductance_limit(structure: LadderStructure) -> float:
     """Largest effective ``G`` [1/s]: two conducting resistors at a node reach ``slope_cap``."""
     return structure.slope_cap / (2.0 * structure.dt)
 
 
-def _effective_conductance(structure: LadderStructure, params: LadderParams) -> np.ndarray:
+def effective_conductance(structure: LadderStructure, params: LadderParams) -> np.ndarray:
+    """``G_k`` limited to :func:`conductance_limit`, what the Euler step uses."""
     return np.minimum(params.conductance, conductance_limit(structure))
 
 
@@ -155,9 +143,30 @@ def step(structure: LadderStructure, params: LadderParams, x: np.ndarray,
     x = np.asarray(x, dtype=float)
     y = params.w[0] * u + params.w[1:] @ x - params.v_b
     v = np.concatenate([[u], x[:-1]]) - x
-    i = _effective_conductance(structure, params) * np.sign(v) * np.maximum(
+    i = effective_conductance(structure, params) * np.sign(v) * np.maximum(
         np.abs(v) - params.band, 0.0)
     return float(y), x + structure.dt * (i - np.append(i[1:], 0.0))
+
+
+def invert_step(structure: LadderStructure, params: LadderParams, x: np.ndarray,
+                y: float) -> tuple[float, np.ndarray]:
+    """One sample of :func:`invert`: ``e = (y + V_b - sum_k w_k U_k) / w_0`` from the present
+    voltages, then the Euler step with ``e``."""
+    x = np.asarray(x, dtype=float)
+    e = (y + params.v_b - params.w[1:] @ x) / params.w[0]
+    return float(e), step(structure, params, x, e)[1]
+
+
+def _rest_input(params: LadderParams, y: float) -> float:
+    w_sum = params.w.sum()
+    return (y + params.v_b) / w_sum if w_sum != 0 else 0.0
+
+
+def rest_state(params: LadderParams, value: float, inverse: bool = False) -> np.ndarray:
+    """Every capacitor at the source voltage ``value``, no current (``inverse``: at the source
+    ``(value + V_b) / sum(w)`` that gives the output ``value``): the start of ``simulate`` /
+    ``invert`` with ``x0=None``."""
+    return np.full(params.n_cells, _rest_input(params, value) if inverse else float(value))
 
 
 def _check(structure: LadderStructure, params: LadderParams, u: np.ndarray,
@@ -174,7 +183,7 @@ def states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
     """
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
-    return kernels.ladder_states(u, x, params.band, _effective_conductance(structure, params),
+    return kernels.states(u, x, params.band, effective_conductance(structure, params),
                                  structure.dt)
 
 
@@ -232,11 +241,9 @@ def invert(structure: LadderStructure, params: LadderParams, y: np.ndarray,
     y = _check(structure, params, y, "y")
     if params.w[0] == 0:
         raise FitDivergedError("the ladder model has w_0 = 0, so it has no inverse")
-    w_sum = params.w.sum()
-    rest = (y[0] + params.v_b) / w_sum if w_sum != 0 else 0.0
-    x = initial_state(structure.n_cells, x0, rest)
-    u_hat, x_end, n_bad = kernels.ladder_invert(y, x, params.band,
-                                                _effective_conductance(structure, params),
+    x = initial_state(structure.n_cells, x0, _rest_input(params, y[0]))
+    u_hat, x_end, n_bad = kernels.invert(y, x, params.band,
+                                                effective_conductance(structure, params),
                                                 params.w, params.v_b, structure.dt)
     if n_bad >= 0:
         raise FitDivergedError(f"the inverse ladder model diverged at sample {n_bad} of "

@@ -1,0 +1,90 @@
+"""The PWL ladder family (Parodi-Storace-Cincotti, sec. 2.1.5) behind the family protocol."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ...errors import FitDivergedError
+from .._protocol import Block, Family
+from . import kernels
+from . import model as ladder
+from .fit import fit_ladder
+
+__all__ = ["LadderFamily"]
+
+
+class LadderFamily(Family):
+    name = "ladder"
+    title = "PWL ladder circuit, Parodi-Storace-Cincotti (sec. 2.1.5)"
+    size_help = "ladder sections N, a PWL resistor and a capacitor each (3N + 2 params)"
+    default_size = 2
+    docs = "docs/models/circuits.md"
+    Structure = ladder.LadderStructure
+    Params = ladder.LadderParams
+
+    def make_structure(self, dt: float, size: int,
+                       slope_cap: float = 1.0) -> ladder.LadderStructure:
+        return ladder.LadderStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
+
+    def at(self, structure, dt):
+        """The same circuit at ``dt``: the slope cap scales with ``dt``, so the conductance
+        limit ``slope_cap / (2 dt)`` [1/s], and with it every effective ``G_k``, stays what
+        the model was fitted with (the fit bounds ``G_k`` by that limit). The relative cap
+        saturates at ``max(slope_cap, 1)``: at a coarser step that needs more, the Euler step
+        stays monotone and the limit falls instead, so the fastest sections lag more than
+        fitted."""
+        dt = float(dt)
+        cap = min(structure.slope_cap * dt / structure.dt, max(structure.slope_cap, 1.0))
+        return dataclasses.replace(structure, dt=dt, slope_cap=cap)
+
+    def rest_state(self, structure, params, value, inverse=False):
+        return ladder.rest_state(params, value, inverse)
+
+    def step(self, structure, params, x, u):
+        return ladder.step(structure, params, x, u)
+
+    def simulate(self, structure, params, u, x0=None):
+        return ladder.simulate(structure, params, u, x0)
+
+    def invert(self, structure, params, y, x0=None):
+        return ladder.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return ladder.invert_step(structure, params, x, y)
+
+    def fit(self, u, y, structure, *, accept=None,
+            accept_reason="rejected by the acceptance test", **options):
+        return fit_ladder(u, y, structure, accept=accept, accept_reason=accept_reason,
+                          **options)
+
+    def block(self, structure, params, inverse=False):
+        if inverse and params.w[0] == 0:
+            raise FitDivergedError("the ladder model has w_0 = 0, so it has no inverse")
+        body = np.concatenate([[params.n_cells, params.v_b, structure.dt], params.band,
+                               ladder.effective_conductance(structure, params), params.w])
+        step = kernels.block_inverse if inverse else kernels.block_forward
+        return Block(step, np.ascontiguousarray(body, dtype=np.float64), structure.n_cells)
+
+    def linearise(self, structure, params, x, u, inverse=False):
+        """Section ``k`` conducts (``|U_k-1 - U_k| > E_k``) or not; a conducting one passes
+        ``di_k = G_k (dU_k-1 - dU_k)``, and ``dU_k+ = dU_k + dt (di_k - di_k+1)``;
+        ``y = w_0 e + w . U - V_b``. The inverse's ``e = (y + V_b - w . U) / w_0`` feeds back
+        into the first section. On a band edge (a kink) the section counts as blocking."""
+        x = np.asarray(x, dtype=float)
+        n = x.size
+        w0, w = params.w[0], params.w[1:]
+        e = (u + params.v_b - w @ x) / w0 if inverse else u
+        v = np.concatenate([[e], x[:-1]]) - x
+        g = ladder.effective_conductance(structure, params) * (np.abs(v) > params.band)
+        di = np.zeros((n, n + 1))  # d i_k / d(U_1..U_N, e): U_0 = e is column n
+        for k in range(n):
+            di[k, k] -= g[k]
+            di[k, k - 1 if k else n] += g[k]
+        jac = np.hstack([np.eye(n), np.zeros((n, 1))]) + structure.dt * (
+            di - np.vstack([di[1:], np.zeros((1, n + 1))]))
+        a, b = jac[:, :n], jac[:, n]
+        if inverse:
+            return a - np.outer(b, w) / w0, b / w0, -w / w0, 1.0 / w0
+        return a, b, w.copy(), float(w0)
