@@ -1,4 +1,4 @@
-"""The Chua-Stromsmoe family (sec. 2.1.3, eq. 2.3) in the model registry, and its fit.
+"""Least-squares identification of the Chua-Stromsmoe model (sec. 2.1.3, eq. 2.3).
 
 The SSE (eq. 5.9) is minimised by bounded least squares (``fit_multistart``) over
 ``ChuaParams.to_vector`` with finite-difference Jacobians: the model has 6 parameters per
@@ -11,12 +11,10 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..models import chua
-from ._least_squares import check_fit_data, fit_multistart
-from ._registry import ModelFamily
-from ._result import FitResult
+from ...identification import FitResult, check_fit_data, fit_multistart
+from . import model as chua
 
-__all__ = ["FAMILY", "default_starts", "fit_chua"]
+__all__ = ["default_starts", "fit_chua"]
 
 # Bounds per element in optimiser coordinates, for data normalised to max |.| = 1 (eq. 5.10):
 # slopes and scales over four decades around 1, bands up to the whole half-range.
@@ -93,14 +91,3 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
                           structure, max_nfev=max_nfev, screen_nfev=screen_nfev,
                           n_polish=n_polish, accept=accept, accept_reason=accept_reason)
 
-
-def _make_structure(dt: float, size: int, slope_cap: float = 1.0) -> chua.ChuaStructure:
-    return chua.ChuaStructure(n_elements=size, dt=dt, slope_cap=slope_cap)
-
-
-FAMILY = ModelFamily(
-    name="chua", title="Chua-Stromsmoe, dy/dt = g(u - f(y)) (sec. 2.1.3, eq. 2.3)",
-    structure_type=chua.ChuaStructure, params_type=chua.ChuaParams,
-    make_structure=_make_structure, simulate=chua.simulate, fit=fit_chua, invert=chua.invert,
-    size_help="elements in series N, output the sum of their states (6N params; 1 = eq. 2.3)",
-    default_size=1)

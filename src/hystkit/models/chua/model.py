@@ -37,9 +37,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FitDivergedError
-from . import _circuit_kernels as kernels
-from ._validation import (
+from ...errors import FitDivergedError
+from .._protocol import Record
+from .._validation import (
     broadcast_state,
     check_dt,
     check_positive_int,
@@ -48,13 +48,18 @@ from ._validation import (
     check_slope_cap,
     frozen_array,
 )
+from . import kernels
 
 __all__ = [
     "ChuaParams",
     "ChuaStructure",
     "dissipation",
+    "dissipation_slope",
     "invert",
     "invert_step",
+    "kernel_args",
+    "limits",
+    "rest_state",
     "restoring",
     "restoring_inverse",
     "simulate",
@@ -66,7 +71,7 @@ _FIELDS = ("k0", "k_inf", "y_s", "g", "v_g", "delta")
 
 
 @dataclass(frozen=True)
-class ChuaStructure:
+class ChuaStructure(Record):
     """What does not get fitted.
 
     Parameters
@@ -94,7 +99,7 @@ class ChuaStructure:
 
 
 @dataclass(frozen=True, eq=False)
-class ChuaParams:
+class ChuaParams(Record):
     """Restoring and dissipation functions of each element, arrays of shape (N,).
 
     Parameters
@@ -144,22 +149,8 @@ class ChuaParams:
         t = np.asarray(theta, dtype=float).reshape(n_elements, 6)
         return cls(*np.exp(t[:, :5]).T, delta=t[:, 5])
 
-    def to_dict(self) -> dict:
-        return {name: getattr(self, name).tolist() for name in _FIELDS}
 
-    @classmethod
-    def from_dict(cls, d: dict) -> ChuaParams:
-        return cls(**{name: d[name] for name in _FIELDS})
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, ChuaParams):
-            return NotImplemented
-        return all(np.array_equal(getattr(self, n), getattr(other, n)) for n in _FIELDS)
-
-    __hash__ = None
-
-
-def _limits(structure: ChuaStructure, params: ChuaParams) -> tuple[np.ndarray, np.ndarray]:
+def limits(structure: ChuaStructure, params: ChuaParams) -> tuple[np.ndarray, np.ndarray]:
     """Per element: the cap on ``g'`` and the knee ``|v|`` beyond which ``g`` is straight."""
     cap = structure.slope_cap / (structure.dt * np.maximum(params.k0, params.k_inf))
     ratio = cap / params.g
@@ -179,17 +170,28 @@ def restoring_inverse(params: ChuaParams, u: float) -> np.ndarray:
 
     ``|f(y) - k_inf y| <= |k_0 - k_inf| y_s`` brackets the root.
     """
-    return kernels.chua_restoring_inverse(float(u), params.k0, params.k_inf, params.y_s)
+    return kernels.restoring_inverse(float(u), params.k0, params.k_inf, params.y_s)
 
 
 def dissipation(structure: ChuaStructure, params: ChuaParams, v: np.ndarray) -> np.ndarray:
     """Limited ``g_k(v_k)`` (dead band, sinh, straight line beyond the knee); shape (..., N)."""
     v = np.asarray(v, dtype=float)
-    cap, knee = _limits(structure, params)
+    cap, knee = limits(structure, params)
     a = np.abs(v)
     inner = np.clip(a, params.delta, knee) - params.delta
     mag = params.g * params.v_g * np.sinh(inner / params.v_g) + cap * np.maximum(a - knee, 0.0)
     return np.sign(v) * mag
+
+
+def dissipation_slope(structure: ChuaStructure, params: ChuaParams,
+                      v: np.ndarray) -> np.ndarray:
+    """``g_k'(v_k)`` of the limited dissipation function: 0 in the dead band, the sinh's slope
+    up to the knee, ``cap`` beyond (on a kink, the inner side's)."""
+    v = np.asarray(v, dtype=float)
+    cap, knee = limits(structure, params)
+    a = np.abs(v)
+    inner = params.g * np.cosh((np.minimum(a, knee) - params.delta) / params.v_g)
+    return np.where(a <= params.delta, 0.0, np.where(a <= knee, inner, cap))
 
 
 def step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
@@ -211,7 +213,7 @@ def invert_step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
     x = np.asarray(x, dtype=float)
     fx = restoring(params, x)
     r = (y - np.sum(x)) / structure.dt
-    cap, knee = _limits(structure, params)
+    cap, knee = limits(structure, params)
     n_el = x.size
     brackets = [_g_inverse(r / n_el, params, cap, knee, upper) + fx for upper in (False, True)]
     lo, hi = float(np.min(brackets[0])), float(np.max(brackets[1]))
@@ -246,15 +248,25 @@ def _check(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
     return check_signal(u, name)
 
 
+def rest_state(params: ChuaParams, value: float, inverse: bool = False) -> np.ndarray:
+    """Element outputs at rest (``g = 0``) under a constant input ``value``, ``f_k^-1(value)``;
+    with ``inverse``, for a constant output ``value``: the common input ``u`` with
+    ``sum_k f_k^-1(u) = value`` first. These are the starts of ``simulate`` / ``invert`` with
+    ``x0=None``."""
+    if inverse:
+        value = kernels.rest_input(float(value), params.k0, params.k_inf, params.y_s)
+    return restoring_inverse(params, value)
+
+
 def _initial_state(params: ChuaParams, x0: np.ndarray | float | None,
                    u0: float) -> np.ndarray:
     if x0 is None:
-        return restoring_inverse(params, u0)
+        return rest_state(params, u0)
     return broadcast_state(x0, params.n_elements)
 
 
-def _kernel_args(structure: ChuaStructure, params: ChuaParams) -> tuple:
-    cap, knee = _limits(structure, params)
+def kernel_args(structure: ChuaStructure, params: ChuaParams) -> tuple:
+    cap, knee = limits(structure, params)
     return (params.k0, params.k_inf, params.y_s, params.g, params.v_g, params.delta, knee, cap,
             structure.dt)
 
@@ -279,7 +291,7 @@ def simulate(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
     """
     u = _check(structure, params, u, "u")
     x = _initial_state(params, x0, u[0])
-    return kernels.chua_simulate(u, x, *_kernel_args(structure, params))
+    return kernels.simulate(u, x, *kernel_args(structure, params))
 
 
 def simulate_reference(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
@@ -316,11 +328,10 @@ def invert(structure: ChuaStructure, params: ChuaParams, y: np.ndarray,
     """
     y = _check(structure, params, y, "y")
     if x0 is None:
-        x = restoring_inverse(params, kernels.chua_rest_input(y[0], params.k0, params.k_inf,
-                                                              params.y_s))
+        x = rest_state(params, y[0], inverse=True)
     else:
         x = _initial_state(params, x0, 0.0)
-    u_hat, x_end, n_bad = kernels.chua_invert(y, x, *_kernel_args(structure, params))
+    u_hat, x_end, n_bad = kernels.invert(y, x, *kernel_args(structure, params))
     if n_bad >= 0:
         raise FitDivergedError(f"the inverse Chua-Stromsmoe model diverged at sample {n_bad} "
                                f"of {y.size}")

@@ -1,5 +1,7 @@
 """Chua-Stromsmoe model (sec. 2.1.3, eq. 2.3-2.4): kernels, closed forms, local memory, fit."""
 
+import json
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -8,8 +10,8 @@ from numpy.testing import assert_allclose
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification.family_chua import fit_chua
-from hystkit.models import chua, get_family
+from hystkit.models import chua, get_family, numerical_linearisation
+from hystkit.models.chua import fit_chua
 from hystkit.sensors import simulate_experiment
 
 DT = 0.025
@@ -229,3 +231,130 @@ def test_compensator_on_the_virtual_sensor(mode):
         assert scores["r2"] > scores["linear_r2"]
     # direct (sensor -> position) is not asserted to beat the line: an element whose f and g
     # increase only lags its input, the opposite loop orientation (docs/models/circuits.md)
+
+
+# --- the family protocol: loop blocks, rest states, at(dt), records, linearisation ---------
+
+FAMILY = get_family("chua")
+
+
+def _drive(run, x0, signal, off=None):
+    """Run ``run`` sample by sample: a compiled block (``off`` = its slice's offset inside a
+    larger loop state whose neighbours must stay untouched) or a step function."""
+    x, out, states = np.asarray(x0, float), [], []
+    for v in signal:
+        if off is None:
+            y, x = run(x, v)
+        else:
+            big = np.full(off + x.size + 2, 7.0)
+            big[off:off + x.size] = x
+            xn = big.copy()
+            y = run.step(run.body, big, xn, off, v)
+            assert np.all(xn[:off] == 7.0) and np.all(xn[off + x.size:] == 7.0)
+            x = xn[off:off + x.size]
+        out.append(y)
+        states.append(x)
+    return np.array(out), np.array(states)
+
+
+@pytest.mark.parametrize("inverse", [False, True])
+def test_block_equals_step_from_a_non_rest_state(inverse):
+    rng = np.random.default_rng(3)
+    x0 = np.array([0.8, -0.6])
+    if inverse:
+        signal = np.sum(x0) + np.cumsum(0.05 * rng.standard_normal(300))
+        run = FAMILY.invert_step
+    else:
+        signal = 2.0 * rng.standard_normal(300)  # large drives reach the capped line of g
+        run = FAMILY.step
+    blk = FAMILY.block(STRUCT2, PARAMS2, inverse)
+    assert blk.n_state == 2
+    out_blk, x_blk = _drive(blk, x0, signal, off=3)
+    out_ref, x_ref = _drive(lambda x, v: run(STRUCT2, PARAMS2, x, v), x0, signal)
+    assert np.all(np.isfinite(out_ref))
+    assert_allclose(out_blk, out_ref, rtol=0, atol=1e-12)
+    assert_allclose(x_blk, x_ref, rtol=0, atol=1e-12)
+    if not inverse:
+        _, knee = chua.limits(STRUCT2, PARAMS2)
+        v = signal[:, None] - chua.restoring(PARAMS2, np.vstack([x0, x_ref[:-1]]))
+        assert np.sum(np.abs(v) > knee) > 50  # the Euler limit is exercised
+
+
+@pytest.mark.parametrize("value", [-0.7, 0.0, 0.45])
+def test_rest_state_is_the_start_of_runs_and_a_fixed_point(value):
+    x_fwd = FAMILY.rest_state(STRUCT2, PARAMS2, value)
+    y, x_next = FAMILY.step(STRUCT2, PARAMS2, x_fwd, value)
+    assert_allclose(x_next, x_fwd, rtol=0, atol=1e-12)
+    y_run, _ = FAMILY.simulate(STRUCT2, PARAMS2, np.full(5, value))
+    assert_allclose(y_run, y, rtol=0, atol=1e-12)
+    x_inv = FAMILY.rest_state(STRUCT2, PARAMS2, value, inverse=True)
+    u_hat, x_next = FAMILY.invert_step(STRUCT2, PARAMS2, x_inv, value)
+    assert_allclose(x_next, x_inv, rtol=0, atol=1e-12)
+    assert np.sum(x_inv) == pytest.approx(value, abs=1e-12)
+    u_run, _ = FAMILY.invert(STRUCT2, PARAMS2, np.full(5, value))
+    assert_allclose(u_run, u_hat, rtol=0, atol=1e-12)
+
+
+def test_at_finer_dt_keeps_the_limited_dissipation_function():
+    v = np.linspace(-3, 3, 601)[:, None]
+    for factor in (0.5, 0.25, 0.1):
+        fine = FAMILY.at(STRUCT2, DT * factor)
+        assert fine.dt == DT * factor and fine.n_elements == 2
+        assert_allclose(chua.limits(fine, PARAMS2)[0], chua.limits(STRUCT2, PARAMS2)[0],
+                        rtol=1e-12)
+        assert_allclose(chua.dissipation(fine, PARAMS2, v), chua.dissipation(STRUCT2, PARAMS2, v),
+                        rtol=1e-12, atol=1e-12)
+        assert FAMILY.at(fine, DT) == STRUCT2  # and back
+    assert FAMILY.at(STRUCT2, DT) == STRUCT2
+
+
+def test_at_coarser_dt_saturates_the_cap_and_stays_monotone():
+    half = chua.ChuaStructure(n_elements=2, dt=DT, slope_cap=0.5)
+    assert FAMILY.at(half, 2 * DT).slope_cap == pytest.approx(1.0)  # same ODE, cap 1
+    coarse = FAMILY.at(STRUCT2, 4 * DT)
+    assert coarse.slope_cap == 1.0 and coarse.dt == 4 * DT
+    # monotone Euler step: a step input never overshoots the element's rest value
+    y, x = FAMILY.simulate(coarse, PARAMS2, np.ones(200), x0=[0.0, 0.0])
+    rest = chua.restoring_inverse(PARAMS2, 1.0)
+    assert np.all(x <= rest + 1e-12) and np.all(np.diff(y) >= -1e-12)
+
+
+def test_at_finer_dt_converges_to_the_same_ode():
+    u = _input(400)
+    t = np.arange(u.size) * DT
+    errors = []
+    for k in (2, 4, 8):
+        t_k = np.arange(u.size * k) * DT / k
+        y_k, _ = FAMILY.simulate(FAMILY.at(STRUCT2, DT / k), PARAMS2, np.interp(t_k, t, u))
+        errors.append(y_k)
+    ref, _ = FAMILY.simulate(FAMILY.at(STRUCT2, DT / 32), PARAMS2,
+                             np.interp(np.arange(u.size * 32) * DT / 32, t, u))
+    gaps = [np.max(np.abs(y[k - 1::k] - ref[32 - 1::32])) for k, y in zip((2, 4, 8), errors)]
+    assert gaps[0] > gaps[1] > gaps[2]  # forward Euler: first order in the step
+    assert gaps[2] < 0.6 * gaps[1] < 0.36 * gaps[0]
+
+
+def test_records_round_trip_and_old_model_files_load():
+    d = PARAMS2.to_dict()
+    assert chua.ChuaParams.from_dict(json.loads(json.dumps(d))) == PARAMS2
+    assert chua.ChuaStructure.from_dict(STRUCT2.to_dict()) == STRUCT2
+    old = {"k0": [1.0, 2.0], "k_inf": [3.0, 0.5], "y_s": [0.3, 0.5], "g": [5.0, 0.5],
+           "v_g": [0.2, 1.0], "delta": [0.0, 0.1]}  # as written by hystkit before the move
+    assert d == old and chua.ChuaParams.from_dict(old) == PARAMS2
+    old_structure = {"n_elements": 2, "dt": DT, "slope_cap": 1.0}  # asdict(structure)
+    assert STRUCT2.to_dict() == old_structure
+    assert chua.ChuaStructure(**old_structure) == STRUCT2
+    assert PARAMS2 != chua.ChuaParams.from_dict({**old, "delta": [0.0, 0.2]})
+
+
+@pytest.mark.parametrize("inverse", [False, True])
+def test_analytical_linearisation_matches_numerical(inverse):
+    x = np.array([0.3, -0.2])
+    run = FAMILY.invert_step if inverse else FAMILY.step
+    for u in (0.9, -1.4, 2.5):  # inside the sinh, and beyond a knee
+        if inverse:
+            u = float(np.sum(x)) + 0.02 * u
+        exact = FAMILY.linearise(STRUCT2, PARAMS2, x, u, inverse)
+        approx = numerical_linearisation(lambda xx, uu: run(STRUCT2, PARAMS2, xx, uu), x, u)
+        for e, a in zip(exact, approx):
+            assert_allclose(e, a, rtol=1e-5, atol=1e-7)

@@ -1,0 +1,81 @@
+"""The Chua-Stromsmoe family (sec. 2.1.3, eq. 2.3) behind the family protocol."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from .._protocol import Block, Family
+from . import kernels
+from . import model as chua
+from .fit import fit_chua
+
+__all__ = ["ChuaFamily"]
+
+
+class ChuaFamily(Family):
+    name = "chua"
+    title = "Chua-Stromsmoe, dy/dt = g(u - f(y)) (sec. 2.1.3, eq. 2.3)"
+    size_help = "elements in series N, output the sum of their states (6N params; 1 = eq. 2.3)"
+    default_size = 1
+    docs = "docs/models/circuits.md"
+    Structure = chua.ChuaStructure
+    Params = chua.ChuaParams
+
+    def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> chua.ChuaStructure:
+        return chua.ChuaStructure(n_elements=size, dt=dt, slope_cap=slope_cap)
+
+    def at(self, structure, dt):
+        """The same ODE at ``dt``: the slope cap scales with ``dt``, so the limit on ``g'``
+        (``slope_cap / (dt max(k_0, k_inf))``, in 1/s) and hence the limited ``g`` the model
+        was fitted with stay what they were. The relative cap saturates at
+        ``max(slope_cap, 1)``: at a coarser step that needs more, the Euler step stays monotone
+        (stable, no overshoot) and the absolute limit falls instead, so the fastest part of
+        ``g`` becomes slower than fitted."""
+        dt = float(dt)
+        cap = min(structure.slope_cap * dt / structure.dt, max(structure.slope_cap, 1.0))
+        return dataclasses.replace(structure, dt=dt, slope_cap=cap)
+
+    def rest_state(self, structure, params, value, inverse=False):
+        return chua.rest_state(params, value, inverse)
+
+    def step(self, structure, params, x, u):
+        return chua.step(structure, params, x, u)
+
+    def simulate(self, structure, params, u, x0=None):
+        return chua.simulate(structure, params, u, x0)
+
+    def invert(self, structure, params, y, x0=None):
+        return chua.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return chua.invert_step(structure, params, x, y)
+
+    def fit(self, u, y, structure, *, accept=None,
+            accept_reason="rejected by the acceptance test", **options):
+        return fit_chua(u, y, structure, accept=accept, accept_reason=accept_reason, **options)
+
+    def block(self, structure, params, inverse=False):
+        *per_element, dt = chua.kernel_args(structure, params)
+        body = np.concatenate([[params.n_elements, dt], *per_element])
+        step = kernels.block_inverse if inverse else kernels.block_forward
+        return Block(step, np.ascontiguousarray(body, dtype=np.float64), structure.n_elements)
+
+    def linearise(self, structure, params, x, u, inverse=False):
+        """Each element ``x+ = x + dt g(u - f(x))`` gives ``dx+ = (1 - dt g' f') dx + dt g' du``
+        and the output ``y = sum x+``. The inverse solves that output for ``u`` at the
+        operating point's input ``u_hat``: ``du = (dy - C dx) / D``; where no element moves
+        (``D = 0``, dead bands) it has no derivative and the numerical default is used."""
+        x = np.asarray(x, dtype=float)
+        u_op = chua.invert_step(structure, params, x, u)[0] if inverse else u
+        fx_slope = params.k_inf + (params.k0 - params.k_inf) / np.cosh(x / params.y_s) ** 2
+        v = u_op - chua.restoring(params, x)
+        b = structure.dt * chua.dissipation_slope(structure, params, v)
+        a = np.diag(1.0 - b * fx_slope)
+        c, d = a.sum(axis=0), float(b.sum())
+        if not inverse:
+            return a, b, c, d
+        if d == 0:
+            return super().linearise(structure, params, x, u, inverse=True)
+        return a - np.outer(b, c) / d, b / d, -c / d, 1.0 / d
