@@ -20,6 +20,7 @@ class BobbioFamily(Family):
     docs = "docs/models/circuits.md"
     Structure = bobbio.BobbioStructure
     Params = bobbio.BobbioParams
+    model = bobbio
 
     def make_structure(self, dt: float, size: int) -> bobbio.BobbioStructure:
         return bobbio.BobbioStructure(n_springs=size, dt=dt)
@@ -28,21 +29,6 @@ class BobbioFamily(Family):
         """The chain is rate-independent (only the input values matter, not their timing), so
         the same model runs at any ``dt``; only the recorded ``dt`` changes."""
         return super().at(structure, dt)
-
-    def rest_state(self, structure, params, value, inverse=False):
-        return bobbio.rest_state(params, value, inverse)
-
-    def step(self, structure, params, x, u):
-        return bobbio.step(structure, params, x, u)
-
-    def simulate(self, structure, params, u, x0=None):
-        return bobbio.simulate(structure, params, u, x0)
-
-    def invert(self, structure, params, y, x0=None):
-        return bobbio.invert(structure, params, y, x0)
-
-    def invert_step(self, structure, params, x, y):
-        return bobbio.invert_step(structure, params, x, y)
 
     def fit(self, u, y, structure, *, accept=None,
             accept_reason="rejected by the acceptance test", **options):

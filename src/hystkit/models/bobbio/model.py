@@ -149,7 +149,8 @@ def _rest_force(params: BobbioParams, y: float) -> float:
     return (y - params.offset) / total if total > 0 else 0.0
 
 
-def rest_state(params: BobbioParams, value: float, inverse: bool = False) -> np.ndarray:
+def rest_state(structure: BobbioStructure, params: BobbioParams, value: float,
+               inverse: bool = False) -> np.ndarray:
     """Every spring carrying the force ``value`` (``inverse``: the force ``(value - b) / sum(c)``
     that gives the deformation ``value``), no piston loaded: the start of ``simulate`` /
     ``invert`` with ``x0=None``."""

@@ -22,6 +22,7 @@ class ChuaFamily(Family):
     docs = "docs/models/circuits.md"
     Structure = chua.ChuaStructure
     Params = chua.ChuaParams
+    model = chua
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> chua.ChuaStructure:
         return chua.ChuaStructure(n_elements=size, dt=dt, slope_cap=slope_cap)
@@ -36,21 +37,6 @@ class ChuaFamily(Family):
         dt = float(dt)
         cap = min(structure.slope_cap * dt / structure.dt, max(structure.slope_cap, 1.0))
         return dataclasses.replace(structure, dt=dt, slope_cap=cap)
-
-    def rest_state(self, structure, params, value, inverse=False):
-        return chua.rest_state(params, value, inverse)
-
-    def step(self, structure, params, x, u):
-        return chua.step(structure, params, x, u)
-
-    def simulate(self, structure, params, u, x0=None):
-        return chua.simulate(structure, params, u, x0)
-
-    def invert(self, structure, params, y, x0=None):
-        return chua.invert(structure, params, y, x0)
-
-    def invert_step(self, structure, params, x, y):
-        return chua.invert_step(structure, params, x, y)
 
     def fit(self, u, y, structure, *, accept=None,
             accept_reason="rejected by the acceptance test", **options):

@@ -248,7 +248,8 @@ def _check(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
     return check_signal(u, name)
 
 
-def rest_state(params: ChuaParams, value: float, inverse: bool = False) -> np.ndarray:
+def rest_state(structure: ChuaStructure, params: ChuaParams, value: float,
+               inverse: bool = False) -> np.ndarray:
     """Element outputs at rest (``g = 0``) under a constant input ``value``, ``f_k^-1(value)``;
     with ``inverse``, for a constant output ``value``: the common input ``u`` with
     ``sum_k f_k^-1(u) = value`` first. These are the starts of ``simulate`` / ``invert`` with
@@ -258,10 +259,10 @@ def rest_state(params: ChuaParams, value: float, inverse: bool = False) -> np.nd
     return restoring_inverse(params, value)
 
 
-def _initial_state(params: ChuaParams, x0: np.ndarray | float | None,
-                   u0: float) -> np.ndarray:
+def _initial_state(structure: ChuaStructure, params: ChuaParams,
+                   x0: np.ndarray | float | None, u0: float) -> np.ndarray:
     if x0 is None:
-        return rest_state(params, u0)
+        return rest_state(structure, params, u0)
     return broadcast_state(x0, params.n_elements)
 
 
@@ -290,7 +291,7 @@ def simulate(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
         Element outputs after the last sample; feeding them back as ``x0`` continues the run.
     """
     u = _check(structure, params, u, "u")
-    x = _initial_state(params, x0, u[0])
+    x = _initial_state(structure, params, x0, u[0])
     return kernels.simulate(u, x, *kernel_args(structure, params))
 
 
@@ -298,7 +299,7 @@ def simulate_reference(structure: ChuaStructure, params: ChuaParams, u: np.ndarr
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step`."""
     u = _check(structure, params, u, "u")
-    x = _initial_state(params, x0, u[0])
+    x = _initial_state(structure, params, x0, u[0])
     y = np.empty_like(u)
     for n, u_n in enumerate(u):
         y[n], x = step(structure, params, x, u_n)
@@ -328,9 +329,9 @@ def invert(structure: ChuaStructure, params: ChuaParams, y: np.ndarray,
     """
     y = _check(structure, params, y, "y")
     if x0 is None:
-        x = rest_state(params, y[0], inverse=True)
+        x = rest_state(structure, params, y[0], inverse=True)
     else:
-        x = _initial_state(params, x0, 0.0)
+        x = _initial_state(structure, params, x0, 0.0)
     u_hat, x_end, n_bad = kernels.invert(y, x, *kernel_args(structure, params))
     if n_bad >= 0:
         raise FitDivergedError(f"the inverse Chua-Stromsmoe model diverged at sample {n_bad} "

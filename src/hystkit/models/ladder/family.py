@@ -23,6 +23,7 @@ class LadderFamily(Family):
     docs = "docs/models/circuits.md"
     Structure = ladder.LadderStructure
     Params = ladder.LadderParams
+    model = ladder
 
     def make_structure(self, dt: float, size: int,
                        slope_cap: float = 1.0) -> ladder.LadderStructure:
@@ -38,21 +39,6 @@ class LadderFamily(Family):
         dt = float(dt)
         cap = min(structure.slope_cap * dt / structure.dt, max(structure.slope_cap, 1.0))
         return dataclasses.replace(structure, dt=dt, slope_cap=cap)
-
-    def rest_state(self, structure, params, value, inverse=False):
-        return ladder.rest_state(params, value, inverse)
-
-    def step(self, structure, params, x, u):
-        return ladder.step(structure, params, x, u)
-
-    def simulate(self, structure, params, u, x0=None):
-        return ladder.simulate(structure, params, u, x0)
-
-    def invert(self, structure, params, y, x0=None):
-        return ladder.invert(structure, params, y, x0)
-
-    def invert_step(self, structure, params, x, y):
-        return ladder.invert_step(structure, params, x, y)
 
     def fit(self, u, y, structure, *, accept=None,
             accept_reason="rejected by the acceptance test", **options):

@@ -162,7 +162,8 @@ def _rest_input(params: LadderParams, y: float) -> float:
     return (y + params.v_b) / w_sum if w_sum != 0 else 0.0
 
 
-def rest_state(params: LadderParams, value: float, inverse: bool = False) -> np.ndarray:
+def rest_state(structure: LadderStructure, params: LadderParams, value: float,
+               inverse: bool = False) -> np.ndarray:
     """Every capacitor at the source voltage ``value``, no current (``inverse``: at the source
     ``(value + V_b) / sum(w)`` that gives the output ``value``): the start of ``simulate`` /
     ``invert`` with ``x0=None``."""
