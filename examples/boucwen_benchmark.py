@@ -38,8 +38,8 @@ import numpy as np
 from scipy.io import loadmat
 from scipy.signal import firwin
 
-from hystkit.identification.family_boucwen import fit_boucwen
 from hystkit.models import boucwen
+from hystkit.models.boucwen import fit_boucwen
 
 FS = 750.0  # benchmark sample rate [Hz]
 PERIOD = 8192  # samples per multisine period

@@ -1,4 +1,4 @@
-"""Bouc-Wen oscillator (force in, displacement out) in the model registry, and its fit.
+"""Identification of the Bouc-Wen oscillator (force in, displacement out).
 
 The fit minimises the sum of squared simulation errors (the cost of eq. 5.9) with
 ``fit_multistart`` (trust-region reflective, finite-difference Jacobian) in two stages, both from
@@ -23,14 +23,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..errors import FitDivergedError
-from ..models import _boucwen_kernels as kernels
-from ..models import boucwen
-from ._least_squares import fit_multistart
-from ._registry import ModelFamily
-from ._result import FitResult
+from ...errors import FitDivergedError
+from ...identification import FitResult, fit_multistart
+from . import kernels
+from . import model as boucwen
 
-__all__ = ["FAMILY", "fit_boucwen", "parameter_bounds"]
+__all__ = ["fit_boucwen", "fit_family", "parameter_bounds"]
 
 _ZETA_BOUNDS = (1e-4, 10.0)
 _LOGIT_R_BOUND = 9.0  # r = alpha / K0 in [1.2e-4, 1 - 1.2e-4]
@@ -206,32 +204,16 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
                    n_starts=stage1.n_starts + stage2.n_starts)
 
 
-def _fit_family(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructure, *,
-                accept: Callable[[boucwen.BoucWenParams], bool] | None = None,
-                accept_reason: str = "rejected by the acceptance test") -> FitResult:
-    """The registry's fit on normalised recordings: ``nu = 1`` and bounded, dissipative loops.
+def fit_family(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructure, *,
+               accept: Callable[[boucwen.BoucWenParams], bool] | None = None,
+               accept_reason: str = "rejected by the acceptance test", **options) -> FitResult:
+    """The registry's fit on normalised recordings: ``nu = 1`` and bounded, dissipative loops
+    unless ``options`` (passed to :func:`fit_boucwen`) say otherwise.
 
     Unrestricted fits on the virtual sensor chose loops outside that class (stiffening on
     loading or softening on unloading, i.e. ``z`` unbounded), and they generalised worse where
     it mattered most: sine validation R^2 0.875 against 0.938 (docs/models/boucwen.md).
     """
-    return fit_boucwen(u, y, structure, nu=1.0, bounded=True, accept=accept,
-                       accept_reason=accept_reason)
+    options = {"nu": 1.0, "bounded": True, **options}
+    return fit_boucwen(u, y, structure, accept=accept, accept_reason=accept_reason, **options)
 
-
-def _make_structure(dt: float, size: int, input_hold: str = "linear",
-                    start: str = "equilibrium") -> boucwen.BoucWenStructure:
-    # Recordings start wherever the sensor happens to be, not at rest with zero force.
-    return boucwen.BoucWenStructure(dt=dt, substeps=size, input_hold=input_hold, start=start)
-
-
-FAMILY = ModelFamily(
-    name="boucwen",
-    title="Bouc-Wen oscillator, m y'' + c y' + k y + z = u (beyond the document; Noel-Schoukens "
-          "benchmark)",
-    structure_type=boucwen.BoucWenStructure, params_type=boucwen.BoucWenParams,
-    make_structure=_make_structure, simulate=boucwen.simulate, fit=_fit_family, invert=None,
-    no_inverse_reason="its input is a force and its output a displacement of a second-order "
-                      "system: the inverse needs the measured output differentiated twice "
-                      "(dynamic inversion), which is not implemented",
-    size_help="RK4 substeps per sample (7 parameters whatever the size)", default_size=2)

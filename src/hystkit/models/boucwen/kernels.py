@@ -1,8 +1,8 @@
-"""Compiled hot loop of the Bouc-Wen oscillator; ``boucwen.py`` holds the reference and checks.
+"""Compiled hot loops of the Bouc-Wen oscillator; ``model.py`` holds the reference and checks.
 
 All arrays are float64 and already validated by the caller. ``theta`` is the physical parameter
 vector ``(m, c, k, alpha, beta, gamma, nu)``; the state is ``(y, v, z, u_prev)`` with ``v = dy/dt``
-(see ``boucwen.py`` for the sampling convention).
+(see ``model.py`` for the sampling convention).
 """
 
 from __future__ import annotations
@@ -71,3 +71,17 @@ def simulate(u, x0, fresh, theta, dt, n_sub, linear, bound):
         states[i, 0], states[i, 1], states[i, 2] = x[0], x[1], x[2]
         u_prev = u[i]
     return states, np.array([x[0], x[1], x[2], u_prev]), -1
+
+
+# Loop blocks (protocol in ``hystkit.models._protocol``): body = [m, c, k, alpha, beta, gamma,
+# nu, dt, substeps, linear (1 or 0)]; the state slice is ``(y, v, z, u_prev)`` as in ``step``.
+
+@njit(cache=True)
+def block_forward(body, x, xn, off, u):
+    """Integrate from the previous force sample to ``u`` (held or linear, as ``advance``)."""
+    n_sub = int(body[8])
+    s = xn[off:off + 3]
+    s[0], s[1], s[2] = x[off], x[off + 1], x[off + 2]
+    advance(s, x[off + 3], u, body[:7], body[7] / n_sub, n_sub, body[9] != 0.0)
+    xn[off + 3] = u
+    return s[0]
