@@ -363,23 +363,35 @@ def test_rest_state_is_the_start_of_runs_and_an_equilibrium(value):
     assert moved == (value != 0.0)
 
 
-def test_at_keeps_the_integration_step_at_most_what_it_was():
+def test_at_keeps_the_substep_count_and_is_reversible():
     s = FAMILY.make_structure(DT, 4)
     assert FAMILY.at(s, DT) == s
-    for dt, substeps in ((DT / 4, 1), (DT / 2, 2), (DT / 3, 2), (2 * DT, 8), (2.5 * DT, 10)):
+    for dt in (DT / 8, DT / 3, 2 * DT, 2.5 * DT):
         other = FAMILY.at(s, dt)
-        assert (other.dt, other.substeps) == (dt, substeps)
-        assert other.step_size <= s.step_size * (1 + 1e-12)
-        assert (other.input_hold, other.start) == (s.input_hold, s.start)
+        assert (other.dt, other.substeps, other.input_hold, other.start) == \
+            (dt, 4, s.input_hold, s.start)
+        assert other.step_size == pytest.approx(s.step_size * dt / DT)
+        assert FAMILY.at(other, DT) == s
+
+
+def test_at_coarser_dt_diverges_loudly_beyond_the_rk4_limit():
+    s = bw.BoucWenStructure(dt=DT, substeps=1, start="equilibrium")
+    w0 = LINEAR.omega0  # 14.1 rad/s: w0 h = 0.14 at DT
+    u = _force(300, dt=DT)
+    y, _ = FAMILY.simulate(FAMILY.at(s, 2.0 / w0), LINEAR, u)  # w0 h = 2: stable
+    assert np.all(np.isfinite(y))
+    with pytest.raises(FitDivergedError, match="substeps"):
+        FAMILY.simulate(FAMILY.at(s, 5.0 / w0), LINEAR, u)  # w0 h = 5: |R| = 19 a step
 
 
 @pytest.mark.parametrize("params", [SOFT, STIFF])
 def test_at_finer_dt_on_the_same_piecewise_linear_force_is_the_same_run(params):
     # Linear hold: the force sampled 4x finer by linear interpolation is the same function of
-    # time, and at(dt / 4) keeps the RK4 step dt / 4 (1 substep instead of 4): the same run.
+    # time, and at(dt / 4) with 1 substep has the RK4 step dt / 4 of 4 substeps at dt: the
+    # same run.
     s = FAMILY.make_structure(DT, 4)
     u = _force(300) + 0.2
-    fine = FAMILY.at(s, DT / 4)
+    fine = bw.BoucWenStructure.from_dict({**FAMILY.at(s, DT / 4).to_dict(), "substeps": 1})
     u_fine = np.interp(np.arange(4 * (u.size - 1) + 1) * DT / 4, np.arange(u.size) * DT, u)
     y, _ = FAMILY.simulate(s, params, u)
     y_fine, _ = FAMILY.simulate(fine, params, u_fine)
@@ -402,7 +414,7 @@ def test_per_sample_scheme_against_a_band_limited_force(params, f_rel):
     y_blk, _ = _drive(FAMILY.block(s, params), FAMILY.rest_state(s, params, u[0]),
                       np.tile(u, periods), off=0)
     assert_allclose(y_blk, y_step, rtol=0, atol=1e-12)
-    fine = FAMILY.at(s, DT / 8)
+    fine = FAMILY.at(s, DT / 8)  # the same 4 substeps: an RK4 step 8x shorter
     y_bl, _ = FAMILY.simulate(fine, params,
                               np.tile(bw.bandlimited_upsample(u, 8, periodic=True), periods))
     last, ref = y_step[-n:], y_bl[-8 * n::8]  # steady state, same sample times
