@@ -81,21 +81,25 @@ def invert(y, x0, band, g, w, v_b, dt):
 # Loop blocks (protocol in ``hystkit.models._protocol``): body = [N, V_b, dt, band (N),
 # effective conductance (N), w (N + 1)], as ``LadderFamily.block`` packs it.
 
+@njit(cache=True, inline="always")
+def _unpack(body):
+    n = int(body[0])
+    return body[3:3 + n], body[3 + n:3 + 2 * n], body[3 + 2 * n:4 + 3 * n], body[1], body[2]
+
+
 @njit(cache=True)
 def block_forward(body, x, xn, off, u):
     """Output from the present voltages, then the Euler step driven by ``u``."""
-    n = int(body[0])
-    band, g, w = body[3:3 + n], body[3 + n:3 + 2 * n], body[3 + 2 * n:4 + 3 * n]
-    y = output(u, x, off, w, body[1])
-    euler(u, x, xn, off, band, g, body[2])
+    band, g, w, v_b, dt = _unpack(body)
+    y = output(u, x, off, w, v_b)
+    euler(u, x, xn, off, band, g, dt)
     return y
 
 
 @njit(cache=True)
 def block_inverse(body, x, xn, off, y):
     """``e = (y + V_b - sum w_k U_k) / w_0``, then the Euler step driven by ``e``."""
-    n = int(body[0])
-    band, g, w = body[3:3 + n], body[3 + n:3 + 2 * n], body[3 + 2 * n:4 + 3 * n]
-    e = solve_input(y, x, off, w, body[1])
-    euler(e, x, xn, off, band, g, body[2])
+    band, g, w, v_b, dt = _unpack(body)
+    e = solve_input(y, x, off, w, v_b)
+    euler(e, x, xn, off, band, g, dt)
     return e
