@@ -104,6 +104,11 @@ class LoopMargins:
     growth_time_s : float or None
         For an unstable loop, the e-folding time ``Ts / ln max|pole|`` [s] of its fastest
         growing mode: a slow drift (hours) and a blow-up (milliseconds) both count as unstable.
+        None when no pole lies outside the unit circle (within :data:`MARGINAL`).
+    marginal : bool
+        The largest pole lies on the unit circle (within :data:`MARGINAL`): a state the
+        linearised loop neither corrects nor amplifies, e.g. a friction element or a dead band
+        of a sensor model that holds its state at rest.
     """
 
     crossover_hz: float | None
@@ -113,9 +118,14 @@ class LoopMargins:
     closed_loop_stable: bool
     max_pole_radius: float
     growth_time_s: float | None = None
+    marginal: bool = False
 
     def to_dict(self) -> dict:
         return dict(vars(self))
+
+
+MARGINAL = 1e-12
+"""Pole radii within this of 1 count as on the unit circle (rounding of the eigenvalues)."""
 
 
 def _finite(x: float) -> float | None:
@@ -161,10 +171,13 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
             j = above[0]
             f_pc = brentq(lambda x: (-h(x)).imag, f[j], f[j + 1], xtol=1e-12 * f[j])
             gm = float(-20 * np.log10(abs(h(f_pc))))
+    marginal = abs(radius - 1.0) <= MARGINAL
+    growing = radius > 1.0 + MARGINAL
     return LoopMargins(crossover_hz=f_c, phase_margin_deg=pm, gain_margin_db=gm,
-                       phase_crossover_hz=f_pc, closed_loop_stable=radius < 1.0,
+                       phase_crossover_hz=f_pc, closed_loop_stable=radius < 1.0 - MARGINAL,
                        max_pole_radius=radius,
-                       growth_time_s=None if radius < 1.0 else float(loop.ts / np.log(radius)))
+                       growth_time_s=float(loop.ts / np.log(radius)) if growing else None,
+                       marginal=marginal)
 
 
 def bode_data(loop: ControlLoop, state: LoopState | None = None,
