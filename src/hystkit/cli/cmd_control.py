@@ -37,6 +37,7 @@ from ..control import (
     table_ii_sensor,
     table_ii_sensors,
     tune_pid,
+    virtual_sensor_block,
 )
 from ..io import check_output_path, read_recording, write_json
 from ..models import FAMILIES
@@ -58,10 +59,12 @@ def _positive_float(text: str) -> float:
 
 
 def _sensor(sensor: str):
-    """``S_r`` from ``--sensor``: None (fit on the virtual sensor), a table-II column, or a
-    model file run position -> sensor."""
+    """``S_r`` from ``--sensor``: None (fit on the virtual sensor), the virtual sensor's own
+    physics, a table-II column, or a model file run position -> sensor."""
     if sensor == "virtual":
         return None
+    if sensor == "virtual-physics":
+        return virtual_sensor_block()
     if sensor.startswith("table-ii-"):
         column = sensor.removeprefix("table-ii-")
         if column not in table_ii_sensors():
@@ -269,9 +272,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mass", type=_positive_float, default=MASS, help="moving mass [kg]")
     p.add_argument("--u-max", type=_positive_float, default=np.inf,
                    help="actuator force limit [N] (default none)")
-    p.add_argument("--sensor", default="virtual", metavar="virtual|table-ii-COLUMN|MODEL.json",
+    p.add_argument("--sensor", default="virtual",
+                   metavar="virtual|virtual-physics|table-ii-COLUMN|MODEL.json",
                    help="S_r: a model (family --sensor-model) fitted on the virtual sensor's "
-                        "noise run (default); a column of paper 9.2's table II run as a sensor "
+                        "noise run (default); the virtual sensor's own causal physics "
+                        "(virtual-physics: no model error, the compensator meets the sensor "
+                        "itself; give --training recording to fit the compensator on its sine "
+                        "recording); a column of paper 9.2's table II run as a sensor "
                         "(its inverse; table-ii-noise is the document's S_r, fig. 7.2); or a "
                         "model file of any family run position -> sensor (an inverse-mode file "
                         "as is, a direct-mode file through its family's inverse)")

@@ -55,6 +55,7 @@ from ._sensors import (
     sensor_block,
     table_ii_sensor,
     table_ii_sensors,
+    virtual_sensor_block,
 )
 
 __all__ = [
@@ -108,4 +109,5 @@ __all__ = [
     "table_ii_sensors",
     "tare",
     "tune_pid",
+    "virtual_sensor_block",
 ]

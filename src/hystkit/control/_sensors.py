@@ -35,7 +35,7 @@ from ..compensation import Compensator, Scaling, fit_compensator
 from ..errors import InputError
 from ..io import Recording
 from ..models import Family, family_of, get_family
-from ..sensors import simulate_experiment
+from ..sensors import VIRTUAL_PHYSICS, VirtualSensor, physics_of, simulate_experiment
 from . import _kernel
 
 __all__ = [
@@ -50,6 +50,7 @@ __all__ = [
     "sensor_block",
     "table_ii_sensor",
     "table_ii_sensors",
+    "virtual_sensor_block",
 ]
 
 MM = 1e-3  # recordings hold position in mm; the loop works in metres
@@ -459,3 +460,22 @@ def table_ii_sensor(column: str = "noise", *, sensor_scale: float = 1.0,
                              "fit)", "size": 1, "fit_dt": structure.dt,
                              "position_scale_m": TABLE_II_POSITION_SCALE,
                              "sensor_scale": sensor_scale})
+
+
+def virtual_sensor_block(sensor: VirtualSensor | None = None, *,
+                         name: str = "S_r") -> SensorBlock:
+    """The virtual sensor's own causal physics as the "real" sensor ``S_r``: position [m] ->
+    ``dR1/R1 - dR2/R2``, the units of its recordings (:mod:`hystkit.sensors._loop_model`).
+
+    The stand-in for the FEM model the document lacked (ch. 6): a compensator fitted on
+    :func:`~hystkit.sensors.simulate_experiment` recordings meets the sensor itself, not a model
+    of it. Deterministic (no noise, temperature or settling); ``fit_dt`` is the recordings'
+    rate, at which ``fit_sensor_models(training="loop")`` runs it.
+    """
+    sensor = VirtualSensor() if sensor is None else sensor
+    structure, params = physics_of(sensor)
+    return SensorBlock(structure, params, False, 0.0, MM, 0.0, 1.0, name=name,
+                       info={"source": "<virtual sensor physics: steps 1-4, causal>",
+                             "model": VIRTUAL_PHYSICS.name, "direction": "position -> sensor",
+                             "size": structure.n_state, "fit_dt": 1.0 / sensor.fs_out},
+                       model_family=VIRTUAL_PHYSICS)

@@ -20,6 +20,9 @@ from the mPL model it is used to test:
 5. Measurement: resistance noise, a 5 um quadrature encoder for position, the document's
    20 Hz zero-phase Butterworth filter, downsampling to 40 Hz, and dR/R about the recording
    mean (eq. 4.4-4.5); the output is ``dR1/R1 - dR2/R2``.
+
+Steps 2-4 are computed by the per-sample laws of :mod:`._physics`, which the causal loop model
+(:mod:`._loop_model`, the sensor as ``S_r`` of the closed loop) shares.
 """
 
 from __future__ import annotations
@@ -32,6 +35,14 @@ from numba import njit
 from ..io import Recording
 from ..preprocess import downsample, lowpass_zero_phase
 from ..signals import EXPERIMENTS, excitation
+from ._physics import (
+    instant_fraction,
+    network_step,
+    piezoresistance,
+    prony_decay,
+    softening_factor,
+    travel_step,
+)
 
 __all__ = ["VirtualSensor", "simulate_experiment"]
 
@@ -75,8 +86,8 @@ class VirtualSensor:
 
     def network_strain(self, strain: np.ndarray) -> np.ndarray:
         """Strain followed by the conductive network, for imposed ``strain`` at ``fs_internal``."""
-        c = 1.0 - sum(self.prony_fractions) - sum(self.play_weights)
-        decay = np.exp(-1.0 / (self.fs_internal * np.asarray(self.prony_taus)))
+        c = instant_fraction(self.prony_fractions, self.play_weights)
+        decay = prony_decay(self.prony_taus, 1.0 / self.fs_internal)
         return _network_strain(np.ascontiguousarray(strain, dtype=float), c,
                                np.asarray(self.prony_fractions, float), decay,
                                np.asarray(self.play_weights, float),
@@ -89,13 +100,16 @@ class VirtualSensor:
         temp = _ornstein_uhlenbeck(t.size, 1.0 / self.fs_internal, self.temp_tau, self.temp_std,
                                    rng)
         age = self.age_hours + t / 3600.0
-        travel = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(strain)))])
+        travel = _strain_travel(np.ascontiguousarray(strain))
         out = np.empty((2, t.size))
         for g, sign in enumerate((1.0, -1.0)):
             m = self.network_strain(sign * strain)
-            softened = 1.0 + self.softening[g] * (1.0 - np.exp(-travel / self.softening_travel))
+            # .py_func: the same law through numpy's exp, which numba's vectorised exp differs
+            # from by an ulp; keeps the recordings bit-identical to earlier releases
+            softened = softening_factor.py_func(travel, self.softening[g], self.softening_travel)
             settle = 1.0 + self.settle_drop[g] * np.exp(-age / self.settle_tau_hours)
-            out[g] = (self.base_resistance[g] * settle * softened * np.exp(self.gauge_factors[g] * m)
+            out[g] = (self.base_resistance[g] * settle * softened
+                      * piezoresistance.py_func(m, self.gauge_factors[g])
                       * (1.0 + self.temp_coefficients[g] * temp)
                       * (1.0 + self.noise_rel * rng.standard_normal(t.size)))
         return out
@@ -151,18 +165,21 @@ def _ar1(kicks, a):
 
 @njit(cache=True)
 def _network_strain(strain, c, fractions, decay, weights, radii):
-    """Instant part + Prony retardation (exact exponential update) + play operators."""
+    """Step 2 over a whole run, from the Prony states at ``strain[0]`` and virgin plays."""
     q = np.full(fractions.size, strain[0])
-    play = np.zeros(radii.size)  # virgin state
+    play = np.zeros(radii.size)
     out = np.empty_like(strain)
     for n in range(strain.size):
-        s = strain[n]
-        acc = c * s
-        for i in range(fractions.size):
-            acc += fractions[i] * q[i]
-            q[i] = s + decay[i] * (q[i] - s)
-        for j in range(radii.size):
-            play[j] = max(s - radii[j], min(s + radii[j], play[j]))  # eq. 2.6 play operator
-            acc += weights[j] * play[j]
+        out[n] = network_step(strain[n], c, fractions, decay, weights, radii, q, play, q, play)
+    return out
+
+
+@njit(cache=True)
+def _strain_travel(strain):
+    """Accumulated strain travel at every sample, 0 at the first."""
+    out = np.empty_like(strain)
+    acc = 0.0
+    for n in range(strain.size):
+        acc = travel_step(acc, strain[n], strain[n - 1]) if n else 0.0
         out[n] = acc
     return out
