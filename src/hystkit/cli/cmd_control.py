@@ -136,6 +136,16 @@ def _loop(args: argparse.Namespace, models: SensorModels):
     return loop
 
 
+def _closed_loop(margins) -> str:
+    if margins.closed_loop_stable:
+        return "stable"
+    if margins.marginal:
+        return ("marginally stable (a pole on the unit circle: a model state the linearised "
+                "loop neither corrects nor amplifies, e.g. a sticking element at rest)")
+    return (f"UNSTABLE (max |pole| {margins.max_pole_radius:.10f}: grows e-fold in "
+            f"{margins.growth_time_s:.3g} s)")
+
+
 def _fmt(x) -> str:
     return "n/a" if x is None else f"{x:.3g}"
 
@@ -151,7 +161,8 @@ def _control(args: argparse.Namespace) -> int:
     if args.sensor != "virtual" and args.sensor_data is not None:
         raise UsageError("--sensor-data fits S_r on a recording; it cannot be combined with "
                          f"--sensor {args.sensor}")
-    training = args.training or ("recording" if args.sensor == "virtual" else "loop")
+    training = args.training or ("recording" if args.sensor in ("virtual", "virtual-physics")
+                                 else "loop")
     t_start = time.perf_counter()
     models = _models(training, args.training_excitation, args.sensor_size,
                      args.model_size, args.sensor_data, args.training_data, args.sensor,
@@ -179,9 +190,7 @@ def _control(args: argparse.Namespace) -> int:
           f"{_fmt(margins.phase_margin_deg)} deg, gain margin "
           f"{_fmt(margins.gain_margin_db) if margins.gain_margin_db is not None else 'inf'} dB,"
           f" closed loop "
-          + ("stable" if margins.closed_loop_stable else
-             f"UNSTABLE (max |pole| {margins.max_pole_radius:.10f}: grows e-fold in "
-             f"{margins.growth_time_s:.3g} s)"))
+          + _closed_loop(margins))
     config = {
         "hystkit_version": __version__, "scheme": args.scheme, "sensor": args.sensor, "experiment": args.experiment,
         "ts": loop.ts, "mass": loop.plant.mass, "u_max": loop.plant.u_max
@@ -277,8 +286,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="S_r: a model (family --sensor-model) fitted on the virtual sensor's "
                         "noise run (default); the virtual sensor's own causal physics "
                         "(virtual-physics: no model error, the compensator meets the sensor "
-                        "itself; give --training recording to fit the compensator on its sine "
-                        "recording); a column of paper 9.2's table II run as a sensor "
+                        "itself; the compensator is fitted on its sine recording, as with "
+                        "virtual); a column of paper 9.2's table II run as a sensor "
                         "(its inverse; table-ii-noise is the document's S_r, fig. 7.2); or a "
                         "model file of any family run position -> sensor (an inverse-mode file "
                         "as is, a direct-mode file through its family's inverse)")
@@ -289,8 +298,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="family of the fitted compensator and S_m (default mpl)")
     p.add_argument("--training", choices=TRAININGS, default=None,
                    help="compensator / S_m data: a virtual-sensor recording (default with "
-                        "--sensor virtual) or S_r's own response to the sine (the document's "
-                        "protocol; default with a table-II sensor)")
+                        "--sensor virtual or virtual-physics) or S_r's own response to the sine "
+                        "(the document's protocol; default with a table-II sensor or a model "
+                        "file)")
     p.add_argument("--training-excitation", choices=sorted(EXCITATIONS), default="sine",
                    help="excitation of the training recording (default sine, 0.5 Hz 3 mm)")
     p.add_argument("--sensor-data", type=Path,
