@@ -128,7 +128,7 @@ def _run(capsys, *args) -> tuple[int, str, str]:
 
 def test_toy_family_is_fitted_saved_and_loaded(toy, recording, tmp_path, capsys):
     model = tmp_path / "toy.json"
-    code, out, err = _run(capsys, "fit", recording, "--model", "toy-lag", "--out", model)
+    code, _out, err = _run(capsys, "fit", recording, "--model", "toy-lag", "--out", model)
     assert code == 0, err
     comp = load_compensator(model)
     assert comp.model == "toy-lag" and isinstance(comp.params, LagParams)
@@ -148,7 +148,7 @@ def test_toy_family_in_the_closed_loop(toy, recording, tmp_path, capsys, scheme)
     model = tmp_path / "toy.json"
     _run(capsys, "fit", recording, "--model", "toy-lag", "--mode", "inverse", "--out", model)
     slot = "--compensator" if scheme == "direct" else "--model-file"
-    code, out, err = _run(capsys, "control", "--scheme", scheme, "--experiment", "sine", slot,
+    code, _out, err = _run(capsys, "control", "--scheme", scheme, "--experiment", "sine", slot,
                           model, "--out", tmp_path / "loop")
     assert code == 0, err
     metrics = json.loads((tmp_path / "loop" / "metrics.json").read_text())
