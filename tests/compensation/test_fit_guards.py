@@ -28,16 +28,42 @@ def test_a_fit_worse_than_its_line_says_so():
     assert status == "worse_than_line"
 
 
+def _on_bound_result(**extra):
+    return FitResult(structure=None, params=None, cost=0.0, n_evaluations=1, seconds=0.0,
+                     converged=True, message="", n_starts=1,
+                     theta=np.array([0.5, np.log(1e3) - 2e-7]),
+                     bounds=(np.array([0.0, np.log(1e-3)]), np.array([1.0, np.log(1e3)])),
+                     **extra)
+
+
 def test_parameters_on_a_bound_are_flagged_never_ok():
     target = np.sin(np.linspace(0, 20, 400))
-    result = FitResult(structure=None, params=None, cost=0.0, n_evaluations=1, seconds=0.0,
-                       converged=True, message="", n_starts=1,
-                       theta=np.array([0.5, np.log(1e3) - 2e-7]),
-                       bounds=(np.array([0.0, np.log(1e-3)]), np.array([1.0, np.log(1e3)])))
-    flags = bound_flags(result)
-    assert flags == [1]
-    assert fit_status(target, target, 0.9 * target, flags, True)[0] == "on_bounds"
+    flags, notes = bound_flags(_on_bound_result())
+    assert flags == ["theta[1] (upper)"] and notes == []
+    status, message = fit_status(target, target, 0.9 * target, flags, True)
+    assert status == "on_bounds" and "theta[1] (upper)" in message
     assert fit_status(target, target, 0.9 * target, [], True)[0] == "ok"
+
+
+def test_a_bound_hit_is_reported_by_name():
+    target = np.sin(np.linspace(0, 20, 400))
+    flags, _ = bound_flags(_on_bound_result(names=("w", "log_v_t")))
+    status, message = fit_status(target, target, 0.9 * target, flags, True)
+    assert status == "on_bounds" and message.endswith("search box: log_v_t (upper)")
+
+
+def test_a_model_limit_is_not_on_bounds():
+    target = np.sin(np.linspace(0, 20, 400))
+    flags, notes = bound_flags(_on_bound_result(
+        names=("w", "log_v_t"), limits=((None, None), (None, "the resistor is linear"))))
+    assert flags == [] and notes == ["the resistor is linear"]
+    assert fit_status(target, target, 0.9 * target, flags, True)[0] == "ok"
+
+
+def test_a_fit_without_bounds_has_no_bound_flags():
+    result = FitResult(structure=None, params=None, cost=0.0, n_evaluations=1, seconds=0.0,
+                       converged=True, message="", n_starts=1)
+    assert bound_flags(result) == (None, [])
 
 
 def test_standard_errors_agree_with_scipy_curve_fit():

@@ -70,6 +70,8 @@ def _fit(args: argparse.Namespace) -> int:
           f"; AIC {info['aic']:.1f}, BIC {info['bic']:.1f}; sensor polarity {comp.polarity:+g}")
     if info.get("joint_fit"):
         print(f"  {info['joint_fit']}")
+    for note in info.get("at_model_limits") or ():
+        print(f"  note: {note}")
     print(f"wrote {args.out}")
     if info["status"] != "ok":
         print(f"hystkit: fit {info['status'].replace('_', ' ')}: {info['status_message']}; the "

@@ -74,25 +74,31 @@ def _finite_or_none(x):
     return [float(v) if np.isfinite(v) else None for v in np.asarray(x)]
 
 
-def bound_flags(result: FitResult) -> list[int] | None:
-    """Indices of optimiser coordinates on or near a bound; None when the fit did not say."""
-    theta, bounds = getattr(result, "theta", None), getattr(result, "bounds", None)
-    if theta is None or bounds is None:
-        return None
-    lower, upper = (np.asarray(b, dtype=float) for b in bounds)
-    width = np.where(np.isfinite(upper - lower), upper - lower, 1.0)
-    tol = BOUND_TOLERANCE * np.maximum(width, 1e-12)
-    near = (np.isfinite(lower) & (theta - lower <= tol)) | \
-        (np.isfinite(upper) & (upper - theta <= tol))
-    return [int(i) for i in np.flatnonzero(near)]
+def bound_flags(result: FitResult) -> tuple[list[str] | None, list[str]]:
+    """Parameters on or near a bound: ``(search box hits, model-limit notes)``.
+
+    The first list names (``FitResult.names``, else ``theta[i]``) the optimiser coordinates
+    on a bound of the search box, with the side, e.g. ``"log_v_t[2] (upper)"``; None when the
+    fit did not record its bounds. The second holds the family's notes for coordinates on a
+    bound that is a limit of the model itself (``"cell 2 runs at the Euler slope cap ..."``):
+    a fitted model there is valid, so these are notes, not a failed guard.
+    """
+    find = getattr(result, "bound_hits", None)
+    hits = None if find is None else find(BOUND_TOLERANCE)
+    if hits is None:
+        return None, []
+    return ([f"{h.name} ({h.side})" for h in hits if h.limit is None],
+            [h.limit for h in hits if h.limit is not None])
 
 
 def fit_status(estimate: np.ndarray, target: np.ndarray, line: np.ndarray,
-               on_bounds: list[int] | None, converged: bool) -> tuple[str, str]:
+               on_bounds: list[str] | None, converged: bool) -> tuple[str, str]:
     """``(status, message)`` of a fit from its training estimate and the straight line's.
 
     Status is the first that applies: ``collapsed`` (estimate constant), ``worse_than_line``
-    (training R² below the line's), ``on_bounds``, ``not_converged``, else ``ok``.
+    (training R² below the line's), ``on_bounds`` (search box hits, by name: see
+    :func:`bound_flags`; a model at its own limit is not on bounds), ``not_converged``, else
+    ``ok``.
     """
     r2_model, r2_line = r2(target, estimate), r2(target, line)
     if np.std(estimate) < COLLAPSE_RATIO * np.std(target):
@@ -102,8 +108,8 @@ def fit_status(estimate: np.ndarray, target: np.ndarray, line: np.ndarray,
         return "worse_than_line", (f"training R² {r2_model:.4f} is below the straight line's "
                                    f"{r2_line:.4f}")
     if on_bounds:
-        return "on_bounds", (f"{len(on_bounds)} parameter(s) on a bound of the search "
-                             f"(optimiser coordinates {on_bounds})")
+        return "on_bounds", (f"{len(on_bounds)} parameter(s) on a bound of the search box: "
+                             f"{', '.join(map(str, on_bounds))}")
     if not converged:
         return "not_converged", "the solver stopped on its evaluation budget"
     return "ok", f"training R² {r2_model:.4f} (straight line {r2_line:.4f})"

@@ -168,7 +168,8 @@ def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording],
     p = np.concatenate(p_list)
     estimate = simulate_segments(run, structure, comp.params, s_list)
     line = comp.baseline(np.concatenate(s_list))
-    on_bounds = bound_flags(result) if len(recs) == 1 else None
+    # after a joint polish (no bounds) the family fit's optimum is not the model's
+    on_bounds, limit_notes = bound_flags(result) if len(recs) == 1 else (None, [])
     status, message = fit_status(estimate, p, line, on_bounds, result.converged)
     n = p.size
     forward = simulate_segments(family.simulate, structure, comp.params, inputs)
@@ -181,7 +182,8 @@ def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording],
             "training_sources": [r.source for r in recs],
             "training_samples": int(n), "status": status, "status_message": message,
             "training_r2": r2(p, estimate), "training_linear_r2": r2(p, line),
-            "on_bounds": on_bounds, "aic": float(log_term + 2 * k),
+            "on_bounds": on_bounds, "at_model_limits": limit_notes,
+            "aic": float(log_term + 2 * k),
             "bic": float(log_term + k * np.log(n))}
     if diagnose:
         target = np.concatenate(targets)

@@ -47,7 +47,10 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
                    jac: Callable[[np.ndarray], np.ndarray] | str = "2-point",
                    max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
                    accept: Callable[[Any], bool] | None = None,
-                   accept_reason: str = "rejected by the acceptance test") -> FitResult:
+                   accept_reason: str = "rejected by the acceptance test",
+                   names: Sequence[str] | None = None,
+                   limits: tuple[Sequence[str | None], Sequence[str | None]] | None = None,
+                   ) -> FitResult:
     """Minimise ``sum(residual(theta)**2)`` from several starts; return the best as a FitResult.
 
     Every start first gets ``screen_nfev`` evaluations; the ``n_polish`` cheapest are then run
@@ -66,13 +69,29 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
         ``theta -> params`` of the model family.
     jac : callable or "2-point"
         Exact Jacobian if the family has one, else finite differences.
+    names : sequence of str, optional
+        Names of the ``theta`` coordinates, so that reports name a parameter on a bound
+        (``FitResult.bound_hits``) instead of giving its index.
+    limits : (lower labels, upper labels), optional
+        Which bounds are limits of the model itself rather than of the search box: per
+        coordinate a note (``"cell 2 runs at the Euler slope cap"``) or None. A fit that ends
+        on such a bound has found a model at its own limit; reports show the note instead of
+        calling the fit "on bounds".
 
     Raises
     ------
     FitDivergedError
         If no start gives a finite cost, or every candidate is vetoed (the message says why).
+    ValueError
+        If ``names`` or ``limits`` do not have one entry per coordinate.
     """
     lower, upper = (np.asarray(b, dtype=float) for b in bounds)
+    names = _per_coordinate(names, lower.size, "names")
+    if limits is not None:
+        if len(limits) != 2:
+            raise ValueError("limits must be a pair (lower labels, upper labels)")
+        limits = (_per_coordinate(limits[0], lower.size, "limits[0]"),
+                  _per_coordinate(limits[1], lower.size, "limits[1]"))
     margin = 1e-9 * np.maximum(1.0, upper - lower)
 
     def solve(theta0: np.ndarray, budget: int):
@@ -114,4 +133,22 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
                      n_evaluations=int(n_eval), seconds=time.perf_counter() - t_start,
                      converged=bool(best.status > 0), message=str(best.message),
                      n_starts=len(starts), theta=np.array(best.x),
-                     bounds=(lower, upper))
+                     bounds=(lower, upper), names=names, limits=limits,
+                     sensitivity=_column_norms(best.jac))
+
+
+def _column_norms(jac: Any) -> np.ndarray | None:
+    """Column norms of the solver's Jacobian at the optimum (None if it has none)."""
+    if jac is None:
+        return None
+    jac = jac.toarray() if hasattr(jac, "toarray") else np.asarray(jac, dtype=float)
+    return np.linalg.norm(jac, axis=0) if jac.ndim == 2 else None
+
+
+def _per_coordinate(values: Sequence | None, n: int, what: str) -> tuple | None:
+    if values is None:
+        return None
+    values = tuple(values)
+    if len(values) != n:
+        raise ValueError(f"{what} must have one entry per coordinate ({n}), got {len(values)}")
+    return values

@@ -5,7 +5,37 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["FitResult"]
+import numpy as np
+
+__all__ = ["INSENSITIVE", "BoundHit", "FitResult"]
+
+# A coordinate whose Jacobian column is below this share of the largest column does not affect
+# the model output at the optimum (e.g. V_T of an mPL cell at the Euler slope cap: exactly 0).
+INSENSITIVE = 1e-10
+
+
+@dataclass(frozen=True)
+class BoundHit:
+    """An optimiser coordinate on (or within a tolerance of) one of its bounds.
+
+    Attributes
+    ----------
+    index : int
+        Position in ``theta``.
+    name : str
+        The coordinate's name if the fit gave names, else ``theta[index]``.
+    side : {"lower", "upper"}
+    limit : str or None
+        Why this hit is not a failure: for a bound that is the model's own limit (e.g. the
+        mPL's Euler slope cap, eq. 5.28-5.29) the family's note on what it means; for a
+        coordinate the model output does not depend on at the optimum, a note saying so (its
+        bound holds nothing). None for a search box hit.
+    """
+
+    index: int
+    name: str
+    side: str
+    limit: str | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -31,6 +61,14 @@ class FitResult:
         The optimum in optimiser coordinates, when the fit used a bounded solver.
     bounds : (lower, upper) or None
         That solver's bounds, so reports can flag parameters sitting on one.
+    names : tuple of str or None
+        Names of the ``theta`` coordinates (optimiser coordinates, e.g. ``log_G[2]``).
+    limits : (lower labels, upper labels) or None
+        Per coordinate and side, the note of a bound that is a limit of the model itself
+        (reaching it is a property of the fitted model, not a search box hit), else None.
+    sensitivity : array or None
+        Column norms of the residual's Jacobian at the optimum (how much each coordinate
+        moves the model output there).
     """
 
     structure: Any
@@ -43,3 +81,36 @@ class FitResult:
     n_starts: int
     theta: Any = None
     bounds: Any = None
+    names: Any = None
+    limits: Any = None
+    sensitivity: Any = None
+
+    def bound_hits(self, tolerance: float) -> list[BoundHit] | None:
+        """Coordinates of ``theta`` within ``tolerance`` x (bound interval) of a finite bound.
+
+        None when the fit did not record ``theta`` and ``bounds``. A coordinate on a model
+        limit carries that limit's note (``BoundHit.limit``), and so does one that does not
+        affect the output at the optimum (Jacobian column below ``INSENSITIVE`` x the largest).
+        """
+        if self.theta is None or self.bounds is None:
+            return None
+        theta = np.asarray(self.theta, dtype=float)
+        lower, upper = (np.asarray(b, dtype=float) for b in self.bounds)
+        width = np.where(np.isfinite(upper - lower), upper - lower, 1.0)
+        tol = tolerance * np.maximum(width, 1e-12)
+        free = np.zeros(theta.size, bool)
+        if self.sensitivity is not None:
+            norms = np.asarray(self.sensitivity, dtype=float)
+            free = norms <= INSENSITIVE * max(float(np.max(norms, initial=0.0)), 1e-300)
+        hits = []
+        for side, on_side in (("lower", np.isfinite(lower) & (theta - lower <= tol)),
+                              ("upper", np.isfinite(upper) & (upper - theta <= tol))):
+            labels = None if self.limits is None else self.limits[0 if side == "lower" else 1]
+            for i in np.flatnonzero(on_side):
+                name = self.names[i] if self.names is not None else f"theta[{i}]"
+                limit = None if labels is None else labels[i]
+                if limit is None and free[i]:
+                    limit = (f"{name} does not affect the model output at the optimum (its "
+                             f"{side} bound holds nothing)")
+                hits.append(BoundHit(int(i), str(name), side, limit))
+        return sorted(hits, key=lambda h: h.index)

@@ -17,7 +17,7 @@ from ...identification import FitResult, check_fit_data, fit_multistart
 from . import kernels
 from . import model as mpl
 
-__all__ = ["default_starts", "fit_mpl"]
+__all__ = ["default_starts", "fit_mpl", "theta_limits", "theta_names"]
 
 # Bounds in optimiser coordinates (see MplParams.to_vector). |w| <= 100 mirrors the document's
 # weight-sum constraint of 10^2 (sec. 5.3.3).
@@ -38,6 +38,40 @@ def _linear_init(structure: mpl.MplStructure, i_s: np.ndarray, v_t: np.ndarray,
     coef = np.linalg.lstsq(lin, y, rcond=None)[0]
     coef[:-1] = np.clip(coef[:-1], -0.9 * _W_BOUND, 0.9 * _W_BOUND)
     return mpl.MplParams(i_s=i_s, v_t=v_t, w=coef[:-1], v_b=coef[-1])
+
+
+def theta_names(n_cells: int) -> list[str]:
+    """Names of the optimiser coordinates (:meth:`MplParams.to_vector`), cells from 1."""
+    cells = [f"{name}[{k}]" for k in range(1, n_cells + 1) for name in ("log_G", "log_v_t")]
+    return [*cells, *(f"w[{k}]" for k in range(n_cells + 1)), "v_b"]
+
+
+def theta_limits(n_cells: int) -> tuple[list[str | None], list[str | None]]:
+    """Which bounds are the model's own limits, with a note for each (see ``fit_multistart``).
+
+    The criterion: moving past the bound cannot change the model's output, so a fit there has
+    found a valid model at a limit of the family, not a search box that is too small.
+
+    * Upper bound of ``log G_k`` (``G_k = 2 I_S / V_T``, the cell's small-signal slope):
+      ``slope_cap / dt`` is the Euler stability limit (eq. 5.28-5.29). At and beyond it the
+      knee voltage is 0 and the limited resistor is the straight line of slope ``slope_cap /
+      dt`` whatever ``G_k`` is: exactly the same model.
+    * Upper bound of ``log V_T,k`` (1e3): at fixed ``G_k`` the resistor ``G V_T sinh(v / V_T)``
+      tends to the linear ``G v`` as ``V_T -> inf``; at 1e3 it differs from that limit by
+      ``(v / V_T)^2 / 6 < 1e-6`` relative for the normalised data (|v| <= 2, eq. 5.10), so the
+      bound stands for a linear cell resistor.
+
+    Every other bound (``G_k`` at its floor, ``V_T`` at 1e-3, ``|w| = 100``) is a search box:
+    past it the model changes, and a fit there is reported as on bounds.
+    """
+    lower: list[str | None] = [None] * (3 * n_cells + 2)
+    upper = list(lower)
+    for k in range(n_cells):
+        upper[2 * k] = (f"cell {k + 1} runs at the Euler slope cap (G dt = slope_cap, "
+                        f"eq. 5.28-5.29)")
+        upper[2 * k + 1] = (f"cell {k + 1} has a linear resistor (V_T at its bound "
+                            f"{np.exp(_LOG_VT_BOUNDS[1]):g} stands for V_T -> inf)")
+    return lower, upper
 
 
 def default_starts(structure: mpl.MplStructure) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -115,4 +149,5 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
                           lambda th: mpl.MplParams.from_vector(th, n), structure,
                           jac=lambda th: run(th)[1], max_nfev=max_nfev,
                           screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
-                          accept_reason=accept_reason)
+                          accept_reason=accept_reason, names=theta_names(n),
+                          limits=theta_limits(n))

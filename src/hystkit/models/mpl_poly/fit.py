@@ -28,13 +28,24 @@ from ...identification import FitResult, check_fit_data, fit_multistart
 from . import model as mpl_poly
 from .presets import PAPER_9_2_TABLE_I, paper_9_2_params
 
-__all__ = ["canonical", "default_starts", "fit_mpl_poly"]
+__all__ = ["canonical", "default_starts", "fit_mpl_poly", "theta_names"]
 
 # Bounds in optimiser coordinates (MplPolyParams.to_vector). |w| <= 100 mirrors the document's
 # weight-sum constraint (sec. 5.3.3); the polynomial coefficients only need to stay finite.
 _COEF_BOUND = 1e3
 _LOG_C3_BOUNDS = (np.log(1e-6), np.log(1e4))
 _W_BOUND = 100.0
+
+
+def theta_names(n_cells: int) -> list[str]:
+    """Names of the optimiser coordinates (:meth:`MplPolyParams.to_vector`), cells from 1.
+
+    No bound of this fit is a model limit: the Euler slope cap acts through the limited
+    resistor's knees (eq. 5.29), not through a bound, so every bound hit is a search box hit.
+    """
+    cells = [f"f[{k}].{c}" for k in range(1, n_cells + 1) for c in ("c0", "c1", "c2", "log_c3")]
+    return [*cells, *(f"g.c{j}" for j in range(4)), *(f"w[{k}]" for k in range(n_cells + 1)),
+            "v_b"]
 
 
 def canonical(structure: mpl_poly.MplPolyStructure,
@@ -172,7 +183,7 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
     result = fit_multistart(lambda th: run(th)[0] - y, thetas, (lower, upper), to_params,
                             structure, jac=lambda th: run(th)[1], max_nfev=max_nfev,
                             screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
-                            accept_reason=accept_reason)
+                            accept_reason=accept_reason, names=theta_names(n))
     # the (N + 2)-dimensional valley of equivalent parameters (see the module docstring)
     if result.params.w[0] == 0:
         return result

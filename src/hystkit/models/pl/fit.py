@@ -29,12 +29,15 @@ from scipy.optimize import lsq_linear
 from ...identification import FitResult, check_fit_data, fit_multistart
 from . import model as pl
 
-__all__ = ["default_starts", "fit_pl", "solve_weights"]
+__all__ = ["THETA_NAMES", "default_starts", "fit_pl", "solve_weights"]
 
 _W_BOUND = 100.0
 _A_MIN = 0.05
 _LOG_VT = (np.log(1e-3), np.log(2.0))  # thresholds beyond N * 2 never matter on [-1, 1] data
 _LOG_IT = (np.log(1e-6), np.log(1e4))
+# The optimiser coordinates. Both bounds are search boxes (the Euler slope cap acts through the
+# straight branches of the characteristic, not through a bound), so no model limits are passed.
+THETA_NAMES = ("log_i_t", "log_v_t")
 
 def solve_weights(structure: pl.PlStructure, x: np.ndarray, u: np.ndarray,
                   y: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -137,4 +140,4 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
                           default_starts(structure) if starts is None else starts,
                           (lower, upper), lambda th: project(th)[0], structure,
                           max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
-                          accept=accept, accept_reason=accept_reason)
+                          accept=accept, accept_reason=accept_reason, names=THETA_NAMES)
