@@ -14,8 +14,7 @@ import time
 from centring_evidence import cases
 
 from hystkit.compensation import evaluate
-from hystkit.reports._compare import compare_models
-from hystkit.reports._select import candidates, select_model
+from hystkit.reports import candidates, compare_models, select_model
 
 
 def _best_of_compare(train, test) -> tuple[str, float]:

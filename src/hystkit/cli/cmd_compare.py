@@ -40,7 +40,7 @@ def _sizes(pairs: list[str]) -> dict[str, int]:
 
 def _compare(args: argparse.Namespace) -> int:
     # Matplotlib and the fits load only for this command.
-    from ..reports._compare import compare_models, format_compare
+    from ..reports import compare_models, format_compare
 
     models = _models(args.models)
     out = args.out
@@ -71,7 +71,7 @@ def _failures_exit(failed: list[str]) -> int:
 
 
 def _generalize(args: argparse.Namespace) -> int:
-    from ..reports._compare import generalization_matrix, plot_generalization
+    from ..reports import generalization_matrix, plot_generalization
 
     models = _models(args.models)
     out = args.out or Path("hystkit-generalize")

@@ -10,17 +10,19 @@ from pathlib import Path
 from ..compensation import (
     CENTERS,
     DEFAULT_CENTER,
+    DEFAULT_TARE_SECONDS,
+    DEFAULT_TRACK_SECONDS,
     MODES,
     ORACLE_CENTER,
+    POSITION_MARGIN,
+    SENSOR_MARGIN,
     center_label,
     evaluate,
     fit_compensator,
     load_compensator,
     save_compensator,
+    use_flags,
 )
-from ..compensation._centring import DEFAULT_TARE_SECONDS, DEFAULT_TRACK_SECONDS
-from ..compensation._compensator import POSITION_MARGIN, SENSOR_MARGIN
-from ..compensation._evaluate import use_flags
 from ..io import check_output_path, read_recording, write_json, write_recording
 from ..models import FAMILIES, get_family
 from ..sensors import simulate_experiment

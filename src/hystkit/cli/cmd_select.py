@@ -30,7 +30,7 @@ def _centers(text: str) -> list[str]:
 def _select(args: argparse.Namespace) -> int:
     import pandas as pd  # only this command needs it and matplotlib
 
-    from ..reports._select import candidates, plot_selection, select_model
+    from ..reports import candidates, plot_selection, select_model
 
     check_output_path(args.out, args.force)
     report = args.report or args.out.with_name(args.out.stem + "-selection")

@@ -3,14 +3,16 @@
 from ._centring import (
     CENTERS,
     DEFAULT_CENTER,
+    DEFAULT_TARE_SECONDS,
+    DEFAULT_TRACK_SECONDS,
     DEPLOYABLE_CENTERS,
     ORACLE_CENTER,
     center_label,
 )
-from ._compensator import MODES, Compensator
-from ._conventions import LinearBaseline, Scaling, prepare_training_data
+from ._compensator import MODES, POSITION_MARGIN, SENSOR_MARGIN, Compensator
+from ._conventions import LinearBaseline, Scaling, centre_and_scale, prepare_training_data
 from ._estimator import CompensatorEstimator
-from ._evaluate import evaluate
+from ._evaluate import evaluate, use_flags
 from ._fitting import fit_compensator
 from ._model_file import (
     compensator_from_dict,
@@ -19,7 +21,9 @@ from ._model_file import (
     save_compensator,
 )
 
-__all__ = ["CENTERS", "DEFAULT_CENTER", "DEPLOYABLE_CENTERS", "MODES", "ORACLE_CENTER",
+__all__ = ["CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",
+           "DEPLOYABLE_CENTERS", "MODES", "ORACLE_CENTER", "POSITION_MARGIN", "SENSOR_MARGIN",
            "Compensator", "CompensatorEstimator", "LinearBaseline", "Scaling", "center_label",
-           "compensator_from_dict", "compensator_to_dict", "evaluate", "fit_compensator",
-           "load_compensator", "prepare_training_data", "save_compensator"]
+           "centre_and_scale", "compensator_from_dict", "compensator_to_dict", "evaluate",
+           "fit_compensator", "load_compensator", "prepare_training_data", "save_compensator",
+           "use_flags"]

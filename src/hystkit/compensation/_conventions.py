@@ -11,7 +11,7 @@ from ..errors import InputError
 from ..io import Recording
 from ._centring import DEFAULT_TARE_SECONDS, DEFAULT_TRACK_SECONDS, ORACLE_CENTER, sensor_level
 
-__all__ = ["LinearBaseline", "Scaling", "prepare_training_data"]
+__all__ = ["LinearBaseline", "Scaling", "centre_and_scale", "prepare_training_data"]
 
 
 @dataclass(frozen=True)
@@ -88,8 +88,9 @@ def prepare_training_data(recordings: Sequence[Recording], center: str, *,
     return (conventions, [polarity * s / s_scale for s in s_c], [p / p_scale for p in p_c])
 
 
-def _centre_and_scale(recording: Recording, center: str) -> tuple[Scaling, np.ndarray,
-                                                                  np.ndarray]:
-    """One recording's scaling and normalised sensor and position (benchmarks use it)."""
+def centre_and_scale(recording: Recording, center: str) -> tuple[Scaling, np.ndarray,
+                                                                 np.ndarray]:
+    """One recording's scaling and its normalised sensor and position (eq. 5.10), centred
+    by ``center`` as a fit would (compare and the benchmarks use it)."""
     conventions, s, p = prepare_training_data([recording], center)
     return conventions["scaling"], s[0], p[0]

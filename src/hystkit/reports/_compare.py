@@ -11,8 +11,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..compensation import evaluate, fit_compensator
-from ..compensation._compensator import _centre_and_scale
+from ..compensation import centre_and_scale, evaluate, fit_compensator
 from ..errors import HystkitError
 from ..io import Recording
 from ..metrics import e_max_pct, e_rms_pct, r2
@@ -37,7 +36,7 @@ def _forward_scores(name: str, size: int | None, fit_rec: Recording,
     validation recording's own means, the paper's protocol).
     """
     family = get_family(name)
-    scaling, s_fit, p_fit = _centre_and_scale(fit_rec, "fit")
+    scaling, s_fit, p_fit = centre_and_scale(fit_rec, "fit")
     structure = family.make_structure(fit_rec.dt, structure_size(family, size))
     result = family.fit(p_fit, s_fit, structure)
     offsets = {"": (scaling.sensor_offset, scaling.position_offset),
