@@ -276,14 +276,33 @@ def test_micromanipulator_pipeline_runs_on_the_excerpts() -> None:
     ident = load_excerpt(MM, "identification")
     unc, ff = load_excerpt(MM, "test_uncompensated"), load_excerpt(MM, "test_feedforward")
     rows, comps = example.compare(ident, unc, ff, n_cells=(1,))
-    assert [r.segment for r in rows] == ["2-6 s", "62-66 s", "2-6 s"]
+    assert [r.segment for r in rows] == ["2-6 s", "2-6 s", "62-66 s", "2-6 s"]
+    assert [r.protocol for r in rows] == [example.DEPLOYABLE, example.AUTHOR, example.AUTHOR,
+                                          example.CALIBRATED]  # the deployable score first
     assert comps[1].structure.dt == pytest.approx(unc.dt)  # same rate, or estimate refuses
-    uncompensated, author, ours = rows
+    assert comps[1].center == "fit"
+    deployable, uncompensated, author, ours = rows
     for row in rows:
         assert np.isfinite([row.e_rms, row.e_max]).all() and row.span == pytest.approx(40.0)
     # Loose: the excerpt is 6 s of fitting data; on it any inverse must beat no inverse.
     assert author.e_rms < 0.2 * uncompensated.e_rms
     assert ours.e_rms < 0.5 * uncompensated.e_rms
+    # calibrating on the scored segment can only remove error (least squares over gain, offset)
+    assert ours.e_rms <= deployable.e_rms
+
+
+def test_the_deployable_score_uses_no_test_position() -> None:
+    """Its error is estimate minus applied drive over the drive map's gain, nothing fitted."""
+    example = _example()
+    unc = load_excerpt(MM, "test_uncompensated")
+    gain, offset = example.drive_map(unc)
+    d = unc.channels["desired_displacement"]
+    assert np.max(np.abs(unc.input - offset - gain * d)) < 1e-5
+    estimate = unc.input + 0.05 * gain  # an estimate 0.05 um of desired too high everywhere
+    row = example.score_deployable("x", "s", estimate, unc.input, d, gain)
+    assert row.e_rms == pytest.approx(0.05) and row.e_max == pytest.approx(0.05)
+    # the calibrated score would call the same constant error zero: that is why it is an oracle
+    assert example.score("x", "s", offset + gain * d + 0.05 * gain, d).e_rms < 1e-9
 
 
 def test_straightness_residual_removes_gain_and_offset_only() -> None:
@@ -298,7 +317,8 @@ def test_example_prints_the_table(capsys: pytest.CaptureFixture[str]) -> None:
     assert _example().main(["--excerpt", "--cells", "1"]) == 0
     out = capsys.readouterr().out
     assert "sample rates: identification 200 Hz, test 200 Hz" in out
-    assert out.count("| hystkit mPL inverse, 1 cell(s)") == 1
+    assert out.count("| hystkit mPL inverse, 1 cell(s)") == 2
+    assert out.index("| deployable |") < out.index("| calibrated on the segment (oracle) |")
 
 
 # --------------------------------------------------------------------------- CLI
