@@ -378,7 +378,8 @@ def test_demo_raw_flag_prints_the_raw_path(tmp_path, capsys, monkeypatch):
     canned = {"metrics": {}, "noise_trained": {}, "config": {},
               "raw_path": {"excitation": "sine", "scope_rate_hz": 5e4,
                            "metrics": {"r2": 0.99, "linear_r2": 0.93, "e_rms_pct": 1.0,
-                                       "loop_area": 0.1},
+                                       "loop_area": 0.1, "center": "fit", "r2_oracle": 0.991,
+                                       "linear_r2_oracle": 0.931},
                            "round_trip": {"validation": {
                                "position_max_error_um": 0.4, "position_max_error_counts": 0.08,
                                "sensor_rms_error": 4e-5, "n_illegal": 0, "n_edges": 240000}}}}
