@@ -39,6 +39,11 @@ demagnetised state (AC-demagnetised: ``S+ = {alpha + beta < 0}``, drawn as a sta
 reaches. The kernels keep it in a buffer of ``capacity`` entries; when it is about to fill, the
 innermost closed loop is forgotten (an output change of twice the weight inside that loop's
 rectangle, small because nested loops shrink).
+
+Loop state. The family protocol needs a state of fixed length, so ``FAMILY`` (``family.py``)
+and the compiled loop block store the staircase *packed*: ``[n, s_0, .., s_{n-1}, 0, ..]``,
+``capacity + 1`` floats (:func:`pack_state`). The functions of this module take and return the
+plain staircase.
 """
 
 from __future__ import annotations
@@ -47,9 +52,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import FitDivergedError
-from . import _preisach_kernels as kernels
-from ._validation import check_dt, check_signal, check_size
+from ...errors import FitDivergedError
+from .._protocol import Record
+from .._validation import check_dt, check_signal, check_size
+from . import kernels
 
 __all__ = [
     "PreisachParams",
@@ -62,11 +68,16 @@ __all__ = [
     "everett_from_masses",
     "grid",
     "invert",
+    "invert_step",
+    "kernel_parts",
     "masses_from_everett",
+    "pack_state",
+    "prepare_run",
     "simulate",
     "simulate_reference",
     "staircase_terms",
     "step",
+    "unpack_state",
     "update_staircase",
 ]
 
@@ -74,7 +85,7 @@ INVERT_TOL = 1e-12  # bisection bracket width on the normalised input before int
 
 
 @dataclass(frozen=True)
-class PreisachStructure:
+class PreisachStructure(Record):
     """What does not get fitted.
 
     Parameters
@@ -85,9 +96,12 @@ class PreisachStructure:
         Sample time [s]. The model is rate independent; ``dt`` only records the sampling.
     capacity : int
         Size of the staircase buffer (>= 2 L + 2); per-sample cost does not depend on it.
+        It is also the fixed length of the loop state (``capacity + 1`` floats, see
+        :func:`pack_state`). When the staircase is about to fill, the innermost closed loop is
+        forgotten (module docstring): the memory degrades gracefully, never overflows.
     smoothing : float
         Fit only: weight of the smoothness penalty on the Preisach density (see
-        ``identification/family_preisach.py``); 0 gives plain bounded least squares.
+        ``models/preisach/fit.py``); 0 gives plain bounded least squares.
     orientation : {"auto", "counterclockwise", "clockwise"}
         Fit only: sign of the hysteretic (off-diagonal) weights. Counter-clockwise loops
         (output lags input) need ``mu >= 0``, clockwise loops ``mu <= 0`` off the diagonal;
@@ -148,7 +162,7 @@ def antisymmetric(e: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class PreisachParams:
+class PreisachParams(Record):
     """Fitted quantities: the Everett function on the grid and the output offset.
 
     Parameters
@@ -189,6 +203,8 @@ class PreisachParams:
         """Cell masses (L-1, L-1); all >= 0 exactly when the weight ``mu`` is non-negative."""
         return masses_from_everett(self.everett)
 
+    # Model files store the strict lower triangle row by row (no zeros); Record's full-matrix
+    # form would change the file format, so the old one is kept.
     def to_dict(self) -> dict:
         rows = [self.everett[i, :i].tolist() for i in range(1, self.levels)]
         return {"everett": rows, "offset": self.offset}
@@ -202,13 +218,6 @@ class PreisachParams:
                 raise ValueError(f"everett row {i} must have {i} values, got {len(row)}")
             e[i, :i] = row
         return cls(everett=e, offset=d["offset"])
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, PreisachParams):
-            return NotImplemented
-        return bool(np.array_equal(self.everett, other.everett) and self.offset == other.offset)
-
-    __hash__ = None
 
 
 def everett(params: PreisachParams, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
@@ -275,6 +284,29 @@ def update_staircase(x: np.ndarray, u: float, capacity: int) -> np.ndarray:
     return np.array(s)
 
 
+def pack_state(x: np.ndarray, capacity: int) -> np.ndarray:
+    """Staircase -> fixed-length state ``[n, s_0 .. s_{n-1}, 0 ..]``, shape (capacity + 1,)."""
+    x = np.asarray(x, dtype=float)
+    if not 1 <= x.size <= capacity:
+        raise ValueError(f"a staircase of {x.size} values does not fit capacity {capacity}")
+    packed = np.zeros(capacity + 1)
+    packed[0] = x.size
+    packed[1:1 + x.size] = x
+    return packed
+
+
+def unpack_state(packed: np.ndarray, capacity: int) -> np.ndarray:
+    """Inverse of :func:`pack_state` (the count is rounded, so a float count is safe)."""
+    packed = np.asarray(packed, dtype=float)
+    if packed.shape != (capacity + 1,):
+        raise ValueError(f"the packed Preisach state has shape ({capacity + 1},) = (capacity "
+                         f"+ 1,), got {packed.shape}")
+    n = int(np.rint(packed[0])) if np.isfinite(packed[0]) else -1
+    if not 1 <= n <= capacity:
+        raise ValueError(f"the packed state's length {packed[0]!r} is not in 1..{capacity}")
+    return packed[1:1 + n].copy()
+
+
 def staircase_terms(e: np.ndarray, x: np.ndarray) -> float:
     """Relay part of eq. 9.13 for Everett nodes ``e`` and staircase ``x`` (plain sum)."""
     probe = PreisachParams(everett=e)
@@ -285,6 +317,13 @@ def staircase_terms(e: np.ndarray, x: np.ndarray) -> float:
 
 def _slope(params: PreisachParams) -> float:
     return float(params.everett[-1, 0])
+
+
+def kernel_parts(params: PreisachParams) -> tuple[np.ndarray, bool, np.ndarray, float]:
+    """What the compiled kernels run on: tables (1, L, L), weighted (False), output polynomial
+    (the offset) and the slope of the straight-line extension."""
+    return (antisymmetric(params.everett)[None], False, np.array([params.offset]),
+            _slope(params))
 
 
 def step(structure: PreisachStructure, params: PreisachParams, x: np.ndarray,
@@ -387,9 +426,15 @@ def invert(structure: PreisachStructure, params: PreisachParams, y: np.ndarray,
     if _slope(params) <= 0:
         raise FitDivergedError("the Preisach model's major loop does not rise (F(1, -1) <= 0); "
                                "it has no inverse")
-    tables = antisymmetric(params.everett)[None]
-    return kernels.invert(y, x, tables, False, np.array([params.offset]), _slope(params),
-                          structure.capacity, INVERT_TOL)
+    tables, weighted, poly, slope = kernel_parts(params)
+    return kernels.invert(y, x, tables, weighted, poly, slope, structure.capacity, INVERT_TOL)
+
+
+def invert_step(structure: PreisachStructure, params: PreisachParams, x: np.ndarray,
+                y: float) -> tuple[float, np.ndarray]:
+    """One sample of :func:`invert` from the staircase ``x``: ``(u_hat, x_next)``."""
+    u_hat, x_next = invert(structure, params, np.array([float(y)]), x0=x)
+    return float(u_hat[0]), x_next
 
 
 def cell_regressors(levels: int, u: np.ndarray, x0: np.ndarray | None = None,

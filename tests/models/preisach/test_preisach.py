@@ -18,9 +18,9 @@ from hystkit.compensation import (
     fit_compensator,
 )
 from hystkit.errors import FitDivergedError
-from hystkit.identification.family_preisach import everett_from_forcs, fit_preisach
 from hystkit.models import get_family
 from hystkit.models import preisach as P
+from hystkit.models.preisach import everett_from_forcs, fit_preisach
 from hystkit.sensors import simulate_experiment
 
 L = 9
@@ -307,3 +307,18 @@ def test_compensator_on_the_virtual_sensor(mode):
     again = compensator_from_dict(json.loads(json.dumps(compensator_to_dict(comp))))
     assert again.params == comp.params and again.structure == comp.structure
     assert get_family("preisach").default_size == comp.structure.levels == 20
+
+
+def test_records_round_trip_and_old_model_files_load():
+    small = P.PreisachParams(everett=[[0, 0, 0], [0.5, 0, 0], [1.25, 0.75, 0]], offset=0.2)
+    # params as written before the move (lower-triangle rows), structure as asdict wrote it
+    old_params = {"everett": [[0.5], [1.25, 0.75]], "offset": 0.2}
+    old_structure = {"levels": 9, "dt": 0.025, "capacity": 22, "smoothing": 1e-05,
+                     "orientation": "auto"}
+    assert P.PreisachParams.from_dict(old_params) == small
+    assert small.to_dict() == old_params
+    assert P.PreisachStructure.from_dict(old_structure) == STRUCT
+    assert STRUCT.to_dict() == old_structure
+    assert P.PreisachParams.from_dict(json.loads(json.dumps(PARAMS.to_dict()))) == PARAMS
+    assert hash(STRUCT) == hash(P.PreisachStructure(**old_structure))  # cacheable
+    assert get_family("preisach").n_params(STRUCT, PARAMS) == L * (L - 1) // 2 + 1

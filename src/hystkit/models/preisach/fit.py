@@ -1,4 +1,4 @@
-"""The classical Preisach family (sec. 2.1.1, appendix 9.3-9.5) in the model registry.
+"""Identification of the classical Preisach model (sec. 2.1.1, appendix 9.3-9.5).
 
 Identification from first-order reversal curves (appendix 9.4, eq. 9.4):
 :func:`everett_from_forcs`. Without FORCs, :func:`fit_preisach` (the family's fit): the
@@ -34,13 +34,11 @@ from scipy.interpolate import LinearNDInterpolator
 from scipy.optimize import lsq_linear
 from threadpoolctl import threadpool_limits
 
-from ..errors import FitDivergedError
-from ..models import preisach
-from ._least_squares import check_fit_data
-from ._registry import ModelFamily
-from ._result import FitResult
+from ...errors import FitDivergedError
+from ...identification import FitResult, check_fit_data
+from . import model as preisach
 
-__all__ = ["FAMILY", "ORIENTATIONS", "check_data", "everett_from_forcs", "fit_oriented", "fit_preisach",
+__all__ = ["ORIENTATIONS", "check_data", "everett_from_forcs", "fit_oriented", "fit_preisach",
            "smoothness_rows", "solve_regularised"]
 
 
@@ -231,17 +229,3 @@ def everett_from_forcs(alphas: np.ndarray, betas: np.ndarray, y: np.ndarray,
     e[na, nb] = LinearNDInterpolator(points, values)(h[na], h[nb])
     offset = 0.5 * (y[-1, start[-1]] + y[-1, 0])
     return preisach.PreisachParams(everett=e, offset=offset)
-
-
-def _make_structure(dt: float, size: int, **options: Any) -> preisach.PreisachStructure:
-    return preisach.PreisachStructure(levels=size, dt=dt, **options)
-
-
-FAMILY = ModelFamily(
-    name="preisach", title="classical Preisach, Everett function on a grid (sec. 2.1.1, "
-                           "eq. 2.1, 9.4-9.13)",
-    structure_type=preisach.PreisachStructure, params_type=preisach.PreisachParams,
-    make_structure=_make_structure, simulate=preisach.simulate, fit=fit_preisach,
-    invert=preisach.invert,
-    size_help="grid levels L over the normalised input (L (L - 1) / 2 Preisach cells)",
-    default_size=20)

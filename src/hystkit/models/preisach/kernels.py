@@ -1,6 +1,6 @@
-"""Compiled hot loops of the Preisach models; ``preisach.py`` holds the readable reference.
+"""Compiled hot loops of the Preisach models; ``model.py`` holds the readable reference.
 
-Shared by the classical (``preisach.py``) and the generalised (``gpreisach.py``) model. The
+Shared by the classical (this folder) and the generalised (``models/gpreisach``) model. The
 memory is the staircase of dominant extrema ``s[0] = -1, s[1], ..., s[n-1]`` (the last entry is
 the present input, clipped to [-1, 1]) in a fixed-capacity buffer. Beside it the kernels keep
 ``c[i, k] = sum_{j <= i} d_j F_k(s_j-1, s_j)``, the running sum of the segment terms of
@@ -11,13 +11,15 @@ cost is amortised O(1) whatever the grid size or the stack depth (O(log n) in th
 ``A[k]`` is an Everett table on the equally spaced grid of ``L`` levels over [-1, 1], extended
 antisymmetrically (``A[i, j] = F(h_i, h_j)`` for ``i > j``, ``A[j, i] = -A[i, j]``, zero
 diagonal); plain bilinear interpolation of that extension is zero on the diagonal
-``alpha = beta``, as an Everett function must be (see ``preisach.py``).
+``alpha = beta``, as an Everett function must be (see ``model.py``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+REST_TOL = 1e-12  # relative output change below which the inverse keeps its input
 
 
 @njit(cache=True, inline="always")
@@ -43,14 +45,20 @@ def _term(A, k, p, q):
 
 
 @njit(cache=True)
-def _load(s, c, s0, A):
-    """Copy a staircase into the buffer and build its running sums; returns its length."""
-    n = s0.size
-    s[:n] = s0
+def _sums(s, c, n, A):
+    """Running sums ``c[0 .. n-2]`` of the staircase ``s[:n]`` (the closed segments)."""
     c[0, :] = 0.0
     for i in range(1, n - 1):
         for k in range(A.shape[0]):
             c[i, k] = c[i - 1, k] + _term(A, k, s[i - 1], s[i])
+
+
+@njit(cache=True)
+def _load(s, c, s0, A):
+    """Copy a staircase into the buffer and build its running sums; returns its length."""
+    n = s0.size
+    s[:n] = s0
+    _sums(s, c, n, A)
     return n
 
 
@@ -69,8 +77,8 @@ def _make_room(s, n):
 
 
 @njit(cache=True)
-def _update(s, c, n, u, A):
-    """Apply the (clipped) input ``u`` to the staircase; returns the new length.
+def _move(s, n, u):
+    """The staircase rule for the (clipped) input ``u``; returns the new length.
 
     A continued move replaces the last entry, a reversal pushes one; then every earlier
     extremum that ``u`` reaches or passes is wiped out together with the reversal after it.
@@ -84,8 +92,6 @@ def _update(s, c, n, u, A):
     elif (u > last) == (last > s[n - 2]):
         s[n - 1] = u
     else:
-        for k in range(A.shape[0]):
-            c[n - 1, k] = c[n - 2, k] + _term(A, k, s[n - 2], s[n - 1])
         s[n] = u
         n += 1
     while n >= 3:
@@ -96,6 +102,16 @@ def _update(s, c, n, u, A):
         else:
             break
     return n
+
+
+@njit(cache=True)
+def _update(s, c, n, u, A):
+    """:func:`_move` keeping the running sums: a reversal closes the last segment, whose
+    term joins ``c`` before the wiping may overwrite its ends."""
+    if n > 1 and u != s[n - 1] and (u > s[n - 1]) != (s[n - 1] > s[n - 2]):
+        for k in range(A.shape[0]):
+            c[n - 1, k] = c[n - 2, k] + _term(A, k, s[n - 2], s[n - 1])
+    return _move(s, n, u)
 
 
 @njit(cache=True, inline="always")
@@ -198,6 +214,48 @@ def combine(P, u, weighted, poly):
 
 
 @njit(cache=True)
+def _invert_sample(target, s, c, n, A, weighted, poly, slope, tol, acc):
+    """One sample of :func:`invert`: the input estimate, then the staircase updated with it.
+
+    Returns ``(u_hat, n)``; ``s``, ``c`` are updated in place.
+    """
+    n = _make_room(s, n)
+    last = s[n - 1]
+    lo = hi = y_lo = y_hi = 0.0
+    u_hat = last
+    y_now = _branch_output(last, s, c, n, A, weighted, poly, acc)
+    if abs(target - y_now) <= REST_TOL * max(1.0, abs(y_now)):
+        # the present output to rounding (a constant output): keep the input, so that a
+        # rest state stays one instead of collecting rounding-sized reversals
+        target = y_now
+    if target > y_now:
+        lo, y_lo, hi = last, y_now, 1.0
+        y_hi = _branch_output(hi, s, c, n, A, weighted, poly, acc)
+        if target > y_hi:
+            u_hat = 1.0 + (target - y_hi) / slope
+    elif target < y_now:
+        lo, hi, y_hi = -1.0, last, y_now
+        y_lo = _branch_output(lo, s, c, n, A, weighted, poly, acc)
+        if target < y_lo:
+            u_hat = -1.0 + (target - y_lo) / slope
+    inside = target != y_now and y_lo <= target <= y_hi
+    if inside:
+        rising = target > y_now
+        for _ in range(200):
+            if hi - lo <= tol:
+                break
+            mid = 0.5 * (lo + hi)
+            y_mid = _branch_output(mid, s, c, n, A, weighted, poly, acc)
+            if (y_mid < target) if rising else (y_mid <= target):
+                lo, y_lo = mid, y_mid
+            else:
+                hi, y_hi = mid, y_mid
+        u_hat = lo + (target - y_lo) * (hi - lo) / (y_hi - y_lo)
+    n = _update(s, c, n, min(1.0, max(-1.0, u_hat)), A)
+    return u_hat, n
+
+
+@njit(cache=True)
 def invert(y, s0, A, weighted, poly, slope, capacity, tol):
     """Monotone search for the input that reproduces each output sample.
 
@@ -214,35 +272,67 @@ def invert(y, s0, A, weighted, poly, slope, capacity, tol):
     acc = np.empty(A.shape[0])
     u_hat = np.empty(y.size)
     for t in range(y.size):
-        target = y[t]
-        n = _make_room(s, n)
-        last = s[n - 1]
-        lo = hi = y_lo = y_hi = 0.0
-        y_now = _branch_output(last, s, c, n, A, weighted, poly, acc)
-        if target > y_now:
-            lo, y_lo, hi = last, y_now, 1.0
-            y_hi = _branch_output(hi, s, c, n, A, weighted, poly, acc)
-            if target > y_hi:
-                u_hat[t] = 1.0 + (target - y_hi) / slope
-        elif target < y_now:
-            lo, hi, y_hi = -1.0, last, y_now
-            y_lo = _branch_output(lo, s, c, n, A, weighted, poly, acc)
-            if target < y_lo:
-                u_hat[t] = -1.0 + (target - y_lo) / slope
-        else:
-            u_hat[t] = last
-        inside = target != y_now and y_lo <= target <= y_hi
-        if inside:
-            rising = target > y_now
-            for _ in range(200):
-                if hi - lo <= tol:
-                    break
-                mid = 0.5 * (lo + hi)
-                y_mid = _branch_output(mid, s, c, n, A, weighted, poly, acc)
-                if (y_mid < target) if rising else (y_mid <= target):
-                    lo, y_lo = mid, y_mid
-                else:
-                    hi, y_hi = mid, y_mid
-            u_hat[t] = lo + (target - y_lo) * (hi - lo) / (y_hi - y_lo)
-        n = _update(s, c, n, min(1.0, max(-1.0, u_hat[t])), A)
+        u_hat[t], n = _invert_sample(y[t], s, c, n, A, weighted, poly, slope, tol, acc)
     return u_hat, s[:n].copy()
+
+
+# Loop blocks (protocol in ``hystkit.models._protocol``), shared by the classical and the
+# generalised model. State slice: ``[n, s_0 .. s_{capacity-1}]``, the staircase length (a
+# float) and the staircase, zero beyond ``n``. body = [capacity, L, K, weighted, slope, tol,
+# n_poly, poly (n_poly), A (K L L, the antisymmetric tables)]. The running sums are rebuilt
+# from the staircase every sample (O(n)): the state stays the staircase alone.
+
+@njit(cache=True, inline="always")
+def _block_parts(body):
+    cap, levels, n_tab = int(body[0]), int(body[1]), int(body[2])
+    n_poly = int(body[6])
+    poly = body[7:7 + n_poly]
+    start = 7 + n_poly
+    tables = body[start:start + n_tab * levels * levels].reshape((n_tab, levels, levels))
+    return cap, tables, body[3] != 0.0, body[4], body[5], poly
+
+
+@njit(cache=True, inline="always")
+def _block_load(x, xn, off, cap, A):
+    """Copy the staircase of ``x`` into ``xn``'s slice; running sums in scratch space."""
+    n = int(x[off] + 0.5)  # a count stored as a float: round, do not truncate
+    s = xn[off + 1:off + 1 + cap]
+    for i in range(n):
+        s[i] = x[off + 1 + i]
+    c = np.empty((n + 1, A.shape[0]))  # a push after _make_room writes at most row n - 1
+    _sums(s, c, n, A)
+    return s, c, n
+
+
+@njit(cache=True, inline="always")
+def _block_store(xn, off, s, n, cap):
+    xn[off] = float(n)
+    for i in range(n, cap):
+        s[i] = 0.0
+
+
+@njit(cache=True)
+def block_forward(body, x, xn, off, u):
+    """Staircase updated with the clipped ``u``, then eq. 9.13 / eq. 2.2 and the straight-line
+    extension beyond [-1, 1] (as ``run_tables`` + the model's output equation)."""
+    cap, A, weighted, slope, _, poly = _block_parts(body)
+    s, c, n = _block_load(x, xn, off, cap, A)
+    u_clip = min(1.0, max(-1.0, u))
+    n = _make_room(s, n)
+    n = _update(s, c, n, u_clip, A)
+    acc = np.empty(A.shape[0])
+    for k in range(A.shape[0]):
+        acc[k] = _table_output(A, k, s, c, n)
+    _block_store(xn, off, s, n, cap)
+    return combine(acc, u_clip, weighted, poly) + slope * (u - u_clip)
+
+
+@njit(cache=True)
+def block_inverse(body, x, xn, off, y):
+    """One sample of :func:`invert` on the staircase of ``x`` (bisection on the branch)."""
+    cap, A, weighted, slope, tol, poly = _block_parts(body)
+    s, c, n = _block_load(x, xn, off, cap, A)
+    acc = np.empty(A.shape[0])
+    u_hat, n = _invert_sample(y, s, c, n, A, weighted, poly, slope, tol, acc)
+    _block_store(xn, off, s, n, cap)
+    return u_hat
