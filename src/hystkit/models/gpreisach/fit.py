@@ -1,7 +1,7 @@
-"""The generalised Preisach family (sec. 2.1.2, eq. 2.2) in the model registry.
+"""Identification of the generalised Preisach model (sec. 2.1.2, eq. 2.2).
 
-Like the classical fit (``family_preisach.py``) this is one bounded linear least-squares
-problem: the output of eq. 2.2 in the form of ``models/gpreisach.py`` is linear in the cell
+Like the classical fit (``models/preisach/fit.py``) this is one bounded linear least-squares
+problem: the output of eq. 2.2 in the form of ``model.py`` is linear in the cell
 masses of ``mu_-`` and ``mu_+`` (columns ``(1 - w) Phi`` and ``w Phi``, ``w = (1 + u) / 2``),
 in the Bernstein coefficients of ``nu`` and in the offset. Bounds: hysteretic masses of the
 chosen loop orientation's sign, ``nu >= 0`` (a non-decreasing reversible part). The relay
@@ -14,16 +14,15 @@ only as strong as the data ask for.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 
-from ..models import gpreisach, preisach
-from ._registry import ModelFamily
-from ._result import FitResult
-from .family_preisach import check_data, fit_oriented, smoothness_rows
+from ...identification import FitResult
+from .. import preisach
+from ..preisach import check_data, fit_oriented, smoothness_rows
+from . import model as gpreisach
 
-__all__ = ["FAMILY", "fit_gpreisach"]
+__all__ = ["fit_gpreisach"]
 
 
 def fit_gpreisach(u: np.ndarray, y: np.ndarray, structure: gpreisach.GPreisachStructure, *,
@@ -78,17 +77,3 @@ def fit_gpreisach(u: np.ndarray, y: np.ndarray, structure: gpreisach.GPreisachSt
 
     return fit_oriented(a, y, penalty, hysteretic, nonneg, structure.orientation, to_params,
                         structure, accept, accept_reason)
-
-
-def _make_structure(dt: float, size: int, **options: Any) -> gpreisach.GPreisachStructure:
-    return gpreisach.GPreisachStructure(levels=size, dt=dt, **options)
-
-
-FAMILY = ModelFamily(
-    name="gpreisach", title="generalised (non-linear) Preisach, input-dependent weight and "
-                            "reversible part (sec. 2.1.2, eq. 2.2)",
-    structure_type=gpreisach.GPreisachStructure, params_type=gpreisach.GPreisachParams,
-    make_structure=_make_structure, simulate=gpreisach.simulate, fit=fit_gpreisach,
-    invert=gpreisach.invert,
-    size_help="grid levels L of the two Preisach weights ((L - 1) (L - 2) relay cells)",
-    default_size=16)

@@ -16,9 +16,9 @@ from scipy.integrate import quad
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification.family_gpreisach import fit_gpreisach
 from hystkit.models import gpreisach as G
 from hystkit.models import preisach as P
+from hystkit.models.gpreisach import fit_gpreisach
 from hystkit.sensors import simulate_experiment
 
 L = 8
@@ -207,3 +207,18 @@ def test_compensator_on_the_virtual_sensor():
     scores = evaluate(comp, simulate_experiment("sine", 2))
     # measured when written: 0.9992 against the line's 0.9384
     assert np.isfinite(scores["r2"]) and scores["r2"] > scores["linear_r2"]
+
+
+def test_records_round_trip_and_old_model_files_load():
+    rows = [row.tolist() for row in (PARAMS.everett_minus[i, :i] for i in range(1, L))]
+    plus = [row.tolist() for row in (PARAMS.everett_plus[i, :i] for i in range(1, L))]
+    # as written before the move: lower-triangle rows, structure by asdict
+    old_params = {"everett_minus": rows, "everett_plus": plus, "nu": [0.5, 0.1, 0.8],
+                  "offset": 0.1}
+    old_structure = {"levels": 8, "dt": 0.025, "capacity": 20, "smoothing": 1e-05,
+                     "orientation": "auto", "degree": 2}
+    assert G.GPreisachParams.from_dict(old_params) == PARAMS
+    assert PARAMS.to_dict() == old_params
+    assert G.GPreisachStructure.from_dict(old_structure) == STRUCT == \
+        G.GPreisachStructure(**json.loads(json.dumps(STRUCT.to_dict())))
+    assert G.FAMILY.n_params(STRUCT, PARAMS) == (L - 1) * (L - 2) + 3 + 1

@@ -1,6 +1,6 @@
 """Generalised ("non-linear") Preisach model of Mayergoyz and Friedman (sec. 2.1.2, eq. 2.2).
 
-Eq. 2.2 adds two things to the classical model (``preisach.py``): the relay weight depends on
+Eq. 2.2 adds two things to the classical model (``models/preisach``): the relay weight depends on
 the present input, ``mu(alpha, beta, u(t))``, and a fully reversible part made of step
 operators ``lambda_a`` (+1 for ``u >= a``, -1 below) with weight ``nu(a)``::
 
@@ -11,7 +11,7 @@ Implemented forms (the document leaves both functions open):
 - ``mu`` is affine in the present input -- the lowest order that relaxes congruency -- written
   as the interpolation ``mu = (1 - w) mu_- + w mu_+`` with ``w = (1 + u) / 2`` between a weight
   valid at ``u = -1`` and one valid at ``u = +1``. Each is a classical Preisach weight stored
-  as an Everett table (same grid and bilinear interpolation as ``preisach.py``), so the relay
+  as an Everett table (same grid and bilinear interpolation as ``models/preisach``), so the relay
   part is ``(1 - w) P_-[u] + w P_+[u]`` with ``P_+-`` the classical outputs of eq. 9.13 on one
   shared staircase. Non-negativity of ``mu`` for every ``u`` in the range is just
   ``mu_- , mu_+ >= 0``.
@@ -24,7 +24,8 @@ Implemented forms (the document leaves both functions open):
 The state is the classical staircase (wiping-out and return-point memory hold; minor loops
 between the same extrema are no longer congruent when ``mu_- != mu_+``). Outside [-1, 1] the
 model continues as a straight line with the mean slope of its major loop,
-``(y(+sat) - y(-sat)) / 2``, as the classical one does.
+``(y(+sat) - y(-sat)) / 2``, as the classical one does. The compiled loops, the packed loop
+state and the protocol methods are the classical model's (``hystkit.models.preisach``).
 """
 
 from __future__ import annotations
@@ -36,13 +37,14 @@ from math import comb
 import numpy as np
 from numpy.polynomial import Polynomial
 
-from ..errors import FitDivergedError
-from . import _preisach_kernels as kernels
-from .preisach import (
+from ...errors import FitDivergedError
+from .._protocol import Record
+from ..preisach import (
     INVERT_TOL,
     PreisachParams,
     PreisachStructure,
     antisymmetric,
+    kernels,
     prepare_run,
     staircase_terms,
     update_staircase,
@@ -52,6 +54,9 @@ __all__ = [
     "GPreisachParams",
     "GPreisachStructure",
     "invert",
+    "invert_step",
+    "kernel_parts",
+    "major_slope",
     "reversible",
     "reversible_basis",
     "simulate",
@@ -61,7 +66,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class GPreisachStructure:
+class GPreisachStructure(Record):
     """What does not get fitted.
 
     Parameters
@@ -109,7 +114,7 @@ def reversible(nu: np.ndarray, u: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class GPreisachParams:
+class GPreisachParams(Record):
     """Fitted quantities of eq. 2.2.
 
     Parameters
@@ -147,6 +152,7 @@ class GPreisachParams:
     def levels(self) -> int:
         return self.everett_minus.shape[0]
 
+    # The tables are stored as lower-triangle rows, as PreisachParams does (the file format).
     def to_dict(self) -> dict:
         return {"everett_minus": PreisachParams(self.everett_minus).to_dict()["everett"],
                 "everett_plus": PreisachParams(self.everett_plus).to_dict()["everett"],
@@ -159,17 +165,8 @@ class GPreisachParams:
         return cls(everett_minus=tables[0], everett_plus=tables[1], nu=d["nu"],
                    offset=d["offset"])
 
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, GPreisachParams):
-            return NotImplemented
-        return bool(np.array_equal(self.everett_minus, other.everett_minus)
-                    and np.array_equal(self.everett_plus, other.everett_plus)
-                    and np.array_equal(self.nu, other.nu) and self.offset == other.offset)
 
-    __hash__ = None
-
-
-def _slope(params: GPreisachParams) -> float:
+def major_slope(params: GPreisachParams) -> float:
     """Mean slope of the major loop, ``(y(+sat) - y(-sat)) / 2``: the extension beyond +-1."""
     rise = params.everett_plus[-1, 0] + params.everett_minus[-1, 0]
     return float(0.5 * (rise + reversible(params.nu, 1.0) - reversible(params.nu, -1.0)))
@@ -193,7 +190,7 @@ def _combine(params: GPreisachParams, relay: np.ndarray, u: np.ndarray) -> np.nd
     u_clip = np.clip(u, -1.0, 1.0)
     w = 0.5 * (1.0 + u_clip)
     return ((1.0 - w) * relay[..., 0] + w * relay[..., 1] + reversible(params.nu, u_clip)
-            + params.offset + _slope(params) * (u - u_clip))
+            + params.offset + major_slope(params) * (u - u_clip))
 
 
 def step(structure: GPreisachStructure, params: GPreisachParams, x: np.ndarray,
@@ -218,6 +215,12 @@ def _check(structure: GPreisachStructure, params: GPreisachParams, v: np.ndarray
         raise ValueError(f"params (levels {params.levels}, {params.nu.size} nu) do not match "
                          f"the structure (levels {structure.levels}, degree {structure.degree})")
     return prepare_run(structure, v, name, x0)
+
+
+def kernel_parts(params: GPreisachParams) -> tuple[np.ndarray, bool, np.ndarray, float]:
+    """What the compiled kernels run on: the two tables, weighted (True), the monomial
+    coefficients of ``R(u) + y_0`` and the slope of the straight-line extension."""
+    return _tables(params), True, _poly(params), major_slope(params)
 
 
 def simulate(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarray,
@@ -267,8 +270,15 @@ def invert(structure: GPreisachStructure, params: GPreisachParams, y: np.ndarray
         If the major loop does not rise (mean slope <= 0): no inverse exists.
     """
     y, x = _check(structure, params, y, "y", x0)
-    if _slope(params) <= 0:
+    tables, weighted, poly, slope = kernel_parts(params)
+    if slope <= 0:
         raise FitDivergedError("the generalised Preisach model's major loop does not rise; it "
                                "has no inverse")
-    return kernels.invert(y, x, _tables(params), True, _poly(params), _slope(params),
-                          structure.capacity, INVERT_TOL)
+    return kernels.invert(y, x, tables, weighted, poly, slope, structure.capacity, INVERT_TOL)
+
+
+def invert_step(structure: GPreisachStructure, params: GPreisachParams, x: np.ndarray,
+                y: float) -> tuple[float, np.ndarray]:
+    """One sample of :func:`invert` from the staircase ``x``: ``(u_hat, x_next)``."""
+    u_hat, x_next = invert(structure, params, np.array([float(y)]), x0=x)
+    return float(u_hat[0]), x_next
