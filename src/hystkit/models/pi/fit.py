@@ -1,5 +1,5 @@
-"""The Kuhnen / modified Prandtl-Ishlinskii family (sec. 2.1.6) in the model registry, and its
-identification: one bounded linear least-squares solve (the document's "quadratic
+"""Identification of the Kuhnen / modified Prandtl-Ishlinskii model (sec. 2.1.6): one bounded
+linear least-squares solve (the document's "quadratic
 optimisation", sec. 2.2).
 
 Kuhnen's generalised error. The output ``y = S[H[x] + K[x] + b]`` is bilinear in the dead-zone
@@ -41,13 +41,12 @@ import numpy as np
 from scipy.optimize import lsq_linear
 from threadpoolctl import threadpool_limits
 
-from ..errors import FitDivergedError
-from ..models import _pi_kernels as kernels
-from ..models import pi
-from ._registry import ModelFamily
-from ._result import FitResult
+from ...errors import FitDivergedError
+from ...identification import FitResult
+from . import kernels
+from . import model as pi
 
-__all__ = ["FAMILY", "fit_pi", "make_structure", "output_thresholds"]
+__all__ = ["MIN_SLOPE", "fit_pi", "make_structure", "output_thresholds"]
 
 MIN_SLOPE = 0.01  # smallest loading-curve / S^-1 slope, in normalised units (slope 1 = linear)
 
@@ -180,12 +179,3 @@ def make_structure(dt: float, size: int, *, n_deadzone: int = 2, n_creep: int = 
     return pi.PiStructure(play_thresholds=tuple(r_max * np.arange(size) / size),
                           n_deadzone=n_deadzone,
                           creep_rates=tuple(1.0 / (tau_min * 10.0 ** np.arange(n_creep))), dt=dt)
-
-
-FAMILY = ModelFamily(
-    name="pi", title="Kuhnen / modified Prandtl-Ishlinskii with creep (sec. 2.1.6, eq. 2.6-2.19)",
-    structure_type=pi.PiStructure, params_type=pi.PiParams, make_structure=make_structure,
-    simulate=pi.simulate, fit=fit_pi, invert=pi.invert,
-    size_help="play operators n (thresholds i/n, i < n; plus 2 x 2 dead zones, 4 creep "
-              "operators by default)",
-    default_size=10)

@@ -37,21 +37,24 @@ and :func:`invert` alike, so model and compensator can be synchronised.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import FitDivergedError
-from . import _pi_kernels as kernels
-from ._validation import (
+from ...errors import FitDivergedError
+from .._protocol import Record
+from .._validation import (
     check_dt,
     check_signal,
     frozen_array,
     initial_state,
 )
+from . import kernels
 
-__all__ = ["PiParams", "PiStructure", "deadzone", "inverse_pi",
-           "inverse_play_states", "inverse_superposition", "invert", "invert_step",
-           "not_invertible_reason", "play", "simulate", "simulate_reference", "step"]
+__all__ = ["InverseParts", "PiParams", "PiStructure", "deadzone", "instantaneous_weights",
+           "inverse_parts", "inverse_pi", "inverse_play_states", "inverse_superposition",
+           "invert", "invert_step", "not_invertible_reason", "play", "rest_input", "rest_state",
+           "simulate", "simulate_reference", "step"]
 
 
 def _float_tuple(values, name: str) -> tuple[float, ...]:
@@ -59,7 +62,7 @@ def _float_tuple(values, name: str) -> tuple[float, ...]:
 
 
 @dataclass(frozen=True)
-class PiStructure:
+class PiStructure(Record):
     """What does not get fitted: operator thresholds, creep eigenvalues and the sample time.
 
     Parameters
@@ -74,7 +77,9 @@ class PiStructure:
         Eigenvalues ``a_j`` [1/s] of the linear creep operators (eq. 2.14); empty for the
         rate-independent model.
     dt : float
-        Sample time [s].
+        Sample time [s]. The plays are rate independent; the creep operators are not, and
+        their per-sample gains :attr:`creep_gains` follow from the rates and ``dt``, so the
+        same structure at another ``dt`` is the same continuous-time model.
     """
 
     play_thresholds: tuple[float, ...] = (0.0,)
@@ -110,7 +115,7 @@ class PiStructure:
 
 
 @dataclass(frozen=True, eq=False)
-class PiParams:
+class PiParams(Record):
     """Fitted quantities of a modified PI model.
 
     Parameters
@@ -155,20 +160,12 @@ class PiParams:
         object.__setattr__(self, "n_creep", int(self.w_k.size))
 
     def to_dict(self) -> dict:
-        return {"w_h": self.w_h.tolist(), "w_s": self.w_s.tolist(), "d_s": self.d_s.tolist(),
-                "w_k": self.w_k.tolist(), "b": self.b}
-
-    @classmethod
-    def from_dict(cls, d: dict) -> PiParams:
-        return cls(w_h=d["w_h"], w_s=d["w_s"], d_s=d["d_s"], w_k=d["w_k"], b=d["b"])
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, PiParams):
-            return NotImplemented
-        return all(np.array_equal(a, b) for a, b in zip(self.to_dict().values(),
-                                                        other.to_dict().values()))
-
-    __hash__ = None
+        """Record's dict, with the centre threshold ``d_0 = 0`` written as the integer 0: it is
+        structural, not fitted, and generic parameter vectors keep integers fixed
+        (``compensation._param_vector``). Same keys and values as before (``0 == 0.0``)."""
+        d = super().to_dict()
+        d["d_s"][self.n_deadzone] = 0
+        return d
 
 
 def play(x: np.ndarray | float, y_prev: np.ndarray | float,
@@ -222,11 +219,51 @@ def inverse_play_states(w: np.ndarray, p: np.ndarray) -> np.ndarray:
     return np.cumsum(w) * p + tail
 
 
-def _instantaneous_weights(structure: PiStructure, params: PiParams) -> np.ndarray:
+def instantaneous_weights(structure: PiStructure, params: PiParams) -> np.ndarray:
     """Play weights of ``H~ = H + kappa x``, the operator one sample of ``H + K`` applies."""
     w = params.w_h.copy()
     w[0] += params.w_k @ structure.creep_gains
     return w
+
+
+class InverseParts(NamedTuple):
+    """What one inverse sample needs (eq. 2.19 with creep), see :func:`inverse_parts`."""
+
+    sign: float
+    w_inst: np.ndarray
+    r_inv: np.ndarray
+    w_inv: np.ndarray
+    d_inv: np.ndarray
+    ws_inv: np.ndarray
+
+
+def inverse_parts(structure: PiStructure, params: PiParams) -> InverseParts:
+    """The inverse operators: polarity ``sign`` of ``H~`` (the polarity lives in ``H``, ``S``
+    increases), its weights ``w_inst``, the inverse plays of ``sign * H~`` and ``S^-1``."""
+    w_inst = instantaneous_weights(structure, params)
+    sign = 1.0 if w_inst[0] > 0 else -1.0
+    r_inv, w_inv = inverse_pi(np.asarray(structure.play_thresholds), sign * w_inst)
+    d_inv, ws_inv = inverse_superposition(params.d_s, params.w_s)
+    return InverseParts(sign, w_inst, r_inv, w_inv, d_inv, ws_inv)
+
+
+def rest_input(params: PiParams, y0: float) -> float:
+    """The input at rest at output ``y0``: ``(S^-1(y0) - b) / (sum w_H + sum w_K)``."""
+    gain = params.w_h.sum() + params.w_k.sum()
+    if gain == 0:
+        raise FitDivergedError("the model's static gain sum(w_H) + sum(w_K) is 0: no input "
+                               "is at rest at y[0]; pass x0")
+    d_inv, ws_inv = inverse_superposition(params.d_s, params.w_s)
+    return (float(ws_inv @ deadzone(y0, d_inv)) - params.b) / gain
+
+
+def rest_state(structure: PiStructure, params: PiParams, value: float,
+               inverse: bool = False) -> np.ndarray:
+    """State at rest: every play and creep state at the input ``value`` (where :func:`simulate`
+    starts), or for ``inverse`` at the input at rest at the output ``value`` (:func:`invert`'s
+    start, :func:`rest_input`)."""
+    u = rest_input(params, float(value)) if inverse else float(value)
+    return np.full(structure.n_play + structure.n_creep, u)
 
 
 def _superposition(params: PiParams, v: float) -> float:
@@ -260,10 +297,7 @@ def invert_step(structure: PiStructure, params: PiParams, x: np.ndarray,
     """
     x = np.asarray(x, dtype=float)
     n, c = structure.n_play, structure.creep_gains
-    w_inst = _instantaneous_weights(structure, params)
-    sign = 1.0 if w_inst[0] > 0 else -1.0  # the polarity lives in H (S increases)
-    r_inv, w_inv = inverse_pi(np.asarray(structure.play_thresholds), sign * w_inst)
-    d_inv, ws_inv = inverse_superposition(params.d_s, params.w_s)
+    sign, w_inst, r_inv, w_inv, d_inv, ws_inv = inverse_parts(structure, params)
     v = float(ws_inv @ deadzone(y, d_inv)) - params.b - params.w_k @ ((1 - c) * x[n:])
     q = play(sign * v, inverse_play_states(sign * w_inst, x[:n]), r_inv)
     u_hat = float(w_inv @ q)
@@ -333,7 +367,7 @@ def not_invertible_reason(structure: PiStructure, params: PiParams) -> str:
     from ``d = 0`` outwards (an increasing ``S``).
     """
     _check_params(structure, params)
-    sums = np.cumsum(_instantaneous_weights(structure, params))
+    sums = np.cumsum(instantaneous_weights(structure, params))
     if not (np.all(sums > 0) or np.all(sums < 0)):
         return (f"the partial sums of the instantaneous play weights {sums.tolist()} change "
                 f"sign or vanish, so H + K is not invertible (eq. 2.19)")
@@ -377,19 +411,8 @@ def invert(structure: PiStructure, params: PiParams, y: np.ndarray,
         raise FitDivergedError(f"the model has no inverse: {reason}")
     y = check_signal(y, "y")
     n = structure.n_play
-    d_inv, ws_inv = inverse_superposition(params.d_s, params.w_s)
-    if x0 is None:
-        gain = params.w_h.sum() + params.w_k.sum()
-        if gain == 0:
-            raise FitDivergedError("the model's static gain sum(w_H) + sum(w_K) is 0: no input "
-                                   "is at rest at y[0]; pass x0")
-        rest = (float(ws_inv @ deadzone(y[0], d_inv)) - params.b) / gain
-    else:
-        rest = 0.0
-    x = _initial_state(structure, x0, rest)
-    w_inst = _instantaneous_weights(structure, params)
-    sign = 1.0 if w_inst[0] > 0 else -1.0
-    r_inv, w_inv = inverse_pi(np.asarray(structure.play_thresholds), sign * w_inst)
+    x = _initial_state(structure, x0, rest_input(params, y[0]) if x0 is None else 0.0)
+    sign, w_inst, r_inv, w_inv, d_inv, ws_inv = inverse_parts(structure, params)
     q0 = inverse_play_states(sign * w_inst, x[:n])
     # The kernel inverts sign * H~; feeding it sign * (everything on the right-hand side) is
     # the same as negating b, the creep weights and S^-1.

@@ -12,8 +12,8 @@ from numpy.testing import assert_allclose
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError
-from hystkit.identification.family_pi import MIN_SLOPE, fit_pi
-from hystkit.models import FAMILIES, pi
+from hystkit.models import FAMILIES, numerical_linearisation, pi
+from hystkit.models.pi import MIN_SLOPE, fit_pi
 from hystkit.sensors import simulate_experiment
 
 DT = 0.025
@@ -319,3 +319,113 @@ def test_compensator_end_to_end_on_the_virtual_sensor(mode):
     assert np.isfinite(scores["r2"])
     assert scores["r2"] > scores["linear_r2"]
     assert comp.fit_info["n_starts"] == 1
+
+
+# -- family protocol ----------------------------------------------------------------------
+
+def _history() -> np.ndarray:
+    """The forward state after a run: plays on and inside their bands, creep half-settled."""
+    return pi.simulate(STRUCT, PARAMS, _input(300, seed=7))[1]
+
+
+@pytest.mark.parametrize("inverse", [False, True])
+def test_block_equals_step_from_a_non_rest_state(inverse):
+    u = _input(400, seed=8)[100:]
+    x = _history()
+    signal = pi.simulate(STRUCT, PARAMS, u, x)[0] if inverse else u
+    block = pi.FAMILY.block(STRUCT, PARAMS, inverse)
+    run = pi.invert_step if inverse else pi.step
+    assert block.n_state == STRUCT.n_play + STRUCT.n_creep
+    off = 2
+    big = np.zeros(off + block.n_state + 3)
+    big[off:off + block.n_state] = x
+    for v in signal:
+        xn = np.full_like(big, np.nan)  # the block writes its whole slice, nothing else
+        out = block.step(block.body, big, xn, off, v)
+        ref, x = run(STRUCT, PARAMS, x, v)
+        assert out == pytest.approx(ref, abs=1e-12)
+        assert_allclose(xn[off:off + block.n_state], x, rtol=0, atol=1e-12)
+        assert np.all(np.isnan(np.r_[xn[:off], xn[off + block.n_state:]]))
+        big[off:off + block.n_state] = xn[off:off + block.n_state]
+
+
+def test_inverse_block_is_refused_for_a_model_without_inverse():
+    flat = pi.PiParams(w_h=[1.0, -1.5, 0.2, 0.1, 0.1], w_s=PARAMS.w_s, d_s=PARAMS.d_s,
+                       w_k=PARAMS.w_k, b=PARAMS.b)
+    with pytest.raises(FitDivergedError, match="no inverse"):
+        pi.FAMILY.block(STRUCT, flat, inverse=True)
+
+
+@pytest.mark.parametrize("inverse", [False, True])
+def test_rest_state_is_the_default_start_and_a_fixed_point(inverse):
+    run = pi.invert if inverse else pi.simulate
+    run_step = pi.invert_step if inverse else pi.step
+    signal = _input(300, seed=9)
+    if inverse:
+        signal = pi.simulate(STRUCT, PARAMS, signal)[0]
+    for value in (signal[0], -0.6, 0.9):
+        x = pi.FAMILY.rest_state(STRUCT, PARAMS, value, inverse)
+        out, x_next = run_step(STRUCT, PARAMS, x, value)
+        assert_allclose(x_next, x, rtol=0, atol=1e-12)
+        assert out == pytest.approx(run(STRUCT, PARAMS, np.array([value]))[0][0], abs=1e-12)
+    x = pi.FAMILY.rest_state(STRUCT, PARAMS, signal[0], inverse)
+    assert_allclose(run(STRUCT, PARAMS, signal, x)[0], run(STRUCT, PARAMS, signal)[0],
+                    rtol=0, atol=1e-12)
+
+
+def test_at_re_discretises_the_creep_and_keeps_the_plays():
+    fine = pi.FAMILY.at(STRUCT, DT / 4)
+    assert fine.play_thresholds == STRUCT.play_thresholds and fine.dt == DT / 4
+    assert fine.creep_rates == STRUCT.creep_rates
+    assert_allclose(fine.creep_gains, 1 - np.exp(-np.asarray(STRUCT.creep_rates) * DT / 4))
+    # an input held over each coarse sample (ZOH) gives the same output at the common
+    # instants: the creep operators are exact for a held input, the plays rate independent
+    u = _input(800, seed=10)
+    y = pi.simulate(STRUCT, PARAMS, u)[0]
+    y_fine = pi.simulate(fine, PARAMS, np.repeat(u, 4))[0]
+    assert_allclose(y_fine[3::4], y, rtol=0, atol=1e-12)
+    # keeping the coarse per-sample gains at the finer step would make creep 4x faster
+    too_fast = pi.simulate(STRUCT, PARAMS, np.repeat(u, 4))[0][3::4]
+    assert np.max(np.abs(too_fast - y)) > 1e-3
+
+
+@pytest.mark.parametrize("inverse", [False, True])
+def test_linearise_matches_the_numerical_jacobian_off_the_kinks(inverse):
+    x = _history()
+    u = 0.37  # off every band edge and dead-zone threshold of this state
+    if inverse:
+        u = pi.step(STRUCT, PARAMS, x, u)[0]
+    run = pi.invert_step if inverse else pi.step
+    got = pi.FAMILY.linearise(STRUCT, PARAMS, x, u, inverse)
+    ref = numerical_linearisation(lambda xx, uu: run(STRUCT, PARAMS, xx, uu), x, u)
+    for a, b in zip(got, ref, strict=True):
+        assert_allclose(np.asarray(a, float), np.asarray(b, float), rtol=1e-6, atol=1e-8)
+
+
+def test_linearise_at_rest_is_the_reversal_slope_with_held_plays():
+    x = pi.FAMILY.rest_state(STRUCT, PARAMS, 0.1)
+    a, b, c, d = pi.FAMILY.linearise(STRUCT, PARAMS, x, 0.1)
+    g = STRUCT.creep_gains
+    held = np.r_[0.0, np.ones(STRUCT.n_play - 1)]  # r_0 = 0 follows the input
+    assert_allclose(np.diag(a), np.r_[held, 1 - g])
+    assert_allclose(b, np.r_[1 - held, g])
+    v = PARAMS.w_h.sum() * 0.1 + PARAMS.w_k.sum() * 0.1 + PARAMS.b
+    s_slope = PARAMS.w_s @ np.where(PARAMS.d_s > 0, v > PARAMS.d_s,
+                                    np.where(PARAMS.d_s < 0, v < PARAMS.d_s, True))
+    assert d == pytest.approx(s_slope * (PARAMS.w_h[0] + PARAMS.w_k @ g))
+    assert_allclose(c, s_slope * np.r_[PARAMS.w_h * held, PARAMS.w_k * (1 - g)])
+
+
+def test_params_and_structure_are_records_and_old_files_load():
+    for record in (STRUCT, PARAMS):
+        again = type(record).from_dict(json.loads(json.dumps(record.to_dict())))
+        assert again == record
+    assert hash(STRUCT) == hash(pi.PiStructure.from_dict(STRUCT.to_dict()))  # cacheable
+    # a model file written before the move (hystkit 0.x, identification/family_pi.py)
+    old_params = {"w_h": [1.0, 0.3, -0.2, 0.2, 0.1], "w_s": [0.3, 0.5, 1.0, -0.4, 0.2],
+                  "d_s": [-0.8, -0.3, 0.0, 0.4, 0.9], "w_k": [0.2, -0.1, 0.3], "b": 0.05}
+    old_structure = {"play_thresholds": [0.0, 0.2, 0.4, 0.6, 0.8], "n_deadzone": 2,
+                     "creep_rates": [10.0, 1.0, 0.1], "dt": 0.025}
+    assert pi.PiParams.from_dict(old_params) == PARAMS
+    assert pi.PiStructure.from_dict(old_structure) == STRUCT
+    assert PARAMS.to_dict() == old_params and STRUCT.to_dict() == old_structure
