@@ -174,3 +174,15 @@ def test_loop_nlsys_matches_the_kernel(models, scheme):
     assert_allclose(u, fast.u, rtol=0, atol=1e-9)  # newtons
     assert_allclose(e, fast.e, rtol=0, atol=1e-15)
     assert_allclose(y_hat, fast.y_hat, rtol=0, atol=1e-15)
+
+
+def test_states_nothing_reads_are_left_out_of_the_analysis():
+    from hystkit.control._analysis import _read_states
+
+    # state 1 follows state 0 but feeds nothing; state 2 is an isolated (even unstable) memory
+    a = np.array([[0.5, 0.0, 0.0], [0.2, 1.0, 0.0], [0.0, 0.0, 2.0]])
+    assert _read_states(a, np.array([1.0, 0.0, 0.0])).tolist() == [True, False, False]
+    # a state read by a read state is kept, through any chain
+    a = np.array([[0.5, 0.3, 0.0], [0.0, 0.9, 0.1], [0.0, 0.0, 0.7]])
+    assert _read_states(a, np.array([1.0, 0.0, 0.0])).tolist() == [True, True, True]
+    assert _read_states(np.zeros((0, 0)), np.zeros(0)).tolist() == []

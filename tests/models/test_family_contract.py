@@ -19,6 +19,7 @@ from hystkit.models import FAMILIES, Family, get_family, numerical_linearisation
 from hystkit.sensors import simulate_experiment
 
 NAMES = sorted(FAMILIES)
+STAIRCASES = ("preisach", "gpreisach")  # Everett staircase state (see the linearisation test)
 N_FIT = 1600  # 40 s at 40 Hz: enough to excite every family, short enough for a quick fit
 
 
@@ -200,6 +201,10 @@ def test_linearisation_matches_the_numerical_one(name, inverse):
     family = get_family(name)
     if inverse and not family.has_inverse:
         pytest.skip(f"{name} has no inverse: {family.no_inverse_reason}")
+    if name in STAIRCASES:
+        pytest.skip("a staircase state is not a vector to differentiate (its first entry is "
+                    "fixed at -1, its length is a count); tests/models/preisach checks the "
+                    "one-sided branch slope instead")
     structure, params, _ = _example(name)
     step = family.invert_step if inverse else family.step
     run = lambda xx, uu: step(structure, params, xx, uu)
@@ -219,4 +224,4 @@ def test_linearisation_matches_the_numerical_one(name, inverse):
             else:
                 assert _kinked_match(got, right, left), k
         _, x = run(x, u_k)
-    assert n_smooth > 0 or name in ("preisach", "gpreisach")  # staircases: every point a kink
+    assert n_smooth > 0

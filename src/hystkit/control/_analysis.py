@@ -40,9 +40,29 @@ def _ss(a, b, c, d, ts, inputs, outputs, name) -> control.StateSpace:
     return control.ss(a, b, c, d, ts, inputs=inputs, outputs=outputs, name=name)
 
 
+def _read_states(a: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Mask of the states the block's output depends on, directly or through other states.
+
+    A state that neither the output nor any other state reads (a Preisach staircase entry, a
+    play inside its band at this operating point) cannot change any signal of the loop; it is
+    dropped so that the analysis costs what the block's dynamics cost, not its memory (a
+    1024-entry staircase would make the loop a 1040-state system).
+    """
+    keep = c != 0
+    while True:
+        grown = keep | np.any(a[keep] != 0, axis=0)  # what the kept states' updates read
+        if np.array_equal(grown, keep):
+            return keep
+        keep = grown
+
+
 def _block_ss(block, x, u_in, ts, inputs, outputs, name) -> control.StateSpace:
     a, b, c, d = block.linearise(x, u_in, ts)
-    return _ss(a, b, c, d, ts, inputs, outputs, name)
+    a = np.atleast_2d(np.asarray(a, dtype=float)).reshape(np.size(c), np.size(c))
+    c = np.asarray(c, dtype=float).reshape(-1)
+    keep = _read_states(a, c)
+    return _ss(a[np.ix_(keep, keep)], np.asarray(b, dtype=float).reshape(-1)[keep], c[keep],
+               d, ts, inputs, outputs, name)
 
 
 def open_loop(loop: ControlLoop, state: LoopState | None = None) -> control.StateSpace:

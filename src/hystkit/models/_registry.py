@@ -38,9 +38,6 @@ def _discover() -> dict[str, Family]:
             if hasattr(module, "FAMILY"):
                 family = _check(module.FAMILY, module.__name__)
                 families[family.name] = family
-    from ._legacy import legacy_families  # TRANSITIONAL
-    for name, family in legacy_families().items():
-        families.setdefault(name, family)
     for point in entry_points(group="hystkit.families"):
         family = _check(point.load().FAMILY, f"entry point {point.name}")
         families.setdefault(family.name, family)
