@@ -176,7 +176,8 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
 
     f = _grid(loop.ts)
     resp = np.asarray(control.frequency_response(lsys, 2 * np.pi * f).complex).reshape(-1)
-    log_mag = np.log(np.abs(resp))
+    # |L| = 0 exactly when the compensator is constant (a collapsed fit): no crossover
+    log_mag = np.log(np.maximum(np.abs(resp), np.finfo(float).tiny))
     cross = np.nonzero(np.sign(log_mag[:-1]) != np.sign(log_mag[1:]))[0]
     f_c = pm = gm = f_pc = None
     if cross.size:
