@@ -1,6 +1,6 @@
 """Cost of every registered model family: simulation per sample and fit time (issue 4).
 
-For each family in ``hystkit.identification.FAMILIES`` at its default size:
+For each family in ``hystkit.models.FAMILIES`` at its default size:
 
 - simulation: ns per sample of ``family.simulate`` on a 100 000-sample normalised input (a sine
   with decaying minor loops plus noise), min of 7 repeats after a warm-up run (which pays for any
@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 from hystkit.compensation._compensator import _centre_and_scale
-from hystkit.identification import FAMILIES
+from hystkit.models import FAMILIES
 from hystkit.sensors import simulate_experiment
 
 

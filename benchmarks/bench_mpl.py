@@ -6,7 +6,7 @@ Table 1 -- forward model cost in ns per sample per cell, for N = 1, 3, 10 cells 
 100 000-sample normalised input (0.5 Hz sine plus white noise, max |u| = 1, dt = 0.025 s):
 
 * ``hystkit.models.mpl.simulate``: the numba kernel plus its Python wrapper (checks, knee),
-* the bare numba kernel ``_mpl_kernels.simulate`` (to show what the wrapper costs),
+* the bare numba kernel ``hystkit.models.mpl.kernels.simulate`` (to show what the wrapper costs),
 * ``_c_reference.c``: the same loop in C, compiled now with ``cc -O2 -shared -fPIC`` (no
   -ffast-math) and called through ctypes; its output must match hystkit's to ~1e-12,
 * ``simulate_reference``: the plain Python loop over ``step``, on 2 000 samples.
@@ -54,9 +54,9 @@ from scipy.optimize import least_squares
 
 import hystkit
 from hystkit.compensation._compensator import _centre_and_scale
-from hystkit.identification import _fit, default_starts, fit_mpl
-from hystkit.models import _mpl_kernels as kernels
 from hystkit.models import mpl
+from hystkit.models.mpl import default_starts, fit_mpl, kernels
+from hystkit.models.mpl import fit as _fit
 from hystkit.sensors._virtual import simulate_experiment
 
 DT = 0.025
@@ -201,7 +201,7 @@ def c_simulate(func, u: np.ndarray, x0: np.ndarray, i_s, v_t, w, v_b, knee, cap,
 
 
 def kernel_args(structure: mpl.MplStructure, params: mpl.MplParams, u: np.ndarray) -> tuple:
-    """Arguments of ``_mpl_kernels.simulate`` exactly as ``mpl.simulate`` builds them."""
+    """Arguments of ``hystkit.models.mpl.kernels.simulate`` exactly as ``mpl.simulate`` builds them."""
     return (u, np.full(structure.n_cells, u[0]), params.i_s, params.v_t, params.w, params.v_b,
             mpl.knee_voltage(structure, params), structure.slope_cap / structure.dt,
             structure.dt)
@@ -284,7 +284,7 @@ def print_simulation_table(c_func, cc: str | None) -> None:
         diff = f"{r['diff']:10.1e}" if "diff" in r else f"{'-':>10}"
         print(f"  {r['n']:>3} {r['hystkit']:9.2f} {r['kernel']:9.2f} {c} {r['python']:10.0f} "
               f"{ratio} {r['python'] / r['hystkit']:8.0f} {diff} {100 * r['linear']:9.2f}")
-    print("  hystkit = mpl.simulate (wrapper + numba kernel); kernel = _mpl_kernels.simulate "
+    print("  hystkit = mpl.simulate (wrapper + numba kernel); kernel = mpl.kernels.simulate "
           "alone")
     print()
 
