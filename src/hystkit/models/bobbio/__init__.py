@@ -5,22 +5,11 @@
 ``fit`` the identification, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
+from . import fit, model
 from .family import BobbioFamily
-from .fit import candidate_thresholds, fit_bobbio
-from .model import (
-    BobbioParams,
-    BobbioStructure,
-    forces,
-    invert,
-    invert_step,
-    rest_state,
-    simulate,
-    simulate_reference,
-    step,
-)
+from .fit import *
+from .model import *
 
 FAMILY = BobbioFamily()
 
-__all__ = ["FAMILY", "BobbioFamily", "BobbioParams", "BobbioStructure", "candidate_thresholds",
-           "fit_bobbio", "forces", "invert", "invert_step", "rest_state", "simulate",
-           "simulate_reference", "step"]
+__all__ = ["FAMILY", "BobbioFamily"] + model.__all__ + fit.__all__

@@ -5,26 +5,11 @@ reference document; docs/models/boucwen.md).
 ``fit`` the identification, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
+from . import fit, model
 from .family import BoucWenFamily
-from .fit import fit_boucwen, fit_family, parameter_bounds
-from .model import (
-    BENCHMARK_PARAMS,
-    HOLDS,
-    STARTS,
-    BoucWenParams,
-    BoucWenStructure,
-    bandlimited_upsample,
-    initial_state,
-    rest_state,
-    simulate,
-    simulate_reference,
-    simulate_states,
-    step,
-)
+from .fit import *
+from .model import *
 
 FAMILY = BoucWenFamily()
 
-__all__ = ["BENCHMARK_PARAMS", "FAMILY", "HOLDS", "STARTS", "BoucWenFamily", "BoucWenParams",
-           "BoucWenStructure", "bandlimited_upsample", "fit_boucwen", "fit_family",
-           "initial_state", "parameter_bounds", "rest_state", "simulate", "simulate_reference",
-           "simulate_states", "step"]
+__all__ = ["FAMILY", "BoucWenFamily"] + model.__all__ + fit.__all__

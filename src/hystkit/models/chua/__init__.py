@@ -4,28 +4,11 @@
 ``fit`` the identification, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
+from . import fit, model
 from .family import ChuaFamily
-from .fit import default_starts, fit_chua
-from .model import (
-    ChuaParams,
-    ChuaStructure,
-    dissipation,
-    dissipation_slope,
-    invert,
-    invert_step,
-    kernel_args,
-    limits,
-    rest_state,
-    restoring,
-    restoring_inverse,
-    simulate,
-    simulate_reference,
-    step,
-)
+from .fit import *
+from .model import *
 
 FAMILY = ChuaFamily()
 
-__all__ = ["FAMILY", "ChuaFamily", "ChuaParams", "ChuaStructure", "default_starts",
-           "dissipation", "dissipation_slope", "fit_chua", "invert", "invert_step",
-           "kernel_args", "limits", "rest_state", "restoring", "restoring_inverse", "simulate",
-           "simulate_reference", "step"]
+__all__ = ["FAMILY", "ChuaFamily"] + model.__all__ + fit.__all__

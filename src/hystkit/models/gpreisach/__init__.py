@@ -6,24 +6,11 @@ loop state and protocol methods it reuses. ``model`` holds the equations and the
 reference, ``fit`` the identification, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
+from . import fit, model
 from .family import GPreisachFamily
-from .fit import fit_gpreisach
-from .model import (
-    GPreisachParams,
-    GPreisachStructure,
-    invert,
-    invert_step,
-    kernel_parts,
-    major_slope,
-    reversible,
-    reversible_basis,
-    simulate,
-    simulate_reference,
-    step,
-)
+from .fit import *
+from .model import *
 
 FAMILY = GPreisachFamily()
 
-__all__ = ["FAMILY", "GPreisachFamily", "GPreisachParams", "GPreisachStructure",
-           "fit_gpreisach", "invert", "invert_step", "kernel_parts", "major_slope",
-           "reversible", "reversible_basis", "simulate", "simulate_reference", "step"]
+__all__ = ["FAMILY", "GPreisachFamily"] + model.__all__ + fit.__all__

@@ -5,24 +5,11 @@
 ``fit`` the identification, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
+from . import fit, model
 from .family import LadderFamily
-from .fit import default_starts, fit_ladder
-from .model import (
-    LadderParams,
-    LadderStructure,
-    conductance_limit,
-    effective_conductance,
-    invert,
-    invert_step,
-    rest_state,
-    simulate,
-    simulate_reference,
-    states,
-    step,
-)
+from .fit import *
+from .model import *
 
 FAMILY = LadderFamily()
 
-__all__ = ["FAMILY", "LadderFamily", "LadderParams", "LadderStructure", "conductance_limit",
-           "default_starts", "effective_conductance", "fit_ladder", "invert", "invert_step",
-           "rest_state", "simulate", "simulate_reference", "states", "step"]
+__all__ = ["FAMILY", "LadderFamily"] + model.__all__ + fit.__all__

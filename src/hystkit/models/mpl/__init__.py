@@ -4,22 +4,11 @@
 ``fit`` the identification, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
+from . import model
 from .family import MplFamily
 from .fit import default_starts, fit_mpl
-from .model import (
-    MplParams,
-    MplStructure,
-    invert,
-    invert_step,
-    knee_voltage,
-    resistor_current,
-    simulate,
-    simulate_reference,
-    step,
-)
+from .model import *
 
 FAMILY = MplFamily()
 
-__all__ = ["FAMILY", "MplFamily", "MplParams", "MplStructure", "default_starts", "fit_mpl",
-           "invert", "invert_step", "knee_voltage", "resistor_current", "simulate",
-           "simulate_reference", "step"]
+__all__ = ["FAMILY", "MplFamily", "default_starts", "fit_mpl"] + model.__all__

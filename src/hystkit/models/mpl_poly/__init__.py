@@ -5,35 +5,13 @@ the compiled loops (with the loop blocks), ``fit`` the identification, ``presets
 tables, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
+from . import model
 from .family import MplPolyFamily
 from .fit import canonical, default_starts, fit_mpl_poly
-from .model import (
-    MplPolyParams,
-    MplPolyStructure,
-    equilibria,
-    inverse_branch,
-    invert,
-    invert_step,
-    knee_points,
-    output_branch,
-    output_current,
-    output_slope,
-    resistor_current,
-    resistor_slope,
-    rest_state,
-    rest_voltages,
-    simulate,
-    simulate_reference,
-    simulate_with_jacobian,
-    step,
-)
+from .model import *
 from .presets import PAPER_9_2_TABLE_I, PAPER_9_2_TABLE_II, paper_9_2_params
 
 FAMILY = MplPolyFamily()
 
-__all__ = ["FAMILY", "PAPER_9_2_TABLE_I", "PAPER_9_2_TABLE_II", "MplPolyFamily",
-           "MplPolyParams", "MplPolyStructure", "canonical", "default_starts", "equilibria",
-           "fit_mpl_poly", "inverse_branch", "invert", "invert_step", "knee_points",
-           "output_branch", "output_current", "output_slope", "paper_9_2_params",
-           "resistor_current", "resistor_slope", "rest_state", "rest_voltages", "simulate",
-           "simulate_reference", "simulate_with_jacobian", "step"]
+__all__ = ["FAMILY", "MplPolyFamily", "PAPER_9_2_TABLE_I", "PAPER_9_2_TABLE_II",
+           "paper_9_2_params", "canonical", "default_starts", "fit_mpl_poly"] + model.__all__

@@ -5,48 +5,13 @@
 squares and FORCs), ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
-from . import kernels
+from . import fit, kernels, model
 from .family import PreisachFamily, StaircaseFamily
-from .fit import (
-    ORIENTATIONS,
-    check_data,
-    everett_from_forcs,
-    fit_oriented,
-    fit_preisach,
-    smoothness_rows,
-    solve_regularised,
-)
-from .model import (
-    INVERT_TOL,
-    PreisachParams,
-    PreisachStructure,
-    antisymmetric,
-    cell_regressors,
-    check_state,
-    demagnetised_state,
-    everett,
-    everett_from_masses,
-    grid,
-    invert,
-    invert_step,
-    kernel_parts,
-    masses_from_everett,
-    pack_state,
-    prepare_run,
-    simulate,
-    simulate_reference,
-    staircase_terms,
-    step,
-    unpack_state,
-    update_staircase,
-)
+from .fit import *
+from .model import *
+from .model import INVERT_TOL
 
 FAMILY = PreisachFamily()
 
-__all__ = ["FAMILY", "INVERT_TOL", "ORIENTATIONS", "PreisachFamily", "PreisachParams",
-           "PreisachStructure", "StaircaseFamily", "antisymmetric", "cell_regressors",
-           "check_data", "check_state", "demagnetised_state", "everett", "everett_from_forcs",
-           "everett_from_masses", "fit_oriented", "fit_preisach", "grid", "invert",
-           "invert_step", "kernel_parts", "kernels", "masses_from_everett", "pack_state",
-           "prepare_run", "simulate", "simulate_reference", "smoothness_rows",
-           "solve_regularised", "staircase_terms", "step", "unpack_state", "update_staircase"]
+__all__ = (["FAMILY", "PreisachFamily", "StaircaseFamily", "INVERT_TOL", "kernels"] + model.__all__
+           + fit.__all__)
