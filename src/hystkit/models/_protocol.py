@@ -159,8 +159,15 @@ class Family(ABC):
     invert: ClassVar[Callable[..., tuple[np.ndarray, np.ndarray]] | None] = None
     invert_step: ClassVar[Callable[..., tuple[float, np.ndarray]] | None] = None
 
+    fit_function: ClassVar[Callable[..., Any] | None] = None
+    """The family's fit function, ``fit_x(u, y, structure, *, accept, accept_reason,
+    **options) -> FitResult``; the default :meth:`fit` calls it."""
+
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
+        fit_function = cls.__dict__.get("fit_function")
+        if fit_function is not None and not isinstance(fit_function, staticmethod):
+            cls.fit_function = staticmethod(fit_function)  # a plain function, not a method
         module = cls.__dict__.get("model")
         if module is None or cls.no_inverse_reason:
             return
@@ -237,11 +244,17 @@ class Family(ABC):
 
     # -- identification ---------------------------------------------------------------------
 
-    @abstractmethod
     def fit(self, u: np.ndarray, y: np.ndarray, structure: Any, *,
             accept: Callable[[Any], bool] | None = None,
             accept_reason: str = "rejected by the acceptance test", **options: Any) -> Any:
-        """Fit ``u -> y`` (centred, normalised data) and return a ``FitResult``."""
+        """Fit ``u -> y`` (centred, normalised data) and return a ``FitResult``.
+
+        The default calls :attr:`fit_function`; a family without one overrides this."""
+        if self.fit_function is None:
+            raise NotImplementedError(f"family {self.name!r} defines no fit and no "
+                                      f"fit_function")
+        return self.fit_function(u, y, structure, accept=accept, accept_reason=accept_reason,
+                                 **options)
 
     # -- loop -------------------------------------------------------------------------------
 

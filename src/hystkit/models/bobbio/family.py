@@ -21,6 +21,7 @@ class BobbioFamily(Family):
     Structure = bobbio.BobbioStructure
     Params = bobbio.BobbioParams
     model = bobbio
+    fit_function = fit_bobbio
 
     def make_structure(self, dt: float, size: int) -> bobbio.BobbioStructure:
         return bobbio.BobbioStructure(n_springs=size, dt=dt)
@@ -29,11 +30,6 @@ class BobbioFamily(Family):
         """The chain is rate-independent (only the input values matter, not their timing), so
         the same model runs at any ``dt``; only the recorded ``dt`` changes."""
         return super().at(structure, dt)
-
-    def fit(self, u, y, structure, *, accept=None,
-            accept_reason="rejected by the acceptance test", **options):
-        return fit_bobbio(u, y, structure, accept=accept, accept_reason=accept_reason,
-                          **options)
 
     def block(self, structure, params, inverse=False):
         body = np.concatenate([[params.n_springs, params.offset], params.compliance,

@@ -22,6 +22,7 @@ class BoucWenFamily(Family):
     Structure = boucwen.BoucWenStructure
     Params = boucwen.BoucWenParams
     model = boucwen
+    fit_function = fit_family
     no_inverse_reason = ("its input is a force and its output a displacement of a second-order "
                          "system: the inverse needs the measured output differentiated twice "
                          "(dynamic inversion), which is not implemented")
@@ -40,11 +41,6 @@ class BoucWenFamily(Family):
         ``FitDivergedError`` if the integration diverges (give more substeps). Keeping the
         count, not ``h``, makes ``at`` reversible, ``at(at(s, dt), s.dt) == s``."""
         return super().at(structure, dt)
-
-    def fit(self, u, y, structure, *, accept=None,
-            accept_reason="rejected by the acceptance test", **options):
-        return fit_family(u, y, structure, accept=accept, accept_reason=accept_reason,
-                          **options)
 
     def block(self, structure, params, inverse=False):
         """The per-sample scheme of :meth:`step`: RK4 substeps with the force held or linear

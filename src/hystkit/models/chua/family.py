@@ -23,6 +23,7 @@ class ChuaFamily(Family):
     Structure = chua.ChuaStructure
     Params = chua.ChuaParams
     model = chua
+    fit_function = fit_chua
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> chua.ChuaStructure:
         return chua.ChuaStructure(n_elements=size, dt=dt, slope_cap=slope_cap)
@@ -37,10 +38,6 @@ class ChuaFamily(Family):
         dt = float(dt)
         cap = min(structure.slope_cap * dt / structure.dt, max(structure.slope_cap, 1.0))
         return dataclasses.replace(structure, dt=dt, slope_cap=cap)
-
-    def fit(self, u, y, structure, *, accept=None,
-            accept_reason="rejected by the acceptance test", **options):
-        return fit_chua(u, y, structure, accept=accept, accept_reason=accept_reason, **options)
 
     def block(self, structure, params, inverse=False):
         *per_element, dt = chua.kernel_args(structure, params)

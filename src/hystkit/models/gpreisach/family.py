@@ -26,6 +26,7 @@ class GPreisachFamily(StaircaseFamily):
     Structure = gpreisach.GPreisachStructure
     Params = gpreisach.GPreisachParams
     stairs = gpreisach
+    fit_function = fit_gpreisach
 
     def make_structure(self, dt: float, size: int,
                        **options: Any) -> gpreisach.GPreisachStructure:
@@ -35,8 +36,3 @@ class GPreisachFamily(StaircaseFamily):
         """Off-diagonal masses of both weights (the fit keeps the diagonal at zero), the
         Bernstein coefficients of ``nu`` and the offset."""
         return (structure.levels - 1) * (structure.levels - 2) + params.nu.size + 1
-
-    def fit(self, u, y, structure, *, accept=None,
-            accept_reason="rejected by the acceptance test", **options):
-        return fit_gpreisach(u, y, structure, accept=accept, accept_reason=accept_reason,
-                             **options)

@@ -24,6 +24,7 @@ class LadderFamily(Family):
     Structure = ladder.LadderStructure
     Params = ladder.LadderParams
     model = ladder
+    fit_function = fit_ladder
 
     def make_structure(self, dt: float, size: int,
                        slope_cap: float = 1.0) -> ladder.LadderStructure:
@@ -39,11 +40,6 @@ class LadderFamily(Family):
         dt = float(dt)
         cap = min(structure.slope_cap * dt / structure.dt, max(structure.slope_cap, 1.0))
         return dataclasses.replace(structure, dt=dt, slope_cap=cap)
-
-    def fit(self, u, y, structure, *, accept=None,
-            accept_reason="rejected by the acceptance test", **options):
-        return fit_ladder(u, y, structure, accept=accept, accept_reason=accept_reason,
-                          **options)
 
     def block(self, structure, params, inverse=False):
         if inverse and params.w[0] == 0:

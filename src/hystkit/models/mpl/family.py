@@ -22,6 +22,7 @@ class MplFamily(Family):
     Structure = mpl.MplStructure
     Params = mpl.MplParams
     model = mpl  # step, simulate, invert, invert_step
+    fit_function = fit_mpl
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> mpl.MplStructure:
         return mpl.MplStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
@@ -33,10 +34,6 @@ class MplFamily(Family):
             w_sum = float(np.sum(params.w))
             value = (value + params.v_b) / w_sum if w_sum != 0 else 0.0
         return np.full(structure.n_cells, float(value))
-
-    def fit(self, u, y, structure, *, accept=None,
-            accept_reason="rejected by the acceptance test", **options):
-        return fit_mpl(u, y, structure, accept=accept, accept_reason=accept_reason, **options)
 
     def block(self, structure, params, inverse=False):
         body = np.concatenate([[params.n_cells, params.v_b, structure.slope_cap / structure.dt,

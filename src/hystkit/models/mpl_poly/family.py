@@ -23,6 +23,8 @@ class MplPolyFamily(Family):
     docs = "docs/models/mpl_poly.md"
     Structure = mpl_poly.MplPolyStructure
     Params = mpl_poly.MplPolyParams
+    model = mpl_poly
+    fit_function = fit_mpl_poly
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0,
                        limit: bool = True) -> mpl_poly.MplPolyStructure:
@@ -44,18 +46,6 @@ class MplPolyFamily(Family):
                                       "direction": "sensor -> position", "fit_dt": 0.025})
                 for name, printed in PAPER_9_2_TABLE_II.items()}
 
-    def rest_state(self, structure, params, value, inverse=False):
-        return mpl_poly.rest_state(structure, params, value, inverse)
-
-    def step(self, structure, params, x, u):
-        return mpl_poly.step(structure, params, x, u)
-
-    def simulate(self, structure, params, u, x0=None):
-        return mpl_poly.simulate(structure, params, u, x0)
-
-    def invert(self, structure, params, y, x0=None):
-        return mpl_poly.invert(structure, params, y, x0)
-
     def invert_step(self, structure, params, x, y):
         """As :func:`model.invert_step`; NaN input estimate and state when ``y`` is outside
         the range of ``g``'s branch (no input gives it), as the compiled block."""
@@ -64,11 +54,6 @@ class MplPolyFamily(Family):
                                     centre)[1]:
             return np.nan, np.full(np.size(x), np.nan)
         return mpl_poly.invert_step(structure, params, x, y)
-
-    def fit(self, u, y, structure, *, accept=None,
-            accept_reason="rejected by the acceptance test", **options):
-        return fit_mpl_poly(u, y, structure, accept=accept, accept_reason=accept_reason,
-                            **options)
 
     def block(self, structure, params, inverse=False):
         if inverse:

@@ -26,6 +26,7 @@ class PiFamily(Family):
     Structure = pi.PiStructure
     Params = pi.PiParams
     model = pi  # rest_state, step, simulate, invert, invert_step: the module's functions
+    fit_function = fit_pi
 
     def make_structure(self, dt, size, **options):
         return make_structure(dt, size, **options)
@@ -40,10 +41,6 @@ class PiFamily(Family):
         the model at ``dt / k`` gives the same output at the common instants.
         """
         return dataclasses.replace(structure, dt=float(dt))
-
-    def fit(self, u, y, structure, *, accept=None,
-            accept_reason="rejected by the acceptance test", **options):
-        return fit_pi(u, y, structure, accept=accept, accept_reason=accept_reason, **options)
 
     def block(self, structure, params, inverse=False):
         pi.simulate(structure, params, np.zeros(2))  # checks that params fit the structure

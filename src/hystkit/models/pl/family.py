@@ -21,6 +21,8 @@ class PlFamily(Family):
     docs = "docs/models/pl.md"
     Structure = pl.PlStructure
     Params = pl.PlParams
+    model = pl
+    fit_function = fit_pl
 
     def make_structure(self, dt: float, size: int, power: float = 21.0, n_basis: int = 1,
                        smoothing: float = 0.001, slope_cap: float = 1.0) -> pl.PlStructure:
@@ -34,25 +36,6 @@ class PlFamily(Family):
         its threshold still follows the input within one sample (the play-operator part), and
         the knees are recomputed from it."""
         return super().at(structure, dt)
-
-    def rest_state(self, structure, params, value, inverse=False):
-        return pl.rest_state(structure, params, value, inverse)
-
-    def step(self, structure, params, x, u):
-        return pl.step(structure, params, x, u)
-
-    def simulate(self, structure, params, u, x0=None):
-        return pl.simulate(structure, params, u, x0)
-
-    def invert(self, structure, params, y, x0=None):
-        return pl.invert(structure, params, y, x0)
-
-    def invert_step(self, structure, params, x, y):
-        return pl.invert_step(structure, params, x, y)
-
-    def fit(self, u, y, structure, *, accept=None,
-            accept_reason="rejected by the acceptance test", **options):
-        return fit_pl(u, y, structure, accept=accept, accept_reason=accept_reason, **options)
 
     def block(self, structure, params, inverse=False):
         if inverse and params.w[0] == 0:

@@ -135,6 +135,7 @@ class PreisachFamily(StaircaseFamily):
     Structure = preisach.PreisachStructure
     Params = preisach.PreisachParams
     stairs = preisach
+    fit_function = fit_preisach
 
     def make_structure(self, dt: float, size: int, **options: Any) -> preisach.PreisachStructure:
         return preisach.PreisachStructure(levels=size, dt=dt, **options)
@@ -142,8 +143,3 @@ class PreisachFamily(StaircaseFamily):
     def n_params(self, structure, params) -> int:
         """The Everett nodes below the diagonal (one per cell mass) and the offset."""
         return structure.levels * (structure.levels - 1) // 2 + 1
-
-    def fit(self, u, y, structure, *, accept=None,
-            accept_reason="rejected by the acceptance test", **options):
-        return fit_preisach(u, y, structure, accept=accept, accept_reason=accept_reason,
-                            **options)
