@@ -4,22 +4,29 @@ Every model validates the same kinds of things: parameter arrays (frozen, finite
 size), the signal a run is fed, the initial state of a run, and the sample time and Euler slope
 cap of its structure. The functions here raise :class:`ValueError` with the wording the models
 have always used, so callers (and tests) see one message for one kind of mistake.
+:func:`run_steps` is the readable reference run every model's ``simulate_reference`` shares.
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 
 __all__ = [
     "broadcast_state",
+    "check_cells",
     "check_dt",
     "check_positive_int",
     "check_signal",
     "check_size",
     "check_slope_cap",
+    "finite_floats",
+    "freeze_arrays",
     "frozen_array",
     "frozen_shaped",
     "initial_state",
+    "run_steps",
 ]
 
 
@@ -58,6 +65,28 @@ def frozen_array(values, n: int | None, name: str) -> np.ndarray:
     if n is not None and arr.shape != (n,):
         raise ValueError(f"{name} must have {n} values, got {arr.size}")
     return _freeze(arr, name)
+
+
+def freeze_arrays(record, **sizes: int | None) -> None:
+    """Replace each named field of the frozen dataclass ``record`` by :func:`frozen_array` of
+    it, ``sizes`` giving the number of values each needs (``None``: any), in that order."""
+    for name, n in sizes.items():
+        object.__setattr__(record, name, frozen_array(getattr(record, name), n, name))
+
+
+def finite_floats(record, *names: str) -> None:
+    """Replace each named field of the frozen dataclass ``record`` by its float value.
+
+    Raises
+    ------
+    ValueError
+        If one is not finite (checked in the order given).
+    """
+    for name in names:
+        value = float(getattr(record, name))
+        if not np.isfinite(value):
+            raise ValueError(f"{name} must be finite, got {value}")
+        object.__setattr__(record, name, value)
 
 
 def frozen_shaped(values, shape: tuple[int, ...] | None, name: str) -> np.ndarray:
@@ -130,6 +159,15 @@ def check_positive_int(value, name: str) -> None:
         raise ValueError(f"{name} must be a positive integer, got {value!r}")
 
 
+def check_cells(n: int, dt: float, slope_cap: float, name: str = "n_cells") -> None:
+    """The checks of a cell (or element, section) model's structure: ``n`` a positive integer
+    (:func:`check_positive_int` under ``name``), then :func:`check_dt` and
+    :func:`check_slope_cap`."""
+    check_positive_int(n, name)
+    check_dt(dt)
+    check_slope_cap(slope_cap)
+
+
 def check_size(ours: int, theirs: int, what: str) -> None:
     """Raise ValueError unless params and structure agree on the number of ``what``.
 
@@ -153,3 +191,12 @@ def check_slope_cap(slope_cap: float) -> None:
     if not 0 < slope_cap < 2:
         raise ValueError(f"slope_cap must lie in (0, 2) for a stable Euler step (eq. 5.28), "
                          f"got {slope_cap!r}")
+
+
+def run_steps(step, structure, params, u: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, Any]:
+    """Readable reference run: ``step(structure, params, x, u_n) -> (y_n, x_next)`` called for
+    every sample of ``u`` (already checked) from the state ``x``; returns ``(y, x_end)``."""
+    y = np.empty_like(u)
+    for n, u_n in enumerate(u):
+        y[n], x = step(structure, params, x, u_n)
+    return y, x

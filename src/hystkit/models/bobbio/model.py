@@ -41,8 +41,10 @@ from .._validation import (
     check_positive_int,
     check_signal,
     check_size,
-    frozen_array,
+    finite_floats,
+    freeze_arrays,
     initial_state,
+    run_steps,
 )
 from . import kernels
 
@@ -105,11 +107,8 @@ class BobbioParams(Record):
     def __post_init__(self) -> None:
         n = np.size(self.compliance)
         object.__setattr__(self, "n_springs", int(n))
-        object.__setattr__(self, "compliance", frozen_array(self.compliance, n, "compliance"))
-        object.__setattr__(self, "friction", frozen_array(self.friction, n - 1, "friction"))
-        object.__setattr__(self, "offset", float(self.offset))
-        if not np.isfinite(self.offset):
-            raise ValueError(f"offset must be finite, got {self.offset}")
+        freeze_arrays(self, compliance=n, friction=n - 1)
+        finite_floats(self, "offset")
         if np.any(self.compliance < 0):
             raise ValueError("compliance must be >= 0 (springs have positive stiffness)")
         if np.any(self.friction <= 0):
@@ -203,10 +202,7 @@ def simulate_reference(structure: BobbioStructure, params: BobbioParams, u: np.n
     """Same as :func:`simulate`, as a plain loop over :func:`step`."""
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_springs - 1, x0, u[0])
-    y = np.empty_like(u)
-    for n, u_n in enumerate(u):
-        y[n], x = step(structure, params, x, u_n)
-    return y, x
+    return run_steps(step, structure, params, u, x)
 
 
 def invert(structure: BobbioStructure, params: BobbioParams, y: np.ndarray,

@@ -41,12 +41,11 @@ from ...errors import FitDivergedError
 from .._protocol import Record
 from .._validation import (
     broadcast_state,
-    check_dt,
-    check_positive_int,
+    check_cells,
     check_signal,
     check_size,
-    check_slope_cap,
-    frozen_array,
+    freeze_arrays,
+    run_steps,
 )
 from . import kernels
 
@@ -89,9 +88,7 @@ class ChuaStructure(Record):
     slope_cap: float = 1.0
 
     def __post_init__(self) -> None:
-        check_positive_int(self.n_elements, "n_elements")
-        check_dt(self.dt)
-        check_slope_cap(self.slope_cap)
+        check_cells(self.n_elements, self.dt, self.slope_cap, "n_elements")
 
     @property
     def n_params(self) -> int:
@@ -132,8 +129,7 @@ class ChuaParams(Record):
     def __post_init__(self) -> None:
         n = np.size(self.k0)
         object.__setattr__(self, "n_elements", int(n))
-        for name in _FIELDS:
-            object.__setattr__(self, name, frozen_array(getattr(self, name), n, name))
+        freeze_arrays(self, **dict.fromkeys(_FIELDS, n))
         for name in _FIELDS[:5]:
             if np.any(getattr(self, name) <= 0):
                 raise ValueError(f"{name} must be positive (f and g strictly increasing, eq. 2.3)")
@@ -300,10 +296,7 @@ def simulate_reference(structure: ChuaStructure, params: ChuaParams, u: np.ndarr
     """Same as :func:`simulate`, as a plain loop over :func:`step`."""
     u = _check(structure, params, u, "u")
     x = _initial_state(structure, params, x0, u[0])
-    y = np.empty_like(u)
-    for n, u_n in enumerate(u):
-        y[n], x = step(structure, params, x, u_n)
-    return y, x
+    return run_steps(step, structure, params, u, x)
 
 
 def invert(structure: ChuaStructure, params: ChuaParams, y: np.ndarray,

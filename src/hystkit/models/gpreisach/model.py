@@ -39,6 +39,7 @@ from numpy.polynomial import Polynomial
 
 from ...errors import FitDivergedError
 from .._protocol import Record
+from .._validation import run_steps
 from ..preisach import (
     INVERT_TOL,
     PreisachParams,
@@ -249,10 +250,7 @@ def simulate_reference(structure: GPreisachStructure, params: GPreisachParams, u
                        x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
     u, x = _check(structure, params, u, "u", x0)
-    y = np.empty_like(u)
-    for n, u_n in enumerate(u):
-        y[n], x = step(structure, params, x, u_n)
-    return y, x
+    return run_steps(step, structure, params, u, x)
 
 
 def invert(structure: GPreisachStructure, params: GPreisachParams, y: np.ndarray,

@@ -37,13 +37,13 @@ import numpy as np
 from ...errors import FitDivergedError
 from .._protocol import Record
 from .._validation import (
-    check_dt,
-    check_positive_int,
+    check_cells,
     check_signal,
     check_size,
-    check_slope_cap,
-    frozen_array,
+    finite_floats,
+    freeze_arrays,
     initial_state,
+    run_steps,
 )
 from . import kernels
 
@@ -81,9 +81,7 @@ class LadderStructure(Record):
     slope_cap: float = 1.0
 
     def __post_init__(self) -> None:
-        check_positive_int(self.n_cells, "n_cells")
-        check_dt(self.dt)
-        check_slope_cap(self.slope_cap)
+        check_cells(self.n_cells, self.dt, self.slope_cap)
 
     @property
     def n_params(self) -> int:
@@ -115,12 +113,8 @@ class LadderParams(Record):
     def __post_init__(self) -> None:
         n = np.size(self.band)
         object.__setattr__(self, "n_cells", int(n))
-        object.__setattr__(self, "band", frozen_array(self.band, n, "band"))
-        object.__setattr__(self, "conductance", frozen_array(self.conductance, n, "conductance"))
-        object.__setattr__(self, "w", frozen_array(self.w, n + 1, "w"))
-        object.__setattr__(self, "v_b", float(self.v_b))
-        if not np.isfinite(self.v_b):
-            raise ValueError(f"v_b must be finite, got {self.v_b}")
+        freeze_arrays(self, band=n, conductance=n, w=n + 1)
+        finite_floats(self, "v_b")
         if np.any(self.band < 0):
             raise ValueError("band (resistor dead band E_k) must be >= 0")
         if np.any(self.conductance <= 0):
@@ -215,10 +209,7 @@ def simulate_reference(structure: LadderStructure, params: LadderParams, u: np.n
     """Same as :func:`simulate`, as a plain loop over :func:`step`."""
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
-    y = np.empty_like(u)
-    for n, u_n in enumerate(u):
-        y[n], x = step(structure, params, x, u_n)
-    return y, x
+    return run_steps(step, structure, params, u, x)
 
 
 def invert(structure: LadderStructure, params: LadderParams, y: np.ndarray,

@@ -31,13 +31,13 @@ import numpy as np
 from ...errors import FitDivergedError
 from .._protocol import Record
 from .._validation import (
-    check_dt,
-    check_positive_int,
+    check_cells,
     check_signal,
     check_size,
-    check_slope_cap,
-    frozen_array,
+    finite_floats,
+    freeze_arrays,
     initial_state,
+    run_steps,
 )
 from . import kernels
 
@@ -73,9 +73,7 @@ class MplStructure(Record):
     slope_cap: float = 1.0
 
     def __post_init__(self) -> None:
-        check_positive_int(self.n_cells, "n_cells")
-        check_dt(self.dt)
-        check_slope_cap(self.slope_cap)
+        check_cells(self.n_cells, self.dt, self.slope_cap)
 
     @property
     def n_params(self) -> int:
@@ -115,12 +113,8 @@ class MplParams(Record):
     def __post_init__(self) -> None:
         n = np.size(self.i_s)
         object.__setattr__(self, "n_cells", int(n))
-        object.__setattr__(self, "i_s", frozen_array(self.i_s, n, "i_s"))
-        object.__setattr__(self, "v_t", frozen_array(self.v_t, n, "v_t"))
-        object.__setattr__(self, "w", frozen_array(self.w, n + 1, "w"))
-        object.__setattr__(self, "v_b", float(self.v_b))
-        if not np.isfinite(self.v_b):
-            raise ValueError(f"v_b must be finite, got {self.v_b}")
+        freeze_arrays(self, i_s=n, v_t=n, w=n + 1)
+        finite_floats(self, "v_b")
         if np.any(self.i_s <= 0) or np.any(self.v_t <= 0):
             raise ValueError("i_s and v_t must be positive (eq. 5.1)")
 
@@ -234,10 +228,7 @@ def simulate_reference(structure: MplStructure, params: MplParams, u: np.ndarray
     _check_params(structure, params)
     u = check_signal(u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
-    y = np.empty_like(u)
-    for n, u_n in enumerate(u):
-        y[n], x = step(structure, params, x, u_n)
-    return y, x
+    return run_steps(step, structure, params, u, x)
 
 
 def invert(structure: MplStructure, params: MplParams, y: np.ndarray,

@@ -35,12 +35,12 @@ from ...errors import FitDivergedError
 from .._protocol import Record
 from .._validation import (
     broadcast_state,
-    check_dt,
-    check_positive_int,
+    check_cells,
     check_signal,
     check_size,
-    check_slope_cap,
+    finite_floats,
     frozen_shaped,
+    run_steps,
 )
 from . import kernels
 
@@ -88,9 +88,7 @@ class MplPolyStructure(Record):
     limit: bool = True
 
     def __post_init__(self) -> None:
-        check_positive_int(self.n_cells, "n_cells")
-        check_dt(self.dt)
-        check_slope_cap(self.slope_cap)
+        check_cells(self.n_cells, self.dt, self.slope_cap)
         if not isinstance(self.limit, bool):
             raise TypeError(f"limit must be true or false, got {self.limit!r}")
 
@@ -135,9 +133,7 @@ class MplPolyParams(Record):
         object.__setattr__(self, "f", frozen_shaped(self.f, (n, 4), "f"))
         object.__setattr__(self, "g", frozen_shaped(self.g, (4,), "g"))
         object.__setattr__(self, "w", frozen_shaped(self.w, (n + 1,), "w"))
-        object.__setattr__(self, "v_b", float(self.v_b))
-        if not np.isfinite(self.v_b):
-            raise ValueError(f"v_b must be finite, got {self.v_b}")
+        finite_floats(self, "v_b")
         if np.any(self.f[:, 3] <= 0):
             raise ValueError("the cubic coefficient of every cell resistor must be positive "
                              "(stable for large |v|, sec. 5.3.5)")
@@ -411,10 +407,7 @@ def simulate_reference(structure: MplPolyStructure, params: MplPolyParams, u: np
     """Same as :func:`simulate` for bounded runs, as a plain loop over :func:`step`."""
     u = _check(structure, params, u, "u")
     x = _start(structure, params, x0, u[0])
-    y = np.empty_like(u)
-    for n, u_n in enumerate(u):
-        y[n], x = step(structure, params, x, u_n)
-    return y, x
+    return run_steps(step, structure, params, u, x)
 
 
 def simulate_with_jacobian(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,

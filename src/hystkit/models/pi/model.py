@@ -46,8 +46,11 @@ from .._protocol import Record
 from .._validation import (
     check_dt,
     check_signal,
+    finite_floats,
+    freeze_arrays,
     frozen_array,
     initial_state,
+    run_steps,
 )
 from . import kernels
 
@@ -142,13 +145,9 @@ class PiParams(Record):
     n_creep: int = field(init=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "w_h", frozen_array(self.w_h, None, "w_h"))
-        object.__setattr__(self, "w_s", frozen_array(self.w_s, None, "w_s"))
-        object.__setattr__(self, "d_s", frozen_array(self.d_s, self.w_s.size, "d_s"))
-        object.__setattr__(self, "w_k", frozen_array(self.w_k, None, "w_k"))
-        object.__setattr__(self, "b", float(self.b))
-        if not np.isfinite(self.b):
-            raise ValueError(f"b must be finite, got {self.b}")
+        freeze_arrays(self, w_h=None, w_s=None)
+        freeze_arrays(self, d_s=self.w_s.size, w_k=None)
+        finite_floats(self, "b")
         m = (self.d_s.size - 1) // 2
         if self.w_h.size < 1 or self.d_s.size % 2 == 0 or self.d_s[m] != 0.0 \
                 or np.any(np.diff(self.d_s) <= 0):
@@ -353,10 +352,7 @@ def simulate_reference(structure: PiStructure, params: PiParams, u: np.ndarray,
     _check_params(structure, params)
     u = check_signal(u, "u")
     x = _initial_state(structure, x0, u[0])
-    y = np.empty_like(u)
-    for n, u_n in enumerate(u):
-        y[n], x = step(structure, params, x, u_n)
-    return y, x
+    return run_steps(step, structure, params, u, x)
 
 
 def not_invertible_reason(structure: PiStructure, params: PiParams) -> str:

@@ -47,8 +47,10 @@ from .._validation import (
     check_dt,
     check_signal,
     check_slope_cap,
-    frozen_array,
+    finite_floats,
+    freeze_arrays,
     initial_state,
+    run_steps,
 )
 from . import kernels
 
@@ -154,13 +156,8 @@ class PlParams(Record):
         object.__setattr__(self, "n_basis", int(np.size(self.a)))
         if self.n_cells < 1 or self.n_basis < 1:
             raise ValueError("w needs N + 1 >= 2 values and a at least one")
-        object.__setattr__(self, "w", frozen_array(self.w, self.n_cells + 1, "w"))
-        object.__setattr__(self, "a", frozen_array(self.a, self.n_basis, "a"))
-        for name in ("i_t", "v_t", "v_b"):
-            value = float(getattr(self, name))
-            if not np.isfinite(value):
-                raise ValueError(f"{name} must be finite, got {value}")
-            object.__setattr__(self, name, value)
+        freeze_arrays(self, w=self.n_cells + 1, a=self.n_basis)
+        finite_floats(self, "i_t", "v_t", "v_b")
         if self.i_t <= 0 or self.v_t <= 0:
             raise ValueError("i_t and v_t must be positive (eq. 2.16)")
         if np.any(self.a <= 0):
@@ -321,10 +318,7 @@ def simulate_reference(structure: PlStructure, params: PlParams, u: np.ndarray,
     """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
-    y = np.empty_like(u)
-    for n, e in enumerate(u):
-        y[n], x = step(structure, params, x, e)
-    return y, x
+    return run_steps(step, structure, params, u, x)
 
 
 def states(structure: PlStructure, params: PlParams, u: np.ndarray,

@@ -54,7 +54,7 @@ import numpy as np
 
 from ...errors import FitDivergedError
 from .._protocol import Record
-from .._validation import check_dt, check_signal, check_size
+from .._validation import check_dt, check_signal, check_size, run_steps
 from . import kernels
 
 __all__ = [
@@ -388,10 +388,7 @@ def simulate_reference(structure: PreisachStructure, params: PreisachParams, u: 
                        x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
     u, x = _check(structure, params, u, "u", x0)
-    y = np.empty_like(u)
-    for n, u_n in enumerate(u):
-        y[n], x = step(structure, params, x, u_n)
-    return y, x
+    return run_steps(step, structure, params, u, x)
 
 
 def invert(structure: PreisachStructure, params: PreisachParams, y: np.ndarray,
