@@ -238,27 +238,8 @@ X_MEMORY = bobbio.simulate(STRUCT, PARAMS, _ramps(0.0, 1.5, -0.6, 0.2, 0.1))[1]
 X_INSIDE = np.array([0.12, 0.05, -0.1, 0.0])
 
 
-def _drive(run, x0, signal, off=None):
-    """Run ``run`` sample by sample: a compiled block (``off`` = its slice's offset inside a
-    larger loop state whose neighbours must stay untouched) or a step function."""
-    x, out, states = np.asarray(x0, float), [], []
-    for v in signal:
-        if off is None:
-            y, x = run(x, v)
-        else:
-            big = np.full(off + x.size + 2, 7.0)
-            big[off:off + x.size] = x
-            xn = big.copy()
-            y = run.step(run.body, big, xn, off, v)
-            assert np.all(xn[:off] == 7.0) and np.all(xn[off + x.size:] == 7.0)
-            x = xn[off:off + x.size]
-        out.append(y)
-        states.append(x)
-    return np.array(out), np.array(states)
-
-
 @pytest.mark.parametrize("inverse", [False, True])
-def test_block_equals_step_from_a_non_rest_state(inverse):
+def test_block_equals_step_from_a_non_rest_state(inverse, drive):
     rng = np.random.default_rng(4)
     x0 = X_MEMORY
     signal = np.cumsum(0.15 * rng.standard_normal(400))
@@ -267,19 +248,19 @@ def test_block_equals_step_from_a_non_rest_state(inverse):
     run = FAMILY.invert_step if inverse else FAMILY.step
     blk = FAMILY.block(STRUCT, PARAMS, inverse)
     assert blk.n_state == 4
-    out_blk, x_blk = _drive(blk, x0, signal, off=2)
-    out_ref, x_ref = _drive(lambda x, v: run(STRUCT, PARAMS, x, v), x0, signal)
+    out_blk, x_blk = drive(blk, x0, signal, off=2)
+    out_ref, x_ref = drive(lambda x, v: run(STRUCT, PARAMS, x, v), x0, signal)
     assert np.all(np.isfinite(out_ref))
     assert_allclose(out_blk, out_ref, rtol=0, atol=1e-12)
     assert_allclose(x_blk, x_ref, rtol=0, atol=1e-12)
     assert np.ptp(x_ref[:, -1]) > 0.5  # the last piston slides, memory is exercised
 
 
-def test_inverse_without_any_compliance_is_nan_in_block_and_step():
+def test_inverse_without_any_compliance_is_nan_in_block_and_step(drive):
     rigid = bobbio.BobbioParams(compliance=np.zeros(3), friction=[0.1, 0.2])
     s = bobbio.BobbioStructure(n_springs=3)
-    u_blk, x_blk = _drive(FAMILY.block(s, rigid, True), [0.0, 0.0], [0.5], off=1)
-    u_ref, x_ref = _drive(lambda x, v: FAMILY.invert_step(s, rigid, x, v), [0.0, 0.0], [0.5])
+    u_blk, x_blk = drive(FAMILY.block(s, rigid, True), [0.0, 0.0], [0.5], off=1)
+    u_ref, x_ref = drive(lambda x, v: FAMILY.invert_step(s, rigid, x, v), [0.0, 0.0], [0.5])
     assert np.isnan(u_blk[0]) and np.isnan(u_ref[0])
     assert np.all(np.isnan(x_blk)) and np.all(np.isnan(x_ref))
     with pytest.raises(FitDivergedError):

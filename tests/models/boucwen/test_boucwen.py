@@ -301,35 +301,16 @@ FAMILY = get_family("boucwen")
 SHARP = bw.BoucWenParams(m=0.01, c=0.05, k=0.5, alpha=1.0, beta=1.0, gamma=0.3, nu=1.7)
 
 
-def _drive(run, x0, signal, off=None):
-    """Run ``run`` sample by sample: the compiled block (``off`` = its slice's offset inside a
-    larger loop state whose neighbours must stay untouched) or a step function."""
-    x, out, states = np.asarray(x0, float), [], []
-    for v in signal:
-        if off is None:
-            y, x = run(x, v)
-        else:
-            big = np.full(off + x.size + 2, 7.0)
-            big[off:off + x.size] = x
-            xn = big.copy()
-            y = run.step(run.body, big, xn, off, v)
-            assert np.all(xn[:off] == 7.0) and np.all(xn[off + x.size:] == 7.0)
-            x = xn[off:off + x.size]
-        out.append(y)
-        states.append(x)
-    return np.array(out), np.array(states)
-
-
 @pytest.mark.parametrize("hold", bw.HOLDS)
 @pytest.mark.parametrize("params", [SOFT, STIFF, SHARP])
-def test_block_equals_step_from_a_non_rest_state(hold, params):
+def test_block_equals_step_from_a_non_rest_state(hold, params, drive):
     s = bw.BoucWenStructure(dt=DT, substeps=3, input_hold=hold)
     u = np.random.default_rng(6).standard_normal(300)
     x0 = np.array([0.4, -3.0, 0.2, -0.5])  # moving, loaded, with another last force
     blk = FAMILY.block(s, params)
     assert blk.n_state == 4
-    y_blk, x_blk = _drive(blk, x0, u, off=2)
-    y_ref, x_ref = _drive(lambda x, v: FAMILY.step(s, params, x, v), x0, u)
+    y_blk, x_blk = drive(blk, x0, u, off=2)
+    y_ref, x_ref = drive(lambda x, v: FAMILY.step(s, params, x, v), x0, u)
     assert np.all(np.isfinite(y_ref))
     # nu != 1: exp(nu log|z|) in the kernel, ** in the reference, differ in the last bits
     assert_allclose(y_blk, y_ref, rtol=0, atol=1e-12)
@@ -400,7 +381,7 @@ def test_at_finer_dt_on_the_same_piecewise_linear_force_is_the_same_run(params):
 
 @pytest.mark.parametrize("params", [LINEAR, SOFT])
 @pytest.mark.parametrize("f_rel", [0.02, 0.05, 0.1, 0.2])
-def test_per_sample_scheme_against_a_band_limited_force(params, f_rel):
+def test_per_sample_scheme_against_a_band_limited_force(params, f_rel, drive):
     """How far block/step (force linear between samples, causal) are from the model run on the
     band-limited force (``bandlimited_upsample``, the benchmark's route): a sine at ``f_rel``
     of the sample rate loses the linear hold's droop ``sinc^2(f dt)`` (1.3e-3 at 0.02, 3 % at
@@ -409,9 +390,9 @@ def test_per_sample_scheme_against_a_band_limited_force(params, f_rel):
     n, periods = 400, 3
     k = round(f_rel * n)
     u = np.sin(2 * np.pi * k * np.arange(n) / n)
-    y_step, _ = _drive(lambda x, v: FAMILY.step(s, params, x, v),
+    y_step, _ = drive(lambda x, v: FAMILY.step(s, params, x, v),
                        FAMILY.rest_state(s, params, u[0]), np.tile(u, periods))
-    y_blk, _ = _drive(FAMILY.block(s, params), FAMILY.rest_state(s, params, u[0]),
+    y_blk, _ = drive(FAMILY.block(s, params), FAMILY.rest_state(s, params, u[0]),
                       np.tile(u, periods), off=0)
     assert_allclose(y_blk, y_step, rtol=0, atol=1e-12)
     fine = FAMILY.at(s, DT / 8)  # the same 4 substeps: an RK4 step 8x shorter

@@ -176,35 +176,16 @@ def test_compensator_on_the_virtual_sensor(mode, size):
 FAMILY = get_family("ladder")
 
 
-def _drive(run, x0, signal, off=None):
-    """Run ``run`` sample by sample: a compiled block (``off`` = its slice's offset inside a
-    larger loop state whose neighbours must stay untouched) or a step function."""
-    x, out, states = np.asarray(x0, float), [], []
-    for v in signal:
-        if off is None:
-            y, x = run(x, v)
-        else:
-            big = np.full(off + x.size + 2, 7.0)
-            big[off:off + x.size] = x
-            xn = big.copy()
-            y = run.step(run.body, big, xn, off, v)
-            assert np.all(xn[:off] == 7.0) and np.all(xn[off + x.size:] == 7.0)
-            x = xn[off:off + x.size]
-        out.append(y)
-        states.append(x)
-    return np.array(out), np.array(states)
-
-
 @pytest.mark.parametrize("inverse", [False, True])
-def test_block_equals_step_from_a_non_rest_state(inverse):
+def test_block_equals_step_from_a_non_rest_state(inverse, drive):
     rng = np.random.default_rng(5)
     x0 = np.array([0.6, -0.4, 0.3])
     signal = np.convolve(1.5 * rng.standard_normal(400), np.ones(4) / 4, "same")
     run = FAMILY.invert_step if inverse else FAMILY.step
     blk = FAMILY.block(STRUCT3, PARAMS3, inverse)
     assert blk.n_state == 3
-    out_blk, x_blk = _drive(blk, x0, signal, off=1)
-    out_ref, x_ref = _drive(lambda x, v: run(STRUCT3, PARAMS3, x, v), x0, signal)
+    out_blk, x_blk = drive(blk, x0, signal, off=1)
+    out_ref, x_ref = drive(lambda x, v: run(STRUCT3, PARAMS3, x, v), x0, signal)
     assert np.all(np.isfinite(out_ref))
     assert_allclose(out_blk, out_ref, rtol=0, atol=1e-12)
     assert_allclose(x_blk, x_ref, rtol=0, atol=1e-12)

@@ -21,36 +21,12 @@ BOUNDED = mp.MplPolyParams(f=[[0.0, 1.0, 0.0, 1.0]], g=[0.0, 1.0, 0.0, -1 / 3], 
 STRUCT1 = mp.MplPolyStructure(n_cells=1, dt=DT)
 
 
-def _run_block(structure, params, inverse, x0, signal, off=3):
-    """Drive the compiled block sample by sample inside a larger loop state vector."""
-    blk = FAMILY.block(structure, params, inverse)
-    x = np.full(off + blk.n_state + 2, 7.0)  # neighbours' state must stay untouched
-    x[off:off + blk.n_state] = x0
-    out, states = [], []
-    for v in signal:
-        xn = x.copy()
-        out.append(blk.step(blk.body, x, xn, off, v))
-        assert np.all(xn[:off] == 7.0) and np.all(xn[off + blk.n_state:] == 7.0)
-        x = xn
-        states.append(x[off:off + blk.n_state].copy())
-    return np.array(out), np.array(states)
-
-
-def _run_step(run, structure, params, x0, signal):
-    x, out, states = np.asarray(x0, float), [], []
-    for v in signal:
-        y, x = run(structure, params, x, v)
-        out.append(y)
-        states.append(x)
-    return np.array(out), np.array(states)
-
-
-def test_forward_block_equals_step_from_a_non_rest_state():
+def test_forward_block_equals_step_from_a_non_rest_state(drive):
     rng = np.random.default_rng(1)
     u = 1.5 * rng.standard_normal(400)
     x0 = np.array([0.7, -0.9])  # far from rest: the steep cell starts on its straight line
-    y_blk, x_blk = _run_block(STRUCT2, PARAMS2, False, x0, u)
-    y_ref, x_ref = _run_step(FAMILY.step, STRUCT2, PARAMS2, x0, u)
+    y_blk, x_blk = drive(FAMILY.block(STRUCT2, PARAMS2, False), x0, u, off=3)
+    y_ref, x_ref = drive(lambda x, v: FAMILY.step(STRUCT2, PARAMS2, x, v), x0, u)
     assert_allclose(y_blk, y_ref, rtol=0, atol=1e-12)
     assert_allclose(x_blk, x_ref, rtol=0, atol=1e-12)
     knees = mp.knee_points(STRUCT2, PARAMS2)[1]
@@ -58,22 +34,22 @@ def test_forward_block_equals_step_from_a_non_rest_state():
     assert np.sum((v <= knees[0]) | (v >= knees[1])) > 50  # the limit is exercised
 
 
-def test_inverse_block_equals_invert_step_from_a_non_rest_state():
+def test_inverse_block_equals_invert_step_from_a_non_rest_state(drive):
     rng = np.random.default_rng(2)
     y = np.convolve(rng.standard_normal(400), np.ones(5) / 5, "same")
     x0 = np.array([0.4, -0.6])
-    u_blk, x_blk = _run_block(STRUCT2, PARAMS2, True, x0, y)
-    u_ref, x_ref = _run_step(FAMILY.invert_step, STRUCT2, PARAMS2, x0, y)
+    u_blk, x_blk = drive(FAMILY.block(STRUCT2, PARAMS2, True), x0, y, off=3)
+    u_ref, x_ref = drive(lambda x, v: FAMILY.invert_step(STRUCT2, PARAMS2, x, v), x0, y)
     assert np.all(np.isfinite(u_ref))
     # Newton (block) vs brentq (invert_step), both to ~1 ulp of z
     assert_allclose(u_blk, u_ref, rtol=0, atol=1e-12)
     assert_allclose(x_blk, x_ref, rtol=0, atol=1e-12)
 
 
-def test_inverse_outside_the_branch_is_nan_in_block_and_step():
+def test_inverse_outside_the_branch_is_nan_in_block_and_step(drive):
     y = np.array([0.1, 0.5, 0.7, 0.2])  # 0.7 > 2/3: no input gives it
-    u_blk, x_blk = _run_block(STRUCT1, BOUNDED, True, [0.1], y)
-    u_ref, x_ref = _run_step(FAMILY.invert_step, STRUCT1, BOUNDED, [0.1], y)
+    u_blk, x_blk = drive(FAMILY.block(STRUCT1, BOUNDED, True), [0.1], y, off=3)
+    u_ref, x_ref = drive(lambda x, v: FAMILY.invert_step(STRUCT1, BOUNDED, x, v), [0.1], y)
     assert_allclose(u_blk[:2], u_ref[:2], rtol=0, atol=1e-12)
     assert np.isnan(u_blk[2]) and np.isnan(u_ref[2])
     assert np.all(np.isnan(x_blk[2:])) and np.all(np.isnan(x_ref[2:]))

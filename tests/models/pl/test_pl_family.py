@@ -19,54 +19,30 @@ STEEP_PARAMS = pl.PlParams(i_t=40.0, v_t=0.3, w=[0.7, 0.4, -0.5], v_b=-0.05, a=[
 CASES = [(STRUCT, PARAMS), (STEEP, STEEP_PARAMS)]
 
 
-def _run_block(structure, params, inverse, x0, signal, off=2):
-    """Drive the compiled block sample by sample inside a larger loop state vector."""
-    blk = FAMILY.block(structure, params, inverse)
-    x = np.full(off + blk.n_state + 3, -5.0)  # neighbours' state must stay untouched
-    x[off:off + blk.n_state] = x0
-    out, states = [], []
-    for v in signal:
-        xn = x.copy()
-        out.append(blk.step(blk.body, x, xn, off, v))
-        assert np.all(xn[:off] == -5.0) and np.all(xn[off + blk.n_state:] == -5.0)
-        x = xn
-        states.append(x[off:off + blk.n_state].copy())
-    return np.array(out), np.array(states)
-
-
-def _run_step(run, structure, params, x0, signal):
-    x, out, states = np.asarray(x0, float), [], []
-    for v in signal:
-        y, x = run(structure, params, x, v)
-        out.append(y)
-        states.append(x)
-    return np.array(out), np.array(states)
-
-
 @pytest.mark.parametrize("structure, params", CASES)
-def test_blocks_equal_step_and_invert_step_from_a_non_rest_state(structure, params):
+def test_blocks_equal_step_and_invert_step_from_a_non_rest_state(structure, params, drive):
     rng = np.random.default_rng(4)
     u = 1.3 * np.convolve(rng.standard_normal(400), np.ones(3) / 3, "same")
     x0 = rng.uniform(-0.8, 0.8, structure.n_cells)
-    y_blk, x_blk = _run_block(structure, params, False, x0, u)
-    y_ref, x_ref = _run_step(FAMILY.step, structure, params, x0, u)
+    y_blk, x_blk = drive(FAMILY.block(structure, params, False), x0, u, off=2)
+    y_ref, x_ref = drive(lambda x, v: FAMILY.step(structure, params, x, v), x0, u)
     # pow rounding; f^-1 walks the segments in another order than the reference
     assert_allclose(y_blk, y_ref, rtol=0, atol=1e-12)
     assert_allclose(x_blk, x_ref, rtol=0, atol=1e-12)
     # the output spans several segments of f, the cells both branches
     assert np.ptp(np.searchsorted(pl.basis_breakpoints(params.n_basis)[1:-1], y_ref)) >= 2
-    e_blk, xi_blk = _run_block(structure, params, True, x0, y_ref)
-    e_ref, xi_ref = _run_step(FAMILY.invert_step, structure, params, x0, y_ref)
+    e_blk, xi_blk = drive(FAMILY.block(structure, params, True), x0, y_ref, off=2)
+    e_ref, xi_ref = drive(lambda x, v: FAMILY.invert_step(structure, params, x, v), x0, y_ref)
     assert_allclose(e_blk, e_ref, rtol=0, atol=1e-12)
     assert_allclose(xi_blk, xi_ref, rtol=0, atol=1e-12)
     assert_allclose(e_ref, u, rtol=0, atol=1e-11)  # same start: the inverse undoes the model
 
 
-def test_invert_step_is_the_readable_reference_of_invert():
+def test_invert_step_is_the_readable_reference_of_invert(drive):
     y, _ = pl.simulate(STRUCT, PARAMS, np.sin(np.arange(500) * 0.03))
     x0 = np.array([0.2, -0.1, 0.4])
     e, x_end = pl.invert(STRUCT, PARAMS, y, x0=x0)
-    e_ref, x_ref = _run_step(pl.invert_step, STRUCT, PARAMS, x0, y)
+    e_ref, x_ref = drive(lambda x, v: pl.invert_step(STRUCT, PARAMS, x, v), x0, y)
     assert_allclose(e, e_ref, rtol=0, atol=1e-13)
     assert_allclose(x_end, x_ref[-1], rtol=0, atol=1e-14)
 
