@@ -20,7 +20,7 @@ import time
 
 import numpy as np
 
-from hystkit.compensation._compensator import _centre_and_scale
+from hystkit.compensation import centre_and_scale
 from hystkit.models import FAMILIES
 from hystkit.sensors import simulate_experiment
 
@@ -50,7 +50,7 @@ def _timed(fn) -> float:
 def main() -> None:
     print(f"{platform.platform()}; python {platform.python_version()}")
     rec = simulate_experiment("sine", 1)
-    _, s, p = _centre_and_scale(rec, "recording")
+    _, s, p = centre_and_scale(rec, "recording")
     u = _input(100_000)
     print(f"\n{'model':<10}{'size':>6}{'sim ns/sample':>15}{'at 2x size':>12}{'fit s':>8}"
           f"{'cost':>10}")

@@ -53,7 +53,7 @@ import scipy
 from scipy.optimize import least_squares
 
 import hystkit
-from hystkit.compensation._compensator import _centre_and_scale
+from hystkit.compensation import centre_and_scale
 from hystkit.models import mpl
 from hystkit.models.mpl import default_starts, fit_mpl, kernels
 from hystkit.models.mpl import fit as _fit
@@ -294,7 +294,7 @@ def print_simulation_table(c_func, cc: str | None) -> None:
 def fit_data() -> tuple[np.ndarray, np.ndarray, float]:
     """Direct mode: input = normalised sensor, output = normalised position (eq. 5.10)."""
     rec = simulate_experiment("sine", FIT_SEED)
-    _, s, p = _centre_and_scale(rec, "recording")
+    _, s, p = centre_and_scale(rec, "recording")
     return s, p, rec.dt
 
 

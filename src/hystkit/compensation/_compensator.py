@@ -33,7 +33,6 @@ from ._centring import (
     sensor_level,
 )
 from ._conventions import LinearBaseline, Scaling
-from ._conventions import centre_and_scale as _centre_and_scale  # noqa: F401  (benchmarks/)
 
 __all__ = ["MODES", "POSITION_MARGIN", "SENSOR_MARGIN", "Compensator", "LinearBaseline",
            "Scaling"]

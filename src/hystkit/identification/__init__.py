@@ -5,6 +5,6 @@ Each family's own fit is in its folder, ``hystkit.models.<family>``; the registr
 """
 
 from ._least_squares import check_fit_data, fit_multistart
-from ._result import FitResult
+from ._result import BoundHit, FitResult
 
-__all__ = ["FitResult", "check_fit_data", "fit_multistart"]
+__all__ = ["BoundHit", "FitResult", "check_fit_data", "fit_multistart"]
