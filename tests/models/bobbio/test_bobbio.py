@@ -34,23 +34,6 @@ def _ramps(*extrema: float, n: int = 50) -> np.ndarray:
     return np.concatenate([[extrema[0]], *legs])
 
 
-def test_kernel_matches_readable_reference():
-    u = _input()
-    y, x_end = bobbio.simulate(STRUCT, PARAMS, u)
-    y_ref, x_ref = bobbio.simulate_reference(STRUCT, PARAMS, u)
-    assert_array_equal(x_end, x_ref)  # the same clips in the same order
-    assert_allclose(y, y_ref, rtol=0, atol=1e-15)  # only the summation order differs
-
-
-def test_split_run_equals_whole_run():
-    u = _input()
-    y, x_end = bobbio.simulate(STRUCT, PARAMS, u)
-    y1, x1 = bobbio.simulate(STRUCT, PARAMS, u[:777])
-    y2, x2 = bobbio.simulate(STRUCT, PARAMS, u[777:], x0=x1)
-    assert_array_equal(np.concatenate([y1, y2]), y)
-    assert_array_equal(x2, x_end)
-
-
 @settings(max_examples=50, deadline=None)
 @given(friction=st.lists(st.floats(1e-3, 2.0), min_size=1, max_size=6),
        seed=st.integers(0, 10_000))
