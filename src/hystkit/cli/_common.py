@@ -3,10 +3,16 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from ..errors import HystkitError
 
-__all__ = ["Parser", "UsageError", "positive_int", "slope_cap"]
+__all__ = ["GUARD_EXIT", "Parser", "UsageError", "failures_exit", "positive_int", "slope_cap"]
+
+# Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
+# bounds, not converged; a family failed in compare/select); 2 is kept for errors that stop a
+# command.
+GUARD_EXIT = 3
 
 
 class UsageError(HystkitError):
@@ -33,3 +39,13 @@ def slope_cap(text: str) -> float:
     return value
 
 
+
+
+def failures_exit(failed: list[str], what: str = "model(s)") -> int:
+    """Exit code after everything else was written: GUARD_EXIT (and a line on stderr) when
+    something failed, else 0."""
+    if failed:
+        print(f"hystkit: {len(failed)} {what} failed: {', '.join(failed)} (reasons above)",
+              file=sys.stderr)
+        return GUARD_EXIT
+    return 0

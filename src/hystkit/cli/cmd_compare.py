@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 from ..compensation import DEFAULT_CENTER
@@ -11,8 +10,7 @@ from ..io import check_output_path, read_recording, write_json
 from ..models import FAMILIES
 from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
-from ._common import UsageError
-from .cmd_core import GUARD_EXIT
+from ._common import UsageError, failures_exit
 
 __all__ = ["register"]
 
@@ -58,16 +56,7 @@ def _compare(args: argparse.Namespace) -> int:
     if out is not None:
         write_json(table, out / "compare.json", force=args.force)
         print(f"wrote {out / 'compare.json'}")
-    return _failures_exit([name for name, m in table.items() if "error" in m])
-
-
-def _failures_exit(failed: list[str]) -> int:
-    """Non-zero when some family failed, after everything else was written."""
-    if failed:
-        print(f"hystkit: {len(failed)} model(s) failed: {', '.join(failed)} (reasons above)",
-              file=sys.stderr)
-        return GUARD_EXIT
-    return 0
+    return failures_exit([name for name, m in table.items() if "error" in m])
 
 
 def _generalize(args: argparse.Namespace) -> int:
@@ -110,7 +99,7 @@ def _generalize(args: argparse.Namespace) -> int:
     write_json(matrix, out / "generalize.json", force=args.force)
     plot_generalization(matrix).savefig(out / "generalize.png", dpi=110)
     print(f"\nwrote {out / 'generalize.json'}, {out / 'generalize.png'}")
-    return _failures_exit(failed)
+    return failures_exit(failed)
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -27,14 +27,10 @@ from ..io import check_output_path, read_recording, write_json, write_recording
 from ..models import FAMILIES, get_family
 from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
-from ._common import UsageError, positive_int, slope_cap
+from ._common import GUARD_EXIT, UsageError, positive_int, slope_cap
 from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_from_args
 
-__all__ = ["GUARD_EXIT", "register"]
-
-# Exit code of a fit that ran but failed its guards (collapsed, worse than the line, on bounds,
-# not converged); 2 is kept for errors that stop a command.
-GUARD_EXIT = 3
+__all__ = ["register"]
 
 
 def _simulate_sensor(args: argparse.Namespace) -> int:

@@ -9,9 +9,8 @@ from pathlib import Path
 
 from ..compensation import CENTERS, DEFAULT_CENTER, save_compensator
 from ..io import check_output_path, read_recording, write_json
-from ._common import UsageError, positive_int
+from ._common import GUARD_EXIT, UsageError, failures_exit, positive_int
 from .cmd_compare import _models
-from .cmd_core import GUARD_EXIT
 
 __all__ = ["register"]
 
@@ -68,12 +67,7 @@ def _select(args: argparse.Namespace) -> int:
     w = result["winner"]
     print(f"winner: {w['candidate']} (held-out deployable R² {w['cv_r2']:.4f}, oracle "
           f"{w['cv_r2_oracle']:.4f}, line {w['cv_linear_r2']:.4f}); wrote {args.out}")
-    failed = [r["candidate"] for r in rows if "error" in r]
-    if failed:
-        print(f"hystkit: {len(failed)} candidate(s) failed: {', '.join(failed)}",
-              file=sys.stderr)
-        return GUARD_EXIT
-    return 0
+    return failures_exit([r["candidate"] for r in rows if "error" in r], "candidate(s)")
 
 
 def register(sub: argparse._SubParsersAction) -> None:

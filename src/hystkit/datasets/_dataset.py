@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import HystkitError, InputError
-from ..io import Recording
+from ..io import Recording, Sampled
 
 __all__ = ["ROLES", "Dataset", "DatasetInfo", "MissingDependencyError", "Provenance",
            "VariantInfo"]
@@ -66,7 +66,7 @@ class Provenance:
 
 
 @dataclass(frozen=True, eq=False)  # eq=False: element-wise array comparison has no single truth
-class Dataset:
+class Dataset(Sampled):
     """One uniformly sampled run of a hysteretic system.
 
     Parameters
@@ -143,21 +143,6 @@ class Dataset:
     def label(self) -> str:
         """``name/variant``, used in messages and as the recording's source."""
         return f"{self.name}/{self.variant}"
-
-    @property
-    def n_samples(self) -> int:
-        """Number of samples n."""
-        return int(self.time.size)
-
-    @property
-    def dt(self) -> float:
-        """Median sampling step [s]."""
-        return float(np.median(np.diff(self.time)))
-
-    @property
-    def fs(self) -> float:
-        """Sampling rate [Hz], 1 / `dt`."""
-        return 1.0 / self.dt
 
     def window(self, t0: float, t1: float, *, label: str = "window") -> Dataset:
         """The samples with ``t0 <= time < t1`` [s] (to within half a step), times unchanged.

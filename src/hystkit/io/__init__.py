@@ -9,6 +9,7 @@ from ._raw_config import (
 )
 from ._recording import (
     Recording,
+    Sampled,
     check_output_path,
     read_recording,
     write_json,
@@ -16,5 +17,5 @@ from ._recording import (
 )
 
 __all__ = ["CONFIG_KEYS", "RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter",
-           "Recording", "check_output_path", "find_raw_config", "open_raw", "read_raw_config",
-           "read_recording", "write_json", "write_raw_config", "write_recording"]
+           "Recording", "Sampled", "check_output_path", "find_raw_config", "open_raw",
+           "read_raw_config", "read_recording", "write_json", "write_raw_config", "write_recording"]

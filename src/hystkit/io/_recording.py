@@ -44,8 +44,27 @@ class _Where:
         return InputError(f"{self.source}: {location}{message}")
 
 
+class Sampled:
+    """Sample count, step and rate of anything with a ``time`` array (recordings, data sets)."""
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples n."""
+        return int(self.time.size)
+
+    @property
+    def dt(self) -> float:
+        """Median sampling step [s]."""
+        return float(np.median(np.diff(self.time)))
+
+    @property
+    def fs(self) -> float:
+        """Sampling rate [Hz], 1 / `dt`."""
+        return 1.0 / self.dt
+
+
 @dataclass(frozen=True, eq=False)  # eq=False: element-wise array comparison has no single truth
-class Recording:
+class Recording(Sampled):
     """One validated, uniformly sampled recording.
 
     Parameters
@@ -81,21 +100,6 @@ class Recording:
         for name, values in arrays.items():
             values.setflags(write=False)
             object.__setattr__(self, name, values)
-
-    @property
-    def n_samples(self) -> int:
-        """Number of samples n."""
-        return int(self.time.size)
-
-    @property
-    def dt(self) -> float:
-        """Median sampling step [s]."""
-        return float(np.median(np.diff(self.time)))
-
-    @property
-    def fs(self) -> float:
-        """Sampling rate [Hz], 1 / `dt`."""
-        return 1.0 / self.dt
 
     def has_position(self) -> bool:
         """Whether the recording carries a reference position."""
