@@ -32,8 +32,34 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Cells", "LinearModel", "cell_report", "discrete_eigenvalues", "linearise",
-           "linearise_cells"]
+from ._protocol import Record
+from ._validation import check_cells
+
+__all__ = ["CellStructure", "Cells", "LinearModel", "cell_report", "discrete_eigenvalues",
+           "linearise", "linearise_cells"]
+
+
+@dataclass(frozen=True)
+class CellStructure(Record):
+    """What does not get fitted in a model of RC cells: cell count, sample time, Euler slope cap.
+
+    Parameters
+    ----------
+    n_cells : int
+        Number of cells ``N`` (>= 1).
+    dt : float
+        Sample time of the recordings the model runs on [s].
+    slope_cap : float
+        Largest allowed Euler slope ``f' dt`` (eq. 5.28 requires < 2; 1 gives overshoot-free
+        cells).
+    """
+
+    n_cells: int = 1
+    dt: float = 0.025
+    slope_cap: float = 1.0
+
+    def __post_init__(self) -> None:
+        check_cells(self.n_cells, self.dt, self.slope_cap)
 
 
 @dataclass(frozen=True, eq=False)

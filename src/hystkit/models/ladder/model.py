@@ -35,9 +35,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._cells import CellStructure
 from .._protocol import Record
 from .._validation import (
-    check_cells,
     check_signal,
     check_size,
     finite_floats,
@@ -63,25 +63,12 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class LadderStructure(Record):
-    """What does not get fitted.
-
-    Parameters
-    ----------
-    n_cells : int
-        Ladder sections ``N`` (>= 1), each a PWL resistor and a capacitor.
-    dt : float
-        Sample time [s].
-    slope_cap : float
-        Largest allowed Euler slope ``dt (G_k + G_k+1)`` at a node (< 2; <= 1: no overshoot).
-    """
+class LadderStructure(CellStructure):
+    """What does not get fitted (:class:`~hystkit.models._cells.CellStructure`): ``n_cells``
+    ladder sections, each a PWL resistor and a capacitor; the slope cap bounds the Euler slope
+    ``dt (G_k + G_k+1)`` at a node."""
 
     n_cells: int = 2
-    dt: float = 0.025
-    slope_cap: float = 1.0
-
-    def __post_init__(self) -> None:
-        check_cells(self.n_cells, self.dt, self.slope_cap)
 
     @property
     def n_params(self) -> int:

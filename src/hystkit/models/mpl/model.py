@@ -29,9 +29,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._cells import CellStructure
 from .._protocol import Record
 from .._validation import (
-    check_cells,
     check_signal,
     check_size,
     finite_floats,
@@ -55,25 +55,9 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class MplStructure(Record):
-    """What does not get fitted: cell count, sample time and the Euler slope cap.
-
-    Parameters
-    ----------
-    n_cells : int
-        Number of RC cells ``N`` (>= 1).
-    dt : float
-        Sample time of the recordings the model runs on [s].
-    slope_cap : float
-        Largest allowed ``f'(v) dt`` (eq. 5.28 requires < 2); 1 gives overshoot-free cells.
-    """
-
-    n_cells: int = 1
-    dt: float = 0.025
-    slope_cap: float = 1.0
-
-    def __post_init__(self) -> None:
-        check_cells(self.n_cells, self.dt, self.slope_cap)
+class MplStructure(CellStructure):
+    """What does not get fitted: cell count ``N``, sample time and the Euler slope cap
+    (:class:`~hystkit.models._cells.CellStructure`; the cap bounds ``f'(v) dt``)."""
 
     @property
     def n_params(self) -> int:

@@ -32,10 +32,10 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ...errors import FitDivergedError
+from .._cells import CellStructure
 from .._protocol import Record
 from .._validation import (
     broadcast_state,
-    check_cells,
     check_signal,
     check_size,
     finite_floats,
@@ -67,28 +67,20 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class MplPolyStructure(Record):
-    """What does not get fitted: cell count, sample time, Euler slope cap and the limit switch.
+class MplPolyStructure(CellStructure):
+    """What does not get fitted: cell count, sample time, Euler slope cap (outside the knees;
+    :class:`~hystkit.models._cells.CellStructure`) and the limit switch.
 
     Parameters
     ----------
-    n_cells : int
-        Number of RC cells ``N`` (>= 1).
-    dt : float
-        Sample time of the recordings the model runs on [s].
-    slope_cap : float
-        Largest allowed ``f'(v) dt`` outside the knees (eq. 5.28 requires < 2); 1 as the mPL.
     limit : bool
         Apply the stability limit eq. 5.29; ``False`` runs the raw cubic (may diverge).
     """
 
-    n_cells: int = 1
-    dt: float = 0.025
-    slope_cap: float = 1.0
     limit: bool = True
 
     def __post_init__(self) -> None:
-        check_cells(self.n_cells, self.dt, self.slope_cap)
+        super().__post_init__()
         if not isinstance(self.limit, bool):
             raise TypeError(f"limit must be true or false, got {self.limit!r}")
 
