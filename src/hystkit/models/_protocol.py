@@ -209,6 +209,12 @@ class Family(ABC):
         """
         return dataclasses.replace(structure, dt=float(dt))
 
+    def random_params(self, structure: Any, rng: np.random.Generator) -> Any:
+        """Parameters drawn at random from the family's *documented domain*: the ranges its
+        docs promise behave (bounded output for inputs within [-1, 1]); the contract test
+        draws from it. The docstring of an override states the domain."""
+        raise NotImplementedError(f"family {self.name!r} documents no parameter domain")
+
     def presets(self) -> dict[str, tuple[Any, Any, dict]]:
         """Named published parameter sets: ``name -> (structure, params, info)``; ``info`` says
         where the values come from. Default: none."""
