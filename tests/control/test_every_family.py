@@ -60,8 +60,12 @@ def test_direct_scheme_with_the_family_as_compensator(model_files, name, tmp_pat
     assert code == 0, err
     metrics = json.loads((tmp_path / "a" / "metrics.json").read_text())
     assert metrics["n_steps"] > 0 and "Traceback" not in err
-    if metrics["bounded"]:
-        assert np.isfinite(metrics["e_p_max"])
+    if model_files[name][0] == 0:  # a fit that passed its guards keeps the loop bounded, with
+        # errors below the 3 mm stroke's double (bounded, not necessarily good: Preisach
+        # trained on noise reaches 3.1 mm)
+        assert metrics["bounded"] and metrics["e_p_max"] < 6e-3, metrics
+    elif not metrics["bounded"]:  # a failed one may run away: stopped and said so
+        assert metrics["stop_reason"] and metrics["n_steps"] < metrics["n_requested"]
 
 
 @pytest.mark.parametrize("name", NAMES)
