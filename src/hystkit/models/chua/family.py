@@ -10,6 +10,7 @@ from .._protocol import Block, Family
 from . import kernels
 from . import model as chua
 from .fit import fit_chua
+from .fit import random_params as _random_params
 
 __all__ = ["ChuaFamily"]
 
@@ -27,6 +28,12 @@ class ChuaFamily(Family):
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> chua.ChuaStructure:
         return chua.ChuaStructure(n_elements=size, dt=dt, slope_cap=slope_cap)
+
+    def random_params(self, structure, rng):
+        """The fit's bounds (:func:`.fit.random_params`): ``k_0``, ``k_inf``, ``y_s`` log-uniform in
+        ``[1e-2, 1e2]``, ``G`` in ``[1e-3, 100 / dt]``, ``V_g`` in ``[1e-3, 1e3]``, ``delta`` in
+        ``[0, 1]``. Bounded: ``|y| <= sum_k (max|u| + delta_k) / min(k_0, k_inf)_k``."""
+        return _random_params(structure, rng)
 
     def at(self, structure, dt):
         """The same ODE at ``dt``: the slope cap scales with ``dt``, so the limit on ``g'``

@@ -14,7 +14,7 @@ import numpy as np
 from ...identification import FitResult, check_fit_data, fit_multistart
 from . import model as chua
 
-__all__ = ["default_starts", "fit_chua"]
+__all__ = ["default_starts", "fit_chua", "random_params"]
 
 # Bounds per element in optimiser coordinates, for data normalised to max |.| = 1 (eq. 5.10):
 # slopes and scales over four decades around 1, bands up to the whole half-range.
@@ -91,3 +91,11 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
                           structure, max_nfev=max_nfev, screen_nfev=screen_nfev,
                           n_polish=n_polish, accept=accept, accept_reason=accept_reason)
 
+
+
+def random_params(structure: chua.ChuaStructure, rng: np.random.Generator) -> chua.ChuaParams:
+    """Parameters drawn from the fit's bounds (the family's documented domain), per element:
+    ``k_0``, ``k_inf``, ``y_s`` log-uniform in ``[1e-2, 1e2]``, ``G`` log-uniform in
+    ``[1e-3, 100 / dt]``, ``V_g`` log-uniform in ``[1e-3, 1e3]``, ``delta`` uniform in ``[0, 1]``."""
+    lower, upper = _bounds(structure)
+    return chua.ChuaParams.from_vector(rng.uniform(lower, upper), structure.n_elements)

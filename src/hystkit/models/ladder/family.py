@@ -11,6 +11,7 @@ from .._protocol import Block, Family
 from . import kernels
 from . import model as ladder
 from .fit import fit_ladder
+from .fit import random_params as _random_params
 
 __all__ = ["LadderFamily"]
 
@@ -29,6 +30,12 @@ class LadderFamily(Family):
     def make_structure(self, dt: float, size: int,
                        slope_cap: float = 1.0) -> ladder.LadderStructure:
         return ladder.LadderStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
+
+    def random_params(self, structure, rng):
+        """The fit's bounds (:func:`.fit.random_params`): ``E_k`` in ``[0, 1.5]``, ``G_k``
+        log-uniform in ``[1e-3, slope_cap / (2 dt)]``, ``w``, ``V_b`` in ``[-100, 100]``.
+        Bounded: ``|y| <= sum |w| max|e| + |V_b|``."""
+        return _random_params(structure, rng)
 
     def at(self, structure, dt):
         """The same circuit at ``dt``: the slope cap scales with ``dt``, so the conductance

@@ -15,7 +15,7 @@ import numpy as np
 from ...identification import FitResult, check_fit_data, fit_multistart
 from . import model as ladder
 
-__all__ = ["default_starts", "fit_ladder"]
+__all__ = ["default_starts", "fit_ladder", "random_params"]
 
 _BAND = (0.0, 1.5)  # normalised data (eq. 5.10): a band beyond the range never conducts
 _LOG_G_MIN = np.log(1e-3)
@@ -90,3 +90,15 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
                           max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
                           accept=accept, accept_reason=accept_reason)
 
+
+
+def random_params(structure: ladder.LadderStructure,
+                  rng: np.random.Generator) -> ladder.LadderParams:
+    """Parameters drawn from the fit's bounds (the family's documented domain): bands ``E_k``
+    uniform in ``[0, 1.5]``, ``G_k`` log-uniform in ``[1e-3, slope_cap / (2 dt)]``, ``w_0..w_N``
+    uniform in ``[-100, 100]``, ``V_b`` too (the fit leaves it free)."""
+    n = structure.n_cells
+    band = rng.uniform(*_BAND, n)
+    g = np.exp(rng.uniform(_LOG_G_MIN, np.log(ladder.conductance_limit(structure)), n))
+    return ladder.LadderParams(band=band, conductance=g, w=rng.uniform(-_W_BOUND, _W_BOUND, n + 1),
+                               v_b=float(rng.uniform(-_W_BOUND, _W_BOUND)))

@@ -9,6 +9,7 @@ from .._protocol import Block, Family
 from . import kernels
 from . import model as mpl
 from .fit import fit_mpl
+from .fit import random_params as _random_params
 
 __all__ = ["MplFamily"]
 
@@ -26,6 +27,12 @@ class MplFamily(Family):
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> mpl.MplStructure:
         return mpl.MplStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
+
+    def random_params(self, structure, rng):
+        """The fit's box (:func:`.fit.fit_mpl`), normalised data: ``G_k = 2 I_S / V_T`` log-uniform
+        in ``[1e-4, slope_cap / dt]``, ``V_T`` log-uniform in ``[1e-3, 1e3]``, ``w`` and ``V_b``
+        uniform in ``[-100, 100]``. Every draw is bounded: ``|y| <= sum |w| max|u| + |V_b|``."""
+        return _random_params(structure, rng)
 
     def rest_state(self, structure, params, value, inverse=False):
         # Forward: each cell equals its drive. Inverse: the drive is the input estimate, at rest

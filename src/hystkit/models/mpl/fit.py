@@ -17,7 +17,7 @@ from ...identification import FitResult, check_fit_data, fit_multistart
 from . import kernels
 from . import model as mpl
 
-__all__ = ["default_starts", "fit_mpl", "theta_limits", "theta_names"]
+__all__ = ["default_starts", "fit_mpl", "random_params", "theta_limits", "theta_names"]
 
 # Bounds in optimiser coordinates (see MplParams.to_vector). |w| <= 100 mirrors the document's
 # weight-sum constraint of 10^2 (sec. 5.3.3).
@@ -151,3 +151,14 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
                           screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
                           accept_reason=accept_reason, names=theta_names(n),
                           limits=theta_limits(n))
+
+
+def random_params(structure: mpl.MplStructure, rng: np.random.Generator) -> mpl.MplParams:
+    """Parameters drawn from the fit's bounds (the family's documented domain): ``log G_k``
+    and ``log V_T,k`` uniform between their bounds, ``w_0..w_N`` and ``V_b`` uniform in
+    ``[-100, 100]`` (``V_b`` gets the weights' box; the fit leaves it free)."""
+    n = structure.n_cells
+    log_g = rng.uniform(_LOG_G_MIN, np.log(structure.slope_cap / structure.dt), n)
+    log_vt = rng.uniform(*_LOG_VT_BOUNDS, n)
+    lin = rng.uniform(-_W_BOUND, _W_BOUND, n + 2)
+    return mpl.MplParams.from_vector(np.r_[np.column_stack([log_g, log_vt]).reshape(-1), lin], n)

@@ -10,6 +10,7 @@ from .._protocol import Block, Family
 from . import kernels
 from . import model as mpl_poly
 from .fit import fit_mpl_poly
+from .fit import random_params as _random_params
 from .presets import PAPER_9_2_TABLE_II, paper_9_2_params
 
 __all__ = ["MplPolyFamily"]
@@ -35,6 +36,12 @@ class MplPolyFamily(Family):
         (``du_k/dt = f_k``), so they do not depend on the step; only the Euler limit does, and
         the knees (``f' = slope_cap / dt``) follow ``dt`` because they are computed from it."""
         return super().at(structure, dt)
+
+    def random_params(self, structure, rng):
+        """Paper 9.2's published range with margin (:func:`.fit.random_params`): ``c_k0..c_k2``
+        in ``[-5, 5]``, ``c_k3`` log-uniform in ``[0.1, 100]``, ``g``, ``w`` in ``[-2, 2]``,
+        ``V_b`` in ``[-1, 1]``. Bounded with ``structure.limit``: ``|u_k| <= max|e| + max|v*_k|``."""
+        return _random_params(structure, rng)
 
     def presets(self):
         """Paper 9.2's table II columns: direct compensators (sensor -> position) fitted on

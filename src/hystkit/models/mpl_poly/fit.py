@@ -28,7 +28,7 @@ from ...identification import FitResult, check_fit_data, fit_multistart
 from . import model as mpl_poly
 from .presets import PAPER_9_2_TABLE_I, paper_9_2_params
 
-__all__ = ["canonical", "default_starts", "fit_mpl_poly", "theta_names"]
+__all__ = ["canonical", "default_starts", "fit_mpl_poly", "random_params", "theta_names"]
 
 # Bounds in optimiser coordinates (MplPolyParams.to_vector). |w| <= 100 mirrors the document's
 # weight-sum constraint (sec. 5.3.3); the polynomial coefficients only need to stay finite.
@@ -189,3 +189,31 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
         return result
     return replace(result, params=canonical(structure, result.params))
 
+
+
+# The domain random_params draws from: the fit's box above is a search box (no bound is a model
+# limit), and at its corners the cells rest ~1e8 away from the data (c3 = 1e-6 with |c2| = 1e3
+# puts the inflection point at -c2 / (3 c3) ~ 3e8), so outputs reach 1e58: finite but
+# meaningless for normalised data. Paper 9.2's published sets (tables I, II; N = 1) have
+# |f0..f2| <= 5, 5e-7 <= c3 <= 31, |g| <= 1.4, |w| <= 1.6, |V_b| <= 0.6; the domain is
+# that range with margin, c3 >= 0.1 keeping the rest points within a few units of 0.
+_RANDOM_F = 5.0
+_RANDOM_LOG_C3 = (np.log(0.1), np.log(100.0))
+_RANDOM_G = 2.0
+_RANDOM_W = 2.0
+_RANDOM_VB = 1.0
+
+
+def random_params(structure: mpl_poly.MplPolyStructure,
+                  rng: np.random.Generator) -> mpl_poly.MplPolyParams:
+    """Parameters from the family's documented domain for normalised data (the range of paper
+    9.2's published sets with margin): ``c_k0..c_k2`` uniform in ``[-5, 5]``, ``c_k3``
+    log-uniform in ``[0.1, 100]``, ``g_0..g_3`` and ``w_0..w_N`` uniform in ``[-2, 2]``, ``V_b``
+    uniform in ``[-1, 1]``. Narrower than the fit's search box: see ``_RANDOM_F``."""
+    n = structure.n_cells
+    cells = np.column_stack([rng.uniform(-_RANDOM_F, _RANDOM_F, (n, 3)),
+                             rng.uniform(*_RANDOM_LOG_C3, n)])
+    rest = np.r_[rng.uniform(-_RANDOM_G, _RANDOM_G, 4),
+                 rng.uniform(-_RANDOM_W, _RANDOM_W, n + 1),
+                 rng.uniform(-_RANDOM_VB, _RANDOM_VB)]
+    return mpl_poly.MplPolyParams.from_vector(np.r_[cells.reshape(-1), rest], n)

@@ -9,6 +9,7 @@ from .._protocol import Block, Family
 from . import kernels
 from . import model as pl
 from .fit import fit_pl
+from .fit import random_params as _random_params
 
 __all__ = ["PlFamily"]
 
@@ -28,6 +29,12 @@ class PlFamily(Family):
                        smoothing: float = 0.001, slope_cap: float = 1.0) -> pl.PlStructure:
         return pl.PlStructure(n_cells=size, power=power, n_basis=n_basis, smoothing=smoothing,
                               dt=dt, slope_cap=slope_cap)
+
+    def random_params(self, structure, rng):
+        """The fit's bounds (:func:`.fit.random_params`): ``I_T`` log-uniform in ``[1e-6, 1e4]``,
+        ``V_T`` in ``[1e-3, 2]``, ``w``, ``V_b`` in ``[-100, 100]``, ``a_j >= 0.05`` with
+        ``sum a_j = M``. Bounded: ``|y| <= (sum |w| max|e| + |V_b|) / min a_j``."""
+        return _random_params(structure, rng)
 
     def at(self, structure, dt):
         """Same N, p, M, S and slope cap at ``dt``. ``I_T``, ``V_T`` are rates and voltages of

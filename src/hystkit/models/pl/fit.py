@@ -29,7 +29,7 @@ from scipy.optimize import lsq_linear
 from ...identification import FitResult, check_fit_data, fit_multistart
 from . import model as pl
 
-__all__ = ["THETA_NAMES", "default_starts", "fit_pl", "solve_weights"]
+__all__ = ["THETA_NAMES", "default_starts", "fit_pl", "random_params", "solve_weights"]
 
 _W_BOUND = 100.0
 _A_MIN = 0.05
@@ -141,3 +141,15 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
                           (lower, upper), lambda th: project(th)[0], structure,
                           max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
                           accept=accept, accept_reason=accept_reason, names=THETA_NAMES)
+
+
+def random_params(structure: pl.PlStructure, rng: np.random.Generator) -> pl.PlParams:
+    """Parameters drawn from the fit's bounds (the family's documented domain): ``log I_T``,
+    ``log V_T`` uniform between their bounds (``I_T`` in ``[1e-6, 1e4]``, ``V_T`` in
+    ``[1e-3, 2]``), ``w_0..w_N`` uniform in ``[-100, 100]``, ``V_b`` too (the fit leaves it
+    free), and slopes ``a_j >= 0.05`` with the fit's scale ``sum a_j = M``."""
+    n, m = structure.n_cells, structure.n_basis
+    i_t, v_t = np.exp(rng.uniform(*_LOG_IT)), np.exp(rng.uniform(*_LOG_VT))
+    a = _A_MIN + (m - m * _A_MIN) * rng.dirichlet(np.ones(m))
+    return pl.PlParams(i_t=float(i_t), v_t=float(v_t), w=rng.uniform(-_W_BOUND, _W_BOUND, n + 1),
+                       v_b=float(rng.uniform(-_W_BOUND, _W_BOUND)), a=a)
