@@ -237,3 +237,33 @@ def test_linearisation_matches_the_numerical_one(name, inverse):
                 assert _kinked_match(got, right, left), k
         _, x = run(x, u_k)
     assert n_smooth > 0
+
+
+def _bounded_probe(dt: float, n: int = 2000) -> np.ndarray:
+    """|u| <= 1: a sine sweep, steps to the extremes and back, reversals."""
+    t = np.arange(n) * dt
+    u = 0.9 * np.sin(2 * np.pi * (0.05 + 0.5 * t / t[-1]) * t)
+    u[n // 2:n // 2 + 100] = 1.0
+    u[n // 2 + 100:n // 2 + 200] = -1.0
+    return u
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("factor", [1, 2])
+def test_random_parameters_give_bounded_output(name, factor):
+    """Parameters drawn from the family's documented domain (``random_params``) keep the
+    output finite and far from a blow-up for any input in [-1, 1]. The family's own tests check
+    its tighter, model-specific bound (tests/models/<family>/)."""
+    family = get_family(name)
+    dt, _, _ = _data()
+    structure = family.make_structure(dt, factor * family.default_size)
+    rng = np.random.default_rng(2026)
+    try:
+        params = [family.random_params(structure, rng) for _ in range(25)]
+    except NotImplementedError as exc:
+        pytest.skip(str(exc))
+    u = _bounded_probe(dt)
+    for k, p in enumerate(params):
+        y, x_end = family.simulate(structure, p, u)
+        assert np.all(np.isfinite(y)) and np.all(np.isfinite(x_end)), k
+        assert np.max(np.abs(y)) < 1e9, (k, float(np.max(np.abs(y))))
