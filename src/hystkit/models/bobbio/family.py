@@ -26,6 +26,21 @@ class BobbioFamily(Family):
     def make_structure(self, dt: float, size: int) -> bobbio.BobbioStructure:
         return bobbio.BobbioStructure(n_springs=size, dt=dt)
 
+    def random_params(self, structure, rng):
+        """The fit's domain (``fit.py``): compliances ``>= 0`` (Dirichlet-spread, total
+        log-uniform in ``[0.1, 10]``), piston thresholds ``a_k > 0`` whose largest play radius
+        ``A_N-1 = sum a_k`` is log-uniform in the fit's ``[0.1, 1.5]`` times the input's
+        half-range 1 (each ``a_k >= 0.1 A_N-1 / (N - 1)``), offset in ``[-1, 1]``. Bounded:
+        every spring force is a play of ``u``, so ``|y| <= sum c_k max|u| + |b|``."""
+        n = structure.n_springs
+        compliance = np.exp(rng.uniform(np.log(0.1), np.log(10.0))) * rng.dirichlet(np.ones(n))
+        m = n - 1
+        radius = np.exp(rng.uniform(np.log(0.1), np.log(1.5)))
+        friction = (radius * (0.1 / m + 0.9 * rng.dirichlet(np.ones(m))) if m
+                    else np.empty(0))
+        return bobbio.BobbioParams(compliance=compliance, friction=friction,
+                                   offset=rng.uniform(-1.0, 1.0))
+
     def at(self, structure, dt):
         """The chain is rate-independent (only the input values matter, not their timing), so
         the same model runs at any ``dt``; only the recorded ``dt`` changes."""

@@ -9,7 +9,11 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
+from .. import preisach
 from ..preisach import StaircaseFamily
+from ..preisach.family import orientation_sign, random_masses
 from . import model as gpreisach
 from .fit import fit_gpreisach
 
@@ -31,6 +35,22 @@ class GPreisachFamily(StaircaseFamily):
     def make_structure(self, dt: float, size: int,
                        **options: Any) -> gpreisach.GPreisachStructure:
         return gpreisach.GPreisachStructure(levels=size, dt=dt, **options)
+
+    def random_params(self, structure, rng):
+        """The fit's constraints (``fit.py``): off-diagonal masses of ``mu_-`` and ``mu_+`` of
+        the structure's loop orientation (``auto``: either), diagonal 0, each weight's
+        ``sum |m|`` log-uniform in ``[0.1, 10]``; ``nu_k >= 0`` with ``int nu`` log-uniform in
+        ``[0.01, 10]``; offset in ``[-1, 1]``. Bounded: ``|y - y_0| <= max(sum |m_-|,
+        sum |m_+|) + int nu`` for ``|u| <= 1``."""
+        levels, degree = structure.levels, structure.degree
+        sign = orientation_sign(structure, rng)
+        tables = [preisach.everett_from_masses(random_masses(levels, sign, rng, diagonal=False))
+                  for _ in range(2)]
+        # int_{-1}^{1} B_k^d = 2 / (d + 1) on [-1, 1]
+        nu = (np.exp(rng.uniform(np.log(0.01), np.log(10.0))) * (degree + 1) / 2
+              * rng.dirichlet(np.ones(degree + 1)))
+        return gpreisach.GPreisachParams(everett_minus=tables[0], everett_plus=tables[1], nu=nu,
+                                         offset=rng.uniform(-1.0, 1.0))
 
     def n_params(self, structure, params) -> int:
         """Off-diagonal masses of both weights (the fit keeps the diagonal at zero), the

@@ -11,7 +11,7 @@ from ...errors import FitDivergedError
 from .._protocol import Block, Family
 from . import kernels
 from . import model as pi
-from .fit import fit_pi, make_structure
+from .fit import MIN_SLOPE, _to_params, fit_pi, make_structure
 
 __all__ = ["PiFamily"]
 
@@ -30,6 +30,19 @@ class PiFamily(Family):
 
     def make_structure(self, dt, size, **options):
         return make_structure(dt, size, **options)
+
+    def random_params(self, structure, rng):
+        """Drawn in the fit's coordinates (``fit.py``), which keep Kuhnen's invertibility
+        condition: loading slopes ``V_i`` and ``S^-1`` slopes log-uniform in ``[MIN_SLOPE,
+        1 / MIN_SLOPE] = [0.01, 100]``, split creep weights ``w+, w-`` uniform in ``[0, 1]``,
+        offset ``b`` in ``[-1, 1]``, ``S^-1`` thresholds of an output range ``[-1, 1]``, either
+        polarity. Bounded: ``|y| <= sum |w_S| (sum |w_H| + sum |w_K| + |b|) max(1, |u|)``."""
+        n, n_k, m = structure.n_play, structure.n_creep, structure.n_deadzone
+        log_slope = np.log(MIN_SLOPE), -np.log(MIN_SLOPE)
+        theta = np.concatenate([np.exp(rng.uniform(*log_slope, n)), rng.uniform(0.0, 1.0, 2 * n_k),
+                                [rng.uniform(-1.0, 1.0)], np.exp(rng.uniform(*log_slope, 2 * m))])
+        d_inv = np.concatenate([-np.arange(m, 0, -1), [0.0], np.arange(1, m + 1)]) / (m + 1)
+        return _to_params(structure, theta, d_inv, float(rng.choice([-1.0, 1.0])))
 
     def at(self, structure, dt):
         """The same continuous-time model sampled every ``dt``.

@@ -19,7 +19,30 @@ from . import kernels
 from . import model as preisach
 from .fit import fit_preisach
 
-__all__ = ["PreisachFamily", "StaircaseFamily"]
+__all__ = ["PreisachFamily", "StaircaseFamily", "orientation_sign", "random_masses"]
+
+_LOG_MASS = (np.log(0.1), np.log(10.0))  # total |mass| of a random weight (random_params)
+
+
+def orientation_sign(structure, rng: np.random.Generator) -> float:
+    """Sign of the hysteretic masses for the structure's orientation (``auto``: random)."""
+    if structure.orientation == "auto":
+        return float(rng.choice([-1.0, 1.0]))
+    return 1.0 if structure.orientation == "counterclockwise" else -1.0
+
+
+def random_masses(levels: int, sign: float, rng: np.random.Generator,
+                  diagonal: bool = True) -> np.ndarray:
+    """Cell masses (L-1, L-1), Dirichlet-spread with ``sum |m|`` log-uniform in [0.1, 10]:
+    off-diagonal ones of sign ``sign``, diagonal ones ``>= 0`` (or 0 without ``diagonal``)."""
+    rows, cols = np.tril_indices(levels - 1)
+    keep = np.ones(rows.size, bool) if diagonal else rows != cols
+    masses = np.zeros((levels - 1, levels - 1))
+    total = np.exp(rng.uniform(*_LOG_MASS))
+    masses[rows[keep], cols[keep]] = total * rng.dirichlet(np.ones(int(keep.sum())))
+    off = rows != cols
+    masses[rows[off], cols[off]] *= sign
+    return masses
 
 
 class StaircaseFamily(Family):
@@ -139,6 +162,15 @@ class PreisachFamily(StaircaseFamily):
 
     def make_structure(self, dt: float, size: int, **options: Any) -> preisach.PreisachStructure:
         return preisach.PreisachStructure(levels=size, dt=dt, **options)
+
+    def random_params(self, structure, rng):
+        """The fit's sign constraints (``fit.py``): cell masses of the structure's loop
+        orientation (``auto``: either, at random) -- counter-clockwise all ``>= 0``, clockwise
+        off-diagonal ``<= 0`` and diagonal ``>= 0`` -- spread at random (Dirichlet) with total
+        ``sum |m|`` log-uniform in ``[0.1, 10]`` (1: a major loop spanning [-1, 1], eq. 5.10),
+        offset in ``[-1, 1]``. Bounded: ``|y - y_0| <= sum |m| max(1, |u|)``."""
+        masses = random_masses(structure.levels, orientation_sign(structure, rng), rng)
+        return preisach.PreisachParams.from_masses(masses, offset=rng.uniform(-1.0, 1.0))
 
     def n_params(self, structure, params) -> int:
         """The Everett nodes below the diagonal (one per cell mass) and the offset."""
