@@ -30,3 +30,37 @@ def _drive(run, x0, signal, off=None):
 def drive():
     """:func:`_drive`: a loop block or a step function run sample by sample."""
     return _drive
+
+
+@pytest.fixture
+def bounded_input() -> np.ndarray:
+    """|u| <= 1 at 40 Hz: a 0.9 sine sweep 0.05 -> 1 Hz, steps to 1, -1 and 0.3 (reversals)."""
+    n, dt = 2000, 0.025
+    t = np.arange(n) * dt
+    u = 0.9 * np.sin(2 * np.pi * np.cumsum(0.05 * 20.0 ** (t / t[-1])) * dt)
+    u[750:850], u[850:950], u[950:1050] = 1.0, -1.0, 0.3
+    return u
+
+
+@pytest.fixture
+def random_draws():
+    """``draws(family, structure, n=50, seed=3)``: seeded parameter sets from the family's
+    ``random_params``."""
+    def draws(family, structure, n: int = 50, seed: int = 3):
+        rng = np.random.default_rng(seed)
+        return [family.random_params(structure, rng) for _ in range(n)]
+    return draws
+
+
+@pytest.fixture
+def random_runs(random_draws, bounded_input):
+    """``runs(family, structure, n=40, seed=11)``: (params, output) of seeded draws run on the
+    bounded input; a non-finite output fails here."""
+    def runs(family, structure, n: int = 40, seed: int = 11):
+        out = []
+        for p in random_draws(family, structure, n, seed):
+            y, _ = family.simulate(structure, p, bounded_input)
+            assert np.all(np.isfinite(y))
+            out.append((p, y))
+        return out
+    return runs

@@ -249,6 +249,22 @@ def _bounded_probe(dt: float, n: int = 2000) -> np.ndarray:
 
 
 @pytest.mark.parametrize("name", NAMES)
+def test_random_parameters_are_reproducible_and_accepted(name):
+    family = get_family(name)
+    structure = family.make_structure(0.025, family.default_size)
+    try:
+        first = family.random_params(structure, np.random.default_rng(7))
+    except NotImplementedError as exc:
+        pytest.skip(str(exc))
+    assert family.random_params(structure, np.random.default_rng(7)) == first  # seeded
+    assert family.random_params(structure, np.random.default_rng(8)) != first
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        p = family.random_params(structure, rng)
+        assert family.Params.from_dict(json.loads(json.dumps(p.to_dict()))) == p
+
+
+@pytest.mark.parametrize("name", NAMES)
 @pytest.mark.parametrize("factor", [1, 2])
 def test_random_parameters_give_bounded_output(name, factor):
     """Parameters drawn from the family's documented domain (``random_params``) keep the

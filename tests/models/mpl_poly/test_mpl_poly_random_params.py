@@ -1,4 +1,4 @@
-"""random_params of the mpl-poly family: accepted by Params, inside the stated domain, seeded."""
+"""random_params of the mpl-poly family: accepted by Params, inside the stated domain."""
 
 import numpy as np
 import pytest
@@ -8,35 +8,19 @@ from hystkit.models import get_family
 FAMILY = get_family("mpl-poly")
 
 
-def _sine_steps(n: int = 2000, dt: float = 0.025) -> np.ndarray:
-    t = np.arange(n) * dt
-    u = 0.9 * np.sin(2 * np.pi * np.cumsum(0.05 * 20.0 ** (t / t[-1])) * dt)
-    u[750:850], u[850:950], u[950:1050] = 1.0, -1.0, 0.3  # steps and reversals
-    return u
-
-
 @pytest.mark.parametrize("size", [FAMILY.default_size, 2 * FAMILY.default_size])
-def test_random_params_in_domain_and_reproducible(size):
+def test_random_params_in_domain(size, random_draws):
     structure = FAMILY.make_structure(0.025, size)
-    a = [FAMILY.random_params(structure, np.random.default_rng(7)) for _ in range(2)]
-    assert a[0] == a[1]
-    rng = np.random.default_rng(3)
-    for _ in range(50):
-        p = FAMILY.random_params(structure, rng)
-        assert FAMILY.Params.from_dict(p.to_dict()) == p  # the constructor accepts it
+    for p in random_draws(FAMILY, structure):
         assert np.all(np.abs(p.f[:, :3]) <= 5)
         assert np.all((p.f[:, 3] >= 0.1 * (1 - 1e-12)) & (p.f[:, 3] <= 100 * (1 + 1e-12)))
         assert np.all(np.abs(p.g) <= 2) and np.all(np.abs(p.w) <= 2) and abs(p.v_b) <= 1
 
 
-def test_random_params_bounded_output():
+def test_random_params_bounded_output(bounded_input, random_runs):
     structure = FAMILY.make_structure(0.025, 2 * FAMILY.default_size)
-    u = _sine_steps()
-    rng = np.random.default_rng(11)
-    for _ in range(40):
-        p = FAMILY.random_params(structure, rng)
-        y, _ = FAMILY.simulate(structure, p, u)
-        assert np.all(np.isfinite(y))
+    u = bounded_input
+    for p, y in random_runs(FAMILY, structure):
         assert np.max(np.abs(y)) <= _poly_bound(structure, p, u)
 
 

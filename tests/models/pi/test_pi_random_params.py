@@ -1,4 +1,4 @@
-"""random_params of the pi family: accepted by Params, inside the stated domain, seeded,
+"""random_params of the pi family: accepted by Params, inside the stated domain,
 and bounded by sum |w_S| (sum |w_H| + sum |w_K| + |b|) for |u| <= 1."""
 
 import numpy as np
@@ -10,23 +10,10 @@ from hystkit.models.pi import MIN_SLOPE, inverse_superposition, not_invertible_r
 FAMILY = get_family("pi")
 
 
-def _sine_steps(n: int = 2000, dt: float = 0.025) -> np.ndarray:
-    t = np.arange(n) * dt
-    u = 0.9 * np.sin(2 * np.pi * np.cumsum(0.05 * 20.0 ** (t / t[-1])) * dt)
-    u[750:850], u[850:950], u[950:1050] = 1.0, -1.0, 0.3  # steps and reversals
-    return u
-
-
 @pytest.mark.parametrize("size", [FAMILY.default_size, 2 * FAMILY.default_size])
-def test_random_params_in_domain_and_reproducible(size):
+def test_random_params_in_domain(size, random_draws):
     structure = FAMILY.make_structure(0.025, size)
-    a = [FAMILY.random_params(structure, np.random.default_rng(7)) for _ in range(2)]
-    assert a[0] == a[1]
-    assert FAMILY.random_params(structure, np.random.default_rng(8)) != a[0]
-    rng = np.random.default_rng(3)
-    for _ in range(50):
-        p = FAMILY.random_params(structure, rng)
-        assert FAMILY.Params.from_dict(p.to_dict()) == p  # the constructor accepts it
+    for p in random_draws(FAMILY, structure):
         m = p.n_deadzone
         k = np.arange(1, m + 1) / (m + 1)
         d_inv, ws_inv = inverse_superposition(p.d_s, p.w_s)  # an involution: back to S^-1
@@ -43,12 +30,7 @@ def test_random_params_in_domain_and_reproducible(size):
 
 
 @pytest.mark.parametrize("size", [FAMILY.default_size, 2 * FAMILY.default_size])
-def test_random_params_bounded_output(size):
+def test_random_params_bounded_output(size, random_runs):
     structure = FAMILY.make_structure(0.025, size)
-    u = _sine_steps()
-    rng = np.random.default_rng(11)
-    for _ in range(40):
-        p = FAMILY.random_params(structure, rng)
-        y, _ = FAMILY.simulate(structure, p, u)
-        assert np.all(np.isfinite(y))
+    for p, y in random_runs(FAMILY, structure):
         assert np.max(np.abs(y)) <= np.sum(np.abs(p.w_s)) * (np.sum(np.abs(p.w_h)) + np.sum(np.abs(p.w_k)) + abs(p.b)) * (1 + 1e-9) + 1e-12
