@@ -7,14 +7,8 @@ from ._raw_config import (
     read_raw_config,
     write_raw_config,
 )
-from ._recording import (
-    Recording,
-    Sampled,
-    check_output_path,
-    read_recording,
-    write_json,
-    write_recording,
-)
+from ._recording import Recording, Sampled, read_recording
+from ._writing import check_output_path, write_json, write_recording
 
 __all__ = ["CONFIG_KEYS", "RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter",
            "Recording", "Sampled", "check_output_path", "find_raw_config", "open_raw",

@@ -31,7 +31,8 @@ from scipy.io.matlab import MatReadError
 
 from hystkit.errors import InputError
 
-from ._recording import _Where, _write_text_safely, check_output_path
+from ._recording import _Where
+from ._writing import _write_text_safely, check_output_path
 
 __all__ = ["RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter", "open_raw"]
 

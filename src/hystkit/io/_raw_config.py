@@ -17,7 +17,7 @@ import numpy as np
 
 from hystkit.errors import InputError
 
-from ._recording import _write_text_safely, check_output_path
+from ._writing import _write_text_safely, check_output_path
 
 __all__ = ["CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_config"]
 
