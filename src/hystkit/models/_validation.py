@@ -13,10 +13,13 @@ from typing import Any
 
 import numpy as np
 
+from hystkit.errors import FitDivergedError
+
 __all__ = [
     "broadcast_state",
     "check_cells",
     "check_dt",
+    "check_finite_run",
     "check_positive_int",
     "check_signal",
     "check_size",
@@ -200,3 +203,14 @@ def run_steps(step, structure, params, u: np.ndarray, x: np.ndarray) -> tuple[np
     for n, u_n in enumerate(u):
         y[n], x = step(structure, params, x, u_n)
     return y, x
+
+
+def check_finite_run(values: np.ndarray, family: str, what: str = "output") -> np.ndarray:
+    """Return `values` when all are finite; otherwise raise `FitDivergedError` naming the family
+    and the first bad sample, so no inf/NaN ever leaves a model run."""
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise FitDivergedError(f"the {family} model's {what} left the finite range at sample "
+                               f"{int(bad[0]) + 1} of {np.size(values)}: the parameters lie "
+                               f"outside the domain where it stays bounded")
+    return values
