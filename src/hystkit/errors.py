@@ -21,3 +21,7 @@ class OutputExistsError(HystkitError, FileExistsError):
 
 class OutputError(HystkitError, OSError):
     """An output path cannot be written (its folder is a file, no permission, disk full)."""
+
+
+class NonFiniteError(HystkitError, ValueError):
+    """A result holds NaN or infinity; it is refused rather than written (names column/key, row)."""

@@ -8,8 +8,16 @@ from ._raw_config import (
     write_raw_config,
 )
 from ._recording import Recording, Sampled, read_recording
-from ._writing import check_output_path, write_json, write_recording
+from ._writing import (
+    atomic_folder,
+    atomic_output,
+    check_output_folder,
+    check_output_path,
+    write_json,
+    write_recording,
+)
 
 __all__ = ["CONFIG_KEYS", "RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter",
-           "Recording", "Sampled", "check_output_path", "find_raw_config", "open_raw",
+           "Recording", "Sampled", "atomic_folder", "atomic_output", "check_output_folder",
+           "check_output_path", "find_raw_config", "open_raw",
            "read_raw_config", "read_recording", "write_json", "write_raw_config", "write_recording"]

@@ -1,18 +1,32 @@
-"""Writing recordings and JSON result files; the output-path checks every command runs first."""
+"""Writing recordings and JSON result files; the output-path checks every command runs first.
+
+Every output is published atomically (see :func:`atomic_output` and :func:`atomic_folder`):
+it is built under a hidden temporary name beside its target and renamed into place only when
+complete, so a crash, Ctrl-C, SIGTERM or a full disk leaves the old file (or nothing), never a
+partial one, and without ``force`` two concurrent writers of one path cannot both win.
+"""
 
 from __future__ import annotations
 
+import errno
 import json
+import math
 import os
+import secrets
+import shutil
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from hystkit.errors import InputError, OutputError, OutputExistsError
+from hystkit.errors import InputError, NonFiniteError, OutputError, OutputExistsError
 
 from ._recording import _COLUMNS, Recording
+
+TEMP_MARK = ".tmp-"  # every temporary's name holds this; tests look for strays by it
 
 
 def write_recording(
@@ -22,7 +36,7 @@ def write_recording(
     extra: dict[str, np.ndarray] | None = None,
     force: bool = False,
 ) -> Path:
-    """Write a recording as CSV or Parquet (chosen by the suffix of `path`).
+    """Write a recording as CSV or Parquet (chosen by the suffix of `path`), atomically.
 
     Parameters
     ----------
@@ -44,10 +58,17 @@ def write_recording(
     Raises
     ------
     OutputExistsError
-        `path` exists and `force` is False (message says to pass ``--force``).
+        `path` exists and `force` is False (message says to pass ``--force``), also when
+        another process created it while this one was writing.
+    NonFiniteError
+        A column holds NaN or infinity (the message names column and row); nothing is written.
     ValueError
         An extra column has the wrong length or clashes with a recording column;
         `InputError` (a ValueError) for a suffix other than ``.csv``/``.parquet``.
+
+    Notes
+    -----
+    The file appears complete or not at all (:func:`atomic_output`).
     """
     path = Path(path)
     suffix = path.suffix.lower()
@@ -64,32 +85,66 @@ def write_recording(
             raise ValueError(f"extra column {name!r} has shape {values.shape}; the recording "
                              f"has {recording.n_samples} samples")
         columns[name] = values
+    for name, values in columns.items():
+        _refuse_non_finite(path, name, np.asarray(values))
     frame = pd.DataFrame(columns)
-    check_output_path(path, force)
-    if suffix == ".csv":  # pandas writes floats as repr(): the shortest exact round trip
-        _write_text_safely(path, lambda: frame.to_csv(path, index=False))
-    else:
-        _write_text_safely(path, lambda: frame.to_parquet(path, index=False))
+    with atomic_output(path, force) as tmp:
+        if suffix == ".csv":  # pandas writes floats as repr(): the shortest exact round trip
+            frame.to_csv(tmp, index=False)
+        else:
+            frame.to_parquet(tmp, index=False)
     return path
 
 
-def write_json(obj: Any, path: str | os.PathLike[str], *, force: bool = False) -> Path:
-    """Write `obj` as indented JSON (metrics, model parameters).
+def _refuse_non_finite(path: Path, name: str, values: np.ndarray) -> None:
+    if values.dtype.kind not in "fc":
+        return
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise NonFiniteError(f"{path}: column {name!r} row {bad[0] + 1} is {values[bad[0]]} "
+                             f"({bad.size} non-finite value(s)); refusing to write it")
 
-    NumPy scalars and arrays are converted to plain numbers and lists. NaN and infinity
-    are refused (ValueError) because standard JSON cannot represent them.
+
+def write_json(obj: Any, path: str | os.PathLike[str], *, force: bool = False) -> Path:
+    """Write `obj` as indented JSON (metrics, model parameters), atomically.
+
+    NumPy scalars and arrays are converted to plain numbers and lists. NaN and infinity are
+    refused because standard JSON cannot represent them.
 
     Raises
     ------
     OutputExistsError
         `path` exists and `force` is False.
+    NonFiniteError
+        `obj` holds NaN or infinity (the message names the key path, e.g.
+        ``metrics.sine.r2`` or ``params.a[3]``); nothing is written.
     """
     path = Path(path)
     check_output_path(path, force)
-    # Serialise before touching the disk so a bad object leaves no half-written file.
-    text = json.dumps(obj, indent=2, allow_nan=False, default=_json_default) + "\n"
-    _write_text_safely(path, lambda: path.write_text(text, encoding="utf-8"))
+    # Serialise before touching the disk so a bad object leaves no file at all.
+    try:
+        text = json.dumps(obj, indent=2, allow_nan=False, default=_json_default) + "\n"
+    except ValueError:
+        where = _first_non_finite(json.loads(json.dumps(obj, default=_json_default)))
+        raise NonFiniteError(f"{path}: {where}; refusing to write NaN or infinity to "
+                             f"JSON") from None
+    with atomic_output(path, force) as tmp:
+        tmp.write_text(text, encoding="utf-8")
     return path
+
+
+def _first_non_finite(obj: Any, where: str = "") -> str:
+    """Key path and value of the first NaN/inf in a plain JSON object."""
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return f"value {where or '(top level)'} is {obj}"
+    items = (obj.items() if isinstance(obj, dict) else enumerate(obj)
+             if isinstance(obj, list) else ())
+    for key, value in items:
+        sub = f"{where}[{key}]" if isinstance(key, int) else f"{where}.{key}" if where else key
+        found = _first_non_finite(value, sub)
+        if found:
+            return found
+    return ""
 
 
 def _json_default(value: Any) -> Any:
@@ -100,26 +155,258 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"cannot write {type(value).__name__} as JSON")
 
 
-def check_output_path(path: str | os.PathLike[str], force: bool = False) -> Path:
-    """Refuse an output path that exists (unless ``force``) or cannot be a file.
+def check_output_path(path: str | os.PathLike[str], force: bool = False, *,
+                      inputs: Iterable[str | os.PathLike[str]] = ()) -> Path:
+    """Refuse an output path that exists (unless ``force``) or cannot be created.
 
     Callers run this before any work, so a refused run costs nothing and writes nothing.
+    Checked: the path exists (without `force`), is a folder, is one of `inputs`, has a file
+    where a parent folder should be, or its nearest existing parent folder is not writable
+    (permission, read-only or virtual file system: probed by creating and removing a hidden
+    file there).
     """
     path = Path(path)
-    if path.exists() and not force:
-        raise OutputExistsError(f"{path} already exists; pass --force to overwrite it")
     if path.is_dir():
         raise OutputError(f"{path} is a folder, not a file")
-    for parent in path.parents:
-        if parent.exists():
-            if not parent.is_dir():
-                raise OutputError(f"{path}: cannot create it, {parent} is a file, not a folder")
-            break
+    for given in inputs:
+        if _same_file(path, Path(given)):
+            raise OutputError(f"{path} is also an input of this command; write elsewhere")
+    if path.exists() and not force:
+        raise OutputExistsError(f"{path} already exists; pass --force to overwrite it")
+    check_folder_writable(path.parent, what=path)
     return path
 
 
+def check_output_folder(folder: str | os.PathLike[str], names: Iterable[str],
+                        force: bool = False, *,
+                        inputs: Iterable[str | os.PathLike[str]] = ()) -> Path:
+    """`check_output_path` for a folder output: the folder itself and each file `names`."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise OutputError(f"{folder} is a file, not a folder")
+    inputs = list(inputs)
+    for name in names:
+        check_output_path(folder / name, force, inputs=inputs)
+    return folder
+
+
+def check_folder_writable(folder: Path, *, what: str | os.PathLike[str] | None = None) -> None:
+    """Refuse when files cannot be created in `folder` or in its nearest existing ancestor."""
+    what = folder if what is None else what
+    existing = Path(folder)
+    while not existing.exists():
+        if existing.parent == existing:
+            break
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        raise OutputError(f"{what}: cannot create it, {existing} is a file, not a folder")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise OutputError(f"{what}: cannot write into {existing} (permission denied)")
+    # os.access says yes to root and knows nothing of read-only mounts or /proc: try it.
+    probe = existing / f".hystkit-probe{TEMP_MARK}{secrets.token_hex(4)}"
+    try:
+        os.close(os.open(probe, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o600))
+    except OSError as exc:
+        raise OutputError(f"{what}: cannot write into {existing} "
+                          f"({exc.strerror or exc})") from None
+    probe.unlink(missing_ok=True)
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.exists() and b.exists() and os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+@contextmanager
+def atomic_output(path: str | os.PathLike[str], force: bool = False) -> Iterator[Path]:
+    """Yield a temporary path to write `path`'s content to; publish it only on success.
+
+    The temporary is a hidden file in the target's folder (``.STEM.tmp-XXXXXXXX.SUFFIX``: the
+    suffix is kept for writers that pick the format by it, e.g. ``savefig``). On leaving the
+    block normally it is renamed into place: with `force` by ``os.replace`` (atomic; readers
+    see the old or the new file), without by exclusive creation (a hard link, which fails if
+    the target appeared meanwhile: of two concurrent writers exactly one wins, the other gets
+    `OutputExistsError`). Where hard links are unsupported, an exclusively created placeholder
+    is replaced instead (still exclusive; the target is briefly empty). On any exception,
+    including KeyboardInterrupt and SystemExit, the temporary is removed and the target left
+    as it was. OS errors while writing become one-line `OutputError`s naming `path`.
+
+    Examples
+    --------
+    >>> with atomic_output("out.csv", force=False) as tmp:  # doctest: +SKIP
+    ...     frame.to_csv(tmp)
+    """
+    path = Path(path)
+    check_output_path(path, force)
+    created: list[Path] = []
+    try:
+        created = _make_parents(path.parent)
+        tmp = _create_temporary(path)
+    except OSError as exc:
+        _remove_folders(created)
+        raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    done = False
+    try:
+        try:
+            yield tmp
+            _fsync(tmp)
+            _publish(tmp, path, force)
+            done = True
+        except (OutputError, OutputExistsError):
+            raise
+        except OSError as exc:
+            raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    finally:
+        tmp.unlink(missing_ok=True)  # after a link, the target keeps the content
+        if not done:
+            _remove_folders(created)
+
+
+def _make_parents(folder: Path) -> list[Path]:
+    """Create `folder` and its missing parents; return those created, innermost first."""
+    missing = []
+    while not folder.exists() and folder.parent != folder:
+        missing.append(folder)
+        folder = folder.parent
+    for made in reversed(missing):
+        made.mkdir(exist_ok=True)
+    return missing
+
+
+def _remove_folders(folders: list[Path]) -> None:
+    """Remove folders a failed write created (innermost first; only while still empty)."""
+    for folder in folders:
+        try:
+            folder.rmdir()
+        except OSError:
+            break
+
+
+def _create_temporary(path: Path) -> Path:
+    """Exclusively create an empty hidden file beside `path` (mode from the umask, unlike
+    mkstemp's 0600, so the published file gets the usual permissions)."""
+    while True:
+        tmp = path.with_name(f".{path.stem}{TEMP_MARK}{secrets.token_hex(4)}{path.suffix}")
+        try:
+            os.close(os.open(tmp, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666))
+            return tmp
+        except FileExistsError:
+            continue
+
+
+def _fsync(path: Path) -> None:
+    """Flush to disk before the rename, so a power cut cannot publish an empty file."""
+    if path.is_file():
+        fd = os.open(path, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def _publish(tmp: Path, path: Path, force: bool) -> None:
+    if force:
+        os.replace(tmp, path)
+        return
+    try:
+        os.link(tmp, path)
+    except FileExistsError:
+        raise OutputExistsError(f"{path} already exists (created while hystkit was writing "
+                                f"it); pass --force to overwrite it") from None
+    except OSError as exc:
+        if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EMLINK,
+                             errno.EXDEV, errno.ENOSYS):
+            raise
+        try:  # no hard links here (FAT, some network shares): claim the name, then replace
+            os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666))
+        except FileExistsError:
+            raise OutputExistsError(f"{path} already exists (created while hystkit was "
+                                    f"writing it); pass --force to overwrite it") from None
+        os.replace(tmp, path)
+
+
+@contextmanager
+def atomic_folder(out: str | os.PathLike[str], force: bool = False,
+                  names: Iterable[str] = ()) -> Iterator[Path]:
+    """Yield a temporary folder to build the folder output `out` in; publish it on success.
+
+    The temporary is a hidden sibling of `out` (``.NAME.tmp-XXXXXXXX``). When the block
+    ends normally: if `out` does not exist, the temporary is renamed to it, so the folder
+    appears complete or not at all; if it exists, the built files are moved into it one by
+    one only after all were built (with `force` replacing same-named files; without, by
+    exclusive creation, and a clash removes the files already moved, so nothing changes).
+    On any exception the temporary folder is removed. `names` (files the caller will write)
+    are checked first like :func:`check_output_folder`.
+    """
+    out = Path(out)
+    check_output_folder(out, names, force)
+    created: list[Path] = []
+    try:
+        created = _make_parents(out.parent)
+        tmp = _create_temporary_folder(out)
+    except OSError as exc:
+        _remove_folders(created)
+        raise OutputError(f"{out}: cannot write ({exc.strerror or exc})") from None
+    done = False
+    try:
+        try:
+            yield tmp
+            _publish_folder(tmp, out, force)
+            done = True
+        except (OutputError, OutputExistsError):
+            raise
+        except OSError as exc:
+            raise OutputError(f"{out}: cannot write ({exc.strerror or exc})") from None
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+        if not done:
+            _remove_folders(created)
+
+
+def _create_temporary_folder(out: Path) -> Path:
+    while True:
+        tmp = out.with_name(f".{out.name}{TEMP_MARK}{secrets.token_hex(4)}")
+        try:
+            tmp.mkdir()
+            return tmp
+        except FileExistsError:
+            continue
+
+
+def _publish_folder(tmp: Path, out: Path, force: bool) -> None:
+    if not out.exists():
+        try:
+            # rename(2) refuses a non-empty target (and replaces an empty one, losing nothing)
+            os.rename(tmp, out)
+            return
+        except OSError as exc:
+            if exc.errno not in (errno.ENOTEMPTY, errno.EEXIST, errno.ENOTDIR):
+                raise
+    if not out.is_dir():
+        raise OutputError(f"{out} is a file, not a folder")
+    files = sorted(p for p in tmp.rglob("*") if p.is_file())
+    moved: list[Path] = []
+    try:
+        for built in files:
+            target = out / built.relative_to(tmp)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            _publish(built, target, force)
+            if not force:
+                moved.append(target)
+    except BaseException:
+        for target in moved:  # undo: without force, only files this run created were moved
+            target.unlink(missing_ok=True)
+        raise
+
+
 def _write_text_safely(path: Path, write: Any) -> None:
-    """Create parent folders and write; OS failures become one-line OutputErrors."""
+    """Create parent folders and write; OS failures become one-line OutputErrors.
+
+    Not atomic: kept for streaming writers that open `path` themselves; new code writes
+    through :func:`atomic_output` instead.
+    """
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         write()
