@@ -7,40 +7,25 @@ the column and the row, so the CLI can print it verbatim.
 from __future__ import annotations
 
 import os
-import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
-import pandas as pd
-from scipy.io import loadmat
-from scipy.io.matlab import MatReadError
 
 from hystkit.errors import InputError
 
-_COLUMNS = ("time", "position", "sensor")  # also the column order of written files
+from ._cells import COLUMNS as _COLUMNS  # also imported by _writing
+from ._cells import Where as _Where  # also imported by _raw
+from ._cells import as_vector
+from ._csv_reader import read_csv
+from ._mat_reader import read_mat
+from ._parquet_reader import read_parquet
+
 _MAX_STEP_DEVIATION = 0.01  # relative to the median step; beyond this we ask for resampling
-
-
-@dataclass(frozen=True)
-class _Where:
-    """Turns a column name and a 0-based sample index into a location for an error message."""
-
-    source: str
-    noun: str = "column"
-    item: str = "row"
-    header_lines: int | None = None  # CSV only: data row r sits on file line r + header_lines
-
-    def fail(self, message: str, column: str | None = None, index: int | None = None) -> InputError:
-        parts = [] if column is None else [f"{self.noun} {column!r}"]
-        if index is not None:
-            text = f"{self.item} {index + 1}"
-            if self.header_lines is not None:
-                text += f" (line {index + 1 + self.header_lines})"
-            parts.append(text)
-        location = f"{', '.join(parts)}: " if parts else ""
-        return InputError(f"{self.source}: {location}{message}")
+MAX_MAGNITUDE = 1e100
+"""Largest |value| accepted in a recording. Finite values near the float64 limit (1.7e308)
+overflow in the first sum or square (metrics, scaling, JSON); 1e100 leaves 200 decades of
+headroom for products and powers and is far beyond any physical time, position or ΔR/R."""
 
 
 class Sampled:
@@ -91,7 +76,7 @@ class Recording(Sampled):
     def __post_init__(self) -> None:
         where = _Where(self.source, item="sample")
         arrays = {
-            name: _as_vector(getattr(self, name), name, where)
+            name: as_vector(getattr(self, name), name, where)
             for name in _COLUMNS
             if name != "position" or self.position is not None
         }
@@ -124,8 +109,9 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True) 
     Raises
     ------
     InputError
-        Unknown suffix, missing or empty file, missing column, non-numeric, empty or
-        non-finite cell, unequal lengths, time not strictly increasing, non-uniform
+        Unknown suffix, missing or empty file, damaged file (MATLAB files are parsed in a
+        child process, so even a crash of the parser ends here), missing column, non-numeric,
+        empty or non-finite cell, magnitude above `MAX_MAGNITUDE`, unequal lengths, time not strictly increasing, non-uniform
         sampling, fewer than 2 samples. The message names file, column and row.
     """
     path = Path(path)
@@ -147,115 +133,7 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True) 
     return Recording(arrays["time"], arrays["sensor"], arrays.get("position"), source)
 
 
-def _read_csv(path: Path, source: str, need_position: bool) -> tuple[dict[str, np.ndarray], _Where]:
-    where = _Where(source, header_lines=1)
-    try:
-        # All cells as text: lets us tell 'abc' from an empty cell and keep exact line numbers
-        # (blank lines are kept). header=None because with a header pandas silently turns
-        # the first column into an index when every data row has one field too many.
-        raw = pd.read_csv(path, header=None, dtype=str, keep_default_na=False,
-                          skip_blank_lines=False, encoding="utf-8-sig")
-    except pd.errors.EmptyDataError as exc:
-        raise where.fail("file is empty (no header row)") from exc
-    except pd.errors.ParserError as exc:
-        found = re.search(r"Expected (\d+) fields in line (\d+), saw (\d+)", str(exc))
-        if found is None:
-            raise where.fail(f"cannot parse CSV ({exc})") from exc
-        expected, line, saw = (int(g) for g in found.groups())
-        raise where.fail(f"{saw} fields but the header names {expected} columns",
-                         index=line - 2) from exc
-    except UnicodeDecodeError as exc:
-        raise where.fail(f"not a UTF-8 text file (byte {exc.start}: {exc.reason})") from exc
-    header = [str(name).strip() for name in raw.iloc[0]]
-    cells = [raw[j].iloc[1:].fillna("").str.strip().reset_index(drop=True) for j in raw.columns]
-    names = _pick(header, need_position, where,
-                  hint=" (the first line must be a comma-separated header naming the columns)")
-    # Trailing blank lines are common at the end of logger files and carry no data.
-    filled = np.flatnonzero(np.logical_or.reduce([(c != "").to_numpy() for c in cells]))
-    n_rows = int(filled[-1]) + 1 if filled.size else 0
-    if n_rows == 0:
-        raise where.fail("no data rows below the header")
-    return {n: _parse_text(cells[header.index(n)].iloc[:n_rows], n, where) for n in names}, where
-
-
-def _read_parquet(
-    path: Path, source: str, need_position: bool
-) -> tuple[dict[str, np.ndarray], _Where]:
-    where = _Where(source)
-    try:
-        frame = pd.read_parquet(path)
-    except (ValueError, OSError) as exc:  # pyarrow's ArrowInvalid / ArrowIOError derive from these
-        raise where.fail(f"cannot read Parquet file ({exc})") from exc
-    names = _pick([str(c) for c in frame.columns], need_position, where)
-    if len(frame) == 0:
-        raise where.fail("no data rows")
-    arrays = {}
-    for name in names:
-        column = frame[name]
-        if pd.api.types.is_numeric_dtype(column) and not pd.api.types.is_bool_dtype(column):
-            arrays[name] = column.to_numpy(dtype=np.float64, na_value=np.nan)
-        elif pd.api.types.is_string_dtype(column) or column.dtype == object:
-            arrays[name] = _parse_text(column.reset_index(drop=True), name, where)
-        else:
-            raise where.fail(f"not numeric (dtype {column.dtype})", name)
-    return arrays, where
-
-
-def _read_mat(path: Path, source: str, need_position: bool) -> tuple[dict[str, np.ndarray], _Where]:
-    where = _Where(source, noun="variable", item="sample")
-    try:
-        contents = loadmat(path)
-    except NotImplementedError as exc:  # scipy's answer to HDF5-based files
-        raise where.fail("MATLAB v7.3 (HDF5) files are not supported; save with '-v7'") from exc
-    except (ValueError, OSError, MatReadError) as exc:
-        raise where.fail(f"cannot read MATLAB file ({exc})") from exc
-    variables = {k: v for k, v in contents.items() if not k.startswith("__")}
-    names = _pick(list(variables), need_position, where)
-    return {name: _as_vector(variables[name], name, where) for name in names}, where
-
-
-_READERS = {".csv": _read_csv, ".parquet": _read_parquet, ".mat": _read_mat}
-
-
-def _pick(found: list[str], need_position: bool, where: _Where, hint: str = "") -> list[str]:
-    """Names of the recording columns present in `found`; missing or doubled ones fail."""
-    required = [n for n in _COLUMNS if need_position or n != "position"]
-    missing = [n for n in required if n not in found]
-    if missing:
-        listed = ", ".join(repr(n) for n in found) or "none"
-        raise where.fail(f"missing required {where.noun} {', '.join(map(repr, missing))}; "
-                         f"{where.noun}s found: {listed}{hint}")
-    for name in _COLUMNS:
-        if found.count(name) > 1:
-            raise where.fail(f"appears {found.count(name)} times in the header", name)
-    return [n for n in _COLUMNS if n in found]
-
-
-def _parse_text(text: pd.Series, name: str, where: _Where) -> np.ndarray:
-    """Parse text cells (positional index) to float64, failing at the first empty or bad cell."""
-    missing = text.isna().to_numpy()
-    text = text.where(~missing, "").astype(str).str.strip()
-    empty = missing | (text == "").to_numpy()
-    numbers = pd.to_numeric(text.where(~empty), errors="coerce")
-    # to_numeric also yields NaN for a literal 'nan'; that one is numeric, _validate reports it.
-    literal_nan = text.str.lower().str.lstrip("+-").eq("nan").to_numpy()
-    bad = np.flatnonzero(empty | (numbers.isna().to_numpy() & ~literal_nan))
-    if bad.size:
-        i = int(bad[0])
-        problem = "empty cell" if empty[i] else f"non-numeric value {text.iloc[i]!r}"
-        raise where.fail(problem, name, i)
-    return numbers.to_numpy(dtype=np.float64, na_value=np.nan)
-
-
-def _as_vector(values: Any, name: str, where: _Where) -> np.ndarray:
-    """Copy `values` to a 1-D float64 array; row and column vectors are accepted."""
-    array = np.asarray(values)
-    if array.dtype.kind not in "iuf":  # bool, complex, text and objects are not measurements
-        raise where.fail(f"not real numbers (dtype {array.dtype})", name)
-    array = np.atleast_1d(np.squeeze(array))
-    if array.ndim != 1:
-        raise where.fail(f"must be a row or column vector, got shape {np.shape(values)}", name)
-    return array.astype(np.float64, copy=True)
+_READERS = {".csv": read_csv, ".parquet": read_parquet, ".mat": read_mat}
 
 
 def _validate(arrays: dict[str, np.ndarray], where: _Where) -> None:
@@ -265,10 +143,17 @@ def _validate(arrays: dict[str, np.ndarray], where: _Where) -> None:
         listed = ", ".join(f"{name} {n}" for name, n in lengths.items())
         raise where.fail(f"{where.noun}s have different lengths: {listed}")
     for name, values in arrays.items():
-        bad = np.flatnonzero(~np.isfinite(values))
+        bad = np.flatnonzero(~(np.abs(values) <= MAX_MAGNITUDE))  # NaN, inf and huge at once
         if bad.size:
             i = int(bad[0])
-            problem = "missing or NaN value" if np.isnan(values[i]) else f"infinite value {values[i]}"
+            value = values[i]
+            if np.isnan(value):
+                problem = "missing or NaN value"
+            elif np.isinf(value):
+                problem = f"infinite value {value}"
+            else:
+                problem = (f"value {value:.6g} is too large; hystkit accepts magnitudes up to "
+                           f"{MAX_MAGNITUDE:g}")
             raise where.fail(problem, name, i)
     time = arrays["time"]
     if time.size < 2:

@@ -1,0 +1,95 @@
+"""What every recording reader shares: error locations, column picking, text and array checks."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from hystkit.errors import InputError
+
+COLUMNS = ("time", "position", "sensor")  # also the column order of written files
+
+
+@dataclass(frozen=True)
+class Where:
+    """Turns a column name and a 0-based sample index into a location for an error message."""
+
+    source: str
+    noun: str = "column"
+    item: str = "row"
+    header_lines: int | None = None  # CSV only: data row r sits on file line r + header_lines
+
+    def fail(self, message: str, column: str | None = None, index: int | None = None) -> InputError:
+        parts = [] if column is None else [f"{self.noun} {column!r}"]
+        if index is not None:
+            text = f"{self.item} {index + 1}"
+            if self.header_lines is not None:
+                text += f" (line {index + 1 + self.header_lines})"
+            parts.append(text)
+        location = f"{', '.join(parts)}: " if parts else ""
+        return InputError(f"{self.source}: {location}{message}")
+
+
+def pick(found: list[str], need_position: bool, where: Where, hint: str = "") -> list[str]:
+    """Names of the recording columns present in `found`; missing or doubled ones fail."""
+    required = [n for n in COLUMNS if need_position or n != "position"]
+    missing = [n for n in required if n not in found]
+    if missing:
+        listed = ", ".join(repr(n) for n in found) or "none"
+        raise where.fail(f"missing required {where.noun} {', '.join(map(repr, missing))}; "
+                         f"{where.noun}s found: {listed}{hint}")
+    for name in COLUMNS:
+        if found.count(name) > 1:
+            raise where.fail(f"appears {found.count(name)} times in the header", name)
+    return [n for n in COLUMNS if n in found]
+
+
+def text_problems(text: pd.Series) -> tuple[np.ndarray, np.ndarray, pd.Series]:
+    """Parse text cells to float64 without failing.
+
+    Returns
+    -------
+    numbers : ndarray of float64
+        The values; NaN where a cell is empty or not a number (and for a literal ``nan``).
+    bad : ndarray of bool
+        Cells that are empty or not a number (a literal ``nan`` is a number here).
+    stripped : Series of str
+        The cells without surrounding whitespace, for the error message.
+    """
+    missing = text.isna().to_numpy()
+    stripped = text.where(~missing, "").astype(str).str.strip()
+    empty = missing | (stripped == "").to_numpy()
+    numbers = pd.to_numeric(stripped.where(~empty), errors="coerce")
+    # to_numeric also yields NaN for a literal 'nan'; that one is numeric, the checks report it.
+    literal_nan = stripped.str.lower().str.lstrip("+-").eq("nan").to_numpy()
+    bad = empty | (numbers.isna().to_numpy() & ~literal_nan)
+    return numbers.to_numpy(dtype=np.float64, na_value=np.nan), bad, stripped
+
+
+def cell_problem(stripped: pd.Series, i: int) -> str:
+    """How to describe the bad cell `i` found by `text_problems`."""
+    value = stripped.iloc[i]
+    return "empty cell" if value == "" else f"non-numeric value {value!r}"
+
+
+def parse_text(text: pd.Series, name: str, where: Where) -> np.ndarray:
+    """Parse text cells (positional index) to float64, failing at the first empty or bad cell."""
+    numbers, bad, stripped = text_problems(text)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise where.fail(cell_problem(stripped, i), name, i)
+    return numbers
+
+
+def as_vector(values: Any, name: str, where: Where) -> np.ndarray:
+    """Copy `values` to a 1-D float64 array; row and column vectors are accepted."""
+    array = np.asarray(values)
+    if array.dtype.kind not in "iuf":  # bool, complex, text and objects are not measurements
+        raise where.fail(f"not real numbers (dtype {array.dtype})", name)
+    array = np.atleast_1d(np.squeeze(array))
+    if array.ndim != 1:
+        raise where.fail(f"must be a row or column vector, got shape {np.shape(values)}", name)
+    return array.astype(np.float64, copy=True)

@@ -1,0 +1,144 @@
+"""CSV recordings: a fast numeric pass, and a chunked text pass that says what is wrong.
+
+Most files are clean, so the first pass asks pandas' C parser for float64 directly (memory: the
+numbers themselves plus parser buffers). pandas >= 3 parses floats exactly by default (earlier
+versions need ``float_precision="round_trip"``), so values stay bit-identical to what
+`write_recording` wrote. Anything unusual in that pass (a cell that is not a number, an empty
+cell or blank line, a long row, bytes that are not UTF-8) sends the file to the second pass,
+which reads it as text in chunks of `CHUNK_ROWS` rows, keeps exact file line numbers and
+produces the error message; it also accepts what the first pass is too strict for (trailing
+blank lines, text columns beside the numbers). Neither pass holds all cells as text at once.
+"""
+
+from __future__ import annotations
+
+import codecs
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ._cells import Where, cell_problem, pick, text_problems
+
+CHUNK_ROWS = 100_000  # text cells held at once by the second pass
+_EXACT = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
+_HINT = " (the first line must be a comma-separated header naming the columns)"
+_TEXT = {"header": None, "dtype": str, "keep_default_na": False, "skip_blank_lines": False,
+         "encoding": "utf-8-sig"}
+# What pandas raises on text it cannot tokenise (NUL bytes, huge fields, stray quotes, ...).
+_PARSE_ERRORS = (pd.errors.ParserError, ValueError, OverflowError, MemoryError)
+
+
+def read_csv(path: Path, source: str, need_position: bool) -> tuple[dict[str, np.ndarray], Where]:
+    """Read the recording columns of a CSV file as float64 arrays (not yet validated)."""
+    where = Where(source, header_lines=1)
+    arrays = _read_numbers(path, need_position, where)
+    if arrays is None:
+        arrays = _read_text(path, need_position, where)
+    return arrays, where
+
+
+def _read_numbers(path: Path, need_position: bool, where: Where) -> dict[str, np.ndarray] | None:
+    """The fast pass: every column as float64, or None when anything needs a closer look."""
+    try:
+        first = pd.read_csv(path, nrows=1, **_TEXT)
+    except (*_PARSE_ERRORS, UnicodeDecodeError):
+        return None
+    if first.empty or first.iloc[0].isna().any():  # blank first line or empty file: pass 2
+        return None
+    header = [str(name).strip() for name in first.iloc[0]]
+    if any("\n" in name or "\r" in name for name in header):  # a quoted header spans lines
+        return None
+    names = pick(header, need_position, where, hint=_HINT)
+    try:
+        # index_col=False: with names given, pandas would otherwise make a long row's extra
+        # leading field an index; skip_blank_lines=False: a blank line becomes a NaN row.
+        frame = pd.read_csv(path, header=None, skiprows=1, names=list(range(len(header))),
+                            index_col=False, dtype=np.float64, skip_blank_lines=False,
+                            encoding="utf-8-sig", **_EXACT)
+    except (*_PARSE_ERRORS, UnicodeDecodeError):
+        return None
+    arrays = {name: frame[header.index(name)].to_numpy(dtype=np.float64) for name in names}
+    if len(frame) == 0 or any(np.isnan(values).any() for values in arrays.values()):
+        return None  # pass 2 tells an empty cell from 'nan' and trailing blank lines
+    return arrays
+
+
+def _read_text(path: Path, need_position: bool, where: Where) -> dict[str, np.ndarray]:
+    """The careful pass: text cells chunk by chunk, the first problem of each column kept."""
+    header: list[str] | None = None
+    names: list[str] = []
+    parts: dict[str, list[np.ndarray]] = {}
+    first_bad: dict[str, tuple[int, str]] = {}
+    n_rows = 0  # data rows up to the last one with any cell filled
+    offset = 0  # data rows before this chunk
+    try:
+        # header=None because with a header pandas silently turns the first column into an
+        # index when every data row has one field too many.
+        for chunk in pd.read_csv(path, chunksize=CHUNK_ROWS, **_TEXT):
+            if header is None:
+                header = [str(name).strip() for name in chunk.iloc[0]]
+                names = pick(header, need_position, where, hint=_HINT)
+                parts = {name: [] for name in names}
+                chunk = chunk.iloc[1:]
+            filled = np.zeros(len(chunk), dtype=bool)
+            for j in chunk.columns:
+                filled |= (chunk[j].fillna("").str.strip() != "").to_numpy()
+            if filled.any():
+                # Trailing blank lines are common at the end of logger files and carry no data.
+                n_rows = offset + int(np.flatnonzero(filled)[-1]) + 1
+            for name in names:
+                numbers, bad, stripped = text_problems(chunk[header.index(name)])
+                if name not in first_bad and bad.any():
+                    i = int(np.argmax(bad))
+                    first_bad[name] = (offset + i, cell_problem(stripped, i))
+                parts[name].append(numbers)
+            offset += len(chunk)
+    except pd.errors.EmptyDataError as exc:
+        raise where.fail("file is empty (no header row)") from exc
+    except UnicodeDecodeError as exc:
+        raise where.fail(f"not a UTF-8 text file ({_first_bad_utf8(path)})") from exc
+    except _PARSE_ERRORS as exc:
+        raise _parse_error(exc, where) from exc
+    if header is None:
+        raise where.fail("file is empty (no header row)")
+    if n_rows == 0:
+        raise where.fail("no data rows below the header")
+    for name in names:  # the first column in recording order with a bad cell in the data
+        if name in first_bad and first_bad[name][0] < n_rows:
+            row, problem = first_bad[name]
+            raise where.fail(problem, name, row)
+    return {name: np.concatenate(parts.pop(name))[:n_rows] for name in names}
+
+
+def _parse_error(exc: Exception, where: Where):
+    found = re.search(r"Expected (\d+) fields in line (\d+), saw (\d+)", str(exc))
+    if found is None:
+        detail = " ".join(str(exc).split())[:200] or type(exc).__name__
+        return where.fail(f"cannot parse CSV ({detail})")
+    expected, line, saw = (int(g) for g in found.groups())
+    return where.fail(f"{saw} fields but the header names {expected} columns", index=line - 2)
+
+
+def _first_bad_utf8(path: Path, block: int = 1 << 20) -> str:
+    """Where the first byte that is not UTF-8 sits: 'line L, byte offset B: reason'."""
+    decoder = codecs.getincrementaldecoder("utf-8")()
+    line, start = 1, 0
+    with path.open("rb") as file:
+        while data := file.read(block):
+            try:
+                decoder.decode(data)
+            except UnicodeDecodeError as exc:
+                # The decoder keeps at most 3 bytes of an unfinished character from the last
+                # block; exc.start counts from those.
+                held = len(exc.object) - len(data)
+                newlines = data.count(b"\n", 0, max(exc.start - held, 0))
+                return f"line {line + newlines}, byte offset {start + exc.start - held}: {exc.reason}"
+            line += data.count(b"\n")
+            start += len(data)
+    try:
+        decoder.decode(b"", final=True)
+    except UnicodeDecodeError as exc:
+        return f"line {line}, byte offset {start - (len(exc.object) - exc.start)}: {exc.reason}"
+    return "invalid byte sequence"
