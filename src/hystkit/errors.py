@@ -25,3 +25,10 @@ class OutputError(HystkitError, OSError):
 
 class NonFiniteError(HystkitError, ValueError):
     """A result holds NaN or infinity; it is refused rather than written (names column/key, row)."""
+
+
+class Terminated(BaseException):
+    """Raised in the main thread on SIGTERM by the CLI's handler, so cleanup runs as for Ctrl-C.
+
+    A BaseException, like KeyboardInterrupt, so that no ``except Exception`` swallows it.
+    """

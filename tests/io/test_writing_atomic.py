@@ -16,6 +16,7 @@ from hystkit.io import (
     Recording,
     atomic_folder,
     atomic_output,
+    atomic_outputs,
     check_output_path,
     write_json,
     write_recording,
@@ -158,3 +159,25 @@ def test_unwritable_places_are_refused_before_any_work(tmp_path: Path) -> None:
 
 
 
+
+
+def test_files_that_belong_together_appear_together_or_not_at_all(tmp_path: Path) -> None:
+    data, report = tmp_path / "out.csv", tmp_path / "sub" / "out.json"
+    with pytest.raises(KeyboardInterrupt), atomic_outputs([data, report]) as (t1, t2):
+        t1.write_text("data")
+        raise KeyboardInterrupt
+    assert _names(tmp_path) == []
+    data.write_text("old data")
+    # with force, the report's clash undoes the data file's replacement
+    with pytest.raises(OutputError, match="out.json"):  # noqa: SIM117  (it fails at publication)
+        with atomic_outputs([data, report], force=True) as (t1, t2):
+            t1.write_text("new data")
+            t2.write_text("new report")
+            report.mkdir()  # a folder where the report should go cannot be replaced
+    assert data.read_text() == "old data"
+    report.rmdir()
+    with atomic_outputs([data, report], force=True) as (t1, t2):
+        t1.write_text("new data")
+        t2.write_text("new report")
+    assert (data.read_text(), report.read_text()) == ("new data", "new report")
+    assert _names(tmp_path) == ["out.csv", "sub", "sub/out.json"]

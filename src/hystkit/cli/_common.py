@@ -7,12 +7,14 @@ import sys
 
 from ..errors import HystkitError
 
-__all__ = ["GUARD_EXIT", "Parser", "UsageError", "failures_exit", "positive_int", "slope_cap"]
+__all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Parser", "UsageError", "failures_exit", "positive_int", "slope_cap"]
 
 # Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
 # bounds, not converged; a family failed in compare/select); 2 is kept for errors that stop a
 # command.
 GUARD_EXIT = 3
+# Exit code of an internal error (a bug; BSD's EX_SOFTWARE): one line instead of a traceback.
+INTERNAL_EXIT = 70
 
 
 class UsageError(HystkitError):

@@ -2,6 +2,11 @@
 
 Subcommands live in ``cmd_*.py`` modules beside this one, each with a ``register(sub)``
 function; they are found here so that adding a capability does not edit a shared file.
+
+Exit codes: 0 success; 2 an error the user can fix (one ``hystkit: error:`` line); 3 work ran
+but failed its guards (`GUARD_EXIT`); 70 an internal error (a bug: one line, the traceback with
+``HYSTKIT_DEBUG=1``); 130 interrupted (Ctrl-C); 143 terminated (SIGTERM). Interrupted or
+failed commands leave no partial output: every writer publishes atomically.
 """
 
 from __future__ import annotations
@@ -10,11 +15,13 @@ import importlib
 import os
 import pkgutil
 import sys
+import traceback
 from collections.abc import Sequence
 
 from .. import __version__
-from ..errors import HystkitError
-from ._common import Parser
+from ..errors import HystkitError, Terminated
+from ._common import INTERNAL_EXIT, Parser
+from ._signals import signals_as_exceptions
 
 __all__ = ["main"]
 
@@ -35,19 +42,42 @@ def _parser() -> Parser:
     return parser
 
 
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split("\n"))
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point; returns the exit code (0 success, 2 bad input or divergence)."""
+    """Entry point; returns the exit code (see the module docstring)."""
     try:
-        args = _parser().parse_args(argv)
-        return args.run(args)
+        with signals_as_exceptions():
+            args = _parser().parse_args(argv)
+            return args.run(args)
     except HystkitError as exc:
-        print(f"hystkit: error: {exc}", file=sys.stderr)
+        print(f"hystkit: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("hystkit: interrupted", file=sys.stderr)
+        return 130
+    except Terminated:
+        print("hystkit: terminated (SIGTERM)", file=sys.stderr)
+        return 143
     except BrokenPipeError:
         # The reader went away (`hystkit ... | head`): not our error. Point stdout at devnull so
         # the interpreter's final flush does not raise again (Python docs, signal module).
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
+    except MemoryError:
+        print("hystkit: error: out of memory (try a smaller input, model size or "
+              "--chunk-size)", file=sys.stderr)
+        return 2
+    except Exception as exc:  # noqa: BLE001  (the last resort is the point)
+        # Last resort. Anything here is a bug (user errors are HystkitErrors): say so on one
+        # line rather than with a traceback; the hostile tests treat this exit code as failure.
+        if os.environ.get("HYSTKIT_DEBUG", "") not in ("", "0"):
+            traceback.print_exc()
+        print(f"hystkit: internal error: {type(exc).__name__}: {_one_line(exc)} (please "
+              f"report; HYSTKIT_DEBUG=1 shows the traceback)", file=sys.stderr)
+        return INTERNAL_EXIT
 
 
 if __name__ == "__main__":

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..compensation import DEFAULT_CENTER
-from ..io import check_output_path, read_recording, write_json
+from ..io import atomic_folder, check_output_folder, read_recording, write_json
 from ..models import FAMILIES
 from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
@@ -42,19 +42,22 @@ def _compare(args: argparse.Namespace) -> int:
 
     models = _models(args.models)
     out = args.out
+    inputs = [args.data_fit, args.data_val]
     if out is not None:
-        check_output_path(out / "compare.json", args.force)
+        check_output_folder(out, ["compare.json"], args.force, inputs=inputs)
+    sizes = _sizes(args.size)
     fit_rec, val_rec = read_recording(args.data_fit), read_recording(args.data_val)
     print(f"comparing {len(models)} models: fit on {args.data_fit}, validate on {args.data_val} "
           f"(deployable centring: {DEFAULT_CENTER}; oracle: recording, the paper's protocol)")
-    table = compare_models(fit_rec, val_rec, models, _sizes(args.size), progress=print)
+    table = compare_models(fit_rec, val_rec, models, sizes, progress=print)
     print(format_compare(table))
     print("R² fwd: forward model position -> sensor; R² inv: its inverse as compensator; "
           "R² dir: a compensator fitted sensor -> position; line: straight line; left of | "
           "with the fitting recording's offsets (deployable), right of it with the validation "
           "recording's own means (oracle)")
     if out is not None:
-        write_json(table, out / "compare.json", force=args.force)
+        with atomic_folder(out, args.force, ["compare.json"]) as tmp:
+            write_json(table, tmp / "compare.json")
         print(f"wrote {out / 'compare.json'}")
     return failures_exit([name for name, m in table.items() if "error" in m])
 
@@ -64,8 +67,9 @@ def _generalize(args: argparse.Namespace) -> int:
 
     models = _models(args.models)
     out = args.out or Path("hystkit-generalize")
-    for name in ("generalize.json", "generalize.png"):
-        check_output_path(out / name, args.force)
+    names = ["generalize.json", "generalize.png"]
+    check_output_folder(out, names, args.force, inputs=args.data)
+    sizes = _sizes(args.size)
     if args.data:
         if len(args.data) < 2:
             raise UsageError("generalize needs at least two recordings (train on each, test on "
@@ -81,7 +85,7 @@ def _generalize(args: argparse.Namespace) -> int:
         where = "virtual sensor, fit seed 1, test seed 2"
     print(f"train on each of {', '.join(train)}, test on each ({where}; direct-mode "
           f"compensators, deployable centring: {DEFAULT_CENTER}, oracle beside it)")
-    matrix = generalization_matrix(train, test, models, _sizes(args.size), progress=print)
+    matrix = generalization_matrix(train, test, models, sizes, progress=print)
     failed = []
     for name, entry in matrix.items():
         for key, label in (("r2", "deployable R²"), ("r2_oracle", "oracle R² (recording)")):
@@ -96,8 +100,9 @@ def _generalize(args: argparse.Namespace) -> int:
             print(f"  {name} {where_}: note: {reason}")
         if entry["errors"]:
             failed.append(name)
-    write_json(matrix, out / "generalize.json", force=args.force)
-    plot_generalization(matrix).savefig(out / "generalize.png", dpi=110)
+    with atomic_folder(out, args.force, names) as tmp:  # complete or not at all
+        write_json(matrix, tmp / "generalize.json")
+        plot_generalization(matrix).savefig(tmp / "generalize.png", dpi=110)
     print(f"\nwrote {out / 'generalize.json'}, {out / 'generalize.png'}")
     return failures_exit(failed)
 

@@ -39,7 +39,7 @@ from ..control import (
     tune_pid,
     virtual_sensor_block,
 )
-from ..io import check_output_path, read_recording, write_json
+from ..io import atomic_folder, check_output_folder, read_recording, write_json
 from ..models import FAMILIES
 from ..signals import EXPERIMENTS as EXCITATIONS
 from ._common import UsageError, positive_int
@@ -156,8 +156,10 @@ def _control(args: argparse.Namespace) -> int:
     stamp = time.strftime("%Y%m%d-%H%M%S")
     out = args.out or Path(f"hystkit-control-{args.scheme}-{args.experiment or 'bode'}-{stamp}")
     paths = _outputs(args, out)
-    for path in paths:  # refuse before any work
-        check_output_path(path, args.force)
+    inputs = [x for x in (args.sensor_data, args.training_data, args.compensator,
+                          args.model_file, Path(args.sensor)) if x is not None]
+    # refuse before any work
+    check_output_folder(out, [p.name for p in paths], args.force, inputs=inputs)
     if args.sensor != "virtual" and args.sensor_data is not None:
         raise UsageError("--sensor-data fits S_r on a recording; it cannot be combined with "
                          f"--sensor {args.sensor}")
@@ -202,33 +204,34 @@ def _control(args: argparse.Namespace) -> int:
         "sensor_gain_m_per_unit": loop.sensor_gain, "models": models.info,
         "sensor_fit": models.sensor.info, "compensator_fit": models.compensator.info,
         "model_fit": models.model.info, "fit_seconds": t_fit}
-    out.mkdir(parents=True, exist_ok=True)
     linear = {"operating_point": "rest (t = 0)", **margins.to_dict()}
-    if args.experiment:
-        result = run_experiment(args.experiment, loop)
+    result = run_experiment(args.experiment, loop) if args.experiment else None
+    if result is not None:
         metrics = {**result.metrics(), "linear": linear}
         if args.experiment == "sine":
             metrics["document"] = DOCUMENT_SINE[args.scheme]
         _print_table(metrics)
-        write_json(metrics, out / "metrics.json", force=args.force)
-        title = f"scheme {args.scheme}, {args.experiment}"
-        if len(result.cases) == 1:
-            plot_response(next(iter(result.cases.values())), title).savefig(
-                out / "response.png", dpi=110)
+    # Built in a hidden sibling and renamed into place: the folder appears complete or not at all.
+    with atomic_folder(out, args.force, [p.name for p in paths]) as tmp:
+        if result is not None:
+            write_json(metrics, tmp / "metrics.json")
+            title = f"scheme {args.scheme}, {args.experiment}"
+            if len(result.cases) == 1:
+                plot_response(next(iter(result.cases.values())), title).savefig(
+                    tmp / "response.png", dpi=110)
+            else:
+                plot_cases(result).savefig(tmp / "cases.png", dpi=110)
+                for label, resp in result.cases.items():
+                    plot_response(resp, f"{title}: {label}").savefig(
+                        tmp / f"case_{_slug(label)}.png", dpi=110)
         else:
-            plot_cases(result).savefig(out / "cases.png", dpi=110)
-            for label, resp in result.cases.items():
-                plot_response(resp, f"{title}: {label}").savefig(
-                    out / f"case_{_slug(label)}.png", dpi=110)
-    else:
-        write_json({"scheme": args.scheme, "linear": linear}, out / "analysis.json",
-                   force=args.force)
-    if args.bode:
-        f, mag, phase = bode_data(loop)
-        plot_bode(f, mag, phase, margins, f"scheme {args.scheme}: linearised open loop at "
-                  f"rest, cut at the plant input").savefig(out / "bode.png", dpi=110)
-    config["seconds"] = time.perf_counter() - t_start
-    write_json(config, out / "config.json", force=args.force)
+            write_json({"scheme": args.scheme, "linear": linear}, tmp / "analysis.json")
+        if args.bode:
+            f, mag, phase = bode_data(loop)
+            plot_bode(f, mag, phase, margins, f"scheme {args.scheme}: linearised open loop at "
+                      f"rest, cut at the plant input").savefig(tmp / "bode.png", dpi=110)
+        config["seconds"] = time.perf_counter() - t_start
+        write_json(config, tmp / "config.json")
     print(f"wrote {out}/: {', '.join(x.name for x in paths)} "
           f"({config['seconds']:.1f} s)")
     return 0

@@ -17,6 +17,7 @@ from ..errors import HystkitError
 from ..io import (
     CONFIG_KEYS,
     RawFormat,
+    atomic_outputs,
     check_output_path,
     find_raw_config,
     read_raw_config,
@@ -114,8 +115,9 @@ def _preprocess(args: argparse.Namespace) -> int:
     report_path = args.report if args.report is not None else args.out.with_suffix(".json")
     if report_path == args.out:
         raise SettingsError(f"--report {report_path} is the data output file")
-    check_output_path(args.out, args.force)
-    check_output_path(report_path, args.force)
+    inputs = [args.raw] + ([args.config] if args.config is not None else [])
+    check_output_path(args.out, args.force, inputs=inputs)
+    check_output_path(report_path, args.force, inputs=inputs)
     settings, fmt, config_path = _settings(args)
     print(f"preprocessing {args.raw}" + (f" with settings from {config_path}" if config_path
                                           else "") + " ...", flush=True)
@@ -140,13 +142,16 @@ def _preprocess(args: argparse.Namespace) -> int:
         else:
             warnings.warn_explicit(warning.message, warning.category, warning.filename,
                                    warning.lineno)
-    write_recording(result.recording, args.out, extra=result.extra, force=args.force)
     seconds = time.perf_counter() - t0
-    write_json({"report": rep.to_dict(), "settings": {k: _plain(v) for k, v in
-                                                      vars(settings).items()},
-                "format": {k: _plain(v) for k, v in vars(fmt).items()},
-                "config_file": None if config_path is None else str(config_path)},
-               report_path, force=args.force)
+    # Data file and report appear together or not at all (a failure in either, or Ctrl-C,
+    # leaves neither).
+    with atomic_outputs([args.out, report_path], args.force) as (data_tmp, report_tmp):
+        write_recording(result.recording, data_tmp, extra=result.extra, force=True)
+        write_json({"report": rep.to_dict(), "settings": {k: _plain(v) for k, v in
+                                                          vars(settings).items()},
+                    "format": {k: _plain(v) for k, v in vars(fmt).items()},
+                    "config_file": None if config_path is None else str(config_path)},
+                   report_tmp, force=True)
     print(f"wrote {args.out}: {rep.n_out} samples at {rep.fs_out:g} Hz (time, position [mm], "
           f"sensor = dR1/R1 - dR2/R2, r1, r2 [Ohm], dr1, dr2) and {report_path} "
           f"({seconds:.1f} s, {rep.n_samples / seconds / 1e6:.3g} M samples/s per channel)")

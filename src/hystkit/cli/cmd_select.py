@@ -8,7 +8,13 @@ import time
 from pathlib import Path
 
 from ..compensation import CENTERS, DEFAULT_CENTER, save_compensator
-from ..io import check_output_path, read_recording, write_json
+from ..io import (
+    atomic_folder,
+    check_output_folder,
+    check_output_path,
+    read_recording,
+    write_json,
+)
 from ._common import GUARD_EXIT, UsageError, failures_exit, positive_int
 from .cmd_compare import _models
 
@@ -31,10 +37,9 @@ def _select(args: argparse.Namespace) -> int:
 
     from ..reports import candidates, plot_selection, select_model
 
-    check_output_path(args.out, args.force)
+    check_output_path(args.out, args.force, inputs=args.data)
     report = args.report or args.out.with_name(args.out.stem + "-selection")
-    for name in SELECTION_FILES:
-        check_output_path(report / name, args.force)
+    check_output_folder(report, SELECTION_FILES, args.force, inputs=args.data)
     recs = [read_recording(path) for path in args.data]
     cands = candidates(_models(args.models), _centers(args.centers))
     t0 = time.perf_counter()
@@ -52,18 +57,21 @@ def _select(args: argparse.Namespace) -> int:
         print(f"{r['candidate']:<32}{r['cv_r2']:>8.4f}{r['cv_r2_min']:>8.4f}"
               f"{r['cv_r2_oracle']:>8.4f}{r['cv_linear_r2']:>8.4f}{r['n_params']:>7d}"
               f"{r['aic']:>10.0f}{r['bic']:>10.0f}  {r['guard_failed'] or 'ok'}")
-    report.mkdir(parents=True, exist_ok=True)
     summary = {"winner": result["winner"], "folds": result["folds"], "ranking": rows,
                "seconds": time.perf_counter() - t0, "model_file": str(args.out)}
-    write_json(summary, report / "selection.json", force=args.force)
-    pd.DataFrame([{k: v for k, v in r.items() if k != "fold_status"} for r in rows]).to_csv(
-        report / "selection.csv", index=False)
-    plot_selection(rows).savefig(report / "selection.png", dpi=110)
+    # The report folder is published only after the winner's model file was: a failure on the
+    # way leaves neither (the model file alone only if the folder's rename itself fails).
+    with atomic_folder(report, args.force, SELECTION_FILES) as tmp:
+        write_json(summary, tmp / "selection.json")
+        pd.DataFrame([{k: v for k, v in r.items() if k != "fold_status"}
+                      for r in rows]).to_csv(tmp / "selection.csv", index=False)
+        plot_selection(rows).savefig(tmp / "selection.png", dpi=110)
+        if result["winner"] is not None:
+            save_compensator(result["compensator"], args.out, force=args.force)
     print(f"wrote {report / 'selection.json'}, .csv, .png ({summary['seconds']:.1f} s)")
     if result["winner"] is None:
         print("hystkit: no candidate passed its guards; no model written", file=sys.stderr)
         return GUARD_EXIT
-    save_compensator(result["compensator"], args.out, force=args.force)
     w = result["winner"]
     print(f"winner: {w['candidate']} (held-out deployable R² {w['cv_r2']:.4f}, oracle "
           f"{w['cv_r2_oracle']:.4f}, line {w['cv_linear_r2']:.4f}); wrote {args.out}")

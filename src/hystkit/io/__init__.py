@@ -11,6 +11,7 @@ from ._recording import Recording, Sampled, read_recording
 from ._writing import (
     atomic_folder,
     atomic_output,
+    atomic_outputs,
     check_output_folder,
     check_output_path,
     write_json,
@@ -18,6 +19,7 @@ from ._writing import (
 )
 
 __all__ = ["CONFIG_KEYS", "RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter",
-           "Recording", "Sampled", "atomic_folder", "atomic_output", "check_output_folder",
+           "Recording", "Sampled", "atomic_folder", "atomic_output", "atomic_outputs",
+           "check_output_folder",
            "check_output_path", "find_raw_config", "open_raw",
            "read_raw_config", "read_recording", "write_json", "write_raw_config", "write_recording"]

@@ -387,18 +387,90 @@ def _publish_folder(tmp: Path, out: Path, force: bool) -> None:
     if not out.is_dir():
         raise OutputError(f"{out} is a file, not a folder")
     files = sorted(p for p in tmp.rglob("*") if p.is_file())
-    moved: list[Path] = []
+    for built in files:
+        (out / built.relative_to(tmp)).parent.mkdir(parents=True, exist_ok=True)
+    _publish_all([(built, out / built.relative_to(tmp)) for built in files], force)
+
+
+def _publish_all(pairs: list[tuple[Path, Path]], force: bool) -> None:
+    """Publish each (temporary, target); if one fails, undo the ones already published.
+
+    Undo removes a file this run created and, with `force`, puts the replaced file back (kept
+    as a hidden hard link until every target is in place).
+    """
+    done: list[tuple[Path, Path | None]] = []  # target, backup of what it replaced
     try:
-        for built in files:
-            target = out / built.relative_to(tmp)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            _publish(built, target, force)
-            if not force:
-                moved.append(target)
+        for tmp, target in pairs:
+            backup = _backup(target) if force else None
+            try:
+                _publish(tmp, target, force)
+            except (OutputError, OutputExistsError):
+                raise
+            except OSError as exc:
+                if backup is not None:
+                    backup.unlink(missing_ok=True)
+                raise OutputError(f"{target}: cannot write ({exc.strerror or exc})") from None
+            done.append((target, backup))
     except BaseException:
-        for target in moved:  # undo: without force, only files this run created were moved
-            target.unlink(missing_ok=True)
+        for target, backup in reversed(done):
+            if backup is not None:
+                os.replace(backup, target)
+            else:
+                target.unlink(missing_ok=True)
         raise
+    finally:
+        for _, backup in done:
+            if backup is not None:
+                backup.unlink(missing_ok=True)
+
+
+def _backup(target: Path) -> Path | None:
+    """A hidden hard link to `target`'s current file (None: no file, or no hard links)."""
+    if not target.is_file():
+        return None
+    backup = target.with_name(f".{target.name}{TEMP_MARK}old-{secrets.token_hex(4)}")
+    try:
+        os.link(target, backup)
+    except OSError:
+        return None
+    return backup
+
+
+@contextmanager
+def atomic_outputs(paths: Iterable[str | os.PathLike[str]],
+                   force: bool = False) -> Iterator[list[Path]]:
+    """:func:`atomic_output` for several files that belong together (data and its report).
+
+    Yields one temporary per path, in order. When the block ends normally they are published
+    in order; if one cannot be (it appeared meanwhile), those already published are undone,
+    so all appear or none does. On any exception every temporary is removed.
+    """
+    paths = [Path(p) for p in paths]
+    for path in paths:
+        check_output_path(path, force)
+    created: list[Path] = []
+    temps: list[Path] = []
+    done = False
+    try:
+        try:
+            for path in paths:
+                created += _make_parents(path.parent)
+                temps.append(_create_temporary(path))
+            yield temps
+            for tmp in temps:
+                _fsync(tmp)
+            _publish_all(list(zip(temps, paths, strict=True)), force)
+            done = True
+        except (OutputError, OutputExistsError):
+            raise
+        except OSError as exc:
+            raise OutputError(f"{exc.filename or paths[0]}: cannot write "
+                              f"({exc.strerror or exc})") from None
+    finally:
+        for tmp in temps:
+            tmp.unlink(missing_ok=True)
+        if not done:
+            _remove_folders(sorted(set(created), key=lambda p: -len(p.parts)))
 
 
 def _write_text_safely(path: Path, write: Any) -> None:

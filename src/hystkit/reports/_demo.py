@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import __version__
 from ..compensation import evaluate, fit_compensator
-from ..io import check_output_path, write_json
+from ..io import atomic_folder, check_output_folder, write_json
 from ..preprocess import PreprocessSettings, preprocess_raw
 from ..sensors import ScopeSettings, simulate_experiment, simulate_raw
 from ..signals import EXPERIMENTS
@@ -60,11 +60,14 @@ def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
     ``noise_trained.json`` (the noise-trained compensator scored on every excitation: does
     compensation generalise?), ``config.json`` and the figures ``loops.png``,
     ``time_series.png``; with `raw`, also ``raw_path.json`` from :func:`run_raw_path` (the
-    returned dict then has a ``raw_path`` key). Checks every output path before writing any.
+    returned dict then has a ``raw_path`` key). Checks every output path before any work, and
+    publishes the folder atomically (:func:`~hystkit.io.atomic_folder`): interrupted or failed,
+    it leaves no folder and no file; into an existing folder, the files go in only once all
+    were built.
     """
     out = Path(out_dir)
-    for name in DEMO_FILES + (RAW_DEMO_FILES if raw else ()):
-        check_output_path(out / name, force)
+    names = DEMO_FILES + (RAW_DEMO_FILES if raw else ())
+    check_output_folder(out, names, force)
     t_start = time.perf_counter()
     recordings, compensators, metrics, shown = {}, {}, {}, {}
     for name in EXPERIMENTS:
@@ -80,18 +83,17 @@ def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
     noise_trained = {name: evaluate(compensators["noise"], rec)
                      for name, rec in recordings.items()}
     raw_path = run_raw_path(n_cells, progress=progress) if raw else None
-    out.mkdir(parents=True, exist_ok=True)
-    write_json(metrics, out / "metrics.json", force=force)
-    write_json(noise_trained, out / "noise_trained.json", force=force)
-    if raw_path is not None:
-        write_json(raw_path, out / "raw_path.json", force=force)
     config = {"hystkit_version": __version__, "n_cells": n_cells, "mode": "direct",
               "center": comp.center, "fit_seed": FIT_SEED, "validation_seed": VALIDATION_SEED,
               "sensor": "VirtualSensor() defaults", "seconds": time.perf_counter() - t_start}
-    write_json(config, out / "config.json", force=force)
-    # check_output_path has vetted these two; savefig has no overwrite guard of its own
-    plot_loops(shown).savefig(out / "loops.png", dpi=110)
-    plot_time_series(shown).savefig(out / "time_series.png", dpi=110)
+    with atomic_folder(out, force, names) as tmp:
+        write_json(metrics, tmp / "metrics.json")
+        write_json(noise_trained, tmp / "noise_trained.json")
+        if raw_path is not None:
+            write_json(raw_path, tmp / "raw_path.json")
+        write_json(config, tmp / "config.json")
+        plot_loops(shown).savefig(tmp / "loops.png", dpi=110)
+        plot_time_series(shown).savefig(tmp / "time_series.png", dpi=110)
     result = {"metrics": metrics, "noise_trained": noise_trained, "config": config}
     return result if raw_path is None else {**result, "raw_path": raw_path}
 
