@@ -42,6 +42,8 @@ MODES = ("direct", "inverse")
 # on either side, an estimate beyond this share of the training position range.
 SENSOR_MARGIN = 0.05
 POSITION_MARGIN = 0.10
+# An estimate beyond this many times the (normalised, max |.| = 1) training positions is refused.
+MAX_NORMALISED = 1e6
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,7 +54,8 @@ class Compensator:
     dataclasses. ``polarity`` (+1 or -1) multiplies the offset-free sensor so that it rises with
     position. ``sensor_reference`` is the training data's sensor level for ``tare`` / ``track``;
     ``rest_position`` [mm] the training position during the tare window; ``position_range``
-    [mm] the training position range (use-time guard).
+    [mm] the training position range (use-time guard). ``source`` names the model file it
+    was loaded from (for messages; not saved).
     """
 
     structure: Any
@@ -70,6 +73,7 @@ class Compensator:
     sensor_reference: float = 0.0
     rest_position: float | None = None
     position_range: tuple[float, float] | None = None
+    source: str | None = field(default=None, compare=False)
 
     @property
     def family(self) -> Family:
@@ -162,15 +166,25 @@ class Compensator:
         self.check_sampling(recording)
         s = self.normalised_sensor(recording.sensor)
         run = self.family.simulate if self.mode == "direct" else self.family.invert
-        p, _ = run(self.structure, self.params, s)
-        estimate = p * self.scaling.position_scale + self.position_offset(position_mean,
-                                                                           rest_position)
-        bad = np.flatnonzero(~np.isfinite(estimate))
+        with np.errstate(over="ignore", invalid="ignore"):
+            p, _ = run(self.structure, self.params, s)
+            estimate = p * self.scaling.position_scale + self.position_offset(position_mean,
+                                                                               rest_position)
+        # Normalised data have |p| <= 1 in training; MAX_NORMALISED times that is no position
+        # estimate but a model that ran away (and would overflow every score).
+        bad = np.flatnonzero(~(np.abs(np.asarray(p, dtype=float)) <= MAX_NORMALISED)
+                             | ~np.isfinite(estimate))
         if bad.size:
+            kind = "not finite" if not np.isfinite(estimate[bad[0]]) else (
+                f"{estimate[bad[0]]:.3g} mm, beyond {MAX_NORMALISED:g} times the training range")
             raise FitDivergedError(
                 f"{recording.source}: column 'sensor', sample {bad[0]}: the {self.model} "
-                f"compensator's estimate is not finite there ({bad.size} such samples)")
+                f"compensator{self._from()} gives an estimate that is {kind} "
+                f"({bad.size} such samples)")
         return estimate
+
+    def _from(self) -> str:
+        return "" if self.source is None else f" of {self.source}"
 
     def estimate_linear(self, recording: Recording, position_mean: float | None = None, *,
                         rest_position: float | None = None) -> np.ndarray:

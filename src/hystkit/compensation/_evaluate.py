@@ -52,7 +52,8 @@ def evaluate(compensator: Compensator, recording: Recording, *,
         with a ``linear_`` prefix for the straight line; the same with an ``_oracle`` suffix
         under the paper's protocol (``center_oracle``); ``sensor_loop_area``, ``n_samples``,
         ``extrapolated_fraction``, ``n_sensor_outside`` / ``n_estimate_outside`` (use-time
-        guards, None if the model file predates them) with their margins.
+        guards, None if the model file predates them) with their margins. Every number is
+        finite; a score that is undefined or overflowed is None.
     """
     if not recording.has_position():
         raise InputError(f"{recording.source}: column 'position' is needed to evaluate")
@@ -67,7 +68,10 @@ def evaluate(compensator: Compensator, recording: Recording, *,
         line = comp.estimate_linear(recording, mean, rest_position=rest_position)
         estimate = guess if estimate is None else estimate
         for prefix, values in (("", guess), ("linear_", line)):
-            for key, value in _scores(position, values, scale, recording.fs).items():
+            # a score that overflows (degenerate recording) becomes None below, not a warning
+            with np.errstate(all="ignore"):
+                found = _scores(position, values, scale, recording.fs)
+            for key, value in found.items():
                 scores[f"{prefix}{key}{suffix}"] = value
     scores["sensor_loop_area"] = _loop_area_or_none(position, recording.sensor)
     flags = use_flags(compensator, recording, estimate)
@@ -75,7 +79,15 @@ def evaluate(compensator: Compensator, recording: Recording, *,
     for name, mask in flags.items():
         scores[f"n_{name}"] = None if mask is None else int(np.sum(mask))
     scores["sensor_margin"], scores["position_margin"] = SENSOR_MARGIN, POSITION_MARGIN
-    return scores
+    return {key: _finite_or_none(value) for key, value in scores.items()}
+
+
+def _finite_or_none(value: object) -> object:
+    """A score that overflowed (a degenerate recording, a huge line) is undefined: None, which
+    JSON can hold, instead of inf/NaN, which it cannot."""
+    if isinstance(value, float | np.floating):
+        return float(value) if np.isfinite(value) else None
+    return value
 
 
 def _loop_area_or_none(x: np.ndarray, y: np.ndarray) -> float | None:

@@ -10,8 +10,10 @@ each recording's own sensor mean: it is an oracle (not causal) and is labelled s
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
+from typing import Any
 
 from .. import __version__
 from ..errors import InputError
@@ -20,6 +22,7 @@ from ..models import FAMILIES
 from ._centring import CENTERS
 from ._compensator import MODES, Compensator
 from ._conventions import LinearBaseline, Scaling
+from ._model_checks import MAX_MODEL_BYTES, check_like, check_model_dict, key_in_message
 
 __all__ = [
     "SCHEMA",
@@ -63,36 +66,79 @@ def compensator_to_dict(comp: Compensator) -> dict:
 
 
 def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
-    """Inverse of :func:`compensator_to_dict`; InputError names what is wrong."""
+    """Inverse of :func:`compensator_to_dict`; InputError names what is wrong and where.
+
+    Every value is checked (type, finiteness, size; :func:`check_model_dict`) before the
+    family sees it, and whatever the family's own validation raises becomes an InputError
+    naming the key path (``params.a``): a model file is untrusted input.
+    """
     if not isinstance(d, dict) or d.get("schema") != SCHEMA:
         found = d.get("schema") if isinstance(d, dict) else type(d).__name__
         raise InputError(f"{source}: not a hystkit compensator file (schema {found!r}, "
                          f"expected {SCHEMA!r})")
-    if d.get("schema_version") != SCHEMA_VERSION:
-        raise InputError(f"{source}: schema_version {d.get('schema_version')!r} is not supported "
-                         f"(this hystkit reads version {SCHEMA_VERSION})")
+    version = d.get("schema_version")
+    if version != SCHEMA_VERSION:
+        newer = (isinstance(version, int | float) and not isinstance(version, bool)
+                 and version > SCHEMA_VERSION)
+        raise InputError(f"{source}: key 'schema_version': {version!r} is not supported (this "
+                         f"hystkit reads version {SCHEMA_VERSION}"
+                         + ("; the file was written by a newer hystkit)" if newer else ")"))
+    missing = [k for k in ("model", "mode", "center", "structure", "params", "normalisation",
+                           "baseline") if k not in d]
+    if missing:
+        raise InputError(f"{source}: key {missing[0]!r} is missing")
+    check_model_dict(d, source)
+    if d["model"] not in FAMILIES:
+        raise InputError(f"{source}: key 'model': {d['model']!r} is not a known model "
+                         f"({', '.join(sorted(FAMILIES))})")
+    for key, known in (("mode", MODES), ("center", CENTERS)):
+        if d[key] not in known:
+            raise InputError(f"{source}: key {key!r}: unknown value {d[key]!r} "
+                             f"({', '.join(known)})")
+    family = FAMILIES[d["model"]]
+    check_like(source, "structure", d["structure"],
+               family.make_structure(1.0, family.default_size).to_dict())
+    structure = _build(source, "structure", {name: "structure" for name in d["structure"]},
+                       lambda: family.structure_type(**d["structure"]))
+    params = _build(source, "params", {name: "params" for name in d["params"]},
+                    lambda: family.params_type.from_dict(d["params"]))
+    # The compensator runs the model on two samples: structure and params must fit together.
+    return _build(source, "params", _sections(d), lambda: Compensator(
+        structure=structure, params=params, mode=d["mode"], center=d["center"],
+        scaling=Scaling(**d["normalisation"]), baseline=LinearBaseline(**d["baseline"]),
+        fit_info=d.get("fit") or {}, training_range=_pair_or_none(d.get("training_range")),
+        position_range=_pair_or_none(d.get("position_range")), model=d["model"],
+        source=source, **_optional(d)))
+
+
+def _sections(d: dict) -> dict[str, str]:
+    """Field name -> its section, to name the key path of a compensator-level error."""
+    sections = {}
+    for section in ("baseline", "normalisation", "structure", "params"):
+        sections.update({name: section for name in d[section]})
+    return sections
+
+
+def _build(source: str, section: str, sections: dict[str, str],
+           make: Callable[[], Any]) -> Any:
+    """Run a family's (or the compensator's) constructor on checked values; whatever it
+    raises becomes an InputError naming the key path (``section.field`` when the message
+    names a field of `sections`, else `section`)."""
     try:
-        if d["model"] not in FAMILIES:
-            raise InputError(f"{source}: key 'model': {d['model']!r} is not a known model "
-                             f"({', '.join(sorted(FAMILIES))})")
-        if d["mode"] not in MODES or d["center"] not in CENTERS:
-            raise InputError(f"{source}: key 'mode'/'center': unknown value "
-                             f"{d['mode']!r}/{d['center']!r}")
-        family = FAMILIES[d["model"]]
-        return Compensator(structure=family.structure_type(**d["structure"]),
-                           params=family.params_type.from_dict(d["params"]), mode=d["mode"],
-                           center=d["center"], scaling=Scaling(**d["normalisation"]),
-                           baseline=LinearBaseline(**d["baseline"]), fit_info=d.get("fit", {}),
-                           training_range=_pair_or_none(d.get("training_range")),
-                           position_range=_pair_or_none(d.get("position_range")),
-                           model=d["model"], **_optional(d))
-    except KeyError as exc:
-        raise InputError(f"{source}: key {exc.args[0]!r} is missing") from None
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{source}: invalid model contents ({exc})") from None
+        return make()
+    except InputError:
+        raise
+    except KeyError as exc:  # Record.from_dict: "Params needs a, b"
+        detail = exc.args[0] if exc.args else exc
+        raise InputError(f"{source}: key {section!r}: {detail} (missing key)") from None
+    except Exception as exc:  # noqa: BLE001 -- untrusted file: whatever a family's code raises
+        message = str(exc) or type(exc).__name__
+        name = key_in_message(message, sections)
+        path = section if name is None else f"{sections[name]}.{name}"
+        raise InputError(f"{source}: key {path!r}: {message}") from None
 
 
-def _pair_or_none(value) -> tuple | None:
+def _pair_or_none(value: list | None) -> tuple | None:
     return None if value is None else tuple(value)
 
 
@@ -108,9 +154,23 @@ def save_compensator(comp: Compensator, path: str | Path, *, force: bool = False
 
 
 def load_compensator(path: str | Path) -> Compensator:
-    """Read a model file written by :func:`save_compensator`."""
+    """Read a model file written by :func:`save_compensator`.
+
+    Raises
+    ------
+    InputError
+        For any problem with the file (missing, a folder, binary, larger than
+        ``MAX_MODEL_BYTES``, not JSON, nested too deeply) or its contents (see
+        :func:`compensator_from_dict`), naming the file and the key path.
+    """
     path = Path(path)
     try:
+        if path.is_dir():
+            raise InputError(f"{path}: is a folder, not a model file")
+        size = path.stat().st_size
+        if size > MAX_MODEL_BYTES:
+            raise InputError(f"{path}: {size} bytes, larger than any model file "
+                             f"(limit {MAX_MODEL_BYTES}); is this a model file?")
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise InputError(f"{path}: file not found") from None
@@ -120,4 +180,6 @@ def load_compensator(path: str | Path) -> Compensator:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise InputError(f"{path}: not JSON (line {exc.lineno}: {exc.msg})") from None
+    except RecursionError:
+        raise InputError(f"{path}: not a model file (JSON nested too deeply)") from None
     return compensator_from_dict(data, source=str(path))
