@@ -28,13 +28,14 @@ from ...identification import FitResult, fit_multistart
 from . import kernels
 from . import model as boucwen
 
-__all__ = ["fit_boucwen", "fit_family", "parameter_bounds"]
+__all__ = ["MIN_SAMPLES", "fit_boucwen", "fit_family", "parameter_bounds"]
 
 _ZETA_BOUNDS = (1e-4, 10.0)
 _LOGIT_R_BOUND = 9.0  # r = alpha / K0 in [1.2e-4, 1 - 1.2e-4]
 _NU_BOUNDS = (1.0, 4.0)
 _SHAPE_BOUND = 1e3  # |beta|, |gamma| <= 1e3 / y_ref: loops far sharper than the record resolves
 _PENALTY = 1e3  # residual of a diverged run, in units of max |y|
+MIN_SAMPLES = 8  # more samples than the 7 parameters
 
 
 def _reference_amplitude(y: np.ndarray) -> float:
@@ -136,6 +137,9 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
 
     Raises
     ------
+    ValueError
+        If the data are too short to identify the model: fewer than ``MIN_SAMPLES`` (8)
+        samples, a constant output, or a record shorter than one cycle at ``1 / h``.
     FitDivergedError
         If no start gives a finite, non-diverged fit, or every candidate is vetoed.
     """
@@ -152,8 +156,17 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
     y_scale = float(np.max(np.abs(y)))
     if y_scale == 0 or not np.any(u):
         raise ValueError("u and y must not be all zero")
+    if n_out < MIN_SAMPLES or np.ptp(y) == 0:
+        raise ValueError(f"a Bouc-Wen fit needs at least {MIN_SAMPLES} samples (it has 7 "
+                         f"parameters) and a varying output, got {n_out} samples with "
+                         f"max - min = {np.ptp(y):.3g}")
     lower, upper = parameter_bounds(structure, u[::stride][discard:], y,
                                     u.size * structure.dt, bounded)
+    if not (np.all(np.isfinite(lower)) and np.all(np.isfinite(upper))
+            and np.all(lower < upper)):
+        raise ValueError(f"the record is too short to fit a Bouc-Wen model: its "
+                         f"{u.size * structure.dt:.3g} s do not span one cycle at the fastest "
+                         f"natural frequency 1 / h = {1 / structure.step_size:.3g} rad/s")
     bound = _PENALTY * y_scale
     penalty = np.full(y.size, bound)
     linear = structure.input_hold == "linear"

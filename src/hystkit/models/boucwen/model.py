@@ -60,10 +60,14 @@ from . import kernels
 __all__ = [
     "BENCHMARK_PARAMS",
     "HOLDS",
+    "MAX_NU",
+    "MAX_SUBSTEPS",
     "STARTS",
     "BoucWenParams",
     "BoucWenStructure",
     "bandlimited_upsample",
+    "bounded_class",
+    "divergence_bound",
     "initial_state",
     "rest_state",
     "simulate",
@@ -74,6 +78,9 @@ __all__ = [
 
 HOLDS = ("linear", "zoh")
 STARTS = ("rest", "equilibrium")
+MAX_SUBSTEPS = 2048  # RK4 steps a sample; the cost at the cap is in BoucWenStructure
+MAX_NU = 8.0  # the fit's nu is <= 4; beyond 8, |z|^nu overflows for |z| > 1e38
+RK4_LIMIT = 2.785  # RK4 is stable on the imaginary axis up to |lambda h| = 2 sqrt(2)
 
 
 @dataclass(frozen=True)
@@ -85,7 +92,9 @@ class BoucWenStructure(Record):
     dt : float
         Sample time of the input and output sequences [s].
     substeps : int
-        RK4 steps per sample (>= 1); the integration step is ``dt / substeps``.
+        RK4 steps per sample, ``1 <= substeps <= MAX_SUBSTEPS`` (2048: 57 ns a step, 0.12 ms a
+        sample, 2 min for a million samples at ``nu = 1``, 4x that otherwise; no memory);
+        the integration step is ``dt / substeps``.
     input_hold : {"linear", "zoh"}
         Force between samples: linear interpolation (first-order hold) or zero-order hold.
     start : {"rest", "equilibrium"}
@@ -99,8 +108,15 @@ class BoucWenStructure(Record):
 
     def __post_init__(self) -> None:
         check_dt(self.dt)
-        if int(self.substeps) != self.substeps or self.substeps < 1:
-            raise ValueError(f"substeps must be a positive integer, got {self.substeps!r}")
+        # Checked before anything loops over it: a model file may say 1e12 (or inf).
+        try:
+            whole = int(self.substeps) == self.substeps
+        except (TypeError, ValueError, OverflowError):
+            whole = False
+        if not whole or not 1 <= self.substeps <= MAX_SUBSTEPS:
+            raise ValueError(f"substeps must be an integer in [1, {MAX_SUBSTEPS}], "
+                             f"got {self.substeps!r}")
+        object.__setattr__(self, "substeps", int(self.substeps))
         if self.input_hold not in HOLDS:
             raise ValueError(f"input_hold must be one of {HOLDS}, got {self.input_hold!r}")
         if self.start not in STARTS:
@@ -125,7 +141,9 @@ class BoucWenParams(Record):
     beta, gamma : float
         Shape of the hysteresis (any sign) [m^-1 N^(1 - nu)].
     nu : float
-        Sharpness of the transition (>= 1, which keeps the right-hand side Lipschitz).
+        Sharpness of the transition, ``1 <= nu <= MAX_NU`` (8): ``>= 1`` keeps the right-hand
+        side Lipschitz, the cap keeps ``|z|^nu`` finite for ``|z| < 1e38`` (the fit's nu is at
+        most 4).
 
     Notes
     -----
@@ -163,8 +181,8 @@ class BoucWenParams(Record):
         for name in ("m", "c", "k", "alpha"):
             if getattr(self, name) <= 0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
-        if self.nu < 1:
-            raise ValueError(f"nu must be >= 1, got {self.nu}")
+        if not 1 <= self.nu <= MAX_NU:
+            raise ValueError(f"nu must lie in [1, {MAX_NU:g}], got {self.nu}")
 
     @classmethod
     def from_benchmark(cls, m: float, c: float, k: float, alpha: float, beta: float,
@@ -261,7 +279,8 @@ def initial_state(structure: BoucWenStructure, params: BoucWenParams,
     """``(y, y', z, u0)`` at the first sample of a run without ``x0`` (``structure.start``)."""
     if structure.start == "rest":
         return np.array([0.0, 0.0, 0.0, u0])
-    y0 = u0 / params.k0
+    with np.errstate(over="ignore"):  # a tiny K0 overflows; simulate_states reports it
+        y0 = np.float64(u0) / params.k0
     return np.array([y0, 0.0, params.alpha * y0, u0])
 
 
@@ -314,19 +333,71 @@ def simulate_states(structure: BoucWenStructure, params: BoucWenParams, u: np.nd
     Raises
     ------
     FitDivergedError
-        If the integration leaves the finite range (RK4 step too long for the parameters).
+        If the integration diverges (:func:`divergence_bound`): the message names the sample
+        and the likely cause (RK4 step too long, or a loop outside the bounded class).
     """
     u = check_signal(u, "u")
     x, fresh = _initial_state(structure, params, x0, u[0])
+    if not np.all(np.isfinite(x)):
+        raise FitDivergedError(f"the Bouc-Wen state diverged at sample 1 of {u.size}: the "
+                               f"start (y, y', z) = {tuple(x[:3].tolist())} overflows "
+                               f"(u[0] / K0 with K0 = {params.k0:.3g})")
+    bound = divergence_bound(structure, params, x, u)
     states, x_end, n_bad = kernels.simulate(u, x, fresh, params.as_array(), structure.dt,
                                             structure.substeps,
-                                            structure.input_hold == "linear", np.inf)
+                                            structure.input_hold == "linear", bound)
     if n_bad >= 0:
-        raise FitDivergedError(
-            f"the Bouc-Wen integration diverged at sample {n_bad} of {u.size}: the RK4 step "
-            f"{structure.step_size:.3g} s is too long for w0 = {params.omega0:.3g} rad/s; "
-            f"use more substeps")
+        raise FitDivergedError(_divergence_message(structure, params, x_end, n_bad, u.size,
+                                                   bound))
     return states, x_end
+
+
+def bounded_class(params: BoucWenParams) -> bool:
+    """``beta + gamma >= 0`` and ``beta - gamma >= 0``: ``z`` stays bounded, loops dissipate."""
+    return params.beta + params.gamma >= 0 and params.beta - params.gamma >= 0
+
+
+def divergence_bound(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
+                     u: np.ndarray) -> float:
+    """A bound on ``|y|`` that the exact solution cannot exceed over a run of ``u`` from ``x``.
+
+    In the bounded class the element is passive: with ``E = m v^2 / 2 + k y^2 / 2 +
+    z^2 / (2 alpha)``, ``dE/dt = u v - c v^2 - |v| |z|^(nu+1) (beta + gamma sign(v z)) / alpha
+    <= u^2 / (4 c)``, so ``|y| <= sqrt(2 (E_0 + T max u^2 / (4 c)) / k)`` over the run's
+    duration ``T``. Twice that (room for the integration error) is returned; an RK4 run beyond
+    it has diverged numerically. Outside the class ``z`` may grow without limit and the bound
+    is ``inf`` (only a non-finite state stops the run).
+    """
+    if not bounded_class(params):
+        return np.inf
+    y0, v0, z0, u_prev = np.asarray(x, dtype=np.float64)  # numpy floats overflow to inf
+    with np.errstate(over="ignore", invalid="ignore"):
+        energy = 0.5 * params.m * v0**2 + 0.5 * params.k * y0**2 + z0**2 / (2 * params.alpha)
+        u_max = max(float(np.max(np.abs(u))), abs(u_prev))
+        energy += u.size * structure.dt * u_max**2 / (4 * params.c)
+        return float(2.0 * np.sqrt(2.0 * energy / params.k))
+
+
+def _divergence_message(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
+                        n_bad: int, n: int, bound: float) -> str:
+    """What happened (the state at the sample it diverged) and the likely cause."""
+    w0h = params.omega0 * structure.step_size
+    state = f"(y, y', z) = ({x[0]:.3g}, {x[1]:.3g}, {x[2]:.3g})"
+    what = (f"the Bouc-Wen state diverged at sample {n_bad + 1} of {n}: {state}"
+            + ("" if np.isinf(bound) else f", beyond the energy bound |y| <= {bound:.3g}"))
+    if w0h > RK4_LIMIT:
+        cause = (f"the RK4 step {structure.step_size:.3g} s is too long for w0 = "
+                 f"{params.omega0:.3g} rad/s (w0 h = {w0h:.3g} > {RK4_LIMIT}); use more "
+                 f"substeps")
+    elif not bounded_class(params):
+        cause = (f"beta + gamma = {params.beta + params.gamma:.3g} and beta - gamma = "
+                 f"{params.beta - params.gamma:.3g} are not both >= 0, so the hysteretic force "
+                 f"z is not bounded")
+    else:
+        cause = (f"w0 h = {w0h:.3g} is within RK4's limit, so the hysteretic element (beta, "
+                 f"gamma, nu = {params.beta:.3g}, {params.gamma:.3g}, {params.nu:.3g}) is too "
+                 f"stiff for the RK4 step {structure.step_size:.3g} s; use more substeps")
+    return f"{what}; {cause}"
 
 
 def simulate(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
