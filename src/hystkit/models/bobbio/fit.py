@@ -45,7 +45,10 @@ def _solve(u: np.ndarray, y: np.ndarray, structure: bobbio.BobbioStructure,
     # the offset is free: eliminate it by centring, then solve the non-negative part
     mean_x, mean_y = design.mean(axis=0), y.mean()
     c, _ = nnls(design - mean_x, y - mean_y)
-    params = bobbio.BobbioParams(compliance=c, friction=a, offset=mean_y - mean_x @ c)
+    offset = mean_y - mean_x @ c
+    if max(float(np.max(c)), abs(offset)) > bobbio.MAX_VALUE:  # outside the bounded domain
+        return None, np.inf
+    params = bobbio.BobbioParams(compliance=c, friction=a, offset=offset)
     resid = design @ c + params.offset - y
     return params, float(resid @ resid)
 
@@ -67,21 +70,30 @@ def fit_bobbio(u: np.ndarray, y: np.ndarray, structure: bobbio.BobbioStructure, 
 
     Raises
     ------
+    ValueError
+        If there are no more samples than parameters (``2 N``).
     FitDivergedError
-        If every candidate is vetoed.
+        If every candidate is vetoed or leaves the parameter domain (``MAX_VALUE``).
     """
     t_start = time.perf_counter()
     u, y = check_fit_data(u, y)
+    if u.size <= structure.n_params:
+        raise ValueError(f"a Bobbio-Marrucci fit with {structure.n_springs} springs needs more "
+                         f"samples than its {structure.n_params} parameters, got {u.size}")
     sets = candidate_thresholds(structure, u) if thresholds is None else thresholds
     fits = sorted((_solve(u, y, structure, np.asarray(a, dtype=float)) for a in sets),
                   key=lambda fit: fit[1])
     for n_rejected, (params, cost) in enumerate(fits):
+        if params is None:  # only out-of-domain candidates are left
+            break
         if accept is None or accept(params):
             return FitResult(structure=structure, params=params, cost=cost,
                              n_evaluations=len(sets), seconds=time.perf_counter() - t_start,
                              converged=True, message=f"best of {len(sets)} threshold sets "
                              f"({n_rejected} better ones rejected), non-negative least "
                              f"squares per set", n_starts=len(sets))
+    reason = accept_reason if fits[0][0] is not None else (
+        f"their compliances or offset exceed {bobbio.MAX_VALUE:g}")
     raise FitDivergedError(f"the fit failed: all {len(fits)} candidate fits were rejected "
-                           f"({accept_reason})")
+                           f"({reason})")
 

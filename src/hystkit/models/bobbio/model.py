@@ -38,6 +38,7 @@ from ...errors import FitDivergedError
 from .._protocol import Record
 from .._validation import (
     check_dt,
+    check_finite_run,
     check_positive_int,
     check_signal,
     check_size,
@@ -49,16 +50,23 @@ from .._validation import (
 from . import kernels
 
 __all__ = [
+    "MAX_SPRINGS",
+    "MAX_VALUE",
     "BobbioParams",
     "BobbioStructure",
     "forces",
     "invert",
     "invert_step",
+    "output_bound",
     "rest_state",
     "simulate",
     "simulate_reference",
     "step",
 ]
+
+
+MAX_SPRINGS = 1000  # simulate and fit hold n x (N - 1) forces: 8 kB a sample at the cap
+MAX_VALUE = 1e6  # compliances, thresholds and |offset| in normalised units (fit: <= ~10)
 
 
 @dataclass(frozen=True)
@@ -68,7 +76,9 @@ class BobbioStructure(Record):
     Parameters
     ----------
     n_springs : int
-        Springs ``N`` (>= 1); there are ``N - 1`` pistons.
+        Springs ``N``, ``1 <= N <= MAX_SPRINGS`` (1000: ``simulate`` and the fit hold the
+        ``N - 1`` spring forces of every sample, 8 kB a sample, 8 GB a million samples, at
+        the cap); there are ``N - 1`` pistons.
     dt : float
         Sample time [s]; the model is rate-independent and does not use it.
     """
@@ -77,6 +87,10 @@ class BobbioStructure(Record):
     dt: float = 0.025
 
     def __post_init__(self) -> None:
+        # the cap first: nothing is allocated or looped over before it holds (inf, 1e12)
+        if not (isinstance(self.n_springs, int | float) and self.n_springs <= MAX_SPRINGS):
+            raise ValueError(f"n_springs must be an integer in [1, {MAX_SPRINGS}], got "
+                             f"{self.n_springs!r}")
         check_positive_int(self.n_springs, "n_springs")
         check_dt(self.dt)
 
@@ -92,11 +106,20 @@ class BobbioParams(Record):
     Parameters
     ----------
     compliance : array, shape (N,)
-        ``c_k = 1 / k_k`` (>= 0; 0 is a rigid spring) [output units per input unit].
+        ``c_k = 1 / k_k`` in ``[0, MAX_VALUE]`` (0 is a rigid spring) [output units per input
+        unit].
     friction : array, shape (N - 1,)
-        Piston thresholds ``a_k`` (> 0) [input units], eq. 2.5.
+        Piston thresholds ``a_k`` in ``(0, MAX_VALUE]`` [input units], eq. 2.5.
     offset : float
-        Output offset ``b``.
+        Output offset ``b``, ``|b| <= MAX_VALUE``.
+
+    Notes
+    -----
+    The domain (``MAX_VALUE = 1e6``, normalised units; the fit's values are below ~10) keeps
+    every run finite and bounded: each spring force is a play of the input, so
+    ``|y| <= sum(c) max(|u|, |x0|) + |b|`` (:func:`output_bound`). The inverse divides by
+    the compliances that move, so tiny ones give huge forces: it returns finite values or
+    raises ``FitDivergedError``.
     """
 
     compliance: np.ndarray
@@ -113,11 +136,23 @@ class BobbioParams(Record):
             raise ValueError("compliance must be >= 0 (springs have positive stiffness)")
         if np.any(self.friction <= 0):
             raise ValueError("friction thresholds a_k must be positive (eq. 2.5)")
+        for name, values in (("compliance", self.compliance), ("friction", self.friction),
+                             ("offset", np.abs(self.offset))):
+            if np.any(values > MAX_VALUE):
+                raise ValueError(f"{name} must be at most {MAX_VALUE:g} in magnitude (the "
+                                 f"domain where runs stay bounded), got "
+                                 f"{float(np.max(values)):g}")
 
     @property
     def radii(self) -> np.ndarray:
         """Play radii ``A_k = a_1 + .. + a_k-1`` of the forces ``F_2 .. F_N``."""
         return np.cumsum(self.friction)
+
+
+def output_bound(params: BobbioParams, u_max: float) -> float:
+    """``sum(c) u_max + |b|``: no output of a run whose inputs and initial forces stay within
+    ``u_max`` in magnitude exceeds it (every spring force is a play of the input)."""
+    return float(params.compliance.sum() * u_max + abs(params.offset))
 
 
 def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
@@ -194,7 +229,9 @@ def simulate(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
     """
     f, x_end = forces(structure, params, u, x0)
     u = np.asarray(u, dtype=float)
-    return params.compliance[0] * u + f @ params.compliance[1:] + params.offset, x_end
+    with np.errstate(over="ignore", invalid="ignore"):  # inputs near the float range
+        y = params.compliance[0] * u + f @ params.compliance[1:] + params.offset
+    return check_finite_run(y, "Bobbio-Marrucci"), x_end
 
 
 def simulate_reference(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
@@ -234,4 +271,4 @@ def invert(structure: BobbioStructure, params: BobbioParams, y: np.ndarray,
     if n_bad >= 0:
         raise FitDivergedError(f"no applied force gives the deformation at sample {n_bad} "
                                f"(all compliances are zero)")
-    return u_hat, x_end
+    return check_finite_run(u_hat, "Bobbio-Marrucci", "inverse"), x_end
