@@ -58,11 +58,16 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
 
     Raises
     ------
+    ValueError
+        If there are no more samples than parameters (``3 N + 2``).
     FitDivergedError
         If no start gives a finite cost or every candidate is vetoed.
     """
     u, y = check_fit_data(u, y)
     n = structure.n_cells
+    if u.size <= structure.n_params:
+        raise ValueError(f"a ladder fit with {n} sections needs more samples than its "
+                         f"{structure.n_params} parameters, got {u.size}")
     lower = np.tile([_BAND[0], _LOG_G_MIN], n)
     upper = np.tile([_BAND[1], np.log(ladder.conductance_limit(structure))], n)
     cache: dict = {}
@@ -78,6 +83,8 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
             design = np.column_stack([u, states, -np.ones_like(u)])
             coef = np.linalg.lstsq(design, y, rcond=None)[0]
             coef[:-1] = np.clip(coef[:-1], -_W_BOUND, _W_BOUND)
+            # V_b is free, but within the domain where runs stay bounded
+            coef[-1] = np.clip(coef[-1], -ladder.MAX_VALUE, ladder.MAX_VALUE)
             params = ladder.LadderParams(band=probe.band, conductance=probe.conductance,
                                          w=coef[:-1], v_b=coef[-1])
             cache.clear()

@@ -38,6 +38,7 @@ from ...errors import FitDivergedError
 from .._cells import CellStructure
 from .._protocol import Record
 from .._validation import (
+    check_finite_run,
     check_signal,
     check_size,
     finite_floats,
@@ -48,12 +49,15 @@ from .._validation import (
 from . import kernels
 
 __all__ = [
+    "MAX_CELLS",
+    "MAX_VALUE",
     "LadderParams",
     "LadderStructure",
     "conductance_limit",
     "effective_conductance",
     "invert",
     "invert_step",
+    "output_bound",
     "rest_state",
     "simulate",
     "simulate_reference",
@@ -62,13 +66,35 @@ __all__ = [
 ]
 
 
+MAX_CELLS = 1000  # simulate and fit hold n x N voltages: 8 kB a sample at the cap
+MAX_VALUE = 1e6  # bands, |w|, |V_b| in normalised units (fit: bands <= 1.5, |w| <= 100)
+
+
 @dataclass(frozen=True)
 class LadderStructure(CellStructure):
     """What does not get fitted (:class:`~hystkit.models._cells.CellStructure`): ``n_cells``
     ladder sections, each a PWL resistor and a capacitor; the slope cap bounds the Euler slope
-    ``dt (G_k + G_k+1)`` at a node."""
+    ``dt (G_k + G_k+1)`` at a node.
+
+    ``1 <= n_cells <= MAX_CELLS`` (1000: ``simulate`` and the fit hold every sample's node
+    voltages, 8 kB a sample, 8 GB a million samples, at the cap) and ``0 < slope_cap <= 1``:
+    the step matrix ``I - dt L`` (``L`` the ladder's conductance Laplacian) has eigenvalues
+    down to ``1 - 2 slope_cap``, so beyond 1 a long ladder of conducting resistors oscillates
+    and diverges (2 sections from 1.53, 5 from about 1.3), unlike one mPL cell.
+    """
 
     n_cells: int = 2
+
+    def __post_init__(self) -> None:
+        # the cap first: nothing is allocated or looped over before it holds (inf, 1e12)
+        if not (isinstance(self.n_cells, int | float) and self.n_cells <= MAX_CELLS):
+            raise ValueError(f"n_cells must be an integer in [1, {MAX_CELLS}], got "
+                             f"{self.n_cells!r}")
+        super().__post_init__()
+        if self.slope_cap > 1:
+            raise ValueError(f"slope_cap must lie in (0, 1] for the ladder (a node couples two "
+                             f"resistors; beyond 1 the Euler step diverges), got "
+                             f"{self.slope_cap!r}")
 
     @property
     def n_params(self) -> int:
@@ -89,6 +115,16 @@ class LadderParams(Record):
         Read-out weights ``w_0 .. w_N`` (eq. 2.18).
     v_b : float
         Bias ``V_b`` (eq. 2.18).
+
+    Notes
+    -----
+    Domain: ``0 <= E_k <= MAX_VALUE``, ``G_k > 0`` (any: the step uses it limited to
+    :func:`conductance_limit`), ``|w_k|, |V_b| <= MAX_VALUE`` (1e6, normalised units; the
+    fit's are at most 1.5 and 100). With ``slope_cap <= 1`` every node voltage stays within
+    the extremes of the input and the initial state, so
+    ``|y| <= sum |w| max(|u|, |x0|) + |V_b|`` (:func:`output_bound`). The inverse divides by
+    ``w_0`` and its stability depends on the weights: it returns finite values or raises
+    ``FitDivergedError``.
     """
 
     band: np.ndarray
@@ -106,6 +142,18 @@ class LadderParams(Record):
             raise ValueError("band (resistor dead band E_k) must be >= 0")
         if np.any(self.conductance <= 0):
             raise ValueError("conductance must be positive")
+        for name, values in (("band", self.band), ("w", np.abs(self.w)),
+                             ("v_b", np.abs(self.v_b))):
+            if np.any(values > MAX_VALUE):
+                raise ValueError(f"{name} must be at most {MAX_VALUE:g} in magnitude (the "
+                                 f"domain where runs stay bounded), got "
+                                 f"{float(np.max(values)):g}")
+
+
+def output_bound(params: LadderParams, u_max: float) -> float:
+    """``sum |w| u_max + |V_b|``: no output of a run whose inputs and initial voltages stay
+    within ``u_max`` in magnitude exceeds it (``slope_cap <= 1``: monotone Euler steps)."""
+    return float(np.abs(params.w).sum() * u_max + abs(params.v_b))
 
 
 def conductance_limit(structure: LadderStructure) -> float:
@@ -188,7 +236,9 @@ def simulate(structure: LadderStructure, params: LadderParams, u: np.ndarray,
     """
     s, x_end = states(structure, params, u, x0)
     u = np.asarray(u, dtype=float)
-    return params.w[0] * u + s @ params.w[1:] - params.v_b, x_end
+    with np.errstate(over="ignore", invalid="ignore"):  # inputs near the float range
+        y = params.w[0] * u + s @ params.w[1:] - params.v_b
+    return check_finite_run(y, "ladder"), x_end
 
 
 def simulate_reference(structure: LadderStructure, params: LadderParams, u: np.ndarray,
@@ -227,4 +277,4 @@ def invert(structure: LadderStructure, params: LadderParams, y: np.ndarray,
     if n_bad >= 0:
         raise FitDivergedError(f"the inverse ladder model diverged at sample {n_bad} of "
                                f"{y.size}; the weights make it unstable on this data")
-    return u_hat, x_end
+    return check_finite_run(u_hat, "ladder", "inverse"), x_end
