@@ -1,13 +1,22 @@
-"""Pieces shared by the subcommand modules: the one-line-error parser and option types."""
+"""Pieces shared by the subcommand modules: the one-line-error parser and option types.
+
+Every numeric option goes through a type here: finite unless infinity means something (no
+actuator limit), within a range, and sizes that allocate below a per-family maximum
+(`SIZE_LIMITS`), so a bad value is one line before any work.
+"""
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+from collections.abc import Callable
 
 from ..errors import HystkitError
 
-__all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Parser", "UsageError", "failures_exit", "positive_int", "slope_cap"]
+__all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "SIZE_LIMITS", "Parser", "UsageError", "check_size",
+           "failures_exit", "integer", "number", "positive_float", "positive_int", "size_limit",
+           "slope_cap"]
 
 # Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
 # bounds, not converged; a family failed in compare/select); 2 is kept for errors that stop a
@@ -15,6 +24,13 @@ __all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Parser", "UsageError", "failures_exit
 GUARD_EXIT = 3
 # Exit code of an internal error (a bug; BSD's EX_SOFTWARE): one line instead of a traceback.
 INTERNAL_EXIT = 70
+
+# Largest size each family accepts on the command line, unless the family states its own
+# (a ``max_size`` class attribute): beyond these a fit takes hours or its Jacobian stops being
+# solvable (mpl with 300 cells: SVD does not converge after 30 s), and staircases grow as L².
+SIZE_LIMITS = {"mpl": 50, "mpl-poly": 30, "pl": 50, "ladder": 50, "chua": 20, "bobbio": 100,
+               "boucwen": 64, "pi": 200, "preisach": 100, "gpreisach": 64}
+DEFAULT_SIZE_LIMIT = 50
 
 
 class UsageError(HystkitError):
@@ -26,21 +42,88 @@ class Parser(argparse.ArgumentParser):
         raise UsageError(f"{message} (see '{self.prog} --help')")
 
 
-def positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a positive integer, got {value}")
-    return value
+def number(low: float | None = None, high: float | None = None, *, low_open: bool = False,
+           high_open: bool = False, allow_inf: bool = False) -> Callable[[str], float]:
+    """An option type: a float in ``[low, high]`` (ends open if asked), finite unless
+    `allow_inf` (then ``inf`` is accepted beside the range)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        if math.isinf(value) and value > 0 and allow_inf:
+            return value
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+        if low is not None and (value < low or (low_open and value == low)):
+            raise argparse.ArgumentTypeError(f"must be {'>' if low_open else '>='} {low:g}, "
+                                             f"got {text}")
+        if high is not None and (value > high or (high_open and value == high)):
+            raise argparse.ArgumentTypeError(f"must be {'<' if high_open else '<='} {high:g}, "
+                                             f"got {text}")
+        return value
+
+    return parse
+
+
+def integer(low: int | None = None, high: int | None = None) -> Callable[[str], int]:
+    """An option type: a whole number (decimal digits, optional sign) in ``[low, high]``."""
+
+    def parse(text: str) -> int:
+        stripped = text.strip()
+        if not stripped.lstrip("+-").isascii() or not stripped.lstrip("+-").isdigit():
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}")
+        value = int(stripped)
+        if (low is not None and value < low) or (high is not None and value > high):
+            span = (f"in [{low}, {high}]" if low is not None and high is not None
+                    else f">= {low}" if low is not None else f"<= {high}")
+            raise argparse.ArgumentTypeError(f"must be a whole number {span}, got {text}")
+        return value
+
+    return parse
+
+
+positive_int = integer(1)
+positive_float = number(0, low_open=True)
 
 
 def slope_cap(text: str) -> float:
-    value = float(text)
-    if not 0 < value < 2:
-        raise argparse.ArgumentTypeError(f"must lie in (0, 2) for a stable Euler step "
-                                         f"(eq. 5.28), got {value}")
+    # Below 1e-3 the cap undercuts the fit's smallest conductance at usual rates: no box left.
+    value = number(1e-3, 2, high_open=True)(text)
     return value
 
 
+def size_limit(family) -> int:
+    """Largest size of `family` the CLI accepts: the family's ``max_size`` if it states one."""
+    return getattr(family, "max_size", None) or SIZE_LIMITS.get(family.name, DEFAULT_SIZE_LIMIT)
+
+
+def check_size(family_name: str, size: int | None, option: str = "--size") -> None:
+    """Refuse a model size beyond the family's limit or its own structure checks, before work.
+
+    Raises
+    ------
+    UsageError
+        One line naming the option, the family and the accepted range.
+    """
+    if size is None:
+        return
+    from ..models import get_family  # the families load only for commands with a model
+
+    family = get_family(family_name)
+    limit = size_limit(family)
+    if size > limit:
+        raise UsageError(f"{_label(option, size)}: {family_name} accepts at most {limit} "
+                         f"({family.size_help})")
+    try:
+        family.make_structure(1 / 40, size)  # the family's own checks (e.g. levels >= 2)
+    except ValueError as exc:
+        raise UsageError(f"{_label(option, size)}: {family_name}: {exc}") from None
+
+
+def _label(option: str, size: int) -> str:
+    return f"{option}{'' if option.endswith('=') else ' '}{size}"
 
 
 def failures_exit(failed: list[str], what: str = "model(s)") -> int:

@@ -10,7 +10,7 @@ from ..io import atomic_folder, check_output_folder, read_recording, write_json
 from ..models import FAMILIES
 from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
-from ._common import UsageError, failures_exit
+from ._common import UsageError, check_size, failures_exit, positive_int
 
 __all__ = ["register"]
 
@@ -27,12 +27,18 @@ def _models(text: str | None) -> list[str]:
 
 
 def _sizes(pairs: list[str]) -> dict[str, int]:
+    """``--size MODEL=N`` options; each size checked against its family's limits."""
     out = {}
     for pair in pairs:
         name, _, value = pair.partition("=")
-        if name not in FAMILIES or not value.isdigit() or int(value) < 1:
-            raise UsageError(f"--size expects MODEL=N with a known model and N >= 1, got {pair!r}")
-        out[name] = int(value)
+        try:
+            if name not in FAMILIES:
+                raise argparse.ArgumentTypeError("unknown model")
+            out[name] = positive_int(value)
+        except argparse.ArgumentTypeError:
+            raise UsageError(f"--size expects MODEL=N with a known model and N >= 1, "
+                             f"got {pair!r}") from None
+        check_size(name, out[name], f"--size {name}=")
     return out
 
 

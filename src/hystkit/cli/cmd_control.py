@@ -42,7 +42,7 @@ from ..control import (
 from ..io import atomic_folder, check_output_folder, read_recording, write_json
 from ..models import FAMILIES
 from ..signals import EXPERIMENTS as EXCITATIONS
-from ._common import UsageError, positive_int
+from ._common import UsageError, check_size, number, positive_float, positive_int
 
 __all__ = ["register"]
 
@@ -51,11 +51,26 @@ DOCUMENT_SINE = {"direct": {"e_p_max": 6.94e-4, "e_p_mean": -1.543e-4, "source":
                  "weighting": {"e_p_max": 1.86e-4, "e_p_mean": -2.29e-5, "source": "eq. 7.8"}}
 
 
-def _positive_float(text: str) -> float:
-    value = float(text)
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be positive, got {text}")
-    return value
+# PID gains (eq. 7.2): Kp > 0, Ti > 0 (inf: no integral action), Td >= 0; one type per slot.
+_PID_TYPES = (number(0, low_open=True), number(0, low_open=True, allow_inf=True), number(0))
+_TUNE_TYPES = (number(0, low_open=True), number(0, 90, low_open=True, high_open=True))
+
+
+class _Checked(argparse.Action):
+    """``nargs`` values, each parsed by its own type (argparse gives all one type)."""
+
+    def __init__(self, *args, types=(), **kwargs) -> None:
+        self.types = types
+        super().__init__(*args, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        parsed = []
+        for meta, parse, text in zip(self.metavar, self.types, values, strict=True):
+            try:
+                parsed.append(parse(text))
+            except argparse.ArgumentTypeError as exc:
+                raise UsageError(f"argument {option_string} {meta}: {exc}") from None
+        setattr(namespace, self.dest, parsed)
 
 
 def _sensor(sensor: str):
@@ -160,6 +175,8 @@ def _control(args: argparse.Namespace) -> int:
                           args.model_file, Path(args.sensor)) if x is not None]
     # refuse before any work
     check_output_folder(out, [p.name for p in paths], args.force, inputs=inputs)
+    check_size(args.sensor_model, args.sensor_size, "--sensor-size")
+    check_size(args.model, args.model_size, "--model-size")
     if args.sensor != "virtual" and args.sensor_data is not None:
         raise UsageError("--sensor-data fits S_r on a recording; it cannot be combined with "
                          f"--sensor {args.sensor}")
@@ -270,19 +287,22 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="write bode.png: the linearised open loop at rest (alone: "
                         "analysis.json)")
     p.add_argument("--dob", action="store_true", help="add the disturbance observer (sec. 7.4)")
-    p.add_argument("--dob-hz", type=_positive_float,
+    p.add_argument("--dob-hz", type=positive_float,
                    help="Q-filter bandwidth [Hz] (default: chosen by design_dob)")
-    p.add_argument("--pid", nargs=3, type=float, metavar=("KP", "TI", "TD"),
-                   help="PID gains (default: the document's for the scheme)")
-    p.add_argument("--tune", nargs=2, type=float, metavar=("FC_HZ", "PM_DEG"),
-                   help="tune the PID for this crossover and phase margin on the linearised "
-                        "loop")
-    p.add_argument("--tf", type=float, default=0.0,
+    p.add_argument("--pid", nargs=3, action=_Checked, types=_PID_TYPES,
+                   metavar=("KP", "TI", "TD"),
+                   help="PID gains: KP > 0, TI > 0 [s] (inf: no integral action), TD >= 0 [s] "
+                        "(default: the document's for the scheme)")
+    p.add_argument("--tune", nargs=2, action=_Checked, types=_TUNE_TYPES,
+                   metavar=("FC_HZ", "PM_DEG"),
+                   help="tune the PID for this crossover (> 0 Hz) and phase margin (between 0 "
+                        "and 90 deg) on the linearised loop")
+    p.add_argument("--tf", type=number(0), default=0.0,
                    help="derivative filter time constant [s] (default 0: eq. 7.2)")
     p.add_argument("--anti-windup", action="store_true",
                    help="conditional integration while the force saturates (needs --u-max)")
-    p.add_argument("--mass", type=_positive_float, default=MASS, help="moving mass [kg]")
-    p.add_argument("--u-max", type=_positive_float, default=np.inf,
+    p.add_argument("--mass", type=positive_float, default=MASS, help="moving mass [kg]")
+    p.add_argument("--u-max", type=number(0, low_open=True, allow_inf=True), default=np.inf,
                    help="actuator force limit [N] (default none)")
     p.add_argument("--sensor", default="virtual",
                    metavar="virtual|virtual-physics|table-ii-COLUMN|MODEL.json",

@@ -27,7 +27,17 @@ from ..io import check_output_path, read_recording, write_json, write_recording
 from ..models import FAMILIES, get_family
 from ..sensors import simulate_experiment
 from ..signals import EXPERIMENTS
-from ._common import GUARD_EXIT, UsageError, positive_int, slope_cap
+from ._common import (
+    GUARD_EXIT,
+    UsageError,
+    check_size,
+    integer,
+    number,
+    positive_float,
+    positive_int,
+    size_limit,
+    slope_cap,
+)
 from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_from_args
 
 __all__ = ["register"]
@@ -45,11 +55,12 @@ def _simulate_sensor(args: argparse.Namespace) -> int:
 
 
 def _fit(args: argparse.Namespace) -> int:
-    check_output_path(args.out, args.force)
+    check_output_path(args.out, args.force, inputs=args.data)
     family = get_family(args.model)
     options = {} if args.slope_cap is None else {"slope_cap": args.slope_cap}
     if options and args.model != "mpl":
         raise UsageError(f"--slope-cap applies to the mpl model only, not {args.model!r}")
+    check_size(args.model, args.cells, "--cells")
     recs = [read_recording(path) for path in args.data]
     size = family.default_size if args.cells is None else args.cells
     print(f"fitting {args.model} ({family.size_help}: {size}, {args.mode} mode, centring: "
@@ -91,7 +102,7 @@ def _print_standard_errors(se: dict | None) -> None:
 
 
 def _compensate(args: argparse.Namespace) -> int:
-    check_output_path(args.out, args.force)
+    check_output_path(args.out, args.force, inputs=[args.model, args.data])
     comp = load_compensator(args.model)
     _warn_if_oracle(comp.center, args.model)
     rec = read_recording(args.data, need_position=False)
@@ -132,7 +143,7 @@ def _warn_if_outside(flags: dict, data: Path) -> None:
 
 def _evaluate(args: argparse.Namespace) -> int:
     if args.json is not None:
-        check_output_path(args.json, args.force)
+        check_output_path(args.json, args.force, inputs=[args.model, args.data])
     comp = load_compensator(args.model)
     _warn_if_oracle(comp.center, args.model)
     rec = read_recording(args.data)
@@ -170,6 +181,7 @@ def _demo(args: argparse.Namespace) -> int:
     from ..reports import DOCUMENT_TABLE_5_5, format_table, run_demo
 
     out = args.out or Path(f"hystkit-demo-{time.strftime('%Y%m%d-%H%M%S')}")
+    check_size("mpl", args.cells, "--cells")
     print(f"hystkit demo: virtual sensor, four experiments, {args.cells}-cell mPL compensator "
           f"fitted on one recording and scored on another (direct mode, deployable centring: "
           f"{DEFAULT_CENTER}; the paper's oracle centring beside it)")
@@ -204,13 +216,6 @@ def _print_raw_path(raw: dict) -> None:
           f"encoder transitions")
 
 
-def positive_float(text: str) -> float:
-    value = float(text)
-    if not 0 < value < float("inf"):
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text}")
-    return value
-
-
 def _add_centring_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--center", choices=CENTERS, default=DEFAULT_CENTER,
                    help="sensor offset: fit = the training offsets (default); tare = the level "
@@ -227,7 +232,7 @@ def _add_centring_options(p: argparse.ArgumentParser) -> None:
 
 
 def _add_rest_position(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--rest-position", type=float, default=None,
+    p.add_argument("--rest-position", type=number(), default=None,
                    help="tare centring: position [mm] during the tare window (default: where "
                         "the device rested in training)")
 
@@ -236,7 +241,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add this module's subcommands to the ``hystkit`` parser."""
     p = sub.add_parser("simulate-sensor", help="record an experiment on the virtual sensor")
     p.add_argument("--excitation", choices=sorted(EXPERIMENTS), required=True)
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
+                   help="random seed, 0 to 2^32 - 1 (default 0)")
     p.add_argument("--out", type=Path, required=True, help="CSV or Parquet file to write")
     add_simulation_options(p)
     p.set_defaults(run=_simulate_sensor)
@@ -249,14 +255,15 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="; ".join(f"{f.name}: {f.title}" for f in FAMILIES.values()))
     p.add_argument("--cells", "--size", type=positive_int, default=None,
                    help="model size: " + "; ".join(f"{f.name}: {f.size_help} (default "
-                                                    f"{f.default_size})"
+                                                    f"{f.default_size}, at most "
+                                                    f"{size_limit(f)})"
                                                     for f in FAMILIES.values()))
     p.add_argument("--mode", choices=MODES, default="direct",
                    help="direct: fit sensor->position (paper 9.2); inverse: fit "
                         "position->sensor and invert it (paper 9.1)")
     _add_centring_options(p)
     p.add_argument("--slope-cap", type=slope_cap, default=None,
-                   help="mpl only: Euler stability cap f'·dt of the cell resistors, in (0, 2) "
+                   help="mpl only: Euler stability cap f'·dt of the cell resistors, in [0.001, 2) "
                         "(default 1)")
     p.add_argument("--out", type=Path, required=True, help="model JSON file to write")
     p.set_defaults(run=_fit)

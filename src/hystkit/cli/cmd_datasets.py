@@ -16,7 +16,7 @@ from ..datasets import (
     shared_data_status,
 )
 from ..errors import InputError
-from ..io import check_output_path, write_json, write_recording
+from ..io import atomic_outputs, check_output_path, write_json, write_recording
 
 __all__ = ["register"]
 
@@ -84,11 +84,13 @@ def _export(args: argparse.Namespace) -> int:
     if args.segment is not None:
         ds = ds.segment(args.segment)
     rec = ds.to_recording(role=args.role)
-    write_recording(rec, out, extra=dict(ds.channels), force=args.force)
     meta = {"exported_by": "hystkit datasets export", "role": args.role,
             "segment": args.segment, "excerpt": args.excerpt, "columns": ds.columns(args.role),
             "dataset": ds.metadata()}
-    write_json(meta, sidecar, force=args.force)
+    # The recording and its sidecar appear together or not at all.
+    with atomic_outputs([out, sidecar], args.force) as (data_tmp, meta_tmp):
+        write_recording(rec, data_tmp, extra=dict(ds.channels), force=True)
+        write_json(meta, meta_tmp, force=True)
     cols = ds.columns(args.role)
     print(f"wrote {out}: {ds.label}{f' segment {args.segment}' if args.segment else ''}, "
           f"{ds.n_samples} samples at {ds.fs:g} Hz")

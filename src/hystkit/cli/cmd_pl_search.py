@@ -3,32 +3,38 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 from pathlib import Path
 
 from ..io import check_output_path, read_recording, write_json
 from ..models.pl import DEFAULT_GRID, format_search_table, structural_search
+from ._common import SIZE_LIMITS, integer, number
 
 __all__ = ["register"]
 
 
-def _floats(text: str) -> tuple[float, ...]:
-    try:
-        return tuple(float(v) for v in text.split(","))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") \
-            from None
+def _list(parse: Callable[[str], float], what: str) -> Callable[[str], tuple]:
+    """An option type: comma-separated values, each checked by `parse`."""
+
+    def parse_all(text: str) -> tuple:
+        try:
+            return tuple(parse(v) for v in text.split(","))
+        except argparse.ArgumentTypeError as exc:
+            raise argparse.ArgumentTypeError(f"expected comma-separated {what}: {exc}") \
+                from None
+
+    return parse_all
 
 
-def _ints(text: str) -> tuple[int, ...]:
-    values = _floats(text)
-    if any(v != int(v) or v < 1 for v in values):
-        raise argparse.ArgumentTypeError(f"expected comma-separated positive integers, got {text!r}")
-    return tuple(int(v) for v in values)
+_cells = _list(integer(1, SIZE_LIMITS["pl"]), f"cell counts 1 to {SIZE_LIMITS['pl']}")
+_powers = _list(number(1, 100, low_open=True), "powers p in (1, 100]")
+_bases = _list(integer(1, 50), "basis counts 1 to 50")
+_smoothing = _list(number(0), "smoothing weights >= 0")
 
 
 def _search(args: argparse.Namespace) -> int:
     if args.json is not None:
-        check_output_path(args.json, args.force)
+        check_output_path(args.json, args.force, inputs=[args.data])
     rec = read_recording(args.data)
     u, y = ((rec.position, rec.sensor) if args.direction == "position-to-sensor"
             else (rec.sensor, rec.position))
@@ -52,11 +58,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("pl-search", help="exhaustive N, p, M, S search of the Power-Law model "
                                          "(sec. 2.2, table 5.1)")
     p.add_argument("data", type=Path, help="fitting recording (time, position, sensor)")
-    p.add_argument("--n", type=_ints, default=DEFAULT_GRID["n"], help="cell counts N")
-    p.add_argument("--p", type=_floats, default=DEFAULT_GRID["p"], help="powers p (> 1)")
-    p.add_argument("--m", type=_ints, default=DEFAULT_GRID["m"],
+    p.add_argument("--n", type=_cells, default=DEFAULT_GRID["n"], help="cell counts N")
+    p.add_argument("--p", type=_powers, default=DEFAULT_GRID["p"], help="powers p (> 1)")
+    p.add_argument("--m", type=_bases, default=DEFAULT_GRID["m"],
                    help="numbers M of output basis functions")
-    p.add_argument("--s", type=_floats, default=DEFAULT_GRID["s"], help="smoothing weights S")
+    p.add_argument("--s", type=_smoothing, default=DEFAULT_GRID["s"],
+                   help="smoothing weights S (>= 0)")
     p.add_argument("--direction", choices=("position-to-sensor", "sensor-to-position"),
                    default="position-to-sensor",
                    help="model the sensor (the document's toolbox, default) or a direct "

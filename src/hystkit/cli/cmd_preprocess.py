@@ -27,6 +27,7 @@ from ..io import (
 from ..preprocess import PreprocessSettings, RawDataWarning, parse_states, preprocess_raw
 from ..sensors import ScopeSettings, VirtualSensor, simulate_raw, with_asymmetry
 from ..signals import EXPERIMENTS
+from ._common import integer, number
 
 __all__ = ["add_simulation_options", "register", "run_raw_simulation", "sensor_from_args"]
 
@@ -35,31 +36,18 @@ class SettingsError(HystkitError, ValueError):
     """Options or a settings file with values preprocessing cannot use."""
 
 
-def _positive(text: str) -> float:
-    value = float(text)
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text}")
-    return value
-
-
-def _non_negative(text: str) -> float:
-    value = float(text)
-    if not value >= 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {text}")
-    return value
-
-
-def _count(text: str) -> int:
-    value = int(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got {text}")
-    return value
+_positive = number(0, low_open=True)
+_non_negative = number(0)
+_count = integer(0, 10**6)
+# Samples per chunk: below ~1000 the filters' edge handling dominates a chunk; above 2^27 a
+# chunk of float64 channels alone passes a gigabyte.
+_chunk_size = integer(1024, 2**27)
 
 
 def _levels(text: str) -> tuple[float, ...]:
     try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError:
+        values = tuple(number()(v) for v in text.split(","))
+    except argparse.ArgumentTypeError:
         raise argparse.ArgumentTypeError(f"must be four comma-separated voltages, got {text!r}")
     if len(values) != 4:
         raise argparse.ArgumentTypeError(f"must be four comma-separated voltages, got {text!r}")
@@ -83,6 +71,9 @@ _OPTIONS = ("r_bridge", "v_supply", "um_per_count", "position_offset_mm", "fs_ou
 def _settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawFormat, Path | None]:
     """Merge defaults, the settings file and the options; return what preprocessing needs."""
     config_path = args.config if args.config is not None else find_raw_config(args.raw)
+    if config_path is not None and not Path(config_path).is_file():
+        problem = "is a folder" if Path(config_path).is_dir() else "does not exist"
+        raise SettingsError(f"--config {config_path} {problem}; expected a TOML settings file")
     values: dict[str, Any] = read_raw_config(config_path) if config_path is not None else {}
     values.pop("simulation", None)
     for key in _OPTIONS:
@@ -176,12 +167,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--v-supply", type=_positive, metavar="V", help="bridge supply V0 (eq. 4.2)")
     p.add_argument("--um-per-count", type=_positive, metavar="UM",
                    help="encoder resolution (default 5; eq. 9.16 calibrates 5.1)")
-    p.add_argument("--position-offset", dest="position_offset_mm", type=float, metavar="MM",
+    p.add_argument("--position-offset", dest="position_offset_mm", type=number(), metavar="MM",
                    help="added to the position, which counts from the first sample (default 0)")
     p.add_argument("--fs-out", type=_positive, metavar="HZ", help="output rate (default 40)")
     p.add_argument("--cutoff", type=_positive, metavar="HZ",
                    help="zero-phase Butterworth cut-off (default 20, eq. 4.1)")
-    p.add_argument("--order", type=int, metavar="N", help="Butterworth order (default 2)")
+    p.add_argument("--order", type=integer(1, 10), metavar="N",
+                   help="Butterworth order, 1 to 10 (default 2)")
     p.add_argument("--fs", type=_positive, metavar="HZ",
                    help="scope sample rate: needed without a time column, checked against one")
     p.add_argument("--time-unit", choices=["s", "ms", "us", "ns"],
@@ -199,8 +191,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "and sensor")
     p.add_argument("--normalise", action="store_true",
                    help="divide position and sensor by their max |.| (eq. 5.10)")
-    p.add_argument("--chunk-size", type=int, metavar="N",
-                   help="samples per chunk (default 262144); memory grows with it")
+    p.add_argument("--chunk-size", type=_chunk_size, metavar="N",
+                   help="samples per chunk, 1024 to 2^27 (default 262144); memory grows with "
+                        "it")
     p.set_defaults(run=_preprocess)
 
 
@@ -212,13 +205,13 @@ def add_simulation_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--age-hours", type=_non_negative, metavar="H",
                    help="hours since printing: the resistance still settles (sec. 3.5.1; "
                         "default 48)")
-    p.add_argument("--asymmetry", type=float, metavar="S",
+    p.add_argument("--asymmetry", type=number(), metavar="S",
                    help="gauge symmetry 2(R1-R2)/(R1+R2) of the base resistances "
                         "(default 0.35: 22.4 / 15.7 kOhm)")
     p.add_argument("--raw", action="store_true",
                    help="write the raw scope recording (time, v1, v2, encoder) and its .toml "
                         "settings instead of the 40 Hz recording")
-    p.add_argument("--scope-rate", type=_positive, metavar="HZ",
+    p.add_argument("--scope-rate", type=number(0, 1e8, low_open=True), metavar="HZ",
                    help="raw: scope sample rate (default 1e6; the document: 1.98e6, 6.25e6)")
     p.add_argument("--duration", type=_positive, metavar="S",
                    help="raw: only the first S seconds of the experiment")

@@ -62,7 +62,8 @@ def _verdict(report: dict) -> str:
 
 def _stability(args: argparse.Namespace) -> int:
     if args.json is not None:
-        check_output_path(args.json, args.force)
+        check_output_path(args.json, args.force,
+                          inputs=[args.model] + ([args.data] if args.data else []))
     comp = load_compensator(args.model)
     family, structure = comp.family, comp.structure
     u = (_probe_input(structure.dt) if args.data is None else _model_input(comp, args.data))
