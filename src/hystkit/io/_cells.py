@@ -11,6 +11,7 @@ import pandas as pd
 from hystkit.errors import InputError
 
 COLUMNS = ("time", "position", "sensor")  # also the column order of written files
+_SHOWN_CHARS = 40  # of a bad cell in a message: a 10 MB field must not become a 10 MB line
 
 
 @dataclass(frozen=True)
@@ -72,7 +73,11 @@ def text_problems(text: pd.Series) -> tuple[np.ndarray, np.ndarray, pd.Series]:
 def cell_problem(stripped: pd.Series, i: int) -> str:
     """How to describe the bad cell `i` found by `text_problems`."""
     value = stripped.iloc[i]
-    return "empty cell" if value == "" else f"non-numeric value {value!r}"
+    if value == "":
+        return "empty cell"
+    shown = repr(value) if len(value) <= _SHOWN_CHARS else f"{value[:_SHOWN_CHARS]!r}... " \
+        f"({len(value)} characters)"
+    return f"non-numeric value {shown}"
 
 
 def parse_text(text: pd.Series, name: str, where: Where) -> np.ndarray:

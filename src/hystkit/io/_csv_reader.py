@@ -19,6 +19,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from hystkit.errors import InputError
+
 from ._cells import Where, cell_problem, pick, text_problems
 
 CHUNK_ROWS = 100_000  # text cells held at once by the second pass
@@ -112,7 +114,11 @@ def _read_text(path: Path, need_position: bool, where: Where) -> dict[str, np.nd
     return {name: np.concatenate(parts.pop(name))[:n_rows] for name in names}
 
 
-def _parse_error(exc: Exception, where: Where):
+def _parse_error(exc: Exception, where: Where) -> InputError:
+    """The InputError for a tokeniser failure, with the file line where pandas names one."""
+    quote = re.search(r"EOF inside string starting at row (\d+)", str(exc))
+    if quote is not None:  # pandas counts file lines from 0 here
+        return where.fail("a quote opened here is never closed", index=int(quote.group(1)) - 1)
     found = re.search(r"Expected (\d+) fields in line (\d+), saw (\d+)", str(exc))
     if found is None:
         detail = " ".join(str(exc).split())[:200] or type(exc).__name__

@@ -128,7 +128,12 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True) 
         raise InputError(f"{source}: not a regular file")
     if path.stat().st_size == 0:
         raise InputError(f"{source}: file is empty (0 bytes)")
-    arrays, where = _READERS[suffix](path, source, need_position)
+    try:
+        with path.open("rb"):  # permissions, a FIFO's or a device's refusal: before any parser
+            pass
+        arrays, where = _READERS[suffix](path, source, need_position)
+    except OSError as exc:  # also a disk failing halfway (EIO)
+        raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
     _validate(arrays, where)
     return Recording(arrays["time"], arrays["sensor"], arrays.get("position"), source)
 
