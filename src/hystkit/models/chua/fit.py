@@ -27,7 +27,7 @@ _DELTA = (0.0, 1.0)
 def _bounds(structure: chua.ChuaStructure) -> tuple[np.ndarray, np.ndarray]:
     # Beyond the Euler cap g is a straight line of the capped slope, so a larger G changes
     # nothing: 100 / dt is above the cap for any restoring slope >= 1e-2.
-    log_g = (np.log(1e-3), np.log(100.0 / structure.dt))
+    log_g = (np.log(1e-3), np.log(min(100.0 / structure.dt, chua.DOMAIN["g"][1])))
     per = [_LOG_SLOPE, _LOG_SLOPE, _LOG_SCALE, log_g, _LOG_VG, _DELTA]
     lower, upper = (np.tile([b[i] for b in per], structure.n_elements) for i in (0, 1))
     return lower, upper
@@ -47,7 +47,8 @@ def default_starts(structure: chua.ChuaStructure, gain: float) -> list[chua.Chua
                           0.9 * structure.slope_cap / structure.dt)
         for delta in (0.0, 0.1):
             for v_g in (0.3, 3.0):
-                starts.append(chua.ChuaParams(k0=k, k_inf=k, y_s=np.full(n, 0.5), g=rate / k,
+                g = np.clip(rate / k, *chua.DOMAIN["g"])
+                starts.append(chua.ChuaParams(k0=k, k_inf=k, y_s=np.full(n, 0.5), g=g,
                                               v_g=np.full(n, v_g), delta=np.full(n, delta)))
     return starts
 
@@ -73,14 +74,19 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
 
     Raises
     ------
+    ValueError
+        If there are no more samples than parameters (``6 N``).
     FitDivergedError
         If no start gives a finite cost or every candidate is vetoed.
     """
     u, y = check_fit_data(u, y)
     n = structure.n_elements
+    if u.size <= structure.n_params:
+        raise ValueError(f"a Chua-Stromsmoe fit with {n} elements needs more samples than its "
+                         f"{structure.n_params} parameters, got {u.size}")
     if starts is None:
         # f and g increase, so the static gain is positive; a floor keeps k finite
-        gain = max(float(np.polyfit(u, y, 1)[0]), 0.05)
+        gain = min(max(float(np.polyfit(u, y, 1)[0]), 0.05), 1e4)  # k within the domain
         starts = default_starts(structure, gain)
 
     def to_params(theta: np.ndarray) -> chua.ChuaParams:

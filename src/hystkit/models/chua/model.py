@@ -42,6 +42,7 @@ from .._protocol import Record
 from .._validation import (
     broadcast_state,
     check_cells,
+    check_finite_run,
     check_signal,
     check_size,
     freeze_arrays,
@@ -50,6 +51,8 @@ from .._validation import (
 from . import kernels
 
 __all__ = [
+    "DOMAIN",
+    "MAX_ELEMENTS",
     "ChuaParams",
     "ChuaStructure",
     "dissipation",
@@ -58,6 +61,7 @@ __all__ = [
     "invert_step",
     "kernel_args",
     "limits",
+    "output_bound",
     "rest_state",
     "restoring",
     "restoring_inverse",
@@ -67,6 +71,12 @@ __all__ = [
 ]
 
 _FIELDS = ("k0", "k_inf", "y_s", "g", "v_g", "delta")
+MAX_ELEMENTS = 100  # O(N) a sample; the fit's Jacobian holds 6 N columns: 4.8 kB a sample
+# Allowed range of each parameter (normalised units, eq. 5.10), wide around the fit's bounds
+# (slopes and scales 1e-2 .. 1e2, G 1e-3 .. 100 / dt, V_g 1e-3 .. 1e3, delta 0 .. 1): within
+# it the restoring function, its inverse and the limited sinh cannot overflow.
+DOMAIN = {"k0": (1e-6, 1e6), "k_inf": (1e-6, 1e6), "y_s": (1e-6, 1e6), "g": (1e-9, 1e12),
+          "v_g": (1e-6, 1e6), "delta": (0.0, 1e6)}
 
 
 @dataclass(frozen=True)
@@ -76,7 +86,9 @@ class ChuaStructure(Record):
     Parameters
     ----------
     n_elements : int
-        Elements in series (>= 1); 1 is eq. 2.3 itself.
+        Elements in series, ``1 <= N <= MAX_ELEMENTS`` (100: a sample costs O(N), the fit's
+        finite-difference Jacobian holds ``6 N`` columns, 4.8 kB a sample, at the cap); 1 is
+        eq. 2.3 itself.
     dt : float
         Sample time [s].
     slope_cap : float
@@ -88,6 +100,10 @@ class ChuaStructure(Record):
     slope_cap: float = 1.0
 
     def __post_init__(self) -> None:
+        # the cap first: nothing is allocated or looped over before it holds (inf, 1e12)
+        if not (isinstance(self.n_elements, int | float) and self.n_elements <= MAX_ELEMENTS):
+            raise ValueError(f"n_elements must be an integer in [1, {MAX_ELEMENTS}], got "
+                             f"{self.n_elements!r}")
         check_cells(self.n_elements, self.dt, self.slope_cap, "n_elements")
 
     @property
@@ -116,6 +132,13 @@ class ChuaParams(Record):
     Notes
     -----
     The optimiser sees ``[log k0, log k_inf, log y_s, log g, log v_g, delta]`` per element.
+
+    Domain (:data:`DOMAIN`): ``k_0, k_inf, y_s, V_g`` in ``[1e-6, 1e6]``, ``G`` in
+    ``[1e-9, 1e12]``, ``delta`` in ``[0, 1e6]``. Within it every element stays within
+    ``(max(|u|, |f(x0)|) + delta) / min(k_0, k_inf)`` of 0 (``slope_cap <= 1``: between
+    ``f^-1(min u - delta)`` and ``f^-1(max u + delta)`` or its start), times
+    ``s / (2 - s)`` for a slope cap ``s > 1`` (:func:`output_bound`). The inverse amplifies by ``1 / (dt g')``: it returns finite values
+    or raises ``FitDivergedError``.
     """
 
     k0: np.ndarray
@@ -135,6 +158,12 @@ class ChuaParams(Record):
                 raise ValueError(f"{name} must be positive (f and g strictly increasing, eq. 2.3)")
         if np.any(self.delta < 0):
             raise ValueError("delta (dead band of g) must be >= 0")
+        for name, (low, high) in DOMAIN.items():
+            values = getattr(self, name)
+            bad = values[(values < low) | (values > high)]
+            if bad.size:
+                raise ValueError(f"{name} must lie in [{low:g}, {high:g}] (the domain where "
+                                 f"runs stay bounded), got {float(bad[0]):g}")
 
     def to_vector(self) -> np.ndarray:
         cols = [np.log(getattr(self, name)) for name in _FIELDS[:5]] + [self.delta]
@@ -144,6 +173,21 @@ class ChuaParams(Record):
     def from_vector(cls, theta: np.ndarray, n_elements: int) -> ChuaParams:
         t = np.asarray(theta, dtype=float).reshape(n_elements, 6)
         return cls(*np.exp(t[:, :5]).T, delta=t[:, 5])
+
+
+def output_bound(structure: ChuaStructure, params: ChuaParams, u_max: float) -> float:
+    """``q sum_k (u_max + delta_k) / min(k_0, k_inf)_k`` with ``q = max(1, s / (2 - s))``,
+    ``s`` the slope cap: no output of a run whose inputs, and the restoring forces
+    ``f_k(x0_k)`` of its start, stay within ``u_max`` in magnitude exceeds it.
+
+    Each element's band of equilibria lies within ``E_k = (u_max + delta_k) / min(k_0,
+    k_inf)`` of 0 (``|f^-1(v)| <= |v| / min(k_0, k_inf)``), and a step multiplies the distance
+    to it by ``1 - dt g' f'`` in ``[1 - s, 1]``: no overshoot for ``s <= 1``; beyond, an
+    overshoot of at most ``s - 1`` times the distance, whose worst alternation settles at
+    ``s E_k / (2 - s)``.
+    """
+    q = max(1.0, structure.slope_cap / (2.0 - structure.slope_cap))
+    return float(q * np.sum((u_max + params.delta) / np.minimum(params.k0, params.k_inf)))
 
 
 def limits(structure: ChuaStructure, params: ChuaParams) -> tuple[np.ndarray, np.ndarray]:
@@ -288,7 +332,8 @@ def simulate(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
     """
     u = _check(structure, params, u, "u")
     x = _initial_state(structure, params, x0, u[0])
-    return kernels.simulate(u, x, *kernel_args(structure, params))
+    y, x_end = kernels.simulate(u, x, *kernel_args(structure, params))
+    return check_finite_run(y, "Chua-Stromsmoe"), x_end
 
 
 def simulate_reference(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
@@ -329,4 +374,4 @@ def invert(structure: ChuaStructure, params: ChuaParams, y: np.ndarray,
     if n_bad >= 0:
         raise FitDivergedError(f"the inverse Chua-Stromsmoe model diverged at sample {n_bad} "
                                f"of {y.size}")
-    return u_hat, x_end
+    return check_finite_run(u_hat, "Chua-Stromsmoe", "inverse"), x_end
