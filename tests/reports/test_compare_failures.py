@@ -31,7 +31,7 @@ def broken_chua(monkeypatch):
 
         return SimpleNamespace(**{k: getattr(family, k) for k in (
             "name", "title", "default_size", "size_help", "make_structure", "simulate",
-            "invert", "no_inverse_reason")}, fit=fit)
+            "invert", "no_inverse_reason", "random_params")}, fit=fit)
 
     monkeypatch.setattr(compare, "get_family", patched)
     monkeypatch.setattr(fitting, "get_family", patched)

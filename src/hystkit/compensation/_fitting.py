@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..errors import HystkitError, InputError
+from ..errors import FitDivergedError, HystkitError, InputError
 from ..identification import FitResult
 from ..io import Recording
 from ..metrics import r2
@@ -29,23 +29,15 @@ from ._compensator import MODES, Compensator, check_training_data, inverse_is_bo
 from ._conventions import LinearBaseline, prepare_training_data
 from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status, standard_errors
 from ._param_vector import flatten_params, simulate_segments
+from ._training_checks import MIN_SAMPLES, check_fitting_data
 
 __all__ = ["MIN_SAMPLES", "fit_compensator"]
 
-# Fewer samples than this cannot describe a loop at all; checked before any fit runs.
-MIN_SAMPLES = 20
 # The joint polish differentiates numerically, one model run per parameter: above this many
 # parameters (Preisach grids) it is skipped and the concatenated fit is kept.
 MAX_POLISH_PARAMS = 40
 # Residual of a parameter vector outside the family's domain (the polish has no bounds).
 _OUTSIDE = 1e3
-
-
-def _check_sample_count(recordings: Sequence[Recording]) -> None:
-    n = sum(r.n_samples for r in recordings)
-    if n < MIN_SAMPLES:
-        raise InputError(f"{recordings[0].source}: column 'position': {n} samples; a fit needs "
-                         f"at least {MIN_SAMPLES}")
 
 
 def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.ndarray],
@@ -116,14 +108,18 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
         raise InputError(f"model {model!r} has no inverse ({family.no_inverse_reason}); "
                          f"use --mode direct")
     check_training_data(recs)
-    _check_sample_count(recs)
+    try:
+        structure = family.make_structure(recs[0].dt, family.default_size if size is None
+                                          else size, **structure_options)
+    except (ValueError, TypeError) as exc:
+        raise InputError(f"model {model!r}: {exc}") from None
+    # Before any fit: enough samples for the parameters and a signal that moves.
+    check_fitting_data(recs, family, structure)
     conventions, s_list, p_list = prepare_training_data(
         recs, center, tare_seconds=tare_seconds, track_seconds=track_seconds)
     s, p = np.concatenate(s_list), np.concatenate(p_list)
-    structure = family.make_structure(recs[0].dt, family.default_size if size is None
-                                      else size, **structure_options)
     inputs, targets = (s_list, p_list) if mode == "direct" else (p_list, s_list)
-    result = _fit_family(family, structure, mode, s, p)
+    result = _fit_family(family, structure, mode, s, p, recs[0].source)
     params, joint_note = result.params, ""
     if len(recs) > 1:
         params, joint_note = _polish_jointly(family.simulate, structure, params, inputs, targets)
@@ -148,7 +144,20 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
 
 
 def _fit_family(family: Family, structure: Any, mode: str, s: np.ndarray,
-                p: np.ndarray) -> FitResult:
+                p: np.ndarray, source: str) -> FitResult:
+    """The family's fit; whatever else it raises on data that passed the checks (a solver's
+    LinAlgError, a family's ValueError) is that family's failure, said in one line."""
+    try:
+        return _run_fit(family, structure, mode, s, p)
+    except HystkitError:
+        raise
+    except Exception as exc:  # any family's failure: reported, not a crash
+        raise FitDivergedError(f"{source}: the {family.name} fit failed on these data "
+                               f"({type(exc).__name__}: {exc})") from exc
+
+
+def _run_fit(family: Family, structure: Any, mode: str, s: np.ndarray,
+             p: np.ndarray) -> FitResult:
     if mode == "direct":
         return family.fit(s, p, structure)
     # The exact inverse of a discrete forward model can be unstable even when the model is

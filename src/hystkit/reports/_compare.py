@@ -11,7 +11,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..compensation import centre_and_scale, evaluate, fit_compensator
+from ..compensation import centre_and_scale, check_fitting_data, evaluate, fit_compensator
 from ..errors import HystkitError
 from ..io import Recording
 from ..metrics import e_max_pct, e_rms_pct, r2
@@ -21,9 +21,10 @@ from ._properties import measure_properties
 __all__ = ["compare_models", "format_compare", "generalization_matrix", "plot_generalization"]
 
 
-# What a failing family can raise: our own errors, and the numerical ones of a fit gone
-# degenerate (e.g. a collapsed model whose properties cannot be measured).
-FAMILY_FAILURES = (HystkitError, ValueError, ArithmeticError, np.linalg.LinAlgError)
+# What a failing family can raise: our own errors, the numerical ones of a fit gone
+# degenerate (e.g. a collapsed model whose properties cannot be measured), and whatever else
+# one family's code raises on odd data: one family never takes the others down.
+FAMILY_FAILURES = (Exception,)
 # Fit statuses (compensation guards) that make a model unusable, not merely suspicious.
 DISQUALIFYING = ("collapsed", "worse_than_line")
 
@@ -38,6 +39,7 @@ def _forward_scores(name: str, size: int | None, fit_rec: Recording,
     family = get_family(name)
     scaling, s_fit, p_fit = centre_and_scale(fit_rec, "fit")
     structure = family.make_structure(fit_rec.dt, structure_size(family, size))
+    check_fitting_data([fit_rec], family, structure)
     result = family.fit(p_fit, s_fit, structure)
     offsets = {"": (scaling.sensor_offset, scaling.position_offset),
                "_oracle": (val_rec.sensor.mean(), val_rec.position.mean())}
@@ -96,7 +98,14 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
         e_rms_pct, e_max_pct (forward, % of the normalised range), rate_dependent,
         return_point_memory, minor_loops_close, ...}}``; a model whose fit fails has ``error``
         (the others are still scored).
+
+    Raises
+    ------
+    InputError
+        Fitting data no family can be fitted to (too short, constant, a spike); checked once
+        before any fit. Too few samples for one family's parameters is that family's error.
     """
+    check_fitting_data([fit_rec])
     models = sorted(FAMILIES) if models is None else list(models)
     table = {}
     for name in models:

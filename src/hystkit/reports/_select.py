@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..compensation import DEFAULT_CENTER, evaluate, fit_compensator
+from ..compensation import DEFAULT_CENTER, check_fitting_data, evaluate, fit_compensator
 from ..io import Recording
 from ..models import FAMILIES, get_family
 from ._compare import DISQUALIFYING, FAMILY_FAILURES
@@ -122,7 +122,14 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
         aic, bic, fold_status, guard_failed, or error), ``folds`` (descriptions), ``winner``
         (its row) and ``compensator`` (fitted on all recordings), or ``winner`` None when
         every candidate failed.
+
+    Raises
+    ------
+    InputError
+        Training data no candidate can be fitted to (too short, constant, a spike); checked
+        once before the folds. A candidate that fails in a fold is that candidate's error.
     """
+    check_fitting_data(recordings)
     pairs = folds(recordings)
     work = [(c, pairs, options) for c in cands]
     progress(f"  {len(cands)} candidates x {len(pairs)} folds"
