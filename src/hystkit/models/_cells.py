@@ -35,8 +35,57 @@ import numpy as np
 from ._protocol import Record
 from ._validation import check_cells
 
-__all__ = ["CellStructure", "Cells", "LinearModel", "cell_report", "discrete_eigenvalues",
-           "linearise", "linearise_cells"]
+__all__ = ["DT_RANGE", "MAX_CELLS", "MAX_VALUE", "CellStructure", "Cells", "LinearModel",
+           "cell_report", "check_magnitude", "check_range", "check_structure_size",
+           "discrete_eigenvalues", "linearise", "linearise_cells", "state_bound"]
+
+# Limits shared by the cell models (mpl, mpl-poly, pl, ladder). Runs cost O(N) a sample and
+# fits hold an (n_samples x ~3N) Jacobian, so 1000 cells (24 kB of parameters, 24 MB of
+# Jacobian per 1000 samples) is far beyond any useful model yet nowhere near a hang.
+MAX_CELLS = 1000
+# Sample times outside 1 ns .. 11.6 days are not recordings; inside, slope_cap / dt and
+# V_T / dt stay far from the float range whatever else the parameters are.
+DT_RANGE = (1e-9, 1e6)
+# Weights and biases in normalised units (eq. 5.10; the fits keep |w| <= 100): beyond 1e6 a
+# model maps [-1, 1] data to nonsense, and sums of them stay finite for any sane input.
+MAX_VALUE = 1e6
+
+
+def check_range(values, name: str, low: float, high: float, why: str = "") -> None:
+    """Raise ValueError unless every value lies in ``[low, high]`` (NaN fails); the message
+    names the parameter, the first offending value and the range."""
+    arr = np.asarray(values, dtype=float).reshape(-1)
+    bad = ~((arr >= low) & (arr <= high))
+    if np.any(bad):
+        raise ValueError(f"{name} must lie in [{low:g}, {high:g}]{why}, got "
+                         f"{float(arr[np.argmax(bad)])!r}")
+
+
+def check_magnitude(values, name: str, limit: float = MAX_VALUE) -> None:
+    """Raise ValueError unless ``|values| <= limit`` (normalised units, see ``MAX_VALUE``)."""
+    check_range(values, name, -limit, limit, " (normalised units: the domain where runs stay "
+                                             "bounded)")
+
+
+def check_structure_size(n, name: str = "n_cells", limit: int = MAX_CELLS) -> None:
+    """Raise ValueError unless ``n`` is a whole number in ``[1, limit]``; checked before any
+    other field, so nothing is allocated or looped over for a huge or non-numeric size."""
+    ok = (isinstance(n, int | float | np.integer | np.floating) and not isinstance(n, bool)
+          and np.isfinite(n) and int(n) == n and 1 <= n <= limit)
+    if not ok:
+        raise ValueError(f"{name} must be a whole number in [1, {limit}], got {n!r}")
+
+
+def state_bound(x0_max: float, u_max: float, slope_cap: float) -> float:
+    """Largest ``|u_k|`` a cell ``x+ = x + f(e - x) dt`` can reach from ``|x0| <= x0_max``
+    under inputs ``|e| <= u_max``, when ``f`` is increasing through ``f(0) = 0`` with secant
+    slope ``f(v) / v <= slope_cap / dt``.
+
+    Each step moves ``x`` towards ``e``; it overshoots by at most ``(slope_cap - 1) |x - e|``,
+    so ``|x+| <= max(|x|, u_max, u_max + (slope_cap - 1)(|x| + u_max))``, whose fixed point is
+    ``u_max slope_cap / (2 - slope_cap)``. With ``slope_cap <= 1`` it is ``max(x0_max, u_max)``.
+    """
+    return max(x0_max, u_max * max(1.0, slope_cap / (2.0 - slope_cap)))
 
 
 @dataclass(frozen=True)
@@ -52,6 +101,9 @@ class CellStructure(Record):
     slope_cap : float
         Largest allowed Euler slope ``f' dt`` (eq. 5.28 requires < 2; 1 gives overshoot-free
         cells).
+
+    Limits: ``1 <= n_cells <= MAX_CELLS`` (1000, checked first, before anything is allocated)
+    and ``dt`` in ``DT_RANGE`` (1e-9 .. 1e6 s).
     """
 
     n_cells: int = 1
@@ -59,7 +111,9 @@ class CellStructure(Record):
     slope_cap: float = 1.0
 
     def __post_init__(self) -> None:
+        check_structure_size(self.n_cells)
         check_cells(self.n_cells, self.dt, self.slope_cap)
+        check_range(self.dt, "dt", *DT_RANGE, " s")
 
 
 @dataclass(frozen=True, eq=False)

@@ -170,7 +170,7 @@ def test_structure_rejects_bad_values(kwargs):
 
 
 def test_params_reject_non_positive_resistor_shape():
-    with pytest.raises(ValueError, match="positive"):
+    with pytest.raises(ValueError, match=r"i_s must lie in \[1e-12, 1e\+12\]"):
         mpl.MplParams(i_s=[-1.0], v_t=[0.2], w=[1.0, 0.4])
 
 

@@ -29,9 +29,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import FitDivergedError
-from .._cells import CellStructure
+from .._cells import (
+    CellStructure,
+    check_magnitude,
+    check_range,
+    check_structure_size,
+    state_bound,
+)
 from .._protocol import Record
 from .._validation import (
+    check_finite_run,
     check_signal,
     check_size,
     finite_floats,
@@ -42,16 +49,27 @@ from .._validation import (
 from . import kernels
 
 __all__ = [
+    "I_S_RANGE",
+    "V_T_RANGE",
     "MplParams",
     "MplStructure",
     "invert",
     "invert_step",
     "knee_voltage",
+    "output_bound",
     "resistor_current",
     "simulate",
     "simulate_reference",
     "step",
 ]
+
+
+# The documented parameter domain (normalised units). The fit's box (V_T in [1e-3, 1e3],
+# G = 2 I_S / V_T in [1e-4, slope_cap / dt]) lies inside for every dt of the structure's range;
+# with these ends and dt >= 1e-9 s no intermediate of a step (sinh at the knee, the capped
+# line, its product with dt) comes near the float range.
+I_S_RANGE = (1e-12, 1e12)
+V_T_RANGE = (1e-6, 1e12)
 
 
 @dataclass(frozen=True)
@@ -82,6 +100,12 @@ class MplParams(Record):
 
     Notes
     -----
+    Domain (checked here): ``I_S`` in ``I_S_RANGE`` (1e-12 .. 1e12), ``V_T`` in
+    ``V_T_RANGE`` (1e-6 .. 1e12), ``|w_k|, |V_b| <= MAX_VALUE`` (1e6), at most ``MAX_CELLS``
+    cells. Every Euler step moves a cell towards its input (overshooting by at most
+    ``slope_cap - 1`` of the gap), so ``|y| <= sum |w| B + |V_b|`` with
+    ``B = max(max|x0|, max|u| max(1, slope_cap / (2 - slope_cap)))`` (:func:`output_bound`).
+
     The optimiser sees the vector ``[log G_1, log V_T1, ..., log G_N, log V_TN, w_0..w_N, V_b]``
     with ``G_k = 2 I_Sk / V_Tk`` the small-signal conductance (the inverse time constant of the
     cell). ``G`` and ``V_T`` are far less correlated than ``I_S`` and ``V_T``, and the logs keep
@@ -96,11 +120,14 @@ class MplParams(Record):
 
     def __post_init__(self) -> None:
         n = np.size(self.i_s)
+        check_structure_size(n, "the number of cells (size of i_s)")  # before any copy
         object.__setattr__(self, "n_cells", int(n))
         freeze_arrays(self, i_s=n, v_t=n, w=n + 1)
         finite_floats(self, "v_b")
-        if np.any(self.i_s <= 0) or np.any(self.v_t <= 0):
-            raise ValueError("i_s and v_t must be positive (eq. 5.1)")
+        check_range(self.i_s, "i_s", *I_S_RANGE, " (eq. 5.1)")
+        check_range(self.v_t, "v_t", *V_T_RANGE, " (eq. 5.1)")
+        check_magnitude(self.w, "w")
+        check_magnitude(self.v_b, "v_b")
 
     def to_vector(self) -> np.ndarray:
         """Optimiser coordinates (see Notes of the class)."""
@@ -116,6 +143,14 @@ class MplParams(Record):
         i_s = 0.5 * np.exp(cells[:, 0]) * v_t
         return cls(i_s=i_s, v_t=v_t, w=theta[2 * n_cells: 3 * n_cells + 1],
                    v_b=theta[3 * n_cells + 1])
+
+
+def output_bound(structure: MplStructure, params: MplParams, u_max: float,
+                 x0_max: float | None = None) -> float:
+    """Largest ``|y|`` of a forward run with ``|u| <= u_max`` from ``|x0| <= x0_max``
+    (default: at rest, ``x0_max = u_max``); see the Notes of :class:`MplParams`."""
+    b = state_bound(u_max if x0_max is None else x0_max, u_max, structure.slope_cap)
+    return float(abs(params.w[0]) * u_max + np.abs(params.w[1:]).sum() * b + abs(params.v_b))
 
 
 def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:
@@ -202,8 +237,9 @@ def simulate(structure: MplStructure, params: MplParams, u: np.ndarray,
     u = check_signal(u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
     knee = knee_voltage(structure, params)
-    return kernels.simulate(u, x, params.i_s, params.v_t, params.w, params.v_b, knee,
-                            structure.slope_cap / structure.dt, structure.dt)
+    y, x_end = kernels.simulate(u, x, params.i_s, params.v_t, params.w, params.v_b, knee,
+                                structure.slope_cap / structure.dt, structure.dt)
+    return check_finite_run(y, "mpl"), x_end  # finite in the domain; inputs near 1e308 are not
 
 
 def simulate_reference(structure: MplStructure, params: MplParams, u: np.ndarray,
