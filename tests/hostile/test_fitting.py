@@ -157,6 +157,6 @@ def test_an_estimate_that_runs_away_is_refused_not_written(cli, good, tmp_path):
     data = tmp_path / "wild.csv"
     table.to_csv(data, index=False)
     _refused(cli, tmp_path, ["compensate", good["model"], data, "--out", tmp_path / "o.csv"],
-             "wild.csv", "sample 0", good["model"].name, "beyond")
+             "wild.csv", "column 'sensor', sample", good["model"].name, "beyond")
     _refused(cli, tmp_path, ["evaluate", good["model"], data, "--json", tmp_path / "s.json"],
              "wild.csv", good["model"].name)
