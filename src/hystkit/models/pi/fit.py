@@ -105,6 +105,14 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
     -------
     FitResult
         ``cost`` is the output SSE (eq. 5.9) of the fitted model, not the generalised error.
+
+    Raises
+    ------
+    ValueError
+        If the data are not finite 1-D pairs or there are no more samples than unknowns.
+    FitDivergedError
+        If the solution is not finite, leaves the parameter domain (``MAX_VALUE``) or is
+        vetoed by ``accept``.
     """
     t_start = time.perf_counter()
     u = np.ascontiguousarray(u, dtype=float)
@@ -114,6 +122,11 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
     if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
         raise ValueError("u and y must be finite")
     n, n_k, m = structure.n_play, structure.n_creep, structure.n_deadzone
+    n_unknowns = n + 2 * n_k + 1 + 2 * m
+    if u.size <= n_unknowns:
+        raise ValueError(f"a PI fit with {n} plays, {n_k} creep operators and {m} dead zones "
+                         f"a side needs more samples than its {n_unknowns} unknowns, got "
+                         f"{u.size}")
     d_inv = output_thresholds(y, m) if d_inv is None else np.asarray(d_inv, dtype=float)
     pi.PiParams(w_h=np.ones(n), w_s=np.ones(2 * m + 1), d_s=d_inv)  # validates d_inv
     # A decreasing model is an increasing one of -u (plays and creep operators are odd).
@@ -138,7 +151,10 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
     if not np.all(np.isfinite(sol.x)):
         raise FitDivergedError(f"the fit failed: the linear solver returned non-finite "
                                f"weights ({sol.message})")
-    params = _to_params(structure, sol.x, d_inv, polarity)
+    try:
+        params = _to_params(structure, sol.x, d_inv, polarity)
+    except ValueError as exc:  # weights beyond the domain where runs stay bounded
+        raise FitDivergedError(f"the fit failed: {exc}") from None
     y_fit, _ = pi.simulate(structure, params, u)
     if accept is not None and not accept(params):
         raise FitDivergedError(f"the fit failed: the fitted model was rejected ({accept_reason})")
@@ -170,10 +186,13 @@ def make_structure(dt: float, size: int, *, n_deadzone: int = 2, n_creep: int = 
     dead zones per side. ``a_j = 1 / (tau_min 10^j)`` (j = 0 .. n_creep - 1): by default time
     constants 0.1, 1, 10 and 100 s, from 4 samples at 40 Hz to half a recording.
     """
-    if int(size) != size or size < 1:
-        raise ValueError(f"size (play operators) must be a positive integer, got {size!r}")
-    if int(n_creep) != n_creep or n_creep < 0:
-        raise ValueError(f"n_creep must be a non-negative integer, got {n_creep!r}")
+    # the caps first, before arange allocates anything (a size of 1e12 or inf)
+    if not (isinstance(size, int | float) and 1 <= size <= pi.MAX_PLAYS) or int(size) != size:
+        raise ValueError(f"size (play operators) must be an integer in [1, {pi.MAX_PLAYS}], "
+                         f"got {size!r}")
+    if not (isinstance(n_creep, int | float) and 0 <= n_creep <= pi.MAX_CREEP) \
+            or int(n_creep) != n_creep:
+        raise ValueError(f"n_creep must be an integer in [0, {pi.MAX_CREEP}], got {n_creep!r}")
     if not (r_max > 0 and tau_min > 0):
         raise ValueError(f"r_max and tau_min must be positive, got {r_max!r}, {tau_min!r}")
     return pi.PiStructure(play_thresholds=tuple(r_max * np.arange(size) / size),

@@ -45,6 +45,7 @@ from ...errors import FitDivergedError
 from .._protocol import Record
 from .._validation import (
     check_dt,
+    check_finite_run,
     check_signal,
     finite_floats,
     freeze_arrays,
@@ -54,10 +55,31 @@ from .._validation import (
 )
 from . import kernels
 
-__all__ = ["InverseParts", "PiParams", "PiStructure", "deadzone", "instantaneous_weights",
+__all__ = ["MAX_CREEP", "MAX_DEADZONES", "MAX_PLAYS", "MAX_VALUE", "InverseParts", "PiParams", "PiStructure", "deadzone", "instantaneous_weights",
            "inverse_parts", "inverse_pi", "inverse_play_states", "inverse_superposition",
-           "invert", "invert_step", "not_invertible_reason", "play", "rest_input", "rest_state",
+           "invert", "invert_step", "not_invertible_reason", "output_bound", "play", "rest_input", "rest_state",
            "simulate", "simulate_reference", "step"]
+
+
+# Sizes: a sample costs O(plays + dead zones + creep operators); the fit's regressor matrix
+# holds n_play + 2 n_creep + 2 n_deadzone + 1 columns, 10 kB a sample at the caps.
+MAX_PLAYS = 1000
+MAX_DEADZONES = 100  # per side
+MAX_CREEP = 20
+MAX_VALUE = 1e6  # weights, thresholds and |b| in normalised units (fit: slopes <= ~100)
+INVERSE_MIN_SLOPE = 1 / MAX_VALUE  # smallest slope partial sum with an inverse (fit: >= 0.01)
+
+
+def _check_count(values, maximum: int, name: str) -> None:
+    """Refuse more than ``maximum`` values before any array is built from them."""
+    if np.ndim(values) > 0 and len(values) > maximum:
+        raise ValueError(f"{name} may hold at most {maximum} values, got {len(values)}")
+
+
+def _check_magnitude(values, name: str) -> None:
+    if np.any(np.abs(values) > MAX_VALUE):
+        raise ValueError(f"{name} must be at most {MAX_VALUE:g} in magnitude (the domain where "
+                         f"runs stay bounded), got {float(np.max(np.abs(values))):g}")
 
 
 def _float_tuple(values, name: str) -> tuple[float, ...]:
@@ -71,14 +93,16 @@ class PiStructure(Record):
     Parameters
     ----------
     play_thresholds : tuple of float
-        ``r_0 = 0 < r_1 < ...`` in input units (eq. 2.11); their number is the model size.
+        ``r_0 = 0 < r_1 < ... <= MAX_VALUE`` in input units (eq. 2.11); their number is the
+        model size, at most ``MAX_PLAYS`` (1000).
     n_deadzone : int
-        One-sided dead-zone operators on *each* side of ``d = 0`` (eq. 2.12); 0 makes ``S``
-        linear. Their thresholds are fitted (they follow from the output range), so they live
+        One-sided dead-zone operators on *each* side of ``d = 0`` (eq. 2.12), at most
+        ``MAX_DEADZONES`` (100); 0 makes ``S`` linear. Their thresholds are fitted (they follow from the output range), so they live
         in :class:`PiParams`.
     creep_rates : tuple of float
-        Eigenvalues ``a_j`` [1/s] of the linear creep operators (eq. 2.14); empty for the
-        rate-independent model.
+        Eigenvalues ``a_j`` [1/s] of the linear creep operators (eq. 2.14), at most
+        ``MAX_CREEP`` (20); empty for the rate-independent model. At the size caps a sample
+        costs about 1300 operator updates and the fit's regressors 10 kB.
     dt : float
         Sample time [s]. The plays are rate independent; the creep operators are not, and
         their per-sample gains :attr:`creep_gains` follow from the rates and ``dt``, so the
@@ -91,7 +115,13 @@ class PiStructure(Record):
     dt: float = 0.025
 
     def __post_init__(self) -> None:
+        _check_count(self.play_thresholds, MAX_PLAYS, "play_thresholds")
+        _check_count(self.creep_rates, MAX_CREEP, "creep_rates")
+        if not (isinstance(self.n_deadzone, int | float) and self.n_deadzone <= MAX_DEADZONES):
+            raise ValueError(f"n_deadzone must be an integer in [0, {MAX_DEADZONES}], got "
+                             f"{self.n_deadzone!r}")
         r = _float_tuple(self.play_thresholds, "play_thresholds")
+        _check_magnitude(r, "play_thresholds")
         object.__setattr__(self, "play_thresholds", r)
         if r[0] != 0.0 or np.any(np.diff(r) <= 0):
             raise ValueError(f"play_thresholds must start at 0 and increase strictly, got {r}")
@@ -133,6 +163,13 @@ class PiParams(Record):
         Creep weights ``w_K`` (eq. 2.14).
     b : float
         Offset inside ``S``.
+
+    Notes
+    -----
+    Domain: every weight, threshold and ``|b|`` at most ``MAX_VALUE`` (1e6, normalised units;
+    the fit's slopes are at most ~100). Plays and creep states stay within ``M = max(|u|,
+    |x0|)`` and ``|S_d(v)| <= |v|``, so ``|y| <= sum |w_S| ((sum |w_H| + sum |w_K|) M + |b|)``
+    (:func:`output_bound`). The inverse returns finite values or raises ``FitDivergedError``.
     """
 
     w_h: np.ndarray
@@ -145,9 +182,14 @@ class PiParams(Record):
     n_creep: int = field(init=False)
 
     def __post_init__(self) -> None:
+        _check_count(self.w_h, MAX_PLAYS, "w_h")
+        _check_count(self.w_s, 2 * MAX_DEADZONES + 1, "w_s")
+        _check_count(self.w_k, MAX_CREEP, "w_k")
         freeze_arrays(self, w_h=None, w_s=None)
         freeze_arrays(self, d_s=self.w_s.size, w_k=None)
         finite_floats(self, "b")
+        for name in ("w_h", "w_s", "d_s", "w_k", "b"):
+            _check_magnitude(getattr(self, name), name)
         m = (self.d_s.size - 1) // 2
         if self.w_h.size < 1 or self.d_s.size % 2 == 0 or self.d_s[m] != 0.0 \
                 or np.any(np.diff(self.d_s) <= 0):
@@ -165,6 +207,13 @@ class PiParams(Record):
         d = super().to_dict()
         d["d_s"][self.n_deadzone] = 0
         return d
+
+
+def output_bound(params: PiParams, u_max: float) -> float:
+    """``sum |w_S| ((sum |w_H| + sum |w_K|) u_max + |b|)``: no output of a run whose inputs
+    and initial states stay within ``u_max`` in magnitude exceeds it."""
+    inner = (np.abs(params.w_h).sum() + np.abs(params.w_k).sum()) * u_max + abs(params.b)
+    return float(np.abs(params.w_s).sum() * inner)
 
 
 def play(x: np.ndarray | float, y_prev: np.ndarray | float,
@@ -249,9 +298,9 @@ def inverse_parts(structure: PiStructure, params: PiParams) -> InverseParts:
 def rest_input(params: PiParams, y0: float) -> float:
     """The input at rest at output ``y0``: ``(S^-1(y0) - b) / (sum w_H + sum w_K)``."""
     gain = params.w_h.sum() + params.w_k.sum()
-    if gain == 0:
-        raise FitDivergedError("the model's static gain sum(w_H) + sum(w_K) is 0: no input "
-                               "is at rest at y[0]; pass x0")
+    if not abs(gain) >= INVERSE_MIN_SLOPE:  # 1 / gain would leave the domain (or the float range)
+        raise FitDivergedError(f"the model's static gain sum(w_H) + sum(w_K) = {gain:g} is "
+                               f"(nearly) 0: no input is at rest at y[0]; pass x0")
     d_inv, ws_inv = inverse_superposition(params.d_s, params.w_s)
     return (float(ws_inv @ deadzone(y0, d_inv)) - params.b) / gain
 
@@ -343,7 +392,7 @@ def simulate(structure: PiStructure, params: PiParams, u: np.ndarray,
     y, p, z = kernels.simulate(u, x[:n].copy(), x[n:].copy(),
                                np.asarray(structure.play_thresholds), params.w_h, params.d_s,
                                params.w_s, structure.creep_gains, params.w_k, params.b)
-    return y, np.concatenate([p, z])
+    return check_finite_run(y, "PI"), np.concatenate([p, z])
 
 
 def simulate_reference(structure: PiStructure, params: PiParams, u: np.ndarray,
@@ -360,18 +409,21 @@ def not_invertible_reason(structure: PiStructure, params: PiParams) -> str:
 
     The instantaneous play weights ``w~`` need partial sums of one sign (a strictly monotone
     loading curve, either polarity) and the dead-zone weights partial sums that are positive
-    from ``d = 0`` outwards (an increasing ``S``).
+    from ``d = 0`` outwards (an increasing ``S``), all at least ``INVERSE_MIN_SLOPE`` (1e-6) in
+    magnitude so that the inverse's slopes stay below 1e6 (the fit's are below 100).
     """
     _check_params(structure, params)
     sums = np.cumsum(instantaneous_weights(structure, params))
-    if not (np.all(sums > 0) or np.all(sums < 0)):
+    if not (np.all(sums >= INVERSE_MIN_SLOPE) or np.all(sums <= -INVERSE_MIN_SLOPE)):
         return (f"the partial sums of the instantaneous play weights {sums.tolist()} change "
-                f"sign or vanish, so H + K is not invertible (eq. 2.19)")
+                f"sign or come within {INVERSE_MIN_SLOPE:g} of 0, so H + K is not invertible "
+                f"(eq. 2.19) within the domain (inverse slopes up to {1 / INVERSE_MIN_SLOPE:g})")
     m = params.n_deadzone
     for side in (params.w_s[m:], params.w_s[m::-1]):
-        if np.any(np.cumsum(side) <= 0):
+        if np.any(np.cumsum(side) < INVERSE_MIN_SLOPE):
             return (f"the partial sums of the dead-zone weights {params.w_s.tolist()} are not "
-                    f"all positive from d = 0 outwards, so S is not invertible (eq. 2.19)")
+                    f"all at least {INVERSE_MIN_SLOPE:g} from d = 0 outwards, so S is not invertible "
+                    f"(eq. 2.19) within the domain")
     return ""
 
 
@@ -419,7 +471,8 @@ def invert(structure: PiStructure, params: PiParams, y: np.ndarray,
         raise FitDivergedError(
             f"the inverse model diverged at sample {n_bad} of {y.size} (|u_hat| > 1e6 times the "
             f"output range); its creep weights make the compensator unstable on this data")
-    return u_hat, np.concatenate([_play_states_from_inverse(sign * w_inst, q), z])
+    x_end = np.concatenate([_play_states_from_inverse(sign * w_inst, q), z])
+    return check_finite_run(u_hat, "PI", "inverse"), check_finite_run(x_end, "PI", "state")
 
 
 def _play_states_from_inverse(w: np.ndarray, q: np.ndarray) -> np.ndarray:
