@@ -18,16 +18,23 @@ EXAMPLES = int(os.environ.get("HYSTKIT_FUZZ_EXAMPLES", "150"))
 U = np.r_[0.9 * np.sin(np.linspace(0, 12, 240)), np.ones(30), -np.ones(30), 0.3 * np.ones(20)]
 
 
-def values(n, near):
-    """``n`` floats: near the domain (log-uniform over its decades and two beyond, either sign)
-    or anywhere in the float range (zeros, subnormals, 1e308)."""
-    lo, hi = near
-    log_near = st.floats(np.log10(lo) - 2, np.log10(hi) + 2).map(lambda e: 10.0 ** e)
-    wild = st.one_of(st.sampled_from([0.0, 5e-324, 1e-310, 1e300, 1.7e308]),
-                     st.floats(-320, 308).map(lambda e: 10.0 ** e))
-    signed = st.tuples(st.sampled_from([1.0, 1.0, 1.0, -1.0]), st.one_of(log_near, log_near,
-                                                                           wild))
-    return st.lists(signed.map(lambda t: t[0] * t[1]), min_size=n, max_size=n)
+def values(draw, n, domain, signed=True):
+    """``n`` floats, each inside the domain ``domain = (lo, hi)`` of magnitudes (log-uniform,
+    either sign if ``signed``) or, with a share drawn per example, anywhere: two decades past
+    either end, negative, zero, subnormal, 1e300, 1.7e308."""
+    lo, hi = np.log10(domain)
+    share = draw(st.sampled_from([0.0, 0.1, 0.5]))
+    out = []
+    for _ in range(n):
+        if draw(st.floats(0, 1)) < share:
+            out.append(draw(st.one_of(
+                st.sampled_from([0.0, -1.0, 5e-324, 1e-310, 1e300, 1.7e308, -1e300]),
+                st.floats(lo - 2, hi + 2).map(lambda e: 10.0 ** e),
+                st.floats(-320, 308).map(lambda e: -(10.0 ** e)))))
+        else:
+            sign = draw(st.sampled_from([1.0, -1.0])) if signed else 1.0
+            out.append(sign * 10.0 ** draw(st.floats(lo, hi)))
+    return out
 
 
 @st.composite
@@ -35,8 +42,9 @@ def models(draw):
     n = draw(st.integers(1, 3))
     structure = mpl.MplStructure(n_cells=n, dt=draw(st.sampled_from([1e-9, 0.025, 1e6])),
                                  slope_cap=draw(st.floats(0.01, 1.99)))
-    raw = {"i_s": draw(values(n, mpl.I_S_RANGE)), "v_t": draw(values(n, mpl.V_T_RANGE)),
-           "w": draw(values(n + 1, (1e-3, 1e6))), "v_b": draw(values(1, (1e-3, 1e6)))[0]}
+    raw = {"i_s": values(draw, n, mpl.I_S_RANGE, signed=False),
+           "v_t": values(draw, n, mpl.V_T_RANGE, signed=False),
+           "w": values(draw, n + 1, (1e-3, 1e6)), "v_b": values(draw, 1, (1e-3, 1e6))[0]}
     try:
         return structure, mpl.MplParams(**raw)
     except ValueError as err:
