@@ -24,6 +24,8 @@ from hystkit.errors import InputError
 from ._cells import Where, cell_problem, pick, text_problems
 
 CHUNK_ROWS = 100_000  # text cells held at once by the second pass
+MAX_COLUMNS = 1000  # a wider file is not a recording; pandas would build a column per field
+_HEADER_BYTES = 1 << 16
 _EXACT = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
 _HINT = " (the first line must be a comma-separated header naming the columns)"
 _TEXT = {"header": None, "dtype": str, "keep_default_na": False, "skip_blank_lines": False,
@@ -35,10 +37,25 @@ _PARSE_ERRORS = (pd.errors.ParserError, ValueError, OverflowError, MemoryError)
 def read_csv(path: Path, source: str, need_position: bool) -> tuple[dict[str, np.ndarray], Where]:
     """Read the recording columns of a CSV file as float64 arrays (not yet validated)."""
     where = Where(source, header_lines=1)
+    _check_width(path, where)
     arrays = _read_numbers(path, need_position, where)
     if arrays is None:
         arrays = _read_text(path, need_position, where)
     return arrays, where
+
+
+def _check_width(path: Path, where: Where) -> None:
+    """Refuse a header with more than `MAX_COLUMNS` fields before pandas builds that many."""
+    with path.open("rb") as file:
+        start = file.read(_HEADER_BYTES)
+    ends = [i for i in (start.find(b"\n"), start.find(b"\r")) if i >= 0]
+    if not ends and len(start) == _HEADER_BYTES:
+        raise where.fail(f"the header line is longer than {_HEADER_BYTES} bytes; this is not "
+                         "a recording")
+    fields = start[:min(ends, default=len(start))].count(b",") + 1
+    if fields > MAX_COLUMNS:
+        raise where.fail(f"the header line has {fields} fields; a recording has at most "
+                         f"{MAX_COLUMNS} columns")
 
 
 def _read_numbers(path: Path, need_position: bool, where: Where) -> dict[str, np.ndarray] | None:
