@@ -63,6 +63,7 @@ class MplPolyFamily(Family):
         return mpl_poly.invert_step(structure, params, x, y)
 
     def block(self, structure, params, inverse=False):
+        mpl_poly.check_rest(structure, params)  # the loop runs only models of the domain
         if inverse:
             if params.w[0] == 0:
                 raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")

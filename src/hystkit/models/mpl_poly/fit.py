@@ -169,7 +169,10 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
         key = theta.tobytes()
         if key not in cache:
             cache.clear()
-            cache[key] = mpl_poly.simulate_with_jacobian(structure, to_params(theta), u)
+            try:
+                cache[key] = mpl_poly.simulate_with_jacobian(structure, to_params(theta), u)
+            except ValueError:  # outside the parameter domain (a rest point beyond REST_MAX)
+                cache[key] = (np.full(u.size, np.nan), np.full((u.size, theta.size), np.nan))
         return cache[key]
 
     candidates = [_table_i_start(n)] + [_linear_output_start(structure, f, u, y)
@@ -187,7 +190,10 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
     # the (N + 2)-dimensional valley of equivalent parameters (see the module docstring)
     if result.params.w[0] == 0:
         return result
-    return replace(result, params=canonical(structure, result.params))
+    try:
+        return replace(result, params=canonical(structure, result.params))
+    except ValueError:  # its canonical form leaves the domain (|w / w_0| > 1e6, say)
+        return result
 
 
 

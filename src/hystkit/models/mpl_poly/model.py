@@ -32,10 +32,11 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ...errors import FitDivergedError
-from .._cells import CellStructure
+from .._cells import CellStructure, check_magnitude, check_range, check_structure_size
 from .._protocol import Record
 from .._validation import (
     broadcast_state,
+    check_finite_run,
     check_signal,
     check_size,
     finite_floats,
@@ -45,13 +46,18 @@ from .._validation import (
 from . import kernels
 
 __all__ = [
+    "C3_RANGE",
+    "POLY_MAX",
+    "REST_MAX",
     "MplPolyParams",
     "MplPolyStructure",
+    "check_rest",
     "equilibria",
     "inverse_branch",
     "invert",
     "invert_step",
     "knee_points",
+    "output_bound",
     "output_branch",
     "output_current",
     "output_slope",
@@ -64,6 +70,15 @@ __all__ = [
     "simulate_with_jacobian",
     "step",
 ]
+
+
+# The documented parameter domain, normalised units (eq. 5.10). The coefficient ranges hold
+# the fit's box (|c| <= 1e3, c3 in [1e-6, 1e4]), its canonical forms and paper 9.2's sets
+# (c3 down to 5e-7); what keeps a run meaningful is REST_MAX: a cell resting 1000 ranges away
+# from [-1, 1] data is a cubic, not a hysteresis cell, and drives z and g(z) to 1e24 .. 1e67.
+POLY_MAX = 1e9
+C3_RANGE = (1e-300, 1e9)  # tiny c3: a near-linear cell (its roots are checked)
+REST_MAX = 1e3
 
 
 @dataclass(frozen=True)
@@ -107,6 +122,12 @@ class MplPolyParams(Record):
 
     Notes
     -----
+    Domain (checked here): ``|c_k0..c_k2|, |g_j| <= POLY_MAX`` (1e9), ``c_k3`` in
+    ``C3_RANGE`` (1e-300 .. 1e9), ``|w_k|, |V_b| <= 1e6``, at most 1000 cells, and every real
+    root of every cell's cubic within ``|v| <= REST_MAX`` (1000). The limited resistor's rest
+    voltages depend on ``dt`` too; runs check them (:func:`check_rest`). With them, a run
+    with ``slope_cap <= 1`` stays within :func:`output_bound`.
+
     The optimiser sees ``[c_k0, c_k1, c_k2, log c_k3 (per cell), g_0..g_3, w_0..w_N, V_b]``.
     """
 
@@ -117,6 +138,8 @@ class MplPolyParams(Record):
     n_cells: int = field(init=False)
 
     def __post_init__(self) -> None:
+        if np.ndim(self.f) >= 1:  # the cell count first, before the values are copied
+            check_structure_size(len(self.f), "the number of cells (rows of f)")
         shape = np.shape(frozen_shaped(self.f, None, "f"))
         if len(shape) != 2 or shape[0] < 1 or shape[1] != 4:
             raise ValueError(f"f must have shape (N, 4), one row per cell, got {shape}")
@@ -126,9 +149,19 @@ class MplPolyParams(Record):
         object.__setattr__(self, "g", frozen_shaped(self.g, (4,), "g"))
         object.__setattr__(self, "w", frozen_shaped(self.w, (n + 1,), "w"))
         finite_floats(self, "v_b")
-        if np.any(self.f[:, 3] <= 0):
-            raise ValueError("the cubic coefficient of every cell resistor must be positive "
-                             "(stable for large |v|, sec. 5.3.5)")
+        check_range(self.f[:, 3], "the cubic coefficient f[k][3]", *C3_RANGE,
+                    " (positive: stable for large |v|, sec. 5.3.5)")
+        check_magnitude(self.f[:, :3], "f (c0..c2)", POLY_MAX)
+        check_magnitude(self.g, "g", POLY_MAX)
+        check_magnitude(self.w, "w")
+        check_magnitude(self.v_b, "v_b")
+        for k, c in enumerate(self.f):
+            roots = np.roots(c[::-1])
+            real = roots[np.abs(roots.imag) <= 1e-9 * (1 + np.abs(roots))].real
+            if np.any(np.abs(real) > REST_MAX):
+                raise ValueError(f"f[{k}] (cell {k + 1}'s resistor) has a rest voltage at "
+                                 f"{real[np.argmax(np.abs(real))]:.4g}, outside the domain "
+                                 f"[-{REST_MAX:g}, {REST_MAX:g}] (normalised units)")
 
     def to_vector(self) -> np.ndarray:
         """Optimiser coordinates (see Notes of the class)."""
@@ -225,6 +258,33 @@ def equilibria(structure: MplPolyStructure, params: MplPolyParams) -> list[np.nd
             v += [xm - f_m / s] if f_m >= 0 else []
         out.append(np.unique(np.asarray(v, dtype=float)))
     return out
+
+
+def check_rest(structure: MplPolyStructure, params: MplPolyParams) -> None:
+    """Raise FitDivergedError unless every rest voltage of the limited resistors at this
+    ``dt`` (:func:`equilibria`) lies within ``REST_MAX``: the straight continuations can move
+    a cell's rest point far beyond its cubic's roots (a steep cubic, a small ``slope_cap``)."""
+    for k, v in enumerate(equilibria(structure, params)):
+        if v.size and np.max(np.abs(v)) > REST_MAX:
+            raise FitDivergedError(
+                f"cell {k + 1} of the mpl-poly model rests at v = {v[np.argmax(np.abs(v))]:.4g} "
+                f"with dt = {structure.dt:g}, slope_cap = {structure.slope_cap:g}: outside the "
+                f"domain |v| <= {REST_MAX:g} where runs stay bounded")
+
+
+def output_bound(structure: MplPolyStructure, params: MplPolyParams, u_max: float) -> float:
+    """Largest ``|y|`` of a forward run from rest with ``|u| <= u_max`` and
+    ``slope_cap <= 1``.
+
+    Each Euler step keeps ``u_k`` between its previous value and ``e - v*`` for the rest
+    voltages ``v*`` of the limited resistor (its slope never exceeds ``slope_cap / dt``), so
+    ``|u_k| <= u_max + R_k`` with ``R_k`` the largest ``|v*|``; then
+    ``|z| <= |w_0| u_max + sum |w_k| (u_max + R_k) + |V_b|`` and
+    ``|y| <= sum_j |g_j| |z|^j``.
+    """
+    r = np.array([np.max(np.abs(v), initial=0.0) for v in equilibria(structure, params)])
+    z = abs(params.w[0]) * u_max + np.abs(params.w[1:]) @ (u_max + r) + abs(params.v_b)
+    return float(np.abs(params.g) @ z ** np.arange(4))
 
 
 def rest_voltages(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarray:
@@ -383,6 +443,7 @@ def simulate(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
         If a cell voltage leaves the finite range (only possible with ``limit=False``).
     """
     u = _check(structure, params, u, "u")
+    check_rest(structure, params)
     x = _start(structure, params, x0, u[0])
     y, x_end, n_bad = kernels.simulate(u, x, *_kernel_args(structure, params), params.w,
                                        params.v_b, structure.dt, _bound(structure, u, x))
@@ -391,7 +452,7 @@ def simulate(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
                                f"voltage exceeded 1e6 times the input range or overflowed); "
                                f"without the stability limit (eq. 5.29) forward Euler is "
                                f"unstable here")
-    return y, x_end
+    return check_finite_run(y, "mpl-poly"), x_end  # inputs near 1e308 may still overflow
 
 
 def simulate_reference(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
@@ -408,6 +469,10 @@ def simulate_with_jacobian(structure: MplPolyStructure, params: MplPolyParams, u
     order of :meth:`MplPolyParams.to_vector`. The rest start (``x0=None``) moves with the
     parameters: ``du_k(0)/dtheta = (df_k/dtheta)(v*) / f'_k(v*)``. Non-finite on divergence."""
     u = _check(structure, params, u, "u")
+    try:
+        check_rest(structure, params)
+    except FitDivergedError:  # a point outside the domain: the fit rejects the step
+        return np.full(u.size, np.nan), np.full((u.size, 5 * structure.n_cells + 6), np.nan)
     x = _start(structure, params, x0, u[0])
     fc, knees, s, limit, gc = _kernel_args(structure, params)
     sens0 = np.zeros((structure.n_cells, 4))
@@ -455,6 +520,7 @@ def invert(structure: MplPolyStructure, params: MplPolyParams, y: np.ndarray,
     y = _check(structure, params, y, "y")
     if params.w[0] == 0:
         raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
+    check_rest(structure, params)
     lo, hi, sign, centre = inverse_branch(structure, params)
     if x0 is None:
         x = rest_state(structure, params, y[0], inverse=True)
