@@ -92,15 +92,19 @@ _OPS = st.one_of(
               st.tuples(st.sampled_from(b'9"\x00,\n\xff'), st.integers(1, 200_000))),
     st.tuples(st.just("truncate"), st.integers(0, 1 << 30), st.just(0)),
 )
-# Headers and tags sit at the start of every format: half the positions fall there.
-_MUTATIONS = st.tuples(st.integers(0, 1), st.booleans(), st.lists(_OPS, min_size=1, max_size=4))
+# Headers and tags sit at the start of CSV and .mat files, Parquet's metadata at the end: a
+# third of the mutations fall in the first 512 bytes, a third in the last 512.
+_MUTATIONS = st.tuples(st.integers(0, 1), st.sampled_from(["start", "anywhere", "end"]),
+                       st.lists(_OPS, min_size=1, max_size=4))
 
 
-def _mutate(seed: bytes, near_start: bool, ops: list[tuple]) -> bytes:
+def _mutate(seed: bytes, region: str, ops: list[tuple]) -> bytes:
     data = bytearray(seed)
     for op, position, arg in ops:
-        span = min(len(data), 512) if near_start else len(data)
+        span = len(data) if region == "anywhere" else min(len(data), 512)
         at = position % max(span, 1)
+        if region == "end":
+            at = max(len(data) - 1 - at, 0)
         if op == "flip" and data:
             data[at] ^= 1 << arg
         elif op == "set" and data:
@@ -124,8 +128,8 @@ def _collect(seeds: list[bytes], n: int) -> list[bytes]:
               suppress_health_check=list(HealthCheck))
     @given(_MUTATIONS)
     def draw(mutation: tuple) -> None:
-        which, near_start, ops = mutation
-        out.append(_mutate(seeds[which % len(seeds)], near_start, ops))
+        which, region, ops = mutation
+        out.append(_mutate(seeds[which % len(seeds)], region, ops))
 
     draw()
     return out
