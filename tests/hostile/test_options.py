@@ -60,6 +60,10 @@ CASES = {
                                ["--tune PM_DEG"]),
     "control-pid-td-nan": ("control --scheme direct --bode --pid 1 1 nan --out {out}",
                            ["--pid TD"]),
+    "control-mass-1e-300": ("control --scheme direct --bode --mass 1e-300 --out {out}",
+                            ["--mass"]),
+    "control-pid-1e300": ("control --scheme direct --bode --pid 1e300 1e-300 1e300 --out {out}",
+                          ["--pid KP"]),
     "control-dob-hz-inf": ("control --scheme direct --bode --dob --dob-hz inf --out {out}",
                            ["--dob-hz"]),
     "control-sensor-size-huge": (("control --scheme direct --bode --sensor-size 10000 --out "

@@ -42,7 +42,7 @@ from ..control import (
 from ..io import atomic_folder, check_output_folder, read_recording, write_json
 from ..models import FAMILIES
 from ..signals import EXPERIMENTS as EXCITATIONS
-from ._common import UsageError, check_size, number, positive_float, positive_int
+from ._common import UsageError, check_size, number, positive_int
 
 __all__ = ["register"]
 
@@ -51,9 +51,12 @@ DOCUMENT_SINE = {"direct": {"e_p_max": 6.94e-4, "e_p_mean": -1.543e-4, "source":
                  "weighting": {"e_p_max": 1.86e-4, "e_p_mean": -2.29e-5, "source": "eq. 7.8"}}
 
 
-# PID gains (eq. 7.2): Kp > 0, Ti > 0 (inf: no integral action), Td >= 0; one type per slot.
-_PID_TYPES = (number(0, low_open=True), number(0, low_open=True, allow_inf=True), number(0))
-_TUNE_TYPES = (number(0, low_open=True), number(0, 90, low_open=True, high_open=True))
+# PID gains (eq. 7.2): 0 < Kp <= 1e9, 1 us <= Ti <= 1e6 s (inf: no integral action),
+# 0 <= Td <= 1000 s; one type per slot. Far beyond any tuning of a 0.25 kg stage, and the range
+# in which the loop's linearisation and simulation stay well conditioned.
+_PID_TYPES = (number(0, 1e9, low_open=True), number(1e-6, 1e6, allow_inf=True),
+              number(0, 1e3))
+_TUNE_TYPES = (number(0, 1e4, low_open=True), number(0, 90, low_open=True, high_open=True))
 
 
 class _Checked(argparse.Action):
@@ -287,7 +290,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="write bode.png: the linearised open loop at rest (alone: "
                         "analysis.json)")
     p.add_argument("--dob", action="store_true", help="add the disturbance observer (sec. 7.4)")
-    p.add_argument("--dob-hz", type=positive_float,
+    p.add_argument("--dob-hz", type=number(0, 1e6, low_open=True),
                    help="Q-filter bandwidth [Hz] (default: chosen by design_dob)")
     p.add_argument("--pid", nargs=3, action=_Checked, types=_PID_TYPES,
                    metavar=("KP", "TI", "TD"),
@@ -297,11 +300,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    metavar=("FC_HZ", "PM_DEG"),
                    help="tune the PID for this crossover (> 0 Hz) and phase margin (between 0 "
                         "and 90 deg) on the linearised loop")
-    p.add_argument("--tf", type=number(0), default=0.0,
+    p.add_argument("--tf", type=number(0, 1e3), default=0.0,
                    help="derivative filter time constant [s] (default 0: eq. 7.2)")
     p.add_argument("--anti-windup", action="store_true",
                    help="conditional integration while the force saturates (needs --u-max)")
-    p.add_argument("--mass", type=positive_float, default=MASS, help="moving mass [kg]")
+    p.add_argument("--mass", type=number(1e-6, 1e6), default=MASS,
+                   help="moving mass [kg], 1e-6 to 1e6")
     p.add_argument("--u-max", type=number(0, low_open=True, allow_inf=True), default=np.inf,
                    help="actuator force limit [N] (default none)")
     p.add_argument("--sensor", default="virtual",
