@@ -75,10 +75,17 @@ def test_fuzz_runs_are_finite_and_bounded_or_refused(n, data, amp, seed):
     bound = bobbio.output_bound(p, np.max(np.abs(u)))
     assert np.max(np.abs(y)) <= bound * (1 + 1e-12)
     x = FAMILY.rest_state(s, p, u[0])
-    # rounding is relative to the terms summed (up to the bound), not to a cancelled y
-    for k in range(3):  # the readable step stays finite too and gives the run's output
+    # the readable step and the loop's compiled block follow the run too; rounding is
+    # relative to the terms summed (up to the bound), not to a cancelled y
+    blk = FAMILY.block(s, p)
+    x = x_blk = FAMILY.rest_state(s, p, u[0])
+    for k in range(3):
         y_k, x = FAMILY.step(s, p, x, u[k])
+        x_next = x_blk.copy()
+        y_blk = blk.step(blk.body, x_blk, x_next, 0, u[k])
+        x_blk = x_next
         assert y_k == pytest.approx(y[k], rel=1e-12, abs=1e-12 * bound)
+        assert y_blk == pytest.approx(y[k], rel=1e-12, abs=1e-12 * bound)
     try:
         u_hat, x_end = FAMILY.invert(s, p, y)
     except FitDivergedError as exc:
