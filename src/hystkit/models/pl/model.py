@@ -42,9 +42,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._cells import (
+    DT_RANGE,
+    MAX_CELLS,
+    check_magnitude,
+    check_range,
+    check_structure_size,
+    state_bound,
+)
 from .._protocol import Record
 from .._validation import (
     check_dt,
+    check_finite_run,
     check_signal,
     check_slope_cap,
     finite_floats,
@@ -55,12 +64,18 @@ from .._validation import (
 from . import kernels
 
 __all__ = [
+    "A_RANGE",
+    "I_T_RANGE",
+    "MAX_BASIS",
+    "POWER_RANGE",
+    "V_T_RANGE",
     "PlParams",
     "PlStructure",
     "basis_breakpoints",
     "invert",
     "invert_step",
     "kernel_args",
+    "output_bound",
     "output_resistor",
     "output_resistor_inverse",
     "output_resistor_slope",
@@ -72,6 +87,17 @@ __all__ = [
     "states",
     "step",
 ]
+
+
+# Limits and the documented parameter domain (normalised units, eq. 5.10). The fit's box
+# (I_T in [1e-6, 1e4], V_T in [1e-3, 2], a_j >= 0.05 with sum a_j = M, |w| <= 100) lies
+# inside. A_RANGE is what keeps the output bounded: y = f^-1(u) divides by the slopes a_j, so
+# a = 1e-30 turned |u| <= 1 into |y| = 1e29.
+MAX_BASIS = 1000
+POWER_RANGE = (1.01, 1000.0)
+I_T_RANGE = (1e-12, 1e12)
+V_T_RANGE = (1e-9, 1e6)
+A_RANGE = (1e-3, 1e3)
 
 
 @dataclass(frozen=True)
@@ -94,6 +120,10 @@ class PlStructure(Record):
         Sample time [s].
     slope_cap : float
         ``G dt`` of the straight branches, the largest Euler slope (< 2, eq. 5.28; 1: no overshoot).
+
+    Limits (checked first, before anything is allocated): ``1 <= n_cells <= 1000``,
+    ``1 <= n_basis <= MAX_BASIS`` (1000), ``power`` in ``POWER_RANGE`` (1.01 .. 1000), ``dt``
+    in 1e-9 .. 1e6 s.
     """
 
     n_cells: int = 1
@@ -104,15 +134,13 @@ class PlStructure(Record):
     slope_cap: float = 1.0
 
     def __post_init__(self) -> None:
-        for name in ("n_cells", "n_basis"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or int(value) != value or value < 1:
-                raise ValueError(f"{name} must be a positive integer, got {value!r}")
-        if not (np.isfinite(self.power) and self.power > 1):
-            raise ValueError(f"power p must be > 1 (eq. 2.16 divides by p - 1), got {self.power!r}")
+        check_structure_size(self.n_cells, "n_cells", MAX_CELLS)
+        check_structure_size(self.n_basis, "n_basis", MAX_BASIS)
+        check_range(self.power, "power p", *POWER_RANGE, " (eq. 2.16 divides by p - 1)")
         if not (np.isfinite(self.smoothing) and self.smoothing >= 0):
             raise ValueError(f"smoothing S must be >= 0, got {self.smoothing!r}")
         check_dt(self.dt)
+        check_range(self.dt, "dt", *DT_RANGE, " s")
         check_slope_cap(self.slope_cap)
 
     @property
@@ -141,6 +169,14 @@ class PlParams(Record):
         Bias ``V_b``, eq. 2.18.
     a : array, shape (M,)
         Slopes ``a_j`` (> 0) of the output resistor on its M segments, eq. 2.17.
+
+    Notes
+    -----
+    Domain (checked here): ``I_T`` in ``I_T_RANGE`` (1e-12 .. 1e12), ``V_T`` in ``V_T_RANGE``
+    (1e-9 .. 1e6), ``a_j`` in ``A_RANGE`` (1e-3 .. 1e3), ``|w_k|, |V_b| <= 1e6``, at most 1000
+    cells and basis slopes. Every Euler step moves a cell towards its input, so
+    ``|y| <= (sum |w| B + |V_b|) / min(a)`` with ``B = max(max|x0|, max|u| max(1,
+    slope_cap / (2 - slope_cap)))`` (:func:`output_bound`).
     """
 
     i_t: float
@@ -156,12 +192,25 @@ class PlParams(Record):
         object.__setattr__(self, "n_basis", int(np.size(self.a)))
         if self.n_cells < 1 or self.n_basis < 1:
             raise ValueError("w needs N + 1 >= 2 values and a at least one")
+        check_structure_size(self.n_cells, "the number of cells (size of w minus 1)")
+        check_structure_size(self.n_basis, "the number of basis slopes (size of a)", MAX_BASIS)
         freeze_arrays(self, w=self.n_cells + 1, a=self.n_basis)
         finite_floats(self, "i_t", "v_t", "v_b")
-        if self.i_t <= 0 or self.v_t <= 0:
-            raise ValueError("i_t and v_t must be positive (eq. 2.16)")
-        if np.any(self.a <= 0):
-            raise ValueError("the output resistor slopes a_j must be positive (f invertible)")
+        check_range(self.i_t, "i_t", *I_T_RANGE, " (eq. 2.16)")
+        check_range(self.v_t, "v_t", *V_T_RANGE, " (eq. 2.16)")
+        check_range(self.a, "a (output resistor slopes)", *A_RANGE,
+                    ": y = f^-1(u) divides by them")
+        check_magnitude(self.w, "w")
+        check_magnitude(self.v_b, "v_b")
+
+
+def output_bound(structure: PlStructure, params: PlParams, u_max: float,
+                 x0_max: float | None = None) -> float:
+    """Largest ``|y|`` of a forward run with ``|u| <= u_max`` from ``|x0| <= x0_max``
+    (default: at rest, ``x0_max = u_max``); see the Notes of :class:`PlParams`."""
+    b = state_bound(u_max if x0_max is None else x0_max, u_max, structure.slope_cap)
+    u = abs(params.w[0]) * u_max + np.abs(params.w[1:]).sum() * b + abs(params.v_b)
+    return float(u / np.min(params.a))
 
 
 def basis_breakpoints(n_basis: int) -> np.ndarray:
@@ -175,7 +224,8 @@ def _cells(structure: PlStructure, params: PlParams) -> tuple[np.ndarray, np.nda
     p = structure.power
     thr = params.v_t * np.arange(1, structure.n_cells + 1)
     # d'(v) = p I_T / ((p - 1) thr) (v / thr)^(p - 1) = G  at  v = knee
-    knee = thr * (g_lin * (p - 1) * thr / (p * params.i_t)) ** (1.0 / (p - 1))
+    with np.errstate(over="ignore"):  # inf for p near 1: the slope never reaches G inside
+        knee = thr * (g_lin * (p - 1) * thr / (p * params.i_t)) ** (1.0 / (p - 1))
     return thr, np.minimum(knee, thr), g_lin
 
 
@@ -309,8 +359,9 @@ def simulate(structure: PlStructure, params: PlParams, u: np.ndarray,
     """
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_cells, x0, u[0])  # = rest_state(..., u[0]) for x0=None
-    return kernels.simulate(u, x, *kernel_args(structure, params), params.w, params.v_b,
-                            basis_breakpoints(structure.n_basis), params.a)
+    y, x_end = kernels.simulate(u, x, *kernel_args(structure, params), params.w, params.v_b,
+                                basis_breakpoints(structure.n_basis), params.a)
+    return check_finite_run(y, "pl"), x_end  # finite in the domain; inputs near 1e308 are not
 
 
 def simulate_reference(structure: PlStructure, params: PlParams, u: np.ndarray,
