@@ -15,7 +15,9 @@ Settings can sit beside the data in a TOML file with the data file's stem
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Iterator
+from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Self
@@ -32,13 +34,16 @@ from scipy.io.matlab import MatReadError
 from hystkit.errors import InputError
 
 from ._recording import _Where
-from ._writing import _write_text_safely, check_output_path
+from ._writing import atomic_output, check_output_path
 
 __all__ = ["RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter", "open_raw"]
 
 RAW_COLUMNS = ("time", "v1", "v2", "encoder", "enc_a", "enc_b")
 _TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 _MAX_STEP_DEVIATION = 0.01  # as for recordings: relative to 1/fs
+_FS_HEAD = 4096  # samples whose mean step gives fs
+# CSV lines skipped after the header (a units line or a few): pandas holds them as a set.
+MAX_SKIP_ROWS = 1_000_000
 
 @dataclass(frozen=True)
 class RawFormat:
@@ -71,9 +76,11 @@ class RawFormat:
         if self.time_unit not in _TIME_UNITS:
             raise ValueError(f"time_unit must be one of {', '.join(_TIME_UNITS)}, "
                              f"got {self.time_unit!r}")
-        if self.skip_rows < 0 or (self.fs is not None and not self.fs > 0) or (
+        if not 0 <= self.skip_rows <= MAX_SKIP_ROWS or (
+                self.fs is not None and not 0 < self.fs < np.inf) or (
                 self.n_samples is not None and self.n_samples < 1):
-            raise ValueError("skip_rows must be >= 0, fs > 0 and n_samples >= 1")
+            raise ValueError(f"skip_rows must lie in [0, {MAX_SKIP_ROWS}], fs be finite and "
+                             f"> 0 and n_samples >= 1")
 
     def name(self, column: str) -> str:
         """The file's name for hystkit column `column`."""
@@ -118,8 +125,8 @@ class RawReader:
         self.source = str(self.path)
         self.fmt = RawFormat() if fmt is None else fmt
         self.chunk_size = int(chunk_size)
-        if self.chunk_size < 2:
-            raise ValueError(f"chunk_size must be at least 2, got {chunk_size}")
+        if self.chunk_size < 1:
+            raise ValueError(f"chunk_size must be at least 1, got {chunk_size}")
         self.suffix = self.path.suffix.lower()
         if self.suffix not in (".csv", ".parquet", ".mat"):
             raise InputError(f"{self.source}: unsupported raw file type "
@@ -207,7 +214,8 @@ class RawReader:
     def _measure_fs(self) -> float:
         if not self.has_time:
             return float(self.fmt.fs)  # type: ignore[arg-type]
-        head = next(self._raw_chunks(min(self.chunk_size, 4096), ("time",)), None)
+        # A fixed head, not one chunk: the rate must not depend on the chunk size.
+        head = next(self._raw_chunks(_FS_HEAD, ("time",)), None)
         if head is None or head[1]["time"].size < 2:
             raise self.fail("fewer than 2 samples; a raw recording needs more")
         t = head[1]["time"]
@@ -423,7 +431,10 @@ class RawWriter:
     """Write a raw recording chunk by chunk to ``.csv`` or ``.parquet`` (one row group a chunk).
 
     Columns ``time`` (float64) and the voltages (float32: a scope's 8-16 bit samples fit its
-    24-bit mantissa, and the file is half the size). Use as a context manager.
+    24-bit mantissa, and the file is half the size). Use as a context manager. The rows go to
+    a hidden temporary beside `path` (:func:`atomic_output`), renamed into place when the block
+    ends normally: an exception, Ctrl-C or SIGTERM in between leaves no partial file, and
+    without `force` a file that appeared meanwhile is not overwritten.
     """
 
     def __init__(self, path: str | os.PathLike[str], columns: tuple[str, ...], *,
@@ -443,19 +454,23 @@ class RawWriter:
         self.n_rows = 0
         self._writer: Any = None
         self._suffix = suffix
+        self._force = force
+        self._stack = ExitStack()
 
     def __enter__(self) -> Self:
-        def start() -> None:
+        tmp = self._stack.enter_context(atomic_output(self.path, self._force))
+        try:
             if self._suffix == ".csv":
                 self._writer = pa_csv.CSVWriter(
-                    self.path, self.schema,
-                    write_options=pa_csv.WriteOptions(quoting_header="none"))
+                    tmp, self.schema, write_options=pa_csv.WriteOptions(quoting_header="none"))
             else:
                 # Noisy samples neither dictionary-encode nor compress: both only cost time
                 # (5x slower writing, 2x slower reading for 1 % smaller files).
-                self._writer = pq.ParquetWriter(self.path, self.schema, use_dictionary=False,
+                self._writer = pq.ParquetWriter(tmp, self.schema, use_dictionary=False,
                                                 compression="none")
-        _write_text_safely(self.path, start)
+        except BaseException:
+            self._stack.__exit__(*sys.exc_info())  # removes the temporary
+            raise
         return self
 
     def write(self, **arrays: np.ndarray) -> None:
@@ -466,5 +481,10 @@ class RawWriter:
         self.n_rows += table.num_rows
 
     def __exit__(self, *exc: object) -> None:
-        if self._writer is not None:
-            self._writer.close()
+        try:
+            if self._writer is not None:
+                self._writer.close()  # a Parquet footer: written before the file is published
+        except BaseException:
+            self._stack.__exit__(*sys.exc_info())
+            raise
+        self._stack.__exit__(*exc)  # publishes on success, removes the temporary otherwise

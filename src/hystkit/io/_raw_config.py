@@ -17,7 +17,8 @@ import numpy as np
 
 from hystkit.errors import InputError
 
-from ._writing import _write_text_safely, check_output_path
+from ._raw import MAX_SKIP_ROWS
+from ._writing import atomic_output
 
 __all__ = ["CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_config"]
 
@@ -46,6 +47,28 @@ CONFIG_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
 }
 
 
+# Ranges of the numeric keys, checked on reading (before anything is allocated or looped over):
+# key: (low, high, low included). Wide enough for every real setup, narrow enough that a typo
+# (skip_rows = 1000000000, fs = 1e300, chunk_size = 0) is named instead of hanging or crashing.
+CONFIG_RANGES: dict[str, tuple[float, float, bool]] = {
+    "r_bridge": (0.0, 1e9, False),
+    "v_supply": (0.0, 1e3, False),
+    "um_per_count": (0.0, 1e6, False),
+    "position_offset_mm": (-1e6, 1e6, True),
+    "fs_out": (0.0, 1e9, False),
+    "cutoff": (0.0, 1e9, False),
+    "order": (1, 20, True),
+    "fs": (0.0, 1e11, False),
+    "n_samples": (1, 1e13, True),
+    "encoder_dwell_us": (0.0, 1e6, False),
+    "chunk_size": (1, 1 << 27, True),
+    "skip_rows": (0, MAX_SKIP_ROWS, True),
+}
+# Encoder levels are voltages a scope can show.
+_MAX_LEVEL_V = 1e3
+_CHOICES = {"illegal": ("continue", "hold"), "time_unit": ("s", "ms", "us", "ns")}
+_COLUMN_NAMES = ("time", "v1", "v2", "encoder", "enc_a", "enc_b")
+
 
 def find_raw_config(data_path: str | os.PathLike[str]) -> Path | None:
     """The settings file stored next to a raw recording (same stem, ``.toml``), if present."""
@@ -59,16 +82,21 @@ def read_raw_config(path: str | os.PathLike[str]) -> dict[str, Any]:
     Raises
     ------
     InputError
-        Unreadable or invalid TOML, an unknown key (a typo would otherwise be ignored), or a
-        value of the wrong type. Ranges are checked by the code that uses the values.
+        Unreadable or invalid TOML, an unknown key (a typo would otherwise be ignored), a value
+        of the wrong type, a number outside :data:`CONFIG_RANGES` (or not finite), an unknown
+        choice or column name; one line naming the file and the key.
     """
     path = Path(path)
     try:
+        if path.is_dir():
+            raise InputError(f"{path}: is a folder, not a TOML settings file")
         with path.open("rb") as handle:
             values = tomllib.load(handle)
     except FileNotFoundError as exc:
         raise InputError(f"{path}: config file not found") from exc
-    except tomllib.TOMLDecodeError as exc:
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read config file ({exc})") from exc
+    except (tomllib.TOMLDecodeError, RecursionError) as exc:
         raise InputError(f"{path}: invalid TOML ({exc})") from exc
     for key, value in values.items():
         if key not in CONFIG_KEYS:
@@ -79,21 +107,52 @@ def read_raw_config(path: str | os.PathLike[str]) -> dict[str, Any]:
         if not ok:
             raise InputError(f"{path}: key {key!r} must be "
                              f"{' or '.join(t.__name__ for t in types)}, got {value!r}")
+        _check_value(path, key, value)
     return values
+
+
+def _check_value(path: Path, key: str, value: Any) -> None:
+    """Range, finiteness and choices of one key whose type is already right."""
+    def fail(message: str) -> None:
+        raise InputError(f"{path}: key {key!r}: {message}")
+
+    if key in CONFIG_RANGES:
+        low, high, closed = CONFIG_RANGES[key]
+        if not math.isfinite(value):
+            fail(f"must be a finite number, got {value}")
+        if not ((value >= low if closed else value > low) and value <= high):
+            fail(f"{value!r} is outside {'[' if closed else '('}{low:g}, {high:g}]")
+    elif key in _CHOICES and value not in _CHOICES[key]:
+        fail(f"must be one of {', '.join(_CHOICES[key])}, got {value!r}")
+    elif key == "encoder_levels":
+        ok = len(value) == 4 and all(
+            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+            and abs(v) <= _MAX_LEVEL_V for v in value)
+        if not ok:
+            fail(f"must be four finite voltages within +-{_MAX_LEVEL_V:g} V, got {value!r}")
+    elif key == "encoder_states" and isinstance(value, list):
+        if len(value) != 4 or not all(isinstance(v, str) for v in value):
+            fail(f"must be four A/B states such as \"00\", got {value!r}")
+    elif key == "columns":
+        for name, column in value.items():
+            if name not in _COLUMN_NAMES or not isinstance(column, str):
+                fail(f"entry {name!r} = {column!r}: names must be among "
+                     f"{', '.join(_COLUMN_NAMES)} and map to column names (strings)")
 
 
 def write_raw_config(path: str | os.PathLike[str], values: dict[str, Any], *,
                      comment: str = "", force: bool = False) -> Path:
-    """Write flat settings (numbers, strings, booleans, lists, one level of tables) as TOML."""
+    """Write flat settings (numbers, strings, booleans, lists, one level of tables) as TOML,
+    atomically (a temporary renamed into place); refuses to overwrite unless `force`."""
     path = Path(path)
-    check_output_path(path, force)
     lines = [f"# {line}" for line in comment.splitlines()]
     tables = {k: v for k, v in values.items() if isinstance(v, dict)}
     lines += [f"{k} = {_toml_value(v)}" for k, v in values.items() if k not in tables]
     for name, table in tables.items():
         lines += ["", f"[{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
     text = "\n".join(lines) + "\n"
-    _write_text_safely(path, lambda: path.write_text(text, encoding="utf-8"))
+    with atomic_output(path, force) as tmp:  # the whole file or nothing
+        tmp.write_text(text, encoding="utf-8")
     return path
 
 

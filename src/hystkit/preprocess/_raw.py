@@ -59,8 +59,13 @@ from ._encoder import (
 from ._filters import lowpass_zero_phase
 from ._levels import LevelSurvey
 
-__all__ = ["PreprocessReport", "PreprocessResult", "PreprocessSettings", "RawDataWarning",
-           "preprocess_raw"]
+__all__ = ["MAX_CHUNK_SIZE", "PreprocessReport", "PreprocessResult", "PreprocessSettings",
+           "RawDataWarning", "preprocess_raw"]
+
+# Encoder levels are surveyed in blocks of this many samples, whatever the chunk size.
+SURVEY_BLOCK = 1 << 16
+# Memory is about 200 bytes per chunk sample; as the CLI's --chunk-size limit.
+MAX_CHUNK_SIZE = 1 << 27
 
 
 class RawDataWarning(UserWarning):
@@ -95,8 +100,9 @@ class PreprocessSettings:
     remove_mean, normalise : bool
         Subtract the mean of position and sensor; divide them by their max |.| (eq. 5.10).
     chunk_size : int
-        Samples per chunk (2**18); memory is about 200 bytes per chunk sample. Larger chunks
-        are no faster: they fall out of the CPU caches between the passes over a chunk.
+        Samples per chunk (2**18; 1 to ``MAX_CHUNK_SIZE``); memory is about 200 bytes per chunk
+        sample. Larger chunks are no faster: they fall out of the CPU caches between the passes
+        over a chunk. The results do not depend on it, bit for bit.
     mid_factor : int
         The intermediate rate is about ``mid_factor * fs_out``.
     """
@@ -127,8 +133,11 @@ class PreprocessSettings:
         if self.cutoff > self.fs_out / 2:
             raise ValueError(f"cutoff {self.cutoff:g} Hz is above fs_out / 2 = "
                              f"{self.fs_out / 2:g} Hz: the output would alias")
-        if self.order < 1 or self.chunk_size < 2 or self.mid_factor < 4:
-            raise ValueError("order must be >= 1, chunk_size >= 2 and mid_factor >= 4")
+        if not (1 <= self.order <= 20 and 1 <= self.chunk_size <= MAX_CHUNK_SIZE
+                and self.mid_factor >= 4):
+            raise ValueError(f"order must lie in [1, 20], chunk_size in [1, {MAX_CHUNK_SIZE}] "
+                             f"and mid_factor be >= 4 (got {self.order}, {self.chunk_size}, "
+                             f"{self.mid_factor})")
         if not 0 <= self.max_illegal_fraction <= 1:
             raise ValueError("max_illegal_fraction must lie in [0, 1]")
         EncoderSettings(states=self.encoder_states, illegal=self.illegal)  # validates both
@@ -275,27 +284,50 @@ def _encoder_setup(reader: RawReader, settings: PreprocessSettings, dwell: int
     enc = EncoderSettings(states=settings.encoder_states, dwell=dwell, illegal=settings.illegal)
     if settings.encoder_levels is not None:
         return enc, np.asarray(settings.encoder_levels, dtype=float), None
-    survey = LevelSurvey()
-    for chunk in reader.chunks(columns=("encoder",)):
-        survey = survey.add(chunk.encoder)
-        if survey.n_levels >= 4 and min(c[3] for c in survey.clusters) >= 100:
-            break
+    survey = _survey(reader, "encoder", 4)
     _check_levels(reader, "encoder", survey, 4)
     return enc, survey.centres, None
 
 
 def _logic_threshold(reader: RawReader, column: str) -> float:
-    survey = LevelSurvey()
-    for chunk in reader.chunks(columns=(column,)):
-        survey = survey.add(getattr(chunk, column))
-        if survey.n_levels >= 2 and min(c[3] for c in survey.clusters) >= 100:
-            break
+    survey = _survey(reader, column, 2)
     _check_levels(reader, column, survey, 2)
     return float(survey.centres.mean())
 
 
+def _survey(reader: RawReader, column: str, wanted: int) -> LevelSurvey:
+    """Levels of `column`, surveyed in blocks of ``SURVEY_BLOCK`` samples from the start until
+    `wanted` levels each hold 100 samples. The blocks do not depend on the reader's chunk size,
+    so neither do the levels found (nor anything decoded with them)."""
+    survey = LevelSurvey()
+    for block in _blocks(reader.chunks(columns=(column,)), column, SURVEY_BLOCK):
+        survey = survey.add(block)
+        if survey.n_levels >= wanted and min(c[3] for c in survey.clusters) >= 100:
+            break
+    return survey
+
+
+def _blocks(chunks: Iterator[RawChunk], column: str, size: int) -> Iterator[np.ndarray]:
+    """`column` of consecutive chunks, re-cut into blocks of `size` samples (the last shorter)."""
+    pending: list[np.ndarray] = []
+    n = 0
+    for chunk in chunks:
+        pending.append(getattr(chunk, column))
+        n += pending[-1].size
+        while n >= size:
+            joined = np.concatenate(pending)
+            yield joined[:size]
+            pending, n = [joined[size:]], n - size
+    if n:
+        yield np.concatenate(pending)
+
+
 def _check_levels(reader: RawReader, column: str, survey: LevelSurvey, wanted: int) -> None:
     found = ", ".join(f"{c:.4g}" for c in survey.centres)
+    if survey.n_levels == 0:  # no level held 2 samples: far too short to survey
+        raise reader.fail(f"only {survey.n_samples} samples: too few to find the "
+                          f"{wanted} levels of the channel (give --encoder-levels, or record "
+                          "longer)", column)
     if survey.n_levels <= 1:
         lo, hi = survey.clusters[0][1], survey.clusters[0][2]
         raise reader.fail(f"flat: one level ({found} V, range {lo:.4g} to {hi:.4g} V) in "
