@@ -16,12 +16,15 @@ from __future__ import annotations
 
 import json
 import os
-import resource
 import sys
 
 
 def _limit_memory(limit: int) -> None:
     # A flipped size field can ask for terabytes; fail with MemoryError instead of swapping.
+    try:
+        import resource
+    except ImportError:  # not POSIX: no limit
+        return
     if limit > 0:
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
