@@ -108,6 +108,7 @@ def test_rest_points_moved_out_by_the_limit_are_refused_at_run_time():
 @pytest.mark.parametrize("field, row, value, message", [
     ("f", 3, 0.0, "cubic coefficient"), ("f", 3, -1.0, "cubic coefficient"),
     ("f", 1, 2e9, "f"), ("f", 0, np.nan, "f"), ("g", 1, 1e10, "g"),
+    ("g", 3, 5e-324, "g must be 0 or at least 1e-200"),
     ("w", 0, -2e6, "w"), ("v_b", None, 1e7, "v_b")])
 def test_out_of_domain_parameters_are_refused_by_name(field, row, value, message):
     raw = {"f": [[0.0, 1.0, 0.0, 1.0]], "g": [0.0, 1.0, 0.0, 0.1], "w": [1.0, -0.5],

@@ -47,6 +47,7 @@ from . import kernels
 
 __all__ = [
     "C3_RANGE",
+    "G_MIN",
     "POLY_MAX",
     "REST_MAX",
     "MplPolyParams",
@@ -77,7 +78,10 @@ __all__ = [
 # (c3 down to 5e-7); what keeps a run meaningful is REST_MAX: a cell resting 1000 ranges away
 # from [-1, 1] data is a cubic, not a hysteresis cell, and drives z and g(z) to 1e24 .. 1e67.
 POLY_MAX = 1e9
-C3_RANGE = (1e-300, 1e9)  # tiny c3: a near-linear cell (its roots are checked)
+# Leading coefficients at least 1e-200 (and nonzero g_j too, any may lead): the root finders
+# divide by them, and POLY_MAX / 1e-200 stays far inside the float range.
+C3_RANGE = (1e-200, 1e9)
+G_MIN = 1e-200
 REST_MAX = 1e3
 
 
@@ -123,8 +127,9 @@ class MplPolyParams(Record):
     Notes
     -----
     Domain (checked here): ``|c_k0..c_k2|, |g_j| <= POLY_MAX`` (1e9), ``c_k3`` in
-    ``C3_RANGE`` (1e-300 .. 1e9), ``|w_k|, |V_b| <= 1e6``, at most 1000 cells, and every real
-    root of every cell's cubic within ``|v| <= REST_MAX`` (1000). The limited resistor's rest
+    ``C3_RANGE`` (1e-200 .. 1e9), each ``g_j`` 0 or at least ``G_MIN`` (1e-200) in
+    magnitude, ``|w_k|, |V_b| <= 1e6``, at most 1000 cells, and every real root of every
+    cell's cubic within ``|v| <= REST_MAX`` (1000). The limited resistor's rest
     voltages depend on ``dt`` too; runs check them (:func:`check_rest`). With them, a run
     with ``slope_cap <= 1`` stays within :func:`output_bound`.
 
@@ -153,6 +158,10 @@ class MplPolyParams(Record):
                     " (positive: stable for large |v|, sec. 5.3.5)")
         check_magnitude(self.f[:, :3], "f (c0..c2)", POLY_MAX)
         check_magnitude(self.g, "g", POLY_MAX)
+        tiny = (self.g != 0) & (np.abs(self.g) < G_MIN)
+        if np.any(tiny):
+            raise ValueError(f"g must be 0 or at least {G_MIN:g} in magnitude (its roots are "
+                             f"solved for), got {float(self.g[np.argmax(tiny)])!r}")
         check_magnitude(self.w, "w")
         check_magnitude(self.v_b, "v_b")
         for k, c in enumerate(self.f):
