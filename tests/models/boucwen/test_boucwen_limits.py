@@ -75,7 +75,7 @@ def test_divergence_in_the_bounded_class_is_stopped_at_the_energy_bound():
     # w0 h = 0.3, but a hysteretic element far too stiff for the step
     p = bw.BoucWenParams(m=1.0, c=0.5, k=1.0, alpha=5.0, beta=400.0, gamma=100.0, nu=1.0)
     s = bw.BoucWenStructure(dt=0.12, substeps=1)
-    with pytest.raises(FitDivergedError, match="beyond the energy bound.*too stiff"):
+    with pytest.raises(FitDivergedError, match="beyond the bound.*too stiff"):
         bw.simulate(s, p, 3 * np.sign(np.sin(np.arange(300) / 3.0)))
 
 
@@ -117,3 +117,17 @@ def test_fuzz_run_is_finite_and_bounded_or_raises_diverged(m, c, k, alpha, beta,
         return
     assert np.all(np.isfinite(y)) and np.all(np.isfinite(x_end))
     assert np.max(np.abs(y)) <= bw.divergence_bound(s, p, bw.initial_state(s, p, u[0]), u)
+
+
+def test_a_fit_whose_runs_all_diverge_says_what_the_last_run_did(monkeypatch):
+    from hystkit.models.boucwen import fit as bw_fit
+
+    def diverging(u, x0, fresh, theta, dt, n_sub, linear, bound):
+        states = np.zeros((u.size, 3))
+        return states, np.array([1e200, -1e300, 3.0, u[3]]), 3
+
+    monkeypatch.setattr(bw_fit.kernels, "simulate", diverging)
+    u = _sweep(200)
+    with pytest.raises(FitDivergedError, match=r"every linear start diverged; the last: the "
+                                               r"Bouc-Wen state diverged at sample 4 of 200"):
+        FAMILY.fit(u, 0.8 * u, FAMILY.make_structure(DT, 2))

@@ -171,12 +171,18 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
     penalty = np.full(y.size, bound)
     linear = structure.input_hold == "linear"
 
+    last_divergence: list[str] = []  # what the most recent diverged run did, for the error
+
     def run(theta: np.ndarray, limit: float) -> np.ndarray | None:
         params = boucwen.BoucWenParams.from_vector(theta)
         x0 = boucwen.initial_state(structure, params, u[0])
-        states, _, n_bad = kernels.simulate(u, x0, True, params.as_array(), structure.dt,
-                                            structure.substeps, linear, limit)
-        return None if n_bad >= 0 else states[::stride, 0][discard:]
+        states, x_end, n_bad = kernels.simulate(u, x0, True, params.as_array(), structure.dt,
+                                                structure.substeps, linear, limit)
+        if n_bad >= 0:
+            last_divergence[:] = [boucwen.divergence_message(structure, params, x_end, n_bad,
+                                                             u.size, limit)]
+            return None
+        return states[::stride, 0][discard:]
 
     def solve(free: np.ndarray, template: np.ndarray, starts: list[np.ndarray],
               **options) -> FitResult:
@@ -203,15 +209,17 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
     lin_starts = _linear_starts(lower, upper, lambda th: run(np.r_[th, template[3:]], np.inf),
                                 y)
     if not lin_starts:
-        raise FitDivergedError("the fit failed: no linear oscillator follows the data's sign")
+        why = (f"every linear start diverged; the last: {last_divergence[0]}"
+               if last_divergence else "no linear oscillator follows the data's sign")
+        raise FitDivergedError(f"the fit failed: {why}")
     stage1 = solve(np.arange(3), template, [np.r_[th, template[3:]] for th in lin_starts])
     free = np.arange(7 if nu is None else 6)
     stage2 = solve(free, template,
                    _hysteretic_starts(stage1.params.to_vector()[:3], _reference_amplitude(y),
                                       nu_start), accept=accept, accept_reason=accept_reason)
     if not stage2.cost < float(penalty @ penalty):
-        raise FitDivergedError("the fit failed: the integration diverged from every start; "
-                               "use more substeps")
+        raise FitDivergedError(f"the fit failed: the integration diverged from every start "
+                               f"(the last: {''.join(last_divergence) or 'no finite cost'})")
     return replace(stage2, seconds=time.perf_counter() - t_start,
                    n_evaluations=stage1.n_evaluations + stage2.n_evaluations,
                    n_starts=stage1.n_starts + stage2.n_starts)

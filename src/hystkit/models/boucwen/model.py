@@ -68,6 +68,7 @@ __all__ = [
     "bandlimited_upsample",
     "bounded_class",
     "divergence_bound",
+    "divergence_message",
     "initial_state",
     "rest_state",
     "simulate",
@@ -347,7 +348,7 @@ def simulate_states(structure: BoucWenStructure, params: BoucWenParams, u: np.nd
                                             structure.substeps,
                                             structure.input_hold == "linear", bound)
     if n_bad >= 0:
-        raise FitDivergedError(_divergence_message(structure, params, x_end, n_bad, u.size,
+        raise FitDivergedError(divergence_message(structure, params, x_end, n_bad, u.size,
                                                    bound))
     return states, x_end
 
@@ -378,13 +379,13 @@ def divergence_bound(structure: BoucWenStructure, params: BoucWenParams, x: np.n
         return float(2.0 * np.sqrt(2.0 * energy / params.k))
 
 
-def _divergence_message(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
+def divergence_message(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
                         n_bad: int, n: int, bound: float) -> str:
     """What happened (the state at the sample it diverged) and the likely cause."""
     w0h = params.omega0 * structure.step_size
     state = f"(y, y', z) = ({x[0]:.3g}, {x[1]:.3g}, {x[2]:.3g})"
     what = (f"the Bouc-Wen state diverged at sample {n_bad + 1} of {n}: {state}"
-            + ("" if np.isinf(bound) else f", beyond the energy bound |y| <= {bound:.3g}"))
+            + ("" if np.isinf(bound) else f", beyond the bound |y| <= {bound:.3g}"))
     if w0h > RK4_LIMIT:
         cause = (f"the RK4 step {structure.step_size:.3g} s is too long for w0 = "
                  f"{params.omega0:.3g} rad/s (w0 h = {w0h:.3g} > {RK4_LIMIT}); use more "
