@@ -160,3 +160,18 @@ def test_an_estimate_that_runs_away_is_refused_not_written(cli, good, tmp_path):
              "wild.csv", "column 'sensor', sample", good["model"].name, "beyond")
     _refused(cli, tmp_path, ["evaluate", good["model"], data, "--json", tmp_path / "s.json"],
              "wild.csv", good["model"].name)
+
+
+def test_evaluate_on_a_position_that_never_moves(cli, good, tmp_path):
+    """R² and loop areas are undefined against a constant position: None in the JSON, not a
+    crash; the run still reports the errors in mm."""
+    table = pd.read_csv(good["val"])
+    table["position"] = 1.0
+    data = tmp_path / "still.csv"
+    table.to_csv(data, index=False)
+    run = cli("evaluate", good["model"], data, "--json", tmp_path / "s.json")
+    run.clean()
+    assert run.code == 0, run.err
+    scores = json.loads((tmp_path / "s.json").read_text())
+    assert scores["r2"] is None and scores["loop_area"] is None
+    assert scores["e_rms_pct"] > 0

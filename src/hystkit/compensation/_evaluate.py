@@ -30,7 +30,7 @@ def use_flags(compensator: Compensator, recording: Recording,
 
 
 def _scores(position: np.ndarray, guess: np.ndarray, scale: float, fs: float) -> dict:
-    return {"r2": r2(position, guess), "e_rms_pct": e_rms_pct(position, guess, scale=scale),
+    return {"r2": _r2_or_none(position, guess), "e_rms_pct": e_rms_pct(position, guess, scale=scale),
             "e_max_pct": e_max_pct(position, guess, scale=scale),
             "sinad_db": _sinad_or_none(guess, fs), "loop_area": _loop_area_or_none(position,
                                                                                   guess)}
@@ -90,9 +90,14 @@ def _finite_or_none(value: object) -> object:
     return value
 
 
+def _r2_or_none(position: np.ndarray, guess: np.ndarray) -> float | None:
+    """R² is undefined (None) against a position that never moves."""
+    return None if np.ptp(position) == 0 else r2(position, guess)
+
+
 def _loop_area_or_none(x: np.ndarray, y: np.ndarray) -> float | None:
-    """eq. 5.15 normalises by the range of y: undefined (None) for a constant estimate."""
-    return None if np.ptp(y) == 0 else loop_area(x, y)
+    """eq. 5.15 normalises by the ranges of x and y: undefined (None) if either is constant."""
+    return None if np.ptp(y) == 0 or np.ptp(x) == 0 else loop_area(x, y)
 
 
 def _sinad_or_none(x: np.ndarray, fs: float) -> float | None:
