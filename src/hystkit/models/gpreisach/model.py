@@ -37,14 +37,16 @@ from math import comb
 import numpy as np
 from numpy.polynomial import Polynomial
 
-from ...errors import FitDivergedError
+from .._cells import check_magnitude
 from .._protocol import Record
-from .._validation import run_steps
+from .._validation import check_finite_run, run_steps
 from ..preisach import (
     INVERT_TOL,
+    MAX_VALUE,
     PreisachParams,
     PreisachStructure,
     antisymmetric,
+    check_rise,
     kernels,
     prepare_run,
     staircase_terms,
@@ -58,6 +60,7 @@ __all__ = [
     "invert_step",
     "kernel_parts",
     "major_slope",
+    "output_bound",
     "reversible",
     "reversible_basis",
     "simulate",
@@ -127,6 +130,13 @@ class GPreisachParams(Record):
         Bernstein coefficients of the reversible weight ``nu``.
     offset : float
         Output offset ``y_0``.
+
+    Notes
+    -----
+    Domain (checked here): both tables as ``PreisachParams`` (``|F| <= 1e6``, at most 128
+    levels), ``|nu_k|, |y_0| <= 1e6``. Then ``|y - y_0| <= B max(1, |u|)`` with
+    ``B = max(sum |m_-|, sum |m_+|) + 2 sum |nu_k| / (d + 1)`` (:func:`output_bound`). The
+    inverse needs a rising major loop (``preisach.check_rise``).
     """
 
     everett_minus: np.ndarray
@@ -145,6 +155,8 @@ class GPreisachParams(Record):
             raise ValueError("nu must be 1..9 finite Bernstein coefficients")
         if not np.isfinite(self.offset):
             raise ValueError("offset must be finite")
+        check_magnitude(nu, "nu", MAX_VALUE)
+        check_magnitude(self.offset, "offset", MAX_VALUE)
         nu.setflags(write=False)
         object.__setattr__(self, "nu", nu)
         object.__setattr__(self, "offset", float(self.offset))
@@ -171,6 +183,20 @@ def major_slope(params: GPreisachParams) -> float:
     """Mean slope of the major loop, ``(y(+sat) - y(-sat)) / 2``: the extension beyond +-1."""
     rise = params.everett_plus[-1, 0] + params.everett_minus[-1, 0]
     return float(0.5 * (rise + reversible(params.nu, 1.0) - reversible(params.nu, -1.0)))
+
+
+def _mass(params: GPreisachParams) -> float:
+    """``max(sum |m_-|, sum |m_+|) + 2 sum |nu_k| / (d + 1)``: the most the relay and the
+    reversible part move the output over [-1, 1] (each ``|R_k| <= 2 / (d + 1)``)."""
+    relay = max(np.abs(PreisachParams(t).masses()).sum()
+                for t in (params.everett_minus, params.everett_plus))
+    return float(relay + 2.0 * np.abs(params.nu).sum() / params.nu.size)
+
+
+def output_bound(params: GPreisachParams, u_max: float) -> float:
+    """``|y_0| + B max(1, u_max)`` (class Notes): no output of a run with ``|u| <= u_max``
+    exceeds it."""
+    return float(abs(params.offset) + _mass(params) * max(1.0, u_max))
 
 
 def _poly(params: GPreisachParams) -> np.ndarray:
@@ -243,7 +269,9 @@ def simulate(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarr
     """
     u, x = _check(structure, params, u, "u", x0)
     relay, x_end = kernels.run_tables(u, x, _tables(params), structure.capacity)
-    return _combine(params, relay, u), x_end
+    with np.errstate(over="ignore", invalid="ignore"):  # inputs near 1e308 on the extension
+        y = _combine(params, relay, u)
+    return check_finite_run(y, "gpreisach"), x_end
 
 
 def simulate_reference(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarray,
@@ -269,10 +297,10 @@ def invert(structure: GPreisachStructure, params: GPreisachParams, y: np.ndarray
     """
     y, x = _check(structure, params, y, "y", x0)
     tables, weighted, poly, slope = kernel_parts(params)
-    if slope <= 0:
-        raise FitDivergedError("the generalised Preisach model's major loop does not rise; it "
-                               "has no inverse")
-    return kernels.invert(y, x, tables, weighted, poly, slope, structure.capacity, INVERT_TOL)
+    check_rise(slope, _mass(params), "generalised Preisach")
+    u_hat, x_end = kernels.invert(y, x, tables, weighted, poly, slope, structure.capacity,
+                                  INVERT_TOL)
+    return check_finite_run(u_hat, "inverse gpreisach", "input estimate"), x_end
 
 
 def invert_step(structure: GPreisachStructure, params: GPreisachParams, x: np.ndarray,

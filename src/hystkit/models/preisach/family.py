@@ -13,7 +13,6 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ...errors import FitDivergedError
 from .._protocol import Block, Family
 from . import kernels
 from . import model as preisach
@@ -101,9 +100,8 @@ class StaircaseFamily(Family):
         """
         self.simulate(structure, params, np.zeros(2))  # checks that params fit the structure
         tables, weighted, poly, slope = self.stairs.kernel_parts(params)
-        if inverse and slope <= 0:
-            raise FitDivergedError(f"the {self.name} model's major loop does not rise; it has "
-                                   f"no inverse")
+        if inverse:  # the inverse's own checks: a major loop that rises enough to invert
+            self.invert(structure, params, np.zeros(2))
         levels = tables.shape[1]
         head = [structure.capacity, levels, tables.shape[0], float(weighted), slope,
                 preisach.INVERT_TOL, poly.size]

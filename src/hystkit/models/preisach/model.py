@@ -53,15 +53,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._cells import check_magnitude, check_structure_size
 from .._protocol import Record
-from .._validation import check_dt, check_signal, check_size, run_steps
+from .._validation import check_dt, check_finite_run, check_signal, check_size, run_steps
 from . import kernels
 
 __all__ = [
+    "MAX_CAPACITY",
+    "MAX_LEVELS",
+    "MAX_VALUE",
+    "MIN_RISE",
     "PreisachParams",
     "PreisachStructure",
     "antisymmetric",
     "cell_regressors",
+    "check_rise",
     "check_state",
     "demagnetised_state",
     "everett",
@@ -71,6 +77,7 @@ __all__ = [
     "invert_step",
     "kernel_parts",
     "masses_from_everett",
+    "output_bound",
     "pack_state",
     "prepare_run",
     "simulate",
@@ -80,6 +87,18 @@ __all__ = [
     "unpack_state",
     "update_staircase",
 ]
+
+# Limits. The fit's design matrix holds n_samples x L (L - 1) / 2 floats: at L = 128 and 8000
+# samples 0.5 GB (measured: 1.5 GB peak, 2.5 min); L = 512 would need 8.4 GB. A run holds one
+# (L, L) table (128 kB) and a staircase of `capacity` floats (8 MB at MAX_CAPACITY).
+MAX_LEVELS = 128
+MAX_CAPACITY = 1 << 20
+# Everett values and offsets in normalised units (eq. 5.10: a major loop spanning [-1, 1] has
+# F(1, -1) = 1); sums of 128^2 of them stay finite.
+MAX_VALUE = 1e6
+# The inverse divides by the major loop's rise beyond saturation: one smaller than this
+# fraction of the total mass turns an output step into an input step 1e9 times larger.
+MIN_RISE = 1e-9
 
 INVERT_TOL = 1e-12  # bisection bracket width on the normalised input before interpolating
 
@@ -91,11 +110,13 @@ class PreisachStructure(Record):
     Parameters
     ----------
     levels : int
-        Grid levels ``L`` over [-1, 1] (>= 2): ``L (L - 1) / 2`` Preisach cells.
+        Grid levels ``L`` over [-1, 1] (``2 .. MAX_LEVELS``, 128): ``L (L - 1) / 2`` Preisach
+        cells.
     dt : float
         Sample time [s]. The model is rate independent; ``dt`` only records the sampling.
     capacity : int
-        Size of the staircase buffer (>= 2 L + 2); per-sample cost does not depend on it.
+        Size of the staircase buffer (``2 L + 2 .. MAX_CAPACITY``, 2^20); per-sample cost does
+        not depend on it.
         It is also the fixed length of the loop state (``capacity + 1`` floats, see
         :func:`pack_state`). When the staircase is about to fill, the innermost closed loop is
         forgotten (module docstring): the memory degrades gracefully, never overflows.
@@ -116,10 +137,12 @@ class PreisachStructure(Record):
     orientation: str = "auto"
 
     def __post_init__(self) -> None:
-        if int(self.levels) != self.levels or self.levels < 2:
+        check_structure_size(self.levels, "levels", MAX_LEVELS)  # first: L^2 tables follow
+        if self.levels < 2:
             raise ValueError(f"levels must be an integer >= 2, got {self.levels!r}")
         check_dt(self.dt)
-        if int(self.capacity) != self.capacity or self.capacity < 2 * self.levels + 2:
+        check_structure_size(self.capacity, "capacity", MAX_CAPACITY)
+        if self.capacity < 2 * self.levels + 2:
             raise ValueError(f"capacity must be an integer >= 2 * levels + 2 = "
                              f"{2 * self.levels + 2}, got {self.capacity!r}")
         if not (np.isfinite(self.smoothing) and self.smoothing >= 0):
@@ -172,12 +195,21 @@ class PreisachParams(Record):
         must be zero (``F(a, a) = 0``; ``F`` is defined for ``alpha >= beta`` only).
     offset : float
         Output offset ``y_0 = (f+ + f-) / 2``.
+
+    Notes
+    -----
+    Domain (checked here): ``|F|, |y_0| <= MAX_VALUE`` (1e6), ``2 <= L <= MAX_LEVELS``. Then
+    ``|y - y_0| <= sum |m| max(1, |u|)`` with ``m`` the cell masses (:func:`output_bound`).
+    The inverse needs a rising major loop, ``F(1, -1) >= MIN_RISE sum |m|``, and returns
+    ``|u| <= 1 + (|y - y_0| + sum |m|) / F(1, -1)``.
     """
 
     everett: np.ndarray
     offset: float = 0.0
 
     def __post_init__(self) -> None:
+        check_structure_size(len(self.everett) if np.ndim(self.everett) else 1,
+                             "levels (rows of everett)", MAX_LEVELS)  # before the copy
         e = np.array(self.everett, dtype=float)
         if e.ndim != 2 or e.shape[0] != e.shape[1] or e.shape[0] < 2:
             raise ValueError(f"everett must be a square (L, L) array with L >= 2, got shape "
@@ -186,6 +218,8 @@ class PreisachParams(Record):
             raise ValueError("everett and offset must be finite")
         if np.any(np.triu(e) != 0):
             raise ValueError("everett must be zero on and above the diagonal (F(a, a) = 0)")
+        check_magnitude(e, "everett", MAX_VALUE)
+        check_magnitude(self.offset, "offset", MAX_VALUE)
         e.setflags(write=False)
         object.__setattr__(self, "everett", e)
         object.__setattr__(self, "offset", float(self.offset))
@@ -212,6 +246,7 @@ class PreisachParams(Record):
     @classmethod
     def from_dict(cls, d: dict) -> PreisachParams:
         rows = d["everett"]
+        check_structure_size(len(rows) + 1, "levels (rows of everett + 1)", MAX_LEVELS)
         e = np.zeros((len(rows) + 1, len(rows) + 1))
         for i, row in enumerate(rows, start=1):
             if len(row) != i:
@@ -381,7 +416,9 @@ def simulate(structure: PreisachStructure, params: PreisachParams, u: np.ndarray
     tables = antisymmetric(params.everett)[None]
     relay, x_end = kernels.run_tables(u, x, tables, structure.capacity)
     u_clip = np.clip(u, -1.0, 1.0)
-    return relay[:, 0] + params.offset + _slope(params) * (u - u_clip), x_end
+    with np.errstate(over="ignore", invalid="ignore"):  # inputs near 1e308 on the extension
+        y = relay[:, 0] + params.offset + _slope(params) * (u - u_clip)
+    return check_finite_run(y, "preisach"), x_end
 
 
 def simulate_reference(structure: PreisachStructure, params: PreisachParams, u: np.ndarray,
@@ -420,11 +457,26 @@ def invert(structure: PreisachStructure, params: PreisachParams, y: np.ndarray,
         If ``F(1, -1) <= 0``: the major loop does not rise, so no inverse exists.
     """
     y, x = _check(structure, params, y, "y", x0)
-    if _slope(params) <= 0:
-        raise FitDivergedError("the Preisach model's major loop does not rise (F(1, -1) <= 0); "
-                               "it has no inverse")
+    check_rise(_slope(params), np.abs(params.masses()).sum(), "Preisach")
     tables, weighted, poly, slope = kernel_parts(params)
-    return kernels.invert(y, x, tables, weighted, poly, slope, structure.capacity, INVERT_TOL)
+    u_hat, x_end = kernels.invert(y, x, tables, weighted, poly, slope, structure.capacity,
+                                  INVERT_TOL)
+    return check_finite_run(u_hat, "inverse Preisach", "input estimate"), x_end
+
+
+def check_rise(rise: float, mass: float, model: str) -> None:
+    """Raise FitDivergedError unless the major loop rises by at least ``MIN_RISE`` of the
+    total mass: the inverse continues beyond saturation with slope ``1 / rise``."""
+    if not rise >= MIN_RISE * max(mass, 1e-300):
+        raise FitDivergedError(f"the {model} model's major loop does not rise (rise {rise:.4g} "
+                               f"for a total mass {mass:.4g}, at least {MIN_RISE:g} of it is "
+                               f"needed); it has no inverse")
+
+
+def output_bound(params: PreisachParams, u_max: float) -> float:
+    """``|y_0| + sum |m| max(1, u_max)``: no output of a run with ``|u| <= u_max`` exceeds it
+    (each cell contributes at most ``|m|``; beyond [-1, 1] the line of slope ``F(1, -1)``)."""
+    return float(abs(params.offset) + np.abs(params.masses()).sum() * max(1.0, u_max))
 
 
 def invert_step(structure: PreisachStructure, params: PreisachParams, x: np.ndarray,
