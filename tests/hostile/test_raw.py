@@ -14,6 +14,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from .conftest import entries, snapshot
@@ -211,3 +212,46 @@ def test_killed_simulate_raw_leaves_nothing(tmp_path):
     assert proc.returncode == 143, err
     assert "Traceback" not in err
     assert entries(tmp_path) == []
+
+
+# ------------------------------------------------------------------ damaged .mat raw files
+
+
+@pytest.fixture(scope="module")
+def raw_mat(raw: Path) -> bytes:
+    """The small raw recording as MATLAB bytes."""
+    import io
+
+    import pandas as pd
+    from scipy.io import savemat
+
+    table = pd.read_csv(raw)
+    buffer = io.BytesIO()
+    savemat(buffer, {c: table[c].to_numpy() for c in table.columns})
+    return buffer.getvalue()
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_byte_mutated_mat_raw_file(cli, raw_mat, tmp_path, seed):
+    """One byte of the header or first variable changed: a result or one error line naming
+    the file, never a crash (the .mat is parsed in a child process)."""
+    rng = np.random.default_rng(seed)
+    data = bytearray(raw_mat)
+    data[int(rng.integers(116, 600))] = int(rng.integers(0, 256))
+    path = tmp_path / "scope.mat"
+    path.write_bytes(bytes(data))
+    (tmp_path / "scope.toml").write_text(BRIDGE)
+    before = snapshot(tmp_path)
+    run = cli("preprocess", path, "--out", tmp_path / "o.csv")
+    run.clean()
+    if run.code != 0:
+        assert run.code == 2, run.err
+        run.error_line("scope.mat")
+        assert snapshot(tmp_path) == before
+
+
+def test_truncated_mat_raw_file(cli, raw_mat, tmp_path):
+    path = tmp_path / "scope.mat"
+    path.write_bytes(raw_mat[: len(raw_mat) // 2])
+    (tmp_path / "scope.toml").write_text(BRIDGE)
+    _refused(cli, tmp_path, ["preprocess", path, "--out", tmp_path / "o.csv"], "scope.mat")

@@ -28,11 +28,10 @@ import pyarrow as pa
 import pyarrow.csv as pa_csv
 import pyarrow.parquet as pq
 from numba import njit
-from scipy.io import loadmat
-from scipy.io.matlab import MatReadError
 
 from hystkit.errors import InputError
 
+from ._mat_reader import load_mat
 from ._recording import _Where
 from ._writing import atomic_output, check_output_path
 
@@ -177,16 +176,13 @@ class RawReader:
                 raise self.fail(f"cannot read Parquet file ({exc}); a file cut short "
                                 "(truncated) has no footer") from exc
             return list(self._schema.names)
-        try:
-            contents = loadmat(self.path)
-        except NotImplementedError as exc:
-            raise self.fail("MATLAB v7.3 (HDF5) files are not supported; save with '-v7'") from exc
-        except (ValueError, OSError, MatReadError) as exc:
-            raise self.fail(f"cannot read MATLAB file ({exc}); truncated?") from exc
-        self._mat = {k: v for k, v in contents.items() if not k.startswith("__")}
-        sizes = {np.size(v) for v in self._mat.values()}
+        # Parsed in a child process: a damaged file cannot crash or hang this one.
+        contents = load_mat(self.path, [self.fmt.name(c) for c in RAW_COLUMNS], self.source)
+        self._mat = contents.arrays
+        self._mat_types = {k: v for k, v in contents.variables.items() if not k.startswith("__")}
+        sizes = {int(np.prod(shape)) for _, shape in self._mat_types.values()}
         self.n_samples = sizes.pop() if len(sizes) == 1 else None
-        return list(self._mat)
+        return list(self._mat_types)
 
     def _pick(self, found: list[str]) -> tuple[str, ...]:
         names = {c: self.fmt.name(c) for c in RAW_COLUMNS}
@@ -352,7 +348,10 @@ class RawReader:
 
     def _mat_vector(self, column: str) -> np.ndarray:
         assert self._mat is not None
-        values = np.asarray(self._mat[self.fmt.name(column)])
+        name = self.fmt.name(column)
+        if name not in self._mat:  # the reader hands back real numbers only
+            raise self.fail(f"not real numbers (type {self._mat_types[name][0]})", column)
+        values = np.asarray(self._mat[name])
         if values.dtype.kind not in "iuf":
             raise self.fail(f"not real numbers (dtype {values.dtype})", column)
         values = np.atleast_1d(np.squeeze(values))
