@@ -67,13 +67,13 @@ def check_magnitude(values, name: str, limit: float = MAX_VALUE) -> None:
                                              "bounded)")
 
 
-def check_structure_size(n, name: str = "n_cells", limit: int = MAX_CELLS) -> None:
-    """Raise ValueError unless ``n`` is a whole number in ``[1, limit]``; checked before any
+def check_structure_size(n, name: str = "n_cells", limit: int = MAX_CELLS, low: int = 1) -> None:
+    """Raise ValueError unless ``n`` is a whole number in ``[low, limit]``; checked before any
     other field, so nothing is allocated or looped over for a huge or non-numeric size."""
     ok = (isinstance(n, int | float | np.integer | np.floating) and not isinstance(n, bool)
-          and np.isfinite(n) and int(n) == n and 1 <= n <= limit)
+          and np.isfinite(n) and int(n) == n and low <= n <= limit)
     if not ok:
-        raise ValueError(f"{name} must be a whole number in [1, {limit}], got {n!r}")
+        raise ValueError(f"{name} must be a whole number in [{low}, {limit}], got {n!r}")
 
 
 def state_bound(x0_max: float, u_max: float, slope_cap: float) -> float:

@@ -137,14 +137,13 @@ class PreisachStructure(Record):
     orientation: str = "auto"
 
     def __post_init__(self) -> None:
-        check_structure_size(self.levels, "levels", MAX_LEVELS)  # first: L^2 tables follow
-        if self.levels < 2:
-            raise ValueError(f"levels must be an integer >= 2, got {self.levels!r}")
+        check_structure_size(self.levels, "levels", MAX_LEVELS, low=2)  # first: L^2 tables
         check_dt(self.dt)
         check_structure_size(self.capacity, "capacity", MAX_CAPACITY)
         if self.capacity < 2 * self.levels + 2:
-            raise ValueError(f"capacity must be an integer >= 2 * levels + 2 = "
-                             f"{2 * self.levels + 2}, got {self.capacity!r}")
+            # worded without "levels", so that a model file's error names this key
+            raise ValueError(f"capacity must be at least 2 L + 2 = {2 * self.levels + 2} for "
+                             f"a grid of L = {self.levels}, got {self.capacity!r}")
         if not (np.isfinite(self.smoothing) and self.smoothing >= 0):
             raise ValueError(f"smoothing must be finite and >= 0, got {self.smoothing!r}")
         if self.orientation not in ("auto", "counterclockwise", "clockwise"):
