@@ -186,3 +186,20 @@ def test_recording_refuses_huge_values(value):
 def test_recording_accepts_the_limit():
     rec = Recording(time=[0.0, 1.0, 2.0], sensor=[MAX_MAGNITUDE, -MAX_MAGNITUDE, 0.0])
     assert rec.sensor[0] == MAX_MAGNITUDE
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet", ".mat"])
+def test_read_recordings_are_read_only(tmp_path, suffix):
+    rec = _recording()
+    path = tmp_path / f"rec{suffix}"
+    if suffix == ".mat":
+        savemat(path, {"time": rec.time, "position": rec.position, "sensor": rec.sensor})
+    else:
+        write_recording(rec, path)
+    back = read_recording(path)
+    for name in ("time", "position", "sensor"):
+        values = getattr(back, name)
+        assert values.dtype == np.float64 and values.ndim == 1
+        with pytest.raises(ValueError, match="read-only"):
+            values[0] = 1.0
+    assert back.source == str(path) and back.n_samples == rec.n_samples

@@ -135,7 +135,24 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True) 
     except OSError as exc:  # also a disk failing halfway (EIO)
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
     _validate(arrays, where)
-    return Recording(arrays["time"], arrays["sensor"], arrays.get("position"), source)
+    return _adopt(arrays, source)
+
+
+def _adopt(arrays: dict[str, np.ndarray], source: str) -> Recording:
+    """A `Recording` around 1-D float64 arrays a reader made and `_validate` checked.
+
+    ``Recording(...)`` would copy and check them again; nothing else holds these arrays, so
+    adopting them saves a copy of the data at the peak (and a second pass over it).
+    """
+    recording = object.__new__(Recording)
+    for name in _COLUMNS:
+        values = arrays.get(name)
+        if values is not None:
+            values = np.ascontiguousarray(values, dtype=np.float64)  # no copy for readers' output
+            values.setflags(write=False)
+        object.__setattr__(recording, name, values)
+    object.__setattr__(recording, "source", source)
+    return recording
 
 
 _READERS = {".csv": read_csv, ".parquet": read_parquet, ".mat": read_mat}
