@@ -104,17 +104,35 @@ def test_header_only_raw_file(cli, raw, tmp_path):
                              tmp_path / "o.csv"], "scope.csv")
 
 
-def test_infinite_voltage_is_named_by_column_and_row(cli, raw, tmp_path):
+# (case id, column index, cell text, fragments besides the file, column and row)
+CELL_CASES = [
+    ("v1-inf", 1, "inf", ["infinite"]),
+    ("v1-denormal", 1, "1e-320", ["bridge voltage"]),
+    ("v2-zero", 2, "0", ["bridge voltage"]),
+    ("v1-above-supply", 1, "5.0", ["bridge voltage"]),
+    ("encoder-huge", 3, "1e308", ["not a scope reading"]),
+    ("encoder-huge-negative", 3, "-1.7e308", ["not a scope reading"]),
+    ("encoder-nan", 3, "nan", ["nan"]),
+    ("encoder-text", 3, "abc", ["abc"]),
+    ("time-huge", 0, "1e308", ["gap"]),
+]
+_COLUMNS = ("time", "v1", "v2", "encoder")
+
+
+@pytest.mark.parametrize("index, cell, fragments", [c[1:] for c in CELL_CASES],
+                         ids=[c[0] for c in CELL_CASES])
+def test_bad_cell_is_named_by_column_and_row(cli, raw, tmp_path, index, cell, fragments):
     data = _copy(raw, tmp_path)
     lines = data.read_text().splitlines(keepends=True)
-    cells = lines[500].split(",")
-    cells[1] = "inf"
-    lines[500] = ",".join(cells)
+    cells = lines[500].rstrip("\n").split(",")
+    cells[index] = cell
+    lines[500] = ",".join(cells) + "\n"
     data.write_text("".join(lines))
     config = tmp_path / "s.toml"
     config.write_text(BRIDGE)
     _refused(cli, tmp_path, ["preprocess", data, "--config", config, "--out",
-                             tmp_path / "o.csv"], "scope.csv", "v1", "row 500 (line 501)")
+                             tmp_path / "o.csv"], "scope.csv", _COLUMNS[index],
+             "row 500 (line 501)", *fragments)
 
 
 # ------------------------------------------------------------------ settings files

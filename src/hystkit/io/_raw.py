@@ -41,6 +41,8 @@ RAW_COLUMNS = ("time", "v1", "v2", "encoder", "enc_a", "enc_b")
 _TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 _MAX_STEP_DEVIATION = 0.01  # as for recordings: relative to 1/fs
 _FS_HEAD = 4096  # samples whose mean step gives fs
+# No scope channel reads more; beyond it a histogram of the levels would overflow.
+MAX_VOLTAGE = 1e6
 # CSV lines skipped after the header (a units line or a few): pandas holds them as a set.
 MAX_SKIP_ROWS = 1_000_000
 
@@ -295,13 +297,16 @@ class RawReader:
             for i in range(0, total, size):
                 yield {c: a[i:i + size] for c, a in arrays.items()}
         else:
-            yield from self._read_csv(size, wanted, names)
+            yield from self._read_csv(size, wanted)
 
-    def _read_csv(self, size: int, wanted: tuple[str, ...], names: list[str]
-                  ) -> Iterator[dict[str, np.ndarray]]:
+    def _read_csv(self, size: int, wanted: tuple[str, ...]) -> Iterator[dict[str, np.ndarray]]:
         # skip_blank_lines=False keeps rows and file lines in step (for error locations) and
         # shows a blank line as an all-NaN row: allowed only at the end of the file.
-        with pd.read_csv(self.path, usecols=names, dtype=np.float64, chunksize=size,
+        # Every channel of the recording is read, even when fewer are wanted: a blank line is
+        # empty in all of them, while a NaN cell of the one wanted column is a bad cell.
+        every = self.columns if hasattr(self, "columns") else wanted
+        read = [self.fmt.name(c) for c in every]
+        with pd.read_csv(self.path, usecols=read, dtype=np.float64, chunksize=size,
                          skiprows=range(1, 1 + self.fmt.skip_rows), skip_blank_lines=False,
                          encoding="utf-8-sig") as reader:
             start = 0
@@ -312,9 +317,10 @@ class RawReader:
                 except StopIteration:
                     return
                 except ValueError as exc:  # pandas: a cell that is not a number
-                    raise self._locate_csv_error(start, size, wanted, names, exc) from exc
-                arrays = {c: frame[n].to_numpy(dtype=np.float64) for c, n in zip(wanted, names)}
+                    raise self._locate_csv_error(start, size, every, read, exc) from exc
+                arrays = {c: frame[n].to_numpy(dtype=np.float64) for c, n in zip(every, read)}
                 empty = np.logical_and.reduce([np.isnan(a) for a in arrays.values()])
+                arrays = {c: arrays[c] for c in wanted}
                 data = np.flatnonzero(~empty)
                 if data.size and blank_at >= 0:
                     raise self.fail("empty line inside the data", index=blank_at)
@@ -363,6 +369,12 @@ class RawReader:
 
     def _check_finite(self, values: np.ndarray, column: str, start: int) -> None:
         i = _first_nonfinite(values)
+        if i < 0 and column != "time":
+            j = _first_beyond(values, MAX_VOLTAGE)
+            if j >= 0:
+                raise self.fail(f"value {values[j]:.6g} V is not a scope reading (hystkit "
+                                f"accepts voltages up to {MAX_VOLTAGE:g} V in magnitude)",
+                                column, start + j)
         if i >= 0:
             last = start + i + 1 == self.n_samples if self.n_samples else False
             problem = "missing or NaN value" if np.isnan(values[i]) else "infinite value"
@@ -376,8 +388,8 @@ class RawReader:
         i = _first_bad_step(t, np.nan if t_prev is None else t_prev, self.fs,
                             _MAX_STEP_DEVIATION)
         if i >= 0:
-            previous = t[i - 1] if i else t_prev
-            step = t[i] - previous
+            previous = float(t[i - 1] if i else t_prev)
+            step = float(t[i]) - previous  # Python floats: a huge step is inf, not a warning
             kind = ("time goes backwards or repeats" if step <= 0 else
                     f"a gap of {step * self.fs - 1:.6g} samples (dropped data?)"
                     if step * self.fs > 1.5 else "non-uniform sampling")
@@ -395,6 +407,14 @@ def _as_float(values: np.ndarray) -> np.ndarray:
 def _first_nonfinite(x):
     for i in range(x.size):
         if not np.isfinite(x[i]):
+            return i
+    return -1
+
+
+@njit(cache=True, nogil=True)
+def _first_beyond(x, limit):
+    for i in range(x.size):
+        if abs(x[i]) > limit:
             return i
     return -1
 

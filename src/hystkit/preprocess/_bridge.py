@@ -93,13 +93,18 @@ def clipped_channels(extremes: np.ndarray, n: int) -> dict[str, tuple[int, float
     return out
 
 
+_OPEN_GAUGE = 1e-12
+
+
 @njit(cache=True, nogil=True)
 def _bridge_row(v, out, r_bridge, v_supply, ext, at):
     """eq. 4.3 for one channel into `out`; updates [max, n at max, min, n at min] at ext[at:]."""
     hi, n_hi, lo, n_lo = ext[at], ext[at + 1], ext[at + 2], ext[at + 3]
     for i in range(v.size):
         vi = float(v[i])
-        if not (0.0 < vi < v_supply):
+        # Below 1e-12 V0, R_S = R_br (V0 / V_m - 1) would pass 1e12 R_br (or overflow): an open
+        # gauge or a broken sample, not a reading.
+        if not (_OPEN_GAUGE * v_supply < vi < v_supply):
             return i
         out[i] = r_bridge * (v_supply / vi - 1.0)
         if vi >= hi:
@@ -131,7 +136,7 @@ def bridge_kernel(v1, v2, r_bridge, v_supply, ext):
     r : ndarray, shape (2, n)
         R1, R2 [Ohm] (valid up to the first invalid sample).
     bad : ndarray of int64, shape (2,)
-        First sample with ``V_m <= 0`` or ``V_m >= V0`` per channel, -1 if none.
+        First sample with ``V_m <= 1e-12 V0`` or ``V_m >= V0`` per channel, -1 if none.
     ext : ndarray, shape (8,)
         Updated statistics.
     """

@@ -348,8 +348,9 @@ def _check_levels(reader: RawReader, column: str, survey: LevelSurvey, wanted: i
 def _raise_bridge(reader: RawReader, g: int, chunk: RawChunk, i: int, v_supply: float) -> None:
     v = (chunk.v1, chunk.v2)[g][i]
     raise reader.fail(f"bridge voltage {v:.6g} V outside (0, V0 = {v_supply:g} V), where "
-                      "R_S = R_br (V0 - V_m) / V_m (eq. 4.3) is undefined; check the channel, "
-                      "its polarity and --v-supply", f"v{g + 1}", chunk.start + i)
+                      "R_S = R_br (V0 - V_m) / V_m (eq. 4.3) is undefined (or, within 1e-12 V0 "
+                      "of 0, absurd); check the channel, its polarity and --v-supply",
+                      f"v{g + 1}", chunk.start + i)
 
 
 def _prefetch(chunks: Iterator[RawChunk]) -> Iterator[RawChunk]:
