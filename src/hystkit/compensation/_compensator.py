@@ -167,7 +167,11 @@ class Compensator:
         s = self.normalised_sensor(recording.sensor)
         run = self.family.simulate if self.mode == "direct" else self.family.invert
         with np.errstate(over="ignore", invalid="ignore"):
-            p, _ = run(self.structure, self.params, s)
+            try:
+                p, _ = run(self.structure, self.params, s)
+            except FitDivergedError as exc:  # the family's own guard: say which file and model
+                raise FitDivergedError(f"{recording.source}: the {self.model} compensator"
+                                       f"{self._from()}: {exc}") from None
             estimate = p * self.scaling.position_scale + self.position_offset(position_mean,
                                                                                rest_position)
         # Normalised data have |p| <= 1 in training; MAX_NORMALISED times that is no position

@@ -228,34 +228,9 @@ def simulate_raw(path: str | os.PathLike[str], name: str, seed: int = 0, *,
         with RawWriter(path, columns, force=force) as writer:
             for b, start in enumerate(range(0, n, _BLOCK)):
                 ts = np.arange(start, min(n, start + _BLOCK)) / scope.fs
-                noise = np.random.default_rng([seed, 0x5C0E, b])
-                pos, r1, r2 = _spline_at(coef, sensor.fs_internal, ts)
-                counts = np.round(pos / step).astype(np.int64)
-                codes = count_to_code(counts)
-                for t_missed, hidden, direction in missed:
-                    hide = (counts == hidden) & (np.abs(ts - t_missed) < 0.5 / sensor.fs_internal)
-                    codes[hide] = count_to_code(np.array([hidden - direction]))[0]
-                chunk = {"time": ts}
-                for g, rg in enumerate((r1, r2)):
-                    chunk[f"v{g + 1}"] = (bridge_voltage(rg, scope.r_bridge, scope.v_supply)
-                                          + scope.bridge_noise_v * noise.standard_normal(ts.size))
-                scale = 1 + scope.supply_drift * np.sin(2 * np.pi * ts / scope.drift_period)
-                local = spikes[(spikes >= start) & (spikes < start + ts.size)] - start
-                if scope.encoder_mode == "merged":
-                    ideal = np.take_along_axis(
-                        merged_levels(scope)[np.newaxis], codes[np.newaxis], 1)[0] * scale
-                    signals = [ideal]
-                else:
-                    signals = [np.where(bit, scope.logic_high, scope.logic_low) * scale
-                               for bit in code_to_ab(codes)]
-                for j, (col, ideal) in enumerate(zip(columns[3:], signals)):
-                    shaped = _one_pole(ideal, a_edge, edge_state[j])
-                    edge_state[j] = shaped[-1]
-                    if local.size and j == 0:  # spikes: one sample jumps to another level
-                        shaped[local] = ideal[local] + np.where(ideal[local] > ideal.mean(), -1, 1) \
-                            * 0.6 * (scope.logic_high - scope.logic_low)
-                    chunk[col] = shaped + scope.encoder_noise_v * noise.standard_normal(ts.size)
-                writer.write(**chunk)
+                writer.write(**_raw_block(ts, start, np.random.default_rng([seed, 0x5C0E, b]),
+                                          coef, sensor, scope, missed, spikes, columns,
+                                          edge_state, a_edge))
             write_raw_config(config_path, {**config, "simulation": notes}, comment=comment,
                              force=force)
             settings_written = True
@@ -267,6 +242,42 @@ def simulate_raw(path: str | os.PathLike[str], name: str, seed: int = 0, *,
                     count0=count0, encoder_mm=step, n_samples=n, fs=scope.fs,
                     missed=np.array([(m[0], m[1]) for m in missed]).reshape(-1, 2),
                     spikes=spikes)
+
+
+def _raw_block(ts: np.ndarray, start: int, noise: np.random.Generator, coef: np.ndarray,
+               sensor: VirtualSensor, scope: ScopeSettings, missed: list, spikes: np.ndarray,
+               columns: tuple[str, ...], edge_state: np.ndarray, a_edge: float
+               ) -> dict[str, np.ndarray]:
+    """The scope's channels at times `ts` (samples from `start` on); `edge_state` carries the
+    encoder edges' filter state from block to block (updated in place)."""
+    step = sensor.encoder_mm
+    pos, r1, r2 = _spline_at(coef, sensor.fs_internal, ts)
+    counts = np.round(pos / step).astype(np.int64)
+    codes = count_to_code(counts)
+    for t_missed, hidden, direction in missed:
+        hide = (counts == hidden) & (np.abs(ts - t_missed) < 0.5 / sensor.fs_internal)
+        codes[hide] = count_to_code(np.array([hidden - direction]))[0]
+    chunk = {"time": ts}
+    for g, rg in enumerate((r1, r2)):
+        chunk[f"v{g + 1}"] = (bridge_voltage(rg, scope.r_bridge, scope.v_supply)
+                              + scope.bridge_noise_v * noise.standard_normal(ts.size))
+    scale = 1 + scope.supply_drift * np.sin(2 * np.pi * ts / scope.drift_period)
+    local = spikes[(spikes >= start) & (spikes < start + ts.size)] - start
+    if scope.encoder_mode == "merged":
+        ideal = np.take_along_axis(
+            merged_levels(scope)[np.newaxis], codes[np.newaxis], 1)[0] * scale
+        signals = [ideal]
+    else:
+        signals = [np.where(bit, scope.logic_high, scope.logic_low) * scale
+                   for bit in code_to_ab(codes)]
+    for j, (col, ideal) in enumerate(zip(columns[3:], signals)):
+        shaped = _one_pole(ideal, a_edge, edge_state[j])
+        edge_state[j] = shaped[-1]
+        if local.size and j == 0:  # spikes: one sample jumps to another level
+            shaped[local] = ideal[local] + np.where(ideal[local] > ideal.mean(), -1, 1) \
+                * 0.6 * (scope.logic_high - scope.logic_low)
+        chunk[col] = shaped + scope.encoder_noise_v * noise.standard_normal(ts.size)
+    return chunk
 
 
 def _choose_missed(t: np.ndarray, x: np.ndarray, step: float, n_missed: int,
