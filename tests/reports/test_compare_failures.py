@@ -69,3 +69,31 @@ def test_generalize_on_own_recordings_lists_the_failure(broken_chua, tmp_path, c
     assert all(v is None for row in matrix["mpl-poly"]["r2"].values() for v in row.values())
     assert set(matrix["mpl-poly"]["errors"]) == {"sine", "noise", "chirp"}
     assert "deployable R²" in capsys.readouterr().out
+
+
+def test_a_forward_model_that_runs_away_leaves_the_table_writable(monkeypatch, tmp_path):
+    """A family whose forward run gives inf on validation fails in its row (exit 3), and
+    compare.json is still written."""
+    real = get_family
+
+    def patched(name):
+        family = real(name)
+        if name != "mpl":
+            return family
+        fields = ("name", "title", "default_size", "size_help", "make_structure", "fit",
+                  "invert", "no_inverse_reason", "random_params")
+
+        def simulate(structure, params, u):  # compare's forward runs (the fit uses its own)
+            y, x = family.simulate(structure, params, u)
+            return np.full_like(y, np.inf), x
+
+        return SimpleNamespace(**{k: getattr(family, k) for k in fields}, simulate=simulate)
+
+    monkeypatch.setattr(compare, "get_family", patched)
+    f, v = tmp_path / "f.csv", tmp_path / "v.csv"
+    assert main(["simulate-sensor", "--excitation", "sine", "--seed", "1", "--out", str(f)]) == 0
+    assert main(["simulate-sensor", "--excitation", "sine", "--seed", "2", "--out", str(v)]) == 0
+    code = main(["compare", str(f), str(v), "--models", "mpl", "--out", str(tmp_path / "c")])
+    assert code == 3
+    row = json.loads((tmp_path / "c" / "compare.json").read_text())["mpl"]
+    assert "infinite" in row["error"]

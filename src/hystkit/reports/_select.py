@@ -18,6 +18,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..compensation import DEFAULT_CENTER, check_fitting_data, evaluate, fit_compensator
+from ..errors import FitDivergedError
 from ..io import Recording
 from ..models import FAMILIES, get_family
 from ._compare import DISQUALIFYING, FAMILY_FAILURES
@@ -81,6 +82,8 @@ def _score_candidate(args: tuple[Candidate, list, dict]) -> dict:
             comp = fit_compensator(train, cand.size, model=cand.model, mode=cand.mode,
                                    center=cand.center, diagnose=False, **options)
             s = evaluate(comp, held)
+            if s["r2"] is None:  # evaluate gives None where R² is undefined or overflowed
+                raise FitDivergedError(f"{held.source}: held-out R² undefined for this fit")
             scores.append(s["r2"])
             oracle.append(s["r2_oracle"])
             line.append(s["linear_r2"])
