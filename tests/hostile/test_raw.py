@@ -273,3 +273,41 @@ def test_truncated_mat_raw_file(cli, raw_mat, tmp_path):
     path.write_bytes(raw_mat[: len(raw_mat) // 2])
     (tmp_path / "scope.toml").write_text(BRIDGE)
     _refused(cli, tmp_path, ["preprocess", path, "--out", tmp_path / "o.csv"], "scope.mat")
+
+
+# ------------------------------------------------------------------ Parquet raw files
+
+
+def _parquet_null(table):
+    import pyarrow as pa
+
+    values = table.column("v1").to_pylist()
+    values[300] = None
+    return table.set_column(1, "v1", pa.array(values, type=pa.float64()))
+
+
+def _parquet_strings(table):
+    import pyarrow as pa
+
+    return table.set_column(1, "v1", pa.array([str(v) for v in table.column("v1").to_pylist()]))
+
+
+PARQUET_CASES = [
+    ("null-cell", _parquet_null, ["v1", "row 301"]),
+    ("string-column", _parquet_strings, ["v1", "not numeric"]),
+    ("no-rows", lambda t: t.slice(0, 0), ["fewer than 2 samples"]),
+    ("three-rows", lambda t: t.slice(0, 3), ["encoder", "3 samples"]),
+]
+
+
+@pytest.mark.parametrize("change, fragments", [c[1:] for c in PARQUET_CASES],
+                         ids=[c[0] for c in PARQUET_CASES])
+def test_bad_parquet_raw_file(cli, raw, tmp_path, change, fragments):
+    import pyarrow.csv as pa_csv
+    import pyarrow.parquet as pq
+
+    path = tmp_path / "scope.parquet"
+    pq.write_table(change(pa_csv.read_csv(raw)), path)
+    (tmp_path / "scope.toml").write_text(BRIDGE)
+    _refused(cli, tmp_path, ["preprocess", path, "--out", tmp_path / "o.csv"], "scope.parquet",
+             *fragments)
