@@ -158,7 +158,9 @@ def initial_state(n: int, x0, at_rest: float, layout: str | None = None) -> np.n
 
 def check_positive_int(value, name: str) -> None:
     """Raise ValueError unless ``value`` is a whole number >= 1 (model sizes)."""
-    if int(value) != value or value < 1:
+    # inf, NaN, text and None are refused here too (int() would raise OverflowError/TypeError)
+    if not isinstance(value, int | float | np.integer | np.floating) or not np.isfinite(value) \
+            or int(value) != value or value < 1:
         raise ValueError(f"{name} must be a positive integer, got {value!r}")
 
 
