@@ -103,7 +103,7 @@ def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
     params = _build(source, "params", {name: "params" for name in d["params"]},
                     lambda: family.params_type.from_dict(d["params"]))
     # The compensator runs the model on two samples: structure and params must fit together.
-    return _build(source, "params", _sections(d), lambda: Compensator(
+    return _build(source, "", _sections(d), lambda: Compensator(
         structure=structure, params=params, mode=d["mode"], center=d["center"],
         scaling=Scaling(**d["normalisation"]), baseline=LinearBaseline(**d["baseline"]),
         fit_info=d.get("fit") or {}, training_range=_pair_or_none(d.get("training_range")),
@@ -112,8 +112,10 @@ def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
 
 
 def _sections(d: dict) -> dict[str, str]:
-    """Field name -> its section, to name the key path of a compensator-level error."""
-    sections = {}
+    """Field name -> its section ("" at the top level), to name the key path of a
+    compensator-level error."""
+    sections = {key: "" for key in ("polarity", "tare_seconds", "track_seconds",
+                                    "training_range", "position_range", "mode", "model")}
     for section in ("baseline", "normalisation", "structure", "params"):
         sections.update({name: section for name in d[section]})
     return sections
@@ -122,8 +124,8 @@ def _sections(d: dict) -> dict[str, str]:
 def _build(source: str, section: str, sections: dict[str, str],
            make: Callable[[], Any]) -> Any:
     """Run a family's (or the compensator's) constructor on checked values; whatever it
-    raises becomes an InputError naming the key path (``section.field`` when the message
-    names a field of `sections`, else `section`)."""
+    raises becomes an InputError naming the key path: ``section.field`` when the message names
+    a field of `sections`, else `section` (none if that is "")."""
     try:
         return make()
     except InputError:
@@ -134,8 +136,9 @@ def _build(source: str, section: str, sections: dict[str, str],
     except Exception as exc:  # noqa: BLE001 -- untrusted file: whatever a family's code raises
         message = str(exc) or type(exc).__name__
         name = key_in_message(message, sections)
-        path = section if name is None else f"{sections[name]}.{name}"
-        raise InputError(f"{source}: key {path!r}: {message}") from None
+        path = section if name is None else ".".join(filter(None, (sections[name], name)))
+        where = f"key {path!r}: " if path else "invalid model contents: "
+        raise InputError(f"{source}: {where}{message}") from None
 
 
 def _pair_or_none(value: list | None) -> tuple | None:
