@@ -1,7 +1,8 @@
 """CSV recordings: a fast numeric pass, and a chunked text pass that says what is wrong.
 
-Most files are clean, so the first pass asks pandas' C parser for float64 directly (memory: the
-numbers themselves plus parser buffers). pandas >= 3 parses floats exactly by default (earlier
+Most files are clean, so the first pass asks pandas' C parser for float64 directly, chunk by
+chunk, into arrays sized by counting the line breaks first (memory: the recording columns
+themselves plus one chunk). pandas >= 3 parses floats exactly by default (earlier
 versions need ``float_precision="round_trip"``), so values stay bit-identical to what
 `write_recording` wrote. Anything unusual in that pass (a cell that is not a number, an empty
 cell or blank line, a long row, bytes that are not UTF-8) sends the file to the second pass,
@@ -24,6 +25,7 @@ from hystkit.errors import InputError
 from ._cells import Where, cell_problem, pick, text_problems
 
 CHUNK_ROWS = 100_000  # text cells held at once by the second pass
+FAST_CHUNK_ROWS = 1 << 18  # rows parsed at once by the first pass, copied into the result
 MAX_COLUMNS = 1000  # a wider file is not a recording; pandas would build a column per field
 _HEADER_BYTES = 1 << 16
 _EXACT = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
@@ -70,18 +72,40 @@ def _read_numbers(path: Path, need_position: bool, where: Where) -> dict[str, np
     if any("\n" in name or "\r" in name for name in header):  # a quoted header spans lines
         return None
     names = pick(header, need_position, where, hint=_HINT)
+    columns = [header.index(name) for name in names]
+    # Rows <= line breaks + 1. np.empty pages that are never written cost no memory, so the
+    # bound may be generous (CRLF counts twice).
+    out = [np.empty(_line_bound(path)) for _ in names]
+    n = 0
     try:
         # index_col=False: with names given, pandas would otherwise make a long row's extra
         # leading field an index; skip_blank_lines=False: a blank line becomes a NaN row.
-        frame = pd.read_csv(path, header=None, skiprows=1, names=list(range(len(header))),
-                            index_col=False, dtype=np.float64, skip_blank_lines=False,
-                            encoding="utf-8-sig", **_EXACT)
+        with pd.read_csv(path, header=None, skiprows=1, names=list(range(len(header))),
+                         index_col=False, dtype=np.float64, skip_blank_lines=False,
+                         encoding="utf-8-sig", chunksize=FAST_CHUNK_ROWS, **_EXACT) as reader:
+            for chunk in reader:
+                if n + len(chunk) > out[0].size:
+                    return None  # cannot happen with the bound above; the text pass decides
+                for target, j in zip(out, columns):
+                    values = chunk[j].to_numpy(dtype=np.float64)
+                    if np.isnan(values).any():
+                        return None  # pass 2 tells an empty cell from 'nan', blank lines
+                    target[n:n + values.size] = values
+                n += len(chunk)
     except (*_PARSE_ERRORS, UnicodeDecodeError):
         return None
-    arrays = {name: frame[header.index(name)].to_numpy(dtype=np.float64) for name in names}
-    if len(frame) == 0 or any(np.isnan(values).any() for values in arrays.values()):
-        return None  # pass 2 tells an empty cell from 'nan' and trailing blank lines
-    return arrays
+    if n == 0:
+        return None
+    return {name: values[:n] for name, values in zip(names, out)}
+
+
+def _line_bound(path: Path, block: int = 1 << 22) -> int:
+    """An upper bound of the data rows: line feeds plus carriage returns plus one."""
+    count = 1
+    with path.open("rb") as file:
+        while data := file.read(block):
+            count += data.count(b"\n") + data.count(b"\r")
+    return count
 
 
 def _read_text(path: Path, need_position: bool, where: Where) -> dict[str, np.ndarray]:
@@ -95,25 +119,26 @@ def _read_text(path: Path, need_position: bool, where: Where) -> dict[str, np.nd
     try:
         # header=None because with a header pandas silently turns the first column into an
         # index when every data row has one field too many.
-        for chunk in pd.read_csv(path, chunksize=CHUNK_ROWS, **_TEXT):
-            if header is None:
-                header = [str(name).strip() for name in chunk.iloc[0]]
-                names = pick(header, need_position, where, hint=_HINT)
-                parts = {name: [] for name in names}
-                chunk = chunk.iloc[1:]
-            filled = np.zeros(len(chunk), dtype=bool)
-            for j in chunk.columns:
-                filled |= (chunk[j].fillna("").str.strip() != "").to_numpy()
-            if filled.any():
-                # Trailing blank lines are common at the end of logger files and carry no data.
-                n_rows = offset + int(np.flatnonzero(filled)[-1]) + 1
-            for name in names:
-                numbers, bad, stripped = text_problems(chunk[header.index(name)])
-                if name not in first_bad and bad.any():
-                    i = int(np.argmax(bad))
-                    first_bad[name] = (offset + i, cell_problem(stripped, i))
-                parts[name].append(numbers)
-            offset += len(chunk)
+        with pd.read_csv(path, chunksize=CHUNK_ROWS, **_TEXT) as reader:
+            for chunk in reader:
+                if header is None:
+                    header = [str(name).strip() for name in chunk.iloc[0]]
+                    names = pick(header, need_position, where, hint=_HINT)
+                    parts = {name: [] for name in names}
+                    chunk = chunk.iloc[1:]
+                filled = np.zeros(len(chunk), dtype=bool)
+                for j in chunk.columns:
+                    filled |= (chunk[j].fillna("").str.strip() != "").to_numpy()
+                if filled.any():
+                    # Trailing blank lines are common at the end of logger files and carry no data.
+                    n_rows = offset + int(np.flatnonzero(filled)[-1]) + 1
+                for name in names:
+                    numbers, bad, stripped = text_problems(chunk[header.index(name)])
+                    if name not in first_bad and bad.any():
+                        i = int(np.argmax(bad))
+                        first_bad[name] = (offset + i, cell_problem(stripped, i))
+                    parts[name].append(numbers)
+                offset += len(chunk)
     except pd.errors.EmptyDataError as exc:
         raise where.fail("file is empty (no header row)") from exc
     except UnicodeDecodeError as exc:
