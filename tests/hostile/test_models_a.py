@@ -3,7 +3,7 @@
 ``good["model"]`` is a 1-cell mPL; a tiny model of each other family is fitted once from the
 command line on the first 1500 rows of ``good["fit"]``. Each case edits one value of a model
 file to something outside the family's documented domain or size limits -- the issue's own
-examples first (mpl-poly resting 1e8 away, pl with ``a = 1e-30``, 20 M mPL cells, Preisach
+examples first (mpl-poly resting 1e10 away, pl with ``a = 1e-30``, 20 M mPL cells, Preisach
 with 512 levels) -- and runs ``evaluate`` and ``compensate`` on it: exit 2, one
 ``hystkit: error:`` line naming the file and the parameter, no traceback, nothing written.
 """
@@ -49,8 +49,8 @@ def _edit(model: dict, key: str, value: object) -> None:
 # (family, case, [(key, value), ...], fragments the error line holds besides the file name)
 CASES = [
     # issue 10's examples
-    ("mpl-poly", "linear-0-rest-1e8", [("params.f.0", [0.0, 0.0, 1.0, 1e-8])],
-     ["params.f", "rest voltage", "-1e+08"]),
+    ("mpl-poly", "linear-0-rest-1e10", [("params.f.0", [0.0, 0.0, 1.0, 1e-10])],
+     ["params.f", "rest voltage", "-1e+10"]),
     ("pl", "a-1e-30", [("params.a.0", 1e-30)], ["params.a", "1e-30", "[0.001, 1000]"]),
     ("mpl", "cells-20M", [("structure.n_cells", 20_000_000)], ["structure.n_cells"]),
     ("preisach", "levels-512", [("structure.levels", 512), ("structure.capacity", 1026)],

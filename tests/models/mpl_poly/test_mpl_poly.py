@@ -82,7 +82,7 @@ def test_inverse_split_run_equals_whole_run():
 def test_linear_cell_step_response_closed_form():
     # c3 -> 0 and c2 = 0: f(v) = G v, so u_n = 1 - (1 - G dt)^n for a unit step from 0.
     s = mp.MplPolyStructure(n_cells=1, dt=DT)
-    p = mp.MplPolyParams(f=[[0.0, 2.0, 0.0, 1e-200]], g=IDENTITY_G, w=[0.0, 1.0])
+    p = mp.MplPolyParams(f=[[0.0, 2.0, 0.0, 1e-300]], g=IDENTITY_G, w=[0.0, 1.0])
     y, _ = mp.simulate(s, p, np.ones(200), x0=0.0)
     assert_allclose(y, 1 - (1 - 2.0 * DT) ** np.arange(200), rtol=1e-12, atol=1e-14)
 

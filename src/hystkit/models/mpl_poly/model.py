@@ -73,16 +73,19 @@ __all__ = [
 ]
 
 
-# The documented parameter domain, normalised units (eq. 5.10). The coefficient ranges hold
-# the fit's box (|c| <= 1e3, c3 in [1e-6, 1e4]), its canonical forms and paper 9.2's sets
-# (c3 down to 5e-7); what keeps a run meaningful is REST_MAX: a cell resting 1000 ranges away
-# from [-1, 1] data is a cubic, not a hysteresis cell, and drives z and g(z) to 1e24 .. 1e67.
+# The documented parameter domain, normalised units (eq. 5.10). It holds the fit's box
+# (|c| <= 1e3, c3 in [1e-6, 1e4]), its canonical forms and paper 9.2's sets (c3 down to 5e-7).
+# REST_MAX bounds where a cell can rest: every cubic of the box has its roots within
+# 1 + 1e3 / 1e-6 (Cauchy), so 2e9 refuses nothing the fit can return (a tighter limit changed
+# fits: on the virtual sensor's noise run c3 drifts along a flat valley to its box floor, cell
+# resting at -3.8e5, and the fit is reported on bounds) but does refuse the cubics beyond
+# (c3 = 1e-10 beside c2 = 1 rests 1e10 away) whose outputs overflow.
 POLY_MAX = 1e9
-# Leading coefficients at least 1e-200 (and nonzero g_j too, any may lead): the root finders
-# divide by them, and POLY_MAX / 1e-200 stays far inside the float range.
-C3_RANGE = (1e-200, 1e9)
+# c3 may be tiny (a near-linear cell; its roots are located through 1 / v where c_j / c3
+# overflows); nonzero g_j at least 1e-200, as the output branch divides by g's leading one.
+C3_RANGE = (1e-300, 1e9)
 G_MIN = 1e-200
-REST_MAX = 1e3
+REST_MAX = 2e9
 
 
 @dataclass(frozen=True)
@@ -127,9 +130,9 @@ class MplPolyParams(Record):
     Notes
     -----
     Domain (checked here): ``|c_k0..c_k2|, |g_j| <= POLY_MAX`` (1e9), ``c_k3`` in
-    ``C3_RANGE`` (1e-200 .. 1e9), each ``g_j`` 0 or at least ``G_MIN`` (1e-200) in
+    ``C3_RANGE`` (1e-300 .. 1e9), each ``g_j`` 0 or at least ``G_MIN`` (1e-200) in
     magnitude, ``|w_k|, |V_b| <= 1e6``, at most 1000 cells, and every real root of every
-    cell's cubic within ``|v| <= REST_MAX`` (1000). The limited resistor's rest
+    cell's cubic within ``|v| <= REST_MAX`` (2e9). The limited resistor's rest
     voltages depend on ``dt`` too; runs check them (:func:`check_rest`). With them, a run
     with ``slope_cap <= 1`` stays within :func:`output_bound`.
 
@@ -165,12 +168,11 @@ class MplPolyParams(Record):
         check_magnitude(self.w, "w")
         check_magnitude(self.v_b, "v_b")
         for k, c in enumerate(self.f):
-            roots = np.roots(c[::-1])
-            real = roots[np.abs(roots.imag) <= 1e-9 * (1 + np.abs(roots))].real
-            if np.any(np.abs(real) > REST_MAX):
+            far = _far_root(c)
+            if far is not None:
                 raise ValueError(f"f[{k}] (cell {k + 1}'s resistor) has a rest voltage at "
-                                 f"{real[np.argmax(np.abs(real))]:.4g}, outside the domain "
-                                 f"[-{REST_MAX:g}, {REST_MAX:g}] (normalised units)")
+                                 f"{far:.4g}, outside the domain [-{REST_MAX:g}, {REST_MAX:g}] "
+                                 f"(normalised units)")
 
     def to_vector(self) -> np.ndarray:
         """Optimiser coordinates (see Notes of the class)."""
@@ -185,6 +187,29 @@ class MplPolyParams(Record):
         f = np.column_stack([cells[:, :3], np.exp(cells[:, 3])])
         rest = theta[4 * n_cells:]
         return cls(f=f, g=rest[:4], w=rest[4: n_cells + 5], v_b=rest[n_cells + 5])
+
+
+def _far_root(c: np.ndarray) -> float | None:
+    """A real root of the cubic ``c`` (``c0..c3``) beyond ``REST_MAX``, or None.
+
+    Roots of ``f`` beyond ``R`` are the roots ``t = 1 / v`` in ``0 < |t| < 1 / R`` of the
+    reversed polynomial ``c3 + c2 t + c1 t^2 + c0 t^3``; that form is used when ``c_j / c3``
+    overflows (a tiny ``c3``), the direct one otherwise.
+    """
+    with np.errstate(all="ignore"):
+        for coef, reverse in ((c[::-1], False), (c, True)):
+            try:
+                roots = np.roots(coef)
+            except np.linalg.LinAlgError:  # inf in the companion matrix
+                continue
+            if not np.all(np.isfinite(roots)):
+                continue
+            real = roots[np.abs(roots.imag) <= 1e-9 * (1 + np.abs(roots))].real
+            if reverse:
+                real = 1.0 / real[(real != 0) & (np.abs(real) < 1.0 / REST_MAX)]
+            far = real[np.abs(real) > REST_MAX]
+            return float(far[np.argmax(np.abs(far))]) if far.size else None
+    return float("inf")  # no finite root computation: refuse rather than guess
 
 
 def knee_points(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarray:
