@@ -80,8 +80,11 @@ def check_excursion(recordings: Sequence[Recording]) -> None:
 def count_fitted(family: Family, structure: Any) -> int | None:
     """Fitted numbers of `family` at `structure`, known before fitting (from a draw of its
     documented domain); None for a family that documents none."""
+    draw = getattr(family, "random_params", None)  # duck-typed stand-ins may lack it
+    if draw is None:
+        return None
     try:
-        params = family.random_params(structure, np.random.default_rng(0))
+        params = draw(structure, np.random.default_rng(0))
     except NotImplementedError:
         return None
     return int(flatten_params(params)[0].size)
