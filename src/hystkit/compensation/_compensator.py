@@ -34,8 +34,8 @@ from ._centring import (
 )
 from ._conventions import LinearBaseline, Scaling
 
-__all__ = ["MODES", "POSITION_MARGIN", "SENSOR_MARGIN", "Compensator", "LinearBaseline",
-           "Scaling"]
+__all__ = ["MAX_NORMALISED", "MODES", "POSITION_MARGIN", "SENSOR_MARGIN", "Compensator",
+           "LinearBaseline", "Scaling"]
 
 MODES = ("direct", "inverse")
 # Use-time guards: a sensor sample is "outside" beyond this share of the training sensor range
@@ -161,7 +161,9 @@ class Compensator:
         Raises
         ------
         FitDivergedError
-            If the model's output is not finite (it is never returned).
+            If the model's run diverges, or its output is not finite or beyond
+            ``MAX_NORMALISED`` times the training positions (none of it is ever returned);
+            the message names the recording, the first such sample and the model file.
         """
         self.check_sampling(recording)
         s = self.normalised_sensor(recording.sensor)
