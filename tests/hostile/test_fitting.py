@@ -175,3 +175,12 @@ def test_evaluate_on_a_position_that_never_moves(cli, good, tmp_path):
     scores = json.loads((tmp_path / "s.json").read_text())
     assert scores["r2"] is None and scores["loop_area"] is None
     assert scores["e_rms_pct"] > 0
+
+
+def test_compare_refuses_a_validation_recording_that_never_moves(cli, good, tmp_path):
+    table = pd.read_csv(good["val"])
+    table["position"] = 0.5
+    val = tmp_path / "still.csv"
+    table.to_csv(val, index=False)
+    _refused(cli, tmp_path, ["compare", good["fit"], val, "--models", "mpl,boucwen", "--out",
+                             tmp_path / "cmp"], "still.csv", "position", "constant")

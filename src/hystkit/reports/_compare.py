@@ -11,7 +11,13 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..compensation import centre_and_scale, check_fitting_data, evaluate, fit_compensator
+from ..compensation import (
+    centre_and_scale,
+    check_excursion,
+    check_fitting_data,
+    evaluate,
+    fit_compensator,
+)
 from ..errors import HystkitError
 from ..io import Recording
 from ..metrics import e_max_pct, e_rms_pct, r2
@@ -102,10 +108,12 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
     Raises
     ------
     InputError
-        Fitting data no family can be fitted to (too short, constant, a spike); checked once
-        before any fit. Too few samples for one family's parameters is that family's error.
+        Fitting data no family can be fitted to (too short, constant, a spike), or validation
+        data no family can be scored on (constant, a spike); checked once before any fit. Too
+        few samples for one family's parameters is that family's error.
     """
     check_fitting_data([fit_rec])
+    check_excursion([val_rec])
     models = sorted(FAMILIES) if models is None else list(models)
     table = {}
     for name in models:
