@@ -556,13 +556,18 @@ def invert(structure: MplPolyStructure, params: MplPolyParams, y: np.ndarray,
         raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
     check_rest(structure, params)
     lo, hi, sign, centre = inverse_branch(structure, params)
-    if x0 is None:
-        x = rest_state(structure, params, y[0], inverse=True)
-    else:
-        x = _start(structure, params, x0, 0.0)
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # a w_0 near 0
+        if x0 is None:
+            x = rest_state(structure, params, y[0], inverse=True)
+        else:
+            x = _start(structure, params, x0, 0.0)
+        bound = min(1e6 * (1.0 + np.max(np.abs(y)) + np.max(np.abs(x))), 1e300)
+    if not np.all(np.isfinite(x)):
+        raise FitDivergedError("the inverse's rest state is not finite: the input at rest "
+                               "divides by sum(w), which is too small")
     e_hat, x_end, n_bad, why = kernels.invert(y, x, *_kernel_args(structure, params), lo, hi,
                                               sign, centre, params.w, params.v_b, structure.dt,
-                                              1e6 * (1.0 + np.max(np.abs(y)) + np.max(np.abs(x))))
+                                              bound)
     if why == 1:
         raise FitDivergedError(
             f"the inverse failed at sample {n_bad} of {y.size}: output {y[n_bad]:.4g} is outside "
