@@ -66,6 +66,8 @@ CASES = [
     ("preisach", "capacity-below-levels", [("structure.capacity", 3)],
      ["structure.capacity", "2 L + 2 = 14"]),
     ("mpl", "dt-1e-300", [("structure.dt", 1e-300)], ["structure.dt", "1e-300"]),
+    ("mpl-poly", "slope-cap-1e-300", [("structure.slope_cap", 1e-300)],
+     ["structure.slope_cap", "1e-06"]),
     ("pl", "power-1", [("structure.power", 1.0)], ["structure.power", "1.01"]),
     # parameter values
     ("mpl", "i_s-negative", [("params.i_s.0", -1.0)], ["params.i_s", "-1.0"]),

@@ -35,9 +35,10 @@ import numpy as np
 from ._protocol import Record
 from ._validation import check_cells
 
-__all__ = ["DT_RANGE", "MAX_CELLS", "MAX_VALUE", "CellStructure", "Cells", "LinearModel",
-           "cell_report", "check_magnitude", "check_range", "check_structure_size",
-           "discrete_eigenvalues", "linearise", "linearise_cells", "state_bound"]
+__all__ = ["DT_RANGE", "MAX_CELLS", "MAX_VALUE", "SLOPE_CAP_MIN", "CellStructure", "Cells",
+           "LinearModel", "cell_report", "check_magnitude", "check_range",
+           "check_structure_size", "discrete_eigenvalues", "linearise", "linearise_cells",
+           "state_bound"]
 
 # Limits shared by the cell models (mpl, mpl-poly, pl, ladder). Runs cost O(N) a sample and
 # fits hold an (n_samples x ~3N) Jacobian, so 1000 cells (24 kB of parameters, 24 MB of
@@ -46,6 +47,9 @@ MAX_CELLS = 1000
 # Sample times outside 1 ns .. 11.6 days are not recordings; inside, slope_cap / dt and
 # V_T / dt stay far from the float range whatever else the parameters are.
 DT_RANGE = (1e-9, 1e6)
+# A slope cap below 1e-6 moves a capped cell by less than a millionth of its gap per sample,
+# and the straight continuations' rest points (f(knee) / cap) run off to 1e300.
+SLOPE_CAP_MIN = 1e-6
 # Weights and biases in normalised units (eq. 5.10; the fits keep |w| <= 100): beyond 1e6 a
 # model maps [-1, 1] data to nonsense, and sums of them stay finite for any sane input.
 MAX_VALUE = 1e6
@@ -102,8 +106,8 @@ class CellStructure(Record):
         Largest allowed Euler slope ``f' dt`` (eq. 5.28 requires < 2; 1 gives overshoot-free
         cells).
 
-    Limits: ``1 <= n_cells <= MAX_CELLS`` (1000, checked first, before anything is allocated)
-    and ``dt`` in ``DT_RANGE`` (1e-9 .. 1e6 s).
+    Limits: ``1 <= n_cells <= MAX_CELLS`` (1000, checked first, before anything is allocated),
+    ``dt`` in ``DT_RANGE`` (1e-9 .. 1e6 s) and ``slope_cap >= SLOPE_CAP_MIN`` (1e-6).
     """
 
     n_cells: int = 1
@@ -114,6 +118,7 @@ class CellStructure(Record):
         check_structure_size(self.n_cells)
         check_cells(self.n_cells, self.dt, self.slope_cap)
         check_range(self.dt, "dt", *DT_RANGE, " s")
+        check_range(self.slope_cap, "slope_cap", SLOPE_CAP_MIN, 2.0, " (below 2: eq. 5.28)")
 
 
 @dataclass(frozen=True, eq=False)

@@ -99,6 +99,12 @@ def test_sample_time_is_range_checked(dt):
         FAMILY.make_structure(dt, 1)
 
 
+@pytest.mark.parametrize("cap", [1e-300, 1e-7])
+def test_slope_cap_has_a_floor(cap):
+    with pytest.raises(ValueError, match=r"slope_cap must lie in \[1e-06, 2\]"):
+        FAMILY.make_structure(0.025, 1, slope_cap=cap)
+
+
 def test_the_fit_box_and_random_params_lie_inside_the_domain():
     """The domain holds everything the fit can return: its box corners at the extreme dts."""
     for dt in (1e-9, 0.025, 100.0):  # beyond ~1e4 s the fit box is empty (G floor 1e-4)

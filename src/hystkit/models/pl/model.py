@@ -45,6 +45,7 @@ from ...errors import FitDivergedError
 from .._cells import (
     DT_RANGE,
     MAX_CELLS,
+    SLOPE_CAP_MIN,
     check_magnitude,
     check_range,
     check_structure_size,
@@ -123,7 +124,7 @@ class PlStructure(Record):
 
     Limits (checked first, before anything is allocated): ``1 <= n_cells <= 1000``,
     ``1 <= n_basis <= MAX_BASIS`` (1000), ``power`` in ``POWER_RANGE`` (1.01 .. 1000), ``dt``
-    in 1e-9 .. 1e6 s.
+    in 1e-9 .. 1e6 s, ``slope_cap`` at least 1e-6.
     """
 
     n_cells: int = 1
@@ -142,6 +143,7 @@ class PlStructure(Record):
         check_dt(self.dt)
         check_range(self.dt, "dt", *DT_RANGE, " s")
         check_slope_cap(self.slope_cap)
+        check_range(self.slope_cap, "slope_cap", SLOPE_CAP_MIN, 2.0, " (below 2: eq. 5.28)")
 
     @property
     def n_params(self) -> int:
