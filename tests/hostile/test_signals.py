@@ -88,6 +88,23 @@ def test_compensate_stopped_while_writing_leaves_no_file(sig: signal.Signals, tm
     assert (out / "keep.csv").read_text() == "an earlier result\n"
 
 
+def _gone(pids: list[str], timeout: float = 10) -> bool:
+    """Whether the processes ended (stopped workers take a moment once their parent exited)."""
+    t_end = time.monotonic() + timeout
+    while any(_running(p) for p in pids):
+        if time.monotonic() > t_end:
+            return False
+        time.sleep(0.01)
+    return True
+
+
+def _running(pid: str) -> bool:
+    try:  # a zombie waiting for its new parent to reap it has ended
+        return Path(f"/proc/{pid}/stat").read_text().split(")")[-1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
 def _children(pid: int) -> list[str]:
     try:
         return Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
@@ -101,8 +118,10 @@ def test_select_with_workers_ctrl_c_is_one_line(tmp_path: Path, good: dict[str, 
     proc = _start("select", good["fit"], "--jobs", "2", "--out", "m.json", cwd=tmp_path)
     _wait_until(proc, lambda: len(_children(proc.pid)) >= 2)
     time.sleep(0.5)  # let the workers get into their candidates
+    workers = _children(proc.pid)
     os.killpg(proc.pid, signal.SIGINT)
     _stopped(proc, signal.SIGINT)
+    assert _gone(workers)
     assert entries(tmp_path) == []
 
 
@@ -117,5 +136,5 @@ def test_select_with_workers_sigterm_stops_them_too(tmp_path: Path,
     proc.send_signal(signal.SIGTERM)
     _stopped(proc, signal.SIGTERM)
     assert time.monotonic() - t0 < 20
-    assert not any(Path(f"/proc/{w}").exists() for w in workers)
+    assert _gone(workers)
     assert entries(tmp_path) == []

@@ -14,6 +14,7 @@ from __future__ import annotations
 import importlib
 import os
 import pkgutil
+import signal
 import sys
 import traceback
 from collections.abc import Sequence
@@ -21,7 +22,7 @@ from collections.abc import Sequence
 from .. import __version__
 from ..errors import HystkitError, Terminated
 from ._common import INTERNAL_EXIT, Parser
-from ._signals import signals_as_exceptions
+from ._signals import forked_workers, received_signal, signals_as_exceptions
 
 __all__ = ["main"]
 
@@ -46,8 +47,31 @@ def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split("\n"))
 
 
+def _stopped(signum: int) -> int:
+    """One line for a command stopped by a signal; exit 128 + its number (130, 143)."""
+    if signum == signal.SIGTERM:
+        print("hystkit: terminated (SIGTERM)", file=sys.stderr)
+    else:
+        print("hystkit: interrupted", file=sys.stderr)
+    return 128 + signum
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point; returns the exit code (see the module docstring)."""
+    """Entry point; returns the exit code (see the module docstring).
+
+    Run as the program (`argv` None) and stopped by a signal after forking workers, it ends
+    the process itself: multiprocessing's exit handlers would otherwise wait forever to flush
+    queues to the workers it stopped.
+    """
+    code = _main(argv)
+    if argv is None and code in (130, 143) and forked_workers():
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
+
+
+def _main(argv: Sequence[str] | None) -> int:
     try:
         with signals_as_exceptions():
             args = _parser().parse_args(argv)
@@ -56,11 +80,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"hystkit: error: {_one_line(exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("hystkit: interrupted", file=sys.stderr)
-        return 130
+        return _stopped(signal.SIGINT)
     except Terminated:
-        print("hystkit: terminated (SIGTERM)", file=sys.stderr)
-        return 143
+        return _stopped(signal.SIGTERM)
     except BrokenPipeError:
         # The reader went away (`hystkit ... | head`): not our error. Point stdout at devnull so
         # the interpreter's final flush does not raise again (Python docs, signal module).
@@ -71,6 +93,8 @@ def main(argv: Sequence[str] | None = None) -> int:
               "--chunk-size)", file=sys.stderr)
         return 2
     except Exception as exc:  # noqa: BLE001  (the last resort is the point)
+        if received_signal() is not None:  # cleanup that failed because of the signal
+            return _stopped(received_signal())
         # Last resort. Anything here is a bug (user errors are HystkitErrors): say so on one
         # line rather than with a traceback; the hostile tests treat this exit code as failure.
         if os.environ.get("HYSTKIT_DEBUG", "") not in ("", "0"):

@@ -11,6 +11,8 @@ group) or when terminated they end without a traceback, and the parent reports o
 
 from __future__ import annotations
 
+import concurrent.futures.thread  # noqa: F401  (registers its at-fork hooks before ours)
+import logging  # noqa: F401  (the same)
 import os
 import signal
 import sys
@@ -21,6 +23,21 @@ from contextlib import contextmanager
 from ..errors import Terminated
 
 _active = False  # a command is running in this process (workers forked now need the reset)
+_received: int | None = None  # the last signal the running command got
+_owner = os.getpid()  # the process running the command (not a forked worker)
+_forking = False  # between this process's at-fork hooks
+_PR_SET_PDEATHSIG = 1  # prctl(2) option
+_forks = 0  # worker processes forked by the running command
+_previous_excepthook = threading.excepthook
+
+
+def received_signal() -> int | None:
+    """The signal (SIGINT or SIGTERM) the current or last command received, if any.
+
+    An exception that follows a signal (a library's cleanup failing half-way, e.g. a process
+    pool interrupted while starting) is the signal's consequence, not a bug of its own.
+    """
+    return _received
 
 
 def _stop_workers() -> None:
@@ -31,43 +48,124 @@ def _stop_workers() -> None:
         child.terminate()
 
 
-def _on_sigint(signum: int, frame: object) -> None:
+def _stopping(signum: int) -> bool:
+    """Common part of the handlers: note the signal, stop the workers; False: do not raise
+    now (a forked worker that is about to reset its handlers, or a fork in progress)."""
+    global _received
+    if os.getpid() != _owner:  # a worker forked a moment ago, before `_quiet_child` ran
+        signal.signal(signum, signal.SIG_DFL)
+        os.kill(os.getpid(), signum)
+        return False
+    _received = signum
+    if _forking:
+        # An exception raised inside another module's at-fork hook (logging's) would only be
+        # printed and ignored: raise it from a timer once the fork has returned.
+        signal.setitimer(signal.ITIMER_REAL, 0.005)
+        return False
     _stop_workers()
-    raise KeyboardInterrupt
+    return True
 
 
-def _on_sigterm(signum: int, frame: object) -> None:
+def _raise_for(signum: int) -> None:
+    raise KeyboardInterrupt if signum == signal.SIGINT else Terminated
+
+
+def _on_signal(signum: int, frame: object) -> None:
+    if _stopping(signum):
+        _raise_for(signum)
+
+
+def _on_alarm(signum: int, frame: object) -> None:
+    """The deferred exception of a signal that arrived while forking."""
+    if _received is None or os.getpid() != _owner:
+        return
+    if _forking:
+        signal.setitimer(signal.ITIMER_REAL, 0.005)
+        return
     _stop_workers()
-    raise Terminated
+    _raise_for(_received)
+
+
+def _fork_starts() -> None:
+    global _forking
+    _forking = True
+
+
+def _fork_done() -> None:
+    global _forking, _forks
+    _forking = False
+    if _active:
+        _forks += 1
+
+
+def forked_workers() -> bool:
+    """Whether the current or last command forked worker processes."""
+    return _forks > 0
+
+
+def _quiet_thread_errors(args: threading.ExceptHookArgs) -> None:
+    """After a signal, errors in helper threads (a process pool's manager finding its workers
+    gone) are the signal's consequence: no traceback for them."""
+    if _received is None:
+        _previous_excepthook(args)
+
+
+def _die_with_parent() -> None:
+    """Linux: have the kernel send SIGTERM when the parent ends, so a worker forked while the
+    parent was being stopped (too late for its terminate) cannot outlive it."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+    except (OSError, AttributeError):  # not Linux: the parent's terminate has to do
+        return
+    if os.getppid() != _owner:  # the parent ended before the request took effect
+        os._exit(128 + signal.SIGTERM)
 
 
 def _quiet_child() -> None:
+    global _forking
+    _forking = False
     if _active:
+        if _received is not None:  # forked by a pool still starting after the signal
+            os._exit(128 + _received)
+        if sys.platform.startswith("linux"):
+            _die_with_parent()
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        if signal.getsignal(signal.SIGINT) is _on_sigint:
+        if signal.getsignal(signal.SIGINT) is _on_signal:
             signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
-os.register_at_fork(after_in_child=_quiet_child)
+# Registered after logging's hooks (imported above for this), so that ours enclose them:
+# `before` hooks run in reverse order of registration, `after_*` hooks in order.
+os.register_at_fork(before=_fork_starts, after_in_parent=_fork_done,
+                    after_in_child=_quiet_child)
 
 
 @contextmanager
 def signals_as_exceptions() -> Iterator[None]:
     """Within the block, SIGTERM raises `Terminated` and SIGINT KeyboardInterrupt, each after
     stopping worker processes (main thread only; the previous handlers are restored)."""
-    global _active
+    global _active, _received, _owner, _forks, _previous_excepthook
+    _received, _owner, _forks = None, os.getpid(), 0
     if threading.current_thread() is not threading.main_thread():
         yield  # signal handlers can only be set from the main thread
         return
-    previous_term = signal.signal(signal.SIGTERM, _on_sigterm)
+    previous_term = signal.signal(signal.SIGTERM, _on_signal)
+    previous_alarm = signal.signal(signal.SIGALRM, _on_alarm)
     previous_int = signal.getsignal(signal.SIGINT)
     if previous_int is signal.default_int_handler:  # leave an ignored SIGINT (nohup) ignored
-        signal.signal(signal.SIGINT, _on_sigint)
+        signal.signal(signal.SIGINT, _on_signal)
+    _previous_excepthook, threading.excepthook = threading.excepthook, _quiet_thread_errors
     was_active, _active = _active, True
     try:
         yield
     finally:
         _active = was_active
+        threading.excepthook = _previous_excepthook
+        signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGTERM, previous_term)
+        signal.signal(signal.SIGALRM, previous_alarm)
         if previous_int is signal.default_int_handler:
             signal.signal(signal.SIGINT, previous_int)
