@@ -77,6 +77,8 @@ def _main(argv: Sequence[str] | None) -> int:
             args = _parser().parse_args(argv)
             return args.run(args)
     except HystkitError as exc:
+        if received_signal() is not None:  # e.g. a reader child killed by the same Ctrl-C
+            return _stopped(received_signal())
         print(f"hystkit: error: {_one_line(exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
