@@ -33,12 +33,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._protocol import Record
-from ._validation import check_cells
+from ._validation import check_cells, check_range, check_structure_size
 
-__all__ = ["DT_RANGE", "MAX_CELLS", "MAX_VALUE", "SLOPE_CAP_MIN", "CellStructure", "Cells",
-           "LinearModel", "cell_report", "check_magnitude", "check_range",
-           "check_structure_size", "discrete_eigenvalues", "linearise", "linearise_cells",
-           "state_bound"]
+__all__ = ["DT_RANGE", "MAX_CELLS", "SLOPE_CAP_MIN", "CellStructure", "Cells", "LinearModel",
+           "cell_report", "discrete_eigenvalues", "linearise", "linearise_cells", "state_bound"]
 
 # Limits shared by the cell models (mpl, mpl-poly, pl, ladder). Runs cost O(N) a sample and
 # fits hold an (n_samples x ~3N) Jacobian, so 1000 cells (24 kB of parameters, 24 MB of
@@ -50,36 +48,6 @@ DT_RANGE = (1e-9, 1e6)
 # A slope cap below 1e-6 moves a capped cell by less than a millionth of its gap per sample,
 # and the straight continuations' rest points (f(knee) / cap) run off to 1e300.
 SLOPE_CAP_MIN = 1e-6
-# Weights and biases in normalised units (eq. 5.10; the fits keep |w| <= 100): beyond 1e6 a
-# model maps [-1, 1] data to nonsense, and sums of them stay finite for any sane input.
-MAX_VALUE = 1e6
-
-
-def check_range(values, name: str, low: float, high: float, why: str = "") -> None:
-    """Raise ValueError unless every value lies in ``[low, high]`` (NaN fails); the message
-    names the parameter, the first offending value and the range."""
-    arr = np.asarray(values, dtype=float).reshape(-1)
-    bad = ~((arr >= low) & (arr <= high))
-    if np.any(bad):
-        raise ValueError(f"{name} must lie in [{low:g}, {high:g}]{why}, got "
-                         f"{float(arr[np.argmax(bad)])!r}")
-
-
-def check_magnitude(values, name: str, limit: float = MAX_VALUE) -> None:
-    """Raise ValueError unless ``|values| <= limit`` (normalised units, see ``MAX_VALUE``)."""
-    check_range(values, name, -limit, limit, " (normalised units: the domain where runs stay "
-                                             "bounded)")
-
-
-def check_structure_size(n, name: str = "n_cells", limit: int = MAX_CELLS, low: int = 1) -> None:
-    """Raise ValueError unless ``n`` is a whole number in ``[low, limit]``; checked before any
-    other field, so nothing is allocated or looped over for a huge or non-numeric size."""
-    ok = (isinstance(n, int | float | np.integer | np.floating) and not isinstance(n, bool)
-          and np.isfinite(n) and int(n) == n and low <= n <= limit)
-    if not ok:
-        raise ValueError(f"{name} must be a whole number in [{low}, {limit}], got {n!r}")
-
-
 def state_bound(x0_max: float, u_max: float, slope_cap: float) -> float:
     """Largest ``|u_k|`` a cell ``x+ = x + f(e - x) dt`` can reach from ``|x0| <= x0_max``
     under inputs ``|e| <= u_max``, when ``f`` is increasing through ``f(0) = 0`` with secant
@@ -115,7 +83,7 @@ class CellStructure(Record):
     slope_cap: float = 1.0
 
     def __post_init__(self) -> None:
-        check_structure_size(self.n_cells)
+        check_structure_size(self.n_cells, "n_cells", MAX_CELLS)
         check_cells(self.n_cells, self.dt, self.slope_cap)
         check_range(self.dt, "dt", *DT_RANGE, " s")
         check_range(self.slope_cap, "slope_cap", SLOPE_CAP_MIN, 2.0, " (below 2: eq. 5.28)")

@@ -16,14 +16,18 @@ import numpy as np
 from hystkit.errors import FitDivergedError
 
 __all__ = [
+    "MAX_VALUE",
     "broadcast_state",
     "check_cells",
     "check_dt",
     "check_finite_run",
+    "check_magnitude",
     "check_positive_int",
+    "check_range",
     "check_signal",
     "check_size",
     "check_slope_cap",
+    "check_structure_size",
     "finite_floats",
     "freeze_arrays",
     "frozen_array",
@@ -216,3 +220,33 @@ def check_finite_run(values: np.ndarray, family: str, what: str = "output") -> n
                                f"{int(bad[0]) + 1} of {np.size(values)}: the parameters lie "
                                f"outside the domain where it stays bounded")
     return values
+
+
+# Weights and biases in normalised units (eq. 5.10; the fits keep |w| <= 100): beyond 1e6 a
+# model maps [-1, 1] data to nonsense, and sums of them stay finite for any sane input.
+MAX_VALUE = 1e6
+
+
+def check_range(values, name: str, low: float, high: float, why: str = "") -> None:
+    """Raise ValueError unless every value lies in ``[low, high]`` (NaN fails); the message
+    names the parameter, the first offending value and the range."""
+    arr = np.asarray(values, dtype=float).reshape(-1)
+    bad = ~((arr >= low) & (arr <= high))
+    if np.any(bad):
+        raise ValueError(f"{name} must lie in [{low:g}, {high:g}]{why}, got "
+                         f"{float(arr[np.argmax(bad)])!r}")
+
+
+def check_magnitude(values, name: str, limit: float = MAX_VALUE) -> None:
+    """Raise ValueError unless ``|values| <= limit`` (normalised units, see ``MAX_VALUE``)."""
+    check_range(values, name, -limit, limit, " (normalised units: the domain where runs stay "
+                                             "bounded)")
+
+
+def check_structure_size(n, name: str, limit: int, low: int = 1) -> None:
+    """Raise ValueError unless ``n`` is a whole number in ``[low, limit]``; checked before any
+    other field, so nothing is allocated or looped over for a huge or non-numeric size."""
+    ok = (isinstance(n, int | float | np.integer | np.floating) and not isinstance(n, bool)
+          and np.isfinite(n) and int(n) == n and low <= n <= limit)
+    if not ok:
+        raise ValueError(f"{name} must be a whole number in [{low}, {limit}], got {n!r}")

@@ -37,9 +37,8 @@ from math import comb
 import numpy as np
 from numpy.polynomial import Polynomial
 
-from .._cells import check_magnitude
 from .._protocol import Record
-from .._validation import check_finite_run, run_steps
+from .._validation import check_finite_run, check_magnitude, run_steps
 from ..preisach import (
     INVERT_TOL,
     MAX_VALUE,

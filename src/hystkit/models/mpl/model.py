@@ -29,18 +29,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import FitDivergedError
-from .._cells import (
-    CellStructure,
-    check_magnitude,
-    check_range,
-    check_structure_size,
-    state_bound,
-)
+from .._cells import MAX_CELLS, CellStructure, state_bound
 from .._protocol import Record
 from .._validation import (
     check_finite_run,
+    check_magnitude,
+    check_range,
     check_signal,
     check_size,
+    check_structure_size,
     finite_floats,
     freeze_arrays,
     initial_state,
@@ -120,7 +117,7 @@ class MplParams(Record):
 
     def __post_init__(self) -> None:
         n = np.size(self.i_s)
-        check_structure_size(n, "the number of cells (size of i_s)")  # before any copy
+        check_structure_size(n, "the number of cells (size of i_s)", MAX_CELLS)  # before copying
         object.__setattr__(self, "n_cells", int(n))
         freeze_arrays(self, i_s=n, v_t=n, w=n + 1)
         finite_floats(self, "v_b")

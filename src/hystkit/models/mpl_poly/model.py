@@ -32,13 +32,16 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ...errors import FitDivergedError
-from .._cells import CellStructure, check_magnitude, check_range, check_structure_size
+from .._cells import MAX_CELLS, CellStructure
 from .._protocol import Record
 from .._validation import (
     broadcast_state,
     check_finite_run,
+    check_magnitude,
+    check_range,
     check_signal,
     check_size,
+    check_structure_size,
     finite_floats,
     frozen_shaped,
     run_steps,
@@ -147,7 +150,7 @@ class MplPolyParams(Record):
 
     def __post_init__(self) -> None:
         if np.ndim(self.f) >= 1:  # the cell count first, before the values are copied
-            check_structure_size(len(self.f), "the number of cells (rows of f)")
+            check_structure_size(len(self.f), "the number of cells (rows of f)", MAX_CELLS)
         shape = np.shape(frozen_shaped(self.f, None, "f"))
         if len(shape) != 2 or shape[0] < 1 or shape[1] != 4:
             raise ValueError(f"f must have shape (N, 4), one row per cell, got {shape}")

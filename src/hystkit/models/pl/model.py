@@ -42,21 +42,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import FitDivergedError
-from .._cells import (
-    DT_RANGE,
-    MAX_CELLS,
-    SLOPE_CAP_MIN,
-    check_magnitude,
-    check_range,
-    check_structure_size,
-    state_bound,
-)
+from .._cells import DT_RANGE, MAX_CELLS, SLOPE_CAP_MIN, state_bound
 from .._protocol import Record
 from .._validation import (
     check_dt,
     check_finite_run,
+    check_magnitude,
+    check_range,
     check_signal,
     check_slope_cap,
+    check_structure_size,
     finite_floats,
     freeze_arrays,
     initial_state,
@@ -194,7 +189,7 @@ class PlParams(Record):
         object.__setattr__(self, "n_basis", int(np.size(self.a)))
         if self.n_cells < 1 or self.n_basis < 1:
             raise ValueError("w needs N + 1 >= 2 values and a at least one")
-        check_structure_size(self.n_cells, "the number of cells (size of w minus 1)")
+        check_structure_size(self.n_cells, "the number of cells (size of w minus 1)", MAX_CELLS)
         check_structure_size(self.n_basis, "the number of basis slopes (size of a)", MAX_BASIS)
         freeze_arrays(self, w=self.n_cells + 1, a=self.n_basis)
         finite_floats(self, "i_t", "v_t", "v_b")

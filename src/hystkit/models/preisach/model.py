@@ -53,9 +53,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import FitDivergedError
-from .._cells import check_magnitude, check_structure_size
 from .._protocol import Record
-from .._validation import check_dt, check_finite_run, check_signal, check_size, run_steps
+from .._validation import (
+    check_dt,
+    check_finite_run,
+    check_magnitude,
+    check_signal,
+    check_size,
+    check_structure_size,
+    run_steps,
+)
 from . import kernels
 
 __all__ = [
