@@ -181,3 +181,16 @@ def test_files_that_belong_together_appear_together_or_not_at_all(tmp_path: Path
         t2.write_text("new report")
     assert (data.read_text(), report.read_text()) == ("new data", "new report")
     assert _names(tmp_path) == ["out.csv", "sub", "sub/out.json"]
+
+
+@pytest.mark.parametrize("name", [".", ".."])
+def test_folder_output_may_be_the_current_folder_or_its_parent(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, name: str) -> None:
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    with atomic_folder(name, names=["a.json"]) as tmp:
+        write_json({"a": 1}, tmp / "a.json")
+    where = work if name == "." else tmp_path
+    assert (where / "a.json").is_file()
+    assert _names(tmp_path) == sorted(["work", "work/a.json" if name == "." else "a.json"])

@@ -332,10 +332,10 @@ def atomic_folder(out: str | os.PathLike[str], force: bool = False,
                   names: Iterable[str] = ()) -> Iterator[Path]:
     """Yield a temporary folder to build the folder output `out` in; publish it on success.
 
-    The temporary is a hidden sibling of `out` (``.NAME.tmp-XXXXXXXX``). When the block
-    ends normally: if `out` does not exist, the temporary is renamed to it, so the folder
-    appears complete or not at all; if it exists, the built files are moved into it one by
-    one only after all were built (with `force` replacing same-named files; without, by
+    The temporary is a hidden sibling of `out` (``.NAME.tmp-XXXXXXXX``; inside `out` if that
+    exists already). When the block ends normally: if `out` does not exist, the temporary is
+    renamed to it, so the folder appears complete or not at all; if it exists, the built
+    files are moved into it one by one only after all were built (with `force` replacing same-named files; without, by
     exclusive creation, and a clash removes the files already moved, so nothing changes).
     On any exception the temporary folder is removed. `names` (files the caller will write)
     are checked first like :func:`check_output_folder`.
@@ -366,8 +366,12 @@ def atomic_folder(out: str | os.PathLike[str], force: bool = False,
 
 
 def _create_temporary_folder(out: Path) -> Path:
+    """A hidden sibling of `out`; inside `out` when it exists (``.``, ``..``, ``/`` have no
+    usable sibling, and the files are merged one by one anyway)."""
     while True:
-        tmp = out.with_name(f".{out.name}{TEMP_MARK}{secrets.token_hex(4)}")
+        name = f".{os.path.basename(os.path.abspath(out)) or 'out'}{TEMP_MARK}" \
+               f"{secrets.token_hex(4)}"
+        tmp = out / name if out.is_dir() else Path(os.path.abspath(out)).with_name(name)
         try:
             tmp.mkdir()
             return tmp
@@ -386,7 +390,7 @@ def _publish_folder(tmp: Path, out: Path, force: bool) -> None:
                 raise
     if not out.is_dir():
         raise OutputError(f"{out} is a file, not a folder")
-    files = sorted(p for p in tmp.rglob("*") if p.is_file())
+    files = sorted(p for p in tmp.rglob("*") if p.is_file())  # tmp may lie inside out
     for built in files:
         (out / built.relative_to(tmp)).parent.mkdir(parents=True, exist_ok=True)
     _publish_all([(built, out / built.relative_to(tmp)) for built in files], force)
