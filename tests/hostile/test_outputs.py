@@ -65,6 +65,11 @@ CASES = {
     "pl-search-json-into-proc": ("pl-search fit.csv --json /proc/x.json", ["/proc/x.json"]),
     "stability-json-over-model": ("stability model.json --json model.json --force",
                                   ["model.json", "input"]),
+    "compensate-over-dev-null": ("compensate model.json val.csv --out /dev/null --force",
+                                 ["/dev/null", "not a regular file"]),
+    "compensate-name-too-long": (f"compensate model.json val.csv --out {'a' * 250}.csv",
+                                 ["file name too long"]),
+    "demo-folder-name-too-long": (f"demo --out {'d' * 250}", ["file name too long"]),
     "datasets-export-into-proc": ("datasets export mr_damper --excerpt --out /proc/x.csv",
                                   ["/proc/x.csv"]),
 }

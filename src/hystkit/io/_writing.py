@@ -173,8 +173,27 @@ def check_output_path(path: str | os.PathLike[str], force: bool = False, *,
             raise OutputError(f"{path} is also an input of this command; write elsewhere")
     if path.exists() and not force:
         raise OutputExistsError(f"{path} already exists; pass --force to overwrite it")
+    if path.exists() and not path.is_file():  # a device, pipe or socket: never replace it
+        raise OutputError(f"{path} is not a regular file; write to a file")
     check_folder_writable(path.parent, what=path)
+    _check_name_length(path)
     return path
+
+
+def _check_name_length(path: Path) -> None:
+    """Refuse a name too long for the folder's file system once the temporary's marks are
+    added (``.`` + ``.tmp-XXXXXXXX``: 14 bytes), rather than after the work."""
+    existing = path.parent
+    while not existing.exists() and existing.parent != existing:
+        existing = existing.parent
+    try:
+        limit = os.pathconf(existing, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    for part in (*path.parent.relative_to(existing).parts, path.name):
+        if len(part.encode()) + 14 + 4 > limit:  # + 4: the "old-" mark of a replaced file
+            raise OutputError(f"{path}: file name too long ({len(part.encode())} bytes; "
+                              f"at most {limit - 18} here)")
 
 
 def check_output_folder(folder: str | os.PathLike[str], names: Iterable[str],
