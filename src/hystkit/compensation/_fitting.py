@@ -151,7 +151,8 @@ def _fit_family(family: Family, structure: Any, mode: str, s: np.ndarray,
         return _run_fit(family, structure, mode, s, p)
     except HystkitError:
         raise
-    except Exception as exc:  # any family's failure: reported, not a crash
+    # A numerical failure of the family's fit is reported; a programming error is not hidden.
+    except (ValueError, TypeError, ArithmeticError, IndexError, np.linalg.LinAlgError) as exc:
         raise FitDivergedError(f"{source}: the {family.name} fit failed on these data "
                                f"({type(exc).__name__}: {exc})") from exc
 

@@ -133,7 +133,9 @@ def _build(source: str, section: str, sections: dict[str, str],
     except KeyError as exc:  # Record.from_dict: "Params needs a, b"
         detail = exc.args[0] if exc.args else exc
         raise InputError(f"{source}: key {section!r}: {detail} (missing key)") from None
-    except Exception as exc:  # noqa: BLE001 -- untrusted file: whatever a family's code raises
+    # What a family's validation raises for bad values; anything else (NameError, ...) is a bug
+    # in hystkit and must reach the CLI's internal-error line, not pose as a bad file.
+    except (ValueError, TypeError, ArithmeticError, IndexError) as exc:
         message = str(exc) or type(exc).__name__
         name = key_in_message(message, sections)
         path = section if name is None else ".".join(filter(None, (sections[name], name)))
