@@ -193,7 +193,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="divide position and sensor by their max |.| (eq. 5.10)")
     p.add_argument("--chunk-size", type=_chunk_size, metavar="N",
                    help="samples per chunk, 1024 to 2^27 (default 262144); memory grows with "
-                        "it")
+                        "it, the result does not depend on it")
     p.set_defaults(run=_preprocess)
 
 

@@ -494,16 +494,3 @@ def atomic_outputs(paths: Iterable[str | os.PathLike[str]],
             tmp.unlink(missing_ok=True)
         if not done:
             _remove_folders(sorted(set(created), key=lambda p: -len(p.parts)))
-
-
-def _write_text_safely(path: Path, write: Any) -> None:
-    """Create parent folders and write; OS failures become one-line OutputErrors.
-
-    Not atomic: kept for streaming writers that open `path` themselves; new code writes
-    through :func:`atomic_output` instead.
-    """
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write()
-    except OSError as exc:
-        raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
