@@ -155,8 +155,8 @@ def test_cli_never_overwrites_without_force(capsys, tmp_path):
 @pytest.mark.parametrize(("argv", "fragment"), [
     (["--scheme", "direct"], "--experiment"),
     (["--scheme", "sideways", "--bode"], "invalid choice"),
-    (["--scheme", "direct", "--bode", "--dob-hz", "0"], "positive"),
-    (["--scheme", "direct", "--bode", "--tune", "20", "95"], "phase margin"),
+    (["--scheme", "direct", "--bode", "--dob-hz", "0"], "--dob-hz: must be > 0"),
+    (["--scheme", "direct", "--bode", "--tune", "20", "95"], "--tune PM_DEG: must be < 90"),
 ])
 def test_cli_bad_options_give_one_error_line(capsys, tmp_path, argv, fragment):
     code, _, err = _run(capsys, "control", *argv, "--out", tmp_path / "x")

@@ -12,8 +12,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 from hystkit import control as hc
 from hystkit.cli import main
 from hystkit.compensation import fit_compensator, save_compensator
-from hystkit.models.mpl_poly import PAPER_9_2_TABLE_II, paper_9_2_params
 from hystkit.models import mpl_poly
+from hystkit.models.mpl_poly import PAPER_9_2_TABLE_II, paper_9_2_params
 from hystkit.sensors import simulate_experiment
 
 TS = hc.TS

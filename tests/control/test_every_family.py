@@ -55,7 +55,7 @@ def test_fit_writes_a_model_file(model_files, name):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_direct_scheme_with_the_family_as_compensator(model_files, name, tmp_path, capsys):
-    code, out, err = _run(capsys, "control", "--scheme", "direct", "--experiment", "sine",
+    code, _, err = _run(capsys, "control", "--scheme", "direct", "--experiment", "sine",
                           "--compensator", model_files[name][1], "--out", tmp_path / "a")
     assert code == 0, err
     metrics = json.loads((tmp_path / "a" / "metrics.json").read_text())

@@ -54,8 +54,16 @@ DOCUMENT_SINE = {"direct": {"e_p_max": 6.94e-4, "e_p_mean": -1.543e-4, "source":
 # PID gains (eq. 7.2): 0 < Kp <= 1e9, 1 us <= Ti <= 1e6 s (inf: no integral action),
 # 0 <= Td <= 1000 s; one type per slot. Far beyond any tuning of a 0.25 kg stage, and the range
 # in which the loop's linearisation and simulation stay well conditioned.
-_PID_TYPES = (number(0, 1e9, low_open=True), number(1e-6, 1e6, allow_inf=True),
-              number(0, 1e3))
+def _gain(text: str) -> float:
+    """KP: finite, nonzero, |KP| <= 1e9. A negative gain is allowed: a sign error is an
+    experiment worth running (the loop then reports itself unbounded)."""
+    value = number(-1e9, 1e9)(text)
+    if value == 0:
+        raise argparse.ArgumentTypeError("must not be 0 (no feedback at all)")
+    return value
+
+
+_PID_TYPES = (_gain, number(1e-6, 1e6, allow_inf=True), number(0, 1e3))
 _TUNE_TYPES = (number(0, 1e4, low_open=True), number(0, 90, low_open=True, high_open=True))
 
 
@@ -294,7 +302,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="Q-filter bandwidth [Hz] (default: chosen by design_dob)")
     p.add_argument("--pid", nargs=3, action=_Checked, types=_PID_TYPES,
                    metavar=("KP", "TI", "TD"),
-                   help="PID gains: KP > 0, TI > 0 [s] (inf: no integral action), TD >= 0 [s] "
+                   help="PID gains: KP nonzero (|KP| <= 1e9), TI > 0 [s] (inf: no integral action), TD >= 0 [s] "
                         "(default: the document's for the scheme)")
     p.add_argument("--tune", nargs=2, action=_Checked, types=_TUNE_TYPES,
                    metavar=("FC_HZ", "PM_DEG"),
