@@ -26,10 +26,17 @@ MESSAGES = {signal.SIGINT: (130, "hystkit: interrupted"),
             signal.SIGTERM: (143, "hystkit: terminated (SIGTERM)")}
 
 
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _start(*argv: object, cwd: Path) -> subprocess.Popen:
     return subprocess.Popen([sys.executable, "-m", "hystkit", *map(str, argv)], cwd=cwd,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True,  # its own group, like a terminal job
+                            # a shell's background job (CI, nohup) ignores SIGINT, and the
+                            # child would inherit that; a terminal's job has the default
+                            preexec_fn=_default_sigint,  # noqa: PLW1509 (no threads here)
                             env={**os.environ, "MPLBACKEND": "Agg", "PYTHONUNBUFFERED": "1"})
 
 
