@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -94,12 +95,17 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
                   _per_coordinate(limits[1], lower.size, "limits[1]"))
     margin = 1e-9 * np.maximum(1.0, upper - lower)
 
-    def solve(theta0: np.ndarray, budget: int):
+    def solve(theta0: np.ndarray, budget: int) -> SimpleNamespace:
         # BLAS threads do not pay on (n x n_params) problems, and under load they cost 10-30x
         # (benchmarks/README.md).
         with threadpool_limits(limits=1, user_api="blas"):
-            return least_squares(residual, theta0, jac=jac, bounds=(lower, upper),
-                                 method="trf", x_scale="jac", max_nfev=budget)
+            sol = least_squares(residual, theta0, jac=jac, bounds=(lower, upper),
+                                method="trf", x_scale="jac", max_nfev=budget)
+        # Keep only what ranking and reporting need: the (n x n_params) Jacobian and the
+        # residuals of every screened start alive together cost GBs on long recordings.
+        return SimpleNamespace(x=sol.x, cost=float(sol.cost), status=sol.status,
+                               message=sol.message, nfev=sol.nfev, njev=sol.njev,
+                               column_norms=_column_norms(sol.jac))
 
     t_start = time.perf_counter()
     screened, n_eval = [], 0
@@ -134,7 +140,7 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
                      converged=bool(best.status > 0), message=str(best.message),
                      n_starts=len(starts), theta=np.array(best.x),
                      bounds=(lower, upper), names=names, limits=limits,
-                     sensitivity=_column_norms(best.jac))
+                     sensitivity=best.column_norms)
 
 
 def _column_norms(jac: Any) -> np.ndarray | None:
