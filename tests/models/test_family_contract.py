@@ -57,6 +57,15 @@ def test_family_declares_the_protocol(name):
 
 
 @pytest.mark.parametrize("name", NAMES)
+def test_every_size_up_to_max_size_makes_a_valid_structure(name):
+    # the CLI offers sizes up to max_size: the structure's own limits must accept all of them
+    family = get_family(name)
+    assert 1 <= family.default_size <= family.max_size
+    for size in (family.default_size, family.max_size):
+        family.make_structure(0.025, size)
+
+
+@pytest.mark.parametrize("name", NAMES)
 def test_params_and_structure_round_trip_through_json(name):
     family = get_family(name)
     structure, params, _ = _example(name)

@@ -2,7 +2,7 @@
 
 Every numeric option goes through a type here: finite unless infinity means something (no
 actuator limit), within a range, and sizes that allocate below a per-family maximum
-(`SIZE_LIMITS`), so a bad value is one line before any work.
+(the family's ``max_size``), so a bad value is one line before any work.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 from ..errors import HystkitError
 
-__all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "SIZE_LIMITS", "Parser", "UsageError", "check_size",
+__all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Parser", "UsageError", "check_size",
            "failures_exit", "integer", "number", "positive_float", "positive_int", "size_limit",
            "slope_cap"]
 
@@ -25,12 +25,6 @@ GUARD_EXIT = 3
 # Exit code of an internal error (a bug; BSD's EX_SOFTWARE): one line instead of a traceback.
 INTERNAL_EXIT = 70
 
-# Largest size each family accepts on the command line, unless the family states its own
-# (a ``max_size`` class attribute): beyond these a fit takes hours or its Jacobian stops being
-# solvable (mpl with 300 cells: SVD does not converge after 30 s), and staircases grow as L².
-SIZE_LIMITS = {"mpl": 50, "mpl-poly": 30, "pl": 50, "ladder": 50, "chua": 20, "bobbio": 100,
-               "boucwen": 64, "pi": 200, "preisach": 100, "gpreisach": 64}
-DEFAULT_SIZE_LIMIT = 50
 
 
 class UsageError(HystkitError):
@@ -95,8 +89,9 @@ def slope_cap(text: str) -> float:
 
 
 def size_limit(family) -> int:
-    """Largest size of `family` the CLI accepts: the family's ``max_size`` if it states one."""
-    return getattr(family, "max_size", None) or SIZE_LIMITS.get(family.name, DEFAULT_SIZE_LIMIT)
+    """Largest size of `family` the CLI accepts (the family's ``max_size``: beyond it a fit
+    takes hours or its Jacobian stops being solvable, e.g. mpl with 300 cells)."""
+    return family.max_size
 
 
 def check_size(family_name: str, size: int | None, option: str = "--size") -> None:

@@ -7,8 +7,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ..io import check_output_path, read_recording, write_json
-from ..models.pl import DEFAULT_GRID, format_search_table, structural_search
-from ._common import SIZE_LIMITS, integer, number
+from ..models.pl import DEFAULT_GRID, FAMILY, format_search_table, structural_search
+from ._common import integer, number
 
 __all__ = ["register"]
 
@@ -26,7 +26,7 @@ def _list(parse: Callable[[str], float], what: str) -> Callable[[str], tuple]:
     return parse_all
 
 
-_cells = _list(integer(1, SIZE_LIMITS["pl"]), f"cell counts 1 to {SIZE_LIMITS['pl']}")
+_cells = _list(integer(1, FAMILY.max_size), f"cell counts 1 to {FAMILY.max_size}")
 _powers = _list(number(1, 100, low_open=True), "powers p in (1, 100]")
 _bases = _list(integer(1, 50), "basis counts 1 to 50")
 _smoothing = _list(number(0), "smoothing weights >= 0")

@@ -130,6 +130,10 @@ class Family(ABC):
     size_help : str
         What the size knob means (cells, operators, grid levels ...).
     default_size : int
+    max_size : int
+        Largest size a fit is offered (the CLI refuses more, before any work): beyond it a fit
+        takes hours or its Jacobian stops being solvable. The structure's own validation may
+        allow more (a hard memory limit for model files).
     docs : str
         Path of the family's page under ``docs/``.
     Structure, Params : type
@@ -142,6 +146,7 @@ class Family(ABC):
     title: ClassVar[str]
     size_help: ClassVar[str] = "model size"
     default_size: ClassVar[int] = 1
+    max_size: ClassVar[int] = 50
     docs: ClassVar[str] = ""
     Structure: ClassVar[type]
     Params: ClassVar[type]

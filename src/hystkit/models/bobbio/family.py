@@ -17,6 +17,7 @@ class BobbioFamily(Family):
     title = "Bobbio-Marrucci springs and friction pistons (sec. 2.1.4, eq. 2.5)"
     size_help = "springs N, with N - 1 pistons (2N params)"
     default_size = 10
+    max_size = 100
     docs = "docs/models/circuits.md"
     Structure = bobbio.BobbioStructure
     Params = bobbio.BobbioParams

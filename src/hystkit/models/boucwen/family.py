@@ -18,6 +18,7 @@ class BoucWenFamily(Family):
              "Noel-Schoukens benchmark)")
     size_help = "RK4 substeps per sample (7 parameters whatever the size)"
     default_size = 2
+    max_size = 64
     docs = "docs/models/boucwen.md"
     Structure = boucwen.BoucWenStructure
     Params = boucwen.BoucWenParams

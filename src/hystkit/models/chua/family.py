@@ -20,6 +20,7 @@ class ChuaFamily(Family):
     title = "Chua-Stromsmoe, dy/dt = g(u - f(y)) (sec. 2.1.3, eq. 2.3)"
     size_help = "elements in series N, output the sum of their states (6N params; 1 = eq. 2.3)"
     default_size = 1
+    max_size = 20
     docs = "docs/models/circuits.md"
     Structure = chua.ChuaStructure
     Params = chua.ChuaParams

@@ -26,6 +26,7 @@ class GPreisachFamily(StaircaseFamily):
              "(sec. 2.1.2, eq. 2.2)")
     size_help = "grid levels L of the two Preisach weights ((L - 1) (L - 2) relay cells)"
     default_size = 16
+    max_size = 64
     docs = "docs/models/preisach.md"
     Structure = gpreisach.GPreisachStructure
     Params = gpreisach.GPreisachParams

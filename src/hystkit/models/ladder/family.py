@@ -21,6 +21,7 @@ class LadderFamily(Family):
     title = "PWL ladder circuit, Parodi-Storace-Cincotti (sec. 2.1.5)"
     size_help = "ladder sections N, a PWL resistor and a capacitor each (3N + 2 params)"
     default_size = 2
+    max_size = 50
     docs = "docs/models/circuits.md"
     Structure = ladder.LadderStructure
     Params = ladder.LadderParams

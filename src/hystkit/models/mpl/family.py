@@ -19,6 +19,7 @@ class MplFamily(Family):
     title = "modified Power-Law, sinh resistors (sec. 5.3.1, eq. 5.1-5.6)"
     size_help = "cells N (3N + 2 params)"
     default_size = 1
+    max_size = 50
     docs = "docs/models/mpl.md"
     Structure = mpl.MplStructure
     Params = mpl.MplParams

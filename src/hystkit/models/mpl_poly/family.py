@@ -21,6 +21,7 @@ class MplPolyFamily(Family):
     title = "polynomial modified Power-Law, cubic resistors (sec. 5.3.5, eq. 5.16-5.17, 5.29)"
     size_help = "cells N (5N + 6 params)"
     default_size = 1
+    max_size = 30
     docs = "docs/models/mpl_poly.md"
     Structure = mpl_poly.MplPolyStructure
     Params = mpl_poly.MplPolyParams

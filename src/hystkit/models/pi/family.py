@@ -22,6 +22,7 @@ class PiFamily(Family):
     size_help = ("play operators n (thresholds i/n, i < n; plus 2 x 2 dead zones, 4 creep "
                  "operators by default)")
     default_size = 10
+    max_size = 200
     docs = "docs/models/pi.md"
     Structure = pi.PiStructure
     Params = pi.PiParams

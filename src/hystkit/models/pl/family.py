@@ -19,6 +19,7 @@ class PlFamily(Family):
     title = "Power-Law model as published, Biggio et al. (sec. 2.1.7, eq. 2.16-2.18)"
     size_help = "cells N (N + M + 4 params; p, M, S via options or 'hystkit pl-search')"
     default_size = 1
+    max_size = 50
     docs = "docs/models/pl.md"
     Structure = pl.PlStructure
     Params = pl.PlParams

@@ -152,6 +152,7 @@ class PreisachFamily(StaircaseFamily):
     title = "classical Preisach, Everett function on a grid (sec. 2.1.1, eq. 2.1, 9.4-9.13)"
     size_help = "grid levels L over the normalised input (L (L - 1) / 2 Preisach cells)"
     default_size = 20
+    max_size = 100
     docs = "docs/models/preisach.md"
     Structure = preisach.PreisachStructure
     Params = preisach.PreisachParams
