@@ -64,3 +64,37 @@ def random_runs(random_draws, bounded_input):
             out.append((p, y))
         return out
     return runs
+
+
+def _check_bounded_run(family, structure, params, u, bound_of, *, rel, diverged=("sample",)):
+    """The fuzz tests' checks of one accepted parameter set (issue 10): the run is finite and
+    within ``bound_of(max|u|)``; the readable step and the loop's compiled block follow it for
+    three samples; the inverse is finite or raises FitDivergedError naming one of `diverged`."""
+    from hystkit.errors import FitDivergedError
+
+    y, x_end = family.simulate(structure, params, u)
+    assert np.all(np.isfinite(y)) and np.all(np.isfinite(x_end))
+    bound = bound_of(np.max(np.abs(u)))
+    # subnormal results are rounded to 5e-324 absolute, not relative
+    assert np.max(np.abs(y)) <= bound * (1 + rel) + 1e-300
+    # rounding is relative to the terms summed (up to the bound), not to a cancelled y
+    blk = family.block(structure, params)
+    x = x_blk = family.rest_state(structure, params, u[0])
+    for k in range(3):
+        y_k, x = family.step(structure, params, x, u[k])
+        x_next = x_blk.copy()
+        y_blk = blk.step(blk.body, x_blk, x_next, 0, u[k])
+        x_blk = x_next
+        assert y_k == pytest.approx(y[k], rel=rel, abs=1e-12 * bound)
+        assert y_blk == pytest.approx(y[k], rel=rel, abs=1e-12 * bound)
+    try:
+        u_hat, x_end = family.invert(structure, params, y)
+    except FitDivergedError as exc:
+        assert any(fragment in str(exc) for fragment in diverged), str(exc)
+        return
+    assert np.all(np.isfinite(u_hat)) and np.all(np.isfinite(x_end))
+
+
+@pytest.fixture(scope="session")  # session scope: usable inside hypothesis tests
+def check_bounded_run():
+    return _check_bounded_run

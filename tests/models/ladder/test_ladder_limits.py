@@ -10,7 +10,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hystkit.errors import FitDivergedError
 from hystkit.models import get_family, ladder
 
 FAMILY = get_family("ladder")
@@ -72,7 +71,7 @@ def test_short_records_are_refused():
 @settings(max_examples=EXAMPLES, deadline=None)
 @given(n=st.integers(1, 6), data=st.data(), amp=_MAG, cap=st.floats(1e-3, 1.0),
        seed=st.integers(0, 2**32 - 1))
-def test_fuzz_runs_are_finite_and_bounded_or_refused(n, data, amp, cap, seed):
+def test_fuzz_runs_are_finite_and_bounded_or_refused(check_bounded_run, n, data, amp, cap, seed):
     band = data.draw(st.lists(_SIGNED, min_size=n, max_size=n))
     conductance = data.draw(st.lists(_SIGNED, min_size=n, max_size=n))
     w = data.draw(st.lists(_SIGNED, min_size=n + 1, max_size=n + 1))
@@ -86,26 +85,5 @@ def test_fuzz_runs_are_finite_and_bounded_or_refused(n, data, amp, cap, seed):
     s = FAMILY.make_structure(data.draw(st.sampled_from([1e-6, 0.025, 10.0])), n,
                               slope_cap=cap)
     u = np.random.default_rng(seed).uniform(-1, 1, 100) * min(amp, 1e100)
-    y, x_end = FAMILY.simulate(s, p, u)
-    assert np.all(np.isfinite(y)) and np.all(np.isfinite(x_end))
-    bound = ladder.output_bound(p, np.max(np.abs(u)))
-    # subnormal results are rounded to 5e-324 absolute, not relative
-    assert np.max(np.abs(y)) <= bound * (1 + 1e-12) + 1e-300
-    x = FAMILY.rest_state(s, p, u[0])
-    # the readable step and the loop's compiled block follow the run too; rounding is
-    # relative to the terms summed (up to the bound), not to a cancelled y
-    blk = FAMILY.block(s, p)
-    x = x_blk = FAMILY.rest_state(s, p, u[0])
-    for k in range(3):
-        y_k, x = FAMILY.step(s, p, x, u[k])
-        x_next = x_blk.copy()
-        y_blk = blk.step(blk.body, x_blk, x_next, 0, u[k])
-        x_blk = x_next
-        assert y_k == pytest.approx(y[k], rel=1e-12, abs=1e-12 * bound)
-        assert y_blk == pytest.approx(y[k], rel=1e-12, abs=1e-12 * bound)
-    try:
-        u_hat, x_end = FAMILY.invert(s, p, y)
-    except FitDivergedError as exc:
-        assert "sample" in str(exc) or "w_0 = 0" in str(exc)
-        return
-    assert np.all(np.isfinite(u_hat)) and np.all(np.isfinite(x_end))
+    check_bounded_run(FAMILY, s, p, u, lambda m: ladder.output_bound(p, m), rel=1e-12,
+                      diverged=("sample", "w_0 = 0"))

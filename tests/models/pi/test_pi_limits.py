@@ -10,7 +10,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hystkit.errors import FitDivergedError
 from hystkit.models import get_family, pi
 
 FAMILY = get_family("pi")
@@ -75,7 +74,7 @@ def test_short_records_are_refused():
 @settings(max_examples=EXAMPLES, deadline=None)
 @given(n=st.integers(1, 5), m=st.integers(0, 2), n_k=st.integers(0, 3), data=st.data(),
        amp=_MAG, seed=st.integers(0, 2**32 - 1))
-def test_fuzz_runs_are_finite_and_bounded_or_refused(n, m, n_k, data, amp, seed):
+def test_fuzz_runs_are_finite_and_bounded_or_refused(check_bounded_run, n, m, n_k, data, amp, seed):
     draw = data.draw
     w_h, w_s, w_k = (draw(st.lists(_SIGNED, min_size=k, max_size=k)) for k in (n, 2 * m + 1, n_k))
     gaps = [draw(_MAG) for _ in range(2 * m)]
@@ -91,26 +90,5 @@ def test_fuzz_runs_are_finite_and_bounded_or_refused(n, m, n_k, data, amp, seed)
     s = FAMILY.make_structure(draw(st.sampled_from([1e-6, 0.025, 10.0])), n, n_creep=n_k,
                               n_deadzone=m)
     u = np.random.default_rng(seed).uniform(-1, 1, 100) * min(amp, 1e100)
-    y, x_end = FAMILY.simulate(s, p, u)
-    assert np.all(np.isfinite(y)) and np.all(np.isfinite(x_end))
-    bound = pi.output_bound(p, np.max(np.abs(u)))
-    # subnormal results are rounded to 5e-324 absolute, not relative
-    assert np.max(np.abs(y)) <= bound * (1 + 1e-9) + 1e-300
-    x = FAMILY.rest_state(s, p, u[0])
-    # the readable step and the loop's compiled block follow the run too; rounding is
-    # relative to the terms summed (up to the bound), not to a cancelled y
-    blk = FAMILY.block(s, p)
-    x = x_blk = FAMILY.rest_state(s, p, u[0])
-    for k in range(3):
-        y_k, x = FAMILY.step(s, p, x, u[k])
-        x_next = x_blk.copy()
-        y_blk = blk.step(blk.body, x_blk, x_next, 0, u[k])
-        x_blk = x_next
-        assert y_k == pytest.approx(y[k], rel=1e-9, abs=1e-12 * bound)
-        assert y_blk == pytest.approx(y[k], rel=1e-9, abs=1e-12 * bound)
-    try:
-        u_hat, x_end = FAMILY.invert(s, p, y)
-    except FitDivergedError as exc:
-        assert "inverse" in str(exc)
-        return
-    assert np.all(np.isfinite(u_hat)) and np.all(np.isfinite(x_end))
+    check_bounded_run(FAMILY, s, p, u, lambda m: pi.output_bound(p, m), rel=1e-9,
+                      diverged=("inverse",))
