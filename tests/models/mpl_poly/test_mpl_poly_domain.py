@@ -5,6 +5,7 @@ limited resistors rest outside the domain at this ``dt``; the rest is refused by
 ``HYSTKIT_FUZZ_EXAMPLES`` raises the number of hypothesis examples (a campaign run)."""
 
 import os
+from functools import partial
 
 import numpy as np
 import pytest
@@ -15,28 +16,11 @@ from hystkit.errors import FitDivergedError
 from hystkit.models import mpl_poly as mp
 from hystkit.models.mpl_poly import FAMILY
 
+from ..fuzz_strategies import values as _values
+
 EXAMPLES = int(os.environ.get("HYSTKIT_FUZZ_EXAMPLES", "150"))
+values = partial(_values, zeros=True)  # here a coefficient set to 0 is a case of its own
 U = np.r_[0.9 * np.sin(np.linspace(0, 12, 240)), np.ones(30), -np.ones(30), 0.3 * np.ones(20)]
-
-
-def values(draw, n, domain, signed=True):
-    """``n`` floats inside ``domain = (lo, hi)`` of magnitudes (log-uniform, either sign if
-    ``signed``, sometimes exactly 0) or, with a share drawn per example, anywhere."""
-    lo, hi = np.log10(domain)
-    share = draw(st.sampled_from([0.0, 0.1, 0.5]))
-    out = []
-    for _ in range(n):
-        if draw(st.floats(0, 1)) < share:
-            out.append(draw(st.one_of(
-                st.sampled_from([0.0, -1.0, 5e-324, 1e-310, 1e300, 1.7e308, -1e300]),
-                st.floats(lo - 2, hi + 2).map(lambda e: 10.0 ** e),
-                st.floats(-320, 308).map(lambda e: -(10.0 ** e)))))
-        elif signed and draw(st.integers(0, 9)) == 0:
-            out.append(0.0)  # a linear (or constant) coefficient set to 0
-        else:
-            sign = draw(st.sampled_from([1.0, -1.0])) if signed else 1.0
-            out.append(sign * 10.0 ** draw(st.floats(lo, hi)))
-    return out
 
 
 @st.composite

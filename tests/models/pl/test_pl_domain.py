@@ -14,27 +14,10 @@ from hystkit.errors import FitDivergedError
 from hystkit.models import pl
 from hystkit.models.pl import FAMILY
 
+from ..fuzz_strategies import values
+
 EXAMPLES = int(os.environ.get("HYSTKIT_FUZZ_EXAMPLES", "150"))
 U = np.r_[0.9 * np.sin(np.linspace(0, 12, 240)), np.ones(30), -np.ones(30), 0.3 * np.ones(20)]
-
-
-def values(draw, n, domain, signed=True):
-    """``n`` floats, each inside the domain ``domain = (lo, hi)`` of magnitudes (log-uniform,
-    either sign if ``signed``) or, with a share drawn per example, anywhere: two decades past
-    either end, negative, zero, subnormal, 1e300, 1.7e308."""
-    lo, hi = np.log10(domain)
-    share = draw(st.sampled_from([0.0, 0.1, 0.5]))
-    out = []
-    for _ in range(n):
-        if draw(st.floats(0, 1)) < share:
-            out.append(draw(st.one_of(
-                st.sampled_from([0.0, -1.0, 5e-324, 1e-310, 1e300, 1.7e308, -1e300]),
-                st.floats(lo - 2, hi + 2).map(lambda e: 10.0 ** e),
-                st.floats(-320, 308).map(lambda e: -(10.0 ** e)))))
-        else:
-            sign = draw(st.sampled_from([1.0, -1.0])) if signed else 1.0
-            out.append(sign * 10.0 ** draw(st.floats(lo, hi)))
-    return out
 
 
 @st.composite
