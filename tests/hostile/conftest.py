@@ -105,3 +105,16 @@ def good(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     for path in paths.values():
         path.chmod(0o444)  # a case that writes to its input fails loudly
     return paths
+
+
+def assert_model_file_refused(cli, good: dict[str, Path], path: Path, folder: Path,
+                              *fragments: object) -> None:
+    """`evaluate` and `compensate` with the model file `path` both exit 2 with one error line
+    naming the file and every fragment, and write nothing into `folder`."""
+    before = snapshot(folder)
+    for argv in (["evaluate", path, good["val"], "--json", folder / "scores.json"],
+                 ["compensate", path, good["val"], "--out", folder / "out.csv"]):
+        run = cli(*argv)
+        assert run.code == 2, (argv[0], run.err)
+        run.error_line(path.name, *fragments)
+    assert snapshot(folder) == before  # nothing written, the model untouched

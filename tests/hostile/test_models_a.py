@@ -18,7 +18,7 @@ import pytest
 
 from hystkit.cli import main
 
-from .conftest import snapshot
+from .conftest import assert_model_file_refused
 
 SIZES = {"mpl-poly": 1, "pl": 1, "preisach": 6, "gpreisach": 6}
 
@@ -96,13 +96,7 @@ def test_model_file_outside_the_domain_is_one_error_line(cli, good, models, tmp_
         _edit(model, key, value)
     path = tmp_path / f"{family}-{case}.json"
     path.write_text(json.dumps(model))  # NaN and inf as JSON's NaN / Infinity
-    before = snapshot(tmp_path)
-    for argv in (["evaluate", path, good["val"], "--json", tmp_path / "scores.json"],
-                 ["compensate", path, good["val"], "--out", tmp_path / "out.csv"]):
-        run = cli(*argv)
-        assert run.code == 2, (argv[0], run.err)
-        run.error_line(path.name, *fragments)
-    assert snapshot(tmp_path) == before  # nothing written, the model untouched
+    assert_model_file_refused(cli, good, path, tmp_path, *fragments)
 
 
 @pytest.mark.parametrize("family", ["mpl", *SIZES])

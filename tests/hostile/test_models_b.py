@@ -18,7 +18,7 @@ import pytest
 
 from hystkit.cli import main
 
-from .conftest import snapshot
+from .conftest import assert_model_file_refused, snapshot
 
 FAMILIES = ("pi", "chua", "bobbio", "ladder", "boucwen")
 
@@ -89,13 +89,7 @@ def test_model_file_outside_the_domain_is_one_error_line(cli, good, fitted, tmp_
     mutate(model)
     path = tmp_path / f"{family}-{case}.json"
     path.write_text(json.dumps(model))  # NaN and inf as JSON's NaN / Infinity
-    before = snapshot(tmp_path)
-    for argv in (["evaluate", path, good["val"], "--json", tmp_path / "scores.json"],
-                 ["compensate", path, good["val"], "--out", tmp_path / "out.csv"]):
-        run = cli(*argv)
-        assert run.code == 2, (argv[0], run.err)
-        run.error_line(path.name, *fragments)
-    assert snapshot(tmp_path) == before  # nothing written, the model untouched
+    assert_model_file_refused(cli, good, path, tmp_path, *fragments)
 
 
 @pytest.mark.parametrize("family", FAMILIES)
