@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 from ..errors import HystkitError
 
-__all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Parser", "UsageError", "check_size",
+__all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Deferred", "Parser", "UsageError", "check_size", "deferred",
            "failures_exit", "integer", "number", "positive_float", "positive_int", "size_limit",
            "slope_cap"]
 
@@ -31,9 +31,44 @@ class UsageError(HystkitError):
     """A command line argparse rejected; reported on one line like every other error."""
 
 
+class Deferred:
+    """A value of an option (its choices, default or help text) that needs a heavy module (the
+    model families, scipy, ...): computed when its subcommand is parsed or its help shown, so
+    building the whole ``hystkit`` parser stays cheap (``--help``, ``--version``)."""
+
+    def __init__(self, compute: Callable[[], object]):
+        self.compute = compute
+
+
+def deferred(action: argparse.Action, **values: Callable[[], object]) -> argparse.Action:
+    """Set `action`'s attributes (``choices``, ``default``, ``help``) to computed-later values."""
+    for name, compute in values.items():
+        setattr(action, name, Deferred(compute))
+    return action
+
+
 class Parser(argparse.ArgumentParser):
     def error(self, message: str):  # argparse would print the usage and call sys.exit(2)
         raise UsageError(f"{message} (see '{self.prog} --help')")
+
+    def _resolve(self) -> None:
+        for action in self._actions:
+            for name in ("choices", "default", "help"):
+                value = getattr(action, name, None)
+                if isinstance(value, Deferred):
+                    setattr(action, name, value.compute())
+
+    def parse_known_args(self, args=None, namespace=None):
+        self._resolve()  # a subcommand's parser: only the chosen one pays for its values
+        return super().parse_known_args(args, namespace)
+
+    def format_usage(self) -> str:
+        self._resolve()
+        return super().format_usage()
+
+    def format_help(self) -> str:
+        self._resolve()
+        return super().format_help()
 
 
 def number(low: float | None = None, high: float | None = None, *, low_open: bool = False,

@@ -5,17 +5,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..compensation import DEFAULT_CENTER
-from ..io import atomic_folder, check_output_folder, read_recording, write_json
-from ..models import FAMILIES
-from ..sensors import simulate_experiment
-from ..signals import EXPERIMENTS
-from ._common import UsageError, check_size, failures_exit, positive_int
+from ._common import UsageError, check_size, deferred, failures_exit, positive_int
 
 __all__ = ["register"]
 
 
 def _models(text: str | None) -> list[str]:
+    from ..models import FAMILIES
+
     if text is None:
         return sorted(FAMILIES)
     names = [n.strip() for n in text.split(",") if n.strip()]
@@ -28,6 +25,8 @@ def _models(text: str | None) -> list[str]:
 
 def _sizes(pairs: list[str]) -> dict[str, int]:
     """``--size MODEL=N`` options; each size checked against its family's limits."""
+    from ..models import FAMILIES
+
     out = {}
     for pair in pairs:
         name, _, value = pair.partition("=")
@@ -44,6 +43,8 @@ def _sizes(pairs: list[str]) -> dict[str, int]:
 
 def _compare(args: argparse.Namespace) -> int:
     # Matplotlib and the fits load only for this command.
+    from ..compensation import DEFAULT_CENTER
+    from ..io import atomic_folder, check_output_folder, read_recording, write_json
     from ..reports import compare_models, format_compare
 
     models = _models(args.models)
@@ -69,7 +70,11 @@ def _compare(args: argparse.Namespace) -> int:
 
 
 def _generalize(args: argparse.Namespace) -> int:
+    from ..compensation import DEFAULT_CENTER
+    from ..io import atomic_folder, check_output_folder, read_recording, write_json
     from ..reports import generalization_matrix, plot_generalization
+    from ..sensors import simulate_experiment
+    from ..signals import EXPERIMENTS
 
     models = _models(args.models)
     out = args.out or Path("hystkit-generalize")
@@ -115,11 +120,15 @@ def _generalize(args: argparse.Namespace) -> int:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``compare`` and ``generalize``."""
-    models_help = f"comma-separated models (default: all: {', '.join(sorted(FAMILIES))})"
+    def models_help() -> str:
+        from ..models import FAMILIES
+
+        return f"comma-separated models (default: all: {', '.join(sorted(FAMILIES))})"
+
     p = sub.add_parser("compare", help="fit every model on one recording, score on another")
     p.add_argument("data_fit", type=Path)
     p.add_argument("data_val", type=Path)
-    p.add_argument("--models", help=models_help)
+    deferred(p.add_argument("--models"), help=models_help)
     p.add_argument("--size", action="append", default=[], metavar="MODEL=N",
                    help="model size, e.g. --size mpl=3 (repeatable)")
     p.add_argument("--out", type=Path, help="folder for compare.json")
@@ -129,7 +138,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                           "four virtual-sensor excitations)")
     p.add_argument("data", type=Path, nargs="*",
                    help="your recordings (at least two, one rate); default: the virtual sensor")
-    p.add_argument("--models", help=models_help)
+    deferred(p.add_argument("--models"), help=models_help)
     p.add_argument("--size", action="append", default=[], metavar="MODEL=N")
     p.add_argument("--out", type=Path, help="output folder (default hystkit-generalize)")
     p.set_defaults(run=_generalize)

@@ -4,45 +4,17 @@ from __future__ import annotations
 
 import argparse
 import functools
+import math
 import re
 import time
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
+from ._common import UsageError, check_size, deferred, number, positive_int
 
-from .. import __version__
-from ..compensation import load_compensator
-from ..control import (
-    EXPERIMENTS,
-    MASS,
-    PID,
-    SCHEMES,
-    TRAININGS,
-    DisturbanceObserver,
-    Plant,
-    SensorModels,
-    bode_data,
-    build_loop,
-    compensator_block,
-    design_dob,
-    experiment_cases,
-    fit_sensor_models,
-    loop_margins,
-    plot_bode,
-    plot_cases,
-    plot_response,
-    run_experiment,
-    sensor_block,
-    table_ii_sensor,
-    table_ii_sensors,
-    tune_pid,
-    virtual_sensor_block,
-)
-from ..io import atomic_folder, check_output_folder, read_recording, write_json
-from ..models import FAMILIES
-from ..signals import EXPERIMENTS as EXCITATIONS
-from ._common import UsageError, check_size, number, positive_int
+if TYPE_CHECKING:  # the library loads when the command runs
+    from ..control import SensorModels
 
 __all__ = ["register"]
 
@@ -87,6 +59,8 @@ class _Checked(argparse.Action):
 def _sensor(sensor: str):
     """``S_r`` from ``--sensor``: None (fit on the virtual sensor), the virtual sensor's own
     physics, a table-II column, or a model file run position -> sensor."""
+    from ..control import sensor_block, table_ii_sensor, table_ii_sensors, virtual_sensor_block
+
     if sensor == "virtual":
         return None
     if sensor == "virtual-physics":
@@ -102,6 +76,8 @@ def _sensor(sensor: str):
 
 def _file_block(make, path: Path, name: str, option: str):
     """A model file as a loop block; a family that cannot serve in that slot is one line."""
+    from ..compensation import load_compensator
+
     try:
         return make(load_compensator(path), name=name)
     except ValueError as exc:
@@ -115,6 +91,9 @@ def _models(training: str, excitation: str, sensor_size: int | None, model_size:
             model: str = "mpl") -> SensorModels:
     # In-memory only, per process (repeated main() calls in one session, e.g. tests); nothing
     # is cached on disk, so every command line fits its models afresh (about 2 s).
+    from ..control import fit_sensor_models
+    from ..io import read_recording
+
     return fit_sensor_models(
         sensor=_sensor(sensor), training=training, training_excitation=excitation,
         sensor_cells=sensor_size, model_cells=model_size, sensor_model=sensor_model,
@@ -128,6 +107,8 @@ def _slug(label: str) -> str:
 
 
 def _outputs(args: argparse.Namespace, out: Path) -> list[Path]:
+    from ..control import experiment_cases
+
     names = []
     if args.experiment:
         names += ["metrics.json", "config.json"]
@@ -143,6 +124,8 @@ def _outputs(args: argparse.Namespace, out: Path) -> list[Path]:
 
 def _loop(args: argparse.Namespace, models: SensorModels):
     """The configured loop; a library ValueError here is a bad option combination."""
+    from ..control import PID, DisturbanceObserver, Plant, build_loop, design_dob, tune_pid
+
     try:
         plant = Plant(args.mass, args.u_max)
         pid = None if args.pid is None else PID(args.pid[0], args.pid[1], args.pid[2])
@@ -177,6 +160,21 @@ def _fmt(x) -> str:
 
 
 def _control(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .. import __version__
+    from ..control import (
+        bode_data,
+        compensator_block,
+        loop_margins,
+        plot_bode,
+        plot_cases,
+        plot_response,
+        run_experiment,
+        sensor_block,
+    )
+    from ..io import atomic_folder, check_output_folder, write_json
+
     if not (args.experiment or args.bode):
         raise UsageError("give --experiment NAME and/or --bode (see 'hystkit control --help')")
     stamp = time.strftime("%Y%m%d-%H%M%S")
@@ -284,16 +282,36 @@ def _print_table(metrics: dict) -> None:
               f"{d['e_p_mean']:.4g} m")
 
 
+def _library(name: str):
+    from .. import control  # python-control, scipy, numba: loaded when the command runs
+
+    return getattr(control, name)
+
+
+def _family_names() -> list[str]:
+    from ..models import FAMILIES
+
+    return sorted(FAMILIES)
+
+
+def _excitation_names() -> list[str]:
+    from ..signals import EXPERIMENTS
+
+    return sorted(EXPERIMENTS)
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``hystkit control`` to the ``hystkit`` parser."""
     p = sub.add_parser("control", help="closed-loop position control with a hysteretic "
                        "sensor: the document's ch. 7 experiments")
-    p.add_argument("--scheme", choices=SCHEMES, required=True,
+    deferred(p.add_argument("--scheme", required=True,
                    help="direct: e = r - compensator(s) (fig. 7.1); weighting: "
-                        "e = g_s (S_m(r) - s) (fig. 7.8)")
-    p.add_argument("--experiment", choices=EXPERIMENTS,
+                        "e = g_s (S_m(r) - s) (fig. 7.8)"),
+             choices=lambda: _library("SCHEMES"))
+    deferred(p.add_argument("--experiment",
                    help="sine (eq. 7.3), frequency / amplitude sweeps, cubic trajectory, "
-                        "output disturbance steps")
+                        "output disturbance steps"),
+             choices=lambda: _library("EXPERIMENTS"))
     p.add_argument("--bode", action="store_true",
                    help="write bode.png: the linearised open loop at rest (alone: "
                         "analysis.json)")
@@ -312,9 +330,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="derivative filter time constant [s] (default 0: eq. 7.2)")
     p.add_argument("--anti-windup", action="store_true",
                    help="conditional integration while the force saturates (needs --u-max)")
-    p.add_argument("--mass", type=number(1e-6, 1e6), default=MASS,
-                   help="moving mass [kg], 1e-6 to 1e6")
-    p.add_argument("--u-max", type=number(0, low_open=True, allow_inf=True), default=np.inf,
+    deferred(p.add_argument("--mass", type=number(1e-6, 1e6),
+                   help="moving mass [kg], 1e-6 to 1e6"),
+             default=lambda: _library("MASS"))
+    p.add_argument("--u-max", type=number(0, low_open=True, allow_inf=True), default=math.inf,
                    help="actuator force limit [N] (default none)")
     p.add_argument("--sensor", default="virtual",
                    metavar="virtual|virtual-physics|table-ii-COLUMN|MODEL.json",
@@ -326,18 +345,22 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "(its inverse; table-ii-noise is the document's S_r, fig. 7.2); or a "
                         "model file of any family run position -> sensor (an inverse-mode file "
                         "as is, a direct-mode file through its family's inverse)")
-    families = sorted(FAMILIES)
-    p.add_argument("--sensor-model", choices=families, default="mpl",
-                   help="family of the fitted S_r (default mpl)")
-    p.add_argument("--model", choices=families, default="mpl",
-                   help="family of the fitted compensator and S_m (default mpl)")
-    p.add_argument("--training", choices=TRAININGS, default=None,
+    deferred(p.add_argument("--sensor-model", default="mpl",
+                            help="family of the fitted S_r (default mpl)"),
+             choices=_family_names)
+    deferred(p.add_argument("--model", default="mpl",
+                            help="family of the fitted compensator and S_m (default mpl)"),
+             choices=_family_names)
+    deferred(p.add_argument("--training", default=None,
                    help="compensator / S_m data: a virtual-sensor recording (default with "
                         "--sensor virtual or virtual-physics) or S_r's own response to the sine "
                         "(the document's protocol; default with a table-II sensor or a model "
-                        "file)")
-    p.add_argument("--training-excitation", choices=sorted(EXCITATIONS), default="sine",
-                   help="excitation of the training recording (default sine, 0.5 Hz 3 mm)")
+                        "file)"),
+             choices=lambda: _library("TRAININGS"))
+    deferred(p.add_argument("--training-excitation", default="sine",
+                            help="excitation of the training recording (default sine, 0.5 Hz "
+                                 "3 mm)"),
+             choices=_excitation_names)
     p.add_argument("--sensor-data", type=Path,
                    help="recording (time, position, sensor) to fit S_r on instead of the "
                         "virtual sensor's noise run")

@@ -7,30 +7,11 @@ import sys
 import time
 from pathlib import Path
 
-from ..compensation import (
-    CENTERS,
-    DEFAULT_CENTER,
-    DEFAULT_TARE_SECONDS,
-    DEFAULT_TRACK_SECONDS,
-    MODES,
-    ORACLE_CENTER,
-    POSITION_MARGIN,
-    SENSOR_MARGIN,
-    center_label,
-    evaluate,
-    fit_compensator,
-    load_compensator,
-    save_compensator,
-    use_flags,
-)
-from ..io import check_output_path, read_recording, write_json, write_recording
-from ..models import FAMILIES, get_family
-from ..sensors import simulate_experiment
-from ..signals import EXPERIMENTS
 from ._common import (
     GUARD_EXIT,
     UsageError,
     check_size,
+    deferred,
     integer,
     number,
     positive_float,
@@ -42,8 +23,28 @@ from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_f
 
 __all__ = ["register"]
 
+# Library functions the commands call through this module, loaded on first use like every
+# library name here; tests replace them on it (monkeypatch cmd_core.evaluate) to build faults.
+_THROUGH_MODULE = ("evaluate", "load_compensator", "use_flags")
+
+
+def __getattr__(name: str):
+    if name in _THROUGH_MODULE:
+        from .. import compensation
+
+        globals()[name] = value = getattr(compensation, name)
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+_module = sys.modules[__name__]
+
 
 def _simulate_sensor(args: argparse.Namespace) -> int:
+    from ..io import check_output_path, write_recording
+    from ..sensors import simulate_experiment
+    from ..signals import EXPERIMENTS
+
     if args.raw:
         return run_raw_simulation(args)
     check_output_path(args.out, args.force)
@@ -55,6 +56,10 @@ def _simulate_sensor(args: argparse.Namespace) -> int:
 
 
 def _fit(args: argparse.Namespace) -> int:
+    from ..compensation import center_label, fit_compensator, save_compensator
+    from ..io import check_output_path, read_recording
+    from ..models import get_family
+
     check_output_path(args.out, args.force, inputs=args.data)
     family = get_family(args.model)
     options = {} if args.slope_cap is None else {"slope_cap": args.slope_cap}
@@ -102,6 +107,11 @@ def _print_standard_errors(se: dict | None) -> None:
 
 
 def _compensate(args: argparse.Namespace) -> int:
+    from ..compensation import center_label
+    from ..io import check_output_path, read_recording, write_recording
+
+    load_compensator, use_flags = _module.load_compensator, _module.use_flags
+
     check_output_path(args.out, args.force, inputs=[args.model, args.data])
     comp = load_compensator(args.model)
     _warn_if_oracle(comp.center, args.model)
@@ -119,6 +129,8 @@ def _compensate(args: argparse.Namespace) -> int:
 
 
 def _warn_if_oracle(center: str, path: Path) -> None:
+    from ..compensation import ORACLE_CENTER
+
     if center == ORACLE_CENTER:
         print(f"hystkit: warning: {path} was fitted with centring 'recording' (the paper's "
               f"protocol): it removes each recording's own sensor mean, which needs the whole "
@@ -128,6 +140,8 @@ def _warn_if_oracle(center: str, path: Path) -> None:
 
 def _warn_if_outside(flags: dict, data: Path) -> None:
     """Say so when the compensator runs outside what it was trained on."""
+    from ..compensation import POSITION_MARGIN, SENSOR_MARGIN
+
     mask = flags["sensor_outside"]
     if mask is not None and mask.any():
         print(f"hystkit: warning: {data}: {int(mask.sum())} sample(s) "
@@ -142,6 +156,11 @@ def _warn_if_outside(flags: dict, data: Path) -> None:
 
 
 def _evaluate(args: argparse.Namespace) -> int:
+    from ..io import check_output_path, read_recording, write_json
+
+    evaluate, load_compensator = _module.evaluate, _module.load_compensator
+    use_flags = _module.use_flags
+
     if args.json is not None:
         check_output_path(args.json, args.force, inputs=[args.model, args.data])
     comp = load_compensator(args.model)
@@ -178,6 +197,7 @@ def _fmt(x: float | None) -> str:
 
 def _demo(args: argparse.Namespace) -> int:
     # Imported here so the other subcommands do not pay for loading matplotlib.
+    from ..compensation import DEFAULT_CENTER
     from ..reports import DOCUMENT_TABLE_5_5, format_table, run_demo
 
     out = args.out or Path(f"hystkit-demo-{time.strftime('%Y%m%d-%H%M%S')}")
@@ -216,19 +236,41 @@ def _print_raw_path(raw: dict) -> None:
           f"encoder transitions")
 
 
+def _compensation(name: str):
+    from .. import compensation  # loaded when a subcommand needs the value
+
+    return getattr(compensation, name)
+
+
+def _families() -> dict:
+    from ..models import FAMILIES
+
+    return FAMILIES
+
+
+def _experiment_names() -> list[str]:
+    from ..signals import EXPERIMENTS
+
+    return sorted(EXPERIMENTS)
+
+
 def _add_centring_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--center", choices=CENTERS, default=DEFAULT_CENTER,
-                   help="sensor offset: fit = the training offsets (default); tare = the level "
+    deferred(p.add_argument("--center"), choices=lambda: _compensation("CENTERS"),
+             default=lambda: _compensation("DEFAULT_CENTER"))
+    p._actions[-1].help = ("sensor offset: fit = the training offsets (default); tare = the level "
                         "of the first --tare-seconds of each recording, device at rest; track = "
                         "a causal low-pass drift tracker (time constant --track-seconds); "
                         "recording = ORACLE, the paper's protocol (whole-recording mean, not "
                         "causal); none")
-    p.add_argument("--tare-seconds", type=positive_float, default=DEFAULT_TARE_SECONDS,
-                   help=f"tare window at the start of each recording [s] (default "
-                        f"{DEFAULT_TARE_SECONDS:g})")
-    p.add_argument("--track-seconds", type=positive_float, default=DEFAULT_TRACK_SECONDS,
-                   help=f"drift-tracker time constant [s] (default {DEFAULT_TRACK_SECONDS:g}); "
-                        f"slower sensor content than ~1/(2 pi T) is taken for drift")
+    deferred(p.add_argument("--tare-seconds", type=positive_float),
+             default=lambda: _compensation("DEFAULT_TARE_SECONDS"),
+             help=lambda: f"tare window at the start of each recording [s] (default "
+                          f"{_compensation('DEFAULT_TARE_SECONDS'):g})")
+    deferred(p.add_argument("--track-seconds", type=positive_float),
+             default=lambda: _compensation("DEFAULT_TRACK_SECONDS"),
+             help=lambda: f"drift-tracker time constant [s] (default "
+                          f"{_compensation('DEFAULT_TRACK_SECONDS'):g}); slower sensor content "
+                          f"than ~1/(2 pi T) is taken for drift")
 
 
 def _add_rest_position(p: argparse.ArgumentParser) -> None:
@@ -240,7 +282,7 @@ def _add_rest_position(p: argparse.ArgumentParser) -> None:
 def register(sub: argparse._SubParsersAction) -> None:
     """Add this module's subcommands to the ``hystkit`` parser."""
     p = sub.add_parser("simulate-sensor", help="record an experiment on the virtual sensor")
-    p.add_argument("--excitation", choices=sorted(EXPERIMENTS), required=True)
+    deferred(p.add_argument("--excitation", required=True), choices=_experiment_names)
     p.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
                    help="random seed, 0 to 2^32 - 1 (default 0)")
     p.add_argument("--out", type=Path, required=True, help="CSV or Parquet file to write")
@@ -251,16 +293,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("data", type=Path, nargs="+",
                    help="recording(s): time, position, sensor (CSV/Parquet/.mat); several are "
                         "fitted jointly, each with its own initial state and tare")
-    p.add_argument("--model", choices=sorted(FAMILIES), default="mpl",
-                   help="; ".join(f"{f.name}: {f.title}" for f in FAMILIES.values()))
-    p.add_argument("--cells", "--size", type=positive_int, default=None,
-                   help="model size: " + "; ".join(f"{f.name}: {f.size_help} (default "
-                                                    f"{f.default_size}, at most "
-                                                    f"{size_limit(f)})"
-                                                    for f in FAMILIES.values()))
-    p.add_argument("--mode", choices=MODES, default="direct",
+    deferred(p.add_argument("--model", default="mpl"), choices=lambda: sorted(_families()),
+             help=lambda: "; ".join(f"{f.name}: {f.title}" for f in _families().values()))
+    deferred(p.add_argument("--cells", "--size", type=positive_int, default=None),
+             help=lambda: "model size: " + "; ".join(f"{f.name}: {f.size_help} (default "
+                                                     f"{f.default_size}, at most "
+                                                     f"{size_limit(f)})"
+                                                     for f in _families().values()))
+    p.add_argument("--mode", default="direct",
                    help="direct: fit sensor->position (paper 9.2); inverse: fit "
                         "position->sensor and invert it (paper 9.1)")
+    deferred(p._actions[-1], choices=lambda: _compensation("MODES"))
     _add_centring_options(p)
     p.add_argument("--slope-cap", type=slope_cap, default=None,
                    help="mpl only: Euler stability cap f'·dt of the cell resistors, in [0.001, 2) "

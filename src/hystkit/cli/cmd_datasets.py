@@ -5,18 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..datasets import (
-    DATASETS,
-    ROLES,
-    Dataset,
-    dataset_info,
-    list_excerpts,
-    load,
-    load_excerpt,
-    shared_data_status,
-)
 from ..errors import InputError
-from ..io import atomic_outputs, check_output_path, write_json, write_recording
+from ._common import deferred
 
 __all__ = ["register"]
 
@@ -34,6 +24,8 @@ def _rates(rates: list[float | None]) -> str:
 
 
 def _list(args: argparse.Namespace) -> int:
+    from ..datasets import DATASETS, list_excerpts, shared_data_status
+
     root, how = shared_data_status(args.root)
     print(f"shared data: {root} ({how})" if root is not None else how)
     if args.name is not None:
@@ -58,6 +50,8 @@ def _list(args: argparse.Namespace) -> int:
 
 
 def _list_variants(name: str, root: Path | None) -> int:
+    from ..datasets import dataset_info
+
     info = dataset_info(name)
     print(f"{info.name}: {info.what}")
     print(f"  input {info.input_name} [{info.input_unit}] -> output {info.output_name} "
@@ -72,6 +66,9 @@ def _list_variants(name: str, root: Path | None) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
+    from ..datasets import Dataset, load, load_excerpt
+    from ..io import atomic_outputs, check_output_path, write_json, write_recording
+
     out = Path(args.out)
     sidecar = out.with_name(out.name + ".json")
     if out.suffix.lower() not in (".csv", ".parquet"):
@@ -100,6 +97,18 @@ def _export(args: argparse.Namespace) -> int:
     return 0
 
 
+def _dataset_names() -> list[str]:
+    from ..datasets import DATASETS
+
+    return list(DATASETS)
+
+
+def _roles() -> tuple[str, ...]:
+    from ..datasets import ROLES
+
+    return ROLES
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``datasets list`` and ``datasets export`` to the ``hystkit`` parser."""
     p = sub.add_parser("datasets", help="public hysteresis data sets: list, export as a "
@@ -111,20 +120,22 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     q = actions.add_parser("list", help="the data sets (or the runs of one) and whether the "
                                         "shared data are here")
-    q.add_argument("name", nargs="?", choices=list(DATASETS), help="list this data set's runs")
+    deferred(q.add_argument("name", nargs="?", help="list this data set's runs"),
+             choices=_dataset_names)
     q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
                                              "or a shared/data folder found above)")
     q.set_defaults(run=_list)
 
     q = actions.add_parser("export", help="write one run as a time, position, sensor "
                                           "recording (CSV or Parquet) plus a .json sidecar")
-    q.add_argument("name", choices=list(DATASETS))
+    deferred(q.add_argument("name"), choices=_dataset_names)
     q.add_argument("--variant", help="the run (default: the data set's default; see "
                                      "'hystkit datasets list NAME')")
     q.add_argument("--segment", help="only this named segment of the run")
-    q.add_argument("--role", choices=ROLES, default="inverse",
+    deferred(q.add_argument("--role", default="inverse",
                    help="inverse (default): position = system input, sensor = output, so "
-                        "'hystkit fit' learns output -> input; forward: the other way round")
+                        "'hystkit fit' learns output -> input; forward: the other way round"),
+             choices=_roles)
     q.add_argument("--excerpt", action="store_true",
                    help="use the excerpt shipped with hystkit instead of the shared data")
     q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "

@@ -6,9 +6,7 @@ import argparse
 from collections.abc import Callable
 from pathlib import Path
 
-from ..io import check_output_path, read_recording, write_json
-from ..models.pl import DEFAULT_GRID, FAMILY, format_search_table, structural_search
-from ._common import integer, number
+from ._common import deferred, integer, number
 
 __all__ = ["register"]
 
@@ -26,13 +24,23 @@ def _list(parse: Callable[[str], float], what: str) -> Callable[[str], tuple]:
     return parse_all
 
 
-_cells = _list(integer(1, FAMILY.max_size), f"cell counts 1 to {FAMILY.max_size}")
+def _cells(text: str) -> tuple:
+    """An option type: comma-separated cell counts up to the family's ``max_size``."""
+    from ..models.pl import FAMILY  # numba kernels: only when --n is given
+
+    return _list(integer(1, FAMILY.max_size), f"cell counts 1 to {FAMILY.max_size}")(text)
+
+
+_cells.__name__ = "parse_all"  # argparse names the type in some messages, as before
 _powers = _list(number(1, 100, low_open=True), "powers p in (1, 100]")
 _bases = _list(integer(1, 50), "basis counts 1 to 50")
 _smoothing = _list(number(0), "smoothing weights >= 0")
 
 
 def _search(args: argparse.Namespace) -> int:
+    from ..io import check_output_path, read_recording, write_json
+    from ..models.pl import format_search_table, structural_search
+
     if args.json is not None:
         check_output_path(args.json, args.force, inputs=[args.data])
     rec = read_recording(args.data)
@@ -53,17 +61,25 @@ def _search(args: argparse.Namespace) -> int:
     return 0
 
 
+def _default_grid(key: str) -> tuple:
+    from ..models.pl import DEFAULT_GRID
+
+    return DEFAULT_GRID[key]
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``pl-search`` subcommand to the ``hystkit`` parser."""
     p = sub.add_parser("pl-search", help="exhaustive N, p, M, S search of the Power-Law model "
                                          "(sec. 2.2, table 5.1)")
     p.add_argument("data", type=Path, help="fitting recording (time, position, sensor)")
-    p.add_argument("--n", type=_cells, default=DEFAULT_GRID["n"], help="cell counts N")
-    p.add_argument("--p", type=_powers, default=DEFAULT_GRID["p"], help="powers p (> 1)")
-    p.add_argument("--m", type=_bases, default=DEFAULT_GRID["m"],
-                   help="numbers M of output basis functions")
-    p.add_argument("--s", type=_smoothing, default=DEFAULT_GRID["s"],
-                   help="smoothing weights S (>= 0)")
+    deferred(p.add_argument("--n", type=_cells, help="cell counts N"),
+             default=lambda: _default_grid("n"))
+    deferred(p.add_argument("--p", type=_powers, help="powers p (> 1)"),
+             default=lambda: _default_grid("p"))
+    deferred(p.add_argument("--m", type=_bases, help="numbers M of output basis functions"),
+             default=lambda: _default_grid("m"))
+    deferred(p.add_argument("--s", type=_smoothing, help="smoothing weights S (>= 0)"),
+             default=lambda: _default_grid("s"))
     p.add_argument("--direction", choices=("position-to-sensor", "sensor-to-position"),
                    default="position-to-sensor",
                    help="model the sensor (the document's toolbox, default) or a direct "

@@ -11,23 +11,15 @@ import sys
 import time
 import warnings
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import HystkitError
-from ..io import (
-    CONFIG_KEYS,
-    RawFormat,
-    atomic_outputs,
-    check_output_path,
-    find_raw_config,
-    read_raw_config,
-    write_json,
-    write_recording,
-)
-from ..preprocess import PreprocessSettings, RawDataWarning, parse_states, preprocess_raw
-from ..sensors import ScopeSettings, VirtualSensor, simulate_raw, with_asymmetry
-from ..signals import EXPERIMENTS
 from ._common import integer, number
+
+if TYPE_CHECKING:  # the library loads when a command runs, not when the parser is built
+    from ..io import RawFormat
+    from ..preprocess import PreprocessSettings
+    from ..sensors import VirtualSensor
 
 __all__ = ["add_simulation_options", "register", "run_raw_simulation", "sensor_from_args"]
 
@@ -55,6 +47,8 @@ def _levels(text: str) -> tuple[float, ...]:
 
 
 def _states(text: str) -> str:
+    from ..preprocess import parse_states
+
     try:
         parse_states(text)
     except ValueError as exc:
@@ -70,6 +64,9 @@ _OPTIONS = ("r_bridge", "v_supply", "um_per_count", "position_offset_mm", "fs_ou
 
 def _settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawFormat, Path | None]:
     """Merge defaults, the settings file and the options; return what preprocessing needs."""
+    from ..io import CONFIG_KEYS, RawFormat, find_raw_config, read_raw_config
+    from ..preprocess import PreprocessSettings, parse_states
+
     config_path = args.config if args.config is not None else find_raw_config(args.raw)
     if config_path is not None and not Path(config_path).is_file():
         problem = "is a folder" if Path(config_path).is_dir() else "does not exist"
@@ -103,6 +100,9 @@ def _settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawFormat, 
 
 
 def _preprocess(args: argparse.Namespace) -> int:
+    from ..io import atomic_outputs, check_output_path, write_json, write_recording
+    from ..preprocess import RawDataWarning, preprocess_raw
+
     report_path = args.report if args.report is not None else args.out.with_suffix(".json")
     if report_path == args.out:
         raise SettingsError(f"--report {report_path} is the data output file")
@@ -232,6 +232,8 @@ _RAW_ONLY = ("scope_rate", "duration", "encoder", "r_bridge", "v_supply", "glitc
 
 def sensor_from_args(args: argparse.Namespace) -> VirtualSensor:
     """The virtual sensor with the --age-hours / --asymmetry options applied."""
+    from ..sensors import VirtualSensor, with_asymmetry
+
     if not args.raw:
         used = [f"--{k.replace('_', '-')}" for k in _RAW_ONLY if getattr(args, k) is not None]
         if used:
@@ -244,6 +246,10 @@ def sensor_from_args(args: argparse.Namespace) -> VirtualSensor:
 
 def run_raw_simulation(args: argparse.Namespace) -> int:
     """simulate-sensor --raw: write the raw file, its settings and optionally the truth."""
+    from ..io import check_output_path, write_recording
+    from ..sensors import ScopeSettings, simulate_raw
+    from ..signals import EXPERIMENTS
+
     config = args.out.with_suffix(".toml")
     for path in (args.out, config) + ((args.truth,) if args.truth else ()):
         check_output_path(path, args.force)

@@ -7,15 +7,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..compensation import CENTERS, DEFAULT_CENTER, save_compensator
-from ..io import (
-    atomic_folder,
-    check_output_folder,
-    check_output_path,
-    read_recording,
-    write_json,
-)
-from ._common import GUARD_EXIT, UsageError, failures_exit, positive_int
+from ._common import GUARD_EXIT, UsageError, deferred, failures_exit, positive_int
 from .cmd_compare import _models
 
 __all__ = ["register"]
@@ -24,6 +16,8 @@ SELECTION_FILES = ("selection.json", "selection.csv", "selection.png")
 
 
 def _centers(text: str) -> list[str]:
+    from ..compensation import CENTERS
+
     names = [n.strip() for n in text.split(",") if n.strip()]
     unknown = [n for n in names if n not in CENTERS]
     if unknown or not names:
@@ -35,6 +29,14 @@ def _centers(text: str) -> list[str]:
 def _select(args: argparse.Namespace) -> int:
     import pandas as pd  # only this command needs it and matplotlib
 
+    from ..compensation import save_compensator
+    from ..io import (
+        atomic_folder,
+        check_output_folder,
+        check_output_path,
+        read_recording,
+        write_json,
+    )
     from ..reports import candidates, plot_selection, select_model
 
     check_output_path(args.out, args.force, inputs=args.data)
@@ -78,6 +80,12 @@ def _select(args: argparse.Namespace) -> int:
     return failures_exit([r["candidate"] for r in rows if "error" in r], "candidate(s)")
 
 
+def _default_center() -> str:
+    from ..compensation import DEFAULT_CENTER
+
+    return DEFAULT_CENTER
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``select``."""
     p = sub.add_parser("select", help="choose model family, size and mode by cross-validation "
@@ -87,8 +95,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--report", type=Path,
                    help="folder for selection.json/.csv/.png (default: OUT's name + -selection)")
     p.add_argument("--models", help="comma-separated families (default: all)")
-    p.add_argument("--centers", default=DEFAULT_CENTER,
-                   help=f"comma-separated centrings to try (default {DEFAULT_CENTER})")
+    deferred(p.add_argument("--centers"), default=_default_center,
+             help=lambda: f"comma-separated centrings to try (default {_default_center()})")
     p.add_argument("--jobs", type=positive_int, default=1,
                    help="worker processes for the candidates (default 1)")
     p.set_defaults(run=_select)

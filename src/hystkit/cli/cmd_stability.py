@@ -9,14 +9,14 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
-
-from ..compensation import Compensator, load_compensator
 from ..errors import InputError
-from ..io import check_output_path, read_recording, write_json
-from ..models import stability_report
-from ..signals import exponential_chirp
+
+if TYPE_CHECKING:  # the library loads when the command runs
+    import numpy as np
+
+    from ..compensation import Compensator
 
 __all__ = ["register"]
 
@@ -24,12 +24,18 @@ __all__ = ["register"]
 def _probe_input(dt: float) -> np.ndarray:
     """The paper's chirp (0.1 -> 3 Hz over 100 s) at unit amplitude: the normalised training
     range [-1, 1] at every rate the experiments use."""
+    import numpy as np
+
+    from ..signals import exponential_chirp
+
     return exponential_chirp(np.arange(round(100.0 / dt)) * dt, amplitude=1.0)
 
 
 def _model_input(comp: Compensator, path: Path) -> np.ndarray:
     """The fitted model's input on a recording, normalised as at fit time (eq. 5.10): the
     sensor signal for a direct compensator, the position for an inverse one's forward model."""
+    from ..io import read_recording
+
     rec = read_recording(path, need_position=comp.mode == "inverse")
     comp.check_sampling(rec)
     if comp.mode == "direct":
@@ -61,6 +67,10 @@ def _verdict(report: dict) -> str:
 
 
 def _stability(args: argparse.Namespace) -> int:
+    from ..compensation import load_compensator
+    from ..io import check_output_path, write_json
+    from ..models import stability_report
+
     if args.json is not None:
         check_output_path(args.json, args.force,
                           inputs=[args.model] + ([args.data] if args.data else []))

@@ -1,0 +1,56 @@
+"""Building the ``hystkit`` parser loads none of the heavy libraries (issue 11, instant start).
+
+Each subcommand imports what it uses when it runs; option values that need the library (model
+family names and sizes, experiment names, centring modes, ...) are computed only when their
+subcommand is parsed or its help shown. Checked in a fresh interpreter, since this test
+session has long imported everything. No timing here: see benchmarks/bench_startup.py.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+HEAVY = ("numpy", "numba", "scipy", "pandas", "matplotlib", "control", "pyarrow")
+
+
+def _loaded_after(code: str) -> list[str]:
+    probe = (f"{code}\nimport sys\n"
+             f"print(','.join(sorted(m for m in {HEAVY!r} if m in sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         check=True, timeout=120)
+    return [m for m in out.stdout.strip().split(",") if m]
+
+
+def test_building_the_parser_loads_no_heavy_library():
+    assert _loaded_after("from hystkit.cli._main import _parser\n_parser()") == []
+
+
+def test_version_and_top_level_help_load_no_heavy_library():
+    for argv in (["--version"], ["--help"]):
+        code = ("from hystkit.cli._main import main\n"
+                "import contextlib, io\n"
+                "with contextlib.redirect_stdout(io.StringIO()):\n"
+                "    try:\n"
+                f"        main({argv!r})\n"
+                "    except SystemExit:\n"
+                "        pass")
+        assert _loaded_after(code) == [], argv
+
+
+def test_a_bad_option_is_refused_before_any_heavy_import():
+    code = ("from hystkit.cli._main import main\n"
+            "import contextlib, io\n"
+            "with contextlib.redirect_stderr(io.StringIO()):\n"
+            "    assert main(['evaluate', '--no-such-option']) == 2")
+    assert _loaded_after(code) == []
+
+
+def test_subcommand_help_still_names_every_family():
+    """The deferred values reach the help text: fit's --model lists the registered families."""
+    from hystkit.models import FAMILIES
+
+    out = subprocess.run([sys.executable, "-m", "hystkit", "fit", "--help"],
+                         capture_output=True, text=True, check=True, timeout=120).stdout
+    for name in FAMILIES:
+        assert name in out
