@@ -205,7 +205,8 @@ def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
 
 
 def _fmt(x: float | None, spec: str = ".4f") -> str:
-    return "-" if x is None else format(x, spec)
+    # the leading space keeps a value wider than its column (R² -2390.9675) apart from the next
+    return " -" if x is None else " " + format(x, spec)
 
 
 def _yes_no(flag: bool | None) -> str:
@@ -223,11 +224,11 @@ def format_compare(table: Mapping[str, dict]) -> str:
             lines.append(f"{name:<10}  FAILED: {m['error']}")
             continue
         lines.append(
-            f"{name:<10}{_fmt(m['n_params'], 'd'):>7}{m['fit_seconds']:>7.2f}"
+            f"{name:<10}{_fmt(m['n_params'], 'd'):>7}{_fmt(m['fit_seconds'], '.2f'):>7}"
             f"{_fmt(m['r2_forward']):>8}{_fmt(m['r2_compensated']):>8}{_fmt(m['r2_direct']):>8}"
             f"{_fmt(m['linear_r2']):>8} |        {_fmt(m['r2_compensated_oracle']):>8}"
             f"{_fmt(m['r2_direct_oracle']):>8}{_fmt(m['linear_r2_oracle']):>8}"
-            f"{m['e_rms_pct']:>8.2f}"
+            f"{_fmt(m['e_rms_pct'], '.2f'):>8}"
             f"  {_yes_no(m['rate_dependent']):>8}  {_yes_no(m['return_point_memory']):>9}"
             f"  {_yes_no(m['minor_loops_close']):>5}  {m['direct_status']}")
     notes = [f"  {name}: no R² inv: {m['compensated_note']}" for name, m in table.items()

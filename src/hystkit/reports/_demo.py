@@ -33,6 +33,12 @@ FIT_SEED, VALIDATION_SEED = 1, 2
 RAW_SCOPE_RATE = 50e3
 
 
+def _cell(x: float | None, spec: str = ".4f") -> str:
+    """A table cell with a leading space, so that a value wider than its column (R² of
+    -2390.9675) still stands apart from its neighbour."""
+    return " -" if x is None else " " + format(x, spec)
+
+
 def format_table(metrics: dict, title: str, reference: dict | None = None) -> str:
     """Plain-text table per excitation: deployable and oracle R² of the model and the line."""
     head = (f"{'excitation':<11}{'mPL R²':>9}{'line R²':>9}{'e_rms %':>9}{'loop area %':>13}"
@@ -43,11 +49,11 @@ def format_table(metrics: dict, title: str, reference: dict | None = None) -> st
     lines = [(f"{title}\ndeployable centring: {centring}; oracle: recording (the paper's "
              f"protocol)"), head]
     for name, m in metrics.items():
-        row = (f"{name:<11}{m['r2']:>9.4f}{m['linear_r2']:>9.4f}{m['e_rms_pct']:>9.2f}"
-               f"{'-' if m['loop_area'] is None else format(m['loop_area'], '.2f'):>13}"
-               f"{m['r2_oracle']:>16.4f}{m['linear_r2_oracle']:>9.4f}")
+        row = (f"{name:<11}{_cell(m['r2']):>9}{_cell(m['linear_r2']):>9}"
+               f"{_cell(m['e_rms_pct'], '.2f'):>9}{_cell(m['loop_area'], '.2f'):>13}"
+               f"{_cell(m['r2_oracle']):>16}{_cell(m['linear_r2_oracle']):>9}")
         if reference and name in reference:
-            row += f"{reference[name][0]:>15.3f} / {reference[name][1]:.3f}"
+            row += f"{_cell(reference[name][0], '.3f'):>15} / {reference[name][1]:.3f}"
         lines.append(row)
     return "\n".join(lines)
 
