@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
+from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
 from ..compensation import (
@@ -178,30 +179,50 @@ def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Rec
 
 
 def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
-    """One heat map per model: rows = trained on, columns = tested on, colour = R²."""
+    """One heat map per model: rows = trained on, columns = tested on, each cell's R² written
+    in it. The colour is the unexplained fraction 1 - R² on a log scale shared by all panels,
+    so 0.99, 0.876 and -2390 all look different (a linear scale clipped at 0.9 made the last
+    two alike); failed cells stay blank."""
     n_cols = min(3, len(matrix))
     n_rows = -(-len(matrix) // n_cols)
     fig = Figure(figsize=(3.6 * n_cols, 3.2 * n_rows), layout="constrained")
     axes = np.atleast_1d(fig.subplots(n_rows, n_cols)).ravel()
     for ax in axes[len(matrix):]:
         ax.set_axis_off()
-    for ax, (name, entry) in zip(axes, matrix.items()):
-        grid = entry["r2"]
-        rows = list(grid)
-        names = list(next(iter(grid.values()))) if grid else []
-        values = np.array([[np.nan if grid[a][b] is None else grid[a][b] for b in names]
-                           for a in rows])
-        image = ax.imshow(values, vmin=0.9, vmax=1.0, cmap="viridis")
+    grids = {name: _r2_grid(entry["r2"]) for name, entry in matrix.items()}
+    worst = max([np.nanmax(1 - v) for _, _, v in grids.values() if np.isfinite(v).any()],
+                default=1.0)
+    norm = LogNorm(vmin=_UNEXPLAINED_FLOOR, vmax=max(1.0, worst))
+    image = None
+    for ax, (name, (rows, names, values)) in zip(axes, grids.items()):
+        unexplained = np.clip(1 - values, _UNEXPLAINED_FLOOR, None)
+        image = ax.imshow(unexplained, norm=norm, cmap="viridis_r")
         for i in range(len(rows)):
             for j in range(len(names)):
-                text = "fail" if np.isnan(values[i, j]) else f"{values[i, j]:.3f}"
-                ax.text(j, i, text, ha="center", va="center", fontsize="small",
-                        color="w" if np.isnan(values[i, j]) or values[i, j] < 0.96 else "k")
+                failed = np.isnan(values[i, j])
+                dark = not failed and norm(unexplained[i, j]) > 0.6  # viridis_r: dark when bad
+                ax.text(j, i, "fail" if failed else f"{values[i, j]:.3f}", ha="center",
+                        va="center", fontsize="small", color="w" if dark else "k")
         ax.set(xticks=range(len(names)), xticklabels=names, yticks=range(len(rows)),
                yticklabels=rows, xlabel="tested on", ylabel="trained on",
                title=f"{name} (deployable R²)")
-    fig.colorbar(image, ax=list(axes[:len(matrix)]), shrink=0.8, label="R² (clipped at 0.9)")
+    if image is not None:
+        fig.colorbar(image, ax=list(axes[:len(matrix)]), shrink=0.8,
+                     label="1 - R² (log scale; 1: no better than the mean)")
     return fig
+
+
+# 1 - R² below this (R² above 0.9999) shows as the best colour
+_UNEXPLAINED_FLOOR = 1e-4
+
+
+def _r2_grid(grid: Mapping[str, Mapping[str, float | None]]) -> tuple[list, list, np.ndarray]:
+    """Row names, column names and the R² values of one model (NaN where it failed)."""
+    rows = list(grid)
+    names = list(next(iter(grid.values()))) if grid else []
+    values = np.array([[np.nan if grid[a][b] is None else grid[a][b] for b in names]
+                       for a in rows], dtype=float).reshape(len(rows), len(names))
+    return rows, names, values
 
 
 def _fmt(x: float | None, spec: str = ".4f") -> str:
