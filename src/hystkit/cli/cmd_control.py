@@ -149,8 +149,9 @@ def _closed_loop(margins) -> str:
     if margins.closed_loop_stable:
         return "stable"
     if margins.marginal:
-        return ("marginally stable (a pole on the unit circle: a model state the linearised "
-                "loop neither corrects nor amplifies, e.g. a sticking element at rest)")
+        return ("marginally stable (a pole on the unit circle, to within the rounding of its "
+                "eigenvalue: a state the linearised loop neither corrects nor amplifies, e.g. a "
+                "sticking element at rest or a double integrator)")
     return (f"UNSTABLE (max |pole| {margins.max_pole_radius:.10f}: grows e-fold in "
             f"{margins.growth_time_s:.3g} s)")
 

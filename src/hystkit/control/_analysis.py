@@ -14,6 +14,7 @@ from dataclasses import dataclass, replace
 
 import control
 import numpy as np
+import scipy.linalg
 from scipy.optimize import brentq
 
 from ._blocks import (
@@ -27,7 +28,7 @@ from ._blocks import (
 )
 from ._loop import ControlLoop, LoopState, rest_state
 
-__all__ = ["LoopMargins", "bode_data", "design_dob", "loop_margins", "open_loop", "tune_pid"]
+__all__ = ["LoopMargins", "bode_data", "classify_poles", "design_dob", "loop_margins", "open_loop", "tune_pid"]
 
 
 def _ss(a, b, c, d, ts, inputs, outputs, name) -> control.StateSpace:
@@ -124,11 +125,12 @@ class LoopMargins:
     growth_time_s : float or None
         For an unstable loop, the e-folding time ``Ts / ln max|pole|`` [s] of its fastest
         growing mode: a slow drift (hours) and a blow-up (milliseconds) both count as unstable.
-        None when no pole lies outside the unit circle (within :data:`MARGINAL`).
+        None when no pole lies outside the unit circle (beyond its rounding).
     marginal : bool
-        The largest pole lies on the unit circle (within :data:`MARGINAL`): a state the
-        linearised loop neither corrects nor amplifies, e.g. a friction element or a dead band
-        of a sensor model that holds its state at rest.
+        No pole outside the unit circle and at least one on it (within the rounding of its
+        eigenvalue, see :func:`classify_poles`): a state the linearised loop neither corrects
+        nor amplifies, e.g. a friction element or a dead band of a sensor model that holds its
+        state at rest, or a double integrator.
     """
 
     crossover_hz: float | None
@@ -145,7 +147,35 @@ class LoopMargins:
 
 
 MARGINAL = 1e-12
-"""Pole radii within this of 1 count as on the unit circle (rounding of the eigenvalues)."""
+"""Least tolerance on a pole radius for counting it on the unit circle."""
+
+
+def classify_poles(a: np.ndarray) -> tuple[float, bool, bool, float]:
+    """``(growth radius, stable, marginal, max |pole|)`` of the discrete system ``x+ = A x``.
+
+    A pole is beyond the unit circle only when its radius exceeds 1 by more than the rounding
+    of that eigenvalue, ``100 eps ||A|| kappa`` with ``kappa = 1 / |y^H x|`` its condition
+    number (unit left and right eigenvectors; at least ``MARGINAL``): a double integrator's two
+    poles at 1 come out as 1 +- 1e-8 with ``kappa`` ~ 1e8, a nearly defective pair 1e-5 apart as
+    1 + 6e-10. The tolerance is capped at a double pole's rounding, ``10 sqrt(eps ||A||)``.
+    A pole is on the circle when not beyond it and within that rounding below 1. The growth
+    radius is the largest radius beyond the circle (1.0 when there is none).
+    """
+    a = np.atleast_2d(np.asarray(a, dtype=float))
+    if a.size == 0:
+        return 1.0, True, False, 0.0
+    poles, left, right = scipy.linalg.eig(a, left=True, right=True)
+    eps, norm = np.finfo(float).eps, np.linalg.norm(a, 2)
+    kappa = 1.0 / np.maximum(np.abs(np.sum(left.conj() * right, axis=0)), 1e-300)
+    # capped at a double pole's rounding, sqrt(eps ||A||): an exactly defective pole has an
+    # infinite kappa, and higher multiplicities are not resolved
+    tol = np.clip(100 * eps * norm * kappa, MARGINAL, 10 * np.sqrt(eps * norm))
+    radii = np.abs(poles)
+    outside = radii > 1 + tol
+    on = ~outside & (radii >= 1 - tol)
+    growth = float(radii[outside].max()) if outside.any() else 1.0
+    return (growth, not (outside.any() or on.any()), bool(on.any() and not outside.any()),
+            float(radii.max()))
 
 
 def _finite(x: float) -> float | None:
@@ -168,8 +198,7 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
     spurious low-frequency crossings.
     """
     lsys = open_loop(loop, state)
-    poles = np.linalg.eigvals(control.feedback(lsys, 1).A)
-    radius = float(np.max(np.abs(poles))) if poles.size else 0.0
+    growth, stable, marginal, radius = classify_poles(control.feedback(lsys, 1).A)
 
     def h(f: float) -> complex:
         return complex(np.asarray(lsys(np.exp(2j * np.pi * f * loop.ts))).reshape(-1)[0])
@@ -192,12 +221,10 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
             j = above[0]
             f_pc = brentq(lambda x: (-h(x)).imag, f[j], f[j + 1], xtol=1e-12 * f[j])
             gm = float(-20 * np.log10(abs(h(f_pc))))
-    marginal = abs(radius - 1.0) <= MARGINAL
-    growing = radius > 1.0 + MARGINAL
     return LoopMargins(crossover_hz=f_c, phase_margin_deg=pm, gain_margin_db=gm,
-                       phase_crossover_hz=f_pc, closed_loop_stable=radius < 1.0 - MARGINAL,
+                       phase_crossover_hz=f_pc, closed_loop_stable=stable,
                        max_pole_radius=radius,
-                       growth_time_s=float(loop.ts / np.log(radius)) if growing else None,
+                       growth_time_s=float(loop.ts / np.log(growth)) if growth > 1 else None,
                        marginal=marginal)
 
 

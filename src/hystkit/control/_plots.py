@@ -112,6 +112,8 @@ def plot_bode(f: np.ndarray, mag_db: np.ndarray, phase_deg: np.ndarray,
                        + ("inf" if margins.gain_margin_db is None
                           else f"{margins.gain_margin_db:.1f} dB")
                        + ("" if margins.closed_loop_stable else
+                          ",\nclosed loop marginally stable (a pole on the unit circle)"
+                          if margins.growth_time_s is None else
                           f",\nclosed loop UNSTABLE: e-fold growth in "
                           f"{margins.growth_time_s:.3g} s"),
                        fontsize=8)
