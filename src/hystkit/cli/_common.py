@@ -12,11 +12,12 @@ import math
 import sys
 from collections.abc import Callable
 
+from .._read_options import MAX_SKIP_ROWS, SEPARATORS, TIME_UNITS, parse_columns
 from ..errors import HystkitError
 
-__all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Deferred", "Parser", "UsageError", "check_size", "deferred",
-           "failures_exit", "integer", "number", "positive_float", "positive_int", "size_limit",
-           "slope_cap"]
+__all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Deferred", "Parser", "UsageError", "add_read_options",
+           "check_size", "deferred", "failures_exit", "integer", "number", "positive_float",
+           "positive_int", "read_options", "size_limit", "slope_cap"]
 
 # Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
 # bounds, not converged; a family failed in compare/select); 2 is kept for errors that stop a
@@ -164,3 +165,51 @@ def failures_exit(failed: list[str], what: str = "model(s)") -> int:
               file=sys.stderr)
         return GUARD_EXIT
     return 0
+
+
+def _columns(text: str) -> tuple[tuple[str, str], ...]:
+    try:
+        return parse_columns(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _separator(text: str) -> str:
+    if text not in SEPARATORS:
+        raise argparse.ArgumentTypeError(f"expected ',', ';', 'tab' or 'auto', got {text!r}")
+    return text
+
+
+OUTPUT_NAMES_NOTE = ("written files use hystkit's column names (time [s], position, sensor, "
+                     "...) whatever --columns and --time-unit read")
+
+
+def add_read_options(p: argparse.ArgumentParser) -> None:
+    """Add ``--columns``, ``--time-unit``, ``--skip-rows`` and ``--sep`` (how to read the
+    user's own recording files); `read_options` turns them into a `hystkit.io.ReadOptions`.
+    Values are checked while parsing, so a bad one is one line (exit 2) before any work."""
+    g = p.add_argument_group("reading your own files (the same settings for every recording)",
+                             OUTPUT_NAMES_NOTE)
+    g.add_argument("--columns", type=_columns, default=(), metavar="NAME=COLUMN,...",
+                   help="the file's names of hystkit's columns, e.g. time=t,position="
+                        "displacement_mm,sensor=resistance_ohm (.mat: variable names); names "
+                        "not given stay time, position, sensor")
+    g.add_argument("--time-unit", choices=list(TIME_UNITS), default="s",
+                   help="unit of the time column, converted to seconds (default s)")
+    g.add_argument("--skip-rows", type=integer(0, MAX_SKIP_ROWS), default=0, metavar="N",
+                   help="CSV: lines to skip after the header, e.g. 1 for a units line "
+                        "(default 0)")
+    g.add_argument("--sep", type=_separator, default=",", metavar="{',',;,tab,auto}",
+                   help="CSV field separator; auto: the most frequent of the three in the "
+                        "header line (default ',')")
+
+
+def read_options(args: argparse.Namespace):
+    """The `hystkit.io.ReadOptions` of the options `add_read_options` added."""
+    from .._read_options import ReadOptions
+
+    try:
+        return ReadOptions(columns=args.columns, time_unit=args.time_unit,
+                           skip_rows=args.skip_rows, sep=args.sep)
+    except ValueError as exc:  # already checked one by one while parsing; kept as a guard
+        raise UsageError(str(exc)) from None

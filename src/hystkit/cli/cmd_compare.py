@@ -5,7 +5,15 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import UsageError, check_size, deferred, failures_exit, positive_int
+from ._common import (
+    UsageError,
+    add_read_options,
+    check_size,
+    deferred,
+    failures_exit,
+    positive_int,
+    read_options,
+)
 
 __all__ = ["register"]
 
@@ -53,7 +61,9 @@ def _compare(args: argparse.Namespace) -> int:
     if out is not None:
         check_output_folder(out, ["compare.json"], args.force, inputs=inputs)
     sizes = _sizes(args.size)
-    fit_rec, val_rec = read_recording(args.data_fit), read_recording(args.data_val)
+    options = read_options(args)
+    fit_rec = read_recording(args.data_fit, options=options)
+    val_rec = read_recording(args.data_val, options=options)
     print(f"comparing {len(models)} models: fit on {args.data_fit}, validate on {args.data_val} "
           f"(deployable centring: {DEFAULT_CENTER}; oracle: recording, the paper's protocol)")
     table = compare_models(fit_rec, val_rec, models, sizes, progress=print)
@@ -132,6 +142,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--size", action="append", default=[], metavar="MODEL=N",
                    help="model size, e.g. --size mpl=3 (repeatable)")
     p.add_argument("--out", type=Path, help="folder for compare.json")
+    add_read_options(p)
     p.set_defaults(run=_compare)
 
     p = sub.add_parser("generalize", help="train on each recording, test on each (default: the "

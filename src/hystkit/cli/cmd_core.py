@@ -9,13 +9,16 @@ from pathlib import Path
 
 from ._common import (
     GUARD_EXIT,
+    OUTPUT_NAMES_NOTE,
     UsageError,
+    add_read_options,
     check_size,
     deferred,
     integer,
     number,
     positive_float,
     positive_int,
+    read_options,
     size_limit,
     slope_cap,
 )
@@ -66,7 +69,8 @@ def _fit(args: argparse.Namespace) -> int:
     if options and args.model != "mpl":
         raise UsageError(f"--slope-cap applies to the mpl model only, not {args.model!r}")
     check_size(args.model, args.cells, "--cells")
-    recs = [read_recording(path) for path in args.data]
+    reading = read_options(args)
+    recs = [read_recording(path, options=reading) for path in args.data]
     size = family.default_size if args.cells is None else args.cells
     print(f"fitting {args.model} ({family.size_help}: {size}, {args.mode} mode, centring: "
           f"{center_label(args.center)}) on {', '.join(map(str, args.data))}: "
@@ -115,7 +119,7 @@ def _compensate(args: argparse.Namespace) -> int:
     check_output_path(args.out, args.force, inputs=[args.model, args.data])
     comp = load_compensator(args.model)
     _warn_if_oracle(comp.center, args.model)
-    rec = read_recording(args.data, need_position=False)
+    rec = read_recording(args.data, need_position=False, options=read_options(args))
     estimate = comp.estimate(rec, rest_position=args.rest_position)
     flags = use_flags(comp, rec, estimate)
     extra = {"position_estimate": estimate}
@@ -165,7 +169,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         check_output_path(args.json, args.force, inputs=[args.model, args.data])
     comp = load_compensator(args.model)
     _warn_if_oracle(comp.center, args.model)
-    rec = read_recording(args.data)
+    rec = read_recording(args.data, options=read_options(args))
     scores = evaluate(comp, rec, rest_position=args.rest_position)
     _warn_if_outside(use_flags(comp, rec, comp.estimate(rec, rest_position=args.rest_position)),
                      args.data)
@@ -309,6 +313,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="mpl only: Euler stability cap f'·dt of the cell resistors, in [0.001, 2) "
                         "(default 1)")
     p.add_argument("--out", type=Path, required=True, help="model JSON file to write")
+    add_read_options(p)
     p.set_defaults(run=_fit)
 
     p = sub.add_parser("compensate", help="add a position_estimate column (and flags) to a "
@@ -316,7 +321,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("model", type=Path)
     p.add_argument("data", type=Path)
     _add_rest_position(p)
-    p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--out", type=Path, required=True,
+                   help=f"CSV or Parquet file to write; {OUTPUT_NAMES_NOTE.replace('...', 'position_estimate')}")
+    add_read_options(p)
     p.set_defaults(run=_compensate)
 
     p = sub.add_parser("evaluate", help="score a compensator on a recording")
@@ -324,6 +331,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("data", type=Path)
     p.add_argument("--json", type=Path, help="also write the scores to this JSON file")
     _add_rest_position(p)
+    add_read_options(p)
     p.set_defaults(run=_evaluate)
 
     p = sub.add_parser("demo", help="the main job on the built-in virtual sensor")

@@ -7,7 +7,15 @@ import sys
 import time
 from pathlib import Path
 
-from ._common import GUARD_EXIT, UsageError, deferred, failures_exit, positive_int
+from ._common import (
+    GUARD_EXIT,
+    UsageError,
+    add_read_options,
+    deferred,
+    failures_exit,
+    positive_int,
+    read_options,
+)
 from .cmd_compare import _models
 
 __all__ = ["register"]
@@ -42,7 +50,8 @@ def _select(args: argparse.Namespace) -> int:
     check_output_path(args.out, args.force, inputs=args.data)
     report = args.report or args.out.with_name(args.out.stem + "-selection")
     check_output_folder(report, SELECTION_FILES, args.force, inputs=args.data)
-    recs = [read_recording(path) for path in args.data]
+    options = read_options(args)
+    recs = [read_recording(path, options=options) for path in args.data]
     cands = candidates(_models(args.models), _centers(args.centers))
     t0 = time.perf_counter()
     print(f"selecting among {len(cands)} candidates on {', '.join(map(str, args.data))} "
@@ -99,4 +108,5 @@ def register(sub: argparse._SubParsersAction) -> None:
              help=lambda: f"comma-separated centrings to try (default {_default_center()})")
     p.add_argument("--jobs", type=positive_int, default=1,
                    help="worker processes for the candidates (default 1)")
+    add_read_options(p)
     p.set_defaults(run=_select)

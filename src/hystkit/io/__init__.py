@@ -1,5 +1,6 @@
 """Reading, validating and writing recordings; JSON result files; raw scope recordings."""
 
+from .._read_options import ReadOptions
 from ._raw import RAW_COLUMNS, RawChunk, RawFormat, RawReader, RawWriter, open_raw
 from ._raw_config import (
     CONFIG_KEYS,
@@ -19,6 +20,7 @@ from ._writing import (
 )
 
 __all__ = ["CONFIG_KEYS", "RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter",
+           "ReadOptions",
            "Recording", "Sampled", "atomic_folder", "atomic_output", "atomic_outputs",
            "check_output_folder",
            "check_output_path", "find_raw_config", "open_raw",

@@ -22,9 +22,21 @@ class Where:
     noun: str = "column"
     item: str = "row"
     header_lines: int | None = None  # CSV only: data row r sits on file line r + header_lines
+    # (hystkit name, file name) of columns named differently in the file (ReadOptions.columns)
+    names: tuple[tuple[str, str], ...] = ()
+
+    def name(self, column: str) -> str:
+        """The file's name for hystkit column `column`."""
+        return dict(self.names).get(column, column)
+
+    def label(self, column: str) -> str:
+        """``'time'``, or ``'t_ms' (time)`` when the file names it differently: the user
+        must recognise the column of their own file."""
+        name = self.name(column)
+        return repr(name) if name == column else f"{name!r} ({column})"
 
     def fail(self, message: str, column: str | None = None, index: int | None = None) -> InputError:
-        parts = [] if column is None else [f"{self.noun} {column!r}"]
+        parts = [] if column is None else [f"{self.noun} {self.label(column)}"]
         if index is not None:
             text = f"{self.item} {index + 1}"
             if self.header_lines is not None:
@@ -35,17 +47,18 @@ class Where:
 
 
 def pick(found: list[str], need_position: bool, where: Where, hint: str = "") -> list[str]:
-    """Names of the recording columns present in `found`; missing or doubled ones fail."""
+    """Hystkit names of the recording columns present in `found` (the file's names, looked up
+    through ``where.name``); missing or doubled ones fail."""
     required = [n for n in COLUMNS if need_position or n != "position"]
-    missing = [n for n in required if n not in found]
+    missing = [n for n in required if where.name(n) not in found]
     if missing:
         listed = ", ".join(repr(n) for n in found) or "none"
-        raise where.fail(f"missing required {where.noun} {', '.join(map(repr, missing))}; "
-                         f"{where.noun}s found: {listed}{hint}")
+        raise where.fail(f"missing required {where.noun} {', '.join(map(where.label, missing))}"
+                         f"; {where.noun}s found: {listed}{hint}")
     for name in COLUMNS:
-        if found.count(name) > 1:
-            raise where.fail(f"appears {found.count(name)} times in the header", name)
-    return [n for n in COLUMNS if n in found]
+        if found.count(where.name(name)) > 1:
+            raise where.fail(f"appears {found.count(where.name(name))} times in the header", name)
+    return [n for n in COLUMNS if where.name(n) in found]
 
 
 def text_problems(text: pd.Series) -> tuple[np.ndarray, np.ndarray, pd.Series]:

@@ -22,6 +22,7 @@ import pandas as pd
 
 from hystkit.errors import InputError
 
+from .._read_options import DEFAULT_OPTIONS, ReadOptions
 from ._cells import Where, cell_problem, pick, text_problems
 
 CHUNK_ROWS = 100_000  # text cells held at once by the second pass
@@ -29,41 +30,54 @@ FAST_CHUNK_ROWS = 1 << 18  # rows parsed at once by the first pass, copied into 
 MAX_COLUMNS = 1000  # a wider file is not a recording; pandas would build a column per field
 _HEADER_BYTES = 1 << 16
 _EXACT = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
-_HINT = " (the first line must be a comma-separated header naming the columns)"
+_SEP_NAMES = {",": "comma", ";": "semicolon", "\t": "tab"}
 _TEXT = {"header": None, "dtype": str, "keep_default_na": False, "skip_blank_lines": False,
          "encoding": "utf-8-sig"}
 # What pandas raises on text it cannot tokenise (NUL bytes, huge fields, stray quotes, ...).
 _PARSE_ERRORS = (pd.errors.ParserError, ValueError, OverflowError, MemoryError)
 
 
-def read_csv(path: Path, source: str, need_position: bool) -> tuple[dict[str, np.ndarray], Where]:
-    """Read the recording columns of a CSV file as float64 arrays (not yet validated)."""
-    where = Where(source, header_lines=1)
-    _check_width(path, where)
-    arrays = _read_numbers(path, need_position, where)
+def read_csv(path: Path, source: str, need_position: bool,
+             options: ReadOptions = DEFAULT_OPTIONS) -> tuple[dict[str, np.ndarray], Where]:
+    """Read the recording columns of a CSV file as float64 arrays (not yet validated).
+
+    `options` gives the file's column names, the separator and the lines skipped after the
+    header; its time unit is applied by the caller.
+    """
+    # Data row r sits on file line r + 1 + skip_rows (the header, then the skipped lines).
+    where = Where(source, header_lines=1 + options.skip_rows, names=options.columns)
+    sep = _check_width(path, where, options.sep)
+    hint = f" (the first line must be a {_SEP_NAMES[sep]}-separated header naming the columns)"
+    arrays = _read_numbers(path, need_position, where, sep, options.skip_rows, hint)
     if arrays is None:
-        arrays = _read_text(path, need_position, where)
+        arrays = _read_text(path, need_position, where, sep, options.skip_rows, hint)
     return arrays, where
 
 
-def _check_width(path: Path, where: Where) -> None:
-    """Refuse a header with more than `MAX_COLUMNS` fields before pandas builds that many."""
+def _check_width(path: Path, where: Where, sep: str) -> str:
+    """Refuse a header with more than `MAX_COLUMNS` fields before pandas builds that many;
+    returns the separator (`sep`, or for ``auto`` the most frequent one in the header)."""
     with path.open("rb") as file:
         start = file.read(_HEADER_BYTES)
     ends = [i for i in (start.find(b"\n"), start.find(b"\r")) if i >= 0]
     if not ends and len(start) == _HEADER_BYTES:
         raise where.fail(f"the header line is longer than {_HEADER_BYTES} bytes; this is not "
                          "a recording")
-    fields = start[:min(ends, default=len(start))].count(b",") + 1
+    line = start[:min(ends, default=len(start))]
+    if sep == "auto":  # ties go to the earlier of comma, semicolon, tab
+        sep = max(_SEP_NAMES, key=lambda c: line.count(c.encode()))
+    fields = line.count(sep.encode()) + 1
     if fields > MAX_COLUMNS:
         raise where.fail(f"the header line has {fields} fields; a recording has at most "
                          f"{MAX_COLUMNS} columns")
+    return sep
 
 
-def _read_numbers(path: Path, need_position: bool, where: Where) -> dict[str, np.ndarray] | None:
+def _read_numbers(path: Path, need_position: bool, where: Where, sep: str = ",", skip: int = 0,
+                  hint: str = "") -> dict[str, np.ndarray] | None:
     """The fast pass: every column as float64, or None when anything needs a closer look."""
     try:
-        first = pd.read_csv(path, nrows=1, **_TEXT)
+        first = pd.read_csv(path, nrows=1, sep=sep, **_TEXT)
     except (*_PARSE_ERRORS, UnicodeDecodeError):
         return None
     if first.empty or first.iloc[0].isna().any():  # blank first line or empty file: pass 2
@@ -71,8 +85,8 @@ def _read_numbers(path: Path, need_position: bool, where: Where) -> dict[str, np
     header = [str(name).strip() for name in first.iloc[0]]
     if any("\n" in name or "\r" in name for name in header):  # a quoted header spans lines
         return None
-    names = pick(header, need_position, where, hint=_HINT)
-    columns = [header.index(name) for name in names]
+    names = pick(header, need_position, where, hint=hint)
+    columns = [header.index(where.name(name)) for name in names]
     # Rows <= line breaks + 1. np.empty pages that are never written cost no memory, so the
     # bound may be generous (CRLF counts twice).
     out = [np.empty(_line_bound(path)) for _ in names]
@@ -80,8 +94,8 @@ def _read_numbers(path: Path, need_position: bool, where: Where) -> dict[str, np
     try:
         # index_col=False: with names given, pandas would otherwise make a long row's extra
         # leading field an index; skip_blank_lines=False: a blank line becomes a NaN row.
-        with pd.read_csv(path, header=None, skiprows=1, names=list(range(len(header))),
-                         index_col=False, dtype=np.float64, skip_blank_lines=False,
+        with pd.read_csv(path, header=None, skiprows=1 + skip, names=list(range(len(header))),
+                         index_col=False, dtype=np.float64, skip_blank_lines=False, sep=sep,
                          encoding="utf-8-sig", chunksize=FAST_CHUNK_ROWS, **_EXACT) as reader:
             for chunk in reader:
                 if n + len(chunk) > out[0].size:
@@ -108,7 +122,8 @@ def _line_bound(path: Path, block: int = 1 << 22) -> int:
     return count
 
 
-def _read_text(path: Path, need_position: bool, where: Where) -> dict[str, np.ndarray]:
+def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", skip: int = 0,
+               hint: str = "") -> dict[str, np.ndarray]:
     """The careful pass: text cells chunk by chunk, the first problem of each column kept."""
     header: list[str] | None = None
     names: list[str] = []
@@ -119,11 +134,12 @@ def _read_text(path: Path, need_position: bool, where: Where) -> dict[str, np.nd
     try:
         # header=None because with a header pandas silently turns the first column into an
         # index when every data row has one field too many.
-        with pd.read_csv(path, chunksize=CHUNK_ROWS, **_TEXT) as reader:
+        with pd.read_csv(path, chunksize=CHUNK_ROWS, sep=sep,
+                         skiprows=range(1, 1 + skip) if skip else None, **_TEXT) as reader:
             for chunk in reader:
                 if header is None:
                     header = [str(name).strip() for name in chunk.iloc[0]]
-                    names = pick(header, need_position, where, hint=_HINT)
+                    names = pick(header, need_position, where, hint=hint)
                     parts = {name: [] for name in names}
                     chunk = chunk.iloc[1:]
                 filled = np.zeros(len(chunk), dtype=bool)
@@ -133,7 +149,7 @@ def _read_text(path: Path, need_position: bool, where: Where) -> dict[str, np.nd
                     # Trailing blank lines are common at the end of logger files and carry no data.
                     n_rows = offset + int(np.flatnonzero(filled)[-1]) + 1
                 for name in names:
-                    numbers, bad, stripped = text_problems(chunk[header.index(name)])
+                    numbers, bad, stripped = text_problems(chunk[header.index(where.name(name))])
                     if name not in first_bad and bad.any():
                         i = int(np.argmax(bad))
                         first_bad[name] = (offset + i, cell_problem(stripped, i))
@@ -160,13 +176,16 @@ def _parse_error(exc: Exception, where: Where) -> InputError:
     """The InputError for a tokeniser failure, with the file line where pandas names one."""
     quote = re.search(r"EOF inside string starting at row (\d+)", str(exc))
     if quote is not None:  # pandas counts file lines from 0 here
-        return where.fail("a quote opened here is never closed", index=int(quote.group(1)) - 1)
+        return where.fail("a quote opened here is never closed",
+                          index=int(quote.group(1)) - where.header_lines)
     found = re.search(r"Expected (\d+) fields in line (\d+), saw (\d+)", str(exc))
     if found is None:
         detail = " ".join(str(exc).split())[:200] or type(exc).__name__
         return where.fail(f"cannot parse CSV ({detail})")
     expected, line, saw = (int(g) for g in found.groups())
-    return where.fail(f"{saw} fields but the header names {expected} columns", index=line - 2)
+    # pandas counts file lines from 1, skipped lines included
+    return where.fail(f"{saw} fields but the header names {expected} columns",
+                      index=line - 1 - where.header_lines)
 
 
 def _first_bad_utf8(path: Path, block: int = 1 << 20) -> str:

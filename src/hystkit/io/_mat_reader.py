@@ -23,6 +23,7 @@ import numpy as np
 
 from hystkit.errors import InputError
 
+from .._read_options import DEFAULT_OPTIONS, ReadOptions
 from ._cells import COLUMNS, Where, as_vector, pick
 
 _CHILD = Path(__file__).with_name("_mat_child.py")
@@ -122,18 +123,21 @@ def _one_line(text: str) -> str:
     return text if len(text) <= _DETAIL_CHARS else text[:_DETAIL_CHARS] + "..."
 
 
-def read_mat(path: Path, source: str, need_position: bool) -> tuple[dict[str, np.ndarray], Where]:
-    """Read the recording variables of a MATLAB file as float64 arrays (not yet validated)."""
-    where = Where(source, noun="variable", item="sample")
-    contents = load_mat(path, list(COLUMNS), source)
+def read_mat(path: Path, source: str, need_position: bool,
+             options: ReadOptions = DEFAULT_OPTIONS) -> tuple[dict[str, np.ndarray], Where]:
+    """Read the recording variables of a MATLAB file as float64 arrays (not yet validated);
+    of `options` only the column (variable) names apply here."""
+    where = Where(source, noun="variable", item="sample", names=options.columns)
+    contents = load_mat(path, [where.name(name) for name in COLUMNS], source)
     names = pick(list(contents.variables), need_position, where)
     arrays = {}
     for name in names:
-        if name not in contents.arrays:  # not real numbers: only described by the child
-            dtype, shape = contents.variables[name]
+        variable = where.name(name)
+        if variable not in contents.arrays:  # not real numbers: only described by the child
+            dtype, shape = contents.variables[variable]
             if dtype == "sparse":
                 raise where.fail(f"a sparse matrix of shape {shape}; save it as a full vector",
                                  name)
             raise where.fail(f"not real numbers (dtype {dtype})", name)
-        arrays[name] = as_vector(contents.arrays[name], name, where)
+        arrays[name] = as_vector(contents.arrays[variable], name, where)
     return arrays, where

@@ -21,21 +21,24 @@ import pyarrow.parquet as pq
 
 from hystkit.errors import InputError
 
+from .._read_options import DEFAULT_OPTIONS, ReadOptions
 from ._cells import Where, parse_text, pick
 
 
 def read_parquet(
-    path: Path, source: str, need_position: bool
+    path: Path, source: str, need_position: bool, options: ReadOptions = DEFAULT_OPTIONS
 ) -> tuple[dict[str, np.ndarray], Where]:
-    """Read the recording columns of a Parquet file as float64 arrays (not yet validated)."""
-    where = Where(source)
+    """Read the recording columns of a Parquet file as float64 arrays (not yet validated);
+    of `options` only the column names apply here."""
+    where = Where(source, names=options.columns)
     try:
         file = pq.ParquetFile(path)
         try:
             names = pick([str(name) for name in file.schema_arrow.names], need_position, where)
             arrays = {}
             for name in names:  # one column at a time: its Arrow buffers go before the next
-                column = file.read(columns=[name], use_pandas_metadata=False).column(0)
+                column = file.read(columns=[where.name(name)],
+                                   use_pandas_metadata=False).column(0)
                 if len(column) == 0:
                     raise where.fail("no data rows")
                 arrays[name] = _column(column, name, where)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hystkit._read_options import ReadOptions
 from hystkit.errors import InputError
 
 from ._cells import COLUMNS as _COLUMNS  # also imported by _writing
@@ -90,7 +91,8 @@ class Recording(Sampled):
         return self.position is not None
 
 
-def read_recording(path: str | os.PathLike[str], *, need_position: bool = True) -> Recording:
+def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
+                   options: ReadOptions | None = None) -> Recording:
     """Read and validate a recording from a ``.csv``, ``.parquet`` or ``.mat`` file.
 
     Parameters
@@ -100,6 +102,10 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True) 
         named like the columns (row or column vectors). Other columns are ignored.
     need_position : bool
         Require a ``position`` column. If False it is still read when present.
+    options : ReadOptions, optional
+        The file's own column (or variable) names, time unit, and for CSV the separator and
+        the lines after the header to skip. Default: columns named ``time``, ``position``,
+        ``sensor``, time in seconds, comma-separated, the header on the first line.
 
     Returns
     -------
@@ -116,6 +122,7 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True) 
     """
     path = Path(path)
     source = str(path)
+    options = ReadOptions() if options is None else options
     suffix = path.suffix.lower()
     if suffix not in _READERS:
         raise InputError(
@@ -131,9 +138,11 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True) 
     try:
         with path.open("rb"):  # permissions, a FIFO's or a device's refusal: before any parser
             pass
-        arrays, where = _READERS[suffix](path, source, need_position)
+        arrays, where = _READERS[suffix](path, source, need_position, options)
     except OSError as exc:  # also a disk failing halfway (EIO)
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
+    if options.time_scale != 1.0:  # to seconds before the checks, whose messages say "s"
+        arrays["time"] = arrays["time"] * options.time_scale
     _validate(arrays, where)
     return _adopt(arrays, source)
 
