@@ -14,7 +14,7 @@ import math
 import os
 import secrets
 import shutil
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -259,26 +259,43 @@ def atomic_output(path: str | os.PathLike[str], force: bool = False) -> Iterator
     """
     path = Path(path)
     check_output_path(path, force)
+
+    def publish(tmp: Path) -> None:
+        _fsync(tmp)
+        _publish(tmp, path, force)
+
+    # after a link, the target keeps the content: the temporary name always goes
+    with _staged(path, _create_temporary, publish, lambda tmp: tmp.unlink(missing_ok=True)) \
+            as tmp:
+        yield tmp
+
+
+@contextmanager
+def _staged(target: Path, make: Callable[[Path], Path], publish: Callable[[Path], None],
+            discard: Callable[[Path], None]) -> Iterator[Path]:
+    """The mechanism of every atomic output: create the missing parent folders, `make` a
+    temporary for `target`, yield it, `publish` it when the block ends normally, `discard` it
+    in any case; on failure the parent folders it created are removed again. OS errors become
+    one-line `OutputError`s naming `target`."""
     created: list[Path] = []
     try:
-        created = _make_parents(path.parent)
-        tmp = _create_temporary(path)
+        created = _make_parents(target.parent)
+        tmp = make(target)
     except OSError as exc:
         _remove_folders(created)
-        raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
+        raise OutputError(f"{target}: cannot write ({exc.strerror or exc})") from None
     done = False
     try:
         try:
             yield tmp
-            _fsync(tmp)
-            _publish(tmp, path, force)
+            publish(tmp)
             done = True
         except (OutputError, OutputExistsError):
             raise
         except OSError as exc:
-            raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
+            raise OutputError(f"{target}: cannot write ({exc.strerror or exc})") from None
     finally:
-        tmp.unlink(missing_ok=True)  # after a link, the target keeps the content
+        discard(tmp)
         if not done:
             _remove_folders(created)
 
@@ -361,27 +378,9 @@ def atomic_folder(out: str | os.PathLike[str], force: bool = False,
     """
     out = Path(out)
     check_output_folder(out, names, force)
-    created: list[Path] = []
-    try:
-        created = _make_parents(out.parent)
-        tmp = _create_temporary_folder(out)
-    except OSError as exc:
-        _remove_folders(created)
-        raise OutputError(f"{out}: cannot write ({exc.strerror or exc})") from None
-    done = False
-    try:
-        try:
-            yield tmp
-            _publish_folder(tmp, out, force)
-            done = True
-        except (OutputError, OutputExistsError):
-            raise
-        except OSError as exc:
-            raise OutputError(f"{out}: cannot write ({exc.strerror or exc})") from None
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-        if not done:
-            _remove_folders(created)
+    with _staged(out, _create_temporary_folder, lambda tmp: _publish_folder(tmp, out, force),
+                 lambda tmp: shutil.rmtree(tmp, ignore_errors=True)) as tmp:
+        yield tmp
 
 
 def _create_temporary_folder(out: Path) -> Path:
