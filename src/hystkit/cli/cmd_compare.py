@@ -15,7 +15,30 @@ from ._common import (
     read_options,
 )
 
-__all__ = ["register"]
+__all__ = ["add_parallel_options", "executor_for", "register", "say_where"]
+
+
+def add_parallel_options(p: argparse.ArgumentParser) -> None:
+    """``--workers`` and ``--scheduler``: where the command's independent pieces run."""
+    g = p.add_argument_group("parallel runs (results are the same as a serial run's)")
+    x = g.add_mutually_exclusive_group()
+    x.add_argument("--workers", type=positive_int, default=None, metavar="N",
+                   help="worker processes of a local Dask cluster (default: one per core); "
+                        "1: serial, in this process, without Dask")
+    x.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on an existing Dask cluster, e.g. tcp://10.0.0.5:8786 (every "
+                        "worker needs the same hystkit version)")
+
+
+def executor_for(args: argparse.Namespace, n_pieces: int):
+    """The executor (context manager) of ``--workers`` / ``--scheduler`` for `n_pieces`."""
+    from ..parallel import open_executor
+
+    return open_executor(args.workers, args.scheduler, n_pieces=n_pieces)
+
+
+def say_where(executor, n_pieces: int) -> None:
+    print(f"{n_pieces} pieces of work on {executor.describe()}", flush=True)
 
 
 def _models(text: str | None) -> list[str]:
@@ -66,7 +89,10 @@ def _compare(args: argparse.Namespace) -> int:
     val_rec = read_recording(args.data_val, options=options)
     print(f"comparing {len(models)} models: fit on {args.data_fit}, validate on {args.data_val} "
           f"(deployable centring: {DEFAULT_CENTER}; oracle: recording, the paper's protocol)")
-    table = compare_models(fit_rec, val_rec, models, sizes, progress=print)
+    with executor_for(args, 2 * len(models)) as executor:
+        say_where(executor, 2 * len(models))
+        table = compare_models(fit_rec, val_rec, models, sizes, progress=print,
+                               executor=executor)
     print(format_compare(table))
     print("R² fwd: forward model position -> sensor; R² inv: its inverse as compensator; "
           "R² dir: a compensator fitted sensor -> position; line: straight line; left of | "
@@ -106,7 +132,10 @@ def _generalize(args: argparse.Namespace) -> int:
         where = "virtual sensor, fit seed 1, test seed 2"
     print(f"train on each of {', '.join(train)}, test on each ({where}; direct-mode "
           f"compensators, deployable centring: {DEFAULT_CENTER}, oracle beside it)")
-    matrix = generalization_matrix(train, test, models, sizes, progress=print)
+    with executor_for(args, len(models) * len(train)) as executor:
+        say_where(executor, len(models) * len(train))
+        matrix = generalization_matrix(train, test, models, sizes, progress=print,
+                                       executor=executor)
     failed = []
     for name, entry in matrix.items():
         for key, label in (("r2", "deployable R²"), ("r2_oracle", "oracle R² (recording)")):
@@ -143,6 +172,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="model size, e.g. --size mpl=3 (repeatable)")
     p.add_argument("--out", type=Path, help="folder for compare.json")
     add_read_options(p)
+    add_parallel_options(p)
     p.set_defaults(run=_compare)
 
     p = sub.add_parser("generalize", help="train on each recording, test on each (default: the "
@@ -152,4 +182,5 @@ def register(sub: argparse._SubParsersAction) -> None:
     deferred(p.add_argument("--models"), help=models_help)
     p.add_argument("--size", action="append", default=[], metavar="MODEL=N")
     p.add_argument("--out", type=Path, help="output folder (default hystkit-generalize)")
+    add_parallel_options(p)
     p.set_defaults(run=_generalize)

@@ -23,6 +23,7 @@ from ..errors import HystkitError
 from ..io import Recording
 from ..metrics import e_max_pct, e_rms_pct, r2
 from ..models import FAMILIES, get_family
+from ..parallel import Executor, SerialExecutor
 from ._properties import measure_properties
 
 __all__ = ["compare_models", "format_compare", "generalization_matrix", "plot_generalization"]
@@ -93,8 +94,12 @@ def _count_numbers(tree) -> int:
 
 def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str] | None = None,
                    sizes: Mapping[str, int] | None = None,
-                   progress: Callable[[str], None] = lambda _: None) -> dict:
+                   progress: Callable[[str], None] = lambda _: None,
+                   executor: Executor | None = None) -> dict:
     """Fit every model on ``fit_rec`` and score it on ``val_rec``.
+
+    Each family is two pieces of work for `executor` (default: serial), its forward model and
+    its direct compensator; the table is the same whichever executor ran them.
 
     Returns
     -------
@@ -103,8 +108,8 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
         compensated_note), r2_direct (a compensator fitted sensor -> position), linear_r2,
         the same four with an ``_oracle`` suffix (paper's protocol), center, direct_status,
         e_rms_pct, e_max_pct (forward, % of the normalised range), rate_dependent,
-        return_point_memory, minor_loops_close, ...}}``; a model whose fit fails has ``error``
-        (the others are still scored).
+        return_point_memory, minor_loops_close, ...}}``, in the order of `models`; a model
+        whose fit fails has ``error`` (the others are still scored).
 
     Raises
     ------
@@ -116,28 +121,57 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
     check_fitting_data([fit_rec])
     check_excursion([val_rec])
     models = sorted(FAMILIES) if models is None else list(models)
+    pieces = [(name, (sizes or {}).get(name), part) for name in models
+              for part in ("forward", "direct")]
+    waiting = {name: 2 for name in models}
+
+    def done(i: int, _: dict) -> None:
+        name = pieces[i][0]
+        waiting[name] -= 1
+        if not waiting[name]:
+            progress(f"  {name}: fitted and scored ({sum(not n for n in waiting.values())}/"
+                     f"{len(models)})")
+
+    results = (executor or SerialExecutor()).map(
+        _compare_piece, pieces, shared={"fit_rec": fit_rec, "val_rec": val_rec}, on_done=done)
     table = {}
-    for name in models:
-        size = (sizes or {}).get(name)
-        progress(f"  {name}: fitting ...")
-        try:
-            entry = _forward_scores(name, size, fit_rec, val_rec)
-            comp = fit_compensator(fit_rec, size, model=name, diagnose=False)
-            direct = evaluate(comp, val_rec)
-            entry["center"], entry["direct_status"] = direct["center"], comp.fit_info["status"]
-            for suffix in ("", "_oracle"):
-                entry[f"r2_direct{suffix}"] = direct[f"r2{suffix}"]
-                entry[f"linear_r2{suffix}"] = direct[f"linear_r2{suffix}"]
-        except FAMILY_FAILURES as exc:
-            entry = {"error": f"{type(exc).__name__}: {exc}"}
-        table[name] = entry
+    for k, name in enumerate(models):
+        forward, direct = results[2 * k], results[2 * k + 1]
+        # the forward fit's error first, as when the two ran one after the other
+        table[name] = next((part for part in (forward, direct) if "error" in part),
+                           {**forward, **direct})
     return table
+
+
+def _compare_piece(piece: tuple[str, int | None, str], *, fit_rec: Recording,
+                   val_rec: Recording) -> dict:
+    """One family's forward scores or its direct compensator's; a failure is an ``error``."""
+    name, size, part = piece
+    try:
+        if part == "forward":
+            return _forward_scores(name, size, fit_rec, val_rec)
+        comp = fit_compensator(fit_rec, size, model=name, diagnose=False)
+        direct = evaluate(comp, val_rec)
+        entry = {"center": direct["center"], "direct_status": comp.fit_info["status"]}
+        for suffix in ("", "_oracle"):
+            entry[f"r2_direct{suffix}"] = direct[f"r2{suffix}"]
+            entry[f"linear_r2{suffix}"] = direct[f"linear_r2{suffix}"]
+        return entry
+    except FAMILY_FAILURES as exc:
+        return {"error": f"{type(exc).__name__}: {exc}"}
+
+
+GRID_KEYS = ("r2", "r2_oracle", "linear_r2")
 
 
 def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Recording],
                           models: Sequence[str], sizes: Mapping[str, int] | None = None,
-                          progress: Callable[[str], None] = lambda _: None) -> dict:
+                          progress: Callable[[str], None] = lambda _: None,
+                          executor: Executor | None = None) -> dict:
     """Train a direct compensator on each training recording, test it on every test recording.
+
+    One piece of work for `executor` (default: serial) per model and training recording: its
+    fit and its tests; the matrix is the same whichever executor ran them.
 
     Returns
     -------
@@ -147,35 +181,51 @@ def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Rec
         gives None and its reason in ``errors``, as does a collapsed fit or one worse than its
         line (its scores are kept); parameters on bounds or an exhausted budget are ``notes``.
     """
+    train, test = dict(train), dict(test)
+    pieces = [(name, (sizes or {}).get(name), train_name) for name in models
+              for train_name in train]
+    results = (executor or SerialExecutor()).map(
+        _generalize_piece, pieces, shared={"train": train, "test": test},
+        on_done=lambda i, _: progress(f"  {pieces[i][0]}: trained on {pieces[i][2]}"))
     out = {}
     for name in models:
-        size = (sizes or {}).get(name)
-        grids = {key: {} for key in ("r2", "r2_oracle", "linear_r2")}
+        grids = {key: {} for key in GRID_KEYS}
         errors, notes = {}, {}
-        for train_name, fit_rec in train.items():
-            progress(f"  {name}: trained on {train_name}")
-            for grid in grids.values():
-                grid[train_name] = dict.fromkeys(test)
-            try:
-                comp = fit_compensator(fit_rec, size, model=name, diagnose=False)
-            except FAMILY_FAILURES as exc:
-                errors[train_name] = f"fit: {exc}"
-                continue
-            status = comp.fit_info["status"]
-            if status != "ok":
-                # collapsed / worse than the line disqualify the row; bounds and budget are notes
-                target = errors if status in DISQUALIFYING else notes
-                target[train_name] = f"fit {status}: {comp.fit_info['status_message']}"
-            for test_name, val_rec in test.items():
-                try:
-                    scores = evaluate(comp, val_rec)
-                except FAMILY_FAILURES as exc:
-                    errors[f"{train_name} -> {test_name}"] = str(exc)
-                    continue
-                for key, grid in grids.items():
-                    grid[train_name][test_name] = scores[key]
+        for (model, _, train_name), (rows, row_errors, row_notes) in zip(pieces, results):
+            if model == name:
+                for key in GRID_KEYS:
+                    grids[key][train_name] = rows[key]
+                errors.update(row_errors)
+                notes.update(row_notes)
         out[name] = {**grids, "errors": errors, "notes": notes}
     return out
+
+
+def _generalize_piece(piece: tuple[str, int | None, str], *, train: Mapping[str, Recording],
+                      test: Mapping[str, Recording]) -> tuple[dict, dict, dict]:
+    """One model trained on one recording, tested on each: (rows of each grid, errors, notes)."""
+    name, size, train_name = piece
+    rows = {key: dict.fromkeys(test) for key in GRID_KEYS}
+    errors, notes = {}, {}
+    try:
+        comp = fit_compensator(train[train_name], size, model=name, diagnose=False)
+    except FAMILY_FAILURES as exc:
+        errors[train_name] = f"fit: {exc}"
+        return rows, errors, notes
+    status = comp.fit_info["status"]
+    if status != "ok":
+        # collapsed / worse than the line disqualify the row; bounds and budget are notes
+        target = errors if status in DISQUALIFYING else notes
+        target[train_name] = f"fit {status}: {comp.fit_info['status_message']}"
+    for test_name, val_rec in test.items():
+        try:
+            scores = evaluate(comp, val_rec)
+        except FAMILY_FAILURES as exc:
+            errors[f"{train_name} -> {test_name}"] = str(exc)
+            continue
+        for key in GRID_KEYS:
+            rows[key][test_name] = scores[key]
+    return rows, errors, notes
 
 
 def plot_generalization(matrix: Mapping[str, dict]) -> Figure:

@@ -1,0 +1,13 @@
+"""Independent pieces of work (family fits, train x test cells, CV folds, structures, sensors)
+run in order-preserving maps, serially in-process or on Dask.
+
+`open_executor` chooses: one worker (or a single piece) runs serially in this process and never
+imports Dask; more start a local Dask cluster sized to the machine; a scheduler address connects
+to an existing cluster. Results come back in the order of the pieces, whatever order they
+finish in, so a parallel run gives the same table as the serial one. Dask is imported only when
+a parallel run starts.
+"""
+
+from ._executor import Executor, SerialExecutor, available_cores, open_executor
+
+__all__ = ["Executor", "SerialExecutor", "available_cores", "open_executor"]

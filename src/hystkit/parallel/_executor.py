@@ -1,0 +1,84 @@
+"""The executor contract, the serial executor, and the choice between it and Dask."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from typing import Any, Protocol
+
+__all__ = ["Executor", "SerialExecutor", "available_cores", "open_executor"]
+
+OnDone = Callable[[int, Any], None]
+
+
+class Executor(Protocol):
+    """Runs ``func(item, **shared)`` for every item; results in the order of `items`."""
+
+    n_workers: int
+
+    def map(self, func: Callable[..., Any], items: Sequence[Any], *,
+            shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None) -> list:
+        """``[func(item, **shared) for item in items]``; `on_done(index, result)` is called as
+        each piece finishes (in finishing order). An exception of a piece is raised here."""
+        ...
+
+    def describe(self) -> str:
+        """Where the pieces run, for a progress line."""
+        ...
+
+
+class SerialExecutor:
+    """Every piece in this process, one after the other (``--workers 1``)."""
+
+    n_workers = 1
+
+    def map(self, func: Callable[..., Any], items: Sequence[Any], *,
+            shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None) -> list:
+        results = []
+        for i, item in enumerate(items):
+            results.append(func(item, **(shared or {})))
+            if on_done is not None:
+                on_done(i, results[-1])
+        return results
+
+    def describe(self) -> str:
+        return "this process, one after the other"
+
+
+def available_cores() -> int:
+    """Cores this process may run on (its affinity mask, not the machine's count)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+@contextmanager
+def open_executor(workers: int | None = None, scheduler: str | None = None, *,
+                  n_pieces: int | None = None) -> Iterator[Executor]:
+    """The executor for one command; its cluster or connection is closed on leaving.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Worker processes of a local cluster (default: one per available core). 1 runs
+        serially in this process, without Dask.
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``); its workers run the
+        pieces and `workers` is ignored.
+    n_pieces : int, optional
+        How many pieces the command has at most: a local cluster gets no more workers than
+        that, and a single piece runs serially.
+    """
+    if scheduler is None:
+        n = available_cores() if workers is None else workers
+        if n_pieces is not None:
+            n = min(n, n_pieces)
+        if n <= 1:
+            yield SerialExecutor()
+            return
+    from ._dask import dask_executor  # Dask loads only for a parallel run
+
+    with dask_executor(None if scheduler is not None else n, scheduler) as executor:
+        yield executor
