@@ -1,0 +1,321 @@
+"""A compensator sample by sample: the same numbers as :meth:`Compensator.estimate`, live.
+
+A stream carries everything a recording's run would have remembered in an explicit
+:class:`StreamState`: the model's state vector, the centring's running sums and the sample
+counter. :func:`advance` is the pure core (``state`` in, estimates and the next state out);
+:class:`Stream` is a thin holder of the present state for an acquisition loop or a ROS node.
+
+Running a recording through a stream in chunks of any size gives exactly (bit for bit) the
+offline :meth:`Compensator.estimate`: every chunk goes through the same data path (the centring's
+running mean / low-pass continued from the stored state, the polarity, the scaling) and the
+family's compiled ``simulate`` / ``invert`` continued from the stored model state, which every
+family guarantees equals the whole run.
+
+Start-up (``start``):
+
+- ``"rest"``: the model at rest at the first sample (what ``estimate`` does);
+- ``"sync"``: the state left by the synchronisation excitation (eq. 2.21-2.22,
+  :func:`sync_excitation`), once the device has been driven through it;
+- an array: a given model state (for example one saved from an earlier run).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+from scipy.signal import lfilter
+
+from ..errors import FitDivergedError, InputError
+from ._centring import ORACLE_CENTER
+from ._compensator import MAX_NORMALISED, Compensator
+
+__all__ = ["StartUp", "Stream", "StreamOutput", "StreamState", "advance", "initial_state"]
+
+StartUp = str | np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class StreamState:
+    """Everything a stream remembers between samples.
+
+    Attributes
+    ----------
+    x : array or None
+        The model's (or its inverse's) state vector; None before the first sample of a stream
+        that starts at rest (the rest state depends on that sample).
+    n_samples : int
+        Samples processed so far (the next sample's index).
+    tare_sum : float
+        Sum of the sensor samples [sensor units] inside the tare window so far (``tare``).
+    track_value : float
+        Last output of the tracker's un-normalised low-pass [sensor units] (``track``).
+    track_weight : float
+        Last output of the same low-pass run on ones: its weight sum (``track``).
+    """
+
+    x: np.ndarray | None
+    n_samples: int = 0
+    tare_sum: float = 0.0
+    track_value: float = 0.0
+    track_weight: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.x is not None:
+            x = np.array(self.x, dtype=np.float64)
+            x.flags.writeable = False
+            object.__setattr__(self, "x", x)
+
+
+class StreamOutput(NamedTuple):
+    """One chunk's results: estimates [mm] and the use-time guards of ``hystkit compensate``.
+
+    ``sensor_outside`` / ``estimate_outside`` are None when the model file does not know the
+    training ranges (files from before they were stored).
+    """
+
+    estimate: np.ndarray
+    sensor_outside: np.ndarray | None
+    estimate_outside: np.ndarray | None
+
+
+@dataclass(frozen=True, eq=False)
+class _Path:
+    """The compensator's per-sample constants, derived once."""
+
+    comp: Compensator
+    rest_position: float | None
+    n_tare: int = field(init=False)
+    track_gain: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        dt = self.comp.structure.dt
+        # The same numbers as _centring.sensor_level.
+        object.__setattr__(self, "n_tare", max(1, round(self.comp.tare_seconds / dt)))
+        object.__setattr__(self, "track_gain", 1.0 - np.exp(-dt / self.comp.track_seconds))
+
+
+def check_streamable(comp: Compensator) -> None:
+    """Refuse a compensator that cannot run causally (the oracle centring)."""
+    if comp.center == ORACLE_CENTER:
+        raise InputError(
+            f"{comp.source or 'compensator'}: key 'center': 'recording' (oracle) removes the "
+            f"whole recording's sensor mean, which a stream does not know until it ends; refit "
+            f"with --center fit, tare or track")
+
+
+def initial_state(comp: Compensator, start: StartUp = "rest") -> StreamState:
+    """The state a stream starts from: ``"rest"``, ``"sync"`` (eq. 2.21-2.22) or a model
+    state vector (its length is the family's state size)."""
+    check_streamable(comp)
+    if isinstance(start, str):
+        if start == "rest":
+            return StreamState(None)
+        if start == "sync":
+            from ._sync import sync_excitation  # _sync runs streams itself
+            return StreamState(sync_excitation(comp).state_after)
+        raise InputError(f"start {start!r}: use 'rest', 'sync' or a model state vector")
+    x = np.asarray(start, dtype=np.float64)
+    size = _state_size(comp)
+    if x.shape != (size,) or not np.all(np.isfinite(x)):
+        raise InputError(f"start state: the {comp.model} {'inverse ' * (comp.mode == 'inverse')}"
+                         f"model needs {size} finite numbers, got shape {x.shape}")
+    return StreamState(x)
+
+
+def _state_size(comp: Compensator) -> int:
+    rest = comp.family.rest_state(comp.structure, comp.params, 0.0, comp.mode == "inverse")
+    return int(np.asarray(rest).size)
+
+
+def advance(comp: Compensator, state: StreamState, sensor: np.ndarray, *,
+            rest_position: float | None = None,
+            label: str = "stream") -> tuple[StreamOutput, StreamState]:
+    """Run one chunk of raw sensor samples [sensor units] from ``state``.
+
+    Pure: nothing is kept anywhere; the returned state continues the stream.
+
+    Raises
+    ------
+    FitDivergedError
+        If an estimate is not finite or beyond ``MAX_NORMALISED`` times the training
+        positions (as :meth:`Compensator.estimate`); the message names ``label`` and the
+        stream's sample index. ``state`` is unchanged then.
+    """
+    return _advance(_Path(comp, rest_position), state, sensor, label)
+
+
+def _advance(path: _Path, state: StreamState, sensor: np.ndarray,
+             label: str) -> tuple[StreamOutput, StreamState]:
+    comp = path.comp
+    s_raw = np.ascontiguousarray(sensor, dtype=np.float64).reshape(-1)
+    if s_raw.size == 0:
+        empty = np.empty(0)
+        flags = _flags(comp, empty, empty)
+        return StreamOutput(empty, *flags), state
+    offset, centring = _sensor_offset(path, state, s_raw)
+    s = comp.polarity * (s_raw - offset) / comp.scaling.sensor_scale
+    with np.errstate(over="ignore", invalid="ignore"):
+        try:
+            p, x_end = _run_model(comp, s, state.x)
+        except FitDivergedError as exc:
+            raise FitDivergedError(f"{label}: samples {state.n_samples}-"
+                                   f"{state.n_samples + s.size - 1}: the {comp.model} "
+                                   f"compensator{_of(comp)}: {exc}") from None
+        estimate = p * comp.scaling.position_scale + comp.position_offset(
+            None, path.rest_position)
+    _check_runaway(comp, p, estimate, state.n_samples, label)
+    flags = _flags(comp, s, estimate)
+    nxt = StreamState(x_end, state.n_samples + s.size, **centring)
+    return StreamOutput(estimate, *flags), nxt
+
+
+def _run_model(comp: Compensator, s: np.ndarray,
+               x: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The family's compiled run from ``x`` (None: at rest at ``s[0]``, as ``estimate``)."""
+    x0 = None if x is None else np.array(x)
+    if comp.mode == "inverse":
+        return comp.family.invert(comp.structure, comp.params, s, x0)
+    p, x_end = comp.family.simulate(comp.structure, comp.params, s, x0)
+    if s.size == 1:
+        # A family whose output is ``states @ weights`` (ladder, bobbio) gets numpy's
+        # single-row matmul here, which sums in another order than the many-row one of a
+        # whole run: take the output of a two-sample run (the sample repeated) instead.
+        try:
+            p = comp.family.simulate(comp.structure, comp.params, np.repeat(s, 2), x0)[0][:1]
+        except FitDivergedError:  # the repeated sample ran away: keep the one-sample output
+            pass
+    return p, x_end
+
+
+def _sensor_offset(path: _Path, state: StreamState,
+                   s: np.ndarray) -> tuple[np.ndarray | float, dict]:
+    """Offset per sample and the centring's next state, continuing ``_centring.sensor_level``
+    with the same floating-point operations in the same order (so chunked == whole)."""
+    comp = path.comp
+    kept = {"tare_sum": state.tare_sum, "track_value": state.track_value,
+            "track_weight": state.track_weight}
+    if comp.center == "none":
+        return 0.0, kept
+    if comp.center == "fit":
+        return comp.scaling.sensor_offset, kept
+    if comp.center == "tare":
+        level, kept["tare_sum"] = _tare_level(path.n_tare, state, s)
+    else:  # track
+        a = path.track_gain
+        b, den = [a], [1.0, a - 1.0]
+        # lfilter's delay after an output y is -(a - 1) y: continue from the stored outputs.
+        value, _ = lfilter(b, den, s, zi=[-(den[1] * state.track_value)])
+        weight, _ = lfilter(b, den, np.ones_like(s), zi=[-(den[1] * state.track_weight)])
+        kept["track_value"], kept["track_weight"] = float(value[-1]), float(weight[-1])
+        level = value / weight
+    return comp.scaling.sensor_offset + level - comp.sensor_reference, kept
+
+
+def _tare_level(n_tare: int, state: StreamState, s: np.ndarray) -> tuple[np.ndarray, float]:
+    """Running mean inside the tare window, its final mean after it."""
+    start = state.n_samples
+    n_in = max(0, min(n_tare - start, s.size))
+    total = state.tare_sum
+    level = np.empty(s.size)
+    if n_in:
+        # cumsum adds in order, so continuing from the stored sum repeats the whole run's sums
+        sums = np.cumsum(np.concatenate([[total], s[:n_in]]))[1:]
+        level[:n_in] = sums / np.arange(start + 1, start + n_in + 1)
+        total = float(sums[-1])
+    if n_in < s.size:
+        level[n_in:] = total / n_tare
+    return level, total
+
+
+def _check_runaway(comp: Compensator, p: np.ndarray, estimate: np.ndarray, first: int,
+                   label: str) -> None:
+    # The guard of Compensator.estimate: |p| beyond MAX_NORMALISED is a model that ran away.
+    bad = np.flatnonzero(~(np.abs(np.asarray(p, dtype=float)) <= MAX_NORMALISED)
+                         | ~np.isfinite(estimate))
+    if bad.size:
+        value = estimate[bad[0]]
+        kind = "not finite" if not np.isfinite(value) else (
+            f"{value:.3g} mm, beyond {MAX_NORMALISED:g} times the training range")
+        raise FitDivergedError(f"{label}: sample {first + bad[0]}: the {comp.model} "
+                               f"compensator{_of(comp)} gives an estimate that is {kind}")
+
+
+def _flags(comp: Compensator, s: np.ndarray,
+           estimate: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+    sensor = None if comp.training_range is None else comp.normalised_outside(s)
+    return sensor, comp.estimate_outside(estimate)
+
+
+def _of(comp: Compensator) -> str:
+    return "" if comp.source is None else f" of {comp.source}"
+
+
+class Stream:
+    """A compensator running live: one sensor sample (or chunk) in, position estimates out.
+
+    Parameters
+    ----------
+    compensator : Compensator
+        Any deployable compensator (centring ``fit``, ``tare``, ``track`` or ``none``), direct or
+        inverse, of any family.
+    start : "rest", "sync" or array
+        Start-up (module docstring). Default: at rest at the first sample.
+    rest_position : float, optional
+        Where the device rests during the tare window [mm], if not where it rested in training
+        (``tare`` only; as :meth:`Compensator.estimate`).
+    label : str
+        Names the stream in error messages.
+
+    Notes
+    -----
+    The object holds only the present :class:`StreamState` (``state`` gives it, ``from_state``
+    resumes from one); two signals need two streams. :func:`advance` is the same computation
+    without an object.
+    """
+
+    def __init__(self, compensator: Compensator, start: StartUp = "rest", *,
+                 rest_position: float | None = None, label: str = "stream") -> None:
+        self._path = _Path(compensator, rest_position)
+        self._state = initial_state(compensator, start)
+        self.label = label
+
+    @classmethod
+    def from_state(cls, compensator: Compensator, state: StreamState, *,
+                   rest_position: float | None = None, label: str = "stream") -> Stream:
+        """Resume a stream from a saved :class:`StreamState`."""
+        stream = cls(compensator, rest_position=rest_position, label=label)
+        if state.x is not None:
+            initial_state(compensator, state.x)  # checks its size
+        stream._state = state
+        return stream
+
+    @classmethod
+    def from_file(cls, model_path: str | Path, start: StartUp = "rest", **options) -> Stream:
+        """A stream of the compensator in a model file (``hystkit fit`` output)."""
+        from ._model_file import load_compensator
+        return cls(load_compensator(model_path), start, **options)
+
+    @property
+    def compensator(self) -> Compensator:
+        return self._path.comp
+
+    @property
+    def state(self) -> StreamState:
+        """The present state (immutable; safe to keep and to resume from)."""
+        return self._state
+
+    def step(self, sensor: float) -> float:
+        """Estimate [mm] for one raw sensor sample."""
+        return float(self.process(np.array([sensor], dtype=np.float64))[0])
+
+    def process(self, sensor: np.ndarray) -> np.ndarray:
+        """Estimates [mm] for a chunk of raw sensor samples (compiled per chunk)."""
+        return self.process_flagged(sensor).estimate
+
+    def process_flagged(self, sensor: np.ndarray) -> StreamOutput:
+        """Estimates and use-time flags for a chunk; see :class:`StreamOutput`."""
+        out, self._state = _advance(self._path, self._state, sensor, self.label)
+        return out
