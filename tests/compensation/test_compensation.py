@@ -96,18 +96,6 @@ def test_constant_signal_cannot_be_fitted():
         fit_compensator(rec, 1)
 
 
-def test_estimator_contract(recordings):
-    from hystkit.compensation import CompensatorEstimator
-
-    fit_rec, val_rec = recordings["noise"]
-    est = CompensatorEstimator(n_cells=1)
-    assert not hasattr(est, "compensator_")
-    with pytest.raises(RuntimeError, match="not fitted"):
-        est.predict(val_rec)
-    assert est.fit(fit_rec) is est
-    assert est.score(val_rec) == pytest.approx(evaluate(est.compensator_, val_rec)["r2"])
-
-
 def test_constant_estimate_has_no_loop_area(recordings):
     """A compensator that outputs a constant is a (bad) result, not a crash: area undefined."""
     fit_rec, val_rec = recordings["sine"]

@@ -7,8 +7,10 @@ the column and the row, so the CLI can print it verbatim.
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,6 +23,10 @@ from ._cells import as_vector
 from ._csv_reader import read_csv
 from ._mat_reader import read_mat
 from ._parquet_reader import read_parquet
+from ._resample import resample_arrays
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 _MAX_STEP_DEVIATION = 0.01  # relative to the median step; beyond this we ask for resampling
 MAX_MAGNITUDE = 1e100
@@ -62,6 +68,10 @@ class Recording(Sampled):
         Reference position [mm]; None when the recording has none.
     source : str
         Where the data came from (a file name); used in error messages.
+    units : mapping or tuple of (str, str)
+        Units of the file's columns as read from it (``{"position": "mm", "sensor":
+        "Ohm"}``), for labels and outputs; hystkit's own computations do not use them (time
+        is always in seconds once read). Stored as a tuple of pairs.
 
     Notes
     -----
@@ -73,8 +83,10 @@ class Recording(Sampled):
     sensor: np.ndarray
     position: np.ndarray | None = None
     source: str = "<memory>"
+    units: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "units", _unit_pairs(self.units))
         where = _Where(self.source, item="sample")
         arrays = {
             name: as_vector(getattr(self, name), name, where)
@@ -90,6 +102,96 @@ class Recording(Sampled):
         """Whether the recording carries a reference position."""
         return self.position is not None
 
+    def unit(self, name: str) -> str:
+        """The unit of column `name` as the file gave it, or "" when unknown."""
+        return dict(self.units).get(name, "")
+
+    def to_frame(self) -> pd.DataFrame:
+        """The recording as a DataFrame with columns ``time`` [s], ``position`` (when present)
+        and ``sensor``; ``attrs`` keeps ``source`` and ``units``.
+
+        Examples
+        --------
+        >>> from hystkit.io import Recording
+        >>> rec = Recording(time=[0.0, 0.1, 0.2], sensor=[1.0, 2.0, 3.0], position=[0, 1, 2])
+        >>> rec.to_frame()
+           time  position  sensor
+        0   0.0       0.0     1.0
+        1   0.1       1.0     2.0
+        2   0.2       2.0     3.0
+        """
+        import pandas as pd
+
+        frame = pd.DataFrame({name: getattr(self, name) for name in _COLUMNS
+                              if getattr(self, name) is not None})
+        frame.attrs.update(source=self.source, units=dict(self.units))
+        return frame
+
+    @classmethod
+    def from_frame(cls, frame: pd.DataFrame, *, columns: Mapping[str, str] | None = None,
+                   time_unit: str = "s", source: str = "<DataFrame>") -> Recording:
+        """A validated recording from a DataFrame's columns.
+
+        Parameters
+        ----------
+        frame : pandas.DataFrame
+            Columns ``time``, ``sensor`` and, optionally, ``position`` (other columns are
+            ignored); other names through `columns`.
+        columns : mapping, optional
+            hystkit name (``time``, ``position``, ``sensor``) -> the frame's column, as for
+            files (`ReadOptions`).
+        time_unit : {"s", "ms", "us", "ns", "min"}
+            Unit of the time column, converted to seconds.
+        source : str
+            Name used in error messages.
+
+        Raises
+        ------
+        InputError
+            A missing time or sensor column, or data a `Recording` refuses (message names the
+            column and the row).
+
+        Examples
+        --------
+        >>> import pandas as pd
+        >>> frame = pd.DataFrame({"t_ms": [0, 10, 20], "x_mm": [0.0, 0.5, 1.0],
+        ...                       "r": [0.1, 0.2, 0.3]})
+        >>> rec = Recording.from_frame(frame, columns={"time": "t_ms", "position": "x_mm",
+        ...                                            "sensor": "r"}, time_unit="ms")
+        >>> rec.dt
+        0.01
+        """
+        options = ReadOptions(columns=columns or (), time_unit=time_unit)
+        arrays = {}
+        for name in _COLUMNS:
+            column = options.name(name)
+            if column in frame.columns:
+                arrays[name] = _numbers(frame[column], f"{source}: column {column!r} ({name})")
+            elif name != "position":
+                raise InputError(f"{source}: missing column {column!r} ({name}); columns: "
+                                 f"{', '.join(map(str, frame.columns))}")
+        arrays["time"] = arrays["time"] * options.time_scale
+        return cls(**arrays, source=source, units=frame.attrs.get("units", ()))
+
+
+def _numbers(values: pd.Series, what: str) -> np.ndarray:
+    """A DataFrame column as float64; InputError naming the first row that is not a number."""
+    import pandas as pd
+
+    numbers = pd.to_numeric(values, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+    bad = np.flatnonzero(np.isnan(numbers) & values.notna().to_numpy())
+    if bad.size:
+        raise InputError(f"{what}, sample {bad[0] + 1}: not a number: {values.iloc[bad[0]]!r}")
+    return numbers
+
+
+def _unit_pairs(units: object) -> tuple[tuple[str, str], ...]:
+    pairs = units.items() if isinstance(units, Mapping) else units
+    try:
+        return tuple((str(name), str(unit)) for name, unit in pairs if str(unit).strip())
+    except (TypeError, ValueError):
+        raise ValueError(f"units must map column names to unit text, got {units!r}") from None
+
 
 def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
                    options: ReadOptions | None = None) -> Recording:
@@ -103,8 +205,10 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
     need_position : bool
         Require a ``position`` column. If False it is still read when present.
     options : ReadOptions, optional
-        The file's own column (or variable) names, time unit, and for CSV the separator and
-        the lines after the header to skip. Default: columns named ``time``, ``position``,
+        The file's own column (or variable) names, time unit, for CSV the separator, the
+        lines after the header to skip and a units line, for ``.mat`` the variable, and a
+        rate to resample to (`hystkit.io._resample`: linear interpolation, a zero-phase
+        anti-alias low-pass when decimating, gaps refused). Default: columns named ``time``, ``position``,
         ``sensor``, time in seconds, comma-separated, the header on the first line.
 
     Returns
@@ -143,11 +247,15 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
     if options.time_scale != 1.0:  # to seconds before the checks, whose messages say "s"
         arrays["time"] = arrays["time"] * options.time_scale
+    if options.resample_hz is not None:
+        _validate(arrays, where, uniform=False)
+        arrays = resample_arrays(arrays, options.resample_hz, where)
     _validate(arrays, where)
     return _adopt(arrays, source)
 
 
-def _adopt(arrays: dict[str, np.ndarray], source: str) -> Recording:
+def _adopt(arrays: dict[str, np.ndarray], source: str,
+           units: tuple[tuple[str, str], ...] = ()) -> Recording:
     """A `Recording` around 1-D float64 arrays a reader made and `_validate` checked.
 
     ``Recording(...)`` would copy and check them again; nothing else holds these arrays, so
@@ -161,14 +269,16 @@ def _adopt(arrays: dict[str, np.ndarray], source: str) -> Recording:
             values.setflags(write=False)
         object.__setattr__(recording, name, values)
     object.__setattr__(recording, "source", source)
+    object.__setattr__(recording, "units", _unit_pairs(units))
     return recording
 
 
 _READERS = {".csv": read_csv, ".parquet": read_parquet, ".mat": read_mat}
 
 
-def _validate(arrays: dict[str, np.ndarray], where: _Where) -> None:
-    """Check 1-D float arrays (``time`` among them) for the invariants of a `Recording`."""
+def _validate(arrays: dict[str, np.ndarray], where: _Where, *, uniform: bool = True) -> None:
+    """Check 1-D float arrays (``time`` among them) for the invariants of a `Recording`
+    (`uniform`: including the uniform sampling, which resampling establishes)."""
     lengths = {name: values.size for name, values in arrays.items()}
     if len(set(lengths.values())) > 1:
         listed = ", ".join(f"{name} {n}" for name, n in lengths.items())
@@ -195,10 +305,12 @@ def _validate(arrays: dict[str, np.ndarray], where: _Where) -> None:
         i = int(bad[0]) + 1
         raise where.fail(f"time is not strictly increasing: {time[i]:.12g} s follows "
                          f"{time[i - 1]:.12g} s", "time", i)
+    if not uniform:
+        return
     median = float(np.median(step))
     bad = np.flatnonzero(np.abs(step - median) > _MAX_STEP_DEVIATION * median)
     if bad.size:
         i = int(bad[0]) + 1
         raise where.fail(f"non-uniform sampling: step {step[i - 1]:.6g} s deviates more than "
                          f"{_MAX_STEP_DEVIATION:.0%} from the median step {median:.6g} s; "
-                         "resample the recording to a uniform time grid", "time", i)
+                         "resample it to a uniform time grid (--resample HZ)", "time", i)

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
+from ..._lazy import lazy
 from .._protocol import Block, Family
-from . import kernels
-from . import model as bobbio
-from .fit import fit_bobbio
+
+if TYPE_CHECKING:
+    from . import model as bobbio
 
 __all__ = ["BobbioFamily"]
 
@@ -19,12 +22,27 @@ class BobbioFamily(Family):
     default_size = 10
     max_size = 100
     docs = "docs/models/circuits.md"
-    Structure = bobbio.BobbioStructure
-    Params = bobbio.BobbioParams
-    model = bobbio
-    fit_function = fit_bobbio
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "BobbioStructure")
+    Params = lazy(".model", "BobbioParams")
+    model = lazy(".model")
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_bobbio`."""
+        from .fit import fit_bobbio
+
+        return fit_bobbio(u, y, structure, **options)
+
+    def invert(self, structure, params, y, x0=None):
+        return self.model.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return self.model.invert_step(structure, params, x, y)
 
     def make_structure(self, dt: float, size: int) -> bobbio.BobbioStructure:
+        from . import model as bobbio
+
         return bobbio.BobbioStructure(n_springs=size, dt=dt)
 
     def random_params(self, structure, rng):
@@ -33,6 +51,8 @@ class BobbioFamily(Family):
         ``A_N-1 = sum a_k`` is log-uniform in the fit's ``[0.1, 1.5]`` times the input's
         half-range 1 (each ``a_k >= 0.1 A_N-1 / (N - 1)``), offset in ``[-1, 1]``. Bounded:
         every spring force is a play of ``u``, so ``|y| <= sum c_k max|u| + |b|``."""
+        from . import model as bobbio
+
         n = structure.n_springs
         compliance = np.exp(rng.uniform(np.log(0.1), np.log(10.0))) * rng.dirichlet(np.ones(n))
         m = n - 1
@@ -48,6 +68,8 @@ class BobbioFamily(Family):
         return super().at(structure, dt)
 
     def block(self, structure, params, inverse=False):
+        from . import kernels
+
         body = np.concatenate([[params.n_springs, params.offset], params.compliance,
                                params.friction])
         step = kernels.block_inverse if inverse else kernels.block_forward
@@ -61,6 +83,8 @@ class BobbioFamily(Family):
         derivative along the motion the chain is making there (where ``D = 0``, a flat
         segment, the numerical default is used). A piston exactly on its threshold (where
         sliding stopped) is a kink; it counts as sticking."""
+        from . import model as bobbio
+
         x = np.asarray(x, dtype=float)
         m = x.size
         u_op = bobbio.invert_step(structure, params, x, u)[0] if inverse else u

@@ -5,11 +5,14 @@ reference document; docs/models/boucwen.md).
 ``fit`` the identification, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
-from . import fit, model
+from ..._lazy import lazy_exports
 from .family import BoucWenFamily
-from .fit import *
-from .model import *
 
 FAMILY = BoucWenFamily()
 
-__all__ = ["FAMILY", "BoucWenFamily"] + model.__all__ + fit.__all__
+# The model's equations, its fit and its numba kernels load when one of their names is first
+# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(),
+    {"model": ("*",), "fit": ("*",)},
+    first=("FAMILY", "BoucWenFamily"))

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
+from ..._lazy import lazy
 from .._protocol import Block, Family
-from . import kernels
-from . import model as boucwen
-from .fit import fit_family
+
+if TYPE_CHECKING:
+    from . import model as boucwen
 
 __all__ = ["BoucWenFamily"]
 
@@ -20,16 +23,25 @@ class BoucWenFamily(Family):
     default_size = 2
     max_size = 64
     docs = "docs/models/boucwen.md"
-    Structure = boucwen.BoucWenStructure
-    Params = boucwen.BoucWenParams
-    model = boucwen
-    fit_function = fit_family
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "BoucWenStructure")
+    Params = lazy(".model", "BoucWenParams")
+    model = lazy(".model")
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_family`."""
+        from .fit import fit_family
+
+        return fit_family(u, y, structure, **options)
     no_inverse_reason = ("its input is a force and its output a displacement of a second-order "
                          "system: the inverse needs the measured output differentiated twice "
                          "(dynamic inversion), which is not implemented")
 
     def make_structure(self, dt: float, size: int, input_hold: str = "linear",
                        start: str = "equilibrium") -> boucwen.BoucWenStructure:
+        from . import model as boucwen
+
         # Recordings start wherever the sensor happens to be, not at rest with zero force.
         return boucwen.BoucWenStructure(dt=dt, substeps=size, input_hold=input_hold, start=start)
 
@@ -45,6 +57,8 @@ class BoucWenFamily(Family):
         and raise ``FitDivergedError`` (:func:`~hystkit.models.boucwen.model.simulate_states`).
         Bounded: by passivity ``|y| <= sqrt(2 (E_0 + T max u^2 / (4 c)) / k)`` over a run of
         ``T`` seconds (:func:`~hystkit.models.boucwen.model.divergence_bound`)."""
+        from . import model as boucwen
+
         k0 = np.exp(rng.uniform(np.log(0.1), np.log(10.0)))
         zeta = np.exp(rng.uniform(np.log(0.1), np.log(10.0)))
         fastest = max(1.0, zeta + np.sqrt(max(zeta**2 - 1.0, 0.0)))  # |lambda| / w0
@@ -70,6 +84,8 @@ class BoucWenFamily(Family):
         between the previous sample and this one (causal). It cannot band-limit the force the
         way :func:`~hystkit.models.boucwen.bandlimited_upsample` does over a whole record;
         docs/models/boucwen.md says how far the two differ."""
+        from . import kernels
+
         if inverse:
             raise ValueError(f"model {self.name!r} has no inverse ({self.no_inverse_reason})")
         body = np.concatenate([params.as_array(), [structure.dt, structure.substeps,

@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..._lazy import lazy
 from .._protocol import Block, Family
-from . import kernels
-from . import model as chua
-from .fit import fit_chua
-from .fit import random_params as _random_params
+
+if TYPE_CHECKING:
+    from . import model as chua
 
 __all__ = ["ChuaFamily"]
 
@@ -22,18 +23,35 @@ class ChuaFamily(Family):
     default_size = 1
     max_size = 20
     docs = "docs/models/circuits.md"
-    Structure = chua.ChuaStructure
-    Params = chua.ChuaParams
-    model = chua
-    fit_function = fit_chua
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "ChuaStructure")
+    Params = lazy(".model", "ChuaParams")
+    model = lazy(".model")
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_chua`."""
+        from .fit import fit_chua
+
+        return fit_chua(u, y, structure, **options)
+
+    def invert(self, structure, params, y, x0=None):
+        return self.model.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return self.model.invert_step(structure, params, x, y)
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> chua.ChuaStructure:
+        from . import model as chua
+
         return chua.ChuaStructure(n_elements=size, dt=dt, slope_cap=slope_cap)
 
     def random_params(self, structure, rng):
         """The fit's bounds (:func:`.fit.random_params`): ``k_0``, ``k_inf``, ``y_s`` log-uniform in
         ``[1e-2, 1e2]``, ``G`` in ``[1e-3, 100 / dt]``, ``V_g`` in ``[1e-3, 1e3]``, ``delta`` in
         ``[0, 1]``. Bounded: ``|y| <= sum_k (max|u| + delta_k) / min(k_0, k_inf)_k``."""
+        from .fit import random_params as _random_params
+
         return _random_params(structure, rng)
 
     def at(self, structure, dt):
@@ -48,6 +66,9 @@ class ChuaFamily(Family):
         return dataclasses.replace(structure, dt=dt, slope_cap=cap)
 
     def block(self, structure, params, inverse=False):
+        from . import kernels
+        from . import model as chua
+
         *per_element, dt = chua.kernel_args(structure, params)
         body = np.concatenate([[params.n_elements, dt], *per_element])
         step = kernels.block_inverse if inverse else kernels.block_forward
@@ -58,6 +79,8 @@ class ChuaFamily(Family):
         and the output ``y = sum x+``. The inverse solves that output for ``u`` at the
         operating point's input ``u_hat``: ``du = (dy - C dx) / D``; where no element moves
         (``D = 0``, dead bands) it has no derivative and the numerical default is used."""
+        from . import model as chua
+
         x = np.asarray(x, dtype=float)
         u_op = chua.invert_step(structure, params, x, u)[0] if inverse else u
         fx_slope = params.k_inf + (params.k0 - params.k_inf) / np.cosh(x / params.y_s) ** 2

@@ -7,15 +7,17 @@ rest states, the shared compiled block, the branch linearisation, rate independe
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..._lazy import lazy
 from .. import preisach
 from ..preisach import StaircaseFamily
 from ..preisach.family import orientation_sign, random_masses
-from . import model as gpreisach
-from .fit import fit_gpreisach
+
+if TYPE_CHECKING:
+    from . import model as gpreisach
 
 __all__ = ["GPreisachFamily"]
 
@@ -28,13 +30,22 @@ class GPreisachFamily(StaircaseFamily):
     default_size = 16
     max_size = 64
     docs = "docs/models/preisach.md"
-    Structure = gpreisach.GPreisachStructure
-    Params = gpreisach.GPreisachParams
-    stairs = gpreisach
-    fit_function = fit_gpreisach
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "GPreisachStructure")
+    Params = lazy(".model", "GPreisachParams")
+    stairs = lazy(".model")
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_gpreisach`."""
+        from .fit import fit_gpreisach
+
+        return fit_gpreisach(u, y, structure, **options)
 
     def make_structure(self, dt: float, size: int,
                        **options: Any) -> gpreisach.GPreisachStructure:
+        from . import model as gpreisach
+
         return gpreisach.GPreisachStructure(levels=size, dt=dt, **options)
 
     def random_params(self, structure, rng):
@@ -43,6 +54,8 @@ class GPreisachFamily(StaircaseFamily):
         ``sum |m|`` log-uniform in ``[0.1, 10]``; ``nu_k >= 0`` with ``int nu`` log-uniform in
         ``[0.01, 10]``; offset in ``[-1, 1]``. Bounded: ``|y - y_0| <= max(sum |m_-|,
         sum |m_+|) + int nu`` for ``|u| <= 1``."""
+        from . import model as gpreisach
+
         levels, degree = structure.levels, structure.degree
         sign = orientation_sign(structure, rng)
         tables = [preisach.everett_from_masses(random_masses(levels, sign, rng, diagonal=False))

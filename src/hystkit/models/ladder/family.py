@@ -3,15 +3,16 @@
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._protocol import Block, Family
-from . import kernels
-from . import model as ladder
-from .fit import fit_ladder
-from .fit import random_params as _random_params
+
+if TYPE_CHECKING:
+    from . import model as ladder
 
 __all__ = ["LadderFamily"]
 
@@ -23,19 +24,36 @@ class LadderFamily(Family):
     default_size = 2
     max_size = 50
     docs = "docs/models/circuits.md"
-    Structure = ladder.LadderStructure
-    Params = ladder.LadderParams
-    model = ladder
-    fit_function = fit_ladder
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "LadderStructure")
+    Params = lazy(".model", "LadderParams")
+    model = lazy(".model")
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_ladder`."""
+        from .fit import fit_ladder
+
+        return fit_ladder(u, y, structure, **options)
+
+    def invert(self, structure, params, y, x0=None):
+        return self.model.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return self.model.invert_step(structure, params, x, y)
 
     def make_structure(self, dt: float, size: int,
                        slope_cap: float = 1.0) -> ladder.LadderStructure:
+        from . import model as ladder
+
         return ladder.LadderStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
 
     def random_params(self, structure, rng):
         """The fit's bounds (:func:`.fit.random_params`): ``E_k`` in ``[0, 1.5]``, ``G_k``
         log-uniform in ``[1e-3, slope_cap / (2 dt)]``, ``w``, ``V_b`` in ``[-100, 100]``.
         Bounded: ``|y| <= sum |w| max|e| + |V_b|``."""
+        from .fit import random_params as _random_params
+
         return _random_params(structure, rng)
 
     def at(self, structure, dt):
@@ -50,6 +68,9 @@ class LadderFamily(Family):
         return dataclasses.replace(structure, dt=dt, slope_cap=cap)
 
     def block(self, structure, params, inverse=False):
+        from . import kernels
+        from . import model as ladder
+
         if inverse and params.w[0] == 0:
             raise FitDivergedError("the ladder model has w_0 = 0, so it has no inverse")
         body = np.concatenate([[params.n_cells, params.v_b, structure.dt], params.band,
@@ -62,6 +83,8 @@ class LadderFamily(Family):
         ``di_k = G_k (dU_k-1 - dU_k)``, and ``dU_k+ = dU_k + dt (di_k - di_k+1)``;
         ``y = w_0 e + w . U - V_b``. The inverse's ``e = (y + V_b - w . U) / w_0`` feeds back
         into the first section. On a band edge (a kink) the section counts as blocking."""
+        from . import model as ladder
+
         x = np.asarray(x, dtype=float)
         n = x.size
         w0, w = params.w[0], params.w[1:]

@@ -4,11 +4,14 @@
 ``fit`` the identification, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
-from . import model
+from ..._lazy import lazy_exports
 from .family import MplFamily
-from .fit import default_starts, fit_mpl
-from .model import *
 
 FAMILY = MplFamily()
 
-__all__ = ["FAMILY", "MplFamily", "default_starts", "fit_mpl"] + model.__all__
+# The model's equations, its fit and its numba kernels load when one of their names is first
+# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(),
+    {"model": ("*",), "fit": ("default_starts", "fit_mpl")},
+    first=("FAMILY", "MplFamily"))

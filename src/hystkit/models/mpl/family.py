@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
+from ..._lazy import lazy
 from .._cells import Cells, cell_report
 from .._protocol import Block, Family
-from . import kernels
-from . import model as mpl
-from .fit import fit_mpl
-from .fit import random_params as _random_params
+
+if TYPE_CHECKING:
+    from . import model as mpl
 
 __all__ = ["MplFamily"]
 
@@ -21,19 +23,34 @@ class MplFamily(Family):
     default_size = 1
     max_size = 50
     docs = "docs/models/mpl.md"
-    Structure = mpl.MplStructure
-    Params = mpl.MplParams
-    model = mpl  # step, simulate, invert, invert_step
-    fit_function = fit_mpl
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "MplStructure")
+    Params = lazy(".model", "MplParams")
+    model = lazy(".model")  # step, simulate, invert, invert_step
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_mpl`."""
+        from .fit import fit_mpl
+
+        return fit_mpl(u, y, structure, **options)
+
+    def invert(self, structure, params, y, x0=None):
+        return self.model.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return self.model.invert_step(structure, params, x, y)
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> mpl.MplStructure:
-        return mpl.MplStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
+        return self.Structure(n_cells=size, dt=dt, slope_cap=slope_cap)
 
     def random_params(self, structure, rng):
         """The fit's box (:func:`.fit.fit_mpl`), normalised data: ``G_k = 2 I_S / V_T`` log-uniform
         in ``[1e-4, slope_cap / dt]``, ``V_T`` log-uniform in ``[1e-3, 1e3]``, ``w`` and ``V_b``
         uniform in ``[-100, 100]``. Every draw is bounded: ``|y| <= sum |w| max|u| + |V_b|``."""
-        return _random_params(structure, rng)
+        from .fit import random_params
+
+        return random_params(structure, rng)
 
     def rest_state(self, structure, params, value, inverse=False):
         # Forward: each cell equals its drive. Inverse: the drive is the input estimate, at rest
@@ -44,6 +61,9 @@ class MplFamily(Family):
         return np.full(structure.n_cells, float(value))
 
     def block(self, structure, params, inverse=False):
+        from . import kernels
+        from . import model as mpl
+
         body = np.concatenate([[params.n_cells, params.v_b, structure.slope_cap / structure.dt,
                                 structure.dt], params.i_s, params.v_t,
                                mpl.knee_voltage(structure, params), params.w])
@@ -55,6 +75,9 @@ class MplFamily(Family):
         ``dx+ = (1 - f' dt) dx + f' dt d(drive)``, ``f'`` the slope of the limited resistor
         (eq. 5.29) at the operating point; the inverse's drive ``(u - w.x + V_b) / w_0`` feeds
         back into every cell."""
+        from . import kernels
+        from . import model as mpl
+
         x = np.asarray(x, dtype=float)
         knee = mpl.knee_voltage(structure, params)
         cap = structure.slope_cap / structure.dt
@@ -69,6 +92,8 @@ class MplFamily(Family):
 
     def cells(self, structure, params) -> Cells:
         """The model as the eq. 5.18-5.28 analysis sees it (linear output ``g(z) = z``)."""
+        from . import model as mpl
+
         knee = mpl.knee_voltage(structure, params)
         cap = structure.slope_cap / structure.dt
         g = 2 * params.i_s / params.v_t

@@ -5,13 +5,15 @@ the compiled loops (with the loop blocks), ``fit`` the identification, ``presets
 tables, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
-from . import model
+from ..._lazy import lazy_exports
 from .family import MplPolyFamily
-from .fit import canonical, default_starts, fit_mpl_poly
-from .model import *
-from .presets import PAPER_9_2_TABLE_I, PAPER_9_2_TABLE_II, paper_9_2_params
 
 FAMILY = MplPolyFamily()
 
-__all__ = ["FAMILY", "MplPolyFamily", "PAPER_9_2_TABLE_I", "PAPER_9_2_TABLE_II",
-           "paper_9_2_params", "canonical", "default_starts", "fit_mpl_poly"] + model.__all__
+# The model's equations, its fit and its numba kernels load when one of their names is first
+# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(),
+    {"model": ("*",), "fit": ("canonical", "default_starts", "fit_mpl_poly"),
+     "presets": ("PAPER_9_2_TABLE_I", "PAPER_9_2_TABLE_II", "paper_9_2_params")},
+    first=("FAMILY", "MplPolyFamily"))

@@ -2,16 +2,17 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
+from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._cells import Cells, cell_report
 from .._protocol import Block, Family
-from . import kernels
-from . import model as mpl_poly
-from .fit import fit_mpl_poly
-from .fit import random_params as _random_params
-from .presets import PAPER_9_2_TABLE_II, paper_9_2_params
+
+if TYPE_CHECKING:
+    from . import model as mpl_poly
 
 __all__ = ["MplPolyFamily"]
 
@@ -23,13 +24,25 @@ class MplPolyFamily(Family):
     default_size = 1
     max_size = 30
     docs = "docs/models/mpl_poly.md"
-    Structure = mpl_poly.MplPolyStructure
-    Params = mpl_poly.MplPolyParams
-    model = mpl_poly
-    fit_function = fit_mpl_poly
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "MplPolyStructure")
+    Params = lazy(".model", "MplPolyParams")
+    model = lazy(".model")
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_mpl_poly`."""
+        from .fit import fit_mpl_poly
+
+        return fit_mpl_poly(u, y, structure, **options)
+
+    def invert(self, structure, params, y, x0=None):
+        return self.model.invert(structure, params, y, x0)
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0,
                        limit: bool = True) -> mpl_poly.MplPolyStructure:
+        from . import model as mpl_poly
+
         return mpl_poly.MplPolyStructure(n_cells=size, dt=dt, slope_cap=slope_cap, limit=limit)
 
     def at(self, structure, dt):
@@ -42,11 +55,16 @@ class MplPolyFamily(Family):
         """Paper 9.2's published range with margin (:func:`.fit.random_params`): ``c_k0..c_k2``
         in ``[-5, 5]``, ``c_k3`` log-uniform in ``[0.1, 100]``, ``g``, ``w`` in ``[-2, 2]``,
         ``V_b`` in ``[-1, 1]``. Bounded with ``structure.limit``: ``|u_k| <= max|e| + max|v*_k|``."""
+        from .fit import random_params as _random_params
+
         return _random_params(structure, rng)
 
     def presets(self):
         """Paper 9.2's table II columns: direct compensators (sensor -> position) fitted on
         normalised 40 Hz data, N = 1, as printed (``f2^2``, ``f3^3``)."""
+        from . import model as mpl_poly
+        from .presets import PAPER_9_2_TABLE_II, paper_9_2_params
+
         structure = mpl_poly.MplPolyStructure(n_cells=1, dt=0.025)
         return {f"table-ii-{name}": (structure, paper_9_2_params(printed),
                                      {"source": f"paper 9.2 table II, {name} column (as "
@@ -57,6 +75,9 @@ class MplPolyFamily(Family):
     def invert_step(self, structure, params, x, y):
         """As :func:`model.invert_step`; NaN input estimate and state when ``y`` is outside
         the range of ``g``'s branch (no input gives it), as the compiled block."""
+        from . import kernels
+        from . import model as mpl_poly
+
         lo, hi, sign, centre = mpl_poly.inverse_branch(structure, params)
         if not kernels.solve_output(float(y), np.ascontiguousarray(params.g), lo, hi, sign,
                                     centre)[1]:
@@ -64,6 +85,9 @@ class MplPolyFamily(Family):
         return mpl_poly.invert_step(structure, params, x, y)
 
     def block(self, structure, params, inverse=False):
+        from . import kernels
+        from . import model as mpl_poly
+
         mpl_poly.check_rest(structure, params)  # the loop runs only models of the domain
         if inverse:
             if params.w[0] == 0:
@@ -83,6 +107,9 @@ class MplPolyFamily(Family):
         ``dy = g'(z) (w_0 du + w . dx)``. Inverse: ``dz = dy / g'(z)``,
         ``de = (dz - w . dx) / w_0``, the cells driven by ``e``. ``f'`` is the slope of the
         limited cubic (eq. 5.29) at the operating point."""
+        from . import kernels
+        from . import model as mpl_poly
+
         x = np.asarray(x, dtype=float)
         w0, w = params.w[0], params.w[1:]
         if inverse:
@@ -105,6 +132,8 @@ class MplPolyFamily(Family):
 
     def cells(self, structure, params) -> Cells:
         """The model as the eq. 5.18-5.28 analysis sees it (cubic output ``g``)."""
+        from . import model as mpl_poly
+
         return Cells(current=lambda v: mpl_poly.resistor_current(structure, params, v),
                      slope=lambda v: mpl_poly.resistor_slope(structure, params, v),
                      output=lambda z: mpl_poly.output_current(params, z),

@@ -7,11 +7,9 @@ import dataclasses
 
 import numpy as np
 
+from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._protocol import Block, Family
-from . import kernels
-from . import model as pi
-from .fit import MIN_SLOPE, _to_params, fit_pi, make_structure
 
 __all__ = ["PiFamily"]
 
@@ -24,12 +22,27 @@ class PiFamily(Family):
     default_size = 10
     max_size = 200
     docs = "docs/models/pi.md"
-    Structure = pi.PiStructure
-    Params = pi.PiParams
-    model = pi  # rest_state, step, simulate, invert, invert_step: the module's functions
-    fit_function = fit_pi
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "PiStructure")
+    Params = lazy(".model", "PiParams")
+    model = lazy(".model")  # rest_state, step, simulate, invert, invert_step: the module's functions
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_pi`."""
+        from .fit import fit_pi
+
+        return fit_pi(u, y, structure, **options)
+
+    def invert(self, structure, params, y, x0=None):
+        return self.model.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return self.model.invert_step(structure, params, x, y)
 
     def make_structure(self, dt, size, **options):
+        from .fit import make_structure
+
         return make_structure(dt, size, **options)
 
     def random_params(self, structure, rng):
@@ -38,6 +51,8 @@ class PiFamily(Family):
         1 / MIN_SLOPE] = [0.01, 100]``, split creep weights ``w+, w-`` uniform in ``[0, 1]``,
         offset ``b`` in ``[-1, 1]``, ``S^-1`` thresholds of an output range ``[-1, 1]``, either
         polarity. Bounded: ``|y| <= sum |w_S| (sum |w_H| + sum |w_K| + |b|) max(1, |u|)``."""
+        from .fit import MIN_SLOPE, _to_params
+
         n, n_k, m = structure.n_play, structure.n_creep, structure.n_deadzone
         log_slope = np.log(MIN_SLOPE), -np.log(MIN_SLOPE)
         theta = np.concatenate([np.exp(rng.uniform(*log_slope, n)), rng.uniform(0.0, 1.0, 2 * n_k),
@@ -57,6 +72,9 @@ class PiFamily(Family):
         return dataclasses.replace(structure, dt=float(dt))
 
     def block(self, structure, params, inverse=False):
+        from . import kernels
+        from . import model as pi
+
         pi.simulate(structure, params, np.zeros(2))  # checks that params fit the structure
         head = [structure.n_play, structure.n_creep, params.d_s.size]
         r, c = np.asarray(structure.play_thresholds), structure.creep_gains
@@ -86,6 +104,8 @@ class PiFamily(Family):
         slopes exactly on a threshold. The inverse follows from the forward Jacobian at the
         estimate ``u_hat``: ``du = (dy - C dx) / D``.
         """
+        from . import model as pi
+
         x = np.asarray(x, dtype=float)
         if inverse:
             u = pi.invert_step(structure, params, x, u)[0]

@@ -5,13 +5,15 @@ the loop blocks), ``fit`` the weight fit for a fixed structure, ``search`` the e
 structural search behind ``hystkit pl-search``, ``family`` the protocol adapter (``FAMILY``).
 """
 
-from . import model
+from ..._lazy import lazy_exports
 from .family import PlFamily
-from .fit import default_starts, fit_pl, solve_weights
-from .model import *
-from .search import DEFAULT_GRID, format_search_table, structural_search
 
 FAMILY = PlFamily()
 
-__all__ = ["FAMILY", "PlFamily", "DEFAULT_GRID", "format_search_table", "structural_search",
-           "default_starts", "fit_pl", "solve_weights"] + model.__all__
+# The model's equations, its fit and its numba kernels load when one of their names is first
+# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(),
+    {"model": ("*",), "fit": ("default_starts", "fit_pl", "solve_weights"),
+     "search": ("DEFAULT_GRID", "format_search_table", "structural_search")},
+    first=("FAMILY", "PlFamily"))

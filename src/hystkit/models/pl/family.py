@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
+from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._protocol import Block, Family
-from . import kernels
-from . import model as pl
-from .fit import fit_pl
-from .fit import random_params as _random_params
+
+if TYPE_CHECKING:
+    from . import model as pl
 
 __all__ = ["PlFamily"]
 
@@ -21,13 +23,28 @@ class PlFamily(Family):
     default_size = 1
     max_size = 50
     docs = "docs/models/pl.md"
-    Structure = pl.PlStructure
-    Params = pl.PlParams
-    model = pl
-    fit_function = fit_pl
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "PlStructure")
+    Params = lazy(".model", "PlParams")
+    model = lazy(".model")
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_pl`."""
+        from .fit import fit_pl
+
+        return fit_pl(u, y, structure, **options)
+
+    def invert(self, structure, params, y, x0=None):
+        return self.model.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        return self.model.invert_step(structure, params, x, y)
 
     def make_structure(self, dt: float, size: int, power: float = 21.0, n_basis: int = 1,
                        smoothing: float = 0.001, slope_cap: float = 1.0) -> pl.PlStructure:
+        from . import model as pl
+
         return pl.PlStructure(n_cells=size, power=power, n_basis=n_basis, smoothing=smoothing,
                               dt=dt, slope_cap=slope_cap)
 
@@ -35,6 +52,8 @@ class PlFamily(Family):
         """The fit's bounds (:func:`.fit.random_params`): ``I_T`` log-uniform in ``[1e-6, 1e4]``,
         ``V_T`` in ``[1e-3, 2]``, ``w``, ``V_b`` in ``[-100, 100]``, ``a_j >= 0.05`` with
         ``sum a_j = M``. Bounded: ``|y| <= (sum |w| max|e| + |V_b|) / min a_j``."""
+        from .fit import random_params as _random_params
+
         return _random_params(structure, rng)
 
     def at(self, structure, dt):
@@ -46,6 +65,9 @@ class PlFamily(Family):
         return super().at(structure, dt)
 
     def block(self, structure, params, inverse=False):
+        from . import kernels
+        from . import model as pl
+
         if inverse and params.w[0] == 0:
             raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 2.20)")
         i_t, thr, knee, power, g_lin, dt = pl.kernel_args(structure, params)
@@ -61,6 +83,8 @@ class PlFamily(Family):
         Forward: ``di = (w_0 de + w . dx) / f'(i)``; inverse: ``de = (f'(i) di - w . dx) / w_0``,
         the cells driven by ``e``. ``f'`` is the slope ``a_j`` of the output resistor's segment
         (on a breakpoint the left one; the numerical default would average the two)."""
+        from . import model as pl
+
         x = np.asarray(x, dtype=float)
         w0, w = params.w[0], params.w[1:]
         if inverse:

@@ -5,13 +5,15 @@
 squares and FORCs), ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
-from . import fit, kernels, model
-from .family import PreisachFamily, StaircaseFamily
-from .fit import *
-from .model import *
-from .model import INVERT_TOL
+from ..._lazy import lazy_exports
+from .family import PreisachFamily
+from .family import StaircaseFamily as StaircaseFamily
 
 FAMILY = PreisachFamily()
 
-__all__ = (["FAMILY", "PreisachFamily", "StaircaseFamily", "INVERT_TOL", "kernels"] + model.__all__
-           + fit.__all__)
+# The model's equations, its fit and its numba kernels load when one of their names is first
+# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+__getattr__, __dir__ = lazy_exports(
+    __name__, globals(),
+    {"model": ("*", "INVERT_TOL"), "fit": ("*",)},
+    first=("FAMILY", "PreisachFamily", "StaircaseFamily", "kernels"))

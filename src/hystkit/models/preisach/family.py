@@ -9,14 +9,15 @@ from __future__ import annotations
 
 import dataclasses
 from types import ModuleType
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from ..._lazy import lazy
 from .._protocol import Block, Family
-from . import kernels
-from . import model as preisach
-from .fit import fit_preisach
+
+if TYPE_CHECKING:
+    from . import model as preisach
 
 __all__ = ["PreisachFamily", "StaircaseFamily", "orientation_sign", "random_masses"]
 
@@ -60,9 +61,13 @@ class StaircaseFamily(Family):
         return dataclasses.replace(structure, dt=float(dt))
 
     def _unpack(self, structure, x):
+        from . import model as preisach
+
         return preisach.unpack_state(x, structure.capacity)
 
     def _pack(self, structure, staircase):
+        from . import model as preisach
+
         return preisach.pack_state(staircase, structure.capacity)
 
     def rest_state(self, structure, params, value, inverse=False):
@@ -98,6 +103,9 @@ class StaircaseFamily(Family):
         forgotten, exactly as in :meth:`simulate` (``PreisachStructure``): a documented
         degradation of the memory, never an overflow.
         """
+        from . import kernels
+        from . import model as preisach
+
         self.simulate(structure, params, np.zeros(2))  # checks that params fit the structure
         tables, weighted, poly, slope = self.stairs.kernel_parts(params)
         if inverse:  # the inverse's own checks: a major loop that rises enough to invert
@@ -154,12 +162,21 @@ class PreisachFamily(StaircaseFamily):
     default_size = 20
     max_size = 100
     docs = "docs/models/preisach.md"
-    Structure = preisach.PreisachStructure
-    Params = preisach.PreisachParams
-    stairs = preisach
-    fit_function = fit_preisach
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "PreisachStructure")
+    Params = lazy(".model", "PreisachParams")
+    stairs = lazy(".model")
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_preisach`."""
+        from .fit import fit_preisach
+
+        return fit_preisach(u, y, structure, **options)
 
     def make_structure(self, dt: float, size: int, **options: Any) -> preisach.PreisachStructure:
+        from . import model as preisach
+
         return preisach.PreisachStructure(levels=size, dt=dt, **options)
 
     def random_params(self, structure, rng):
@@ -168,6 +185,8 @@ class PreisachFamily(StaircaseFamily):
         off-diagonal ``<= 0`` and diagonal ``>= 0`` -- spread at random (Dirichlet) with total
         ``sum |m|`` log-uniform in ``[0.1, 10]`` (1: a major loop spanning [-1, 1], eq. 5.10),
         offset in ``[-1, 1]``. Bounded: ``|y - y_0| <= sum |m| max(1, |u|)``."""
+        from . import model as preisach
+
         masses = random_masses(structure.levels, orientation_sign(structure, rng), rng)
         return preisach.PreisachParams.from_masses(masses, offset=rng.uniform(-1.0, 1.0))
 

@@ -1,0 +1,283 @@
+"""The notebook interface: ``import hystkit as hk``, then ``hk.read``, ``hk.fit``, ``hk.evaluate``.
+
+Thin wrappers over the library (``hystkit.io``, ``hystkit.compensation``, ``hystkit.reports``)
+that take a recording in whatever form a notebook holds it -- a `Recording`, a pandas
+DataFrame with columns ``time`` [s], ``position`` [mm] and ``sensor``, or a file path -- and give
+tables back as DataFrames. ``hystkit/__init__`` exports these names lazily (PEP 562), so
+``import hystkit`` stays instant and the first call pays for the imports it needs.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Union
+
+from .compensation import (
+    DEFAULT_CENTER,
+    Compensator,
+    fit_compensator,
+    load_compensator,
+    save_compensator,
+)
+from .compensation import evaluate as _evaluate
+from .compensation import use_flags as _use_flags
+from .io import ReadOptions, Recording, read_recording
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["compare", "compensate", "evaluate", "fit", "load", "read", "save"]
+
+Data = Union[Recording, "pd.DataFrame", str, os.PathLike]
+"""What every function here accepts as a recording: a `Recording`, a DataFrame with columns
+``time`` [s], ``position`` [mm] (needed to fit and to score) and ``sensor``, or a file path
+(CSV, Parquet, MATLAB) with those columns."""
+
+
+def read(path: str | os.PathLike, *, columns: Mapping[str, str] | None = None,
+         time_unit: str = "s", **options: Any) -> Recording:
+    """Read a recording from a CSV, Parquet or MATLAB file, with its own column names.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    columns : mapping, optional
+        hystkit name (``time``, ``position``, ``sensor``) -> the file's column (or MATLAB
+        variable) name; names not given are read as hystkit's.
+    time_unit : {"s", "ms", "us", "ns", "min"}
+        Unit of the time column, converted to seconds.
+    **options
+        The other fields of `hystkit.io.ReadOptions` (``skip_rows``, ``sep``, ``units_row``,
+        ...).
+
+    Returns
+    -------
+    Recording
+        ``time`` [s], ``sensor``, ``position`` [mm] when the file has one; ``to_frame()`` gives
+        a DataFrame.
+
+    Raises
+    ------
+    InputError
+        A missing file or column, or bad data; the message names file, column and row.
+
+    Examples
+    --------
+    >>> import hystkit as hk
+    >>> path = "own.csv"
+    >>> with open(path, "w") as f:
+    ...     _ = f.write("t_ms,x_mm,r_ohm\\n0,0.0,100.0\\n25,0.5,100.2\\n50,1.0,100.5\\n")
+    >>> rec = hk.read(path, columns={"time": "t_ms", "position": "x_mm", "sensor": "r_ohm"},
+    ...               time_unit="ms")
+    >>> rec.fs
+    40.0
+    >>> rec.to_frame().columns.tolist()
+    ['time', 'position', 'sensor']
+    """
+    reading = ReadOptions(columns=columns or (), time_unit=time_unit, **options)
+    return read_recording(path, need_position=False, options=reading)
+
+
+def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None, *,
+        mode: str = "direct", center: str = DEFAULT_CENTER, **options: Any) -> Compensator:
+    """Fit a compensator (sensor -> position) on one or several recordings.
+
+    Parameters
+    ----------
+    data : Recording, DataFrame or path, or a sequence of them
+        Fitting recording(s) with ``time`` [s], ``position`` [mm] and ``sensor``; several are
+        fitted jointly, each with its own initial state and centring.
+    model : str
+        A model family of ``hystkit.models.FAMILIES`` (``mpl``, ``pi``, ``preisach``, ...).
+    size : int, optional
+        The family's size knob (mpl: cells N); default: the family's ``default_size``.
+    mode : {"direct", "inverse"}
+        ``direct`` fits sensor -> position; ``inverse`` fits position -> sensor and inverts it.
+    center : {"fit", "tare", "track", "recording", "none"}
+        How the sensor offset is removed in use (see ``docs/centring.md``); ``recording`` is the
+        paper's oracle protocol, which a deployed compensator cannot have.
+    **options
+        Passed to `hystkit.compensation.fit_compensator` (``tare_seconds``, ``track_seconds``,
+        ``diagnose``, the family's structure options such as ``slope_cap``).
+
+    Returns
+    -------
+    Compensator
+        ``fit_info["status"]`` is ``"ok"`` only when the fit converged, beats a straight line
+        and has no parameter on a bound; ``estimate(recording)`` gives the position [mm].
+
+    Examples
+    --------
+    >>> import hystkit as hk
+    >>> from hystkit.sensors import simulate_experiment
+    >>> frame = simulate_experiment("noise", seed=1).to_frame()   # a DataFrame
+    >>> comp = hk.fit(frame, "mpl", size=1)
+    >>> comp.fit_info["status"], comp.fit_info["training_r2"] > comp.fit_info["training_linear_r2"]
+    ('ok', True)
+    """
+    items = [data] if _is_single(data) else list(data)
+    recordings = [as_recording(item) for item in items]
+    return fit_compensator(recordings, size, model=model, mode=mode, center=center, **options)
+
+
+def evaluate(compensator: Compensator, data: Data, *,
+             rest_position: float | None = None) -> dict:
+    """Score a compensator on a recording: deployable scores first, the oracle's labelled.
+
+    Parameters
+    ----------
+    compensator : Compensator
+        From :func:`fit` or :func:`load`.
+    data : Recording, DataFrame or path
+        A recording with ``position`` [mm].
+    rest_position : float, optional
+        ``tare`` centring: the position [mm] during the tare window (default: the training
+        rest position).
+
+    Returns
+    -------
+    dict
+        In this order: ``center`` and the deployable scores ``r2``, ``e_rms_pct``,
+        ``e_max_pct``, ``sinad_db``, ``loop_area`` (the compensator's own, causal centring);
+        the same with a ``linear_`` prefix (the straight-line baseline); ``center_oracle`` and
+        every score again with an ``_oracle`` suffix (the paper's protocol: the recording's
+        own means, not available in use); then ``n_samples``, ``extrapolated_fraction``,
+        the use-time guard counts and their margins. See
+        `hystkit.compensation.evaluate`.
+
+    Examples
+    --------
+    >>> import hystkit as hk
+    >>> from hystkit.sensors import simulate_experiment
+    >>> comp = hk.fit(simulate_experiment("noise", seed=1))
+    >>> scores = hk.evaluate(comp, simulate_experiment("noise", seed=2))
+    >>> list(scores)[:3]
+    ['center', 'r2', 'e_rms_pct']
+    >>> scores["r2"] > scores["linear_r2"]
+    True
+    """
+    scores = _evaluate(compensator, as_recording(data), rest_position=rest_position)
+    return dict(sorted(scores.items(), key=lambda item: _score_rank(item[0])))
+
+
+def _score_rank(key: str) -> int:
+    if key == "center_oracle" or key.endswith("_oracle"):
+        return 2
+    if key == "center" or key.startswith(("r2", "e_", "sinad", "loop_area", "linear_")):
+        return 1
+    return 3
+
+
+def compensate(compensator: Compensator, data: Data, *,
+               rest_position: float | None = None) -> pd.DataFrame:
+    """The recording as a DataFrame with the compensator's ``position_estimate`` [mm] added.
+
+    Also adds the use-time guards ``sensor_outside`` and ``estimate_outside`` (True where the
+    sensor or the estimate leaves the training range), as ``hystkit compensate`` writes them.
+
+    Examples
+    --------
+    >>> import hystkit as hk
+    >>> from hystkit.sensors import simulate_experiment
+    >>> comp = hk.fit(simulate_experiment("noise", seed=1))
+    >>> out = hk.compensate(comp, simulate_experiment("noise", seed=2))
+    >>> out.columns.tolist()
+    ['time', 'position', 'sensor', 'position_estimate', 'sensor_outside', 'estimate_outside']
+    """
+    recording = as_recording(data)
+    estimate = compensator.estimate(recording, rest_position=rest_position)
+    frame = recording.to_frame()
+    frame["position_estimate"] = estimate
+    for name, mask in _use_flags(compensator, recording, estimate).items():
+        if mask is not None:
+            frame[name] = mask
+    return frame
+
+
+def compare(fit_data: Data, val_data: Data, models: Sequence[str] | None = None, *,
+            sizes: Mapping[str, int] | None = None) -> pd.DataFrame:
+    """Fit several model families on one recording and score them on another.
+
+    Parameters
+    ----------
+    fit_data, val_data : Recording, DataFrame or path
+        Fitting and validation recordings (``time``, ``position``, ``sensor``).
+    models : sequence of str, optional
+        Family names; default: every registered family (minutes for all of them).
+    sizes : mapping, optional
+        Family name -> size; default: each family's ``default_size``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per model (the index), the columns of
+        `hystkit.reports.compare_models`: ``n_params``, ``fit_seconds``, ``r2_forward``,
+        ``r2_compensated``, ``r2_direct`` (deployable), ``linear_r2``, the ``_oracle`` scores,
+        ``direct_status``, ...; a family whose fit failed has its reason in ``error``.
+
+    Examples
+    --------
+    >>> import hystkit as hk
+    >>> from hystkit.sensors import simulate_experiment
+    >>> table = hk.compare(simulate_experiment("noise", seed=1),
+    ...                    simulate_experiment("noise", seed=2), models=["mpl", "pi"])
+    >>> table.index.tolist()
+    ['mpl', 'pi']
+    >>> bool((table["r2_direct"] > table["linear_r2"]).all())
+    True
+    """
+    import pandas as pd
+
+    from .reports import compare_models
+
+    table = compare_models(as_recording(fit_data), as_recording(val_data), models, sizes)
+    return pd.DataFrame.from_dict(table, orient="index")
+
+
+def load(path: str | os.PathLike) -> Compensator:
+    """Load a model file written by :func:`save` or ``hystkit fit --out`` (JSON or ``.mat``).
+
+    Examples
+    --------
+    >>> import hystkit as hk
+    >>> from hystkit.sensors import simulate_experiment
+    >>> comp = hk.fit(simulate_experiment("noise", seed=1))
+    >>> _ = hk.save(comp, "model.json")
+    >>> loaded = hk.load("model.json")
+    >>> loaded.params == comp.params, loaded.center == comp.center
+    (True, True)
+    """
+    return load_compensator(path)
+
+
+def save(compensator: Compensator, path: str | os.PathLike, *, force: bool = False) -> Path:
+    """Write a compensator to a model file (JSON); returns the path.
+
+    An existing file is kept unless ``force``; the file appears whole or not at all.
+    """
+    return save_compensator(compensator, path, force=force)
+
+
+def as_recording(data: Data) -> Recording:
+    """`data` as a `Recording`: kept, converted from a DataFrame, or read from a file path.
+
+    Raises
+    ------
+    TypeError
+        `data` is none of those.
+    """
+    if isinstance(data, Recording):
+        return data
+    if isinstance(data, str | os.PathLike):
+        return read_recording(data, need_position=False)
+    if hasattr(data, "columns") and hasattr(data, "to_numpy"):  # a DataFrame, without pandas
+        return Recording.from_frame(data)
+    raise TypeError(f"expected a Recording, a DataFrame or a file path, got "
+                    f"{type(data).__name__}")
+
+
+def _is_single(data: object) -> bool:
+    return isinstance(data, Recording | str | os.PathLike) or hasattr(data, "columns")
