@@ -1,0 +1,244 @@
+"""The report of one model file on the user's recordings: provenance, fit, scores, figures.
+
+Scores come from :func:`hystkit.compensation.evaluate`, the function ``hystkit evaluate`` runs:
+the deployable ones first (the compensator's own centring), the oracle ones (the paper's
+protocol, which needs the whole recording) after them and labelled so.
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from matplotlib.figure import Figure
+
+from ..compensation import Compensator, center_label, evaluate, load_compensator
+from ..io import Recording
+from ._figures import DEFAULT_SENSOR_LABEL, plot_loops, plot_time_series
+from ._html import Section, definition_list, figure_png, note, paragraph, png_block, table
+
+__all__ = ["FIGURE_DPI", "ReportContent", "compensator_sections", "model_report",
+           "named_parameters", "score_sections"]
+
+# (evaluate key, column heading, format)
+_SCORES = (("r2", "R²", ".4f"), ("e_rms_pct", "e_rms %", ".3f"), ("e_max_pct", "e_max %", ".3f"),
+           ("sinad_db", "SINAD dB", ".2f"), ("loop_area", "loop area %", ".3f"))
+FIGURE_DPI = 100  # the page's PNGs and the PNG files: sharp at the page's width, ~100 kB each
+
+
+@dataclass
+class ReportContent:
+    """What a report shows: a title, sections, and its figures by file stem: ``pngs`` (every
+    figure, as embedded in the page) and ``figures`` (those drawn here, which can also be saved
+    as SVG or PDF; a ``control`` run's own PNG files have no Figure)."""
+
+    title: str
+    sections: list[Section] = field(default_factory=list)
+    pngs: dict[str, bytes] = field(default_factory=dict)
+    figures: dict[str, Figure] = field(default_factory=dict)
+    prefix: str = ""  # put before every figure name (several folders on one page)
+
+    def add_figure(self, section: Section, name: str, fig: Figure, caption: str) -> None:
+        """Render `fig` once: embedded in `section`, kept for the figure files."""
+        self.add_png(section, name, figure_png(fig, FIGURE_DPI), caption)
+        self.figures[self.prefix + name] = fig
+
+    def add_png(self, section: Section, name: str, png: bytes, caption: str) -> None:
+        name = self.prefix + name
+        if name in self.pngs:
+            raise ValueError(f"two figures named {name!r}")
+        self.pngs[name] = png
+        section.add(png_block(png, caption))
+
+
+def named_parameters(params: dict) -> list[str]:
+    """Names of the float entries of ``params.to_dict()`` in the order the fit's standard
+    errors use (depth first: ``w[1]``, ``v_b``; nested lists ``a[0][2]``)."""
+    names: list[str] = []
+
+    def walk(value: object, name: str) -> None:
+        if isinstance(value, dict):
+            for key, item in value.items():
+                walk(item, f"{name}.{key}" if name else str(key))
+        elif isinstance(value, list | tuple):
+            for i, item in enumerate(value):
+                walk(item, f"{name}[{i}]")
+        elif isinstance(value, float):
+            names.append(name)
+
+    walk(params, "")
+    return names
+
+
+def _provenance(comp: Compensator, model_path: Path | None, version: str | None) -> Section:
+    info = comp.fit_info
+    items = [("model file", str(model_path) if model_path else "(in memory)"),
+             ("model", f"{comp.model}: {comp.family.title}"),
+             ("structure", ", ".join(f"{k} = {v}" for k, v in comp.structure.to_dict().items())),
+             ("mode", comp.mode), ("centring", center_label(comp.center)),
+             ("fitted on", ", ".join(info.get("training_sources") or
+                                     [info.get("training_source") or "not stored"])),
+             ("training samples", info.get("training_samples")),
+             ("fit date", info.get("fit_date") or "not stored in the model file"),
+             ("written by hystkit", version or "not stored")]
+    if model_path is not None:
+        stamp = datetime.datetime.fromtimestamp(os.stat(model_path).st_mtime, datetime.UTC)
+        items.append(("file last modified", stamp.strftime("%Y-%m-%d %H:%M UTC")))
+    return Section("Model file").add(definition_list(items))
+
+
+def _fit_section(comp: Compensator) -> Section:
+    info = comp.fit_info
+    section = Section("Fit")
+    status = info.get("status")
+    if status is None:
+        section.add(note("fit status: not stored in the model file"))
+    elif status == "ok":
+        section.add(note(f"fit status: ok ({info.get('status_message', '')})", "good"))
+    else:
+        section.add(note(f"fit status: {status.replace('_', ' ')}: "
+                         f"{info.get('status_message', '')}. Do not use this model as a "
+                         f"compensator.", "bad"))
+    section.add(definition_list([
+        ("solver", info.get("message")), ("converged", info.get("converged")),
+        ("starts", info.get("n_starts")), ("evaluations", info.get("n_evaluations")),
+        ("fit time [s]", _fixed(info.get("fit_seconds"), ".2f")),
+        ("cost (SSE, normalised)", _fixed(info.get("cost"), ".5g")),
+        ("training R²", _fixed(info.get("training_r2"), ".4f")),
+        ("training R², straight line", _fixed(info.get("training_linear_r2"), ".4f")),
+        ("AIC / BIC", f"{_fixed(info.get('aic'), '.1f')} / {_fixed(info.get('bic'), '.1f')}"),
+        ("parameters on a search-box bound",
+         ", ".join(info["on_bounds"]) if info.get("on_bounds") else
+         ("none" if "on_bounds" in info else "not stored")),
+        ("at the model's own limits", "; ".join(info.get("at_model_limits") or ()) or "none"),
+        ("joint fit", info.get("joint_fit") or "no (one recording)")]))
+    section.add(_parameter_table(comp))
+    return section
+
+
+def _fixed(value: object, spec: str) -> str:
+    return "not stored" if value is None else format(value, spec)
+
+
+def _parameter_table(comp: Compensator) -> str:
+    """Fitted values with their standard errors (Gauss-Newton, stored by the fit)."""
+    names = named_parameters(comp.params.to_dict())
+    se = comp.fit_info.get("standard_errors")
+    if not se or len(se.get("values", ())) != len(names):
+        rows = [(n, v, "not stored") for n, v in zip(names, _floats(comp.params.to_dict()))]
+        return (table(("parameter", "value", "standard error"), rows, spec=".6g")
+                + paragraph("Standard errors are not stored in this model file (written "
+                            "before they were); refit to get them."))
+    rows = [(n, v, s, "undetermined" if r is None else f"{100 * r:.3g} %")
+            for n, v, s, r in zip(names, se["values"], se["standard_errors"], se["relative"])]
+    blind = sum(s is None for s in se["standard_errors"])
+    text = ("Standard errors: Gauss-Newton, s² (JᵀJ)⁻¹ from the finite-difference Jacobian at "
+            f"the optimum (condition number of JᵀJ {_fixed(se.get('condition_number'), '.3g')})"
+            + (f"; {blind} parameter(s) not determined by the data (–)." if blind else "."))
+    return (table(("parameter", "value", "standard error", "relative"), rows, spec=".6g")
+            + paragraph(text))
+
+
+def _floats(tree: object) -> list[float]:
+    if isinstance(tree, dict):
+        return [x for v in tree.values() for x in _floats(v)]
+    if isinstance(tree, list | tuple):
+        return [x for v in tree for x in _floats(v)]
+    return [tree] if isinstance(tree, float) else []
+
+
+def score_sections(comp: Compensator, scores: Mapping[str, dict]) -> Section:
+    """Deployable scores of every recording, then the oracle ones, from `evaluate`'s dicts."""
+    head = ("recording", "", *(label for _, label, _ in _SCORES))
+    deployable, oracle = [], []
+    for name, s in scores.items():
+        for rows, suffix in ((deployable, ""), (oracle, "_oracle")):
+            rows.append((name, comp.model, *(_fixed_or_none(s[f"{k}{suffix}"], f)
+                                             for k, _, f in _SCORES)))
+            rows.append((name, "straight line", *(_fixed_or_none(s[f"linear_{k}{suffix}"], f)
+                                                  for k, _, f in _SCORES)))
+    first = next(iter(scores.values()))
+    section = Section("Scores")
+    section.add(paragraph(f"Deployable: centring {first['center']}, what the compensator "
+                          f"delivers in use. Errors in % of the fitting data's largest "
+                          f"|position| (eq. 5.10-5.11); loop area: eq. 5.15, 0 for a perfect "
+                          f"compensator."),
+                table(head, deployable, text_columns=2))
+    section.add(paragraph(f"Oracle: centring {first['center_oracle']}, the paper's protocol. It "
+                          f"removes each recording's own sensor mean and adds its true mean "
+                          f"position, which no compensator in use can know: for comparison "
+                          f"with the document only."),
+                table(head, oracle, text_columns=2, row_classes=["oracle"] * len(oracle)))
+    guards = [(name, s["n_samples"], _count(s["n_sensor_outside"]),
+               _count(s["n_estimate_outside"]), _fixed_or_none(s["sensor_loop_area"], ".3f"))
+              for name, s in scores.items()]
+    section.add(table(("recording", "samples", "sensor outside training",
+                       "estimate outside training", "sensor loop area %"), guards))
+    return section
+
+
+def _fixed_or_none(value: float | None, spec: str) -> str | None:
+    return None if value is None else format(value, spec)
+
+
+def _count(n: int | None) -> str:
+    return "unknown (old model file)" if n is None else str(n)
+
+
+def compensator_sections(comp: Compensator, recordings: Mapping[str, Recording], *,
+                         model_path: Path | None = None, version: str | None = None,
+                         sensor_label: str = DEFAULT_SENSOR_LABEL,
+                         prefix: str = "") -> ReportContent:
+    """Sections and figures of one compensator on named recordings (each needs a position).
+
+    Figures (file stems ``{prefix}loops`` and ``{prefix}time_series``): the loops before and
+    after compensation with the error against the position, and every recording's whole run
+    with its error trace (:mod:`hystkit.reports._figures`). `version`: the hystkit version
+    that wrote the model file.
+    """
+    content = ReportContent(title="")
+    content.sections += [_provenance(comp, model_path, version), _fit_section(comp)]
+    scores, shown = {}, {}
+    for name, rec in recordings.items():
+        scores[name] = evaluate(comp, rec)
+        shown[name] = (rec, comp.estimate(rec), comp.estimate_linear(rec))
+    content.sections.append(score_sections(comp, scores))
+    figures = Section("Figures")
+    content.sections.append(figures)
+    centring = center_label(comp.center)
+    content.add_figure(
+        figures, f"{prefix}loops",
+        plot_loops(shown, sensor_label=sensor_label, model_label=comp.model),
+        f"Loops: the sensor against the position (top), the {comp.model} and straight-line "
+        f"estimates against it (middle, dashed: ideal) and their error (bottom); deployable "
+        f"centring {centring}.")
+    content.add_figure(
+        figures, f"{prefix}time_series", plot_time_series(shown, model_label=comp.model),
+        "Each recording's whole run: measured and estimated position, and the error "
+        "(estimate − position); right: a zoom on the stretch around the largest "
+        f"{comp.model} error.")
+    return content
+
+
+def model_report(model_path: Path, recordings: Mapping[str, Recording], *,
+                 sensor_label: str = DEFAULT_SENSOR_LABEL) -> ReportContent:
+    """The page of a model file (read with :func:`~hystkit.compensation.load_compensator`,
+    which checks it) on named recordings."""
+    comp = load_compensator(model_path)
+    version = _written_by(Path(model_path))
+    content = compensator_sections(comp, recordings, model_path=Path(model_path),
+                                   version=version, sensor_label=sensor_label)
+    content.title = f"hystkit report: {Path(model_path).name} on {', '.join(recordings)}"
+    return content
+
+
+def _written_by(path: Path) -> str | None:
+    """The hystkit version a JSON model file names (a top-level key the Compensator does not
+    keep); None for other model files. The file was checked by ``load_compensator``."""
+    if path.suffix.lower() != ".json":
+        return None
+    return json.loads(path.read_text(encoding="utf-8")).get("hystkit_version")
