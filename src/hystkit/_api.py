@@ -118,7 +118,7 @@ def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None
     >>> comp.fit_info["status"], comp.fit_info["training_r2"] > comp.fit_info["training_linear_r2"]
     ('ok', True)
     """
-    items = [data] if _is_single(data) else list(data)
+    items = list(data) if isinstance(data, list | tuple) else [data]
     recordings = [as_recording(item) for item in items]
     return fit_compensator(recordings, size, model=model, mode=mode, center=center, **options)
 
@@ -277,7 +277,3 @@ def as_recording(data: Data) -> Recording:
         return Recording.from_frame(data)
     raise TypeError(f"expected a Recording, a DataFrame or a file path, got "
                     f"{type(data).__name__}")
-
-
-def _is_single(data: object) -> bool:
-    return isinstance(data, Recording | str | os.PathLike) or hasattr(data, "columns")
