@@ -21,12 +21,13 @@ from ._model_file import (
     save_compensator,
 )
 from ._stream import Stream, StreamOutput, StreamState, advance
+from ._sync import SyncExcitation, sync_excitation
 from ._training_checks import check_excursion, check_fitting_data
 
 __all__ = ["CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",
            "DEPLOYABLE_CENTERS", "MODES", "ORACLE_CENTER", "POSITION_MARGIN", "SENSOR_MARGIN",
            "Compensator", "CompensatorEstimator", "LinearBaseline", "Scaling", "Stream",
-           "StreamOutput", "StreamState", "advance", "center_label", "centre_and_scale",
-           "check_excursion", "check_fitting_data", "compensator_from_dict",
+           "StreamOutput", "StreamState", "SyncExcitation", "advance", "center_label",
+           "centre_and_scale", "check_excursion", "check_fitting_data", "compensator_from_dict",
            "compensator_to_dict", "evaluate", "fit_compensator", "load_compensator",
-           "prepare_training_data", "save_compensator", "use_flags"]
+           "prepare_training_data", "save_compensator", "sync_excitation", "use_flags"]
