@@ -1,0 +1,16 @@
+"""Export a fitted compensator as code that runs where the sensor is: dependency-free C99
+(microcontrollers) and MATLAB / Simulink (Octave-compatible).
+
+The generated code repeats :meth:`hystkit.compensation.Compensator.estimate` sample by sample:
+the causal centring (fit / tare / track), polarity and scaling, and the family's compiled
+block (``Family.block``), translated per family in :mod:`._families`. A family, mode or
+centring without a translation is refused with the reason (``InputError``), never stubbed.
+"""
+
+from ._c import COMPILE_LINE, c_files, float_warning
+from ._matlab import matlab_files
+from ._plan import ExportPlan, identifier, make_plan
+from ._write import LANGUAGES, export_compensator
+
+__all__ = ["COMPILE_LINE", "LANGUAGES", "ExportPlan", "c_files", "export_compensator",
+           "float_warning", "identifier", "make_plan", "matlab_files"]

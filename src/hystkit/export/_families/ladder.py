@@ -1,0 +1,123 @@
+"""PWL ladder (``models/ladder/kernels.py``): ``block_forward`` / ``block_inverse``, rest state.
+
+Body: ``[N, V_b, dt, band (N), effective conductance (N), w (N + 1)]``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+HAS_INVERSE = True
+
+
+def extra(comp) -> dict:
+    """``W_SUM``: ``sum(w)``, the divisor of the inverse's rest input ``(y + V_b) / sum(w)``."""
+    return {"W_SUM": float(np.sum(comp.params.w))}
+
+
+def state_size(plan) -> int:
+    return plan.n_block_state
+
+
+def c_model(plan, lit: Callable[[float], str]) -> str:
+    n = int(plan.body[0])
+    w_sum = plan.extra["W_SUM"]
+    rest = ("value" if not plan.inverse else
+            f"(value + BODY[1]) / {lit(w_sum)}" if w_sum != 0 else "R(0.0)")
+    if plan.inverse:  # solve_input: (y + V_b - sum w_k U_k) / w_0
+        head = """    real acc = u + BODY[1];
+    for (k = 0; k < N_CELLS; k++) acc -= BODY[IW + 1 + k] * x[k];
+    drive = acc / BODY[IW];
+    out = drive;"""
+    else:  # output: w_0 e + sum w_k U_k - V_b
+        head = """    real acc = BODY[IW] * u - BODY[1];
+    for (k = 0; k < N_CELLS; k++) acc += BODY[IW + 1 + k] * x[k];
+    drive = u;
+    out = acc;"""
+    return f"""#define N_CELLS {n}
+#define IW (3 + 2 * N_CELLS)
+
+/* Dead-zone resistor current (kernels._dead_zone_current) */
+static real dead_zone(real v, int k)
+{{
+    const real band = BODY[3 + k], g = BODY[3 + N_CELLS + k];
+    if (v > band) return g * (v - band);
+    if (v < -band) return g * (v + band);
+    return R(0.0);
+}}
+
+static void model_rest(real *x, real value)
+{{
+    int k;
+    const real v = {rest};
+    for (k = 0; k < N_CELLS; k++) x[k] = v;
+}}
+
+/* Output from the present voltages, then the Euler step (kernels.euler) driven by the source */
+static real model_step(real *x, real u)
+{{
+    int k;
+    real drive, out, i_in, i_out;
+{head}
+    i_in = dead_zone(drive - x[0], 0);
+    for (k = 0; k < N_CELLS; k++) {{
+        i_out = R(0.0);
+        if (k + 1 < N_CELLS) i_out = dead_zone(x[k] - x[k + 1], k + 1);
+        x[k] = x[k] + BODY[2] * (i_in - i_out);
+        i_in = i_out;
+    }}
+    return out;
+}}
+"""
+
+
+def m_model(plan, lit: Callable[[float], str]) -> str:
+    w_sum = plan.extra["W_SUM"]
+    rest = ("value" if not plan.inverse else
+            f"(value + B(2)) / {lit(w_sum)}" if w_sum != 0 else "0.0")
+    if plan.inverse:
+        head = """acc = u + B(2);
+for k = 1:n
+    acc = acc - B(iw + 1 + k) * x(k);
+end
+drive = acc / B(iw);
+out = drive;"""
+    else:
+        head = """acc = B(iw) * u - B(2);
+for k = 1:n
+    acc = acc + B(iw + 1 + k) * x(k);
+end
+drive = u;
+out = acc;"""
+    return f"""function x = model_rest(B, value)
+x = ({rest}) * ones(round(B(1)), 1);
+end
+
+function [out, x] = model_step(B, x, u)
+n = round(B(1));
+iw = 4 + 2 * n;
+{head}
+i_in = dead_zone(B, drive - x(1), 1, n);
+for k = 1:n
+    i_out = 0.0;
+    if k < n
+        i_out = dead_zone(B, x(k) - x(k + 1), k + 1, n);
+    end
+    x(k) = x(k) + B(3) * (i_in - i_out);
+    i_in = i_out;
+end
+end
+
+function i = dead_zone(B, v, k, n)
+band = B(3 + k); g = B(3 + n + k);
+if v > band
+    i = g * (v - band);
+elseif v < -band
+    i = g * (v + band);
+else
+    i = 0.0;
+end
+end
+"""

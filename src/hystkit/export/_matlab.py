@@ -1,0 +1,176 @@
+"""Write an :class:`ExportPlan` as MATLAB / GNU Octave code (double precision).
+
+Files:
+
+- ``NAME_init.m``: ``state = NAME_init(first_sensor)``, at rest at the first sensor sample;
+- ``NAME.m``: ``[estimate, state, flags] = NAME(sensor, state)`` over a chunk (a vector) of
+  sensor samples; ``state`` omitted or ``[]`` starts with ``NAME_init(sensor(1))``; calling it
+  chunk after chunk gives the same as one call on the whole signal;
+- ``NAME_block.m``: one sample in, one estimate out, the state ``persistent`` (for a Simulink
+  MATLAB Function block; ``clear NAME_block`` restarts it);
+- ``NAME_sync.m`` when the state after the synchronisation excitation is known.
+
+The arithmetic repeats :meth:`Compensator.estimate` in the same order as the C export.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._families import translator
+from ._plan import ExportPlan
+
+__all__ = ["matlab_files"]
+
+
+def lit(value: float) -> str:
+    """A MATLAB literal that reads back as the same double."""
+    value = float(value)
+    if np.isinf(value):
+        return "Inf" if value > 0 else "-Inf"
+    return repr(value)
+
+
+def _column(values: np.ndarray) -> str:
+    items = [lit(v) for v in np.asarray(values, dtype=float).ravel()]
+    rows = [", ".join(items[i:i + 6]) for i in range(0, len(items), 6)]
+    return "[" + " ...\n     ".join(rows) + "]'"
+
+
+def _comment(plan: ExportPlan, what: str) -> str:
+    p = plan.provenance
+    return f"""% {what}
+% Hysteresis compensator exported by hystkit {p['hystkit']} on {p['exported']}.
+% Do not edit: re-export from the model file instead.
+%
+% model family : {p['family']}
+% mode         : {p['mode']}
+% structure    : {p['structure']}
+% centring     : {p['center']} (causal)
+% source file  : {p['source']}
+% fit date     : {p['fit_date']}
+"""
+
+
+def _constants(plan: ExportPlan) -> dict[str, str]:
+    return {k: lit(v) for k, v in plan.constants.items()}
+
+
+def _centring(plan: ExportPlan) -> str:
+    c = _constants(plan)
+    if plan.center in ("fit", "none"):
+        offset = c["SENSOR_OFFSET"]
+        level = ""
+    else:
+        offset = f"(({c['SENSOR_OFFSET']} + st.level) - {c['SENSOR_REFERENCE']})"
+        if plan.center == "tare":
+            level = f"""if st.n_seen < {int(plan.constants['N_TARE'])}
+    st.sum_z = st.sum_z + sensor;
+    st.n_seen = st.n_seen + 1;
+    st.level = st.sum_z / st.n_seen;
+end
+"""
+        else:
+            level = f"""num = st.sum_z + {c['TRACK_A']} * sensor;
+den = st.weight_z + {c['TRACK_A']} * 1.0;
+st.sum_z = sensor * 0.0 - num * {c['TRACK_A1']};
+st.weight_z = 0.0 - den * {c['TRACK_A1']};
+st.level = num / den;
+"""
+    return f"""function [s, st] = normalised(st, sensor)
+% the model's input: offset removed, flipped by the polarity, scaled (eq. 5.10)
+{level}s = ({c['POLARITY']} * (sensor - {offset})) / {c['SENSOR_SCALE']};
+end
+"""
+
+
+def _body(plan: ExportPlan) -> str:
+    return f"""function B = body()
+% the family block's parameters (Family.block(...).body)
+B = {_column(plan.body)};
+end
+"""
+
+
+def _init(plan: ExportPlan) -> str:
+    n = plan.name
+    return _comment(plan, f"{n}_init.m") + f"""function state = {n}_init(first_sensor)
+% state = {n}_init(first_sensor): at rest at the first sensor sample (pass that sample to
+% {n} too).
+state = struct('x', zeros({plan.n_state}, 1), 'level', 0.0, 'sum_z', 0.0, 'weight_z', 0.0, ...
+               'n_seen', 0);
+[s, probe] = normalised(state, first_sensor);
+state.x = model_rest(body(), s);
+end
+
+{_centring(plan)}
+{_body(plan)}
+{translator(plan.model).m_model(plan, lit)}"""
+
+
+def _chunk(plan: ExportPlan) -> str:
+    n, c = plan.name, _constants(plan)
+    return _comment(plan, f"{n}.m") + f"""function [estimate, state, flags] = {n}(sensor, state)
+% [estimate, state, flags] = {n}(sensor, state): position estimates [mm] for a chunk of sensor
+% samples. state omitted or [] starts at rest at sensor(1) ({n}_init); pass the returned state
+% to the next call. flags per sample: 1 sensor outside the training range, 2 estimate outside
+% the training positions, 4 model output not finite or beyond 1e6 x the training range.
+if nargin < 2 || isempty(state)
+    state = {n}_init(sensor(1));
+end
+B = body();
+estimate = zeros(size(sensor));
+flags = zeros(size(sensor));
+x = state.x;
+for i = 1:numel(sensor)
+    [s, state] = normalised(state, sensor(i));
+    [p, x] = model_step(B, x, s);
+    e = p * {c['POSITION_SCALE']} + {c['POSITION_OFFSET']};
+    f = 0;
+    if s < {c['SENSOR_LOW']} || s > {c['SENSOR_HIGH']}, f = f + 1; end
+    if e < {c['ESTIMATE_LOW']} || e > {c['ESTIMATE_HIGH']}, f = f + 2; end
+    if ~(abs(p) <= {c['MAX_NORMALISED']}) || ~isfinite(e), f = f + 4; end
+    estimate(i) = e;
+    flags(i) = f;
+end
+state.x = x;
+end
+
+{_centring(plan)}
+{_body(plan)}
+{translator(plan.model).m_model(plan, lit)}"""
+
+
+def _block(plan: ExportPlan) -> str:
+    n = plan.name
+    return _comment(plan, f"{n}_block.m") + f"""function estimate = {n}_block(sensor)
+% estimate = {n}_block(sensor): one sample in, one estimate [mm] out, the state kept in a
+% persistent variable (for a Simulink MATLAB Function block). Starts at rest at the first
+% sample; 'clear {n}_block' starts again.
+persistent state
+if isempty(state)
+    state = {n}_init(sensor);
+end
+[estimate, state] = {n}(sensor, state);
+end
+"""
+
+
+def _sync(plan: ExportPlan) -> str:
+    n = plan.name
+    return _comment(plan, f"{n}_sync.m") + f"""function state = {n}_sync()
+% state = {n}_sync(): the state after the synchronisation excitation e_sync (eq. 2.21-2.22);
+% run e_sync on the device, then use this instead of {n}_init. Centring starts afresh.
+state = struct('x', {_column(plan.sync_state)}, 'level', 0.0, 'sum_z', 0.0, ...
+               'weight_z', 0.0, 'n_seen', 0);
+end
+"""
+
+
+def matlab_files(plan: ExportPlan) -> dict[str, str]:
+    """File name -> text of the MATLAB export."""
+    files = {f"{plan.name}.m": _chunk(plan), f"{plan.name}_init.m": _init(plan),
+             f"{plan.name}_block.m": _block(plan)}
+    if plan.sync_state is not None:
+        files[f"{plan.name}_sync.m"] = _sync(plan)
+    return files

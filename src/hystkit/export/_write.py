@@ -1,0 +1,58 @@
+"""Write an export folder atomically (all files or none; an existing folder only with force)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..compensation import Compensator
+from ..errors import InputError, OutputExistsError
+from ..io import atomic_folder
+from ._c import c_files
+from ._matlab import matlab_files
+from ._plan import ExportPlan, make_plan
+
+__all__ = ["LANGUAGES", "export_compensator", "sync_state_of"]
+
+LANGUAGES = ("c", "matlab")
+
+
+def sync_state_of(comp: Compensator) -> tuple[np.ndarray | None, str]:
+    """The model state after the synchronisation excitation (eq. 2.21-2.22) and a note; the
+    state is None, and the note says why, when the model does not forget its history."""
+    from ..compensation._sync import sync_excitation
+
+    try:
+        sync = sync_excitation(comp)
+    except InputError as exc:
+        return None, f"no sync start-up: {exc}"
+    return sync.state_after, (f"sync start-up: after e_sync ({sync.duration:g} s of levels "
+                              f"{', '.join(f'{v:g}' for v in sync.levels)} in normalised "
+                              f"{sync.quantity}, {sync.rule})")
+
+
+def export_compensator(comp: Compensator, out: str | Path, lang: str = "c", *,
+                       double: bool = False, name: str | None = None,
+                       force: bool = False) -> tuple[ExportPlan, dict[str, str]]:
+    """Write ``comp`` as code into the folder ``out``; returns the plan and file name -> text.
+
+    Raises
+    ------
+    InputError
+        Unknown language, or a compensator that cannot be exported (the reason).
+    OutputExistsError
+        ``out`` exists and ``force`` is not given.
+    """
+    if lang not in LANGUAGES:
+        raise InputError(f"--lang {lang!r}: choose one of {', '.join(LANGUAGES)}")
+    out = Path(out)
+    if out.exists() and not force:
+        raise OutputExistsError(f"{out} exists; use --force to write into it")
+    sync_state, sync_note = sync_state_of(comp)
+    plan = make_plan(comp, name, sync_state=sync_state, sync_note=sync_note)
+    files = c_files(plan, double) if lang == "c" else matlab_files(plan)
+    with atomic_folder(out, force=force, names=files) as tmp:
+        for file_name, text in files.items():
+            (tmp / file_name).write_text(text, encoding="utf-8")
+    return plan, files
