@@ -4,9 +4,11 @@ Ctrl-C already raises KeyboardInterrupt; SIGTERM by default kills the process on
 which would skip the atomic writers' cleanup. While a command runs, SIGTERM raises
 `~hystkit.errors.Terminated` instead, so ``finally`` blocks remove temporaries and `main`
 prints one line and exits 143. Both handlers first terminate this process's multiprocessing
-workers (``select --jobs``), so a pool being shut down does not wait for their work. Forked
-workers get the default actions back: on Ctrl-C (the terminal signals the whole process
-group) or when terminated they end without a traceback, and the parent reports once.
+workers (the processes of a local Dask cluster, `hystkit.parallel`), so a cluster being shut
+down does not wait for their work. Forked workers get the default actions back: on Ctrl-C (the
+terminal signals the whole process group) or when terminated they end without a traceback, and
+the parent reports once; a worker a cluster forks after the signal (a nanny restarting the one
+just stopped) ends at once.
 """
 
 from __future__ import annotations

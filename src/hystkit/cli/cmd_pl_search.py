@@ -7,6 +7,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ._common import deferred, integer, number
+from .cmd_compare import add_parallel_options, executor_for, say_where
 
 __all__ = ["register"]
 
@@ -47,7 +48,10 @@ def _search(args: argparse.Namespace) -> int:
     u, y = ((rec.position, rec.sensor) if args.direction == "position-to-sensor"
             else (rec.sensor, rec.position))
     grid = {"n": args.n, "p": args.p, "m": args.m, "s": args.s}
-    rows = structural_search(u, y, rec.dt, grid)
+    n_pieces = len(args.n) * len(args.p) * len(args.m) * len(args.s)
+    with executor_for(args, n_pieces) as executor:
+        say_where(executor, n_pieces)
+        rows = structural_search(u, y, rec.dt, grid, executor=executor)
     print(f"{args.data}: Power-Law structural search, {args.direction}, {u.size} samples, "
           f"dt = {rec.dt:g} s (errors eq. 5.11 on data normalised by eq. 5.10)")
     print(format_search_table(rows))
@@ -85,4 +89,5 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="model the sensor (the document's toolbox, default) or a direct "
                         "compensator")
     p.add_argument("--json", type=Path, help="also write the rows to this JSON file")
+    add_parallel_options(p)
     p.set_defaults(run=_search)

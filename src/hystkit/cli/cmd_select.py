@@ -16,7 +16,7 @@ from ._common import (
     positive_int,
     read_options,
 )
-from .cmd_compare import _models
+from .cmd_compare import _models, add_parallel_options, executor_for
 
 __all__ = ["register"]
 
@@ -45,7 +45,7 @@ def _select(args: argparse.Namespace) -> int:
         read_recording,
         write_json,
     )
-    from ..reports import candidates, plot_selection, select_model
+    from ..reports import candidates, folds, plot_selection, select_model
 
     check_output_path(args.out, args.force, inputs=args.data)
     report = args.report or args.out.with_name(args.out.stem + "-selection")
@@ -57,7 +57,9 @@ def _select(args: argparse.Namespace) -> int:
     print(f"selecting among {len(cands)} candidates on {', '.join(map(str, args.data))} "
           f"(deployable held-out R², "
           f"{'leave-one-recording-out' if len(recs) > 1 else 'blocked time folds'})")
-    result = select_model(recs, cands, jobs=args.jobs, progress=print)
+    n_pieces = len(cands) * len(folds(recs))
+    with executor_for(args, n_pieces) as executor:
+        result = select_model(recs, cands, executor=executor, progress=print)
     rows = result["ranking"]
     print(f"{'candidate':<32}{'cv R²':>8}{'min':>8}{'oracle':>8}{'line':>8}{'params':>7}"
           f"{'AIC':>10}{'BIC':>10}  guards")
@@ -106,7 +108,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--models", help="comma-separated families (default: all)")
     deferred(p.add_argument("--centers"), default=_default_center,
              help=lambda: f"comma-separated centrings to try (default {_default_center()})")
-    p.add_argument("--jobs", type=positive_int, default=1,
-                   help="worker processes for the candidates (default 1)")
     add_read_options(p)
+    add_parallel_options(p)
+    # the option's name before issue 13; --workers N does the same
+    p.add_argument("--jobs", type=positive_int, dest="workers", help=argparse.SUPPRESS)
     p.set_defaults(run=_select)

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,6 +20,7 @@ from ..compensation import DEFAULT_CENTER, check_fitting_data, evaluate, fit_com
 from ..errors import FitDivergedError
 from ..io import Recording
 from ..models import FAMILIES, get_family
+from ..parallel import Executor, SerialExecutor
 from ._compare import DISQUALIFYING, FAMILY_FAILURES
 
 __all__ = ["Candidate", "candidates", "folds", "plot_selection", "select_model"]
@@ -73,32 +73,39 @@ def _block(rec: Recording, start: int, stop: int, k: int) -> Recording:
                      position=rec.position[start:stop], source=f"{rec.source}[block {k + 1}]")
 
 
-def _score_candidate(args: tuple[Candidate, list, dict]) -> dict:
-    """Cross-validate one candidate (a top-level function, so worker processes can run it)."""
-    cand, pairs, options = args
-    scores, oracle, line, aic, bic, statuses = [], [], [], [], [], []
+def _score_fold(piece: tuple[Candidate, int, dict], *, pairs: Sequence) -> dict:
+    """One candidate fitted on one fold's training part and scored on its held-out part."""
+    cand, k, options = piece
+    train, held = pairs[k]
     try:
-        for train, held in pairs:
-            comp = fit_compensator(train, cand.size, model=cand.model, mode=cand.mode,
-                                   center=cand.center, diagnose=False, **options)
-            s = evaluate(comp, held)
-            if s["r2"] is None:  # evaluate gives None where R² is undefined or overflowed
-                raise FitDivergedError(f"{held.source}: held-out R² undefined for this fit")
-            scores.append(s["r2"])
-            oracle.append(s["r2_oracle"])
-            line.append(s["linear_r2"])
-            aic.append(comp.fit_info["aic"])
-            bic.append(comp.fit_info["bic"])
-            statuses.append(comp.fit_info["status"])
-            n_params = comp.fit_info["n_params"]
+        comp = fit_compensator(train, cand.size, model=cand.model, mode=cand.mode,
+                               center=cand.center, diagnose=False, **options)
+        s = evaluate(comp, held)
+        if s["r2"] is None:  # evaluate gives None where R² is undefined or overflowed
+            raise FitDivergedError(f"{held.source}: held-out R² undefined for this fit")
     except FAMILY_FAILURES as exc:
-        return {**_describe(cand), "error": f"{type(exc).__name__}: {exc}"}
+        return {"error": f"{type(exc).__name__}: {exc}"}
+    info = comp.fit_info
+    return {"r2": s["r2"], "r2_oracle": s["r2_oracle"], "linear_r2": s["linear_r2"],
+            "aic": info["aic"], "bic": info["bic"], "status": info["status"],
+            "n_params": info["n_params"]}
+
+
+def _candidate_row(cand: Candidate, fold_rows: Sequence[dict]) -> dict:
+    """A candidate's cross-validation row from its folds (in fold order): the first failing
+    fold's error, or the means over the folds."""
+    failed = next((f for f in fold_rows if "error" in f), None)
+    if failed is not None:
+        return {**_describe(cand), "error": failed["error"]}
+    scores = [f["r2"] for f in fold_rows]
+    statuses = [f["status"] for f in fold_rows]
     # One bad fold (e.g. a block that is all rest) does not condemn a family; most folds do.
     failing = [st for st in statuses if st in DISQUALIFYING]
     bad = sorted(set(failing)) if 2 * len(failing) > len(statuses) else []
+    mean = lambda key: float(np.mean([f[key] for f in fold_rows]))
     return {**_describe(cand), "cv_r2": float(np.mean(scores)), "cv_r2_min": float(min(scores)),
-            "cv_r2_oracle": float(np.mean(oracle)), "cv_linear_r2": float(np.mean(line)),
-            "n_params": n_params, "aic": float(np.mean(aic)), "bic": float(np.mean(bic)),
+            "cv_r2_oracle": mean("r2_oracle"), "cv_linear_r2": mean("linear_r2"),
+            "n_params": fold_rows[-1]["n_params"], "aic": mean("aic"), "bic": mean("bic"),
             "fold_status": statuses, "guard_failed": ", ".join(bad) or None}
 
 
@@ -114,9 +121,12 @@ def _rank_key(row: dict) -> tuple:
 
 
 def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
-                 jobs: int = 1, progress: Callable[[str], None] = lambda _: None,
-                 **options) -> dict:
+                 executor: Executor | None = None,
+                 progress: Callable[[str], None] = lambda _: None, **options) -> dict:
     """Rank candidates by cross-validated deployable R²; refit the winner on all recordings.
+
+    Every candidate x fold is one piece of work for `executor` (default: serial); the ranking
+    is the same whichever executor ran them. The winner's refit runs here.
 
     Returns
     -------
@@ -134,14 +144,21 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
     """
     check_fitting_data(recordings)
     pairs = folds(recordings)
-    work = [(c, pairs, options) for c in cands]
-    progress(f"  {len(cands)} candidates x {len(pairs)} folds"
-             f"{f' on {jobs} processes' if jobs > 1 else ''} ...")
-    if jobs > 1:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            rows = list(pool.map(_score_candidate, work))
-    else:
-        rows = [_score_candidate(w) for w in work]
+    executor = executor or SerialExecutor()
+    progress(f"  {len(cands)} candidates x {len(pairs)} folds on {executor.describe()} ...")
+    pieces = [(c, k, options) for c in cands for k in range(len(pairs))]
+    folds_left = [len(pairs)] * len(cands)
+
+    def fold_done(i: int, _: dict) -> None:
+        j = i // len(pairs)
+        folds_left[j] -= 1
+        if not folds_left[j]:
+            progress(f"  {cands[j].label}: cross-validated "
+                     f"({folds_left.count(0)}/{len(cands)})")
+
+    fold_rows = executor.map(_score_fold, pieces, shared={"pairs": pairs}, on_done=fold_done)
+    rows = [_candidate_row(c, fold_rows[j * len(pairs):(j + 1) * len(pairs)])
+            for j, c in enumerate(cands)]
     rows.sort(key=_rank_key)
     out = {"folds": [{"train": [r.source for r in train], "test": held.source}
                      for train, held in pairs], "ranking": rows, "winner": None,

@@ -10,6 +10,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ...metrics import e_max_pct, e_rms_pct
+from ...parallel import Executor, SerialExecutor
 from . import model as pl
 from .fit import fit_pl
 
@@ -22,8 +23,11 @@ DEFAULT_GRID: dict[str, tuple] = {"n": (1, 2, 5, 10), "p": (5.0, 21.0), "m": (1,
 
 def structural_search(u: np.ndarray, y: np.ndarray, dt: float,
                       grid: Mapping[str, Sequence] | None = None,
-                      slope_cap: float = 1.0) -> list[dict]:
+                      slope_cap: float = 1.0, executor: Executor | None = None) -> list[dict]:
     """Exhaustive search over N, p, M, S (sec. 2.2, table 5.1): fit every combination.
+
+    Each combination is one piece of work for `executor` (default: serial); the rows are the
+    same whichever executor ran them (but for ``seconds``, each fit's own time).
 
     Parameters
     ----------
@@ -43,21 +47,25 @@ def structural_search(u: np.ndarray, y: np.ndarray, dt: float,
     u = np.asarray(u, dtype=float) - np.mean(u)
     y = np.asarray(y, dtype=float) - np.mean(y)
     u, y = u / np.max(np.abs(u)), y / np.max(np.abs(y))
-    rows = []
-    for n, p, m, s in itertools.product(grid["n"], grid["p"], grid["m"], grid["s"]):
-        structure = pl.PlStructure(n_cells=int(n), power=float(p), n_basis=int(m),
-                                   smoothing=float(s), dt=dt, slope_cap=slope_cap)
-        t0 = time.perf_counter()
-        result = fit_pl(u, y, structure)
-        seconds = time.perf_counter() - t0
-        y_hat = pl.simulate(structure, result.params, u)[0]
-        rows.append({"n_cells": structure.n_cells, "power": structure.power,
-                     "n_basis": structure.n_basis, "smoothing": structure.smoothing,
-                     "n_params": structure.n_params, "e_rms_pct": e_rms_pct(y, y_hat, 1.0),
-                     "e_max_pct": e_max_pct(y, y_hat, 1.0), "seconds": seconds,
-                     "structure": structure.to_dict(),
-                     "params": result.params.to_dict()})
-    return rows
+    structures = [pl.PlStructure(n_cells=int(n), power=float(p), n_basis=int(m),
+                                 smoothing=float(s), dt=dt, slope_cap=slope_cap)
+                  for n, p, m, s in itertools.product(grid["n"], grid["p"], grid["m"],
+                                                      grid["s"])]
+    return (executor or SerialExecutor()).map(_fit_structure, structures,
+                                              shared={"u": u, "y": y})
+
+
+def _fit_structure(structure: pl.PlStructure, *, u: np.ndarray, y: np.ndarray) -> dict:
+    """One row of the search: `structure` fitted to normalised ``u -> y``."""
+    t0 = time.perf_counter()
+    result = fit_pl(u, y, structure)
+    seconds = time.perf_counter() - t0
+    y_hat = pl.simulate(structure, result.params, u)[0]
+    return {"n_cells": structure.n_cells, "power": structure.power,
+            "n_basis": structure.n_basis, "smoothing": structure.smoothing,
+            "n_params": structure.n_params, "e_rms_pct": e_rms_pct(y, y_hat, 1.0),
+            "e_max_pct": e_max_pct(y, y_hat, 1.0), "seconds": seconds,
+            "structure": structure.to_dict(), "params": result.params.to_dict()}
 
 
 def format_search_table(rows: Sequence[dict], best_only_per_n: bool = False) -> str:
