@@ -216,6 +216,9 @@ class LoopResponse:
     ----------
     t : time [s]; r, y, y_hat, y_hat_plant : positions [m]; s, s_hat : sensor units;
     e : tracking error the PID sees [m]; u : applied force [N]; d_hat : DOB force [N]
+    seconds : wall time of the simulation [s], JIT compilation excluded
+    compile_seconds : JIT compilation of the loop kernel before the run [s] (0 when this
+        combination of blocks was compiled before in the process)
     """
 
     scheme: str
@@ -236,6 +239,7 @@ class LoopResponse:
     stop_time: float | None = None
     stop_reason: str | None = None
     seconds: float = 0.0
+    compile_seconds: float = 0.0
 
     @property
     def plant_error(self) -> np.ndarray:
@@ -250,7 +254,8 @@ class LoopResponse:
         (one period of the trained 0.5 Hz sine: the start-up transient), when the run is longer.
         """
         e_p = self.plant_error
-        out = {"bounded": self.bounded, "seconds": self.seconds, "n_steps": int(self.t.size),
+        out = {"bounded": self.bounded, "seconds": self.seconds,
+               "compile_seconds": self.compile_seconds, "n_steps": int(self.t.size),
                "n_requested": self.n_requested}
         if e_p.size:
             i = int(np.argmax(np.abs(e_p)))
@@ -293,7 +298,8 @@ def _prepare(loop: ControlLoop, r, state, d_out, d_in, noise):
     return r, extra, state
 
 
-def _response(loop, r, t0, out, x_end, n_done, reason, seconds) -> LoopResponse:
+def _response(loop, r, t0, out, x_end, n_done, reason, seconds,
+              compile_seconds=0.0) -> LoopResponse:
     sig = dict(zip(_kernel.SIGNALS, out[:, :n_done], strict=True))
     bounded = reason == 0
     return LoopResponse(
@@ -306,7 +312,8 @@ def _response(loop, r, t0, out, x_end, n_done, reason, seconds) -> LoopResponse:
         n_requested=r.size,
         stop_step=None if bounded else int(n_done),
         stop_time=None if bounded else float(t0 + n_done * loop.ts),
-        stop_reason=None if bounded else _kernel.STOP_REASONS[reason], seconds=seconds)
+        stop_reason=None if bounded else _kernel.STOP_REASONS[reason], seconds=seconds,
+        compile_seconds=compile_seconds)
 
 
 def simulate_loop(loop: ControlLoop, r: np.ndarray, *, state: LoopState | None = None,
@@ -339,11 +346,12 @@ def simulate_loop(loop: ControlLoop, r: np.ndarray, *, state: LoopState | None =
         the signals then stop before that step.
     """
     r, (d_out, d_in, noise), state = _prepare(loop, r, state, d_out, d_in, noise)
-    args = loop.kernel_arguments()
+    args = (r, d_out, d_in, noise, state.to_vector(), *loop.kernel_arguments())
+    compile_seconds = _kernel.compile_run(*args)  # JIT, first run of these blocks only
     t_start = time.perf_counter()
-    out, x_end, n_done, reason = _kernel.run(r, d_out, d_in, noise, state.to_vector(), *args)
+    out, x_end, n_done, reason = _kernel.run(*args)
     seconds = time.perf_counter() - t_start
-    return _response(loop, r, t0, out, x_end, n_done, reason, seconds)
+    return _response(loop, r, t0, out, x_end, n_done, reason, seconds, compile_seconds)
 
 
 def simulate_loop_reference(loop: ControlLoop, r: np.ndarray, *,
