@@ -54,3 +54,26 @@ def test_subcommand_help_still_names_every_family():
                          capture_output=True, text=True, check=True, timeout=120).stdout
     for name in FAMILIES:
         assert name in out
+
+
+def test_the_family_registry_and_metadata_load_no_numba_or_scipy():
+    """What ``fit --help`` asks of the families (names, titles, sizes, docs) comes without
+    their numba kernels, scipy or pandas: each family folder loads its model on first use."""
+    code = ("from hystkit.models import FAMILIES, get_family\n"
+            "rows = [(f.name, f.title, f.size_help, f.default_size, f.max_size, f.docs)\n"
+            "        for f in FAMILIES.values()]\n"
+            "assert get_family('mpl').name == 'mpl' and len(rows) == len(FAMILIES)")
+    assert set(_loaded_after(code)) <= {"numpy"}
+
+
+def test_a_missing_input_is_refused_before_any_heavy_import():
+    """cli._inputs.check_inputs_exist: the instant 'file not found' of a misspelt input."""
+    code = ("from hystkit.cli._inputs import check_inputs_exist\n"
+            "from hystkit.errors import InputError\n"
+            "try:\n"
+            "    check_inputs_exist(['no-such-model.json'])\n"
+            "except InputError as exc:\n"
+            "    assert str(exc) == 'no-such-model.json: file not found'\n"
+            "else:\n"
+            "    raise AssertionError('no error')")
+    assert _loaded_after(code) == []
