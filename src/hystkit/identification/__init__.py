@@ -5,6 +5,14 @@ Each family's own fit is in its folder, ``hystkit.models.<family>``; the registr
 """
 
 from ._least_squares import check_fit_data, fit_multistart
+from ._lm import solve_lm
+from ._normal_equations import (
+                                ChunkedDifferences,
+                                NormalEquations,
+                                SolveResult,
+                                dense_normal_equations,
+)
 from ._result import BoundHit, FitResult
 
-__all__ = ["BoundHit", "FitResult", "check_fit_data", "fit_multistart"]
+__all__ = ["BoundHit", "ChunkedDifferences", "FitResult", "NormalEquations", "SolveResult",
+           "check_fit_data", "dense_normal_equations", "fit_multistart", "solve_lm"]

@@ -1,4 +1,15 @@
-"""Multi-start bounded least squares shared by the model families' fits (eq. 5.9)."""
+"""Multi-start bounded least squares shared by the model families' fits (eq. 5.9).
+
+The solvers work on normal equations ``(cost, J^T J, J^T r)`` that a family forms in one pass
+(its compiled sensitivity kernel, or chunked differences); given only a residual and a
+Jacobian (or '2-point'), the normal equations are formed from them:
+
+* ``solver="tr"`` (default): scipy's trust-region reflective on the normal equations
+  (:mod:`._trust_region`), the same iterates as before at a cost independent of the Jacobian;
+* ``solver="lm"``: a projected Levenberg-Marquardt (:mod:`._lm`);
+* ``solver="trf"``: scipy's ``least_squares(method="trf", x_scale="jac")`` on the residual and
+  dense Jacobian, kept for comparison and as a fallback.
+"""
 
 from __future__ import annotations
 
@@ -12,9 +23,14 @@ from scipy.optimize import least_squares
 from threadpoolctl import threadpool_limits
 
 from ..errors import FitDivergedError
+from ._lm import solve_lm
+from ._normal_equations import NormalEquations, dense_normal_equations
 from ._result import FitResult
+from ._trust_region import solve_trust_region
 
 __all__ = ["check_fit_data", "fit_multistart"]
+
+_SOLVERS = {"tr": solve_trust_region, "lm": solve_lm, "trf": None}
 
 
 def check_fit_data(u: np.ndarray, y: np.ndarray,
@@ -46,6 +62,9 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
                    to_params: Callable[[np.ndarray], Any],
                    structure: Any, *,
                    jac: Callable[[np.ndarray], np.ndarray] | str = "2-point",
+                   normal_equations: Callable[[np.ndarray], NormalEquations] | None = None,
+                   cost: Callable[[np.ndarray], float] | None = None,
+                   solver: str = "tr",
                    max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
                    accept: Callable[[Any], bool] | None = None,
                    accept_reason: str = "rejected by the acceptance test",
@@ -70,6 +89,15 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
         ``theta -> params`` of the model family.
     jac : callable or "2-point"
         Exact Jacobian if the family has one, else finite differences.
+    normal_equations : callable, optional
+        ``theta -> NormalEquations`` (cost ``0.5 sum(r**2)``, ``J^T J``, ``J^T r``) formed
+        without the dense Jacobian, for ``solver="tr"`` or ``"lm"``; by default formed from
+        ``residual`` and ``jac``.
+    cost : callable, optional
+        ``theta -> 0.5 sum(r**2)`` alone: trial points are then judged by it, and the normal
+        equations formed only where a step is accepted.
+    solver : {"tr", "lm", "trf"}
+        See the module docstring.
     names : sequence of str, optional
         Names of the ``theta`` coordinates, so that reports name a parameter on a bound
         (``FitResult.bound_hits``) instead of giving its index.
@@ -84,8 +112,11 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
     FitDivergedError
         If no start gives a finite cost, or every candidate is vetoed (the message says why).
     ValueError
-        If ``names`` or ``limits`` do not have one entry per coordinate.
+        If ``names`` or ``limits`` do not have one entry per coordinate, or ``solver`` is
+        unknown.
     """
+    if solver not in _SOLVERS:
+        raise ValueError(f"solver must be one of {sorted(_SOLVERS)}, got {solver!r}")
     lower, upper = (np.asarray(b, dtype=float) for b in bounds)
     names = _per_coordinate(names, lower.size, "names")
     if limits is not None:
@@ -94,17 +125,32 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
         limits = (_per_coordinate(limits[0], lower.size, "limits[0]"),
                   _per_coordinate(limits[1], lower.size, "limits[1]"))
     margin = 1e-9 * np.maximum(1.0, upper - lower)
+    if solver != "trf" and normal_equations is None:
+        normal_equations = dense_normal_equations(residual, jac, lower, upper)
+        if cost is None and not callable(jac):
+            # a difference Jacobian costs n_params runs: judge trial points by the cost alone
+            def cost(theta: np.ndarray) -> float:
+                r = residual(theta)
+                return 0.5 * float(r @ r)
 
     def solve(theta0: np.ndarray, budget: int) -> SimpleNamespace:
         # BLAS threads do not pay on (n x n_params) problems, and under load they cost 10-30x
         # (benchmarks/README.md).
         with threadpool_limits(limits=1, user_api="blas"):
+            if solver != "trf":
+                # lm may stop on a bound, the margin keeps it inside as trf and tr stay
+                shrink = margin if solver == "lm" else 0.0
+                sol = _SOLVERS[solver](normal_equations, theta0, lower + shrink,
+                                       upper - shrink, cost=cost, max_nfev=budget)
+                return SimpleNamespace(x=sol.x, cost=sol.cost, status=sol.status,
+                                       message=sol.message, n_runs=sol.n_runs,
+                                       column_norms=sol.column_norms)
             sol = least_squares(residual, theta0, jac=jac, bounds=(lower, upper),
                                 method="trf", x_scale="jac", max_nfev=budget)
         # Keep only what ranking and reporting need: the (n x n_params) Jacobian and the
         # residuals of every screened start alive together cost GBs on long recordings.
         return SimpleNamespace(x=sol.x, cost=float(sol.cost), status=sol.status,
-                               message=sol.message, nfev=sol.nfev, njev=sol.njev,
+                               message=sol.message, n_runs=sol.nfev + (sol.njev or 0),
                                column_norms=_column_norms(sol.jac))
 
     t_start = time.perf_counter()
@@ -112,7 +158,7 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
     for theta0 in starts:
         sol = solve(np.clip(np.asarray(theta0, dtype=float), lower + margin, upper - margin),
                     screen_nfev)
-        n_eval += sol.nfev + (sol.njev or 0)
+        n_eval += sol.n_runs
         if np.isfinite(sol.cost):
             screened.append(sol)
     screened.sort(key=lambda sol: sol.cost)
@@ -122,7 +168,7 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
             break
         if sol.status == 0:  # budget ran out: continue from where it stopped
             sol = solve(sol.x, max_nfev)
-            n_eval += sol.nfev + (sol.njev or 0)
+            n_eval += sol.n_runs
         if not np.isfinite(sol.cost):
             continue
         if accept is not None and not accept(to_params(sol.x)):

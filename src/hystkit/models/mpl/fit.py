@@ -1,8 +1,10 @@
 """Least-squares identification of the mPL model (sec. 5.3.2, cost eq. 5.9).
 
 The document minimised the SSE with fmincon / patternsearch for about a minute. Here the same
-cost goes to ``scipy.optimize.least_squares`` (trust-region reflective, bounds) with the exact
-Jacobian from forward sensitivities of the Euler recursion, from a few deterministic starts.
+cost goes to the bounded Levenberg-Marquardt of ``hystkit.identification`` with exact normal
+equations ``J^T J``, ``J^T r`` accumulated in one pass of the forward sensitivities of the Euler
+recursion (``kernels.normal_equations``; the ``n x p`` Jacobian is never stored), from a few
+deterministic starts (``solver="trf"``: scipy's trust-region reflective on the dense Jacobian).
 Each start sets the cell time constants and gets its linear parameters (``w``, ``V_b``, which
 enter the output linearly) by linear least squares, so no start begins far off.
 """
@@ -13,7 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ...identification import FitResult, check_fit_data, fit_multistart
+from ...identification import FitResult, NormalEquations, check_fit_data, fit_multistart
 from . import kernels
 from . import model as mpl
 
@@ -28,14 +30,18 @@ _W_BOUND = 100.0
 
 def _linear_init(structure: mpl.MplStructure, i_s: np.ndarray, v_t: np.ndarray,
                  u: np.ndarray, y: np.ndarray) -> mpl.MplParams:
-    """Given cell resistors, the best weights and bias by linear least squares."""
+    """Given cell resistors, the best weights and bias by linear least squares.
+
+    With ``w = 0``, ``V_b = 0`` the model output is 0, so ``r = -y`` and the normal equations'
+    block of the linear columns (``[u, x_1..x_N, -1]``) gives ``coef = -(J_l^T J_l)^+ J_l^T r``.
+    """
     probe = mpl.MplParams(i_s=i_s, v_t=v_t, w=np.zeros(structure.n_cells + 1))
     knee = mpl.knee_voltage(structure, probe)
-    _, jac = kernels.simulate_with_jacobian(u, np.full(structure.n_cells, u[0]), probe.i_s,
-                                            probe.v_t, probe.w, 0.0, knee,
-                                            structure.slope_cap / structure.dt, structure.dt)
-    lin = jac[:, 2 * structure.n_cells:]  # columns of w_0..w_N and V_b: [u, x_1..x_N, -1]
-    coef = np.linalg.lstsq(lin, y, rcond=None)[0]
+    _, jtj, jtr = kernels.normal_equations(u, y, np.full(structure.n_cells, u[0]), probe.i_s,
+                                           probe.v_t, probe.w, 0.0, knee,
+                                           structure.slope_cap / structure.dt, structure.dt)
+    lin = slice(2 * structure.n_cells, None)
+    coef = -np.linalg.lstsq(jtj[lin, lin], jtr[lin], rcond=None)[0]
     coef[:-1] = np.clip(coef[:-1], -0.9 * _W_BOUND, 0.9 * _W_BOUND)
     return mpl.MplParams(i_s=i_s, v_t=v_t, w=coef[:-1], v_b=coef[-1])
 
@@ -97,7 +103,8 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
             starts: list[tuple[np.ndarray, np.ndarray]] | None = None,
             max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
             accept: Callable[[mpl.MplParams], bool] | None = None,
-            accept_reason: str = "rejected by the acceptance test") -> FitResult:
+            accept_reason: str = "rejected by the acceptance test",
+            solver: str = "tr") -> FitResult:
     """Fit an mPL model mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9).
 
     Parameters
@@ -116,6 +123,8 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     accept : callable, optional
         A candidate solution counts only if ``accept(params)`` is true (inverse mode uses it to
         require a bounded inverse); ``accept_reason`` says why others were rejected.
+    solver : {"tr", "lm", "trf"}
+        See :func:`hystkit.identification.fit_multistart`.
 
     Raises
     ------
@@ -131,26 +140,31 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     starts = default_starts(structure) if starts is None else starts
     cache: dict = {}
 
+    def kernel_args(theta: np.ndarray) -> tuple:
+        p = mpl.MplParams.from_vector(theta, n)
+        return p.i_s, p.v_t, p.w, p.v_b, mpl.knee_voltage(structure, p), cap, structure.dt
+
     def run(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        # least_squares asks for the residual and then the Jacobian at the same point: the
-        # sensitivity kernel yields both in one pass.
+        # least_squares (solver="trf") asks for the residual and then the Jacobian at the same
+        # point: the sensitivity kernel yields both in one pass.
         key = theta.tobytes()
         if key not in cache:
-            p = mpl.MplParams.from_vector(theta, n)
-            knee = mpl.knee_voltage(structure, p)
             cache.clear()
-            cache[key] = kernels.simulate_with_jacobian(u, x0, p.i_s, p.v_t, p.w, p.v_b, knee,
-                                                        cap, structure.dt)
+            cache[key] = kernels.simulate_with_jacobian(u, x0, *kernel_args(theta))
         return cache[key]
+
+    def normal_equations(theta: np.ndarray) -> NormalEquations:
+        sse, jtj, jtr = kernels.normal_equations(u, y, x0, *kernel_args(theta))
+        return NormalEquations(0.5 * sse, jtj, jtr)
 
     thetas = [_linear_init(structure, np.asarray(i_s, float), np.asarray(v_t, float), u,
                            y).to_vector() for i_s, v_t in starts]
     return fit_multistart(lambda th: run(th)[0] - y, thetas, (lower, upper),
                           lambda th: mpl.MplParams.from_vector(th, n), structure,
-                          jac=lambda th: run(th)[1], max_nfev=max_nfev,
-                          screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
-                          accept_reason=accept_reason, names=theta_names(n),
-                          limits=theta_limits(n))
+                          jac=lambda th: run(th)[1], normal_equations=normal_equations,
+                          solver=solver, max_nfev=max_nfev, screen_nfev=screen_nfev,
+                          n_polish=n_polish, accept=accept, accept_reason=accept_reason,
+                          names=theta_names(n), limits=theta_limits(n))
 
 
 def random_params(structure: mpl.MplStructure, rng: np.random.Generator) -> mpl.MplParams:

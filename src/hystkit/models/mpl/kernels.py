@@ -100,6 +100,64 @@ def simulate_with_jacobian(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
     return y, jac
 
 
+# Rows of J gathered before they are folded into J^T J by one matrix product (BLAS): a block of
+# 256 rows costs 256 x p x 8 bytes and made the 3-cell pass ~2x faster than row-by-row sums.
+NORMAL_BLOCK = 256
+
+
+@njit(cache=True)
+def normal_equations(u, y_target, x0, i_s, v_t, w, v_b, knee, cap, dt):
+    """``sum(r^2)``, ``J^T J`` and ``J^T r`` for ``r = y - y_target`` in one pass.
+
+    The same forward sensitivities and column order as :func:`simulate_with_jacobian`, but
+    the Jacobian rows are folded into the (p x p) and (p,) sums block by block as they are
+    formed, so memory is independent of ``u.size``.
+    """
+    n_cells = x0.size
+    p = 3 * n_cells + 2
+    x = x0.copy()
+    sens = np.zeros((n_cells, 2))
+    rows = np.empty((NORMAL_BLOCK, p))
+    res = np.empty(NORMAL_BLOCK)
+    jtj = np.zeros((p, p))
+    jtr = np.zeros(p)
+    sse = 0.0
+    m = 0
+    for n in range(u.size):
+        acc = w[0] * u[n] - v_b
+        for k in range(n_cells):
+            acc += w[k + 1] * x[k]
+            rows[m, 2 * k] = w[k + 1] * sens[k, 0]
+            rows[m, 2 * k + 1] = w[k + 1] * sens[k, 1]
+            rows[m, 2 * n_cells + 1 + k] = x[k]
+        rows[m, 2 * n_cells] = u[n]
+        rows[m, 3 * n_cells + 1] = -1.0
+        r = acc - y_target[n]
+        res[m] = r
+        sse += r * r
+        m += 1
+        if m == NORMAL_BLOCK or n == u.size - 1:
+            block = rows[:m]
+            jtj += block.T @ block
+            jtr += block.T @ res[:m]
+            m = 0
+        for k in range(n_cells):
+            v = u[n] - x[k]
+            f, slope = current(v, i_s[k], v_t[k], knee[k], cap)
+            if abs(v) <= knee[k]:
+                d_log_g = f
+                d_log_vt = f - v * slope
+            else:
+                s = 1.0 if v > 0 else -1.0
+                f_knee = 2.0 * i_s[k] * np.sinh(knee[k] / v_t[k])
+                d_log_g = s * f_knee
+                d_log_vt = s * (f_knee - knee[k] * cap)
+            sens[k, 0] += (d_log_g - slope * sens[k, 0]) * dt
+            sens[k, 1] += (d_log_vt - slope * sens[k, 1]) * dt
+            x[k] += f * dt
+    return sse, 0.5 * (jtj + jtj.T), jtr  # symmetric whatever order BLAS summed in
+
+
 # Loop blocks (protocol in ``hystkit.models._protocol``): body = [n, v_b, cap, dt,
 # i_s (n), v_t (n), knee (n), w (n + 1)].
 

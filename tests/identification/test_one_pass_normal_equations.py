@@ -1,0 +1,56 @@
+"""One-pass normal equations of the compiled kernels equal those of the dense Jacobian."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from hystkit.models import mpl
+from hystkit.models.mpl import kernels as mpl_kernels
+
+
+def _input(n, seed):
+    t = np.arange(n) * 0.025
+    rng = np.random.default_rng(seed)
+    u = np.sin(2 * np.pi * 0.5 * t) + 0.3 * rng.normal(size=n)
+    return u / np.max(np.abs(u))
+
+
+def _dense(y_model, jac, target):
+    r = y_model - target
+    return float(r @ r), jac.T @ jac, jac.T @ r
+
+
+def _assert_same(one_pass, dense):
+    """To 1e-10 relative: the sums differ only in the order of floating-point additions."""
+    sse, jtj, jtr = one_pass
+    sse_ref, jtj_ref, jtr_ref = dense
+    assert_allclose(sse, sse_ref, rtol=1e-10)
+    assert_allclose(jtj, jtj_ref, rtol=1e-10, atol=1e-10 * np.max(np.abs(jtj_ref)))
+    assert_allclose(jtr, jtr_ref, rtol=1e-10, atol=1e-10 * np.max(np.abs(jtr_ref)))
+    assert_allclose(jtj, jtj.T, rtol=0, atol=0)
+
+
+@pytest.mark.parametrize("n_cells", [1, 3])
+@pytest.mark.parametrize("rate", [0.05, 0.95])  # cells far below the cap / near it (knee)
+def test_mpl_one_pass_equals_the_dense_jacobian(n_cells, rate):
+    structure = mpl.MplStructure(n_cells=n_cells, dt=0.025)
+    cap = structure.slope_cap / structure.dt
+    rng = np.random.default_rng(n_cells)
+    v_t = rng.uniform(0.1, 0.5, n_cells)
+    g = rate * cap * rng.uniform(0.5, 1.0, n_cells)
+    params = mpl.MplParams(i_s=0.5 * g * v_t, v_t=v_t, w=rng.uniform(-1, 1, n_cells + 1),
+                           v_b=0.1)
+    u = _input(3000, n_cells)
+    target = np.roll(u, 7) ** 3
+    knee = mpl.knee_voltage(structure, params)
+    args = (np.full(n_cells, u[0]), params.i_s, params.v_t, params.w, params.v_b, knee, cap,
+            structure.dt)
+    y_model, jac = mpl_kernels.simulate_with_jacobian(u, *args)
+    # cell states (the output with w = e_k, V_b = 0): both branches of the limited resistor
+    # (eq. 5.29) must be exercised when the rate is near the cap
+    states = np.column_stack([
+        mpl_kernels.simulate(u, args[0], params.i_s, params.v_t, np.eye(n_cells + 1)[k + 1],
+                             0.0, knee, cap, structure.dt)[0] for k in range(n_cells)])
+    share_beyond = np.mean(np.abs(u[:, None] - states) > knee)
+    assert share_beyond > 0.2 if rate > 0.5 else share_beyond < 0.05
+    _assert_same(mpl_kernels.normal_equations(u, target, *args), _dense(y_model, jac, target))
