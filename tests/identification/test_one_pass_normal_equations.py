@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from hystkit.models import mpl
+from hystkit.models import mpl, mpl_poly
 from hystkit.models.mpl import kernels as mpl_kernels
+from hystkit.models.mpl_poly.fit import normal_equations, random_params
 
 
 def _input(n, seed):
@@ -54,3 +55,29 @@ def test_mpl_one_pass_equals_the_dense_jacobian(n_cells, rate):
     share_beyond = np.mean(np.abs(u[:, None] - states) > knee)
     assert share_beyond > 0.2 if rate > 0.5 else share_beyond < 0.05
     _assert_same(mpl_kernels.normal_equations(u, target, *args), _dense(y_model, jac, target))
+
+
+@pytest.mark.parametrize("limit", [True, False])
+@pytest.mark.parametrize("n_cells", [1, 2])
+def test_mpl_poly_one_pass_equals_the_dense_jacobian(n_cells, limit):
+    """From rest (the start moves with the parameters), with and without the Euler limit."""
+    structure = mpl_poly.MplPolyStructure(n_cells=n_cells, dt=0.025, limit=limit)
+    rng = np.random.default_rng(10 + n_cells)
+    params = random_params(structure, rng)
+    u = _input(3000, n_cells)
+    target = np.tanh(2 * np.roll(u, 5))
+    y_model, jac = mpl_poly.simulate_with_jacobian(structure, params, u)
+    assert np.all(np.isfinite(jac))
+    ne = normal_equations(structure, params, u, target)
+    _assert_same((2 * ne.cost, ne.jtj, ne.jtr), _dense(y_model, jac, target))
+
+
+def test_mpl_poly_one_pass_rejects_a_diverging_run():
+    """Without the limit a steep cubic overshoots each Euler step and runs away: infinite
+    cost, where the dense run gives NaN."""
+    structure = mpl_poly.MplPolyStructure(n_cells=1, dt=0.025, limit=False)
+    params = mpl_poly.MplPolyParams(f=[[0.0, 1.0, 0.0, 1e3]], g=[0.0, 1.0, 0.0, 0.0],
+                                    w=[1.0, 1.0])
+    u = 3 * _input(500, 0)
+    assert not np.all(np.isfinite(mpl_poly.simulate_with_jacobian(structure, params, u)[0]))
+    assert normal_equations(structure, params, u, u).cost == np.inf

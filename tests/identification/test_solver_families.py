@@ -10,7 +10,7 @@ rounding moves the stopping point, while a different local minimum changes the S
 import pytest
 
 from hystkit.compensation import centre_and_scale
-from hystkit.models import mpl
+from hystkit.models import mpl, mpl_poly
 from hystkit.sensors._virtual import simulate_experiment
 
 RTOL = 1e-4
@@ -36,3 +36,10 @@ def _same_cost(fit, *args, **kwargs):
 def test_mpl(sine_data, n_cells):
     u, y, dt = sine_data
     _same_cost(mpl.fit_mpl, u, y, mpl.MplStructure(n_cells=n_cells, dt=dt))
+
+
+@pytest.mark.parametrize("limit", [True, False])
+def test_mpl_poly(sine_data, limit):
+    u, y, dt = sine_data
+    _same_cost(mpl_poly.fit_mpl_poly, u, y, mpl_poly.MplPolyStructure(n_cells=1, dt=dt,
+                                                                      limit=limit))

@@ -1,8 +1,9 @@
 """Least-squares identification of the polynomial mPL (sec. 5.3.5, paper 9.2).
 
 The paper ran MATLAB's patternsearch for 60 s from table I's start. Here the same SSE (eq. 5.9)
-goes to the shared multi-start trust-region least squares with the exact Jacobian (forward
-sensitivities through the Euler recursion and the limited cubic), from deterministic starts:
+goes to the shared multi-start trust-region least squares with exact normal equations
+``J^T J``, ``J^T r`` accumulated in one pass of the forward sensitivities through the Euler
+recursion and the limited cubic (``kernels.normal_equations``), from deterministic starts:
 table I of paper 9.2 as printed, and six "linear-output" starts whose cells are sinh-like
 cubics with time constants spread over decades and whose weights come from linear least
 squares (with ``g(z) = z`` the output is linear in ``w`` and ``V_b``).
@@ -24,7 +25,8 @@ from dataclasses import replace
 import numpy as np
 
 from ...errors import FitDivergedError
-from ...identification import FitResult, check_fit_data, fit_multistart
+from ...identification import FitResult, NormalEquations, check_fit_data, fit_multistart
+from . import kernels
 from . import model as mpl_poly
 from .presets import PAPER_9_2_TABLE_I, paper_9_2_params
 
@@ -116,22 +118,53 @@ def default_starts(structure: mpl_poly.MplPolyStructure) -> list[np.ndarray]:
 def _linear_output_start(structure: mpl_poly.MplPolyStructure, f: np.ndarray, u: np.ndarray,
                          y: np.ndarray) -> mpl_poly.MplPolyParams | None:
     """Given the cell resistors and ``g(z) = z``: weights and bias by linear least squares.
-    None if the cells diverge on ``u`` (possible only without the limit)."""
+    None if the cells diverge on ``u`` (possible only without the limit).
+
+    With ``w = 0``, ``V_b = 0`` the output is ``g(0) = 0``, so ``r = -y``, and as ``g' = 1`` the
+    columns of ``w_0..w_N``, ``V_b`` are ``[u, x_1..x_N, -1]``: their block of the normal
+    equations gives ``coef = -(J_l^T J_l)^+ J_l^T r``.
+    """
     n = structure.n_cells
     probe = mpl_poly.MplPolyParams(f=f, g=[0.0, 1.0, 0.0, 0.0], w=np.zeros(n + 1))
-    _, jac = mpl_poly.simulate_with_jacobian(structure, probe, u)
-    lin = jac[:, 4 * n + 4:]  # columns of w_0..w_N and V_b: [u, x_1..x_N, -1] as g' = 1
-    if not np.all(np.isfinite(lin)):
+    ne = normal_equations(structure, probe, u, y)
+    if not np.isfinite(ne.cost):
         return None
-    coef = np.linalg.lstsq(lin, y, rcond=None)[0]
+    lin = slice(4 * n + 4, None)
+    coef = -np.linalg.lstsq(ne.jtj[lin, lin], ne.jtr[lin], rcond=None)[0]
     coef[:-1] = np.clip(coef[:-1], -0.9 * _W_BOUND, 0.9 * _W_BOUND)
     return mpl_poly.MplPolyParams(f=f, g=probe.g, w=coef[:-1], v_b=coef[-1])
+
+
+def normal_equations(structure: mpl_poly.MplPolyStructure, params: mpl_poly.MplPolyParams,
+                     u: np.ndarray, y: np.ndarray) -> NormalEquations:
+    """Cost ``0.5 SSE``, ``J^T J`` and ``J^T r`` of the run from rest, in one pass.
+
+    As :func:`mpl_poly.simulate_with_jacobian` (the rest start moves with the parameters)
+    without the ``n x (5N + 6)`` Jacobian; infinite cost outside the domain or on divergence.
+    """
+    p = 5 * structure.n_cells + 6
+    try:
+        mpl_poly.check_rest(structure, params)
+    except FitDivergedError:
+        return NormalEquations(np.inf, np.full((p, p), np.nan), np.full(p, np.nan))
+    x = mpl_poly._start(structure, params, None, u[0])
+    fc, knees, s, limit, gc = mpl_poly._kernel_args(structure, params)
+    slope = mpl_poly.resistor_slope(structure, params, u[0] - x)
+    sens0 = np.array([kernels.cell_gradient(u[0] - x[k], fc[k], knees[k, 0], knees[k, 1], s,
+                                            limit) / slope[k] for k in range(structure.n_cells)])
+    sse, jtj, jtr, n_bad = kernels.normal_equations(
+        u, y, x, sens0, fc, knees, s, limit, gc, params.w,
+        params.v_b, structure.dt, mpl_poly._bound(structure, u, x))
+    if n_bad >= 0:
+        return NormalEquations(np.inf, np.full((p, p), np.nan), np.full(p, np.nan))
+    return NormalEquations(0.5 * sse, jtj, jtr)
 
 
 def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStructure, *,
                  max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
                  accept: Callable[[mpl_poly.MplPolyParams], bool] | None = None,
-                 accept_reason: str = "rejected by the acceptance test") -> FitResult:
+                 accept_reason: str = "rejected by the acceptance test",
+                 solver: str = "tr") -> FitResult:
     """Fit a polynomial mPL mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9).
 
     Parameters
@@ -145,6 +178,8 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
         As :func:`hystkit.identification.fit_multistart`.
     accept : callable, optional
         A candidate counts only if ``accept(params)``; ``accept_reason`` says why others failed.
+    solver : {"tr", "lm", "trf"}
+        See :func:`hystkit.identification.fit_multistart` ("trf" works on the dense Jacobian).
 
     Raises
     ------
@@ -163,9 +198,9 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
         return mpl_poly.MplPolyParams.from_vector(theta, n)
 
     def run(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        # least_squares asks for the residual and then the Jacobian at the same point: the
-        # sensitivity kernel yields both in one pass. A diverged run is all NaN, which the
-        # trust-region solver treats as a rejected step.
+        # solver="trf": least_squares asks for the residual and then the Jacobian at the same
+        # point: the sensitivity kernel yields both in one pass. A diverged run is all NaN,
+        # which the trust-region solver treats as a rejected step.
         key = theta.tobytes()
         if key not in cache:
             cache.clear()
@@ -175,18 +210,27 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
                 cache[key] = (np.full(u.size, np.nan), np.full((u.size, theta.size), np.nan))
         return cache[key]
 
+    def one_pass(theta: np.ndarray) -> NormalEquations:
+        try:
+            params = to_params(theta)
+        except ValueError:  # outside the parameter domain (a rest point beyond REST_MAX)
+            p = theta.size
+            return NormalEquations(np.inf, np.full((p, p), np.nan), np.full(p, np.nan))
+        return normal_equations(structure, params, u, y)
+
     candidates = [_table_i_start(n)] + [_linear_output_start(structure, f, u, y)
                                         for f in default_starts(structure)]
-    # the solver needs a finite residual at each start
+    # the solver needs a finite cost at each start
     thetas = [p.to_vector() for p in candidates
-              if p is not None and np.all(np.isfinite(run(p.to_vector())[0]))]
+              if p is not None and np.isfinite(one_pass(p.to_vector()).cost)]
     if not thetas:
         raise FitDivergedError("the fit failed: the model diverges on the training data from "
                                "every start (use the stability limit)")
     result = fit_multistart(lambda th: run(th)[0] - y, thetas, (lower, upper), to_params,
-                            structure, jac=lambda th: run(th)[1], max_nfev=max_nfev,
-                            screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
-                            accept_reason=accept_reason, names=theta_names(n))
+                            structure, jac=lambda th: run(th)[1], normal_equations=one_pass,
+                            solver=solver, max_nfev=max_nfev, screen_nfev=screen_nfev,
+                            n_polish=n_polish, accept=accept, accept_reason=accept_reason,
+                            names=theta_names(n))
     # the (N + 2)-dimensional valley of equivalent parameters (see the module docstring)
     if result.params.w[0] == 0:
         return result

@@ -114,6 +114,62 @@ def simulate_with_jacobian(u, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt, bo
     return y, jac, -1
 
 
+# Jacobian rows gathered before one matrix product folds them into J^T J (as in the mPL's).
+NORMAL_BLOCK = 256
+
+
+@njit(cache=True)
+def normal_equations(u, y_target, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt, bound):
+    """``sum(r^2)``, ``J^T J``, ``J^T r`` for ``r = y - y_target`` in one pass, with the
+    sensitivities and column order of :func:`simulate_with_jacobian` but without storing ``J``.
+    Returns ``(sse, jtj, jtr, n_bad)``, ``n_bad`` as :func:`simulate` (the sums then stop)."""
+    n_cells = x0.size
+    p = 5 * n_cells + 6
+    x = x0.copy()
+    sens = sens0.copy()
+    rows = np.zeros((NORMAL_BLOCK, p))
+    res = np.empty(NORMAL_BLOCK)
+    jtj = np.zeros((p, p))
+    jtr = np.zeros(p)
+    sse = 0.0
+    m = 0
+    col_g, col_w, col_vb = 4 * n_cells, 4 * n_cells + 4, 5 * n_cells + 5
+    for n in range(u.size):
+        z = w[0] * u[n] - v_b
+        for k in range(n_cells):
+            z += w[k + 1] * x[k]
+        y, dg = _cubic(gc[0], gc[1], gc[2], gc[3], z)
+        zj = 1.0
+        for j in range(4):
+            rows[m, col_g + j] = zj
+            zj *= z
+        rows[m, col_w] = dg * u[n]
+        rows[m, col_vb] = -dg
+        for k in range(n_cells):
+            rows[m, col_w + 1 + k] = dg * x[k]
+            for j in range(4):
+                rows[m, 4 * k + j] = dg * w[k + 1] * sens[k, j]
+        r = y - y_target[n]
+        res[m] = r
+        sse += r * r
+        m += 1
+        if m == NORMAL_BLOCK or n == u.size - 1:
+            block = rows[:m]
+            jtj += block.T @ block
+            jtr += block.T @ res[:m]
+            m = 0
+        for k in range(n_cells):
+            v = u[n] - x[k]
+            f, slope = _cell(v, fc[k], knees[k, 0], knees[k, 1], s, limit)
+            grad = cell_gradient(v, fc[k], knees[k, 0], knees[k, 1], s, limit)
+            for j in range(4):
+                sens[k, j] += (grad[j] - slope * sens[k, j]) * dt
+            x[k] += f * dt
+            if not abs(x[k]) < bound:
+                return sse, jtj, jtr, n
+    return sse, 0.5 * (jtj + jtj.T), jtr, -1  # symmetric whatever order BLAS summed in
+
+
 @njit(cache=True)
 def solve_output(i, gc, lo, hi, sign, centre):
     """The ``z`` in ``[lo, hi]`` (a monotone branch of ``g`` around ``centre``, ``sign`` = sign
