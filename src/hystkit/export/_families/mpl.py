@@ -75,14 +75,14 @@ def m_model(plan, lit: Callable[[float], str]) -> str:
     if plan.inverse:
         head = """acc = u + B(2);
 for k = 1:n
-    acc = acc - B(iw + 1 + k) * x(k);
+    acc = acc - B(iw + k) * x(k);
 end
 drive = acc / B(iw);
 out = drive;"""
     else:
         head = """acc = B(iw) * u - B(2);
 for k = 1:n
-    acc = acc + B(iw + 1 + k) * x(k);
+    acc = acc + B(iw + k) * x(k);
 end
 drive = u;
 out = acc;"""
