@@ -16,9 +16,12 @@ from ..preprocess import PreprocessSettings, preprocess_raw
 from ..sensors import ScopeSettings, simulate_experiment, simulate_raw
 from ..signals import EXPERIMENTS
 from ._figures import plot_loops, plot_time_series
+from ._html import figure_png, render_page
+from ._report_demo import demo_report
 
-__all__ = ["DEMO_FILES", "DOCUMENT_TABLE_5_5", "RAW_DEMO_FILES", "RAW_SCOPE_RATE", "format_table",
-           "run_demo", "run_raw_path"]
+__all__ = ["DEMO_FILES", "DOCUMENT_TABLE_5_5", "RAW_DEMO_FILES", "RAW_SCOPE_RATE",
+           "REPORT_DEMO_FILES", "VIRTUAL_SENSOR_LABEL", "format_table", "run_demo",
+           "run_raw_path"]
 
 # Table 5.5 / paper 9.2 table I: (model R², straight-line R²) on the document's lab data.
 DOCUMENT_TABLE_5_5 = {"sine": (0.990, 0.928), "chirp": (0.984, 0.945),
@@ -26,6 +29,15 @@ DOCUMENT_TABLE_5_5 = {"sine": (0.990, 0.928), "chirp": (0.984, 0.945),
 DEMO_FILES = ("metrics.json", "noise_trained.json", "config.json", "loops.png",
               "time_series.png")
 RAW_DEMO_FILES = ("raw_path.json",)  # written too with raw=True
+REPORT_DEMO_FILES = ("report.html",)  # written too with report=True
+# What the virtual sensor outputs (hystkit.sensors): the half-bridge's differential signal.
+VIRTUAL_SENSOR_LABEL = "ΔR1/R1 − ΔR2/R2 [-]"
+FIGURE_DPI = 110
+_LOOPS_CAPTION = ("Validation loops: the sensor against the position (top), the mPL and "
+                  "straight-line estimates against it (middle, dashed: ideal), their error "
+                  "against the position (bottom).")
+_SERIES_CAPTION = ("Each validation recording's whole run with the error trace; right: a zoom "
+                   "on the stretch around the largest mPL error.")
 FIT_SEED, VALIDATION_SEED = 1, 2
 # The raw path's scope rate: low enough to keep the demo fast (10 M samples per channel and
 # recording), high enough for every encoder state to last 25 samples. The lab used 2 and
@@ -59,20 +71,23 @@ def format_table(metrics: dict, title: str, reference: dict | None = None) -> st
 
 
 def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
-             progress: Callable[[str], None] = print, raw: bool = False) -> dict:
+             progress: Callable[[str], None] = print, raw: bool = False,
+             report: bool = False) -> dict:
     """Simulate the four experiments, fit on each fitting recording, score on its validation one.
 
     Writes ``metrics.json`` (per excitation, the keys of :func:`~hystkit.compensation.evaluate`),
     ``noise_trained.json`` (the noise-trained compensator scored on every excitation: does
     compensation generalise?), ``config.json`` and the figures ``loops.png``,
     ``time_series.png``; with `raw`, also ``raw_path.json`` from :func:`run_raw_path` (the
-    returned dict then has a ``raw_path`` key). Checks every output path before any work, and
+    returned dict then has a ``raw_path`` key); with `report`, also ``report.html``, one
+    self-contained page of all of it (:func:`~hystkit.reports._report_demo.demo_report`).
+    Checks every output path before any work, and
     publishes the folder atomically (:func:`~hystkit.io.atomic_folder`): interrupted or failed,
     it leaves no folder and no file; into an existing folder, the files go in only once all
     were built.
     """
     out = Path(out_dir)
-    names = DEMO_FILES + (RAW_DEMO_FILES if raw else ())
+    names = DEMO_FILES + (RAW_DEMO_FILES if raw else ()) + (REPORT_DEMO_FILES if report else ())
     check_output_folder(out, names, force)
     t_start = time.perf_counter()
     recordings, compensators, metrics, shown = {}, {}, {}, {}
@@ -92,14 +107,24 @@ def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
     config = {"hystkit_version": __version__, "n_cells": n_cells, "mode": "direct",
               "center": comp.center, "fit_seed": FIT_SEED, "validation_seed": VALIDATION_SEED,
               "sensor": "VirtualSensor() defaults", "seconds": time.perf_counter() - t_start}
+    loops = figure_png(plot_loops(shown, sensor_label=VIRTUAL_SENSOR_LABEL), FIGURE_DPI)
+    series = figure_png(plot_time_series(shown), FIGURE_DPI)
+    figures = {"loops": (loops, _LOOPS_CAPTION), "time_series": (series, _SERIES_CAPTION)}
     with atomic_folder(out, force, names) as tmp:
         write_json(metrics, tmp / "metrics.json")
         write_json(noise_trained, tmp / "noise_trained.json")
         if raw_path is not None:
             write_json(raw_path, tmp / "raw_path.json")
         write_json(config, tmp / "config.json")
-        plot_loops(shown).savefig(tmp / "loops.png", dpi=110)
-        plot_time_series(shown).savefig(tmp / "time_series.png", dpi=110)
+        for name, (png, _) in figures.items():
+            (tmp / f"{name}.png").write_bytes(png)
+        if report:
+            page = demo_report(metrics, noise_trained, compensators, config, figures,
+                               DOCUMENT_TABLE_5_5)
+            footer = (f"written by hystkit {__version__}; self-contained: figures embedded, "
+                      f"nothing loaded from outside")
+            (tmp / "report.html").write_text(render_page(page.title, page.sections, footer),
+                                             encoding="utf-8")
     result = {"metrics": metrics, "noise_trained": noise_trained, "config": config}
     return result if raw_path is None else {**result, "raw_path": raw_path}
 

@@ -21,7 +21,7 @@ from ..io import Recording
 from ._figures import DEFAULT_SENSOR_LABEL, plot_loops, plot_time_series
 from ._html import Section, definition_list, figure_png, note, paragraph, png_block, table
 
-__all__ = ["FIGURE_DPI", "ReportContent", "compensator_sections", "model_report",
+__all__ = ["FIGURE_DPI", "ReportContent", "compensator_sections", "fit_section", "model_report",
            "named_parameters", "score_sections"]
 
 # (evaluate key, column heading, format)
@@ -91,9 +91,10 @@ def _provenance(comp: Compensator, model_path: Path | None, version: str | None)
     return Section("Model file").add(definition_list(items))
 
 
-def _fit_section(comp: Compensator) -> Section:
+def fit_section(comp: Compensator, title: str = "Fit", sub: bool = False) -> Section:
+    """Fit status, solver, training scores, bound hits and the parameter table."""
     info = comp.fit_info
-    section = Section("Fit")
+    section = Section(title, sub=sub)
     status = info.get("status")
     if status is None:
         section.add(note("fit status: not stored in the model file"))
@@ -201,7 +202,7 @@ def compensator_sections(comp: Compensator, recordings: Mapping[str, Recording],
     that wrote the model file.
     """
     content = ReportContent(title="")
-    content.sections += [_provenance(comp, model_path, version), _fit_section(comp)]
+    content.sections += [_provenance(comp, model_path, version), fit_section(comp)]
     scores, shown = {}, {}
     for name, rec in recordings.items():
         scores[name] = evaluate(comp, rec)
