@@ -1,0 +1,68 @@
+"""The order-keeping map: serial without Dask, on a real Dask cluster, errors and signals."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+
+import cloudpickle
+import pytest
+
+from hystkit.errors import HystkitError
+from hystkit.parallel import SerialExecutor, open_executor
+
+# the pieces below are defined here: send them to the workers by value
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
+
+
+def _slow_square(x: float, *, delay: float) -> float:
+    """x², after a wait that is longest for the first pieces (they finish last)."""
+    time.sleep(delay * (3 - x))
+    return x * x
+
+
+def test_serial_map_runs_in_order_and_loads_no_dask():
+    code = ("import sys\n"
+            "from hystkit.parallel import open_executor\n"
+            "seen = []\n"
+            "with open_executor(1) as ex:\n"
+            "    out = ex.map(pow, [2, 3, 4], shared={'exp': 2},\n"
+            "                 on_done=lambda i, r: seen.append(i))\n"
+            "assert out == [4, 9, 16] and seen == [0, 1, 2], (out, seen)\n"
+            "print(type(ex).__name__, 'distributed' in sys.modules, 'dask' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=120).stdout.split()
+    assert out == ["SerialExecutor", "False", "False"]
+
+
+def test_more_workers_than_pieces_is_serial():
+    with open_executor(4, n_pieces=1) as executor:
+        assert isinstance(executor, SerialExecutor)
+
+
+def test_dask_map_keeps_the_order_of_the_pieces(cluster_address):
+    """Pieces finishing in reverse order still come back in the order given."""
+    finished = []
+    with open_executor(scheduler=cluster_address) as executor:
+        assert executor.n_workers == 2
+        out = executor.map(_slow_square, [0, 1, 2, 3], shared={"delay": 0.3},
+                           on_done=lambda i, r: finished.append((i, r)))
+    assert out == [0, 1, 4, 9]
+    assert sorted(finished) == [(0, 0), (1, 1), (2, 4), (3, 9)]  # each reported once
+    assert finished[0][0] != 0  # the first piece waited longest: not the first finished
+
+
+def test_a_failing_piece_raises_in_the_caller(cluster_address):
+    with open_executor(scheduler=cluster_address) as executor, \
+            pytest.raises(TypeError):
+        executor.map(pow, [2, "x"], shared={"exp": 2})
+
+
+def test_an_unreachable_scheduler_is_one_error(monkeypatch):
+    import hystkit.parallel._dask as dask_executor
+
+    monkeypatch.setattr(dask_executor, "CONNECT_TIMEOUT", 1)
+    with pytest.raises(HystkitError, match=r"--scheduler tcp://127.0.0.1:9: cannot connect"), \
+            open_executor(scheduler="tcp://127.0.0.1:9"):
+        pass
