@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
-from hystkit.io import Recording
+from hystkit.io import ReadOptions, Recording
 from hystkit.reports._figures import envelope_indices, plot_loops, plot_time_series, zoom_window
 from hystkit.reports._report_model import named_parameters
+from hystkit.reports._report_page import sensor_label
 
 
 def test_envelope_keeps_every_sample_of_a_short_run() -> None:
@@ -85,3 +86,18 @@ def test_time_series_covers_the_whole_run() -> None:
     x = np.concatenate([line.get_xdata() for line in full.get_lines()])
     rec = results["run"][0]
     assert x.min() == rec.time[0] and x.max() == rec.time[-1]
+
+
+def test_sensor_label_names_the_users_column_and_unit() -> None:
+    t = np.arange(10) * 0.1
+    plain = Recording(time=t, sensor=t, position=t)
+    assert sensor_label(None, [plain]) == "sensor"
+    own = ReadOptions(columns={"sensor": "resistance_ohm"})
+    assert sensor_label(own, [plain]) == "resistance_ohm"
+    if "units" not in Recording.__dataclass_fields__:
+        pytest.skip("recordings carry no units in this version")
+    ohm = Recording(time=t, sensor=t, position=t, units={"sensor": "Ohm"})
+    volt = Recording(time=t, sensor=t, position=t, units={"sensor": "V"})
+    assert sensor_label(own, [ohm, ohm]) == "resistance_ohm [Ohm]"
+    assert sensor_label(None, [ohm]) == "sensor [Ohm]"
+    assert sensor_label(own, [ohm, volt]) == "resistance_ohm"  # no common unit: none shown

@@ -15,7 +15,7 @@ from pathlib import Path
 from .. import __version__
 from .._read_options import ReadOptions
 from ..errors import InputError
-from ..io import atomic_outputs, read_recording
+from ..io import Recording, atomic_outputs, read_recording
 from ._figures import DEFAULT_SENSOR_LABEL
 from ._html import render_page
 from ._report_control import control_report
@@ -28,11 +28,14 @@ FIGURE_FORMATS = ("png", "svg", "pdf")
 MODEL_SUFFIXES = (".json", ".mat")  # what save_compensator writes
 
 
-def sensor_label(options: ReadOptions | None) -> str:
-    """The sensor axis' label: the user's own column name when they mapped one, else the
-    neutral "sensor" (hystkit does not know what a recording's sensor measures)."""
-    name = dict((options or ReadOptions()).columns).get("sensor", "sensor")
-    return DEFAULT_SENSOR_LABEL if name == "sensor" else name
+def sensor_label(options: ReadOptions | None, recordings: Sequence[Recording] = ()) -> str:
+    """The sensor axis' label: the user's own column name when they mapped one (else the
+    neutral "sensor": hystkit does not know what a recording's sensor measures), with the unit
+    the files give when they all give the same one."""
+    name = dict((options or ReadOptions()).columns).get("sensor", DEFAULT_SENSOR_LABEL)
+    units = {dict(getattr(rec, "units", ())).get("sensor", "") for rec in recordings}
+    unit = units.pop() if len(units) == 1 else ""
+    return f"{name} [{unit}]" if unit else name
 
 
 def build_report(inputs: Sequence[str | os.PathLike[str]], *,
@@ -66,7 +69,8 @@ def build_report(inputs: Sequence[str | os.PathLike[str]], *,
             raise InputError(f"{path}: two recordings named {path.name!r}; the page and its "
                              f"figures name them by file name")
         recordings[path.name] = read_recording(path, options=options)
-    return model_report(first, recordings, sensor_label=sensor_label(options))
+    return model_report(first, recordings,
+                        sensor_label=sensor_label(options, list(recordings.values())))
 
 
 def _folders(folders: list[Path]) -> ReportContent:
