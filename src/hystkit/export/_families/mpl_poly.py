@@ -1,0 +1,270 @@
+"""Polynomial mPL (``models/mpl_poly/kernels.py``): ``block_forward`` / ``block_inverse``
+(``solve_output`` on the rest branch of ``g``) and the rest state (``model.rest_state``).
+
+Body: ``[n, v_b, s, dt, limit, lo, hi, sign, centre, g0..g3, fc (N x 4), knees (N x 2),
+w (N + 1)]``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+HAS_INVERSE = True
+
+
+def extra(comp) -> dict:
+    """Rest voltages ``v*_k`` (the forward rest is ``e - v*``), ``sum(w)`` and ``w . v*`` of
+    the inverse's rest input (``model.rest_state``)."""
+    from ...models.mpl_poly.model import rest_voltages
+
+    p = comp.params
+    v_rest = np.asarray(rest_voltages(comp.structure, p), float)
+    return {"V_REST": v_rest, "W_SUM": float(p.w.sum()), "W_V": float(p.w[1:] @ v_rest)}
+
+
+def state_size(plan) -> int:
+    return plan.n_block_state
+
+
+def c_model(plan, lit: Callable[[float], str]) -> str:
+    n = int(plan.body[0])
+    e = plan.extra
+    v_rest = ", ".join(lit(v) for v in e["V_REST"])
+    if not plan.inverse:
+        rest_e = "value"
+    elif e["W_SUM"] != 0:
+        rest_e = (f"ok ? (z0 + {lit(e['W_V'])} + BODY[1]) / {lit(e['W_SUM'])} : R(0.0)")
+    else:
+        rest_e = "R(0.0)"
+    rest_z = ("    int ok;\n    const real z0 = solve_output(value, &ok);\n"
+              if plan.inverse and e["W_SUM"] != 0 else
+              "    (void)value;\n" if plan.inverse else "")
+    step = _C_INVERSE if plan.inverse else _C_FORWARD
+    solver = _C_SOLVE if plan.inverse else ""
+    return f"""#define N_CELLS {n}
+#define IG 9
+#define IF 13
+#define IK (IF + 4 * N_CELLS)
+#define IW (IF + 6 * N_CELLS)
+
+static const real V_REST[N_CELLS] = {{{v_rest}}};
+
+/* c0 + c1 x + c2 x^2 + c3 x^3 and its slope: kernels._cubic */
+static real cubic(const real *c, real x, real *slope)
+{{
+    if (slope != 0) *slope = c[1] + x * (R(2.0) * c[2] + R(3.0) * c[3] * x);
+    return c[0] + x * (c[1] + x * (c[2] + x * c[3]));
+}}
+
+/* Limited cell-resistor current (eq. 5.16, 5.29): kernels._cell */
+static real cell(real v, int k)
+{{
+    const real xm = BODY[IK + 2 * k], xp = BODY[IK + 2 * k + 1];
+    if (BODY[4] != R(0.0) && (v >= xp || v <= xm)) {{
+        const real x_b = v >= xp ? xp : xm;
+        return cubic(BODY + IF + 4 * k, x_b, 0) + BODY[2] * (v - x_b);
+    }}
+    return cubic(BODY + IF + 4 * k, v, 0);
+}}
+
+static void cells(real *x, real drive)
+{{
+    int k;
+    for (k = 0; k < N_CELLS; k++) x[k] = x[k] + cell(drive - x[k], k) * BODY[3];
+}}
+{solver}
+static void model_rest(real *x, real value)
+{{
+    int k;
+{rest_z}    {{
+        const real e0 = {rest_e};
+        for (k = 0; k < N_CELLS; k++) x[k] = e0 - V_REST[k];
+    }}
+}}
+{step}"""
+
+
+_C_FORWARD = """
+/* block_forward: y = g(w_0 u + sum w_k x_k - V_b) (eq. 5.17), then the cells driven by u */
+static real model_step(real *x, real u)
+{
+    int k;
+    real z = BODY[IW] * u - BODY[1], y;
+    for (k = 0; k < N_CELLS; k++) z += BODY[IW + 1 + k] * x[k];
+    y = cubic(BODY + IG, z, 0);
+    cells(x, u);
+    return y;
+}
+"""
+
+_C_SOLVE = """
+/* The z on the rest branch [lo, hi] of g with g(z) = i: safeguarded Newton inside a
+   bisection bracket (kernels.solve_output); *ok = 0 when i is outside the branch's range */
+static real solve_output(real i, int *ok)
+{
+    const real *g = BODY + IG;
+    const real lo = BODY[5], hi = BODY[6], sign = BODY[7], centre = BODY[8];
+    real width = R(1.0), a, b, h_a, h_b, z;
+    int it;
+    *ok = 0;
+    a = isfinite(lo) ? lo : centre - width;
+    h_a = sign * (cubic(g, a, 0) - i);
+    while (h_a > R(0.0)) {
+        if (isfinite(lo) || width > R(1e15)) return R(0.0);
+        width *= R(2.0);
+        a = centre - width;
+        h_a = sign * (cubic(g, a, 0) - i);
+    }
+    width = R(1.0);
+    b = isfinite(hi) ? hi : centre + width;
+    h_b = sign * (cubic(g, b, 0) - i);
+    while (h_b < R(0.0)) {
+        if (isfinite(hi) || width > R(1e15)) return R(0.0);
+        width *= R(2.0);
+        b = centre + width;
+        h_b = sign * (cubic(g, b, 0) - i);
+    }
+    z = g[1] != R(0.0) ? (i - g[0]) / g[1] : a;
+    if (!(a < z && z < b)) z = R(0.5) * (a + b);
+    for (it = 0; it < 200; it++) {
+        real dg, gz = cubic(g, z, &dg), h, z_new;
+        int newton;
+        h = sign * (gz - i);
+        if (h == R(0.0)) break;
+        if (h < R(0.0)) a = z;
+        else b = z;
+        newton = dg != R(0.0);
+        z_new = newton ? z - (gz - i) / dg : z;
+        if (!newton || !(a < z_new && z_new < b)) z_new = R(0.5) * (a + b);
+        if (FABS(z_new - z) <= R(4e-16) * (R(1.0) + FABS(z))
+            || b - a <= R(4e-16) * (R(1.0) + FABS(z))) {
+            z = z_new;
+            break;
+        }
+        z = z_new;
+    }
+    *ok = 1;
+    return z;
+}
+"""
+
+_C_INVERSE = """
+/* block_inverse: z = g^-1(y) on the rest branch, u_hat = (z - sum w_k x_k + V_b) / w_0, the
+   cells driven by u_hat; NaN when y is outside the branch's range (no input gives it) */
+static real model_step(real *x, real y)
+{
+    int k, ok;
+    const real z = solve_output(y, &ok);
+    real acc = z + BODY[1], u_hat;
+    for (k = 0; k < N_CELLS; k++) acc -= BODY[IW + 1 + k] * x[k];
+    u_hat = ok ? acc / BODY[IW] : (real)NAN;
+    cells(x, u_hat);
+    return u_hat;
+}
+"""
+
+
+def m_model(plan, lit: Callable[[float], str]) -> str:
+    e = plan.extra
+    v_rest = "[" + "; ".join(lit(v) for v in e["V_REST"]) + "]"
+    if not plan.inverse:
+        rest = "e0 = value;"
+    elif e["W_SUM"] != 0:
+        rest = (f"[z0, ok] = solve_output(B, value);\nif ok\n    e0 = (z0 + {lit(e['W_V'])} "
+                f"+ B(2)) / {lit(e['W_SUM'])};\nelse\n    e0 = 0.0;\nend")
+    else:
+        rest = "e0 = 0.0;"
+    step = _M_INVERSE if plan.inverse else _M_FORWARD
+    return f"""function x = model_rest(B, value)
+{rest}
+x = e0 - {v_rest};
+end
+
+function [v, slope] = cubic(c, x)
+v = c(1) + x * (c(2) + x * (c(3) + x * c(4)));
+slope = c(2) + x * (2.0 * c(3) + 3.0 * c(4) * x);
+end
+
+function x = cells(B, x, drive)
+n = round(B(1)); if_ = 13; ik = if_ + 4 * n;
+for k = 1:n
+    v = drive - x(k);
+    c = B(if_ + 4 * (k - 1) + 1:if_ + 4 * k);
+    xm = B(ik + 2 * k - 1); xp = B(ik + 2 * k);
+    if B(5) ~= 0 && (v >= xp || v <= xm)
+        if v >= xp, x_b = xp; else, x_b = xm; end
+        f = cubic(c, x_b) + B(3) * (v - x_b);
+    else
+        f = cubic(c, v);
+    end
+    x(k) = x(k) + f * B(4);
+end
+end
+
+function [z, ok] = solve_output(B, i)
+g = B(10:13); lo = B(6); hi = B(7); sign_ = B(8); centre = B(9);
+z = NaN; ok = false;
+width = 1.0;
+if isfinite(lo), a = lo; else, a = centre - width; end
+h_a = sign_ * (cubic(g, a) - i);
+while h_a > 0
+    if isfinite(lo) || width > 1e15, return; end
+    width = width * 2.0;
+    a = centre - width;
+    h_a = sign_ * (cubic(g, a) - i);
+end
+width = 1.0;
+if isfinite(hi), b = hi; else, b = centre + width; end
+h_b = sign_ * (cubic(g, b) - i);
+while h_b < 0
+    if isfinite(hi) || width > 1e15, return; end
+    width = width * 2.0;
+    b = centre + width;
+    h_b = sign_ * (cubic(g, b) - i);
+end
+if g(2) ~= 0, z = (i - g(1)) / g(2); else, z = NaN; end
+if ~(a < z && z < b), z = 0.5 * (a + b); end
+for it = 1:200
+    [gz, dg] = cubic(g, z);
+    h = sign_ * (gz - i);
+    if h == 0, break; end
+    if h < 0, a = z; else, b = z; end
+    if dg ~= 0, z_new = z - (gz - i) / dg; else, z_new = NaN; end
+    if ~(a < z_new && z_new < b), z_new = 0.5 * (a + b); end
+    if abs(z_new - z) <= 4e-16 * (1.0 + abs(z)) || b - a <= 4e-16 * (1.0 + abs(z))
+        z = z_new;
+        break;
+    end
+    z = z_new;
+end
+ok = true;
+end
+{step}"""
+
+
+_M_FORWARD = """
+function [y, x] = model_step(B, x, u)
+n = round(B(1)); iw = 14 + 6 * n;
+z = B(iw) * u - B(2);
+for k = 1:n
+    z = z + B(iw + k) * x(k);
+end
+y = cubic(B(10:13), z);
+x = cells(B, x, u);
+end
+"""
+
+_M_INVERSE = """
+function [u_hat, x] = model_step(B, x, y)
+n = round(B(1)); iw = 14 + 6 * n;
+[z, ok] = solve_output(B, y);
+acc = z + B(2);
+for k = 1:n
+    acc = acc - B(iw + k) * x(k);
+end
+if ok, u_hat = acc / B(iw); else, u_hat = NaN; end
+x = cells(B, x, u_hat);
+end
+"""
