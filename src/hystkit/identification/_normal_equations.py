@@ -181,7 +181,8 @@ class ChunkedDifferences:
             for i in range(p):
                 out, states[i + 1] = self.simulate(shifted[i + 1], self.u[start:stop],
                                                    states[i + 1])
-                jc[:, i] = (out - base) / steps[i]
+                # differences of residuals, not outputs: bit for bit scipy's '2-point' J
+                jc[:, i] = ((out - self.y[start:stop]) - r) / steps[i]
             total += float(r @ r)
             jtj += jc.T @ jc
             jtr += jc.T @ r

@@ -106,7 +106,8 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
                 discard: int = 0,
                 max_nfev: int = 200, screen_nfev: int = 10, n_polish: int = 2,
                 accept: Callable[[boucwen.BoucWenParams], bool] | None = None,
-                accept_reason: str = "rejected by the acceptance test") -> FitResult:
+                accept_reason: str = "rejected by the acceptance test",
+                solver: str = "tr") -> FitResult:
     """Fit a Bouc-Wen oscillator mapping the force ``u`` to the displacement ``y`` (SSE, eq. 5.9).
 
     Parameters
@@ -129,6 +130,10 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
     accept : callable, optional
         A candidate counts only if ``accept(params)`` is true; ``accept_reason`` says why others
         were rejected.
+    solver : {"tr", "lm", "trf"}
+        See :func:`~hystkit.identification.fit_multistart`. The difference Jacobian is formed
+        densely (``n x 7``): the residual's stride, discard and divergence penalty do not split
+        into chunks.
 
     Returns
     -------
@@ -200,7 +205,7 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
                               (lower[free], upper[free]),
                               lambda th: boucwen.BoucWenParams.from_vector(full(th)), structure,
                               max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
-                              **options)
+                              solver=solver, **options)
 
     t_start = time.perf_counter()
     nu_start = 1.0 if nu is None else float(nu)

@@ -2,7 +2,9 @@
 
 The SSE (eq. 5.9) is minimised by bounded least squares (``fit_multistart``) over
 ``ChuaParams.to_vector`` with finite-difference Jacobians: the model has 6 parameters per
-element and none enters the output linearly.
+element and none enters the output linearly. The normal equations of those differences are
+formed chunk by chunk (``ChunkedDifferences``: each perturbed run carries its state from chunk
+to chunk), so memory stays ``O(chunk x 6N)`` on long recordings.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ...identification import FitResult, check_fit_data, fit_multistart
+from ...identification import ChunkedDifferences, FitResult, check_fit_data, fit_multistart
 from . import model as chua
 
 __all__ = ["default_starts", "fit_chua", "random_params"]
@@ -57,7 +59,8 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
              starts: list[chua.ChuaParams] | None = None, max_nfev: int = 100,
              screen_nfev: int = 10, n_polish: int = 2,
              accept: Callable[[chua.ChuaParams], bool] | None = None,
-             accept_reason: str = "rejected by the acceptance test") -> FitResult:
+             accept_reason: str = "rejected by the acceptance test",
+             solver: str = "tr") -> FitResult:
     """Fit a Chua-Stromsmoe model mapping ``u`` to ``y`` (SSE, eq. 5.9).
 
     Parameters
@@ -71,6 +74,8 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
         Jacobian costs another 6N model runs).
     accept, accept_reason
         Candidates for which ``accept(params)`` is false are skipped.
+    solver : {"tr", "lm", "trf"}
+        See :func:`hystkit.identification.fit_multistart` ("trf": dense difference Jacobian).
 
     Raises
     ------
@@ -92,10 +97,16 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
     def to_params(theta: np.ndarray) -> chua.ChuaParams:
         return chua.ChuaParams.from_vector(theta, n)
 
+    bounds = _bounds(structure)
+    chunked = ChunkedDifferences(
+        lambda th, u_chunk, x: chua.simulate(structure, to_params(th), u_chunk, x), u, y,
+        *bounds)
     return fit_multistart(lambda th: chua.simulate(structure, to_params(th), u)[0] - y,
-                          [p.to_vector() for p in starts], _bounds(structure), to_params,
-                          structure, max_nfev=max_nfev, screen_nfev=screen_nfev,
-                          n_polish=n_polish, accept=accept, accept_reason=accept_reason)
+                          [p.to_vector() for p in starts], bounds, to_params,
+                          structure, normal_equations=chunked.normal_equations,
+                          cost=chunked.cost, solver=solver, max_nfev=max_nfev,
+                          screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
+                          accept_reason=accept_reason)
 
 
 

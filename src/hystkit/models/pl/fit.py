@@ -99,7 +99,8 @@ def default_starts(structure: pl.PlStructure) -> list[np.ndarray]:
 def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
            starts: list[np.ndarray] | None = None, max_nfev: int = 40, screen_nfev: int = 4,
            n_polish: int = 2, accept: Callable[[pl.PlParams], bool] | None = None,
-           accept_reason: str = "rejected by the acceptance test") -> FitResult:
+           accept_reason: str = "rejected by the acceptance test",
+           solver: str = "tr") -> FitResult:
     """Fit the weights, bias, output resistor and ``I_T``, ``V_T`` for a fixed structure.
 
     Parameters
@@ -112,6 +113,9 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
         Passed to ``fit_multistart``.
     accept, accept_reason
         Candidates with ``accept(params)`` false are skipped.
+    solver : {"tr", "lm", "trf"}
+        See :func:`hystkit.identification.fit_multistart`. Variable projection leaves two
+        coordinates, so their difference Jacobian (``n x 2``) is formed densely.
 
     Raises
     ------
@@ -140,7 +144,8 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
                           default_starts(structure) if starts is None else starts,
                           (lower, upper), lambda th: project(th)[0], structure,
                           max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
-                          accept=accept, accept_reason=accept_reason, names=THETA_NAMES)
+                          accept=accept, accept_reason=accept_reason, names=THETA_NAMES,
+                          solver=solver)
 
 
 def random_params(structure: pl.PlStructure, rng: np.random.Generator) -> pl.PlParams:
