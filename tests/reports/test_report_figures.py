@@ -7,7 +7,13 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from hystkit.io import ReadOptions, Recording
-from hystkit.reports._figures import envelope_indices, plot_loops, plot_time_series, zoom_window
+from hystkit.reports._figures import (
+    LOOP_COLUMNS,
+    envelope_indices,
+    plot_loops,
+    plot_time_series,
+    zoom_window,
+)
 from hystkit.reports._report_model import named_parameters
 from hystkit.reports._report_page import sensor_label
 
@@ -101,3 +107,14 @@ def test_sensor_label_names_the_users_column_and_unit() -> None:
     assert sensor_label(own, [ohm, ohm]) == "resistance_ohm [Ohm]"
     assert sensor_label(None, [ohm]) == "sensor [Ohm]"
     assert sensor_label(own, [ohm, volt]) == "resistance_ohm"  # no common unit: none shown
+
+
+def test_many_recordings_wrap_into_bands_of_loop_columns() -> None:
+    run = _results()["run"]
+    results = {f"r{k}": run for k in range(LOOP_COLUMNS + 2)}
+    fig = plot_loops(results)
+    visible = [ax for ax in fig.axes if ax.axison]
+    assert len(visible) == 3 * len(results)
+    assert [ax.get_title() for ax in visible if ax.get_title().endswith(": sensor")] == [
+        f"r{k}: sensor" for k in range(LOOP_COLUMNS + 2)]
+    assert fig.get_size_inches()[0] == pytest.approx(3.4 * LOOP_COLUMNS)

@@ -15,10 +15,11 @@ from matplotlib.figure import Figure
 
 from ..io import Recording
 
-__all__ = ["DEFAULT_SENSOR_LABEL", "MAX_POINTS", "envelope_indices", "plot_loops",
+__all__ = ["DEFAULT_SENSOR_LABEL", "LOOP_COLUMNS", "MAX_POINTS", "envelope_indices", "plot_loops",
            "plot_time_series", "zoom_window"]
 
 DEFAULT_SENSOR_LABEL = "sensor"
+LOOP_COLUMNS = 4  # recordings side by side in the loop figure: readable at a page's width
 # Points per drawn trace: beyond this a line is drawn through its per-bin minima and maxima.
 MAX_POINTS = 20_000
 # Trace colours, shared by both figures so a legend reads the same in each.
@@ -77,7 +78,8 @@ def _legend_below(fig: Figure, ax) -> None:
 
 def plot_loops(results: Results, *, sensor_label: str = DEFAULT_SENSOR_LABEL,
                model_label: str = "mPL") -> Figure:
-    """Hysteresis loops before and after compensation and the error, one column per recording.
+    """Hysteresis loops before and after compensation and the error, one column per recording
+    (at most `LOOP_COLUMNS` side by side; more recordings continue in a further band below).
 
     Rows: the sensor against the position (the loop to remove); both estimates against the
     position with the ideal diagonal; the error (estimate - position) against the position.
@@ -90,13 +92,18 @@ def plot_loops(results: Results, *, sensor_label: str = DEFAULT_SENSOR_LABEL,
     model_label : str
         The compensator's name in the legend.
     """
-    fig = Figure(figsize=(3.4 * max(len(results), 2), 8.4), layout="constrained")
-    axes = fig.subplots(3, len(results), squeeze=False)
-    for col, (name, (rec, estimate, linear)) in enumerate(results.items()):
+    n_cols = min(len(results), LOOP_COLUMNS)
+    n_bands = -(-len(results) // n_cols)
+    fig = Figure(figsize=(3.4 * max(n_cols, 2), 8.4 * n_bands), layout="constrained")
+    axes = fig.subplots(3 * n_bands, n_cols, squeeze=False)
+    for ax in axes[3 * (n_bands - 1):, len(results) - (n_bands - 1) * n_cols:].ravel():
+        ax.set_axis_off()  # the last band's empty columns
+    for k, (name, (rec, estimate, linear)) in enumerate(results.items()):
         p = rec.position
         errors = (linear - p, estimate - p)
         keep = envelope_indices([p, rec.sensor, *errors])
-        top, mid, low = axes[:, col]
+        band, col = divmod(k, n_cols)
+        top, mid, low = axes[3 * band:3 * band + 3, col]
         top.plot(p[keep], rec.sensor[keep], lw=0.6, color=_COLORS["sensor"])
         top.set(title=f"{name}: sensor", xlabel="position [mm]", ylabel=sensor_label)
         lo, hi = float(p.min()), float(p.max())

@@ -22,7 +22,7 @@ from ._figures import DEFAULT_SENSOR_LABEL, plot_loops, plot_time_series
 from ._html import Section, definition_list, figure_png, note, paragraph, png_block, table
 
 __all__ = ["FIGURE_DPI", "ReportContent", "compensator_sections", "fit_section", "model_report",
-           "named_parameters", "score_sections"]
+           "named_parameters", "score_section"]
 
 # (evaluate key, column heading, format)
 _SCORES = (("r2", "R²", ".4f"), ("e_rms_pct", "e_rms %", ".3f"), ("e_max_pct", "e_max %", ".3f"),
@@ -152,7 +152,7 @@ def _floats(tree: object) -> list[float]:
     return [tree] if isinstance(tree, float) else []
 
 
-def score_sections(comp: Compensator, scores: Mapping[str, dict]) -> Section:
+def score_section(comp: Compensator, scores: Mapping[str, dict]) -> Section:
     """Deployable scores of every recording, then the oracle ones, from `evaluate`'s dicts."""
     head = ("recording", "", *(label for _, label, _ in _SCORES))
     deployable, oracle = [], []
@@ -207,7 +207,7 @@ def compensator_sections(comp: Compensator, recordings: Mapping[str, Recording],
     for name, rec in recordings.items():
         scores[name] = evaluate(comp, rec)
         shown[name] = (rec, comp.estimate(rec), comp.estimate_linear(rec))
-    content.sections.append(score_sections(comp, scores))
+    content.sections.append(score_section(comp, scores))
     figures = Section("Figures")
     content.sections.append(figures)
     centring = center_label(comp.center)
