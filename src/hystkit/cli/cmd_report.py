@@ -32,6 +32,9 @@ def _report(args: argparse.Namespace) -> int:
     print(f"wrote {paths[0]} ({size / 1e6:.2f} MB, {len(content.pngs)} figure(s) embedded)")
     if len(paths) > 1:
         print(f"wrote {len(paths) - 1} figure file(s) to {args.figures}/")
+    png_only = sorted(set(content.pngs) - set(content.figures))
+    if args.figures is not None and args.format != "png" and png_only:
+        print(f"  as PNG only (a control run's own figures): {', '.join(png_only)}")
     return 0
 
 
