@@ -1,0 +1,216 @@
+"""Fit a fleet of sensors: one model file per sensor, one results table, resumable.
+
+The batch folder ``OUT`` holds ``batch.json`` (what made it), ``models/<id>.json`` (each
+sensor's compensator, as ``hystkit fit`` writes it), ``sensors/<id>.json`` (each finished
+sensor's row, full scores and the job it answers) and ``results.parquet`` / ``results.csv``
+(one row per sensor, in the manifest's order). A sensor's record is written after its model
+file, so a record proves the sensor finished: a rerun skips sensors whose record matches their
+job (same options, same recordings: path, size and modification time) and fits the others,
+sensors that failed included. The results table is rebuilt from the records on every run, so
+an interrupted batch, rerun, gives the table of an uninterrupted one.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from .. import __version__
+from ..compensation import DEFAULT_CENTER, evaluate, fit_compensator, save_compensator
+from ..errors import InputError, OutputError
+from ..io import (
+    ReadOptions,
+    Recording,
+    atomic_outputs,
+    check_output_path,
+    read_recording,
+    write_json,
+)
+from ..models import get_family
+from ..parallel import Executor, SerialExecutor
+from ._manifest import SensorJob
+
+__all__ = ["RESULT_COLUMNS", "fit_sensor", "run_batch"]
+
+#: Columns of ``results.parquet`` / ``results.csv``. Scores are on the validation recordings
+#: (the mean over several): deployable (the model's own centring) and oracle (the paper's
+#: protocol, each recording's own means: not available in use).
+RESULT_COLUMNS = ("sensor", "status", "model", "size", "mode", "center", "r2_deployable",
+                  "e_rms_pct_deployable", "r2_oracle", "linear_r2_deployable", "fit_seconds",
+                  "seconds", "guards", "error", "model_file")
+MARKER = "batch.json"
+
+
+def fit_sensor(job: SensorJob, *, read_options: ReadOptions | None = None) -> dict:
+    """Read, fit and score one sensor (one piece of a batch; never raises for the sensor's own
+    failure: it is the row's ``error``).
+
+    Returns
+    -------
+    dict
+        ``row`` (the results-table row), ``scores`` (evaluate's dict per validation
+        recording) and ``compensator`` (None if the sensor failed).
+    """
+    t0 = time.perf_counter()
+    row = {key: None for key in RESULT_COLUMNS}
+    row.update(sensor=job.sensor, model=job.model, mode=job.mode,
+               size=get_family(job.model).default_size if job.size is None else job.size,
+               center=DEFAULT_CENTER if job.center is None else job.center)
+    try:
+        fit_recs, val_recs = _recordings(job, read_options)
+        options = {} if job.center is None else {"center": job.center}
+        comp = fit_compensator(fit_recs, job.size, model=job.model, mode=job.mode, **options)
+        scores = [evaluate(comp, rec) for rec in val_recs]
+    except Exception as exc:  # noqa: BLE001  (one sensor never stops the batch)
+        row.update(status="failed", error=f"{type(exc).__name__}: {exc}",
+                   seconds=time.perf_counter() - t0)
+        return {"row": row, "scores": [], "compensator": None}
+    info = comp.fit_info
+    row.update(status=info["status"],
+               r2_deployable=_mean(scores, "r2"), e_rms_pct_deployable=_mean(scores, "e_rms_pct"),
+               r2_oracle=_mean(scores, "r2_oracle"),
+               linear_r2_deployable=_mean(scores, "linear_r2"),
+               fit_seconds=info["fit_seconds"], seconds=time.perf_counter() - t0,
+               guards=None if info["status"] == "ok" else info["status_message"],
+               model_file=f"models/{job.sensor}.json")
+    return {"row": row, "scores": scores, "compensator": comp}
+
+
+def _mean(scores: Sequence[dict], key: str) -> float | None:
+    values = [s[key] for s in scores]
+    return None if any(v is None for v in values) else float(sum(values) / len(values))
+
+
+def _recordings(job: SensorJob, options: ReadOptions | None) -> tuple[list, list]:
+    fit = [read_recording(p, options=options) for p in job.fit]
+    if not job.split:
+        return fit, [read_recording(p, options=options) for p in job.validate]
+    return [_part(fit[0], 0, "first half")], [_part(fit[0], 1, "second half")]
+
+
+def _part(rec: Recording, half: int, label: str) -> Recording:
+    if rec.n_samples < 4:
+        raise InputError(f"{rec.source}: {rec.n_samples} samples cannot be split into a "
+                         f"fitting and a validation half")
+    mid = rec.n_samples // 2
+    cut = slice(0, mid) if half == 0 else slice(mid, rec.n_samples)
+    time_ = rec.time[cut] - rec.time[cut][0]
+    return Recording(time=time_, sensor=rec.sensor[cut], position=rec.position[cut],
+                     source=f"{rec.source} ({label})")
+
+
+def fingerprint(job: SensorJob) -> list:
+    """The job's recordings as (path, size, modification time): a changed file is refit."""
+    out = []
+    for path in (*job.fit, *job.validate):
+        try:
+            st = os.stat(path)
+            out.append([str(path), st.st_size, st.st_mtime_ns])
+        except OSError:
+            out.append([str(path), None, None])
+    return out
+
+
+def run_batch(jobs: Sequence[SensorJob], out: Path, *, executor: Executor | None = None,
+              read_options: ReadOptions | None = None, refit: bool = False,
+              source: str = "", progress: Callable[[str], None] = lambda _: None) -> list[dict]:
+    """Fit every sensor not finished in `out` yet (all with `refit`); write the results table.
+
+    Returns
+    -------
+    list of dict
+        The results rows (`RESULT_COLUMNS`), in the order of `jobs`.
+
+    Raises
+    ------
+    OutputError
+        `out` exists, is not empty and is not a batch folder (no ``batch.json``), unless
+        `refit`.
+    """
+    out = Path(out)
+    _claim(out, refit, source)
+    rows: dict[str, dict] = {}
+    todo = []
+    for job in jobs:
+        record = None if refit else _finished(out, job)
+        if record is None:
+            todo.append(job)
+        else:
+            rows[job.sensor] = record["row"]
+    progress(f"{len(jobs)} sensors: {len(rows)} finished before, {len(todo)} to fit on "
+             f"{(executor or SerialExecutor()).describe()}")
+
+    def finished(i: int, result: dict) -> None:
+        job = todo[i]
+        _store(out, job, result)
+        rows[job.sensor] = row = result["row"]
+        progress(f"[{len(rows)}/{len(jobs)}] {_summary(row)}")
+
+    (executor or SerialExecutor()).map(fit_sensor, todo, shared={"read_options": read_options},
+                                       on_done=finished)
+    table = [rows[job.sensor] for job in jobs]
+    _write_table(out, table)
+    return table
+
+
+def _claim(out: Path, refit: bool, source: str) -> None:
+    """Make `out` a batch folder, or check that it is one."""
+    marker = out / MARKER
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"{out} is a file, not a folder")
+    if out.is_dir() and any(out.iterdir()) and not marker.exists() and not refit:
+        raise OutputError(f"{out} is not empty and not a hystkit batch folder (no {MARKER}); "
+                          f"choose another --out or pass --force")
+    check_output_path(marker, force=True)  # the folder (or its nearest parent) is writable
+    if not marker.exists() or refit:
+        write_json({"hystkit": __version__, "source": source}, marker, force=True)
+
+
+def _finished(out: Path, job: SensorJob) -> dict | None:
+    """The sensor's record if it finished this very job (options and recordings unchanged)
+    and its model file is there; failed sensors are tried again."""
+    path = out / "sensors" / f"{job.sensor}.json"
+    try:
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if record.get("job") != job.describe() or record.get("inputs") != fingerprint(job):
+        return None
+    row = record.get("row") or {}
+    if row.get("status") in (None, "failed") or not (out / "models" /
+                                                    f"{job.sensor}.json").is_file():
+        return None
+    return record
+
+
+def _store(out: Path, job: SensorJob, result: dict) -> None:
+    """The model file first, then the record that says the sensor is done."""
+    model = out / "models" / f"{job.sensor}.json"
+    if result["compensator"] is not None:
+        save_compensator(result["compensator"], model, force=True)
+    else:
+        model.unlink(missing_ok=True)  # a model of an earlier run would contradict the row
+    write_json({"job": job.describe(), "inputs": fingerprint(job), "row": result["row"],
+                "scores": result["scores"]}, out / "sensors" / f"{job.sensor}.json", force=True)
+
+
+def _summary(row: dict) -> str:
+    if row["status"] == "failed":
+        return f"{row['sensor']}: FAILED: {row['error']}"
+    r2 = lambda v: "-" if v is None else f"{v:.4f}"
+    note = "" if row["status"] == "ok" else f"; guard: {row['status']}: {row['guards']}"
+    return (f"{row['sensor']}: {row['status']}, R² {r2(row['r2_deployable'])} (oracle "
+            f"{r2(row['r2_oracle'])}), fit {row['fit_seconds']:.2f} s{note}")
+
+
+def _write_table(out: Path, table: list[dict]) -> None:
+    import pandas as pd
+
+    frame = pd.DataFrame(table, columns=list(RESULT_COLUMNS))
+    # derived from the records: rebuilt (replaced) on every run of the batch
+    with atomic_outputs([out / "results.parquet", out / "results.csv"], force=True) as (pq, cs):
+        frame.to_parquet(pq, index=False)
+        frame.to_csv(cs, index=False)
