@@ -195,3 +195,27 @@ def test_baud_without_serial_is_refused(model, capsys):
     _, path = model
     assert main(["stream", str(path), "--baud", "9600"]) == 2
     assert "--baud is for --serial" in capsys.readouterr().err
+
+
+def test_a_runaway_sample_is_skipped_and_the_stream_goes_on(model, validation, tmp_path,
+                                                            capsys):
+    comp, path = model
+    lines = lines_of(validation, 30)
+    lines[10] = f"{float(validation.time[10])!r},1e300\n"  # the estimate runs away
+    data = tmp_path / "in.csv"
+    data.write_text("".join(lines))
+    assert main(["stream", str(path), "--in", str(data)]) == 0
+    captured = capsys.readouterr()
+    _, estimate, _ = parse_output(captured.out)
+    assert_array_equal(estimate, expected(comp, np.delete(validation.sensor[:30], 10))[0])
+    assert ("hystkit: warning: " + str(data) + ": 1 line(s) estimate ran away (skipped; "
+            "first at line 11)") in captured.err
+    assert "irregular step" in captured.err  # the gap the skipped sample left
+
+
+def test_a_missing_input_file_is_one_error_line(model, tmp_path, capsys):
+    _, path = model
+    assert main(["stream", str(path), "--in", str(tmp_path / "none.csv")]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err.startswith("hystkit: error: ")
+    assert "none.csv: cannot read" in captured.err

@@ -164,8 +164,6 @@ class _Latency:
 
 def _run_stream(stream: Stream, lines: Iterator[str], tally: _Tally, latency: _Latency) -> None:
     """Compensate every line, writing each result at once."""
-    import numpy as np
-
     from ..errors import FitDivergedError
 
     dt = stream.compensator.structure.dt
@@ -189,14 +187,13 @@ def _run_stream(stream: Stream, lines: Iterator[str], tally: _Tally, latency: _L
         if previous is not None and abs(t - previous - dt) > STEP_TOLERANCE * dt:
             tally.add("irregular step", line_no)
         try:
-            result = stream.process_flagged(np.array([s]))
+            result = stream.step_flagged(s)
         except FitDivergedError:
             tally.add("estimate ran away", line_no)
             continue
         previous = t
-        flags = sum(bit for bit, mask in ((1, result.sensor_outside), (2, result.estimate_outside))
-                    if mask is not None and mask[0])
-        row = f"{text},{float(result.estimate[0])!r},{flags}\n"
+        flags = (1 if result.sensor_outside else 0) + (2 if result.estimate_outside else 0)
+        row = f"{text},{result.estimate!r},{flags}\n"
         # counted before the line leaves: a reader that got it finds it in the summary
         latency.add(time.perf_counter() - arrived)
         out.write(row)

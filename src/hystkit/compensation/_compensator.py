@@ -214,13 +214,9 @@ class Compensator:
         """
         if self.training_range is None:
             return None
-        return self.normalised_outside(self.normalised_sensor(recording.sensor), margin)
-
-    def normalised_outside(self, s: np.ndarray, margin: float = SENSOR_MARGIN) -> np.ndarray:
-        """Mask of normalised sensor values ``s`` outside the (known) training range widened by
-        ``margin`` of its width on each side (shared with the streaming compensator)."""
         lo, hi = self.training_range
         pad = margin * (hi - lo)
+        s = self.normalised_sensor(recording.sensor)
         return (s < lo - pad) | (s > hi + pad)
 
     def estimate_outside(self, estimate: np.ndarray,

@@ -21,6 +21,7 @@ Start-up (``start``):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
@@ -30,9 +31,11 @@ from scipy.signal import lfilter
 
 from ..errors import FitDivergedError, InputError
 from ._centring import ORACLE_CENTER
-from ._compensator import MAX_NORMALISED, Compensator
+from ._compensator import MAX_NORMALISED, POSITION_MARGIN, SENSOR_MARGIN, Compensator
+from ._sync import sync_excitation
 
-__all__ = ["StartUp", "Stream", "StreamOutput", "StreamState", "advance", "initial_state"]
+__all__ = ["StartUp", "StepOutput", "Stream", "StreamOutput", "StreamState", "advance",
+           "initial_state"]
 
 StartUp = str | np.ndarray
 
@@ -81,20 +84,45 @@ class StreamOutput(NamedTuple):
     estimate_outside: np.ndarray | None
 
 
+class StepOutput(NamedTuple):
+    """One sample's result: estimate [mm] and its use-time guards (None: ranges unknown)."""
+
+    estimate: float
+    sensor_outside: bool | None
+    estimate_outside: bool | None
+
+
 @dataclass(frozen=True, eq=False)
 class _Path:
-    """The compensator's per-sample constants, derived once."""
+    """The compensator's per-sample constants, derived once, with the same operations as
+    ``Compensator`` and ``_centring.sensor_level`` (so that both give the same bits)."""
 
     comp: Compensator
     rest_position: float | None
     n_tare: int = field(init=False)
     track_gain: float = field(init=False)
+    position_offset: float = field(init=False)
+    sensor_bounds: tuple[float, float] | None = field(init=False)
+    estimate_bounds: tuple[float, float] | None = field(init=False)
 
     def __post_init__(self) -> None:
-        dt = self.comp.structure.dt
-        # The same numbers as _centring.sensor_level.
-        object.__setattr__(self, "n_tare", max(1, round(self.comp.tare_seconds / dt)))
-        object.__setattr__(self, "track_gain", 1.0 - np.exp(-dt / self.comp.track_seconds))
+        comp, dt = self.comp, self.comp.structure.dt
+        values = {"n_tare": max(1, round(comp.tare_seconds / dt)),
+                  "track_gain": float(1.0 - np.exp(-dt / comp.track_seconds)),
+                  "position_offset": comp.position_offset(None, self.rest_position),
+                  "sensor_bounds": None, "estimate_bounds": None}
+        # Compensator.sensor_outside / estimate_outside: outside [lo - pad, hi + pad]
+        if comp.training_range is not None:
+            lo, hi = comp.training_range
+            pad = SENSOR_MARGIN * (hi - lo)
+            values["sensor_bounds"] = (lo - pad, hi + pad)
+        if comp.position_range is not None:
+            lo, hi = comp.position_range
+            pad = POSITION_MARGIN * (hi - lo)
+            offset = comp.position_offset() - comp.scaling.position_offset
+            values["estimate_bounds"] = (lo + offset - pad, hi + offset + pad)
+        for name, value in values.items():
+            object.__setattr__(self, name, value)
 
 
 def check_streamable(comp: Compensator) -> None:
@@ -114,7 +142,6 @@ def initial_state(comp: Compensator, start: StartUp = "rest") -> StreamState:
         if start == "rest":
             return StreamState(None)
         if start == "sync":
-            from ._sync import sync_excitation  # _sync runs streams itself
             return StreamState(sync_excitation(comp).state_after)
         raise InputError(f"start {start!r}: use 'rest', 'sync' or a model state vector")
     x = np.asarray(start, dtype=np.float64)
@@ -153,23 +180,21 @@ def _advance(path: _Path, state: StreamState, sensor: np.ndarray,
     s_raw = np.ascontiguousarray(sensor, dtype=np.float64).reshape(-1)
     if s_raw.size == 0:
         empty = np.empty(0)
-        flags = _flags(comp, empty, empty)
-        return StreamOutput(empty, *flags), state
+        return StreamOutput(empty, *_flags(path, empty, empty)), state
     offset, centring = _sensor_offset(path, state, s_raw)
     s = comp.polarity * (s_raw - offset) / comp.scaling.sensor_scale
     with np.errstate(over="ignore", invalid="ignore"):
         try:
             p, x_end = _run_model(comp, s, state.x)
         except FitDivergedError as exc:
-            raise FitDivergedError(f"{label}: samples {state.n_samples}-"
-                                   f"{state.n_samples + s.size - 1}: the {comp.model} "
-                                   f"compensator{_of(comp)}: {exc}") from None
-        estimate = p * comp.scaling.position_scale + comp.position_offset(
-            None, path.rest_position)
+            first, last = state.n_samples, state.n_samples + s.size - 1
+            where = f"sample {first}" if first == last else f"samples {first}-{last}"
+            raise FitDivergedError(f"{label}: {where}: the {comp.model} compensator"
+                                   f"{_of(comp)}: {exc}") from None
+        estimate = p * comp.scaling.position_scale + path.position_offset
     _check_runaway(comp, p, estimate, state.n_samples, label)
-    flags = _flags(comp, s, estimate)
     nxt = StreamState(x_end, state.n_samples + s.size, **centring)
-    return StreamOutput(estimate, *flags), nxt
+    return StreamOutput(estimate, *_flags(path, s, estimate)), nxt
 
 
 def _run_model(comp: Compensator, s: np.ndarray,
@@ -243,10 +268,53 @@ def _check_runaway(comp: Compensator, p: np.ndarray, estimate: np.ndarray, first
                                f"compensator{_of(comp)} gives an estimate that is {kind}")
 
 
-def _flags(comp: Compensator, s: np.ndarray,
-           estimate: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
-    sensor = None if comp.training_range is None else comp.normalised_outside(s)
-    return sensor, comp.estimate_outside(estimate)
+def _flags(path: _Path, s: np.ndarray | float,
+           estimate: np.ndarray | float) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Masks (or booleans, for scalars) of ``Compensator.sensor_outside`` / ``estimate_outside``."""
+    return _outside(s, path.sensor_bounds), _outside(estimate, path.estimate_bounds)
+
+
+def _outside(values, bounds: tuple[float, float] | None):
+    if bounds is None:
+        return None
+    return (values < bounds[0]) | (values > bounds[1])
+
+
+def _advance_one(path: _Path, state: StreamState, v: float,
+                 label: str) -> tuple[StepOutput, StreamState]:
+    """:func:`_advance` for one sample, in Python floats (the same operations, so the same
+    bits) around the family's compiled run: a fraction of the array path's overhead."""
+    comp = path.comp
+    v = float(v)
+    tare_sum, track_value, track_weight = state.tare_sum, state.track_value, state.track_weight
+    if comp.center in ("fit", "none"):
+        offset = comp.scaling.sensor_offset if comp.center == "fit" else 0.0
+    else:
+        if comp.center == "tare":
+            if state.n_samples < path.n_tare:
+                tare_sum = tare_sum + v
+                level = tare_sum / (state.n_samples + 1)
+            else:
+                level = tare_sum / path.n_tare
+        else:  # track: scipy's lfilter, one step of its transposed direct form II
+            den = path.track_gain - 1.0
+            track_value = -(den * track_value) + path.track_gain * v
+            track_weight = -(den * track_weight) + path.track_gain * 1.0
+            level = track_value / track_weight
+        offset = comp.scaling.sensor_offset + level - comp.sensor_reference
+    s = comp.polarity * (v - offset) / comp.scaling.sensor_scale
+    with np.errstate(over="ignore", invalid="ignore"):
+        try:
+            p_run, x_end = _run_model(comp, np.array([s]), state.x)
+        except FitDivergedError as exc:
+            raise FitDivergedError(f"{label}: sample {state.n_samples}: the {comp.model} "
+                                   f"compensator{_of(comp)}: {exc}") from None
+    p = float(p_run[0])
+    estimate = p * comp.scaling.position_scale + path.position_offset
+    if not (abs(p) <= MAX_NORMALISED and math.isfinite(estimate)):
+        _check_runaway(comp, np.array([p]), np.array([estimate]), state.n_samples, label)
+    nxt = StreamState(x_end, state.n_samples + 1, tare_sum, track_value, track_weight)
+    return StepOutput(estimate, *_flags(path, s, estimate)), nxt
 
 
 def _of(comp: Compensator) -> str:
@@ -308,8 +376,13 @@ class Stream:
         return self._state
 
     def step(self, sensor: float) -> float:
-        """Estimate [mm] for one raw sensor sample."""
-        return float(self.process(np.array([sensor], dtype=np.float64))[0])
+        """Estimate [mm] for one raw sensor sample (the same bits as :meth:`process`)."""
+        return self.step_flagged(sensor).estimate
+
+    def step_flagged(self, sensor: float) -> StepOutput:
+        """Estimate and use-time flags for one raw sensor sample."""
+        out, self._state = _advance_one(self._path, self._state, sensor, self.label)
+        return out
 
     def process(self, sensor: np.ndarray) -> np.ndarray:
         """Estimates [mm] for a chunk of raw sensor samples (compiled per chunk)."""
