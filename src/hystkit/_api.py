@@ -119,7 +119,7 @@ def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None
     ('ok', True)
     """
     items = list(data) if isinstance(data, list | tuple) else [data]
-    recordings = [as_recording(item) for item in items]
+    recordings = [_as_recording(item) for item in items]
     return fit_compensator(recordings, size, model=model, mode=mode, center=center, **options)
 
 
@@ -159,7 +159,7 @@ def evaluate(compensator: Compensator, data: Data, *,
     >>> scores["r2"] > scores["linear_r2"]
     True
     """
-    scores = _evaluate(compensator, as_recording(data), rest_position=rest_position)
+    scores = _evaluate(compensator, _as_recording(data), rest_position=rest_position)
     return dict(sorted(scores.items(), key=lambda item: _score_rank(item[0])))
 
 
@@ -178,6 +178,19 @@ def compensate(compensator: Compensator, data: Data, *,
     Also adds the use-time guards ``sensor_outside`` and ``estimate_outside`` (True where the
     sensor or the estimate leaves the training range), as ``hystkit compensate`` writes them.
 
+    Parameters
+    ----------
+    compensator : Compensator
+    data : Recording, DataFrame or path
+        The recording to compensate (``position`` is not needed).
+    rest_position : float, optional
+        ``tare`` centring: the position [mm] during the tare window.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The recording's columns, ``position_estimate`` [mm] and the guard flags.
+
     Examples
     --------
     >>> import hystkit as hk
@@ -187,7 +200,7 @@ def compensate(compensator: Compensator, data: Data, *,
     >>> out.columns.tolist()
     ['time', 'position', 'sensor', 'position_estimate', 'sensor_outside', 'estimate_outside']
     """
-    recording = as_recording(data)
+    recording = _as_recording(data)
     estimate = compensator.estimate(recording, rest_position=rest_position)
     frame = recording.to_frame()
     frame["position_estimate"] = estimate
@@ -233,12 +246,17 @@ def compare(fit_data: Data, val_data: Data, models: Sequence[str] | None = None,
 
     from .reports import compare_models
 
-    table = compare_models(as_recording(fit_data), as_recording(val_data), models, sizes)
+    table = compare_models(_as_recording(fit_data), _as_recording(val_data), models, sizes)
     return pd.DataFrame.from_dict(table, orient="index")
 
 
 def load(path: str | os.PathLike) -> Compensator:
     """Load a model file written by :func:`save` or ``hystkit fit --out`` (JSON or ``.mat``).
+
+    Raises
+    ------
+    InputError
+        A missing, damaged or foreign file (one line naming it).
 
     Examples
     --------
@@ -254,14 +272,26 @@ def load(path: str | os.PathLike) -> Compensator:
 
 
 def save(compensator: Compensator, path: str | os.PathLike, *, force: bool = False) -> Path:
-    """Write a compensator to a model file (JSON); returns the path.
+    """Write a compensator to a model file; returns the path.
 
-    An existing file is kept unless ``force``; the file appears whole or not at all.
+    Parameters
+    ----------
+    compensator : Compensator
+        From :func:`fit` or :func:`load`.
+    path : str or path-like
+        ``.json`` (or ``.mat`` where `hystkit.compensation.save_compensator` supports it).
+    force : bool
+        Replace an existing file; without it an existing file is an error and is kept. The
+        file appears whole or not at all.
+
+    Returns
+    -------
+    pathlib.Path
     """
     return save_compensator(compensator, path, force=force)
 
 
-def as_recording(data: Data) -> Recording:
+def _as_recording(data: Data) -> Recording:
     """`data` as a `Recording`: kept, converted from a DataFrame, or read from a file path.
 
     Raises
