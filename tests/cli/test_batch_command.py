@@ -78,3 +78,31 @@ def test_bad_input_is_one_line(manifest, tmp_path, capsys, args, message):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("hystkit: error:") and message in err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_batch_killed_after_its_first_sensor_resumes_to_the_same_table(manifest, tmp_path):
+    """Ctrl-C on the running command (two Dask workers): one line, exit 130; the rerun fits
+    only what was not finished and writes the table of an uninterrupted run."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    out = tmp_path / "killed"
+    proc = subprocess.Popen([sys.executable, "-m", "hystkit", "batch", str(manifest), "--out",
+                             str(out), "--workers", "2"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    for line in proc.stdout:  # the first finished sensor
+        if line.startswith("[1/3]"):
+            break
+    os.killpg(proc.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole process group
+    rest, err = proc.communicate(timeout=60)
+    assert (proc.returncode, err.splitlines()) == (130, ["hystkit: interrupted"]) or \
+        (proc.returncode == 0 and "wrote" in rest)  # finished before the signal arrived
+    finished = len(list((out / "sensors").iterdir()))
+    assert finished >= 1
+    assert main(["batch", str(manifest), "--out", str(out), "--workers", "1"]) == 0
+    assert main(["batch", str(manifest), "--out", str(tmp_path / "whole"), "--workers", "1"]) == 0
+    pd.testing.assert_frame_equal(_table(out).drop(columns=TIMES),
+                                  _table(tmp_path / "whole").drop(columns=TIMES))

@@ -15,9 +15,10 @@ from hystkit.sensors import simulate_experiment
 @pytest.fixture(scope="session")
 def cluster_address() -> Iterator[str]:
     distributed = pytest.importorskip("distributed")
+    from hystkit.parallel._dask import NO_DASHBOARD
+
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None,
-                                  silence_logs=logging.CRITICAL) as cluster:
+                                  silence_logs=logging.CRITICAL, **NO_DASHBOARD) as cluster:
         yield cluster.scheduler_address
 
 

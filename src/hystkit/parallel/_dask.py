@@ -32,6 +32,9 @@ __all__ = ["DaskExecutor", "SchedulerError", "WarmUp", "dask_executor"]
 # signal has just ended must not hold the command's exit).
 CONNECT_TIMEOUT = 10
 CLOSE_TIMEOUT = 3
+# No dashboard; the scheduler's HTTP server (health checks) on a free port, not 8787, which
+# another cluster may hold (then Dask warns and moves).
+NO_DASHBOARD = {"dashboard_address": None, "scheduler_kwargs": {"dashboard_address": ":0"}}
 
 
 class SchedulerError(HystkitError):
@@ -121,8 +124,8 @@ def dask_executor(n_workers: int | None, scheduler: str | None) -> Iterator[Dask
                 warm_kernels()
             with dask.config.set({"distributed.worker.multiprocessing-method": method}):
                 cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1,
-                                       processes=True, dashboard_address=None,
-                                       silence_logs=logging.CRITICAL)
+                                       processes=True, silence_logs=logging.CRITICAL,
+                                       **NO_DASHBOARD)
             stack.callback(cluster.close, timeout=CLOSE_TIMEOUT)
             client = Client(cluster)
             where = f"local, {method}ed"
