@@ -1,6 +1,7 @@
 """Speed of hystkit's mPL forward model and of its fit, against references run in the same process.
 
-Run:  /tmp/venv/bin/python benchmarks/bench_mpl.py      (about a minute on 2 cores)
+Run:  python benchmarks/bench_mpl.py [--fit-only]   (several minutes on 2 cores: the 128k-sample
+      trf fits take up to a minute each; --fit-only skips table 1 and the compile costs)
 
 Table 1 -- forward model cost in ns per sample per cell, for N = 1, 3, 10 cells on a
 100 000-sample normalised input (0.5 Hz sine plus white noise, max |u| = 1, dt = 0.025 s):
@@ -15,15 +16,19 @@ Each figure is the *minimum* over 15 repeats of ``time.perf_counter`` around one
 warm-up call, with the variants interleaved within each repeat; the minimum is the least disturbed estimate of the cost of the work. The
 numba compile (or cache load) and the C compile are one-off costs, reported separately.
 
-Table 2 -- wall time of ``fit_mpl`` on the virtual sensor's sine fitting recording (8000
-samples, seed 1 as in the demo report), direct mode (input = normalised sensor, output =
-normalised position), N = 1, 2, 3, *median* of 3 runs after a warm-up, with the final SSE.
-Reference for N = 1: ``scipy.optimize.least_squares`` with a finite-difference ('2-point')
-Jacobian, from the same first start and bounds as ``fit_mpl``, with hystkit's compiled
-``simulate`` for the residuals.
+Table 2 -- wall time of ``fit_mpl`` in *simulations' worth*: fit wall time divided by one
+compiled ``mpl.simulate`` of the same data with the same cell count, both measured in the same
+run (the ratio cancels most of the machine's speed and load). N = 1, 3, 5 cells on the virtual
+sensor's sine fitting recording (8000 samples, seed 1 as in the demo report) and on 16 such
+recordings (seeds 1-16) joined into 128 000 samples, direct mode (input = normalised sensor,
+output = normalised position). Each row compares the default solver (``solver="tr"``: scipy's
+trust-region reflective on one-pass normal equations) with the previous one (``solver="trf"``:
+``scipy.optimize.least_squares`` on the dense exact Jacobian), interleaved A B A B, with the
+medians, their ratio and both final SSEs. Reference for N = 1: ``least_squares`` with a
+finite-difference ('2-point') Jacobian from the same first start.
 
 BLAS: unless OPENBLAS_NUM_THREADS is already set, this script sets it to 1 before numpy loads.
-The fit's linear algebra (scipy's SVD in least_squares) is on 8000 x <= 11 matrices, too small
+The trf path's linear algebra (scipy's SVD in least_squares) is on n x <= 17 matrices, too small
 for threads to pay; on a 2-core machine with another process busy, OpenBLAS's two spinning
 threads made the same fit 10-30x slower and erratic (N = 3: 8-28 s instead of 0.8 s), while on
 an idle machine 1 and 2 threads timed alike. Export OPENBLAS_NUM_THREADS to measure another
@@ -64,8 +69,11 @@ SIM_CELLS = (1, 3, 10)
 SIM_SAMPLES = 100_000
 SIM_REPEATS = 15
 PY_SAMPLES = 2_000
-FIT_CELLS = (1, 2, 3)
-FIT_REPEATS = 3
+FIT_CELLS = (1, 3, 5)
+FIT_SIZES = (8000, 128_000)  # samples: one recording, 16 recordings joined
+FIT_REPEATS = {8000: 3, 128_000: 2}  # interleaved pairs (tr, trf) per row
+SIM_TIMING_REPEATS = 7
+FIT_ONLY = "--fit-only" in sys.argv
 FIT_SEED = 1  # the demo report's fitting seed (hystkit.reports._demo.FIT_SEED)
 C_FLAGS = ("-O2", "-shared", "-fPIC")
 C_SOURCE = Path(__file__).with_name("_c_reference.c")
@@ -230,8 +238,11 @@ def print_compile_costs(c_seconds: float | None) -> None:
     u = sim_input(1000)
     sim = numba_compile_seconds(kernels.simulate, kernel_args(structure, params, u))
     jac = numba_compile_seconds(kernels.simulate_with_jacobian, kernel_args(structure, params, u))
+    args = kernel_args(structure, params, u)
+    normal = numba_compile_seconds(kernels.normal_equations, (u, u, *args[1:]))
     print("One-off costs (not included in the tables)")
-    for name, (first, cold, note) in (("simulate", sim), ("simulate_with_jacobian", jac)):
+    for name, (first, cold, note) in (("simulate", sim), ("simulate_with_jacobian", jac),
+                                      ("normal_equations", normal)):
         print(f"  numba {name:<23} first call {first * 1e3:8.1f} ms ({note}); "
               f"cold compile {cold * 1e3:8.1f} ms")
     if c_seconds is not None:
@@ -291,11 +302,21 @@ def print_simulation_table(c_func, cc: str | None) -> None:
 
 # ----------------------------------------------------------------------------- table 2
 
-def fit_data() -> tuple[np.ndarray, np.ndarray, float]:
-    """Direct mode: input = normalised sensor, output = normalised position (eq. 5.10)."""
-    rec = simulate_experiment("sine", FIT_SEED)
-    _, s, p = centre_and_scale(rec, "recording")
-    return s, p, rec.dt
+def fit_data(n_samples: int = 8000) -> tuple[np.ndarray, np.ndarray, float]:
+    """Direct mode: input = normalised sensor, output = normalised position (eq. 5.10).
+
+    8000 samples: the seed-1 sine recording; more: recordings of seeds 1, 2, ... joined (each
+    normalised on its own, as a user would fit several recordings).
+    """
+    parts, dt = [], None
+    for seed in range(FIT_SEED, FIT_SEED + max(1, n_samples // 8000)):
+        rec = simulate_experiment("sine", seed)
+        _, s, p = centre_and_scale(rec, "recording")
+        parts.append((s, p))
+        dt = rec.dt
+    u = np.concatenate([s for s, _ in parts])[:n_samples]
+    y = np.concatenate([p for _, p in parts])[:n_samples]
+    return np.ascontiguousarray(u), np.ascontiguousarray(y), dt
 
 
 def fit_bounds(structure: mpl.MplStructure) -> tuple[np.ndarray, np.ndarray]:
@@ -335,19 +356,40 @@ def fd_reference_fit(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure) 
 
 
 def hystkit_fit(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure,
-                starts=None) -> dict:
-    t0 = time.perf_counter()
-    res = fit_mpl(u, y, structure, starts=starts)
-    return {"seconds": time.perf_counter() - t0, "cost": res.cost, "runs": res.n_evaluations,
-            "converged": res.converged}
+                starts=None, solver: str = "tr") -> dict:
+    t0, c0 = time.perf_counter(), time.process_time()
+    res = fit_mpl(u, y, structure, starts=starts, solver=solver)
+    return {"seconds": time.perf_counter() - t0, "cpu": time.process_time() - c0,
+            "cost": res.cost, "runs": res.n_evaluations, "converged": res.converged,
+            "params": res.params}
 
 
 def repeated(fn, repeats: int) -> dict:
     """Median wall time of ``repeats`` runs (plus min and max); cost etc. of the last run."""
     runs = [fn() for _ in range(repeats)]
+    return summarise(runs)
+
+
+def summarise(runs: list[dict]) -> dict:
     times = [r["seconds"] for r in runs]
-    return {**runs[-1], "seconds": statistics.median(times), "min": min(times),
-            "max": max(times)}
+    out = {**runs[-1], "seconds": statistics.median(times), "min": min(times),
+           "max": max(times)}
+    if "cpu" in runs[-1]:
+        out["cpu"] = statistics.median(r["cpu"] for r in runs)
+    return out
+
+
+def simulate_seconds(structure: mpl.MplStructure, params: mpl.MplParams,
+                     u: np.ndarray) -> tuple[float, float]:
+    """Median wall and CPU time of one compiled ``mpl.simulate`` (wrapper included) over ``u``."""
+    mpl.simulate(structure, params, u)
+    wall, cpu = [], []
+    for _ in range(SIM_TIMING_REPEATS):
+        t0, c0 = time.perf_counter(), time.process_time()
+        mpl.simulate(structure, params, u)
+        wall.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+    return statistics.median(wall), statistics.median(cpu)
 
 
 def fit_line(label: str, r: dict) -> str:
@@ -355,36 +397,75 @@ def fit_line(label: str, r: dict) -> str:
             f"{r['cost']:10.4f} {r['runs']:>6} {'yes' if r['converged'] else 'no':>5}")
 
 
+def solver_row(n_cells: int, n_samples: int, u: np.ndarray, y: np.ndarray, dt: float) -> dict:
+    """Interleaved tr / trf fits and the simulate time of the same data, in one row."""
+    structure = mpl.MplStructure(n_cells=n_cells, dt=dt)
+    runs: dict[str, list] = {"tr": [], "trf": []}
+    sim = []
+    for _ in range(FIT_REPEATS[n_samples]):
+        for solver in ("tr", "trf"):
+            runs[solver].append(hystkit_fit(u, y, structure, solver=solver))
+        sim.append(simulate_seconds(structure, runs["tr"][-1]["params"], u))
+    row = {solver: summarise(r) for solver, r in runs.items()}
+    row.update(n=n_cells, size=n_samples, sim=statistics.median(w for w, _ in sim),
+               sim_cpu=statistics.median(c for _, c in sim))
+    return row
+
+
+def print_solver_row(r: dict) -> None:
+    new, old, sim, sim_cpu = r["tr"], r["trf"], r["sim"], r["sim_cpu"]
+
+    def part(f: dict) -> str:
+        return (f"{f['seconds']:7.3f} {f['seconds'] / sim:6.0f} {f['cpu'] / sim_cpu:6.0f} "
+                f"{f['cost']:11.6f} {f['runs']:>5} {'yes' if f['converged'] else 'no':>4}")
+
+    print(f"  {r['n']:>2} {r['size']:>7} {sim * 1e3:7.2f} | {part(new)} | {part(old)} | "
+          f"{old['seconds'] / new['seconds']:5.2f} {old['cpu'] / new['cpu']:5.2f} "
+          f"{abs(new['cost'] - old['cost']) / old['cost']:8.1e}", flush=True)
+
+
 def print_fit_table() -> None:
-    u, y, dt = fit_data()
-    # Warm-up outside the timed runs: fit_mpl's first call would otherwise pay the kernel load.
-    hystkit_fit(u[:500], y[:500], mpl.MplStructure(n_cells=1, dt=dt))
-    print(f"Table 2. fit_mpl on the virtual sine fitting recording (seed {FIT_SEED}, "
-          f"{u.size} samples, dt = {dt:.3f} s), direct mode; wall time, median of "
-          f"{FIT_REPEATS} runs after warm-up")
-    print("  cost = SSE on the normalised data (eq. 5.9); runs: hystkit = FitResult.n_evaluations"
-          " (residual + exact-Jacobian evaluations), scipy FD = simulate calls incl. the FD"
-          " Jacobian's")
-    head = (f"  {'':<40} {'median s':>8} {'min-max s':>15} {'cost':>10} {'runs':>6} "
-            f"{'conv.':>5}")
+    u8, y8, dt = fit_data()
+    # Warm-up outside the timed runs: the first call of each path pays the kernel load.
+    for solver in ("tr", "trf"):
+        hystkit_fit(u8[:500], y8[:500], mpl.MplStructure(n_cells=1, dt=dt), solver=solver)
+    print("Table 2. fit_mpl in simulations' worth (fit wall time / one mpl.simulate of the same "
+          "data, same N, same run),")
+    print(f"  virtual sine fitting recording(s) from seed {FIT_SEED}, dt = {dt:.3f} s, direct "
+          f"mode; tr = default solver (normal equations), trf = previous (dense Jacobian);")
+    print(f"  interleaved tr, trf x {FIT_REPEATS[8000]} (8000 samples) / "
+          f"x {FIT_REPEATS[128_000]} (128k), medians; sim = median of {SIM_TIMING_REPEATS} "
+          f"simulate calls per pair; runs = FitResult.n_evaluations")
+    print("  (tr: model runs, each yielding cost and normal equations; trf: residual + "
+          "Jacobian evaluations, one kernel run each pair); cost = SSE (eq. 5.9)")
+    print("  sims = fit / simulate by wall time; cpu = the same by process CPU time "
+          "(time.process_time), which a loaded machine distorts far less")
+    head = (f"  {'N':>2} {'samples':>7} {'sim ms':>7} | {'tr s':>7} {'sims':>6} {'cpu':>6} "
+            f"{'tr cost':>11} {'runs':>5} {'conv':>4} | {'trf s':>7} {'sims':>6} {'cpu':>6} "
+            f"{'trf cost':>11} {'runs':>5} {'conv':>4} | {'trf/tr':>5} {'cpu':>5} "
+            f"{'|dcost|':>8}")
     print(head)
     print("  " + "-" * (len(head) - 2))
-    results = {}
-    for n in FIT_CELLS:
-        structure = mpl.MplStructure(n_cells=n, dt=dt)
-        results[n] = repeated(lambda s=structure: hystkit_fit(u, y, s), FIT_REPEATS)
-        print(fit_line(f"hystkit fit_mpl, N = {n} (6 starts)", results[n]), flush=True)
+    for size in FIT_SIZES:
+        u, y, _ = (u8, y8, dt) if size == u8.size else fit_data(size)
+        for n in FIT_CELLS:
+            print_solver_row(solver_row(n, size, u, y, dt))
+    print("  trf/tr = ratio of median wall times (cpu: of median CPU times); "
+          "|dcost| = |SSE_tr - SSE_trf| / SSE_trf")
+    print()
 
     structure = mpl.MplStructure(n_cells=1, dt=dt)
-    one = repeated(lambda: hystkit_fit(u, y, structure, starts=default_starts(structure)[:1]),
-                   FIT_REPEATS)
-    ref = repeated(lambda: fd_reference_fit(u, y, structure), FIT_REPEATS)
-    print()
-    print("  Reference, N = 1, same first start, theta0 and bounds:")
-    print(fit_line("hystkit fit_mpl, start [0] only", one))
+    one = repeated(lambda: hystkit_fit(u8, y8, structure, starts=default_starts(structure)[:1]),
+                   FIT_REPEATS[8000])
+    ref = repeated(lambda: fd_reference_fit(u8, y8, structure), FIT_REPEATS[8000])
+    print("  Reference, N = 1, 8000 samples, same first start, theta0 and bounds "
+          "(wall time, median of 3):")
+    head = f"  {'':<40} {'median s':>8} {'min-max s':>15} {'cost':>10} {'runs':>6} {'conv.':>5}"
+    print(head)
+    print(fit_line("hystkit fit_mpl (tr), start [0] only", one))
     print(fit_line("scipy least_squares '2-point' + simulate", ref))
-    print(f"  time ratio scipy-FD / hystkit: {ref['seconds'] / results[1]['seconds']:.2f}x vs the "
-          f"default 6-start fit, {ref['seconds'] / one['seconds']:.2f}x vs the same single start")
+    print(f"  time ratio scipy-FD / hystkit: {ref['seconds'] / one['seconds']:.2f}x on the same "
+          f"single start")
     print("  Document's reference: MATLAB patternsearch took about 60 s on 6 cores (paper 9.2); "
           "different data and machine, for scale only.")
     print()
@@ -406,8 +487,9 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="hystkit-bench-") as workdir:
         c_func, c_seconds = build_c_reference(cc, workdir) if cc else (None, None)
         # Compile costs first: the tables' warm-ups would otherwise hide the first call.
-        print_compile_costs(c_seconds)
-        print_simulation_table(c_func, cc)
+        if not FIT_ONLY:
+            print_compile_costs(c_seconds)
+            print_simulation_table(c_func, cc)
     print_fit_table()
     print(f"Total benchmark time {time.perf_counter() - t_total:.1f} s")
     return 0

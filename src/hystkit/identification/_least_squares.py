@@ -13,6 +13,7 @@ Jacobian (or '2-point'), the normal equations are formed from them:
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable, Sequence
 from types import SimpleNamespace
@@ -20,7 +21,7 @@ from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from ..errors import FitDivergedError
 from ._lm import solve_lm
@@ -136,7 +137,7 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
     def solve(theta0: np.ndarray, budget: int) -> SimpleNamespace:
         # BLAS threads do not pay on (n x n_params) problems, and under load they cost 10-30x
         # (benchmarks/README.md).
-        with threadpool_limits(limits=1, user_api="blas"):
+        with _blas_controller().limit(limits=1, user_api="blas"):
             if solver != "trf":
                 # lm may stop on a bound, the margin keeps it inside as trf and tr stay
                 shrink = margin if solver == "lm" else 0.0
@@ -204,3 +205,10 @@ def _per_coordinate(values: Sequence | None, n: int, what: str) -> tuple | None:
     if len(values) != n:
         raise ValueError(f"{what} must have one entry per coordinate ({n}), got {len(values)}")
     return values
+
+
+@functools.cache
+def _blas_controller() -> ThreadpoolController:
+    """One controller per process: finding the loaded BLAS libraries reads /proc/self/maps
+    (~20 ms), which per solve cost more than a short fit's model runs."""
+    return ThreadpoolController()

@@ -12,6 +12,7 @@ enter the output linearly) by linear least squares, so no start begins far off.
 from __future__ import annotations
 
 from collections.abc import Callable
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -141,8 +142,14 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     cache: dict = {}
 
     def kernel_args(theta: np.ndarray) -> tuple:
-        p = mpl.MplParams.from_vector(theta, n)
-        return p.i_s, p.v_t, p.w, p.v_b, mpl.knee_voltage(structure, p), cap, structure.dt
+        # MplParams.from_vector's arithmetic without its validation (bounds keep theta in the
+        # domain): hundreds of calls per fit, each a model run's worth on short recordings
+        cells = theta[: 2 * n].reshape(n, 2)
+        v_t = np.exp(cells[:, 1])
+        resistors = SimpleNamespace(i_s=0.5 * np.exp(cells[:, 0]) * v_t, v_t=v_t)
+        return (resistors.i_s, v_t, np.ascontiguousarray(theta[2 * n: 3 * n + 1]),
+                float(theta[3 * n + 1]), mpl.knee_voltage(structure, resistors), cap,
+                structure.dt)
 
     def run(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         # least_squares (solver="trf") asks for the residual and then the Jacobian at the same
