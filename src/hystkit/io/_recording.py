@@ -23,7 +23,6 @@ from ._cells import as_vector
 from ._csv_reader import read_csv
 from ._mat_reader import read_mat
 from ._parquet_reader import read_parquet
-from ._resample import resample_arrays
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -68,10 +67,6 @@ class Recording(Sampled):
         Reference position [mm]; None when the recording has none.
     source : str
         Where the data came from (a file name); used in error messages.
-    units : mapping or tuple of (str, str)
-        Units of the file's columns as read from it (``{"position": "mm", "sensor":
-        "Ohm"}``), for labels and outputs; hystkit's own computations do not use them (time
-        is always in seconds once read). Stored as a tuple of pairs.
 
     Notes
     -----
@@ -83,10 +78,8 @@ class Recording(Sampled):
     sensor: np.ndarray
     position: np.ndarray | None = None
     source: str = "<memory>"
-    units: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "units", _unit_pairs(self.units))
         where = _Where(self.source, item="sample")
         arrays = {
             name: as_vector(getattr(self, name), name, where)
@@ -102,13 +95,9 @@ class Recording(Sampled):
         """Whether the recording carries a reference position."""
         return self.position is not None
 
-    def unit(self, name: str) -> str:
-        """The unit of column `name` as the file gave it, or "" when unknown."""
-        return dict(self.units).get(name, "")
-
     def to_frame(self) -> pd.DataFrame:
         """The recording as a DataFrame with columns ``time`` [s], ``position`` (when present)
-        and ``sensor``; ``attrs`` keeps ``source`` and ``units``.
+        and ``sensor``; ``attrs`` keeps ``source``.
 
         Examples
         --------
@@ -124,7 +113,7 @@ class Recording(Sampled):
 
         frame = pd.DataFrame({name: getattr(self, name) for name in _COLUMNS
                               if getattr(self, name) is not None})
-        frame.attrs.update(source=self.source, units=dict(self.units))
+        frame.attrs.update(source=self.source)
         return frame
 
     @classmethod
@@ -171,7 +160,7 @@ class Recording(Sampled):
                 raise InputError(f"{source}: missing column {column!r} ({name}); columns: "
                                  f"{', '.join(map(str, frame.columns))}")
         arrays["time"] = arrays["time"] * options.time_scale
-        return cls(**arrays, source=source, units=frame.attrs.get("units", ()))
+        return cls(**arrays, source=source)
 
 
 def _numbers(values: pd.Series, what: str) -> np.ndarray:
@@ -183,14 +172,6 @@ def _numbers(values: pd.Series, what: str) -> np.ndarray:
     if bad.size:
         raise InputError(f"{what}, sample {bad[0] + 1}: not a number: {values.iloc[bad[0]]!r}")
     return numbers
-
-
-def _unit_pairs(units: object) -> tuple[tuple[str, str], ...]:
-    pairs = units.items() if isinstance(units, Mapping) else units
-    try:
-        return tuple((str(name), str(unit)) for name, unit in pairs if str(unit).strip())
-    except (TypeError, ValueError):
-        raise ValueError(f"units must map column names to unit text, got {units!r}") from None
 
 
 def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
@@ -205,10 +186,8 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
     need_position : bool
         Require a ``position`` column. If False it is still read when present.
     options : ReadOptions, optional
-        The file's own column (or variable) names, time unit, for CSV the separator, the
-        lines after the header to skip and a units line, for ``.mat`` the variable, and a
-        rate to resample to (`hystkit.io._resample`: linear interpolation, a zero-phase
-        anti-alias low-pass when decimating, gaps refused). Default: columns named ``time``, ``position``,
+        The file's own column (or variable) names, time unit, and for CSV the separator and
+        the lines after the header to skip. Default: columns named ``time``, ``position``,
         ``sensor``, time in seconds, comma-separated, the header on the first line.
 
     Returns
@@ -247,15 +226,11 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
     if options.time_scale != 1.0:  # to seconds before the checks, whose messages say "s"
         arrays["time"] = arrays["time"] * options.time_scale
-    if options.resample_hz is not None:
-        _validate(arrays, where, uniform=False)
-        arrays = resample_arrays(arrays, options.resample_hz, where)
     _validate(arrays, where)
     return _adopt(arrays, source)
 
 
-def _adopt(arrays: dict[str, np.ndarray], source: str,
-           units: tuple[tuple[str, str], ...] = ()) -> Recording:
+def _adopt(arrays: dict[str, np.ndarray], source: str) -> Recording:
     """A `Recording` around 1-D float64 arrays a reader made and `_validate` checked.
 
     ``Recording(...)`` would copy and check them again; nothing else holds these arrays, so
@@ -269,16 +244,14 @@ def _adopt(arrays: dict[str, np.ndarray], source: str,
             values.setflags(write=False)
         object.__setattr__(recording, name, values)
     object.__setattr__(recording, "source", source)
-    object.__setattr__(recording, "units", _unit_pairs(units))
     return recording
 
 
 _READERS = {".csv": read_csv, ".parquet": read_parquet, ".mat": read_mat}
 
 
-def _validate(arrays: dict[str, np.ndarray], where: _Where, *, uniform: bool = True) -> None:
-    """Check 1-D float arrays (``time`` among them) for the invariants of a `Recording`
-    (`uniform`: including the uniform sampling, which resampling establishes)."""
+def _validate(arrays: dict[str, np.ndarray], where: _Where) -> None:
+    """Check 1-D float arrays (``time`` among them) for the invariants of a `Recording`."""
     lengths = {name: values.size for name, values in arrays.items()}
     if len(set(lengths.values())) > 1:
         listed = ", ".join(f"{name} {n}" for name, n in lengths.items())
@@ -305,12 +278,10 @@ def _validate(arrays: dict[str, np.ndarray], where: _Where, *, uniform: bool = T
         i = int(bad[0]) + 1
         raise where.fail(f"time is not strictly increasing: {time[i]:.12g} s follows "
                          f"{time[i - 1]:.12g} s", "time", i)
-    if not uniform:
-        return
     median = float(np.median(step))
     bad = np.flatnonzero(np.abs(step - median) > _MAX_STEP_DEVIATION * median)
     if bad.size:
         i = int(bad[0]) + 1
         raise where.fail(f"non-uniform sampling: step {step[i - 1]:.6g} s deviates more than "
                          f"{_MAX_STEP_DEVIATION:.0%} from the median step {median:.6g} s; "
-                         "resample it to a uniform time grid (--resample HZ)", "time", i)
+                         "resample the recording to a uniform time grid", "time", i)
