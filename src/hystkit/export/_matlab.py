@@ -92,17 +92,30 @@ end
 """
 
 
+_LOAD = """function x = model_load(B, x_block)
+x = x_block(:);
+end
+"""
+
+
 def _init(plan: ExportPlan) -> str:
     n = plan.name
-    return _comment(plan, f"{n}_init.m") + f"""function state = {n}_init(first_sensor)
+    load = getattr(translator(plan.model), "M_LOAD", _LOAD)
+    return _comment(plan, f"{n}_init.m") + f"""function state = {n}_init(first_sensor, x_model)
 % state = {n}_init(first_sensor): at rest at the first sensor sample (pass that sample to
-% {n} too).
+% {n} too). state = {n}_init([], x_model): from a saved model state (the family block's state
+% vector, as hystkit's Stream and {n}_sync give it); the centring starts afresh.
 state = struct('x', zeros({plan.n_state}, 1), 'level', 0.0, 'sum_z', 0.0, 'weight_z', 0.0, ...
                'n_seen', 0);
+if nargin > 1
+    state.x = model_load(body(), x_model);
+    return;
+end
 [s, probe] = normalised(state, first_sensor);
 state.x = model_rest(body(), s);
 end
 
+{load}
 {_centring(plan)}
 {_body(plan)}
 {translator(plan.model).m_model(plan, lit)}"""
@@ -161,8 +174,7 @@ def _sync(plan: ExportPlan) -> str:
     return _comment(plan, f"{n}_sync.m") + f"""function state = {n}_sync()
 % state = {n}_sync(): the state after the synchronisation excitation e_sync (eq. 2.21-2.22);
 % run e_sync on the device, then use this instead of {n}_init. Centring starts afresh.
-state = struct('x', {_column(plan.sync_state)}, 'level', 0.0, 'sum_z', 0.0, ...
-               'weight_z', 0.0, 'n_seen', 0);
+state = {n}_init([], {_column(plan.sync_state)});
 end
 """
 

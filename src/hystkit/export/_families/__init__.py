@@ -22,7 +22,8 @@ from types import ModuleType
 
 __all__ = ["REFUSALS", "TRANSLATED", "refusal", "translator"]
 
-TRANSLATED = {"mpl": "mpl", "mpl-poly": "mpl_poly", "pi": "pi", "ladder": "ladder"}
+TRANSLATED = {"mpl": "mpl", "mpl-poly": "mpl_poly", "pi": "pi", "preisach": "preisach",
+              "ladder": "ladder"}
 
 REFUSALS = {
     "pl": "the power-law family's block is not translated to C/MATLAB yet (its resistor is a "
