@@ -80,7 +80,7 @@ def folders(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         patch.setattr(hystkit.reports, "candidates", lambda *a, **k: [
             Candidate("mpl", 1, "direct", "fit"), Candidate("mpl", 2, "direct", "fit")])
         assert main(["select", str(fit), "--out", str(root / "sel.json"), "--report",
-                     str(out["sel"])]) == 0
+                     str(out["sel"]), "--workers", "1"]) == 0  # serial: no cluster to start
     assert main(["control", "--scheme", "direct", "--experiment", "sine", "--bode", "--out",
                  str(out["ctl"])]) == 0
     return out

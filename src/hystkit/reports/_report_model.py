@@ -237,9 +237,9 @@ def model_report(model_path: Path, recordings: Mapping[str, Recording], *,
     return content
 
 
-def _written_by(path: Path) -> str | None:
+def _written_by(path: Path) -> str:
     """The hystkit version a JSON model file names (a top-level key the Compensator does not
-    keep); None for other model files. The file was checked by ``load_compensator``."""
+    keep). The file was checked by ``load_compensator``."""
     if path.suffix.lower() != ".json":
-        return None
-    return json.loads(path.read_text(encoding="utf-8")).get("hystkit_version")
+        return "not shown for a .mat model file"
+    return json.loads(path.read_text(encoding="utf-8")).get("hystkit_version") or "not stored"

@@ -13,9 +13,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from .. import __version__
-from .._read_options import ReadOptions
 from ..errors import InputError
-from ..io import Recording, atomic_outputs, read_recording
+from ..io import ReadOptions, Recording, atomic_outputs, read_recording
 from ._figures import DEFAULT_SENSOR_LABEL
 from ._html import render_page
 from ._report_control import control_report
