@@ -13,7 +13,9 @@ Whole-process wall time, from starting ``python -m hystkit ...`` to its exit, of
   within 2x of the fit itself, measured here in this process as ``fit_compensator`` on the same
   recording (what the command computes, without start-up, reading and writing).
 
-Paired and interleaved: every repeat runs the floor, each command and the in-process fits once,
+Wall and CPU time (user + system of the child process) are both reported: on a shared machine
+the wall time carries the other jobs' load, the CPU time much less. Paired and interleaved:
+every repeat runs the floor, each command and the in-process fits once,
 one after the other, so bursts of load hit all alike; reported are the medians and the median
 of the per-repeat ratios. One warm-up round is not counted.
 """
@@ -23,6 +25,7 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import resource
 import statistics
 import subprocess
 import sys
@@ -51,23 +54,30 @@ def _machine() -> str:
             f"python {platform.python_version()} ({sys.executable})")
 
 
-def _wall(argv: list[str], cwd: Path) -> float:
+def _run(argv: list[str], cwd: Path, times: dict[str, float], label: str) -> None:
+    """Wall time and CPU time (user + system of the child) of one process."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run([sys.executable, *argv], stdout=subprocess.DEVNULL,
                    stderr=subprocess.DEVNULL, check=False, cwd=cwd)
-    return time.perf_counter() - t0
+    times[label] = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    times[f"cpu {label}"] = (after.ru_utime - before.ru_utime) + (after.ru_stime
+                                                                  - before.ru_stime)
 
 
 def _round(cwd: Path, recording) -> dict[str, float]:
     from hystkit.compensation import fit_compensator
 
-    times = {"floor": _wall(FLOOR, cwd)}
+    times: dict[str, float] = {}
+    _run(FLOOR, cwd, times, "floor")
     for label, argv in COMMANDS.items():
-        times[label] = _wall(argv, cwd)
+        _run(argv, cwd, times, label)
     for label, cells in IN_PROCESS.items():
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         fit_compensator(recording, cells)
         times[f"in-process {label}"] = time.perf_counter() - t0
+        times[f"cpu in-process {label}"] = time.process_time() - c0
     return times
 
 
@@ -94,17 +104,22 @@ def main() -> None:
     def ratio(key: str, ref: str) -> float:
         return statistics.median(r[key] / r[ref] for r in rounds)
 
-    lines.append(f"{'command':<22}{'median s':>10}{'/ numpy':>10}{'/ in-process fit':>18}")
-    lines.append(f"{'python -c import numpy':<22}{med['floor']:>10.3f}{1:>10.2f}")
-    for label in COMMANDS:
-        extra = (f"{ratio(label, f'in-process {label}'):>17.2f}x" if label in IN_PROCESS
-                 else "")
-        lines.append(f"{'hystkit ' + label:<22}{med[label]:>10.3f}{ratio(label, 'floor'):>9.2f}x"
-                     f"{extra}")
+    lines.append(f"{'':<24}{'wall time':^30}|{'CPU time (user + sys)':^30}")
+    lines.append(f"{'command':<24}{'median s':>10}{'/ numpy':>9}{'/ in-proc':>11}|"
+                 f"{'median s':>10}{'/ numpy':>9}{'/ in-proc':>11}")
+    for label in ("floor", *COMMANDS):
+        name = 'python -c "import numpy"' if label == "floor" else f"hystkit {label}"
+        row = f"{name:<24}"
+        for prefix in ("", "cpu "):
+            key, ref = f"{prefix}{label}", f"{prefix}in-process {label}"
+            vs_fit = f"{ratio(key, ref):>10.2f}x" if label in IN_PROCESS else f"{'':>11}"
+            row += (f"{med[key]:>10.3f}{ratio(key, f'{prefix}floor'):>8.2f}x{vs_fit}"
+                    + ("|" if not prefix else ""))
+        lines.append(row)
     for label in IN_PROCESS:
         key = f"in-process {label}"
-        lines.append(f"{key:<22}{med[key]:>10.3f}   (fit_compensator, {recording.n_samples} "
-                     f"samples)")
+        lines.append(f"{key:<24}{med[key]:>10.3f}{'':>20}|{med['cpu ' + key]:>10.3f}"
+                     f"   (fit_compensator, {recording.n_samples} samples)")
     lines.append(f"load average after: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
     report = "\n".join(lines)
     print(report)
