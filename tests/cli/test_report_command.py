@@ -129,3 +129,21 @@ def test_own_column_names_label_the_sensor_axis(inputs: dict, tmp_path: Path,
                         "--format", "svg")
     assert (code, err) == (0, "")
     assert "resistance_ohm" in (figures / "loops.svg").read_text(encoding="utf-8")
+
+
+def test_a_failure_while_writing_leaves_nothing(inputs: dict, tmp_path: Path) -> None:
+    """The disk fills while the last figure file is written: neither the page nor any figure
+    file appears, and no temporary file stays behind."""
+    from hystkit.errors import OutputError
+    from hystkit.reports import build_report, write_report
+
+    content = build_report([inputs["model"], inputs["data"]])
+
+    def full_disk(*args: object, **kwargs: object) -> None:
+        raise OSError(28, "No space left on device")
+
+    content.figures["time_series"].savefig = full_disk
+    out, figures = tmp_path / "r.html", tmp_path / "figs"
+    with pytest.raises(OutputError, match="No space left on device"):
+        write_report(content, out, figures=figures, fmt="pdf")
+    assert sorted(p.name for p in tmp_path.rglob("*")) == []
