@@ -7,10 +7,13 @@ Re-exported as `hystkit.io.ReadOptions`.
 
 from __future__ import annotations
 
+import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-__all__ = ["DEFAULT_OPTIONS", "FIELDS", "MAX_SKIP_ROWS", "SEPARATORS", "TIME_UNITS", "ReadOptions", "parse_columns"]
+__all__ = ["DEFAULT_OPTIONS", "FIELDS", "MAX_RESAMPLE_HZ", "MAX_SKIP_ROWS", "SEPARATORS",
+           "TIME_UNITS", "ReadOptions", "parse_columns"]
 
 FIELDS = ("time", "position", "sensor")  # hystkit's names, as io._cells.COLUMNS
 # Seconds per unit. s/ms/us/ns are the names raw files use (io._raw_config); min for slow logs.
@@ -19,6 +22,8 @@ TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "min": 60.0}
 SEPARATORS = {",": ",", ";": ";", "tab": "\t", "\t": "\t", "\\t": "\t", "auto": "auto"}
 # CSV lines skipped after the header (a units line or a few): pandas holds them as a set.
 MAX_SKIP_ROWS = 1_000_000
+MAX_RESAMPLE_HZ = 1e9  # as the raw files' fs_out
+_MATLAB_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,62}")
 
 
 @dataclass(frozen=True)
@@ -40,6 +45,24 @@ class ReadOptions:
     sep : {",", ";", "tab", "auto"}
         CSV only: field separator; ``auto`` takes the most frequent of the three in the
         header line (a comma when none occurs). Stored as the character itself.
+    units_row : bool
+        CSV only: the line after the header holds units (``s,mm,Ohm``); they are kept with
+        the recording (`Recording.units`) and written to outputs. Lines skipped by
+        `skip_rows` follow it.
+    resample_hz : float, optional
+        Bring the recording onto a uniform time grid at this rate [Hz] (for jittered or
+        non-uniform time; method in `hystkit.io.resample_arrays`). None: the time must be
+        uniform already.
+    mat_var : str, optional
+        ``.mat`` only: the variable holding the recording, a struct (fields named as
+        `columns` says) or a matrix with samples as rows (`columns` then gives 1-based column
+        numbers, ``time=1,position=2,sensor=3``). None: variables ``time``, ``position``,
+        ``sensor`` (or as `columns` names them), else the file's only struct or matrix.
+    units : mapping or tuple of (str, str)
+        Units of the columns (``{"position": "mm", "sensor": "Ohm"}``; hystkit's names for
+        its three, the file's names for other columns) for a file without a units row; a
+        units row's entries take precedence. Only labels: values are not converted (the time
+        unit is `time_unit`).
 
     Raises
     ------
@@ -58,6 +81,10 @@ class ReadOptions:
     time_unit: str = "s"
     skip_rows: int = 0
     sep: str = ","
+    units_row: bool = False
+    resample_hz: float | None = None
+    mat_var: str | None = None
+    units: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         pairs = self.columns.items() if isinstance(self.columns, Mapping) else self.columns
@@ -92,6 +119,30 @@ class ReadOptions:
         if self.sep not in SEPARATORS:
             raise ValueError(f"sep must be one of ',', ';', 'tab', 'auto', got {self.sep!r}")
         object.__setattr__(self, "sep", SEPARATORS[self.sep])
+        if not isinstance(self.units_row, bool):
+            # ValueError like every bad setting: callers catch one type
+            raise ValueError(f"units_row must be true or false, got {self.units_row!r}")  # noqa: TRY004
+        if self.resample_hz is not None:
+            rate = self.resample_hz
+            if (isinstance(rate, bool) or not isinstance(rate, int | float)
+                    or not math.isfinite(rate) or not 0 < rate <= MAX_RESAMPLE_HZ):
+                raise ValueError(f"resample rate must be a number in (0, {MAX_RESAMPLE_HZ:g}] "
+                                 f"Hz, got {rate!r}")
+            object.__setattr__(self, "resample_hz", float(rate))
+        units = self.units.items() if isinstance(self.units, Mapping) else self.units
+        try:
+            units = tuple((str(k), v) for k, v in units)
+        except (TypeError, ValueError):
+            raise ValueError(f"units must map column names to unit text, got "
+                             f"{self.units!r}") from None
+        for key, unit in units:
+            if not key.strip() or not isinstance(unit, str) or not unit.strip():
+                raise ValueError(f"units: {key!r} = {unit!r}; give unit text for a column")
+        object.__setattr__(self, "units", units)
+        if self.mat_var is not None and (not isinstance(self.mat_var, str)
+                                         or not _MATLAB_NAME.fullmatch(self.mat_var)):
+            raise ValueError(f"mat_var must be a MATLAB variable name (a letter, then letters, "
+                             f"digits or _), got {self.mat_var!r}")
 
     def name(self, field: str) -> str:
         """The file's name for hystkit column `field`."""

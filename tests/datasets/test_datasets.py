@@ -379,7 +379,8 @@ def test_cli_export_refuses_overwrite_unless_forced(
     (("--excerpt", "--segment", "nope"), "x.csv", ("no segment 'nope'; segments: author_cycle",)),
     (("--variant", "test", "--root", "{tmp}"), "x.csv",
      ("{tmp}/piezo_micromanipulator_capsensor: data folder not found",)),
-    (("--excerpt",), "x.txt", ("x.txt: cannot write file type '.txt'; accepted: .csv",)),
+    (("--excerpt",), "x.txt",
+     ("x.txt: a recording is written as .csv, .parquet or .mat, not '.txt'",)),
 ])
 def test_cli_export_errors_are_one_line_and_write_nothing(
         capsys: pytest.CaptureFixture[str], tmp_path: Path, args: tuple[str, ...],

@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 from scipy.io import savemat
 
-from hystkit.errors import InputError, OutputExistsError
+from hystkit.errors import InputError, OutputError, OutputExistsError
 from hystkit.io import Recording, read_recording, write_json, write_recording
 
 
@@ -300,8 +300,9 @@ def test_write_rejects_bad_extra(tmp_path: Path, extra: dict, match: str) -> Non
 
 
 def test_write_rejects_unknown_suffix(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match="cannot write file type '.mat'"):
-        write_recording(_recording(10), tmp_path / "out.mat")
+    with pytest.raises(OutputError, match=r"written as \.csv, \.parquet or \.mat, not '\.txt'"):
+        write_recording(_recording(10), tmp_path / "out.txt")
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_write_json(tmp_path: Path) -> None:

@@ -86,7 +86,8 @@ def test_child_passes_back_only_plain_arrays(tmp_path):
     assert set(contents.arrays) == {"time", "position", "sensor"}  # not the struct 'notes'
     assert contents.arrays["position"].dtype == np.int16
     assert contents.variables["other"] == ("float64", (1, 7))
-    assert contents.variables["notes"][0].startswith("[(")
+    assert contents.variables["notes"] == ("struct", (1, 1))
+    assert contents.fields["notes"] == {"a": ("int64", (1, 1))}
 
 
 # --- CSV: the fast pass and the text pass agree --------------------------------------------

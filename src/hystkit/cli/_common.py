@@ -12,12 +12,19 @@ import math
 import sys
 from collections.abc import Callable
 
-from .._read_options import MAX_SKIP_ROWS, SEPARATORS, TIME_UNITS, parse_columns
+from .._read_options import (
+    MAX_RESAMPLE_HZ,
+    MAX_SKIP_ROWS,
+    SEPARATORS,
+    TIME_UNITS,
+    parse_columns,
+)
 from ..errors import HystkitError
 
 __all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Deferred", "Parser", "UsageError", "add_read_options",
-           "check_size", "deferred", "failures_exit", "integer", "number", "positive_float",
-           "positive_int", "read_options", "size_limit", "slope_cap"]
+           "check_size", "deferred", "failures_exit", "given_read_options", "integer", "number",
+           "positive_float", "positive_int", "read_options", "read_recording_args",
+           "size_limit", "slope_cap"]
 
 # Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
 # bounds, not converged; a family failed in compare/select); 2 is kept for errors that stop a
@@ -192,24 +199,87 @@ def add_read_options(p: argparse.ArgumentParser) -> None:
                              OUTPUT_NAMES_NOTE)
     g.add_argument("--columns", type=_columns, default=(), metavar="NAME=COLUMN,...",
                    help="the file's names of hystkit's columns, e.g. time=t,position="
-                        "displacement_mm,sensor=resistance_ohm (.mat: variable names); names "
-                        "not given stay time, position, sensor")
-    g.add_argument("--time-unit", choices=list(TIME_UNITS), default="s",
+                        "displacement_mm,sensor=resistance_ohm (.mat: variable or struct field "
+                        "names; matrix column numbers, see --mat-var); names not given stay "
+                        "time, position, sensor")
+    g.add_argument("--time-unit", choices=list(TIME_UNITS), default=None,
                    help="unit of the time column, converted to seconds (default s)")
-    g.add_argument("--skip-rows", type=integer(0, MAX_SKIP_ROWS), default=0, metavar="N",
+    g.add_argument("--skip-rows", type=integer(0, MAX_SKIP_ROWS), default=None, metavar="N",
                    help="CSV: lines to skip after the header, e.g. 1 for a units line "
                         "(default 0)")
-    g.add_argument("--sep", type=_separator, default=",", metavar="{',',;,tab,auto}",
+    g.add_argument("--sep", type=_separator, default=None, metavar="{',',;,tab,auto}",
                    help="CSV field separator; auto: the most frequent of the three in the "
                         "header line (default ',')")
+    g.add_argument("--units-row", action="store_true", default=False,
+                   help="CSV: the line after the header holds units (s,mm,Ohm); they are "
+                        "kept and written to the outputs (--skip-rows counts lines after it)")
+    g.add_argument("--resample", type=number(0, MAX_RESAMPLE_HZ, low_open=True), default=None,
+                   metavar="HZ",
+                   help="bring jittered or non-uniform time onto a uniform grid at HZ: linear "
+                        "interpolation of position and sensor; more than 5 %% below the "
+                        "file's mean rate a zero-phase low-pass at 0.4 HZ first (anti-alias); "
+                        "gaps longer than 3 median steps (and than 1/HZ) are refused "
+                        "(default: time must be uniform)")
+    g.add_argument("--mat-var", type=_mat_var, default=None, metavar="NAME",
+                   help=".mat: the variable holding the recording: a struct (fields named as "
+                        "--columns says) or a matrix with one sample per row (--columns gives "
+                        "1-based column numbers, time=1,position=2,sensor=3; default 2 "
+                        "columns: time, sensor; 3: time, position, sensor)")
 
 
-def read_options(args: argparse.Namespace):
-    """The `hystkit.io.ReadOptions` of the options `add_read_options` added."""
+def _mat_var(text: str) -> str:
     from .._read_options import ReadOptions
 
     try:
-        return ReadOptions(columns=args.columns, time_unit=args.time_unit,
-                           skip_rows=args.skip_rows, sep=args.sep)
+        return ReadOptions(mat_var=text).mat_var
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+# Namespace attribute -> ReadOptions field, for the options add_read_options adds
+_READ_OPTIONS = {"columns": "columns", "time_unit": "time_unit", "skip_rows": "skip_rows",
+                 "sep": "sep", "units_row": "units_row", "resample": "resample_hz",
+                 "mat_var": "mat_var"}
+
+
+def given_read_options(args: argparse.Namespace) -> dict:
+    """The reading options set on the command line (not left at their defaults), as
+    `hystkit.io.ReadOptions` keyword arguments."""
+    given = {}
+    for attr, name in _READ_OPTIONS.items():
+        value = getattr(args, attr, None)
+        if value not in (None, (), False):
+            given[name] = value
+    return given
+
+
+def read_options(args: argparse.Namespace, path=None):
+    """The `hystkit.io.ReadOptions` of the options `add_read_options` added.
+
+    With `path` (a recording), the settings file next to it (``my.toml`` for ``my.csv``,
+    `hystkit.io.options_for`) comes first and the command line overrides it; the file used
+    is printed once per command. Without, only the command line counts.
+    """
+    from .._read_options import ReadOptions
+
+    if path is not None:
+        from ..io import options_for
+
+        options, settings = options_for(path, given_read_options(args))
+        shown = args.__dict__.setdefault("_settings_shown", set())  # once per command
+        if settings is not None and str(settings) not in shown:
+            shown.add(str(settings))
+            print(f"reading {path} with the settings in {settings}", flush=True)
+        return options
+    try:
+        return ReadOptions(**given_read_options(args))
     except ValueError as exc:  # already checked one by one while parsing; kept as a guard
         raise UsageError(str(exc)) from None
+
+
+def read_recording_args(args: argparse.Namespace, path, *, need_position: bool = True):
+    """Read recording `path` with the command line's reading options and its settings file
+    (`read_options`): what every command that reads a user's recording calls."""
+    from ..io import read_recording
+
+    return read_recording(path, need_position=need_position, options=read_options(args, path))

@@ -59,25 +59,30 @@ def _simulate_sensor(args: argparse.Namespace) -> int:
 
 
 def _fit(args: argparse.Namespace) -> int:
-    from ..compensation import center_label, fit_compensator, save_compensator
+    from ..compensation import MODEL_SUFFIXES, center_label, fit_compensator, save_compensator
     from ..io import check_output_path, read_recording
     from ..models import get_family
 
-    check_output_path(args.out, args.force, inputs=args.data)
+    check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
+                      what="a model file")
     family = get_family(args.model)
     options = {} if args.slope_cap is None else {"slope_cap": args.slope_cap}
     if options and args.model != "mpl":
         raise UsageError(f"--slope-cap applies to the mpl model only, not {args.model!r}")
+    options.update(_pl_options(args, family))
     check_size(args.model, args.cells, "--cells")
-    reading = read_options(args)
-    recs = [read_recording(path, options=reading) for path in args.data]
+    recs = [read_recording(path, options=read_options(args, path)) for path in args.data]
     size = family.default_size if args.cells is None else args.cells
-    print(f"fitting {args.model} ({family.size_help}: {size}, {args.mode} mode, centring: "
+    shown = "".join(f", {name} {value:g}" for name, value in options.items())
+    print(f"fitting {args.model} ({family.size_help}: {size}{shown}, {args.mode} mode, centring: "
           f"{center_label(args.center)}) on {', '.join(map(str, args.data))}: "
           f"{sum(r.n_samples for r in recs)} samples at {recs[0].fs:g} Hz ...", flush=True)
     comp = fit_compensator(recs, size, model=args.model, mode=args.mode, center=args.center,
                            tare_seconds=args.tare_seconds, track_seconds=args.track_seconds,
                            **options)
+    units = _training_units(recs, args.data)
+    if units:
+        comp.fit_info["units"] = units
     save_compensator(comp, args.out, force=args.force)
     info = comp.fit_info
     print(f"done in {info['fit_seconds']:.2f} s: SSE {info['cost']:.4g} (normalised), solver: "
@@ -100,6 +105,35 @@ def _fit(args: argparse.Namespace) -> int:
     return 0
 
 
+def _pl_options(args: argparse.Namespace, family) -> dict:
+    """``--p``, ``--m``, ``--s`` of the pl model as structure options, checked by the family
+    before any work (one line naming the option)."""
+    given = {name: value for name, value in (("power", args.p), ("n_basis", args.m),
+                                             ("smoothing", args.s)) if value is not None}
+    if not given:
+        return {}
+    if args.model != "pl":
+        raise UsageError(f"--p, --m and --s apply to the pl model only, not {args.model!r}")
+    size = family.default_size if args.cells is None else args.cells
+    try:
+        family.make_structure(1 / 40, size, **given)
+    except ValueError as exc:
+        raise UsageError(f"--p/--m/--s: {exc}") from None
+    return given
+
+
+def _training_units(recs: list, paths: list[Path]) -> dict[str, str]:
+    """Units of position and sensor of the training recordings (saved in the model file, so
+    compensate can label its estimate); several recordings must agree."""
+    units: dict[str, str] = {}
+    for rec, path in zip(recs, paths):
+        for name, unit in rec.units:
+            if units.setdefault(name, unit) != unit:
+                raise UsageError(f"{path}: {name} is in {unit!r}, an earlier recording's in "
+                                 f"{units[name]!r}; fit recordings in one unit")
+    return units
+
+
 def _print_standard_errors(se: dict | None) -> None:
     if not se:
         return
@@ -112,24 +146,64 @@ def _print_standard_errors(se: dict | None) -> None:
 
 def _compensate(args: argparse.Namespace) -> int:
     from ..compensation import center_label
-    from ..io import check_output_path, read_recording, write_recording
+    from ..io import (
+        RECORDING_SUFFIXES,
+        check_output_path,
+        read_other_columns,
+        read_recording,
+        sidecar_path,
+        write_recording,
+    )
 
     load_compensator, use_flags = _module.load_compensator, _module.use_flags
 
-    check_output_path(args.out, args.force, inputs=[args.model, args.data])
+    check_output_path(args.out, args.force, inputs=[args.model, args.data],
+                      formats=RECORDING_SUFFIXES, what="a recording")
     comp = load_compensator(args.model)
     _warn_if_oracle(comp.center, args.model)
-    rec = read_recording(args.data, need_position=False, options=read_options(args))
+    options = read_options(args, args.data)
+    rec = read_recording(args.data, need_position=False, options=options)
+    kept = read_other_columns(args.data, rec.n_samples, options)
+    units = _output_units(comp, rec, options, kept, args.data)
+    if units and args.out.suffix.lower() == ".csv":  # the units go beside it: check it too
+        check_output_path(sidecar_path(args.out), args.force, inputs=[args.data])
     estimate = comp.estimate(rec, rest_position=args.rest_position)
     flags = use_flags(comp, rec, estimate)
     extra = {"position_estimate": estimate}
-    extra.update({name: mask.astype(int) for name, mask in flags.items() if mask is not None})
-    write_recording(rec, args.out, extra=extra, force=args.force)
-    print(f"wrote {args.out}: {rec.n_samples} samples with column 'position_estimate' [mm] "
+    extra.update({name: mask for name, mask in flags.items() if mask is not None})
+    taken = {"time", "position", "sensor", *extra}  # an input column of such a name is renamed
+    kept = {(f"{name}_input" if name in taken else name): values for name, values in kept.items()}
+    write_recording(rec, args.out, extra=extra, kept=kept, units=units, force=args.force,
+                    units_sidecar=True)
+    unit = units.get("position_estimate", "unit of the training position")
+    print(f"wrote {args.out}: {rec.n_samples} samples with column 'position_estimate' [{unit}] "
           f"(centring: {center_label(comp.center)}) and the flag columns "
-          f"{', '.join(n for n, m in flags.items() if m is not None) or '(none: old model file)'}")
+          f"{', '.join(n for n, m in flags.items() if m is not None) or '(none: old model file)'}"
+          + (f"; kept {len(kept)} other column(s): {', '.join(kept)}" if kept else "")
+          + (f"; units in {sidecar_path(args.out)}" if units and args.out.suffix.lower()
+             == ".csv" else ""))
+    if options.resample_hz is not None:
+        print("  (resampled: the input's other columns are not kept, they have no values at "
+              "the new times)")
     _warn_if_outside(flags, args.data)
     return 0
+
+
+def _output_units(comp, rec, options, kept: dict, data: Path) -> dict[str, str]:
+    """Units of compensate's output columns: the recording's, the estimate in the training
+    position's unit (from the model file, else the input's position unit), the kept
+    columns' from the settings file. Warns when the sensor unit differs from training."""
+    trained = comp.fit_info.get("units") or {}
+    units = dict(rec.units)
+    position = trained.get("position") or rec.unit("position")
+    if position:
+        units["position_estimate"] = position
+    if trained.get("sensor") and rec.unit("sensor") and trained["sensor"] != rec.unit("sensor"):
+        print(f"hystkit: warning: {data}: sensor unit {rec.unit('sensor')!r} but the model was "
+              f"trained on {trained['sensor']!r}; the estimate is meaningless unless the "
+              f"values are in the same unit", file=sys.stderr)
+    units.update({name: unit for name, unit in options.units if name in kept})
+    return units
 
 
 def _warn_if_oracle(center: str, path: Path) -> None:
@@ -160,17 +234,22 @@ def _warn_if_outside(flags: dict, data: Path) -> None:
 
 
 def _evaluate(args: argparse.Namespace) -> int:
-    from ..io import check_output_path, read_recording, write_json
+    from ..io import check_output_path, read_recording, write_json, write_mat
 
     evaluate, load_compensator = _module.evaluate, _module.load_compensator
     use_flags = _module.use_flags
 
     if args.json is not None:
-        check_output_path(args.json, args.force, inputs=[args.model, args.data])
+        check_output_path(args.json, args.force, inputs=[args.model, args.data],
+                          formats=(".json",), what="--json output")
+    if args.out is not None:
+        check_output_path(args.out, args.force, inputs=[args.model, args.data, args.json or ""],
+                          formats=(".json", ".mat"), what="the scores")
     comp = load_compensator(args.model)
     _warn_if_oracle(comp.center, args.model)
-    rec = read_recording(args.data, options=read_options(args))
+    rec = read_recording(args.data, options=read_options(args, args.data))
     scores = evaluate(comp, rec, rest_position=args.rest_position)
+    scores["units"] = dict(rec.units)  # of position and sensor, as the file gave them
     _warn_if_outside(use_flags(comp, rec, comp.estimate(rec, rest_position=args.rest_position)),
                      args.data)
     print(f"{args.data} with {args.model} ({scores['n_samples']} samples); deployable centring: "
@@ -188,6 +267,12 @@ def _evaluate(args: argparse.Namespace) -> int:
     if args.json is not None:
         write_json(scores, args.json, force=args.force)
         print(f"wrote {args.json}")
+    if args.out is not None:
+        if args.out.suffix.lower() == ".mat":
+            write_mat(args.out, scores, force=args.force)
+        else:
+            write_json(scores, args.out, force=args.force)
+        print(f"wrote {args.out}")
     return 0
 
 
@@ -283,6 +368,9 @@ def _add_rest_position(p: argparse.ArgumentParser) -> None:
                         "the device rested in training)")
 
 
+_MODEL_HELP = "model file written by fit or select (.json or .mat)"
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add this module's subcommands to the ``hystkit`` parser."""
     p = sub.add_parser("simulate-sensor", help="record an experiment on the virtual sensor")
@@ -312,24 +400,40 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--slope-cap", type=slope_cap, default=None,
                    help="mpl only: Euler stability cap f'·dt of the cell resistors, in [0.001, 2) "
                         "(default 1)")
-    p.add_argument("--out", type=Path, required=True, help="model JSON file to write")
+    p.add_argument("--p", type=number(1, low_open=True), default=None, metavar="P",
+                   help="pl only: power p of the cells, > 1 (default 21; 'hystkit pl-search' "
+                        "searches it)")
+    p.add_argument("--m", type=integer(1, 1000), default=None, metavar="M",
+                   help="pl only: number M of output basis functions, 1 to 1000 (default 1)")
+    p.add_argument("--s", type=number(0), default=None, metavar="S",
+                   help="pl only: smoothing weight S >= 0 (default 0.001)")
+    p.add_argument("--out", type=Path, required=True,
+                   help="model file to write: .json, or .mat (a MATLAB struct with every field "
+                        "of the JSON file; evaluate and compensate read both)")
     add_read_options(p)
     p.set_defaults(run=_fit)
 
     p = sub.add_parser("compensate", help="add a position_estimate column (and flags) to a "
                                           "recording")
-    p.add_argument("model", type=Path)
-    p.add_argument("data", type=Path)
+    p.add_argument("model", type=Path, help=_MODEL_HELP)
+    p.add_argument("data", type=Path, help="recording to compensate (CSV/Parquet/.mat): time "
+                                           "and sensor; position is optional")
     _add_rest_position(p)
     p.add_argument("--out", type=Path, required=True,
-                   help=f"CSV or Parquet file to write; {OUTPUT_NAMES_NOTE.replace('...', 'position_estimate')}")
+                   help="file to write, by its extension: .csv, .parquet or .mat (MATLAB: one "
+                        "variable per column, with column_names and units); the input's "
+                        "columns, then position_estimate and the flags sensor_outside, "
+                        f"estimate_outside; {OUTPUT_NAMES_NOTE.replace(', ...', '')}")
     add_read_options(p)
     p.set_defaults(run=_compensate)
 
     p = sub.add_parser("evaluate", help="score a compensator on a recording")
-    p.add_argument("model", type=Path)
-    p.add_argument("data", type=Path)
-    p.add_argument("--json", type=Path, help="also write the scores to this JSON file")
+    p.add_argument("model", type=Path, help=_MODEL_HELP)
+    p.add_argument("data", type=Path, help="recording with the true position (CSV/Parquet/.mat)")
+    p.add_argument("--json", type=Path, help="also write the scores to this JSON file (.json)")
+    p.add_argument("--out", type=Path,
+                   help="also write the scores to this file, by its extension: .json or .mat "
+                        "(MATLAB: one variable per score; missing scores are [])")
     _add_rest_position(p)
     add_read_options(p)
     p.set_defaults(run=_evaluate)

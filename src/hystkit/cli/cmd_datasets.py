@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import InputError
 from ._common import deferred
 
 __all__ = ["register"]
@@ -67,34 +66,56 @@ def _list_variants(name: str, root: Path | None) -> int:
 
 def _export(args: argparse.Namespace) -> int:
     from ..datasets import Dataset, load, load_excerpt
-    from ..io import atomic_outputs, check_output_path, write_json, write_recording
+    from ..io import (
+        RECORDING_SUFFIXES,
+        atomic_outputs,
+        check_output_path,
+        sidecar_path,
+        units_settings_text,
+        write_json,
+        write_recording,
+    )
 
     out = Path(args.out)
     sidecar = out.with_name(out.name + ".json")
-    if out.suffix.lower() not in (".csv", ".parquet"):
-        raise InputError(f"{out}: cannot write file type {out.suffix or '(no suffix)'!r}; "
-                         "accepted: .csv, .parquet")
-    for path in (out, sidecar):  # refuse before reading anything
-        check_output_path(path, args.force)
+    # CSV keeps its units in the settings file beside it, which reading it picks up
+    settings = sidecar_path(out) if out.suffix.lower() == ".csv" else None
+    check_output_path(out, args.force, formats=RECORDING_SUFFIXES, what="a recording")
+    for path in (sidecar, settings):  # refuse before reading anything
+        if path is not None:
+            check_output_path(path, args.force)
     ds: Dataset = (load_excerpt(args.name, args.variant) if args.excerpt
                    else load(args.name, args.variant, root=args.root))
     if args.segment is not None:
         ds = ds.segment(args.segment)
     rec = ds.to_recording(role=args.role)
+    units = _units(ds, args.role)
     meta = {"exported_by": "hystkit datasets export", "role": args.role,
             "segment": args.segment, "excerpt": args.excerpt, "columns": ds.columns(args.role),
-            "dataset": ds.metadata()}
-    # The recording and its sidecar appear together or not at all.
-    with atomic_outputs([out, sidecar], args.force) as (data_tmp, meta_tmp):
-        write_recording(rec, data_tmp, extra=dict(ds.channels), force=True)
-        write_json(meta, meta_tmp, force=True)
+            "units": units, "dataset": ds.metadata()}
+    # The recording and its sidecars appear together or not at all.
+    paths = [out, sidecar] + ([settings] if settings is not None else [])
+    with atomic_outputs(paths, args.force) as temps:
+        write_recording(rec, temps[0], extra=dict(ds.channels), units=units, force=True)
+        write_json(meta, temps[1], force=True)
+        if settings is not None:
+            temps[2].write_text(units_settings_text(units), encoding="utf-8")
     cols = ds.columns(args.role)
     print(f"wrote {out}: {ds.label}{f' segment {args.segment}' if args.segment else ''}, "
           f"{ds.n_samples} samples at {ds.fs:g} Hz")
     for column, meaning in cols.items():
         print(f"  {column:<22}{meaning}")
     print(f"wrote {sidecar} (units, provenance, licence: {ds.provenance.licence})")
+    if settings is not None:
+        print(f"wrote {settings} (units of the columns; read with {out})")
     return 0
+
+
+def _units(ds, role: str) -> dict[str, str]:
+    """Units of the exported columns: the data set's, not hystkit's lab units (mm, ΔR/R)."""
+    position, sensor = ((ds.input_unit, ds.output_unit) if role == "inverse"
+                        else (ds.output_unit, ds.input_unit))
+    return {"position": position, "sensor": sensor, **dict(ds.channel_units)}
 
 
 def _dataset_names() -> list[str]:
@@ -127,7 +148,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.set_defaults(run=_list)
 
     q = actions.add_parser("export", help="write one run as a time, position, sensor "
-                                          "recording (CSV or Parquet) plus a .json sidecar")
+                                          "recording (CSV, Parquet or .mat) plus a .json sidecar")
     deferred(q.add_argument("name"), choices=_dataset_names)
     q.add_argument("--variant", help="the run (default: the data set's default; see "
                                      "'hystkit datasets list NAME')")
@@ -140,7 +161,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="use the excerpt shipped with hystkit instead of the shared data")
     q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
                                              "or a shared/data folder found above)")
-    q.add_argument("--out", type=Path, required=True, help="CSV or Parquet file to write")
+    q.add_argument("--out", type=Path, required=True,
+                   help="file to write, by its extension: .csv, .parquet or .mat (MATLAB: one "
+                        "variable per column, with units)")
     q.add_argument("--force", action="store_true", default=argparse.SUPPRESS,
                    help="overwrite existing output files")
     q.set_defaults(run=_export)

@@ -15,19 +15,20 @@ from ._estimator import CompensatorEstimator
 from ._evaluate import evaluate, use_flags
 from ._fitting import fit_compensator
 from ._model_file import (
+    MODEL_SUFFIXES,
     compensator_from_dict,
     compensator_to_dict,
     load_compensator,
     save_compensator,
 )
-from ._stream import Stream, StreamOutput, StreamState, advance
+from ._stream import StepOutput, Stream, StreamOutput, StreamState, advance
 from ._sync import SyncExcitation, sync_excitation
 from ._training_checks import check_excursion, check_fitting_data
 
 __all__ = ["CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",
-           "DEPLOYABLE_CENTERS", "MODES", "ORACLE_CENTER", "POSITION_MARGIN", "SENSOR_MARGIN",
-           "Compensator", "CompensatorEstimator", "LinearBaseline", "Scaling", "Stream",
-           "StreamOutput", "StreamState", "SyncExcitation", "advance", "center_label",
+           "DEPLOYABLE_CENTERS", "MODEL_SUFFIXES", "MODES", "ORACLE_CENTER", "POSITION_MARGIN", "SENSOR_MARGIN",
+           "Compensator", "CompensatorEstimator", "LinearBaseline", "Scaling", "StepOutput",
+           "Stream", "StreamOutput", "StreamState", "SyncExcitation", "advance", "center_label",
            "centre_and_scale", "check_excursion", "check_fitting_data", "compensator_from_dict",
            "compensator_to_dict", "evaluate", "fit_compensator", "load_compensator",
            "prepare_training_data", "save_compensator", "sync_excitation", "use_flags"]

@@ -1,4 +1,11 @@
-"""Compensator <-> JSON model file (schema ``hystkit.compensator``, version 1).
+"""Compensator <-> model file (schema ``hystkit.compensator``, version 1), JSON or MATLAB.
+
+A ``.mat`` model file holds every key of the JSON file as a MATLAB variable (structs for the
+sections; ``m = load('model.mat')`` gives one struct with every field) and the JSON text itself
+as ``hystkit_json``, which is what hystkit reads back: MATLAB has no integers, nulls or
+one-element lists apart from scalars, so only the text round-trips exactly. Reading checks that
+the ``params`` variables still equal the text's, so a model edited in MATLAB is refused rather
+than silently ignored.
 
 Keys added since the first files (``polarity``, ``tare_seconds``, ``track_seconds``,
 ``sensor_reference``, ``rest_position``, ``position_range``) are optional when reading, with the
@@ -17,7 +24,7 @@ from typing import Any
 
 from .. import __version__
 from ..errors import InputError
-from ..io import write_json
+from ..io import check_output_format, write_json, write_mat
 from ..models import FAMILIES
 from ._centring import CENTERS
 from ._compensator import MODES, Compensator
@@ -25,6 +32,8 @@ from ._conventions import LinearBaseline, Scaling
 from ._model_checks import MAX_MODEL_BYTES, check_like, check_model_dict, key_in_message
 
 __all__ = [
+    "MAT_JSON_KEY",
+    "MODEL_SUFFIXES",
     "SCHEMA",
     "SCHEMA_VERSION",
     "compensator_from_dict",
@@ -153,13 +162,32 @@ def _optional(d: dict) -> dict:
     return {k: (float(d[k]) if d[k] is not None else None) for k in keys if k in d}
 
 
+MODEL_SUFFIXES = (".json", ".mat")
+MAT_JSON_KEY = "hystkit_json"  # the variable of a .mat model file that hystkit reads back
+
+
 def save_compensator(comp: Compensator, path: str | Path, *, force: bool = False) -> Path:
-    """Write the model file; refuses to overwrite unless ``force``."""
-    return write_json(compensator_to_dict(comp), path, force=force)
+    """Write the model file, JSON or MATLAB by the extension of `path` (``.json``/``.mat``);
+    refuses another extension, and to overwrite unless ``force``."""
+    path = Path(path)
+    d = compensator_to_dict(comp)
+    if check_output_format(path, MODEL_SUFFIXES, "a model file") == ".json":
+        return write_json(d, path, force=force)
+    text = json.dumps(d, allow_nan=False, default=_plain)
+    return write_mat(path, {**d, MAT_JSON_KEY: text}, force=force)
+
+
+def _plain(value: Any) -> Any:
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"cannot write {type(value).__name__} to a model file")
 
 
 def load_compensator(path: str | Path) -> Compensator:
     """Read a model file written by :func:`save_compensator`.
+
+    ``.mat`` files (written by :func:`save_compensator`) are parsed in a child process like
+    every MATLAB input.
 
     Raises
     ------
@@ -176,6 +204,8 @@ def load_compensator(path: str | Path) -> Compensator:
         if size > MAX_MODEL_BYTES:
             raise InputError(f"{path}: {size} bytes, larger than any model file "
                              f"(limit {MAX_MODEL_BYTES}); is this a model file?")
+        if path.suffix.lower() == ".mat":
+            return _load_mat_model(path)
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise InputError(f"{path}: file not found") from None
@@ -188,3 +218,40 @@ def load_compensator(path: str | Path) -> Compensator:
     except RecursionError:
         raise InputError(f"{path}: not a model file (JSON nested too deeply)") from None
     return compensator_from_dict(data, source=str(path))
+
+
+def _load_mat_model(path: Path) -> Compensator:
+    """A ``.mat`` model file: the model in its ``hystkit_json`` text, after checking that its
+    ``params`` variables (what a MATLAB user would edit) still equal the text's."""
+    import numpy as np
+
+    from ..io import load_mat, matlab_name
+
+    source = str(path)
+    contents = load_mat(path, ["params.*"], source, texts=(MAT_JSON_KEY,))
+    if MAT_JSON_KEY not in contents.texts:
+        listed = ", ".join(contents.variables) or "none"
+        raise InputError(f"{source}: not a hystkit model file (no text variable "
+                         f"{MAT_JSON_KEY!r}; variables: {listed})")
+    try:
+        data = json.loads(contents.texts[MAT_JSON_KEY])
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{source}: variable {MAT_JSON_KEY!r} is not JSON ({exc.msg})") from None
+    except RecursionError:
+        raise InputError(f"{source}: not a model file (JSON nested too deeply)") from None
+    comp = compensator_from_dict(data, source=source)
+    for name, value in data["params"].items():
+        if not _numeric(value):  # nested lists are cell arrays in MATLAB: not compared
+            continue
+        stored = contents.arrays.get(f"params.{matlab_name(name)}")
+        if stored is None or not np.array_equal(np.ravel(stored), np.ravel(value)):
+            raise InputError(f"{source}: variable params.{name} differs from the model in "
+                             f"{MAT_JSON_KEY!r} (edited in MATLAB?); hystkit reads the model "
+                             f"from {MAT_JSON_KEY!r}: fit again rather than edit a model file")
+    return comp
+
+
+def _numeric(value: Any) -> bool:
+    """A number or a flat list of numbers (what a MATLAB double array holds)."""
+    items = value if isinstance(value, list) else [value]
+    return all(isinstance(v, int | float) and not isinstance(v, bool) for v in items)

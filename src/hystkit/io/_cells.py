@@ -24,6 +24,8 @@ class Where:
     header_lines: int | None = None  # CSV only: data row r sits on file line r + header_lines
     # (hystkit name, file name) of columns named differently in the file (ReadOptions.columns)
     names: tuple[tuple[str, str], ...] = ()
+    # (hystkit name, unit) the file itself states (a CSV units row, Parquet metadata, .mat units)
+    units: tuple[tuple[str, str], ...] = ()
 
     def name(self, column: str) -> str:
         """The file's name for hystkit column `column`."""

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import codecs
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -44,14 +45,36 @@ def read_csv(path: Path, source: str, need_position: bool,
     `options` gives the file's column names, the separator and the lines skipped after the
     header; its time unit is applied by the caller.
     """
-    # Data row r sits on file line r + 1 + skip_rows (the header, then the skipped lines).
-    where = Where(source, header_lines=1 + options.skip_rows, names=options.columns)
+    # Data row r sits on file line r + 1 + units + skip_rows (header, units line, skipped lines).
+    skip = options.skip_rows + options.units_row
+    where = Where(source, header_lines=1 + skip, names=options.columns)
     sep = _check_width(path, where, options.sep)
     hint = f" (the first line must be a {_SEP_NAMES[sep]}-separated header naming the columns)"
-    arrays = _read_numbers(path, need_position, where, sep, options.skip_rows, hint)
+    arrays = _read_numbers(path, need_position, where, sep, skip, hint)
     if arrays is None:
-        arrays = _read_text(path, need_position, where, sep, options.skip_rows, hint)
+        arrays = _read_text(path, need_position, where, sep, skip, hint,
+                            units_hint=not options.units_row)
+    if options.units_row:
+        where = replace(where, units=_units_row(path, where, sep, list(arrays)))
     return arrays, where
+
+
+def _units_row(path: Path, where: Where, sep: str, names: list[str]) -> tuple[tuple[str, str], ...]:
+    """(hystkit name, unit) from the line after the header; empty cells give no unit."""
+    try:
+        lines = pd.read_csv(path, nrows=2, sep=sep, **_TEXT)
+    except (*_PARSE_ERRORS, UnicodeDecodeError) as exc:
+        raise where.fail(f"cannot read the units line (line 2): {exc}") from exc
+    if len(lines) < 2:
+        raise where.fail("--units-row: there is no line 2 to read units from")
+    header = [str(name).strip() for name in lines.iloc[0]]
+    row = lines.iloc[1].fillna("")
+    units = []
+    for name in names:
+        unit = str(row.iloc[header.index(where.name(name))]).strip()
+        if unit:
+            units.append((name, unit))
+    return tuple(units)
 
 
 def _check_width(path: Path, where: Where, sep: str) -> str:
@@ -123,8 +146,9 @@ def _line_bound(path: Path, block: int = 1 << 22) -> int:
 
 
 def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", skip: int = 0,
-               hint: str = "") -> dict[str, np.ndarray]:
-    """The careful pass: text cells chunk by chunk, the first problem of each column kept."""
+               hint: str = "", units_hint: bool = False) -> dict[str, np.ndarray]:
+    """The careful pass: text cells chunk by chunk, the first problem of each column kept;
+    `units_hint`: when every column's first data cell is text, suggest ``--units-row``."""
     header: list[str] | None = None
     names: list[str] = []
     parts: dict[str, list[np.ndarray]] = {}
@@ -165,9 +189,14 @@ def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", sk
         raise where.fail("file is empty (no header row)")
     if n_rows == 0:
         raise where.fail("no data rows below the header")
+    units_like = units_hint and all(first_bad.get(name, (-1, ""))[0] == 0 for name in names) \
+        and all(first_bad[name][1].startswith("non-numeric") for name in names)
     for name in names:  # the first column in recording order with a bad cell in the data
         if name in first_bad and first_bad[name][0] < n_rows:
             row, problem = first_bad[name]
+            if units_like:
+                problem += ("; if this line holds units, pass --units-row (or units_row = "
+                            "true in the settings file)")
             raise where.fail(problem, name, row)
     return {name: np.concatenate(parts.pop(name))[:n_rows] for name in names}
 

@@ -12,6 +12,8 @@ in-process (``tests/hostile/test_reader_fuzz.py`` keeps checking that).
 
 from __future__ import annotations
 
+import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +31,8 @@ def read_parquet(
     path: Path, source: str, need_position: bool, options: ReadOptions = DEFAULT_OPTIONS
 ) -> tuple[dict[str, np.ndarray], Where]:
     """Read the recording columns of a Parquet file as float64 arrays (not yet validated);
-    of `options` only the column names apply here."""
+    of `options` only the column names apply here. Units hystkit wrote into the schema
+    metadata come back in ``where.units``."""
     where = Where(source, names=options.columns)
     try:
         file = pq.ParquetFile(path)
@@ -43,15 +46,26 @@ def read_parquet(
                     raise where.fail("no data rows")
                 arrays[name] = _column(column, name, where)
                 del column
+            units = _units(file.schema_arrow.metadata, names)
         finally:
             file.close()
-        return arrays, where
+        return arrays, replace(where, units=units)
     except InputError:
         raise  # our own (a ValueError too), from pick or the column checks
     except (pa.ArrowException, OSError, ValueError, TypeError, KeyError, IndexError,
             MemoryError, OverflowError, UnicodeDecodeError, RecursionError) as exc:
         detail = " ".join(str(exc).split())[:200] or type(exc).__name__
         raise where.fail(f"cannot read Parquet file ({detail})") from exc
+
+
+def _units(metadata: dict | None, names: list[str]) -> tuple[tuple[str, str], ...]:
+    """Units hystkit wrote into the schema metadata (``hystkit.units``); anything unexpected
+    there is ignored: units are labels, never needed to read the numbers."""
+    try:
+        units = json.loads((metadata or {}).get(b"hystkit.units", b"{}"))
+        return tuple((n, units[n]) for n in names if isinstance(units.get(n), str))
+    except (ValueError, TypeError, AttributeError):
+        return ()
 
 
 def _column(column: pa.ChunkedArray, name: str, where: Where) -> np.ndarray:

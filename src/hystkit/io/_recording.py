@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from hystkit._read_options import ReadOptions
+from hystkit._read_options import TIME_UNITS, ReadOptions
 from hystkit.errors import InputError
 
 from ._cells import COLUMNS as _COLUMNS  # also imported by _writing
@@ -23,6 +23,7 @@ from ._cells import as_vector
 from ._csv_reader import read_csv
 from ._mat_reader import read_mat
 from ._parquet_reader import read_parquet
+from ._resample import resample_arrays
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -67,6 +68,10 @@ class Recording(Sampled):
         Reference position [mm]; None when the recording has none.
     source : str
         Where the data came from (a file name); used in error messages.
+    units : mapping or tuple of (str, str)
+        Units of the file's columns as read from it (``{"position": "mm", "sensor":
+        "Ohm"}``), for labels and outputs; hystkit's own computations do not use them (time
+        is always in seconds once read). Stored as a tuple of pairs.
 
     Notes
     -----
@@ -78,8 +83,10 @@ class Recording(Sampled):
     sensor: np.ndarray
     position: np.ndarray | None = None
     source: str = "<memory>"
+    units: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "units", _unit_pairs(self.units))
         where = _Where(self.source, item="sample")
         arrays = {
             name: as_vector(getattr(self, name), name, where)
@@ -95,9 +102,13 @@ class Recording(Sampled):
         """Whether the recording carries a reference position."""
         return self.position is not None
 
+    def unit(self, name: str) -> str:
+        """The unit of column `name` as the file gave it, or "" when unknown."""
+        return dict(self.units).get(name, "")
+
     def to_frame(self) -> pd.DataFrame:
         """The recording as a DataFrame with columns ``time`` [s], ``position`` (when present)
-        and ``sensor``; ``attrs`` keeps ``source``.
+        and ``sensor``; ``attrs`` keeps ``source`` and ``units``.
 
         Examples
         --------
@@ -113,7 +124,7 @@ class Recording(Sampled):
 
         frame = pd.DataFrame({name: getattr(self, name) for name in _COLUMNS
                               if getattr(self, name) is not None})
-        frame.attrs.update(source=self.source)
+        frame.attrs.update(source=self.source, units=dict(self.units))
         return frame
 
     @classmethod
@@ -160,7 +171,7 @@ class Recording(Sampled):
                 raise InputError(f"{source}: missing column {column!r} ({name}); columns: "
                                  f"{', '.join(map(str, frame.columns))}")
         arrays["time"] = arrays["time"] * options.time_scale
-        return cls(**arrays, source=source)
+        return cls(**arrays, source=source, units=frame.attrs.get("units", ()))
 
 
 def _numbers(values: pd.Series, what: str) -> np.ndarray:
@@ -172,6 +183,14 @@ def _numbers(values: pd.Series, what: str) -> np.ndarray:
     if bad.size:
         raise InputError(f"{what}, sample {bad[0] + 1}: not a number: {values.iloc[bad[0]]!r}")
     return numbers
+
+
+def _unit_pairs(units: object) -> tuple[tuple[str, str], ...]:
+    pairs = units.items() if isinstance(units, Mapping) else units
+    try:
+        return tuple((str(name), str(unit)) for name, unit in pairs if str(unit).strip())
+    except (TypeError, ValueError):
+        raise ValueError(f"units must map column names to unit text, got {units!r}") from None
 
 
 def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
@@ -186,8 +205,10 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
     need_position : bool
         Require a ``position`` column. If False it is still read when present.
     options : ReadOptions, optional
-        The file's own column (or variable) names, time unit, and for CSV the separator and
-        the lines after the header to skip. Default: columns named ``time``, ``position``,
+        The file's own column (or variable) names, time unit, for CSV the separator, the
+        lines after the header to skip and a units line, for ``.mat`` the variable, and a
+        rate to resample to (`hystkit.io._resample`: linear interpolation, a zero-phase
+        anti-alias low-pass when decimating, gaps refused). Default: columns named ``time``, ``position``,
         ``sensor``, time in seconds, comma-separated, the header on the first line.
 
     Returns
@@ -224,13 +245,32 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
         arrays, where = _READERS[suffix](path, source, need_position, options)
     except OSError as exc:  # also a disk failing halfway (EIO)
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
+    units = {**dict(options.units), **dict(where.units)}  # the file's own units first
+    _check_time_unit(units.get("time"), options, where)
     if options.time_scale != 1.0:  # to seconds before the checks, whose messages say "s"
         arrays["time"] = arrays["time"] * options.time_scale
+    if options.resample_hz is not None:
+        _validate(arrays, where, uniform=False)
+        arrays = resample_arrays(arrays, options.resample_hz, where)
     _validate(arrays, where)
-    return _adopt(arrays, source)
+    # time is in seconds once read, whatever the file's unit
+    return _adopt(arrays, source, tuple((k, v) for k, v in units.items()
+                                        if k in ("position", "sensor")))
 
 
-def _adopt(arrays: dict[str, np.ndarray], source: str) -> Recording:
+def _check_time_unit(unit: str | None, options: ReadOptions, where: _Where) -> None:
+    """A units row naming a time unit other than the one read would mean reading ms as s."""
+    if unit is None:
+        return
+    named = unit.strip().strip("[]()").strip()
+    if named in TIME_UNITS and named != options.time_unit:
+        raise where.fail(f"the file gives the time unit {unit!r} but time is read in "
+                         f"{options.time_unit}; pass --time-unit {named} (or time_unit = "
+                         f"\"{named}\" in the settings file)", "time")
+
+
+def _adopt(arrays: dict[str, np.ndarray], source: str,
+           units: tuple[tuple[str, str], ...] = ()) -> Recording:
     """A `Recording` around 1-D float64 arrays a reader made and `_validate` checked.
 
     ``Recording(...)`` would copy and check them again; nothing else holds these arrays, so
@@ -244,14 +284,16 @@ def _adopt(arrays: dict[str, np.ndarray], source: str) -> Recording:
             values.setflags(write=False)
         object.__setattr__(recording, name, values)
     object.__setattr__(recording, "source", source)
+    object.__setattr__(recording, "units", _unit_pairs(units))
     return recording
 
 
 _READERS = {".csv": read_csv, ".parquet": read_parquet, ".mat": read_mat}
 
 
-def _validate(arrays: dict[str, np.ndarray], where: _Where) -> None:
-    """Check 1-D float arrays (``time`` among them) for the invariants of a `Recording`."""
+def _validate(arrays: dict[str, np.ndarray], where: _Where, *, uniform: bool = True) -> None:
+    """Check 1-D float arrays (``time`` among them) for the invariants of a `Recording`
+    (`uniform`: including the uniform sampling, which resampling establishes)."""
     lengths = {name: values.size for name, values in arrays.items()}
     if len(set(lengths.values())) > 1:
         listed = ", ".join(f"{name} {n}" for name, n in lengths.items())
@@ -278,10 +320,12 @@ def _validate(arrays: dict[str, np.ndarray], where: _Where) -> None:
         i = int(bad[0]) + 1
         raise where.fail(f"time is not strictly increasing: {time[i]:.12g} s follows "
                          f"{time[i - 1]:.12g} s", "time", i)
+    if not uniform:
+        return
     median = float(np.median(step))
     bad = np.flatnonzero(np.abs(step - median) > _MAX_STEP_DEVIATION * median)
     if bad.size:
         i = int(bad[0]) + 1
         raise where.fail(f"non-uniform sampling: step {step[i - 1]:.6g} s deviates more than "
                          f"{_MAX_STEP_DEVIATION:.0%} from the median step {median:.6g} s; "
-                         "resample the recording to a uniform time grid", "time", i)
+                         "resample it to a uniform time grid (--resample HZ)", "time", i)

@@ -22,11 +22,14 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from hystkit.errors import InputError, NonFiniteError, OutputError, OutputExistsError
+from hystkit.errors import NonFiniteError, OutputError, OutputExistsError
 
 from ._recording import _COLUMNS, Recording
 
 TEMP_MARK = ".tmp-"  # every temporary's name holds this; tests look for strays by it
+
+
+RECORDING_SUFFIXES = (".csv", ".parquet", ".mat")
 
 
 def write_recording(
@@ -35,25 +38,44 @@ def write_recording(
     *,
     extra: dict[str, np.ndarray] | None = None,
     force: bool = False,
+    kept: dict[str, np.ndarray] | None = None,
+    units: dict[str, str] | None = None,
+    units_sidecar: bool = False,
 ) -> Path:
-    """Write a recording as CSV or Parquet (chosen by the suffix of `path`), atomically.
+    """Write a recording as CSV, Parquet or MATLAB (chosen by the suffix of `path`), atomically.
 
     Parameters
     ----------
     recording : Recording
         Written as columns ``time``, ``position`` (if present), ``sensor``.
     path : str or path-like
-        ``.csv`` or ``.parquet``; parent directories are created.
+        ``.csv``, ``.parquet`` or ``.mat``; parent directories are created.
     extra : dict of str to ndarray, shape (n,), optional
-        Further columns appended in the given order (e.g. a compensated position [mm]).
+        Further columns appended in the given order (e.g. a compensated position [mm]);
+        boolean ones (flags) are written as 0/1 (logical in ``.mat``).
     force : bool
         Overwrite an existing file.
+    kept : dict of str to ndarray, shape (n,), optional
+        Columns of the input copied as they were (numbers, or text), written between the
+        recording's columns and `extra`; empty input cells (NaN, "") stay empty.
+    units : dict of str to str, optional
+        Units of columns beyond ``recording.units`` (e.g. ``position_estimate``). Written to
+        Parquet's schema metadata (``hystkit.units``) and as the ``units`` struct of a
+        ``.mat`` file; CSV keeps its header plain (a units line would need ``--units-row`` to
+        read back).
+    units_sidecar : bool
+        CSV with units: also write them to the settings file beside it (``out.toml``, a
+        ``[units]`` table, `sidecar_path`), which reading ``out.csv`` picks up; both files
+        appear together or not at all.
 
     Returns
     -------
     Path
         The written file. Floats are written in shortest round-trip form, so reading it
-        back gives bit-identical values.
+        back gives bit-identical values. In a ``.mat`` file every column is a variable
+        (column vector; flags as logical, text as a cell array), names made MATLAB
+        identifiers (`matlab_name`), with ``column_names`` (the written names in order) and
+        ``units`` (a struct).
 
     Raises
     ------
@@ -63,37 +85,76 @@ def write_recording(
     NonFiniteError
         A column holds NaN or infinity (the message names column and row); nothing is written.
     ValueError
-        An extra column has the wrong length or clashes with a recording column;
-        `InputError` (a ValueError) for a suffix other than ``.csv``/``.parquet``.
+        An extra column has the wrong length or clashes with a recording column.
+    OutputError
+        A suffix other than ``.csv``/``.parquet``/``.mat`` (`check_output_format`).
 
     Notes
     -----
     The file appears complete or not at all (:func:`atomic_output`).
     """
     path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in (".csv", ".parquet"):
-        raise InputError(f"{path}: cannot write file type {suffix or '(no suffix)'!r}; "
-                         "accepted: .csv, .parquet")
+    suffix = check_output_format(path, RECORDING_SUFFIXES, "a recording")
     columns = {name: getattr(recording, name) for name in _COLUMNS
                if getattr(recording, name) is not None}
-    for name, values in (extra or {}).items():
-        values = np.asarray(values)
-        if name in columns:
-            raise ValueError(f"extra column {name!r} clashes with a recording column")
-        if values.shape != (recording.n_samples,):
-            raise ValueError(f"extra column {name!r} has shape {values.shape}; the recording "
-                             f"has {recording.n_samples} samples")
-        columns[name] = values
+    for group in (kept or {}), (extra or {}):
+        for name, values in group.items():
+            values = np.asarray(values)
+            if name in columns:
+                raise ValueError(f"extra column {name!r} clashes with a recording column")
+            if values.shape != (recording.n_samples,):
+                raise ValueError(f"extra column {name!r} has shape {values.shape}; the "
+                                 f"recording has {recording.n_samples} samples")
+            columns[name] = values
     for name, values in columns.items():
-        _refuse_non_finite(path, name, np.asarray(values))
-    frame = pd.DataFrame(columns)
+        if name not in (kept or {}):
+            _refuse_non_finite(path, name, np.asarray(values))
+    all_units = {**dict(recording.units), **(units or {})}
+    all_units = {name: unit for name, unit in all_units.items() if name in columns}
+    if suffix == ".mat":
+        from ._mat_writer import recording_variables, write_mat
+
+        return write_mat(path, {}, force=force,
+                         verbatim=recording_variables(columns, all_units))
+    # flags (bool) as 0/1 in text and Parquet files, as the files hystkit always wrote
+    frame = pd.DataFrame({name: values.astype(int) if np.asarray(values).dtype.kind == "b"
+                          else values for name, values in columns.items()})
+    if suffix == ".csv" and units_sidecar and all_units:
+        with atomic_outputs([path, sidecar_path(path)], force) as (tmp, toml_tmp):
+            frame.to_csv(tmp, index=False)
+            toml_tmp.write_text(units_settings_text(all_units), encoding="utf-8")
+        return path
     with atomic_output(path, force) as tmp:
         if suffix == ".csv":  # pandas writes floats as repr(): the shortest exact round trip
             frame.to_csv(tmp, index=False)
         else:
-            frame.to_parquet(tmp, index=False)
+            _write_parquet(frame, tmp, all_units)
     return path
+
+
+def sidecar_path(path: str | os.PathLike[str]) -> Path:
+    """The settings file beside a recording (``out.csv`` -> ``out.toml``)."""
+    return Path(path).with_suffix(".toml")
+
+
+def units_settings_text(units: dict[str, str]) -> str:
+    """A recording's settings file (``out.toml``) that holds only the units of its columns."""
+    lines = ["# written by hystkit: units of the columns of the file beside this one", "",
+             "[units]"]
+    lines += [f"{json.dumps(name)} = {json.dumps(unit)}" for name, unit in units.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _write_parquet(frame: pd.DataFrame, path: Path, units: dict[str, str]) -> None:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    if units:
+        metadata = {**(table.schema.metadata or {}),
+                    b"hystkit.units": json.dumps(units).encode()}
+        table = table.replace_schema_metadata(metadata)
+    pq.write_table(table, path)
 
 
 def _refuse_non_finite(path: Path, name: str, values: np.ndarray) -> None:
@@ -115,12 +176,14 @@ def write_json(obj: Any, path: str | os.PathLike[str], *, force: bool = False) -
     ------
     OutputExistsError
         `path` exists and `force` is False.
+    OutputError
+        `path` does not end in ``.json`` (`check_output_format`).
     NonFiniteError
         `obj` holds NaN or infinity (the message names the key path, e.g.
         ``metrics.sine.r2`` or ``params.a[3]``); nothing is written.
     """
     path = Path(path)
-    check_output_path(path, force)
+    check_output_path(path, force, formats=(".json",), what="a JSON file")
     # Serialise before touching the disk so a bad object leaves no file at all.
     try:
         text = json.dumps(obj, indent=2, allow_nan=False, default=_json_default) + "\n"
@@ -155,15 +218,54 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"cannot write {type(value).__name__} as JSON")
 
 
+def check_output_format(path: str | os.PathLike[str], suffixes: Iterable[str],
+                        what: str = "this output") -> str:
+    """Refuse a file name whose extension does not match the format written to it.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The output file.
+    suffixes : iterable of str
+        Accepted extensions with the dot (``".json"``), compared without case; the first
+        is the format written when there is one.
+    what : str
+        What is written, for the message (``"a model file"``).
+
+    Returns
+    -------
+    str
+        The extension of `path` in lower case (one of `suffixes`): writers pick the format by it.
+
+    Raises
+    ------
+    OutputError
+        One line: ``out.xlsx: a model file is written as .json or .mat, not '.xlsx'``. A file
+        named ``s.mat`` holding JSON, or ``x.xlsx`` holding JSON, would mislead every program
+        that opens it.
+    """
+    suffixes = tuple(s.lower() for s in suffixes)
+    suffix = Path(path).suffix.lower()
+    if suffix not in suffixes:
+        found = f"{suffix!r}" if suffix else "no extension"
+        accepted = (", ".join(suffixes[:-1]) + " or " if len(suffixes) > 1 else "") \
+            + suffixes[-1]
+        raise OutputError(f"{path}: {what} is written as {accepted}, not {found}; name the "
+                          f"file accordingly")
+    return suffix
+
+
 def check_output_path(path: str | os.PathLike[str], force: bool = False, *,
-                      inputs: Iterable[str | os.PathLike[str]] = ()) -> Path:
+                      inputs: Iterable[str | os.PathLike[str]] = (),
+                      formats: Iterable[str] | None = None, what: str = "this output") -> Path:
     """Refuse an output path that exists (unless ``force``) or cannot be created.
 
     Callers run this before any work, so a refused run costs nothing and writes nothing.
     Checked: the path exists (without `force`), is a folder, is one of `inputs`, has a file
     where a parent folder should be, or its nearest existing parent folder is not writable
     (permission, read-only or virtual file system: probed by creating and removing a hidden
-    file there).
+    file there); with `formats` (accepted extensions, e.g. ``(".json", ".mat")``), an
+    extension that does not match (`check_output_format`, `what` names the content).
     """
     path = Path(path)
     if path.is_dir():
@@ -177,6 +279,8 @@ def check_output_path(path: str | os.PathLike[str], force: bool = False, *,
         raise OutputError(f"{path} is not a regular file; write to a file")
     check_folder_writable(path.parent, what=path)
     _check_name_length(path)
+    if formats is not None:
+        check_output_format(path, formats, what)
     return path
 
 

@@ -1,0 +1,137 @@
+"""How to read a recording, from a TOML settings file stored next to it.
+
+The rule (as for raw files, `hystkit.io.find_raw_config`): the settings of ``my.csv`` are in
+``my.toml`` in the same folder (same stem). The file holds the `ReadOptions` settings as flat
+keys and two tables::
+
+    time_unit = "ms"          # s, ms, us, ns, min
+    skip_rows = 0             # CSV lines skipped after the header (after the units line)
+    sep = ";"                 # ",", ";", "tab", "auto"
+    units_row = true          # CSV: the line after the header holds units
+    resample_hz = 100.0       # bring jittered time onto a uniform grid
+    mat_var = "run1"          # .mat: the struct or matrix holding the recording
+
+    [columns]                 # hystkit name = the file's column (or .mat field/number)
+    time = "t_ms"
+    position = "displacement_mm"
+    sensor = "resistance_ohm"
+
+    [units]                   # units when the file has no units line (other columns
+    position = "mm"           # by their own names)
+    sensor = "Ohm"
+
+Options given on the command line override the file's. The format is the one ``preprocess``
+reads for raw files (flat keys, a ``[columns]`` table); keys only raw files have are refused
+with a line saying so.
+"""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from dataclasses import fields, replace
+from pathlib import Path
+from typing import Any
+
+from hystkit.errors import InputError
+
+from .._read_options import FIELDS, ReadOptions
+
+__all__ = ["RECORDING_KEYS", "find_recording_config", "options_for", "read_recording_config"]
+
+RECORDING_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
+    "time_unit": ((str,), "unit of the time column: s, ms, us, ns or min"),
+    "skip_rows": ((int,), "CSV: lines to skip after the header (and its units line)"),
+    "sep": ((str,), "CSV field separator: ',', ';', 'tab' or 'auto'"),
+    "units_row": ((bool,), "CSV: the line after the header holds units"),
+    "resample_hz": ((int, float), "resample to a uniform grid at this rate [Hz]"),
+    "mat_var": ((str,), ".mat: the variable holding the recording"),
+    "columns": ((dict,), "hystkit name = the file's column, e.g. {time = 't_ms'}"),
+    "units": ((dict,), "units of the columns, e.g. {position = 'mm', sensor = 'Ohm'}"),
+}
+
+
+def find_recording_config(data_path: str | os.PathLike[str]) -> Path | None:
+    """The settings file of a recording: same folder, same stem, ``.toml``; None if absent."""
+    candidate = Path(data_path).with_suffix(".toml")
+    return candidate if candidate.is_file() else None
+
+
+def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """Read a recording's TOML settings as `ReadOptions` keyword arguments.
+
+    Raises
+    ------
+    InputError
+        Unreadable or invalid TOML, an unknown key (or one of raw files only), a value of the
+        wrong type or one `ReadOptions` refuses; one line naming the file and the key.
+    """
+    from ._raw_config import CONFIG_KEYS as RAW_KEYS
+
+    path = Path(path)
+    try:
+        with path.open("rb") as handle:
+            values = tomllib.load(handle)
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read settings file ({exc})") from exc
+    except (tomllib.TOMLDecodeError, RecursionError) as exc:
+        raise InputError(f"{path}: invalid TOML ({exc})") from exc
+    for key, value in values.items():
+        if key not in RECORDING_KEYS:
+            raw = " (a setting of raw scope files, for 'hystkit preprocess')" \
+                if key in RAW_KEYS else ""
+            raise InputError(f"{path}: unknown key {key!r}{raw}; a recording's settings file "
+                             f"knows {', '.join(RECORDING_KEYS)}")
+        types = RECORDING_KEYS[key][0]
+        if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
+            raise InputError(f"{path}: key {key!r} must be "
+                             f"{' or '.join(t.__name__ for t in types)}, got {value!r}")
+    for name, item in values.get("columns", {}).items():
+        if name not in FIELDS or not isinstance(item, str):
+            raise InputError(f"{path}: key 'columns.{name}' = {item!r}: names must be among "
+                             f"{', '.join(FIELDS)} and map to column names (text)")
+    for name, item in values.get("units", {}).items():
+        if not isinstance(item, str):
+            raise InputError(f"{path}: key 'units.{name}' = {item!r}: units are text")
+    if "columns" in values:
+        values["columns"] = tuple(values["columns"].items())
+    if "units" in values:
+        values["units"] = tuple(values["units"].items())
+    try:
+        ReadOptions(**values)
+    except ValueError as exc:
+        raise InputError(f"{path}: {exc}") from None
+    return values
+
+
+_FIELD_NAMES = {f.name for f in fields(ReadOptions)}
+
+
+def options_for(data_path: str | os.PathLike[str], given: dict[str, Any] | None = None,
+                ) -> tuple[ReadOptions, Path | None]:
+    """The settings to read `data_path` with: its settings file, then `given` on top.
+
+    Parameters
+    ----------
+    data_path : str or path-like
+        The recording.
+    given : dict, optional
+        `ReadOptions` keyword arguments set explicitly (on the command line); they override
+        the file's. ``columns`` overrides name by name (``--columns sensor=R`` keeps the
+        file's time and position names).
+
+    Returns
+    -------
+    options : ReadOptions
+    settings : Path or None
+        The settings file used, if any.
+    """
+    given = {k: v for k, v in (given or {}).items() if k in _FIELD_NAMES}
+    settings = find_recording_config(data_path)
+    values = read_recording_config(settings) if settings is not None else {}
+    if "columns" in given and "columns" in values:
+        given["columns"] = tuple({**dict(values["columns"]), **dict(given["columns"])}.items())
+    try:
+        return replace(ReadOptions(**values), **given), settings
+    except ValueError as exc:
+        raise InputError(f"{data_path}: {exc}") from None

@@ -1,0 +1,189 @@
+"""A user's file with its settings beside it (``my.csv`` + ``my.toml``), a units line, extra
+columns: read, carried through fit/evaluate/compensate, written back (issue 11)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from numpy.testing import assert_array_equal
+from scipy.io import loadmat
+
+from hystkit.cli import main
+from hystkit.errors import InputError
+from hystkit.io import ReadOptions, options_for, read_recording
+
+SETTINGS = """time_unit = "ms"
+units_row = true
+sep = ";"
+
+[columns]
+time = "t_ms"
+position = "displacement_mm"
+sensor = "resistance_ohm"
+
+[units]
+temp_C = "degC"
+"""
+OWN = ["--columns", "time=t_ms,position=displacement_mm,sensor=resistance_ohm",
+       "--time-unit", "ms", "--sep", ";", "--units-row"]
+
+
+def _run(capsys, *argv: object) -> tuple[int, str, str]:
+    capsys.readouterr()
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory) -> dict[str, Path]:
+    """The simulated sine as a user's CSV: own names, ms, ';', a units line, two more
+    columns (a temperature with one empty cell, a text note)."""
+    folder = tmp_path_factory.mktemp("settings")
+    std = folder / "std.csv"
+    assert main(["simulate-sensor", "--excitation", "sine", "--out", str(std)]) == 0
+    frame = pd.read_csv(std)
+    temp = np.linspace(20, 21, len(frame))
+    temp[5] = np.nan
+    own = pd.DataFrame({"t_ms": frame["time"] * 1e3, "displacement_mm": frame["position"],
+                        "resistance_ohm": frame["sensor"], "temp_C": temp,
+                        "note": ["start"] + [""] * (len(frame) - 1)})
+    data = {}
+    for name in ("with_toml", "plain"):
+        path = folder / name / "my.csv"
+        path.parent.mkdir()
+        with path.open("w", encoding="utf-8") as f:
+            f.write("t_ms;displacement_mm;resistance_ohm;temp_C;note\nms;mm;Ohm;degC;\n")
+            own.to_csv(f, sep=";", index=False, header=False)
+        data[name] = path
+    (folder / "with_toml" / "my.toml").write_text(SETTINGS, encoding="utf-8")
+    data["std"] = std
+    data["own"] = own
+    return data
+
+
+def test_settings_file_reads_as_the_options(files):
+    by_file, settings = options_for(files["with_toml"])
+    assert settings == files["with_toml"].with_suffix(".toml")
+    rec = read_recording(files["with_toml"], options=by_file)
+    by_cli = read_recording(files["plain"], options=ReadOptions(
+        columns={"time": "t_ms", "position": "displacement_mm", "sensor": "resistance_ohm"},
+        time_unit="ms", sep=";", units_row=True))
+    std = read_recording(files["std"])
+    for a in (rec, by_cli):
+        assert_array_equal(a.position, std.position)
+        assert_array_equal(a.sensor, std.sensor)
+        np.testing.assert_allclose(a.time, std.time, rtol=1e-15, atol=0)  # ms -> s, 1 rounding
+        assert dict(a.units) == {"position": "mm", "sensor": "Ohm"}
+
+
+def test_fit_with_settings_file_equals_fit_with_options(files, tmp_path, capsys):
+    code, out, err = _run(capsys, "fit", files["with_toml"], "--cells", 1, "--out",
+                          tmp_path / "a.json")
+    assert code == 0, err
+    assert out.count("with the settings in") == 1
+    code, out, err = _run(capsys, "fit", files["plain"], "--cells", 1, "--out",
+                          tmp_path / "b.json", *OWN)
+    assert code == 0, err
+    assert "with the settings in" not in out
+    a, b = (json.loads((tmp_path / n).read_text()) for n in ("a.json", "b.json"))
+    assert a["params"] == b["params"]
+    assert a["fit"]["units"] == {"position": "mm", "sensor": "Ohm"}
+
+
+def test_command_line_overrides_the_settings_file(tmp_path, files, capsys):
+    folder = tmp_path / "wrong"
+    folder.mkdir()
+    data = folder / "my.csv"
+    data.write_bytes(files["with_toml"].read_bytes())
+    (folder / "my.toml").write_text(SETTINGS.replace('"ms"', '"s"'), encoding="utf-8")
+    code, _, err = _run(capsys, "fit", data, "--cells", 1, "--out", tmp_path / "m.json")
+    assert code == 2 and "the file gives the time unit 'ms' but time is read in s" in err
+    code, _, err = _run(capsys, "fit", data, "--cells", 1, "--time-unit", "ms", "--out",
+                        tmp_path / "m.json")
+    assert code == 0, err
+
+
+@pytest.mark.parametrize("text, fragments", [
+    ('r_bridge = 100.0\n', ["key 'r_bridge'", "raw scope files", "preprocess"]),
+    ('time_unit = 3\n', ["key 'time_unit' must be str"]),
+    ('time_unit = "h"\n', ["time_unit must be one of"]),
+    ('[columns]\nvoltage = "v"\n', ["'columns.voltage'"]),
+    ('sep = \n', ["invalid TOML"]),
+])
+def test_bad_settings_file_is_one_line(tmp_path, files, capsys, text, fragments):
+    data = tmp_path / "x.csv"
+    data.write_bytes(files["std"].read_bytes())
+    (tmp_path / "x.toml").write_text(text, encoding="utf-8")
+    with pytest.raises(InputError) as info:
+        options_for(data)
+    assert str(info.value).startswith(str(tmp_path / "x.toml"))
+    for fragment in fragments:
+        assert fragment in str(info.value)
+    code, _, err = _run(capsys, "fit", data, "--out", tmp_path / "m.json")
+    assert code == 2 and len(err.strip().splitlines()) == 1
+
+
+def test_forgotten_units_row_says_so(files, tmp_path, capsys):
+    argv = [a for a in OWN if a != "--units-row"]
+    code, _, err = _run(capsys, "fit", files["plain"], *argv, "--out", tmp_path / "m.json")
+    assert code == 2
+    assert "row 1 (line 2): non-numeric value 'ms'; if this line holds units, pass " \
+           "--units-row" in err
+
+
+def test_compensate_keeps_other_columns_and_units(files, tmp_path, capsys):
+    model = tmp_path / "m.json"
+    assert _run(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
+    out = tmp_path / "c.csv"
+    code, stdout, err = _run(capsys, "compensate", model, files["with_toml"], "--out", out)
+    assert code == 0, err
+    assert "position_estimate' [mm]" in stdout and "kept 2 other column(s)" in stdout
+    written = pd.read_csv(out, keep_default_na=False, na_values=[""])
+    assert list(written.columns) == ["time", "position", "sensor", "temp_C", "note",
+                                     "position_estimate", "sensor_outside",
+                                     "estimate_outside"]
+    own = files["own"]
+    assert_array_equal(written["temp_C"].to_numpy(), own["temp_C"].to_numpy())  # NaN kept
+    assert written["note"].fillna("").tolist() == own["note"].tolist()
+    # the units went into c.toml, which reading c.csv picks up again
+    back, settings = options_for(out)
+    assert settings == tmp_path / "c.toml"
+    assert dict(read_recording(out, options=back).units) == {"position": "mm",
+                                                              "sensor": "Ohm"}
+    assert dict(back.units)["position_estimate"] == "mm"
+    assert dict(back.units)["temp_C"] == "degC"
+    mat = tmp_path / "c.mat"
+    assert _run(capsys, "compensate", model, files["with_toml"], "--out", mat)[0] == 0
+    m = loadmat(mat, simplify_cells=True)
+    assert m["units"] == {"position": "mm", "sensor": "Ohm", "position_estimate": "mm",
+                          "temp_C": "degC"}
+    assert_array_equal(m["temp_C"], own["temp_C"].to_numpy())
+    # a cell array of text; scipy reads an empty char as an empty array
+    notes = [x if isinstance(x, str) else ("" if np.size(x) == 0 else x) for x in m["note"]]
+    assert notes == own["note"].tolist()
+    assert_array_equal(m["position_estimate"], written["position_estimate"].to_numpy())
+
+
+def test_compensate_refuses_an_existing_units_file_before_work(files, tmp_path, capsys):
+    model = tmp_path / "m.json"
+    assert _run(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
+    (tmp_path / "c.toml").write_text("precious\n")
+    code, _, err = _run(capsys, "compensate", model, files["with_toml"], "--out",
+                        tmp_path / "c.csv")
+    assert code == 2 and "c.toml already exists" in err
+    assert not (tmp_path / "c.csv").exists()
+
+
+def test_evaluate_reports_units(files, tmp_path, capsys):
+    model = tmp_path / "m.json"
+    assert _run(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
+    code, _, err = _run(capsys, "evaluate", model, files["with_toml"], "--json",
+                        tmp_path / "e.json")
+    assert code == 0, err
+    scores = json.loads((tmp_path / "e.json").read_text())
+    assert scores["units"] == {"position": "mm", "sensor": "Ohm"}
