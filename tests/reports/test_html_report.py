@@ -19,6 +19,7 @@ from hystkit.compensation import evaluate, fit_compensator, load_compensator, sa
 from hystkit.io import write_recording
 from hystkit.reports import build_report, write_report
 from hystkit.reports._html import Section, render_page, table
+from hystkit.reports._report_model import named_parameters
 from hystkit.sensors import simulate_experiment
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -156,6 +157,8 @@ def test_scores_are_evaluates_deployable_first_then_oracle(fitted: dict, page: P
 
 def test_parameters_and_standard_errors_are_the_model_files(fitted: dict, page: Path) -> None:
     se = json.loads(fitted["model"].read_text(encoding="utf-8"))["fit"]["standard_errors"]
+    # the names follow the order of the fit's vector: each name's value is the SE's value
+    assert [v for _, v in named_parameters(fitted["comp"].params.to_dict())] == se["values"]
     rows = _rows(parse(page.read_text(encoding="utf-8")).tables, ("parameter",))[0]
     assert rows[0] == ["parameter", "value", "standard error", "relative"]
     assert [r[0] for r in rows[1:]] == ["i_s[0]", "v_t[0]", "w[0]", "w[1]", "v_b"]

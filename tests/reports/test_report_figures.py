@@ -57,9 +57,10 @@ def test_zoom_window_is_centred_on_the_largest_error_inside_the_run() -> None:
 def test_named_parameters_follow_the_order_of_the_fit_vector() -> None:
     params = {"i_s": [0.1, 0.2], "v_t": [0.5, 0.6], "w": [1.0, -1.0, 0.5], "v_b": -0.01,
               "n": 3, "nested": {"a": [[1.0, 2.0], [3.0]]}}
-    assert named_parameters(params) == ["i_s[0]", "i_s[1]", "v_t[0]", "v_t[1]", "w[0]", "w[1]",
-                                        "w[2]", "v_b", "nested.a[0][0]", "nested.a[0][1]",
-                                        "nested.a[1][0]"]
+    assert named_parameters(params) == [
+        ("i_s[0]", 0.1), ("i_s[1]", 0.2), ("v_t[0]", 0.5), ("v_t[1]", 0.6), ("w[0]", 1.0),
+        ("w[1]", -1.0), ("w[2]", 0.5), ("v_b", -0.01), ("nested.a[0][0]", 1.0),
+        ("nested.a[0][1]", 2.0), ("nested.a[1][0]", 3.0)]
 
 
 def _results(n: int = 400) -> dict:

@@ -55,10 +55,10 @@ class ReportContent:
         section.add(png_block(png, caption))
 
 
-def named_parameters(params: dict) -> list[str]:
-    """Names of the float entries of ``params.to_dict()`` in the order the fit's standard
-    errors use (depth first: ``w[1]``, ``v_b``; nested lists ``a[0][2]``)."""
-    names: list[str] = []
+def named_parameters(params: dict) -> list[tuple[str, float]]:
+    """``(name, value)`` of the float entries of ``params.to_dict()``, in the order the fit's
+    standard errors use (depth first: ``w[1]``, ``v_b``; nested lists ``a[0][2]``)."""
+    found: list[tuple[str, float]] = []
 
     def walk(value: object, name: str) -> None:
         if isinstance(value, dict):
@@ -68,10 +68,10 @@ def named_parameters(params: dict) -> list[str]:
             for i, item in enumerate(value):
                 walk(item, f"{name}[{i}]")
         elif isinstance(value, float):
-            names.append(name)
+            found.append((name, value))
 
     walk(params, "")
-    return names
+    return found
 
 
 def _provenance(comp: Compensator, model_path: Path | None, version: str | None) -> Section:
@@ -127,10 +127,11 @@ def _fixed(value: object, spec: str) -> str:
 
 def _parameter_table(comp: Compensator) -> str:
     """Fitted values with their standard errors (Gauss-Newton, stored by the fit)."""
-    names = named_parameters(comp.params.to_dict())
+    named = named_parameters(comp.params.to_dict())
+    names = [name for name, _ in named]
     se = comp.fit_info.get("standard_errors")
     if not se or len(se.get("values", ())) != len(names):
-        rows = [(n, v, "not stored") for n, v in zip(names, _floats(comp.params.to_dict()))]
+        rows = [(name, value, "not stored") for name, value in named]
         return (table(("parameter", "value", "standard error"), rows, spec=".6g")
                 + paragraph("Standard errors are not stored in this model file (written "
                             "before they were); refit to get them."))
@@ -142,14 +143,6 @@ def _parameter_table(comp: Compensator) -> str:
             + (f"; {blind} parameter(s) not determined by the data (–)." if blind else "."))
     return (table(("parameter", "value", "standard error", "relative"), rows, spec=".6g")
             + paragraph(text))
-
-
-def _floats(tree: object) -> list[float]:
-    if isinstance(tree, dict):
-        return [x for v in tree.values() for x in _floats(v)]
-    if isinstance(tree, list | tuple):
-        return [x for v in tree for x in _floats(v)]
-    return [tree] if isinstance(tree, float) else []
 
 
 def score_section(comp: Compensator, scores: Mapping[str, dict]) -> Section:
