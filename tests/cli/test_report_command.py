@@ -147,3 +147,18 @@ def test_a_failure_while_writing_leaves_nothing(inputs: dict, tmp_path: Path) ->
     with pytest.raises(OutputError, match="No space left on device"):
         write_report(content, out, figures=figures, fmt="pdf")
     assert sorted(p.name for p in tmp_path.rglob("*")) == []
+
+
+def test_a_training_recording_is_pointed_out(tmp_path: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    from hystkit.io import read_recording
+
+    fit = write_recording(simulate_experiment("sine", 1), tmp_path / "train.csv")
+    val = write_recording(simulate_experiment("sine", 2), tmp_path / "val.csv")
+    model = save_compensator(fit_compensator(read_recording(fit), 1), tmp_path / "m.json")
+    out = tmp_path / "r.html"
+    code, _, err = _run(capsys, "report", model, fit, val, "--out", out)
+    assert (code, err) == (0, "")
+    page = out.read_text(encoding="utf-8")
+    assert "train.csv: the file name of a recording the model was fitted on" in page
+    assert "val.csv: the file name" not in page

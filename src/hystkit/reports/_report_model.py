@@ -162,6 +162,11 @@ def score_section(comp: Compensator, scores: Mapping[str, dict]) -> Section:
                           f"|position| (eq. 5.10-5.11); loop area: eq. 5.15, 0 for a perfect "
                           f"compensator."),
                 table(head, deployable, text_columns=2))
+    trained = _training_names(comp) & set(scores)
+    if trained:
+        section.add(note(f"{', '.join(sorted(trained))}: the file name of a recording the model "
+                         f"was fitted on; if it is that recording, its scores are training "
+                         f"scores, not validation."))
     section.add(paragraph(f"Oracle: centring {first['center_oracle']}, the paper's protocol. It "
                           f"removes each recording's own sensor mean and adds its true mean "
                           f"position, which no compensator in use can know: for comparison "
@@ -173,6 +178,13 @@ def score_section(comp: Compensator, scores: Mapping[str, dict]) -> Section:
     section.add(table(("recording", "samples", "sensor outside training",
                        "estimate outside training", "sensor loop area %"), guards))
     return section
+
+
+def _training_names(comp: Compensator) -> set[str]:
+    """File names of the recordings the model file says it was fitted on."""
+    info = comp.fit_info
+    sources = info.get("training_sources") or [info.get("training_source") or ""]
+    return {Path(s).name for s in sources if s}
 
 
 def _fixed_or_none(value: float | None, spec: str) -> str | None:
