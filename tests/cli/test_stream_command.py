@@ -125,6 +125,21 @@ def test_every_line_is_answered_before_the_next_arrives_and_ctrl_c_exits_130(mod
     assert err.rstrip().endswith("hystkit: interrupted")
 
 
+def test_sigterm_also_prints_the_summary(model, validation):
+    _, path = model
+    with command(str(path), stdin=subprocess.PIPE, bufsize=0) as proc:
+        assert read_line(proc.stdout) == b"time,position_estimate,flags\n"
+        proc.stdin.write("".join(lines_of(validation, 3)).encode())
+        for _ in range(3):
+            read_line(proc.stdout)
+        proc.send_signal(signal.SIGTERM)
+        code = proc.wait(WAIT)
+        err = proc.stderr.read().decode()
+    assert code == 143, err
+    assert "hystkit stream: 3 samples; latency per sample median" in err
+    assert err.rstrip().endswith("hystkit: terminated (SIGTERM)")
+
+
 def test_a_model_that_cannot_stream_fails_before_reading(tmp_path):
     oracle = fit_compensator(simulate_experiment("sine", 1), 1, center="recording",
                              diagnose=False)

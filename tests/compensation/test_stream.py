@@ -137,6 +137,10 @@ def test_a_resumed_stream_continues_exactly():
     tail = Stream.from_state(comp, saved).process(sensor[123:])
     assert_array_equal(np.concatenate([head, tail]), offline(comp, sensor))
     assert saved.n_samples == 123 and not saved.x.flags.writeable
+    with pytest.raises(InputError, match="needs 3 finite numbers"):
+        Stream.from_state(comp, StreamState(np.zeros(2), 5))
+    with pytest.raises(InputError, match="no model state"):
+        Stream.from_state(comp, StreamState(None, 5))
 
 
 def test_advance_is_pure():

@@ -357,6 +357,8 @@ class Stream:
         stream = cls(compensator, rest_position=rest_position, label=label)
         if state.x is not None:
             initial_state(compensator, state.x)  # checks its size
+        elif state.n_samples:
+            raise InputError(f"stream state: {state.n_samples} samples seen but no model state")
         stream._state = state
         return stream
 
