@@ -26,9 +26,10 @@ from ._sync import SyncExcitation, sync_excitation
 from ._training_checks import check_excursion, check_fitting_data
 
 __all__ = ["CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",
-           "DEPLOYABLE_CENTERS", "MODEL_SUFFIXES", "MODES", "ORACLE_CENTER", "POSITION_MARGIN", "SENSOR_MARGIN",
-           "Compensator", "CompensatorEstimator", "LinearBaseline", "Scaling", "StepOutput",
-           "Stream", "StreamOutput", "StreamState", "SyncExcitation", "advance", "center_label",
-           "centre_and_scale", "check_excursion", "check_fitting_data", "compensator_from_dict",
-           "compensator_to_dict", "evaluate", "fit_compensator", "load_compensator",
-           "prepare_training_data", "save_compensator", "sync_excitation", "use_flags"]
+           "DEPLOYABLE_CENTERS", "MODEL_SUFFIXES", "MODES", "ORACLE_CENTER", "POSITION_MARGIN",
+           "SENSOR_MARGIN", "Compensator", "CompensatorEstimator", "LinearBaseline", "Scaling",
+           "StepOutput", "Stream", "StreamOutput", "StreamState", "SyncExcitation", "advance",
+           "center_label", "centre_and_scale", "check_excursion", "check_fitting_data",
+           "compensator_from_dict", "compensator_to_dict", "evaluate", "fit_compensator",
+           "load_compensator", "prepare_training_data", "save_compensator", "sync_excitation",
+           "use_flags"]
