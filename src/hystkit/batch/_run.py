@@ -33,7 +33,7 @@ from ..models import get_family
 from ..parallel import Executor, SerialExecutor
 from ._manifest import SensorJob
 
-__all__ = ["RESULT_COLUMNS", "fit_sensor", "run_batch"]
+__all__ = ["RESULT_COLUMNS", "fit_sensor", "pending", "run_batch"]
 
 #: Columns of ``results.parquet`` / ``results.csv``. Scores are on the validation recordings
 #: (the mean over several): deployable (the model's own centring) and oracle (the paper's
@@ -132,14 +132,9 @@ def run_batch(jobs: Sequence[SensorJob], out: Path, *, executor: Executor | None
     """
     out = Path(out)
     _claim(out, refit, source)
-    rows: dict[str, dict] = {}
-    todo = []
-    for job in jobs:
-        record = None if refit else _finished(out, job)
-        if record is None:
-            todo.append(job)
-        else:
-            rows[job.sensor] = record["row"]
+    rows = {job.sensor: record["row"] for job in jobs
+            if (record := None if refit else _finished(out, job)) is not None}
+    todo = [job for job in jobs if job.sensor not in rows]
     progress(f"{len(jobs)} sensors: {len(rows)} finished before, {len(todo)} to fit on "
              f"{(executor or SerialExecutor()).describe()}")
 
@@ -167,6 +162,11 @@ def _claim(out: Path, refit: bool, source: str) -> None:
     check_output_path(marker, force=True)  # the folder (or its nearest parent) is writable
     if not marker.exists() or refit:
         write_json({"hystkit": __version__, "source": source}, marker, force=True)
+
+
+def pending(jobs: Sequence[SensorJob], out: Path, refit: bool = False) -> list[SensorJob]:
+    """The jobs `run_batch` will fit (those not finished in `out`), e.g. to size a cluster."""
+    return [job for job in jobs if refit or _finished(Path(out), job) is None]
 
 
 def _finished(out: Path, job: SensorJob) -> dict | None:

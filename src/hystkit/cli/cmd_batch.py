@@ -19,7 +19,7 @@ __all__ = ["register"]
 
 
 def _batch(args: argparse.Namespace) -> int:
-    from ..batch import jobs_from_folder, read_manifest, run_batch
+    from ..batch import jobs_from_folder, pending, read_manifest, run_batch
 
     defaults = {"model": args.model, "size": args.size, "mode": args.mode,
                 "center": args.center}
@@ -32,7 +32,8 @@ def _batch(args: argparse.Namespace) -> int:
     print(f"batch of {len(jobs)} sensors from {args.source} into {args.out} (scores on the "
           f"validation recordings: deployable; oracle: each recording's own means, the "
           f"paper's protocol)", flush=True)
-    with executor_for(args, len(jobs)) as executor:
+    # a rerun with everything finished starts no cluster
+    with executor_for(args, len(pending(jobs, args.out, args.force))) as executor:
         table = run_batch(jobs, args.out, executor=executor, read_options=read_options(args),
                           refit=args.force, source=str(args.source), progress=_say)
     print(f"wrote {args.out / 'results.parquet'}, {args.out / 'results.csv'} and "
