@@ -72,3 +72,27 @@ def test_matlab_files_are_named_after_the_model(compensators):
     assert files["tip.m"].splitlines()[0] == "% tip.m"
     assert "function [estimate, state, flags] = tip(sensor, state)" in files["tip.m"]
     assert "persistent state" in files["tip_block.m"]
+
+
+@pytest.mark.parametrize("label, mode, center", [("mpl3", "direct", "track"),
+                                                 ("preisach", "direct", "fit")])
+def test_matlab_sync_start_matches_the_stream(label, mode, center, compensators, recordings,
+                                              tmp_path):
+    """NAME_sync(): the state after e_sync, centring from the next sample, as Stream("sync")."""
+    from hystkit.compensation._stream import Stream
+    from hystkit.compensation._sync import sync_excitation
+
+    octave = need("octave")
+    _, val = recordings
+    comp = compensators(label, mode, center)
+    plan = make_plan(comp, "comp", sync_state=sync_excitation(comp).state_after)
+    for name, text in matlab_files(plan).items():
+        (tmp_path / name).write_text(text)
+    np.savetxt(tmp_path / "sensor.txt", val.sensor[:2000], fmt="%.17g")
+    subprocess.run([octave, "--no-gui", "--quiet", "--no-window-system", "--eval",
+                    f"cd('{tmp_path}'); s = load('sensor.txt'); e = comp(s, comp_sync()); "
+                    "fid = fopen('out.txt', 'w'); fprintf(fid, '%.17g\\n', e); fclose(fid);"],
+                   check=True, capture_output=True, timeout=600)
+    got = np.loadtxt(tmp_path / "out.txt")
+    ref = Stream(comp, start="sync").process(val.sensor[:2000])
+    assert np.max(np.abs(got - ref)) <= 1e-9
