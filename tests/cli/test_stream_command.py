@@ -234,3 +234,16 @@ def test_a_missing_input_file_is_one_error_line(model, tmp_path, capsys):
     captured = capsys.readouterr()
     assert captured.out == "" and captured.err.startswith("hystkit: error: ")
     assert "none.csv: cannot read" in captured.err
+
+
+def test_an_endless_line_is_skipped_in_bounded_memory(model, validation, tmp_path, capsys):
+    comp, path = model
+    lines = lines_of(validation, 20)
+    lines.insert(5, "1" * 1_000_000 + ",2\n")  # no pair of numbers: a megabyte of noise
+    data = tmp_path / "in.csv"
+    data.write_text("".join(lines))
+    assert main(["stream", str(path), "--in", str(data)]) == 0
+    captured = capsys.readouterr()
+    _, estimate, _ = parse_output(captured.out)
+    assert_array_equal(estimate, expected(comp, validation.sensor[:20])[0])
+    assert f"{data}: 1 line(s) line too long (skipped; first at line 6)" in captured.err

@@ -9,14 +9,14 @@ after a header line. ``time`` is echoed as received, the estimate [mm] is printe
 precision, ``flags`` is a bit mask: 1 = sensor outside the training range, 2 = estimate outside
 the training position range (the columns of ``hystkit compensate``).
 
-Bad input never stops the stream: a line that is not numbers, lacks a field, or whose time does
-not advance is skipped; a sample whose step differs from the model's ``dt`` by more than 1 %
-(the tolerance ``compensate`` allows a recording's rate) is compensated but counted, since the
-model's Euler step assumes ``dt`` (a dropped sample, jitter); a sample whose estimate runs away
-is skipped and the model state kept. At the end (end of input, a closed port, Ctrl-C or SIGTERM)
-stderr gets one warning line per kind with its count and first line number, and the latency
-per sample (from the line's arrival until its output line is ready: parse, compensate,
-format; writing it is one system call more).
+Bad input never stops the stream: a line that is not numbers, lacks a field, is longer than
+4096 characters, or whose time does not advance is skipped; a sample whose step differs from the
+model's ``dt`` by more than 1 % (the tolerance ``compensate`` allows a recording's rate) is
+compensated but counted, since the model's Euler step assumes ``dt`` (a dropped sample,
+jitter); a sample whose estimate runs away is skipped and the model state kept. At the end (end
+of input, a closed port, Ctrl-C or SIGTERM) stderr gets one warning line per kind with its count
+and first line number, and the latency per sample (from the line's arrival until its output
+line is ready: parse, compensate, format; writing it is one system call more).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ import argparse
 import sys
 import time
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
@@ -41,6 +41,9 @@ STEP_TOLERANCE = 0.01
 # Latency percentiles are over the most recent samples (memory stays bounded on a long run).
 LATENCY_WINDOW = 100_000
 DEFAULT_BAUD = 115200
+# A longer line is no "time,sensor" pair: skipped without holding it in memory.
+MAX_LINE = 4096
+TOO_LONG = "\0 line too long"
 SERIAL_HINT = 'pip install "hystkit[serial]"'
 
 
@@ -76,10 +79,21 @@ def _lines(args: argparse.Namespace) -> tuple[str, Iterator[str]]:
     return "<stdin>", _file_lines(sys.stdin)
 
 
+def _bounded(readline: Callable[[int], str]) -> Iterator[str]:
+    """Lines from ``readline(limit)``; a line longer than ``MAX_LINE`` is read to its end in
+    pieces (memory stays bounded) and given as ``TOO_LONG``."""
+    while piece := readline(MAX_LINE):
+        if len(piece) < MAX_LINE or piece.endswith("\n"):
+            yield piece
+            continue
+        while (more := readline(MAX_LINE)) and not more.endswith("\n"):
+            pass
+        yield TOO_LONG
+
+
 def _file_lines(handle: TextIO) -> Iterator[str]:
     with handle:
-        while line := handle.readline():
-            yield line
+        yield from _bounded(handle.readline)
 
 
 def _open_serial(port: str, baud: int):
@@ -100,15 +114,11 @@ def _serial_lines(port: str, baud: int) -> Iterator[str]:
 
     def lines() -> Iterator[str]:
         with handle:
-            while True:
-                try:
-                    raw = handle.readline()
-                except serial.SerialException:  # unplugged, or the other end closed
-                    print(f"hystkit stream: {port} closed", file=sys.stderr)
-                    return
-                if not raw:
-                    return
-                yield raw.decode("ascii", errors="replace")
+            try:
+                yield from _bounded(lambda limit: handle.readline(limit).decode(
+                    "ascii", errors="replace"))
+            except serial.SerialException:  # unplugged, or the other end closed
+                print(f"hystkit stream: {port} closed", file=sys.stderr)
 
     return lines()
 
@@ -171,6 +181,9 @@ def _run_stream(stream: Stream, lines: Iterator[str], tally: _Tally, latency: _L
     columns, previous = (0, 1), None
     for line_no, line in enumerate(lines, start=1):
         arrived = time.perf_counter()
+        if line is TOO_LONG:
+            tally.add("line too long", line_no)
+            continue
         if not line.strip():
             continue
         if line_no == 1 and (named := _columns(line.split(","))) is not None:
