@@ -59,7 +59,7 @@ def test_after_sync_the_state_is_that_of_any_history_or_the_model_is_refused(cas
     scale = max(1.0, np.max(np.abs(sync.state_after)))
     for x0 in other_histories(comp):
         _, x_end = family.simulate(st, params, sync.normalised, x0)
-        assert_allclose(x_end, sync.state_after, rtol=0, atol=sync.tolerance * scale * 10)
+        assert_allclose(x_end, sync.state_after, rtol=0, atol=sync.tolerance * scale)
     assert sync.spread <= sync.tolerance * scale
     assert sync.duration == pytest.approx(len(sync.levels) * sync.hold_seconds)
     assert sync.normalised.size == sync.signal.size

@@ -8,8 +8,9 @@ counter. :func:`advance` is the pure core (``state`` in, estimates and the next 
 Running a recording through a stream in chunks of any size gives exactly (bit for bit) the
 offline :meth:`Compensator.estimate`: every chunk goes through the same data path (the centring's
 running mean / low-pass continued from the stored state, the polarity, the scaling) and the
-family's compiled ``simulate`` / ``invert`` continued from the stored model state, which every
-family guarantees equals the whole run.
+family's compiled ``simulate`` / ``invert`` continued from the stored model state, which equals
+the whole run for every family (the PI inverse to rounding: it rebuilds its inverse-play states
+from the forward state at each chunk start).
 
 Start-up (``start``):
 
@@ -47,8 +48,9 @@ class StreamState:
     Attributes
     ----------
     x : array or None
-        The model's (or its inverse's) state vector; None before the first sample of a stream
-        that starts at rest (the rest state depends on that sample).
+        The model's state vector (for an inverse compensator its forward model's, which every
+        family's ``invert`` carries); None before the first sample of a stream that starts at
+        rest (the rest state depends on that sample).
     n_samples : int
         Samples processed so far (the next sample's index).
     tare_sum : float
