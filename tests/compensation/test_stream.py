@@ -143,6 +143,18 @@ def test_a_resumed_stream_continues_exactly():
         Stream.from_state(comp, StreamState(None, 5))
 
 
+def test_a_tare_rest_position_moves_the_estimate_as_offline():
+    comp = dataclasses.replace(make_compensator("mpl", "direct", "tare"), rest_position=2.0)
+    sensor = sensor_for(comp)
+    rec = Recording(time=np.arange(N) * DT, sensor=sensor)
+    want = comp.estimate(rec, rest_position=3.5)
+    stream = Stream(comp, rest_position=3.5)
+    got = np.concatenate([stream.process(sensor[k:k + 50]) for k in range(0, N, 50)])
+    assert_array_equal(got, want)
+    # moved by 3.5 - 2.0 mm, up to the rounding of p * scale + offset
+    assert_allclose(got - comp.estimate(rec), np.full(N, 1.5), rtol=0, atol=1e-12)
+
+
 def test_advance_is_pure():
     comp = make_compensator("pl", "direct", "track")
     sensor = sensor_for(comp)
