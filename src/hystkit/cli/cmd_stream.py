@@ -258,7 +258,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("model", type=Path, help="model JSON file written by 'hystkit fit' "
                                             "(centring fit, tare, track or none)")
     source = p.add_mutually_exclusive_group()
-    source.add_argument("--in", dest="input", type=Path, help="read this file instead of stdin")
+    source.add_argument("--in", dest="input", type=Path, metavar="FILE",
+                        help="read this file instead of stdin")
     source.add_argument("--serial", metavar="PORT",
                         help=f"read a serial port (needs pyserial: {SERIAL_HINT})")
     p.add_argument("--baud", type=positive_int, help="serial baud rate (default 115200)")
