@@ -282,8 +282,20 @@ def _outside(values, bounds: tuple[float, float] | None):
     return (values < bounds[0]) | (values > bounds[1])
 
 
-def _advance_one(path: _Path, state: StreamState, v: float,
-                 label: str) -> tuple[StepOutput, StreamState]:
+class _Previous(NamedTuple):
+    """What a direct stream's last one-sample step started from: lets the next step run the
+    last two samples in one compiled call (see :func:`_run_model`) instead of two. A cache,
+    not memory: valid only for the exact ``after`` state it was made with, and the result is
+    the same bits with or without it."""
+
+    after: StreamState
+    x: np.ndarray | None
+    s: float
+
+
+def _advance_one(path: _Path, state: StreamState, v: float, label: str,
+                 previous: _Previous | None = None
+                 ) -> tuple[StepOutput, StreamState, _Previous]:
     """:func:`_advance` for one sample, in Python floats (the same operations, so the same
     bits) around the family's compiled run: a fraction of the array path's overhead."""
     comp = path.comp
@@ -307,7 +319,15 @@ def _advance_one(path: _Path, state: StreamState, v: float,
     s = comp.polarity * (v - offset) / comp.scaling.sensor_scale
     with np.errstate(over="ignore", invalid="ignore"):
         try:
-            p_run, x_end = _run_model(comp, np.array([s]), state.x)
+            if comp.mode == "direct" and previous is not None and previous.after is state:
+                # the last two samples from the state before the last: output and state at once
+                p_run, x_end = comp.family.simulate(comp.structure, comp.params,
+                                                    np.array([previous.s, s]),
+                                                    None if previous.x is None
+                                                    else np.array(previous.x))
+                p_run = p_run[1:]
+            else:
+                p_run, x_end = _run_model(comp, np.array([s]), state.x)
         except FitDivergedError as exc:
             raise FitDivergedError(f"{label}: sample {state.n_samples}: the {comp.model} "
                                    f"compensator{_of(comp)}: {exc}") from None
@@ -316,7 +336,7 @@ def _advance_one(path: _Path, state: StreamState, v: float,
     if not (abs(p) <= MAX_NORMALISED and math.isfinite(estimate)):
         _check_runaway(comp, np.array([p]), np.array([estimate]), state.n_samples, label)
     nxt = StreamState(x_end, state.n_samples + 1, tare_sum, track_value, track_weight)
-    return StepOutput(estimate, *_flags(path, s, estimate)), nxt
+    return StepOutput(estimate, *_flags(path, s, estimate)), nxt, _Previous(nxt, state.x, s)
 
 
 def _of(comp: Compensator) -> str:
@@ -350,6 +370,7 @@ class Stream:
                  rest_position: float | None = None, label: str = "stream") -> None:
         self._path = _Path(compensator, rest_position)
         self._state = initial_state(compensator, start)
+        self._previous: _Previous | None = None  # speeds up step; never changes a result
         self.label = label
 
     @classmethod
@@ -385,7 +406,8 @@ class Stream:
 
     def step_flagged(self, sensor: float) -> StepOutput:
         """Estimate and use-time flags for one raw sensor sample."""
-        out, self._state = _advance_one(self._path, self._state, sensor, self.label)
+        out, self._state, self._previous = _advance_one(self._path, self._state, sensor,
+                                                        self.label, self._previous)
         return out
 
     def process(self, sensor: np.ndarray) -> np.ndarray:
