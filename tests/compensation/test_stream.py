@@ -106,6 +106,20 @@ def test_step_by_step_equals_process(case, center):
     assert stream.state.n_samples == sensor.size
 
 
+@pytest.mark.parametrize("name", ["ladder", "bobbio", "mpl"])
+def test_steps_and_chunks_mixed_give_the_offline_estimate(name):
+    """Steps reuse the previous step's start (direct mode); a chunk in between resets that."""
+    comp = make_compensator(name, "direct", "track")
+    sensor = sensor_for(comp)
+    stream, out, k = Stream(comp), [], 0
+    for n_steps, chunk in [(5, 7), (3, 1), (9, 64), (1, 2), (40, 0)] * 4:  # 528 of 600
+        out += [stream.step(v) for v in sensor[k:k + n_steps]]
+        out += list(stream.process(sensor[k + n_steps:k + n_steps + chunk]))
+        k += n_steps + chunk
+    out += list(stream.process(sensor[k:]))
+    assert_array_equal(np.array(out), offline(comp, sensor))
+
+
 @settings(max_examples=25, deadline=None)
 @given(sizes=st.lists(st.integers(1, 90), min_size=1, max_size=12),
        case=st.sampled_from(CASES), center=st.sampled_from(CENTERS))
