@@ -14,10 +14,11 @@ from hystkit.export import make_plan, matlab_files
 from .export_support import CASES, CENTRINGS, need
 
 N_BLOCK = 300  # samples run through NAME_block (one Octave call per sample: slow)
-# The Preisach inverse bisects ~40 times a sample: 80 s per 8000 samples in Octave. Its tare
+# The Preisach inverses bisect ~40 times a sample: 80 s per 8000 samples in Octave. Its tare
 # and track runs are checked on the first 1000 samples (causal: the estimate's prefix), which
 # hold the whole tare window and the tracker's start; fit runs the whole recording.
-N_SAMPLES = {("preisach", "inverse", "tare"): 1000, ("preisach", "inverse", "track"): 1000}
+N_SAMPLES = {(family, "inverse", center): 1000 for family in ("preisach", "gpreisach")
+             for center in ("tare", "track")}
 
 
 def _octave_script(folders: list, sensor_file, out_files: list, sizes: list) -> str:
@@ -89,9 +90,9 @@ def test_matlab_sync_start_matches_the_stream(label, mode, center, compensators,
     for name, text in matlab_files(plan).items():
         (tmp_path / name).write_text(text)
     np.savetxt(tmp_path / "sensor.txt", val.sensor[:2000], fmt="%.17g")
-    subprocess.run([octave, "--no-gui", "--quiet", "--no-window-system", "--eval",
-                    f"cd('{tmp_path}'); s = load('sensor.txt'); e = comp(s, comp_sync()); "
-                    "fid = fopen('out.txt', 'w'); fprintf(fid, '%.17g\\n', e); fclose(fid);"],
+    script = (f"cd('{tmp_path}'); s = load('sensor.txt'); e = comp(s, comp_sync()); "
+              "fid = fopen('out.txt', 'w'); fprintf(fid, '%.17g\\n', e); fclose(fid);")
+    subprocess.run([octave, "--no-gui", "--quiet", "--no-window-system", "--eval", script],
                    check=True, capture_output=True, timeout=600)
     got = np.loadtxt(tmp_path / "out.txt")
     ref = Stream(comp, start="sync").process(val.sensor[:2000])

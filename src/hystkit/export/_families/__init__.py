@@ -23,7 +23,7 @@ from types import ModuleType
 __all__ = ["REFUSALS", "TRANSLATED", "refusal", "translator"]
 
 TRANSLATED = {"mpl": "mpl", "mpl-poly": "mpl_poly", "pi": "pi", "preisach": "preisach",
-              "ladder": "ladder"}
+              "gpreisach": "preisach", "ladder": "ladder"}
 
 REFUSALS = {
     "pl": "the power-law family's block is not translated to C/MATLAB yet (its resistor is a "
@@ -33,8 +33,6 @@ REFUSALS = {
     "bobbio": "the Bobbio spring-piston block is not translated to C/MATLAB yet",
     "boucwen": "the Bouc-Wen block (a second-order ODE integrated per sample) is not "
                "translated to C/MATLAB yet",
-    "gpreisach": "the generalised Preisach block (two weighted Everett tables) is not "
-                 "translated to C/MATLAB yet; the classical preisach family is",
 }
 
 
