@@ -10,6 +10,8 @@ waits for: start-up, reading, the work, writing), of
   blocked time folds of one recording) at ``--workers 1`` (serial, in-process, no Dask) and
   ``--workers 2`` (a local Dask cluster of two forked workers); issue 13 asks for >= 1.7x on 2
   cores;
+- ``compare`` inside one process, split into start-up, opening the executor (Dask import,
+  kernel warm-up, cluster start), the map and closing, to see where the time goes;
 - a fleet of 20 virtual sensors (different seeds; a fit and a validation recording each)
   through ``hystkit batch`` at 1 and 2 workers, against a shell loop that runs ``hystkit fit``
   and ``hystkit evaluate`` for each sensor (the same work: fit, model file, scores).
@@ -25,6 +27,7 @@ fewer select candidates (a quick check, not the issue's numbers).
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
 import resource
@@ -36,6 +39,25 @@ import time
 from pathlib import Path
 
 N_SENSORS = 20
+
+# compare in a fresh process, timed inside: start-up, opening the executor (Dask import, kernel
+# warm-up, cluster start), the map itself, closing. Serial map / (2 x parallel map) is the
+# efficiency of the 2-worker map; what it lacks is scheduling, transfer and load imbalance.
+BREAKDOWN = """
+import json, sys, time
+t0 = time.perf_counter()
+from hystkit.io import read_recording
+from hystkit.parallel import open_executor
+from hystkit.reports import compare_models
+fit, val = read_recording("fit.csv"), read_recording("val.csv")
+t1 = time.perf_counter()
+with open_executor(int(sys.argv[1])) as executor:
+    t2 = time.perf_counter()
+    compare_models(fit, val, executor=executor)
+    t3 = time.perf_counter()
+t4 = time.perf_counter()
+print(json.dumps({"start-up": t1 - t0, "open": t2 - t1, "map": t3 - t2, "close": t4 - t3}))
+"""
 
 
 def _machine() -> str:
@@ -112,6 +134,13 @@ def main() -> None:
         for repeat in range(args.repeats):
             order = ("1", "2") if repeat % 2 == 0 else ("2", "1")
             times.setdefault("shell loop", []).append(_run(["bash", "loop.sh"], cwd))
+            for workers in order:
+                parts = json.loads(subprocess.run(
+                    [sys.executable, "-c", BREAKDOWN, workers], cwd=cwd, check=True,
+                    capture_output=True, text=True).stdout)
+                for part, seconds in parts.items():
+                    times.setdefault(f"in-process compare {part} @{workers}", []).append(
+                        (seconds, 0.0))
             for name, argv in commands.items():
                 for workers in order:
                     times.setdefault(f"{name} @{workers}", []).append(
@@ -138,6 +167,11 @@ def _report(times: dict, commands: dict, args: argparse.Namespace, n_samples: in
         lines.append(f"{name:<12}{med[f'{name} @1']:>10.2f}{med[f'{name} @2']:>11.2f}"
                      f"{med[f'{name} @1'] / med[f'{name} @2']:>9.2f}x{ratio:>20.2f}x"
                      f"{cpu[f'{name} @1']:>8.1f}{cpu[f'{name} @2']:>8.1f}")
+    lines += ["", "compare in one process [s]: " + "; ".join(
+        f"{part} {med[f'in-process compare {part} @1']:.2f} / "
+        f"{med[f'in-process compare {part} @2']:.2f}"
+        for part in ("start-up", "open", "map", "close")) + " (1 / 2 workers); map efficiency "
+        f"{med['in-process compare map @1'] / (2 * med['in-process compare map @2']):.2f}"]
     loop = med["shell loop"]
     lines += ["", (f"{n_sensors} sensors: shell loop of hystkit fit + evaluate {loop:.2f} s "
               f"(CPU {cpu['shell loop']:.1f} s, {loop / n_sensors:.2f} s per sensor); "
@@ -145,7 +179,8 @@ def _report(times: dict, commands: dict, args: argparse.Namespace, n_samples: in
               f"({loop / med['batch @1']:.1f}x faster), {med['batch @2']:.2f} s at 2 "
               f"({loop / med['batch @2']:.1f}x faster)"),
               "all times: " + "; ".join(f"{k} " + ", ".join(f"{w:.2f}" for w, _ in v)
-                                        for k, v in times.items())]
+                                        for k, v in times.items()
+                                        if not k.startswith("in-process"))]
     return "\n".join(lines)
 
 
