@@ -14,7 +14,7 @@ from scipy.io import loadmat
 
 from hystkit.cli import main
 from hystkit.errors import InputError
-from hystkit.io import ReadOptions, options_for, read_recording
+from hystkit.io import ReadOptions, options_for, read_recording, read_recording_config
 
 SETTINGS = """time_unit = "ms"
 units_row = true
@@ -109,7 +109,8 @@ def test_command_line_overrides_the_settings_file(tmp_path, files, capsys):
 
 
 @pytest.mark.parametrize("text, fragments", [
-    ('r_bridge = 100.0\n', ["key 'r_bridge'", "raw scope files", "preprocess"]),
+    ('units_row = "yes"\n', ["key 'units_row' must be bool"]),
+    ('columns = 3\n', ["key 'columns' must be dict"]),
     ('time_unit = 3\n', ["key 'time_unit' must be str"]),
     ('time_unit = "h"\n', ["time_unit must be one of"]),
     ('[columns]\nvoltage = "v"\n', ["'columns.voltage'"]),
@@ -187,3 +188,18 @@ def test_evaluate_reports_units(files, tmp_path, capsys):
     assert code == 0, err
     scores = json.loads((tmp_path / "e.json").read_text())
     assert scores["units"] == {"position": "mm", "sensor": "Ohm"}
+
+
+def test_a_raw_recordings_settings_of_the_same_stem_are_left_alone(files, tmp_path, capsys):
+    # preprocess turns run.parquet (+ run.toml, its raw settings) into run.csv beside them
+    data = tmp_path / "run.csv"
+    data.write_bytes(files["std"].read_bytes())
+    (tmp_path / "run.toml").write_text('r_bridge = 100.0\n\n[columns]\nv1 = "A"\n',
+                                       encoding="utf-8")
+    options, settings = options_for(data)
+    assert settings is None and options == ReadOptions()
+    code, out, err = _run(capsys, "fit", data, "--cells", 1, "--out", tmp_path / "m.json")
+    assert code == 0, err
+    assert "with the settings in" not in out
+    with pytest.raises(InputError, match="key 'r_bridge' .*raw scope files.*preprocess"):
+        read_recording_config(tmp_path / "run.toml")  # named when read as a recording's

@@ -21,8 +21,9 @@ keys and two tables::
     sensor = "Ohm"
 
 Options given on the command line override the file's. The format is the one ``preprocess``
-reads for raw files (flat keys, a ``[columns]`` table); keys only raw files have are refused
-with a line saying so.
+reads for raw files (flat keys, a ``[columns]`` table). A raw recording's own settings file
+(``run.toml`` of ``run.parquet``, which ``preprocess`` turns into ``run.csv`` beside it) is
+recognised by its raw-only keys or raw column names and left alone (`is_raw_settings`).
 """
 
 from __future__ import annotations
@@ -37,7 +38,8 @@ from hystkit.errors import InputError
 
 from .._read_options import FIELDS, ReadOptions
 
-__all__ = ["RECORDING_KEYS", "find_recording_config", "options_for", "read_recording_config"]
+__all__ = ["RECORDING_KEYS", "find_recording_config", "is_raw_settings", "options_for",
+           "read_recording_config"]
 
 RECORDING_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
     "time_unit": ((str,), "unit of the time column: s, ms, us, ns or min"),
@@ -69,13 +71,7 @@ def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
     from ._raw_config import CONFIG_KEYS as RAW_KEYS
 
     path = Path(path)
-    try:
-        with path.open("rb") as handle:
-            values = tomllib.load(handle)
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot read settings file ({exc})") from exc
-    except (tomllib.TOMLDecodeError, RecursionError) as exc:
-        raise InputError(f"{path}: invalid TOML ({exc})") from exc
+    values = _load(path)
     for key, value in values.items():
         if key not in RECORDING_KEYS:
             raw = " (a setting of raw scope files, for 'hystkit preprocess')" \
@@ -104,6 +100,30 @@ def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
     return values
 
 
+def _load(path: Path) -> dict[str, Any]:
+    try:
+        with path.open("rb") as handle:
+            return tomllib.load(handle)
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read settings file ({exc})") from exc
+    except (tomllib.TOMLDecodeError, RecursionError) as exc:
+        raise InputError(f"{path}: invalid TOML ({exc})") from exc
+
+
+def is_raw_settings(values: dict[str, Any]) -> bool:
+    """Whether TOML `values` are a raw scope recording's settings (`read_raw_config`): a key
+    only raw files have (``r_bridge``, ``fs_out``, ...) or a raw column name (``v1``,
+    ``encoder``, ...) in ``[columns]``. ``run.parquet`` (raw) and ``preprocess``'s ``run.csv``
+    share the stem, so ``run.toml`` beside ``run.csv`` may be the raw file's."""
+    from ._raw_config import _COLUMN_NAMES as RAW_COLUMNS
+    from ._raw_config import CONFIG_KEYS as RAW_KEYS
+
+    raw_only = set(RAW_KEYS) - set(RECORDING_KEYS)
+    columns = values.get("columns")
+    return bool(raw_only & set(values)) or (
+        isinstance(columns, dict) and bool(set(columns) & (set(RAW_COLUMNS) - set(FIELDS))))
+
+
 _FIELD_NAMES = {f.name for f in fields(ReadOptions)}
 
 
@@ -124,10 +144,13 @@ def options_for(data_path: str | os.PathLike[str], given: dict[str, Any] | None 
     -------
     options : ReadOptions
     settings : Path or None
-        The settings file used, if any.
+        The settings file used, if any. A raw recording's settings file of the same stem
+        (`is_raw_settings`) is not used.
     """
     given = {k: v for k, v in (given or {}).items() if k in _FIELD_NAMES}
     settings = find_recording_config(data_path)
+    if settings is not None and is_raw_settings(_load(settings)):
+        settings = None  # the raw recording's settings (for preprocess), not this file's
     values = read_recording_config(settings) if settings is not None else {}
     if "columns" in given and "columns" in values:
         given["columns"] = tuple({**dict(values["columns"]), **dict(given["columns"])}.items())
