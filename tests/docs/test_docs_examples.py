@@ -9,7 +9,8 @@
   model (minutes); the README walk-through test runs its own-data path.
 - A block preceded by ``<!-- skip-test: reason -->`` is not run (its commands are still parsed);
   ``test_skipped_blocks_say_why`` lists them with their reasons.
-- Other blocks (``text``, unlabelled output, ``toml``) are not code and are left alone.
+- Other blocks are left alone: output and settings (``text``, unlabelled, ``toml``), and C or
+  MATLAB listings (the export tests compile and run the generated code itself).
 """
 
 from __future__ import annotations
