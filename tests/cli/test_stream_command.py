@@ -247,3 +247,17 @@ def test_an_endless_line_is_skipped_in_bounded_memory(model, validation, tmp_pat
     _, estimate, _ = parse_output(captured.out)
     assert_array_equal(estimate, expected(comp, validation.sensor[:20])[0])
     assert f"{data}: 1 line(s) line too long (skipped; first at line 6)" in captured.err
+
+
+def test_a_header_with_other_columns_after_a_blank_line(model, validation, tmp_path, capsys):
+    comp, path = model
+    rows = [f"{s!r},7,{t!r}\n" for t, s in zip(validation.time[:30].tolist(),
+                                                validation.sensor[:30].tolist(), strict=True)]
+    data = tmp_path / "in.csv"
+    data.write_text("\n\ufeffSensor,temperature,Time\n" + "".join(rows), encoding="utf-8")
+    assert main(["stream", str(path), "--in", str(data)]) == 0
+    captured = capsys.readouterr()
+    times, estimate, _ = parse_output(captured.out)
+    assert_array_equal(estimate, expected(comp, validation.sensor[:30])[0])
+    assert times[1] == repr(float(validation.time[1]))
+    assert "warning" not in captured.err

@@ -1,8 +1,8 @@
 """``hystkit stream MODEL``: compensate a live sensor, one ``time,sensor`` line at a time.
 
 Input: CSV lines ``time,sensor`` (time in seconds) from stdin, a file (``--in``) or a serial
-port (``--serial PORT --baud B``, needs the ``serial`` extra). An optional first line naming
-the columns (``time,sensor``, any order, more columns allowed) is read as a header.
+port (``--serial PORT --baud B``, needs the ``serial`` extra). An optional first non-empty
+line naming the columns (``time,sensor``, any order, more columns allowed) is read as a header.
 
 Output, one line per accepted sample and flushed at once: ``time,position_estimate,flags``
 after a header line. ``time`` is echoed as received, the estimate [mm] is printed to full
@@ -125,7 +125,7 @@ def _serial_lines(port: str, baud: int) -> Iterator[str]:
 
 def _columns(fields: list[str]) -> tuple[int, int] | None:
     """Indices of time and sensor if ``fields`` is a header naming them, else None."""
-    names = [f.strip().lower() for f in fields]
+    names = [f.strip().lstrip("\ufeff").lower() for f in fields]  # a UTF-8 BOM first
     if "time" in names and "sensor" in names:
         return names.index("time"), names.index("sensor")
     return None
@@ -178,7 +178,7 @@ def _run_stream(stream: Stream, lines: Iterator[str], tally: _Tally, latency: _L
 
     dt = stream.compensator.structure.dt
     out = sys.stdout
-    columns, previous = (0, 1), None
+    columns, previous, first = (0, 1), None, True  # first: no non-empty line yet
     for line_no, line in enumerate(lines, start=1):
         arrived = time.perf_counter()
         if line is TOO_LONG:
@@ -186,9 +186,10 @@ def _run_stream(stream: Stream, lines: Iterator[str], tally: _Tally, latency: _L
             continue
         if not line.strip():
             continue
-        if line_no == 1 and (named := _columns(line.split(","))) is not None:
-            columns = named
+        if first and (named := _columns(line.split(","))) is not None:
+            columns, first = named, False
             continue
+        first = False
         parsed = _parse(line, columns)
         if isinstance(parsed, str):
             tally.add(parsed, line_no)
