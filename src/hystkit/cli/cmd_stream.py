@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, TextIO
 from ..errors import InputError
 
 if TYPE_CHECKING:
-    from ..compensation import Stream
+    from ..compensation import Stream, SyncExcitation
 
 __all__ = ["register"]
 
@@ -220,12 +220,11 @@ def _stream(args: argparse.Namespace) -> int:
     if args.serial is None and args.baud is not None:
         raise InputError("--baud is for --serial")
     comp = load_compensator(args.model)
-    start = "rest"
+    stream = Stream(comp, label=str(args.model))  # refuses the oracle centring
     if args.start == "sync":
         sync = sync_excitation(comp)
         _print_sync(sync)
-        start = sync.state_after
-    stream = Stream(comp, start, label=str(args.model))  # refuses the oracle centring
+        stream = Stream(comp, sync.state_after, label=str(args.model))
     source, lines = _lines(args)
     sys.stdout.write("time,position_estimate,flags\n")
     sys.stdout.flush()
@@ -238,14 +237,16 @@ def _stream(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_sync(sync) -> None:
+def _print_sync(sync: SyncExcitation) -> None:
     levels = ", ".join(f"{v:.6g}" for v in _user_levels(sync))
+    where = " (at the training data's offsets)" if sync.quantity == "sensor" else ""
     print(f"hystkit stream: start-up e_sync ({sync.rule}): drive the {sync.quantity} to "
-          f"{levels} {sync.unit}, holding each {sync.hold_seconds:g} s ({sync.duration:g} s in "
-          f"all); the stream starts from the state it leaves", file=sys.stderr)
+          f"{levels} {sync.unit}{where}, holding each {sync.hold_seconds:g} s "
+          f"({sync.duration:g} s in all); the stream starts from the state it leaves",
+          file=sys.stderr)
 
 
-def _user_levels(sync) -> list[float]:
+def _user_levels(sync: SyncExcitation) -> list[float]:
     n_hold = round(sync.hold_seconds / sync.dt)
     return [float(sync.signal[k * n_hold]) for k in range(len(sync.levels))]
 
