@@ -11,7 +11,7 @@ import pytest
 
 from hystkit.export import make_plan, matlab_files
 
-from .export_support import CASES, CENTRINGS, need
+from .export_support import CENTRINGS, MODE_CASES, need
 
 N_BLOCK = 300  # samples run through NAME_block (one Octave call per sample: slow)
 # The Preisach inverses bisect ~40 times a sample: 80 s per 8000 samples in Octave. Its tare
@@ -38,8 +38,7 @@ def _octave_script(folders: list, sensor_file, out_files: list, sizes: list) -> 
     return "\n".join(lines)
 
 
-@pytest.mark.parametrize("mode", ["direct", "inverse"])
-@pytest.mark.parametrize("label", [c[0] for c in CASES])
+@pytest.mark.parametrize("label, mode", MODE_CASES)
 def test_matlab_reproduces_python(label, mode, compensators, recordings, tmp_path):
     octave = need("octave")
     _, val = recordings

@@ -23,7 +23,7 @@ from types import ModuleType
 __all__ = ["REFUSALS", "TRANSLATED", "refusal", "translator"]
 
 TRANSLATED = {"mpl": "mpl", "mpl-poly": "mpl_poly", "pi": "pi", "preisach": "preisach",
-              "gpreisach": "preisach", "ladder": "ladder"}
+              "gpreisach": "preisach", "ladder": "ladder", "boucwen": "boucwen"}
 
 REFUSALS = {
     "pl": "the power-law family's block is not translated to C/MATLAB yet (its resistor is a "
@@ -31,8 +31,6 @@ REFUSALS = {
     "chua": "the Chua-Stromsmoe block (a piecewise restoring function solved per sample) is not "
             "translated to C/MATLAB yet",
     "bobbio": "the Bobbio spring-piston block is not translated to C/MATLAB yet",
-    "boucwen": "the Bouc-Wen block (a second-order ODE integrated per sample) is not "
-               "translated to C/MATLAB yet",
 }
 
 

@@ -1,0 +1,117 @@
+"""Bouc-Wen oscillator (``models/boucwen/kernels.py``): ``block_forward`` (RK4 substeps from the
+previous force sample to this one) and the start state (``model.initial_state``); no inverse.
+
+Body: ``[m, c, k, alpha, beta, gamma, nu, dt, substeps, linear]``; state ``(y, v, z, u_prev)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+HAS_INVERSE = False
+
+
+def extra(comp) -> dict:
+    """The start: ``rest`` (``y = z = 0``) or ``equilibrium`` (``y = u / K0``,
+    ``z = alpha y``)."""
+    s, p = comp.structure, comp.params
+    return {"EQUILIBRIUM": s.start != "rest", "K0": float(p.k0), "ALPHA": float(p.alpha)}
+
+
+def state_size(plan) -> int:
+    return plan.n_block_state
+
+
+def c_model(plan, lit: Callable[[float], str]) -> str:
+    e = plan.extra
+    rest = (f"const real y0 = value / {lit(e['K0'])};\n    x[0] = y0;\n    x[1] = R(0.0);\n"
+            f"    x[2] = {lit(e['ALPHA'])} * y0;" if e["EQUILIBRIUM"] else
+            "x[0] = R(0.0);\n    x[1] = R(0.0);\n    x[2] = R(0.0);")
+    return f"""/* Right-hand side (dy/dt, dv/dt, dz/dt) with the Bouc-Wen force z: kernels._rhs */
+static void rhs(real y, real v, real z, real u, real *dy, real *dv, real *dz)
+{{
+    const real m = BODY[0], c = BODY[1], k = BODY[2], alpha = BODY[3], beta = BODY[4];
+    const real gamma = BODY[5], nu = BODY[6];
+    const real p = nu == R(1.0) ? FABS(z) : EXP(nu * LOG(FABS(z)));
+    const real q = z >= R(0.0) ? p : -p;
+    *dz = alpha * v - beta * FABS(v) * q - gamma * v * p;
+    *dy = v;
+    *dv = (u - c * v - k * y - z) / m;
+}}
+
+static void model_rest(real *x, real value)
+{{
+    {rest}
+    x[3] = value;
+}}
+
+/* block_forward: RK4 substeps from the previous force sample to u (kernels.advance) */
+static real model_step(real *x, real u)
+{{
+    const int n_sub = (int)BODY[8];
+    const real h = BODY[7] / (real)n_sub, u_a = x[3];
+    const real du = BODY[9] != R(0.0) ? (u - u_a) / (real)n_sub : R(0.0);
+    real y = x[0], v = x[1], z = x[2];
+    int j;
+    for (j = 0; j < n_sub; j++) {{
+        const real u0 = u_a + (real)j * du, u1 = u0 + R(0.5) * du, u2 = u0 + du;
+        real k1y, k1v, k1z, k2y, k2v, k2z, k3y, k3v, k3z, k4y, k4v, k4z;
+        rhs(y, v, z, u0, &k1y, &k1v, &k1z);
+        rhs(y + R(0.5) * h * k1y, v + R(0.5) * h * k1v, z + R(0.5) * h * k1z, u1,
+            &k2y, &k2v, &k2z);
+        rhs(y + R(0.5) * h * k2y, v + R(0.5) * h * k2v, z + R(0.5) * h * k2z, u1,
+            &k3y, &k3v, &k3z);
+        rhs(y + h * k3y, v + h * k3v, z + h * k3z, u2, &k4y, &k4v, &k4z);
+        y += h / R(6.0) * (k1y + R(2.0) * k2y + R(2.0) * k3y + k4y);
+        v += h / R(6.0) * (k1v + R(2.0) * k2v + R(2.0) * k3v + k4v);
+        z += h / R(6.0) * (k1z + R(2.0) * k2z + R(2.0) * k3z + k4z);
+    }}
+    x[0] = y;
+    x[1] = v;
+    x[2] = z;
+    x[3] = u;
+    return y;
+}}
+"""
+
+
+def m_model(plan, lit: Callable[[float], str]) -> str:
+    e = plan.extra
+    rest = (f"y0 = value / {lit(e['K0'])};\nx = [y0; 0.0; {lit(e['ALPHA'])} * y0; value];"
+            if e["EQUILIBRIUM"] else "x = [0.0; 0.0; 0.0; value];")
+    return f"""function x = model_rest(B, value)
+{rest}
+end
+
+function [dy, dv, dz] = rhs(B, y, v, z, u)
+m = B(1); c = B(2); k = B(3); alpha = B(4); beta = B(5); gamma = B(6); nu = B(7);
+if nu == 1.0
+    p = abs(z);
+else
+    p = exp(nu * log(abs(z)));
+end
+if z >= 0.0, q = p; else, q = -p; end
+dz = alpha * v - beta * abs(v) * q - gamma * v * p;
+dy = v;
+dv = (u - c * v - k * y - z) / m;
+end
+
+function [out, x] = model_step(B, x, u)
+n_sub = fix(B(9));
+h = B(8) / n_sub; u_a = x(4);
+if B(10) ~= 0, du = (u - u_a) / n_sub; else, du = 0.0; end
+y = x(1); v = x(2); z = x(3);
+for j = 0:n_sub - 1
+    u0 = u_a + j * du; u1 = u0 + 0.5 * du; u2 = u0 + du;
+    [k1y, k1v, k1z] = rhs(B, y, v, z, u0);
+    [k2y, k2v, k2z] = rhs(B, y + 0.5 * h * k1y, v + 0.5 * h * k1v, z + 0.5 * h * k1z, u1);
+    [k3y, k3v, k3z] = rhs(B, y + 0.5 * h * k2y, v + 0.5 * h * k2v, z + 0.5 * h * k2z, u1);
+    [k4y, k4v, k4z] = rhs(B, y + h * k3y, v + h * k3v, z + h * k3z, u2);
+    y = y + h / 6.0 * (k1y + 2.0 * k2y + 2.0 * k3y + k4y);
+    v = v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+    z = z + h / 6.0 * (k1z + 2.0 * k2z + 2.0 * k3z + k4z);
+end
+x = [y; v; z; u];
+out = y;
+end
+"""
