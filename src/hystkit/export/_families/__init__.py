@@ -23,14 +23,14 @@ from types import ModuleType
 __all__ = ["REFUSALS", "TRANSLATED", "refusal", "translator"]
 
 TRANSLATED = {"mpl": "mpl", "mpl-poly": "mpl_poly", "pi": "pi", "preisach": "preisach",
-              "gpreisach": "preisach", "ladder": "ladder", "boucwen": "boucwen"}
+              "gpreisach": "preisach", "ladder": "ladder", "boucwen": "boucwen",
+              "bobbio": "bobbio"}
 
 REFUSALS = {
     "pl": "the power-law family's block is not translated to C/MATLAB yet (its resistor is a "
           "fitted basis expansion); export an mpl, mpl-poly, pi, preisach or ladder model",
     "chua": "the Chua-Stromsmoe block (a piecewise restoring function solved per sample) is not "
             "translated to C/MATLAB yet",
-    "bobbio": "the Bobbio spring-piston block is not translated to C/MATLAB yet",
 }
 
 
