@@ -1,6 +1,6 @@
 """Peak memory and wall time of reading, ``fit``, ``evaluate`` and ``compensate`` (issue 10).
 
-Run:  python benchmarks/bench_memory.py [--quick] [--fit-rows N] [--old-reader REV]
+Run:  python benchmarks/bench_memory.py [--quick] [--fit-rows N] [--old-reader REV] [--only-fit]
 
 Synthetic recordings of 0.1, 1 and 5 million rows (``--quick``: 0.1 and 1 million): a long sine
 position (10 mm, 0.05 Hz, 40 Hz sampling) through a simple hysteretic map (the sensor lags the
@@ -13,6 +13,8 @@ position by 0.3 rad and bends with a cubic term, plus 1e-4 noise), written by
 - ``fit``: ``hystkit fit --model mpl --cells 1`` (the smallest mPL, 5 parameters, exact
   Jacobian; ``--fit-rows N`` skips fits above N rows);
 - ``evaluate``/``compensate``: with an mPL 1-cell model fitted once on the 0.1 M CSV.
+
+``--only-fit`` runs only the ``fit`` rows (and their 1000-row base), at 1 and 5 million rows.
 
 Table 1 shows per command: the data's own size (rows x 3 columns x 8 bytes), wall time, peak
 RSS, and peak RSS over the data, raw and after subtracting the same command's peak on a
@@ -132,6 +134,8 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--fit-rows", type=int, default=FIT_ROWS)
     parser.add_argument("--old-reader", metavar="REV")
+    parser.add_argument("--only-fit", action="store_true",
+                        help="only the fit rows, at 1 and 5 million rows")
     args = parser.parse_args()
     started = time.perf_counter()
     print(machine())
@@ -144,6 +148,8 @@ def main() -> None:
                 ["git", "show", f"{args.old_reader}:src/hystkit/io/_recording.py"],
                 check=True, capture_output=True, text=True).stdout)
         rows = QUICK_ROWS if args.quick else ROWS
+        if args.only_fit:
+            rows = tuple(n for n in rows if n >= 1_000_000)
         files = {}
         for n in (BASE_ROWS, *rows):
             rec = recording(n)
@@ -151,8 +157,9 @@ def main() -> None:
                 files[n, suffix] = write_recording(rec, folder / f"r{n}{suffix}")
             del rec
         model = folder / "model.json"
-        measure(*hystkit_cmd("fit", files[rows[0], ".csv"], "--model", "mpl", "--cells", "1",
-                             "--out", model))
+        if not args.only_fit:
+            measure(*hystkit_cmd("fit", files[rows[0], ".csv"], "--model", "mpl", "--cells",
+                                 "1", "--out", model))
         print("Table 1. Peak RSS and wall time per command (fresh process each)")
         base: dict[tuple[str, str], float] = {}
         head = (f"  {'rows':>10}{'format':>9}{'file MB':>9}{'data MB':>9}  {'command':<14}"
@@ -162,17 +169,18 @@ def main() -> None:
             data_mb = n * 3 * 8 / 2**20
             for suffix in (".csv", ".parquet"):
                 path = files[n, suffix]
-                commands = {"read": [sys.executable, "-c", _READ, path]}
-                if old is not None:
+                commands = {} if args.only_fit else {"read": [sys.executable, "-c", _READ, path]}
+                if old is not None and not args.only_fit:
                     commands[f"read ({args.old_reader[:7]})"] = [sys.executable, "-c", _OLD_READ,
                                                                  path, old]
                 if n <= args.fit_rows:
                     commands["fit mpl 1"] = hystkit_cmd("fit", path, "--model", "mpl", "--cells",
                                                         "1", "--out", folder / "fitted.json",
                                                         "--force")
-                commands["evaluate"] = hystkit_cmd("evaluate", model, path)
-                commands["compensate"] = hystkit_cmd("compensate", model, path, "--out",
-                                                     folder / f"out{suffix}", "--force")
+                if not args.only_fit:
+                    commands["evaluate"] = hystkit_cmd("evaluate", model, path)
+                    commands["compensate"] = hystkit_cmd("compensate", model, path, "--out",
+                                                         folder / f"out{suffix}", "--force")
                 for label, argv in commands.items():
                     r = measure(*argv)
                     if n == BASE_ROWS:
@@ -183,9 +191,12 @@ def main() -> None:
                     print(f"  {n:>10,}{suffix[1:]:>9}{path.stat().st_size / 2**20:>9.1f}"
                           f"{data_mb:>9.1f}  {label:<14}{r['wall']:>8.1f}{r['rss_mb']:>9.0f}"
                           f"{r['rss_mb'] / data_mb:>10.1f}{extra:>18}", flush=True)
-        print("\nTable 2. Reading .mat in a child process vs scipy's loadmat in-process (min of 5)")
-        print(f"  {'samples':>10}{'file MB':>9}{'loadmat s':>12}{'hystkit s':>12}{'extra s':>10}")
-        print("\n".join(mat_overhead(folder)))
+        if not args.only_fit:
+            print("\nTable 2. Reading .mat in a child process vs scipy's loadmat in-process "
+                  "(min of 5)")
+            print(f"  {'samples':>10}{'file MB':>9}{'loadmat s':>12}{'hystkit s':>12}"
+                  f"{'extra s':>10}")
+            print("\n".join(mat_overhead(folder)))
     print(f"\nTotal benchmark time {time.perf_counter() - started:.0f} s")
 
 

@@ -49,7 +49,9 @@ class FitResult:
     cost : float
         Sum of squared errors (eq. 5.9) on the data as given (normalised by the caller).
     n_evaluations : int
-        Model runs over all starts (a Jacobian counts as one).
+        Model runs over all starts: with the normal-equation solvers ("tr", "lm") each run
+        yields the cost and ``J^T J``, ``J^T r`` (or the cost alone); with "trf" a residual and
+        a Jacobian evaluation count one each.
     seconds : float
         Wall time of the fit.
     converged : bool
@@ -67,8 +69,8 @@ class FitResult:
         Per coordinate and side, the note of a bound that is a limit of the model itself
         (reaching it is a property of the fitted model, not a search box hit), else None.
     sensitivity : array or None
-        Column norms of the residual's Jacobian at the optimum (how much each coordinate
-        moves the model output there).
+        Column norms of the residual's Jacobian at the optimum, ``sqrt(diag(J^T J))`` (how
+        much each coordinate moves the model output there).
     """
 
     structure: Any
