@@ -8,6 +8,8 @@ has one sample per row); the values read must equal the arrays written, bit for 
 from __future__ import annotations
 
 import re
+import shutil
+import subprocess
 
 import h5py
 import numpy as np
@@ -150,3 +152,24 @@ def test_cli_fit_reads_a_struct_by_mat_var(tmp_path, capsys):
     code = main(["fit", str(path), "--mat-var", "1run", "--out", str(tmp_path / "n.json")])
     err = capsys.readouterr().err
     assert code == 2 and "MATLAB variable name" in err
+
+
+@pytest.mark.skipif(shutil.which("octave") is None, reason="octave is not installed")
+def test_files_saved_by_octave(tmp_path):
+    # an independent writer of MATLAB files: a struct and an N x 3 matrix saved with -v7
+    path = tmp_path / "oct.mat"
+    script = ("t = (0:199)' / 100; s.time = t; s.position = sin(2*pi*t); "
+              "s.sensor = cos(2*pi*t); M = [t, s.position, s.sensor]; "
+              f"save('-v7', '{path}', 's', 'M');")
+    subprocess.run(["octave", "--no-gui", "--quiet", "--eval", script], capture_output=True,
+                   timeout=120, check=False)
+    assert path.exists()
+    for var in ("s", "M"):
+        rec = read_recording(path, options=ReadOptions(mat_var=var))
+        assert_array_equal(rec.time, T)  # (0:199)/100: the same IEEE divisions
+        # Octave's and numpy's sin/cos may differ by an ulp
+        np.testing.assert_allclose(rec.position, np.sin(2 * np.pi * T), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(rec.sensor, np.cos(2 * np.pi * T), rtol=0, atol=1e-15)
+    text = _message(path)
+    assert "'s' (struct with fields time, position, sensor)" in text
+    assert "'M' (double 200x3)" in text

@@ -76,7 +76,8 @@ def _fit(args: argparse.Namespace) -> int:
     shown = "".join(f", {name} {value:g}" for name, value in options.items())
     print(f"fitting {args.model} ({family.size_help}: {size}{shown}, {args.mode} mode, centring: "
           f"{center_label(args.center)}) on {', '.join(map(str, args.data))}: "
-          f"{sum(r.n_samples for r in recs)} samples at {recs[0].fs:g} Hz ...", flush=True)
+          f"{sum(r.n_samples for r in recs)} samples at {recs[0].fs:g} Hz"
+          f"{_units_label(recs[0])} ...", flush=True)
     comp = fit_compensator(recs, size, model=args.model, mode=args.mode, center=args.center,
                            tare_seconds=args.tare_seconds, track_seconds=args.track_seconds,
                            **options)
@@ -103,6 +104,12 @@ def _fit(args: argparse.Namespace) -> int:
         return GUARD_EXIT
     print(f"  status: ok ({info['status_message']})")
     return 0
+
+
+def _units_label(rec) -> str:
+    """`` (position [mm], sensor [Ohm])`` when the file gave units, else ""."""
+    shown = ", ".join(f"{name} [{unit}]" for name, unit in rec.units)
+    return f" ({shown})" if shown else ""
 
 
 def _pl_options(args: argparse.Namespace, family) -> dict:
