@@ -64,3 +64,18 @@ def test_names_and_limits_need_one_entry_per_coordinate():
         _fit(names=["a", "b"])
     with pytest.raises(ValueError, match="one entry per coordinate"):
         _fit(limits=([None] * 3, [None] * 2))
+
+
+def test_an_unknown_solver_is_refused():
+    with pytest.raises(ValueError, match="solver must be one of"):
+        _fit(solver="newton")
+
+
+@pytest.mark.parametrize("solver", ["tr", "lm", "trf"])
+def test_every_solver_finds_the_box_optimum(solver):
+    result = _fit(names=["a", "b", "c"], solver=solver)
+    assert result.converged, result.message
+    assert_allclose(result.theta, [0.3, 1.0, -1.0], atol=1e-6)
+    # cost of the clipped target: (5 - 1)^2 + (-4 + 1)^2 = 25, to the bounds' margin
+    assert_allclose(result.cost, 25.0, rtol=1e-6)
+    assert_allclose(result.sensitivity, np.ones(3), rtol=1e-6)  # J = I

@@ -81,3 +81,15 @@ def test_mpl_poly_one_pass_rejects_a_diverging_run():
     u = 3 * _input(500, 0)
     assert not np.all(np.isfinite(mpl_poly.simulate_with_jacobian(structure, params, u)[0]))
     assert normal_equations(structure, params, u, u).cost == np.inf
+
+
+def test_mpl_fit_sensitivity_is_the_dense_column_norms():
+    """FitResult.sensitivity comes from diag(J^T J): the column norms of the dense Jacobian."""
+    structure = mpl.MplStructure(n_cells=2, dt=0.025)
+    u = _input(2000, 3)
+    result = mpl.fit_mpl(u, np.tanh(2 * np.roll(u, 4)), structure)
+    p = result.params
+    _, jac = mpl_kernels.simulate_with_jacobian(
+        u, np.full(2, u[0]), p.i_s, p.v_t, p.w, p.v_b, mpl.knee_voltage(structure, p),
+        structure.slope_cap / structure.dt, structure.dt)
+    assert_allclose(result.sensitivity, np.linalg.norm(jac, axis=0), rtol=1e-10)
