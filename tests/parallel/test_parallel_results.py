@@ -9,9 +9,15 @@ from __future__ import annotations
 import json
 
 from hystkit.cli._main import main
+from hystkit.compensation import DEFAULT_CENTER
 from hystkit.models.pl import structural_search
 from hystkit.parallel import open_executor
-from hystkit.reports import candidates, compare_models, generalization_matrix, select_model
+from hystkit.reports import (
+    Candidate,
+    compare_models,
+    generalization_matrix,
+    select_model,
+)
 
 TIMES = {"fit_seconds", "seconds"}
 
@@ -49,7 +55,9 @@ def test_generalize_on_the_cluster_equals_the_serial_run(cluster_address, short_
 
 
 def test_select_on_the_cluster_equals_the_serial_run(cluster_address, short_pair):
-    cands = candidates(["mpl", "pi"], extra_sizes={})
+    # fast candidates; mpl:1:inverse fails in one fold (its inverse diverges): an error row
+    cands = [Candidate("mpl", 1, mode, DEFAULT_CENTER) for mode in ("direct", "inverse")]
+    cands.append(Candidate("bobbio", 10, "direct", DEFAULT_CENTER))
     serial = select_model([short_pair[0]], cands)
     with open_executor(scheduler=cluster_address) as executor:
         parallel = select_model([short_pair[0]], cands, executor=executor)
@@ -57,6 +65,7 @@ def test_select_on_the_cluster_equals_the_serial_run(cluster_address, short_pair
     assert parallel["winner"]["candidate"] == serial["winner"]["candidate"]
     assert parallel["compensator"].params == serial["compensator"].params
     assert len(serial["ranking"]) == len(cands)
+    assert [r["candidate"] for r in serial["ranking"] if "error" in r] == ["mpl:1:inverse:fit"]
 
 
 def test_pl_search_on_the_cluster_equals_the_serial_run(cluster_address, short_pair):
@@ -87,3 +96,19 @@ def test_compare_cli_with_scheduler_writes_the_serial_table(cluster_address, sho
 def test_workers_and_scheduler_exclude_each_other(capsys):
     assert main(["compare", "a.csv", "b.csv", "--workers", "2", "--scheduler", "x"]) == 2
     assert "not allowed with argument" in capsys.readouterr().err
+
+
+def test_batch_on_the_cluster_equals_the_serial_run(cluster_address, short_pair, tmp_path):
+    from hystkit.batch import read_manifest, run_batch
+    from hystkit.io import write_recording
+
+    for name, rec in zip(("a", "b"), short_pair):
+        write_recording(rec, tmp_path / f"{name}.csv")
+    (tmp_path / "m.csv").write_text("sensor,fit,validate,size\nab,a.csv,b.csv,1\n"
+                                    "ba,b.csv,a.csv,1\nbroken,missing.csv,a.csv,1\n")
+    jobs = read_manifest(tmp_path / "m.csv", {})
+    serial = run_batch(jobs, tmp_path / "serial")
+    with open_executor(scheduler=cluster_address) as executor:
+        parallel = run_batch(jobs, tmp_path / "dask", executor=executor)
+    assert [r["status"] for r in parallel] == ["ok", "ok", "failed"]
+    assert _untimed(parallel) == _untimed(serial)

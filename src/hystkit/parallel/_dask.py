@@ -89,7 +89,8 @@ class DaskExecutor:
     def map(self, func: Callable[..., Any], items: Sequence[Any], *,
             shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None) -> list:
         # Shared inputs (recordings) travel to each worker once, not with every piece.
-        sent = {key: self.client.scatter(value, broadcast=True, hash=False)
+        sent = {key: value if value is None else self.client.scatter(value, broadcast=True,
+                                                                     hash=False)
                 for key, value in (shared or {}).items()}
         run = uuid.uuid4().hex[:8]
         futures = [self.client.submit(func, item, **sent, pure=False,
