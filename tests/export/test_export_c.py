@@ -29,8 +29,12 @@ from .export_support import (
 
 # Float builds off by more than 1e-4 of the range although the export's probe (the chirp)
 # found the model well conditioned: the probe misses them (a known gap, reported).
-KNOWN_FLOAT_MISSES = {("pi", "inverse", "track"): "the probe measured 1.7e-6 on the chirp, "
-                                                  "the validation recording amplifies more"}
+KNOWN_FLOAT_MISSES = {
+    ("pi", "inverse", "track"): "the probe measured 1.7e-6 on the chirp, the validation "
+                                "recording amplifies more",
+    # the inverse divides the output change by dt and solves the dissipation for it
+    ("chua", "inverse", "tare"): "the probe passed it; float rounding of (y - sum x) / dt",
+    ("chua", "inverse", "track"): "the probe passed it; float rounding of (y - sum x) / dt"}
 
 _HARNESS = """#include <stdio.h>
 #include <stdlib.h>
@@ -182,7 +186,7 @@ def test_existing_folder_needs_force(compensators, tmp_path, capsys):
                                                      "m.c", "m.h"]
 
 
-@pytest.mark.parametrize("model, mode", [("pl", "direct"), ("chua", "inverse")])
+@pytest.mark.parametrize("model, mode", [("pl", "direct"), ("pl", "inverse")])
 def test_untranslated_family_is_refused_with_its_reason(model, mode, recordings, tmp_path,
                                                         capsys):
     train, val = recordings

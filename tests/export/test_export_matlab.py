@@ -19,6 +19,9 @@ N_BLOCK = 300  # samples run through NAME_block (one Octave call per sample: slo
 # hold the whole tare window and the tracker's start; fit runs the whole recording.
 N_SAMPLES = {(family, "inverse", center): 1000 for family in ("preisach", "gpreisach")
              for center in ("tare", "track")}
+# The Chua inverse bisects twice a sample (~100 evaluations of every element): its MATLAB run
+# (an addition beyond the families) is checked on the first 1500 samples.
+N_SAMPLES.update({("chua", "inverse", center): 1500 for center in CENTRINGS})
 
 
 def _octave_script(folders: list, sensor_file, out_files: list, sizes: list) -> str:

@@ -25,7 +25,8 @@ COMPILE_LINE = "cc -O2 -std=c99 *.c -lm -o estimate"
 
 _MATH = {  # macro -> (double, float) function of math.h
     "FABS": ("fabs", "fabsf"), "SINH": ("sinh", "sinhf"), "COSH": ("cosh", "coshf"),
-    "EXP": ("exp", "expf"), "LOG": ("log", "logf"), "SQRT": ("sqrt", "sqrtf"), "FLOOR": ("floor", "floorf"),
+    "EXP": ("exp", "expf"), "LOG": ("log", "logf"), "TANH": ("tanh", "tanhf"),
+    "ASINH": ("asinh", "asinhf"), "SQRT": ("sqrt", "sqrtf"), "FLOOR": ("floor", "floorf"),
 }
 
 

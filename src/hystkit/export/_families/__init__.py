@@ -24,13 +24,11 @@ __all__ = ["REFUSALS", "TRANSLATED", "refusal", "translator"]
 
 TRANSLATED = {"mpl": "mpl", "mpl-poly": "mpl_poly", "pi": "pi", "preisach": "preisach",
               "gpreisach": "preisach", "ladder": "ladder", "boucwen": "boucwen",
-              "bobbio": "bobbio"}
+              "bobbio": "bobbio", "chua": "chua"}
 
 REFUSALS = {
     "pl": "the power-law family's block is not translated to C/MATLAB yet (its resistor is a "
           "fitted basis expansion); export an mpl, mpl-poly, pi, preisach or ladder model",
-    "chua": "the Chua-Stromsmoe block (a piecewise restoring function solved per sample) is not "
-            "translated to C/MATLAB yet",
 }
 
 

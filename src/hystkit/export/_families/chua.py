@@ -1,0 +1,293 @@
+"""Chua-Stromsmoe model (``models/chua/kernels.py``): ``block_forward`` / ``block_inverse``
+(bisection on the input) and the rest state (``model.rest_state``: ``f_k^-1`` by bisection).
+
+Body: ``[N, dt, k0 (N), k_inf (N), y_s (N), g (N), v_g (N), delta (N), knee (N), cap (N)]``;
+state: the element outputs ``y_k``.
+
+One addition to the kernels: every bisection also stops when the midpoint no longer lies
+strictly inside the bracket. In double the kernels' relative tolerances end the loops long
+before (the numbers do not change); in float they are below the resolution and would not.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+HAS_INVERSE = True
+
+
+def extra(comp) -> dict:
+    """The bracket of ``kernels.rest_input``: ``max(max(k0, k_inf))``,
+    ``max(|k0 - k_inf| y_s)``."""
+    p = comp.params
+    return {"MAX_K": float(np.max(np.maximum(p.k0, p.k_inf))),
+            "MAX_SPREAD": float(np.max(np.abs(p.k0 - p.k_inf) * p.y_s))}
+
+
+def state_size(plan) -> int:
+    return plan.n_block_state
+
+
+def c_model(plan, lit: Callable[[float], str]) -> str:
+    n = int(plan.body[0])
+    e = plan.extra
+    value = ("rest_input(value)" if plan.inverse else "value")
+    rest_input = f"""
+/* The common input whose rest states sum to y0 (increasing): kernels.rest_input */
+static real rest_input(real y0)
+{{
+    const real span = (FABS(y0) + R(1.0)) * {lit(e['MAX_K'])} + {lit(e['MAX_SPREAD'])};
+    real lo = -span * (real)N_EL, hi = span * (real)N_EL;
+    while (hi - lo > R(1e-16) * (R(1.0) + FABS(lo) + FABS(hi))) {{
+        const real mid = R(0.5) * (lo + hi);
+        real total = R(0.0);
+        int k;
+        if (mid <= lo || mid >= hi) break;
+        for (k = 0; k < N_EL; k++) total += restoring_inverse(mid, k);
+        if (total >= y0) hi = mid;
+        else lo = mid;
+    }}
+    return R(0.5) * (lo + hi);
+}}
+""" if plan.inverse else ""
+    step = _C_INVERSE if plan.inverse else _C_FORWARD
+    return f"""#define N_EL {n}
+#define P(i, k) BODY[2 + (i) * N_EL + (k)]  /* parameter i of element k */
+
+/* Restoring function f: odd, slope k0 at 0 and k_inf far out */
+static real restoring(real y, int k)
+{{
+    return P(1, k) * y + (P(0, k) - P(1, k)) * P(2, k) * TANH(y / P(2, k));
+}}
+
+/* f_k^-1(u) by bisection: kernels.restoring_inverse */
+static real restoring_inverse(real u, int k)
+{{
+    const real spread = FABS(P(0, k) - P(1, k)) * P(2, k);
+    real lo = (u - spread) / P(1, k), hi = (u + spread) / P(1, k);
+    while (hi - lo > R(1e-16) * (R(1.0) + FABS(lo) + FABS(hi))) {{
+        const real mid = R(0.5) * (lo + hi);
+        if (mid <= lo || mid >= hi) break;
+        if (restoring(mid, k) >= u) hi = mid;
+        else lo = mid;
+    }}
+    return R(0.5) * (lo + hi);
+}}
+
+/* Limited dissipation function g: dead band, sinh, straight line of slope cap */
+static real dissipation(real v, int k)
+{{
+    const real g = P(3, k), v_g = P(4, k), band = P(5, k), knee = P(6, k), cap = P(7, k);
+    const real a = FABS(v);
+    real s;
+    if (a <= band) return R(0.0);
+    s = v > R(0.0) ? R(1.0) : R(-1.0);
+    if (a <= knee) return s * g * v_g * SINH((a - band) / v_g);
+    return s * (g * v_g * SINH((knee - band) / v_g) + cap * (a - knee));
+}}
+{rest_input}
+static void model_rest(real *x, real value)
+{{
+    const real u = {value};
+    int k;
+    for (k = 0; k < N_EL; k++) x[k] = restoring_inverse(u, k);
+}}
+{step}"""
+
+
+_C_FORWARD = """
+/* block_forward: Euler step of every element driven by u; the output is the sum of the new
+   states (kernels.advance) */
+static real model_step(real *x, real u)
+{
+    real acc = R(0.0);
+    int k;
+    for (k = 0; k < N_EL; k++) {
+        const real v = u - restoring(x[k], k);
+        x[k] = x[k] + BODY[1] * dissipation(v, k);
+        acc += x[k];
+    }
+    return acc;
+}
+"""
+
+_C_INVERSE = """
+/* Smallest (upper 0) or largest v with g(v) = r: kernels._dissipation_inverse */
+static real dissipation_inverse(real r, int k, int upper)
+{
+    const real g = P(3, k), v_g = P(4, k), band = P(5, k), knee = P(6, k), cap = P(7, k);
+    real s, a, g_knee;
+    if (r == R(0.0)) return upper ? band : -band;
+    s = r > R(0.0) ? R(1.0) : R(-1.0);
+    a = FABS(r);
+    g_knee = g * v_g * SINH((knee - band) / v_g);
+    if (a <= g_knee) return s * (band + v_g * ASINH(a / (g * v_g)));
+    return s * (knee + (a - g_knee) / cap);
+}
+
+/* block_inverse: the input u with sum_k g_k(u - f_k(x_k)) = (y - sum x) / dt by bisection
+   (kernels.solve_input), then the Euler step it gives (kernels.invert_sample) */
+static real model_step(real *x, real y)
+{
+    real fx[N_EL], total = R(0.0), r, lo = (real)HUGE_VAL, hi = -(real)HUGE_VAL, ends[2], e;
+    int k, side;
+    for (k = 0; k < N_EL; k++) {
+        fx[k] = restoring(x[k], k);
+        total += x[k];
+    }
+    r = (y - total) / BODY[1];
+    for (k = 0; k < N_EL; k++) {
+        const real l = fx[k] + dissipation_inverse(r / (real)N_EL, k, 0);
+        const real h = fx[k] + dissipation_inverse(r / (real)N_EL, k, 1);
+        if (l < lo) lo = l;
+        if (h > hi) hi = h;
+    }
+    for (side = 0; side < 2; side++) {
+        real a = lo, b = hi;
+        while (b - a > R(1e-14) * (R(1.0) + FABS(a) + FABS(b))) {
+            const real m = R(0.5) * (a + b);
+            real rate = R(0.0);
+            if (m <= a || m >= b) break;
+            for (k = 0; k < N_EL; k++) rate += dissipation(m - fx[k], k);
+            if (rate > r || (side == 0 && rate == r)) b = m;
+            else a = m;
+        }
+        ends[side] = side == 0 ? b : a;
+    }
+    e = R(0.5) * (ends[0] + ends[1]);
+    for (k = 0; k < N_EL; k++) x[k] = x[k] + BODY[1] * dissipation(e - fx[k], k);
+    return e;
+}
+"""
+
+
+def m_model(plan, lit: Callable[[float], str]) -> str:
+    e = plan.extra
+    value = "rest_input(B, value)" if plan.inverse else "value"
+    step = (_M_INVERSE.replace("@MAXK@", lit(e["MAX_K"])).replace("@MAXS@",
+                                                                   lit(e["MAX_SPREAD"]))
+            if plan.inverse else _M_FORWARD)
+    return f"""function x = model_rest(B, value)
+u = {value};
+n = round(B(1));
+x = zeros(n, 1);
+for k = 1:n
+    x(k) = restoring_inverse(B, u, k);
+end
+end
+
+function v = P(B, i, k)
+v = B(3 + i * round(B(1)) + k - 1);
+end
+
+function f = restoring(B, y, k)
+f = P(B, 1, k) * y + (P(B, 0, k) - P(B, 1, k)) * P(B, 2, k) * tanh(y / P(B, 2, k));
+end
+
+function y = restoring_inverse(B, u, k)
+spread = abs(P(B, 0, k) - P(B, 1, k)) * P(B, 2, k);
+lo = (u - spread) / P(B, 1, k); hi = (u + spread) / P(B, 1, k);
+while hi - lo > 1e-16 * (1.0 + abs(lo) + abs(hi))
+    mid = 0.5 * (lo + hi);
+    if mid <= lo || mid >= hi, break; end
+    if restoring(B, mid, k) >= u, hi = mid; else, lo = mid; end
+end
+y = 0.5 * (lo + hi);
+end
+
+function d = dissipation(B, v, k)
+g = P(B, 3, k); v_g = P(B, 4, k); band = P(B, 5, k); knee = P(B, 6, k); cap = P(B, 7, k);
+a = abs(v);
+if a <= band
+    d = 0.0;
+    return;
+end
+if v > 0, s = 1.0; else, s = -1.0; end
+if a <= knee
+    d = s * g * v_g * sinh((a - band) / v_g);
+else
+    d = s * (g * v_g * sinh((knee - band) / v_g) + cap * (a - knee));
+end
+end
+{step}"""
+
+
+_M_FORWARD = """
+function [acc, x] = model_step(B, x, u)
+acc = 0.0;
+for k = 1:round(B(1))
+    v = u - restoring(B, x(k), k);
+    x(k) = x(k) + B(2) * dissipation(B, v, k);
+    acc = acc + x(k);
+end
+end
+"""
+
+_M_INVERSE = """
+function u = rest_input(B, y0)
+n = round(B(1));
+span = (abs(y0) + 1.0) * @MAXK@ + @MAXS@;
+lo = -span * n; hi = span * n;
+while hi - lo > 1e-16 * (1.0 + abs(lo) + abs(hi))
+    mid = 0.5 * (lo + hi);
+    if mid <= lo || mid >= hi, break; end
+    total = 0.0;
+    for k = 1:n
+        total = total + restoring_inverse(B, mid, k);
+    end
+    if total >= y0, hi = mid; else, lo = mid; end
+end
+u = 0.5 * (lo + hi);
+end
+
+function v = dissipation_inverse(B, r, k, upper)
+g = P(B, 3, k); v_g = P(B, 4, k); band = P(B, 5, k); knee = P(B, 6, k); cap = P(B, 7, k);
+if r == 0
+    if upper, v = band; else, v = -band; end
+    return;
+end
+if r > 0, s = 1.0; else, s = -1.0; end
+a = abs(r);
+g_knee = g * v_g * sinh((knee - band) / v_g);
+if a <= g_knee
+    v = s * (band + v_g * asinh(a / (g * v_g)));
+else
+    v = s * (knee + (a - g_knee) / cap);
+end
+end
+
+function [e, x] = model_step(B, x, y)
+n = round(B(1)); dt = B(2);
+fx = zeros(n, 1); total = 0.0;
+for k = 1:n
+    fx(k) = restoring(B, x(k), k);
+    total = total + x(k);
+end
+r = (y - total) / dt;
+lo = Inf; hi = -Inf;
+for k = 1:n
+    lo = min(lo, fx(k) + dissipation_inverse(B, r / n, k, false));
+    hi = max(hi, fx(k) + dissipation_inverse(B, r / n, k, true));
+end
+ends = [0.0, 0.0];
+for side = 0:1
+    a = lo; b = hi;
+    while b - a > 1e-14 * (1.0 + abs(a) + abs(b))
+        m = 0.5 * (a + b);
+        if m <= a || m >= b, break; end
+        rate = 0.0;
+        for k = 1:n
+            rate = rate + dissipation(B, m - fx(k), k);
+        end
+        if rate > r || (side == 0 && rate == r), b = m; else, a = m; end
+    end
+    if side == 0, ends(1) = b; else, ends(2) = a; end
+end
+e = 0.5 * (ends(1) + ends(2));
+for k = 1:n
+    x(k) = x(k) + dt * dissipation(B, e - fx(k), k);
+end
+end
+"""
