@@ -23,7 +23,7 @@ from hystkit.models import get_family
 CASES = [("mpl1", "mpl", 1), ("mpl3", "mpl", 3), ("mpl-poly", "mpl-poly", 1), ("pi", "pi", 6),
          ("preisach", "preisach", 12), ("gpreisach", "gpreisach", 10), ("ladder", "ladder", 3),
          ("boucwen", "boucwen", 1), ("bobbio", "bobbio", 6),
-         ("chua", "chua", 2)]
+         ("chua", "chua", 2), ("pl", "pl", 2)]
 # (label, mode) pairs: inverse only where the family has one.
 MODE_CASES = [(label, mode) for label, model, _ in CASES for mode in ("direct", "inverse")
               if mode == "direct" or get_family(model).invert is not None]

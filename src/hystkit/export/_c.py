@@ -25,7 +25,7 @@ COMPILE_LINE = "cc -O2 -std=c99 *.c -lm -o estimate"
 
 _MATH = {  # macro -> (double, float) function of math.h
     "FABS": ("fabs", "fabsf"), "SINH": ("sinh", "sinhf"), "COSH": ("cosh", "coshf"),
-    "EXP": ("exp", "expf"), "LOG": ("log", "logf"), "TANH": ("tanh", "tanhf"),
+    "EXP": ("exp", "expf"), "LOG": ("log", "logf"), "TANH": ("tanh", "tanhf"), "POW": ("pow", "powf"),
     "ASINH": ("asinh", "asinhf"), "SQRT": ("sqrt", "sqrtf"), "FLOOR": ("floor", "floorf"),
 }
 
@@ -59,6 +59,13 @@ def float_warning(plan: ExportPlan) -> str:
     return (f"float is not enough for this model: rounding its input to float moves its output "
             f"by {plan.float_sensitivity:.2g} of its range (weights that nearly cancel); "
             f"export with --double")
+
+
+def _float_note(plan: ExportPlan) -> str:
+    if plan.float_sensitivity != plan.float_sensitivity:  # NaN: the probe could not run
+        return ("Float check: not possible (the model leaves the finite range on the probe "
+                "chirp even in double); compare with --double on your data.\n")
+    return ""
 
 
 def _comment(plan: ExportPlan, what: str, double: bool) -> str:
@@ -262,7 +269,7 @@ def _readme(plan: ExportPlan, double: bool) -> str:
 Model: {p['family']}, {p['mode']}, centring {p['center']}
 From:  {p['source']} (fit date: {p['fit_date']})
 Arithmetic: {'double' if double else 'float'}; state: {plan.n_state} numbers.
-{'' if double or plan.float_is_enough else 'WARNING: ' + float_warning(plan) + chr(10)}
+{_float_note(plan) if not double else ''}{'' if double or plan.float_is_enough else 'WARNING: ' + float_warning(plan) + chr(10)}
 Build and run the example (one sensor value per line in, one estimate [mm] per line out):
 
     {COMPILE_LINE}

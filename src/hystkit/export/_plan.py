@@ -84,8 +84,9 @@ class ExportPlan:
 
     @property
     def float_is_enough(self) -> bool:
-        """Whether single precision can follow the model (see :func:`float_sensitivity`)."""
-        return self.float_sensitivity <= FLOAT_SENSITIVITY_LIMIT
+        """Whether single precision can follow the model (see :func:`float_sensitivity`); also
+        True when the probe could not run (NaN), which the generated README says."""
+        return not self.float_sensitivity > FLOAT_SENSITIVITY_LIMIT
 
     @property
     def inverse(self) -> bool:
@@ -154,7 +155,9 @@ def float_sensitivity(comp: Compensator) -> float:
     its parameters, input, state and output rounded to float32 at every sample (what a float
     export stores). A well-conditioned model moves by ~1e-7 of its range; one whose weights
     nearly cancel amplifies rounding by orders of magnitude, and then no float implementation
-    can follow the double reference. ``inf`` when the model leaves the finite range.
+    can follow the double reference. ``inf`` when only the float run leaves the finite
+    range; NaN when the double run does too (the model is unstable on the probe itself, so the
+    probe says nothing).
     """
     from ..signals import exponential_chirp
 
@@ -174,6 +177,8 @@ def float_sensitivity(comp: Compensator) -> float:
                 out[k] = dtype(block.step(body, x, xn, 0, u))
                 x = xn.astype(dtype).astype(np.float64)
         runs.append(out)
+    if not np.all(np.isfinite(runs[0])):
+        return float("nan")
     with np.errstate(all="ignore"):
         change = float(np.max(np.abs(runs[1] - runs[0])) / max(float(np.ptp(runs[0])), 1e-300))
     return change if np.isfinite(change) else float("inf")

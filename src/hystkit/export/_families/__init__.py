@@ -24,12 +24,9 @@ __all__ = ["REFUSALS", "TRANSLATED", "refusal", "translator"]
 
 TRANSLATED = {"mpl": "mpl", "mpl-poly": "mpl_poly", "pi": "pi", "preisach": "preisach",
               "gpreisach": "preisach", "ladder": "ladder", "boucwen": "boucwen",
-              "bobbio": "bobbio", "chua": "chua"}
+              "bobbio": "bobbio", "chua": "chua", "pl": "pl"}
 
-REFUSALS = {
-    "pl": "the power-law family's block is not translated to C/MATLAB yet (its resistor is a "
-          "fitted basis expansion); export an mpl, mpl-poly, pi, preisach or ladder model",
-}
+REFUSALS: dict[str, str] = {}  # every registered family is translated
 
 
 def translator(model: str) -> ModuleType | None:
