@@ -80,3 +80,22 @@ def test_a_missing_input_is_refused_before_any_heavy_import():
             "else:\n"
             "    raise AssertionError('no error')")
     assert _loaded_after(code) == []
+
+
+def test_every_subcommand_help_loads_at_most_numpy():
+    """A subcommand's help computes its option values (families, centring modes, modes, ...)
+    from light modules only: no numba, scipy, pandas or matplotlib before the work starts."""
+    # Not yet: control and pl-search take their defaults from the control package and the PL
+    # search module, which load numba kernels (their constants need a light module first).
+    commands = ("batch", "compare", "compensate", "datasets", "demo", "evaluate", "export",
+                "fit", "generalize", "preprocess", "report", "select", "simulate-sensor",
+                "stability", "stream")
+    for command in commands:
+        code = ("from hystkit.cli._main import main\n"
+                "import contextlib, io\n"
+                "with contextlib.redirect_stdout(io.StringIO()):\n"
+                "    try:\n"
+                f"        main([{command!r}, '--help'])\n"
+                "    except SystemExit:\n"
+                "        pass")
+        assert set(_loaded_after(code)) <= {"numpy"}, command

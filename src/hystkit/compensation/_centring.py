@@ -23,7 +23,6 @@ in the model file only.
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import lfilter
 
 __all__ = ["CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",
            "DEPLOYABLE_CENTERS", "ORACLE_CENTER", "center_label", "sensor_level"]
@@ -58,6 +57,8 @@ def sensor_level(center: str, sensor: np.ndarray, dt: float, *, tare_seconds: fl
     if center == "track":
         # Exponentially weighted mean normalised by its weight sum: the running mean while
         # fewer than ~track_seconds have passed, a first-order low-pass afterwards.
+        from scipy.signal import lfilter  # here: scipy.signal costs ~0.7 s to import
+
         a = 1.0 - np.exp(-dt / track_seconds)
         b, den = [a], [1.0, a - 1.0]
         return lfilter(b, den, s) / lfilter(b, den, np.ones_like(s))

@@ -33,11 +33,11 @@ from ._centring import (
     sensor_level,
 )
 from ._conventions import LinearBaseline, Scaling
+from ._modes import MODES
 
 __all__ = ["MAX_NORMALISED", "MODES", "POSITION_MARGIN", "SENSOR_MARGIN", "Compensator",
            "LinearBaseline", "Scaling"]
 
-MODES = ("direct", "inverse")
 # Use-time guards: a sensor sample is "outside" beyond this share of the training sensor range
 # on either side, an estimate beyond this share of the training position range.
 SENSOR_MARGIN = 0.05

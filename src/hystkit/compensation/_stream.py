@@ -28,7 +28,6 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-from scipy.signal import lfilter
 
 from ..errors import FitDivergedError, InputError
 from ._centring import ORACLE_CENTER
@@ -233,6 +232,8 @@ def _sensor_offset(path: _Path, state: StreamState,
     else:  # track
         a = path.track_gain
         b, den = [a], [1.0, a - 1.0]
+        from scipy.signal import lfilter  # here: scipy.signal costs ~0.7 s to import
+
         # lfilter's delay after an output y is -(a - 1) y: continue from the stored outputs.
         value, _ = lfilter(b, den, s, zi=[-(den[1] * state.track_value)])
         weight, _ = lfilter(b, den, np.ones_like(s), zi=[-(den[1] * state.track_weight)])

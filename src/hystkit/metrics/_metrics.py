@@ -6,8 +6,6 @@ import math
 
 import numpy as np
 import numpy.typing as npt
-from scipy.integrate import trapezoid
-from scipy.signal import periodogram
 
 # Kaiser beta of MATLAB's ``sinad``: its side lobes (~ -350 dB) sit below double
 # precision, so no leakage escapes the main lobes of the DC and the fundamental.
@@ -151,6 +149,8 @@ def sinad_db(x: npt.ArrayLike, fs: float = 1.0) -> float:
     if n_bins <= 3 * h + 2:  # DC lobe + a full fundamental lobe + at least one noise bin
         raise ValueError(f"x has {sig.size} samples; sinad_db needs at least {6 * h + 4}")
     # detrend=False: MATLAB removes nothing by hand; the DC lobe is excluded below instead.
+    from scipy.signal import periodogram  # here: scipy.signal costs ~0.7 s to import
+
     _, pxx = periodogram(sig, fs=fs, window=("kaiser", _KAISER_BETA), detrend=False)
     rest = np.ones(n_bins, dtype=bool)
     rest[: h + 1] = False  # DC main lobe
@@ -230,4 +230,6 @@ def loop_area(x: npt.ArrayLike, y: npt.ArrayLike) -> float:
     x_hat = (xs - xs.min()) / x_rng
     y_hat = (ys - ys.min()) / y_rng
     n_cycles = max(1.0, _sweep_total(x_hat, _REVERSAL_DEADBAND) / 2.0)
+    from scipy.integrate import trapezoid
+
     return 100.0 / n_cycles * float(trapezoid(y_hat, x_hat))  # eq. 5.15

@@ -6,7 +6,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import optimize, signal
 
 __all__ = [
     "EXPERIMENTS",
@@ -39,6 +38,8 @@ def decaying_sine(t: np.ndarray, frequency: float = 0.5, start_amplitude: float 
 def exponential_chirp(t: np.ndarray, f0: float = 0.1, f1: float = 3.0, duration: float = 100.0,
                       amplitude: float = 3.0) -> np.ndarray:
     """Sine sweep whose frequency rises exponentially from ``f0`` to ``f1`` over ``duration``."""
+    from scipy import signal  # here, not at the top: listing the experiments stays light
+
     return amplitude * signal.chirp(np.asarray(t, dtype=float), f0=f0, t1=duration, f1=f1,
                                     method="logarithmic", phi=-90)
 
@@ -49,6 +50,8 @@ def _fir_lowpass(fs: float, cutoff_3db: float, numtaps: int) -> np.ndarray:
     ``firwin``'s cut-off is the -6 dB point, so the design cut-off is solved for the stated
     -3 dB point, as the document specifies its filter by it.
     """
+    from scipy import optimize, signal
+
     def gain_error(fc: float) -> float:
         taps = signal.firwin(numtaps, fc, fs=fs)
         _, h = signal.freqz(taps, worN=[cutoff_3db], fs=fs)
@@ -65,6 +68,8 @@ def filtered_noise(t: np.ndarray, seed: int, cutoff: float = 4.0, order: int = 5
     Scaled so that max |x| equals ``amplitude``. The filter's start-up transient is discarded by
     generating ``order`` extra samples first.
     """
+    from scipy import signal
+
     t = np.asarray(t, dtype=float)
     fs = 1.0 / np.median(np.diff(t))
     taps = _fir_lowpass(fs, cutoff, order + 1)
