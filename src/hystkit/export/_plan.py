@@ -37,7 +37,17 @@ FLOAT_SENSITIVITY_LIMIT = 1e-5
 C_KEYWORDS = frozenset(
     ["auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else", "enum", "extern", "float", "for", "goto", "if", "inline", "int", "long", "register", "restrict", "return", "short", "signed", "sizeof", "static", "struct", "switch", "typedef", "union", "unsigned", "void", "volatile", "while", "main"])
 # Names the MATLAB/Octave side would shadow (functions a generated file calls).
-_MATLAB_TAKEN = frozenset(["abs", "sinh", "cosh", "exp", "max", "min", "floor", "sum", "zeros", "numel", "isempty", "end"])
+_MATLAB_TAKEN = frozenset([
+    "abs", "sinh", "cosh", "exp", "log", "tanh", "asinh", "max", "min", "fix", "round", "sum",
+    "zeros", "ones", "numel", "isempty", "isfinite", "struct", "end",
+    # subfunctions of the generated files: a main function of the same name would shadow them
+    "body", "normalised", "model_step", "model_rest", "model_load", "layout", "superposition",
+    "move", "current", "mpl_current", "dead_zone", "cubic", "cells", "solve_output", "everett",
+    "term", "load_sums", "make_room", "update", "combine", "last_index", "running_sum",
+    "branch_output", "rhs", "project", "restoring", "restoring_inverse", "dissipation",
+    "dissipation_inverse", "rest_input", "f_of", "f_inverse", "a", "p",
+    # NAME_step of the C side would clash with its static model_step
+    "model"])
 # Fit-date keys a model file's ``fit`` section may carry (none is written by hystkit yet).
 _DATE_KEYS = ("fit_date", "fitted_at", "date", "created")
 
