@@ -28,7 +28,7 @@ MODEL_KEYS = {"schema", "schema_version", "hystkit_version", "model", "mode", "c
 EVALUATE_KEYS = {"r2", "e_rms_pct", "e_max_pct", "sinad_db", "loop_area", "linear_r2",
                  "n_samples"}
 DEMO_FILES = ("metrics.json", "noise_trained.json", "config.json", "loops.png",
-              "time_series.png")
+              "time_series.png", "report.html")
 EXCITATIONS = {"sine", "decay", "chirp", "noise"}
 N_SAMPLES = 8000  # virtual-sensor sine recording
 BAD_ROW = 10  # 0-based data row the bad-file helpers break: "row 11", file line 12

@@ -22,6 +22,7 @@ from ._common import (
     size_limit,
     slope_cap,
 )
+from ._inputs import check_inputs_exist
 from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_from_args
 
 __all__ = ["register"]
@@ -59,6 +60,7 @@ def _simulate_sensor(args: argparse.Namespace) -> int:
 
 
 def _fit(args: argparse.Namespace) -> int:
+    check_inputs_exist(args.data)  # a misspelt name is refused before the heavy imports
     from ..compensation import MODEL_SUFFIXES, center_label, fit_compensator, save_compensator
     from ..io import check_output_path, read_recording
     from ..models import get_family
@@ -152,6 +154,7 @@ def _print_standard_errors(se: dict | None) -> None:
 
 
 def _compensate(args: argparse.Namespace) -> int:
+    check_inputs_exist([args.model, args.data])
     from ..compensation import center_label
     from ..io import (
         RECORDING_SUFFIXES,
@@ -241,6 +244,7 @@ def _warn_if_outside(flags: dict, data: Path) -> None:
 
 
 def _evaluate(args: argparse.Namespace) -> int:
+    check_inputs_exist([args.model, args.data])
     from ..io import check_output_path, read_recording, write_json, write_mat
 
     evaluate, load_compensator = _module.evaluate, _module.load_compensator
@@ -302,7 +306,7 @@ def _demo(args: argparse.Namespace) -> int:
           f"fitted on one recording and scored on another (direct mode, deployable centring: "
           f"{DEFAULT_CENTER}; the paper's oracle centring beside it)")
     t0 = time.perf_counter()
-    result = run_demo(out, n_cells=args.cells, force=args.force, raw=args.raw)
+    result = run_demo(out, n_cells=args.cells, force=args.force, raw=args.raw, report=True)
     print()
     print(format_table(result["metrics"], "Validation (fit on seed 1, test on seed 2); cf. "
                        "document table 5.5", DOCUMENT_TABLE_5_5))
@@ -313,7 +317,7 @@ def _demo(args: argparse.Namespace) -> int:
     if raw is not None:
         _print_raw_path(raw)
     print(f"\nwrote {out}/: metrics.json, noise_trained.json, config.json, loops.png, "
-          f"time_series.png{', raw_path.json' if raw else ''} "
+          f"time_series.png, report.html{', raw_path.json' if raw else ''} "
           f"({time.perf_counter() - t0:.1f} s)")
     return 0
 

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._names import MASS
+
 __all__ = [
     "DOCUMENT_PID_DIRECT",
     "DOCUMENT_PID_WEIGHTING",
@@ -28,8 +30,6 @@ __all__ = [
 TS = 5.04e-4
 """Loop sample time [s], sec. 7.2 (derived from the filtered measurement data)."""
 
-MASS = 0.250
-"""Moving mass of the SMAC stroke [kg], eq. 7.1."""
 
 
 def _positive(name: str, value: float) -> float:

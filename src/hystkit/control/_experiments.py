@@ -22,6 +22,7 @@ from ._blocks import (
     Plant,
 )
 from ._loop import ControlLoop, LoopResponse, simulate_loop, tare
+from ._names import EXPERIMENTS
 from ._sensors import SensorModels
 
 __all__ = [
@@ -37,7 +38,6 @@ __all__ = [
     "sine_reference",
 ]
 
-EXPERIMENTS = ("sine", "frequency", "amplitude", "cubic", "disturbance")
 FREQUENCIES_HZ = (0.125, 0.25, 0.5, 1.0, 2.0)
 """Frequency sweep at 3 mm (fig. 7.6, 7.13); 0.5 Hz is the trained excitation."""
 AMPLITUDES_MM = (1.0, 2.0, 3.0, 4.5, 6.0)

@@ -22,12 +22,12 @@ import pandas as pd
 
 from . import _kernel
 from ._blocks import PID, TS, DisturbanceObserver, Plant, plant_matrices
+from ._names import SCHEMES
 from ._sensors import SensorBlock
 
 __all__ = ["SCHEMES", "ControlLoop", "LoopResponse", "LoopState", "rest_state",
            "simulate_loop", "simulate_loop_reference", "tare"]
 
-SCHEMES = ("direct", "weighting")
 
 
 @dataclass(frozen=True, eq=False)

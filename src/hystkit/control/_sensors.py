@@ -37,6 +37,7 @@ from ..io import Recording
 from ..models import Family, family_of, get_family
 from ..sensors import VIRTUAL_PHYSICS, VirtualSensor, physics_of, simulate_experiment
 from . import _kernel
+from ._names import TRAININGS
 
 __all__ = [
     "TRAININGS",
@@ -309,7 +310,6 @@ def linear_block(gain: float, offset: float = 0.0, *, name: str = "linear") -> S
                        info={"kind": "ideal linear", "gain": gain})
 
 
-TRAININGS = ("recording", "loop")
 
 
 @dataclass(frozen=True, eq=False)
