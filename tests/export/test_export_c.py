@@ -259,3 +259,18 @@ def _sync_state(comp):
     from hystkit.compensation._sync import sync_excitation
 
     return sync_excitation(comp).state_after
+
+
+def test_cli_warns_when_float_is_not_enough(compensators, tmp_path, capsys):
+    """The Bobbio inverse amplifies float rounding (its float build is off by 3-6 % of the
+    range): a float export says so on stderr, a double export does not."""
+    comp = compensators("bobbio", "inverse", "fit")
+    assert not make_plan(comp).float_is_enough
+    model = tmp_path / "b.json"
+    save_compensator(comp, model)
+    assert main(["export", str(model), "--out", str(tmp_path / "f")]) == 0
+    assert "hystkit: warning: float is not enough for this model" in capsys.readouterr().err
+    assert main(["export", str(model), "--out", str(tmp_path / "d"), "--double"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    assert "WARNING" in (tmp_path / "f" / "README").read_text()
+    assert "WARNING" not in (tmp_path / "d" / "README").read_text()

@@ -99,3 +99,16 @@ def test_matlab_sync_start_matches_the_stream(label, mode, center, compensators,
     got = np.loadtxt(tmp_path / "out.txt")
     ref = Stream(comp, start="sync").process(val.sensor[:2000])
     assert np.max(np.abs(got - ref)) <= 1e-9
+
+
+def test_cli_writes_the_matlab_files(compensators, tmp_path, capsys):
+    from hystkit.cli import main
+    from hystkit.compensation import save_compensator
+
+    model = tmp_path / "tip.json"
+    save_compensator(compensators("mpl1", "direct", "tare"), model)
+    out = tmp_path / "m"
+    assert main(["export", str(model), "--lang", "matlab", "--out", str(out)]) == 0
+    names = {p.name for p in out.iterdir()}
+    assert {"tip.m", "tip_init.m", "tip_block.m"} <= names
+    assert ("tip_sync.m" in names) == ("sync start-up: after e_sync" in capsys.readouterr().out)
