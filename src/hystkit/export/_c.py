@@ -262,13 +262,13 @@ int main(void)
 def _readme(plan: ExportPlan, double: bool) -> str:
     n, p = plan.name, plan.provenance
     sync = (f"- `{n}_sync(&st)`: instead of `{n}_init`, start after the synchronisation "
-            f"excitation e_sync\n  ({plan.sync_note}).\n" if plan.sync_state is not None else
+            f"excitation e_sync;\n  {plan.sync_note}.\n" if plan.sync_state is not None else
             f"- {plan.sync_note}\n")
     return f"""{n}: hysteresis compensator exported by hystkit {p['hystkit']}
 
 Model: {p['family']}, {p['mode']}, centring {p['center']}
 From:  {p['source']} (fit date: {p['fit_date']})
-Arithmetic: {'double' if double else 'float'}; state: {plan.n_state} numbers.
+Arithmetic: {'double' if double else 'float'}; model state: {plan.n_state} number(s).
 {_float_note(plan) if not double else ''}{'' if double or plan.float_is_enough else 'WARNING: ' + float_warning(plan) + chr(10)}
 Build and run the example (one sensor value per line in, one estimate [mm] per line out):
 

@@ -27,9 +27,11 @@ def sync_state_of(comp: Compensator) -> tuple[np.ndarray | None, str]:
         sync = sync_excitation(comp)
     except InputError as exc:
         return None, f"no sync start-up: {exc}"
-    return sync.state_after, (f"sync start-up: after e_sync ({sync.duration:g} s of levels "
-                              f"{', '.join(f'{v:g}' for v in sync.levels)} in normalised "
-                              f"{sync.quantity}, {sync.rule})")
+    n_hold = round(sync.hold_seconds / sync.dt)
+    levels = ", ".join(f"{sync.signal[i * n_hold]:.6g}" for i in range(len(sync.levels)))
+    return sync.state_after, (f"sync start-up: after e_sync, the {sync.quantity} held at "
+                              f"{levels} {sync.unit} for {sync.hold_seconds:g} s each "
+                              f"({sync.rule})")
 
 
 def export_compensator(comp: Compensator, out: str | Path, lang: str = "c", *,
