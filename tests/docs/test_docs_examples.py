@@ -59,11 +59,16 @@ def blocks_of(path: Path) -> list[Block]:
 
 def commands_of(code: str) -> list[list[str]]:
     """The ``hystkit`` command lines of a bash block as argument lists (continuations joined,
-    comments dropped)."""
+    comments dropped, the shell's redirections and what follows a pipe left out)."""
     joined = re.sub(r"\\\n", " ", code)
     commands = []
     for line in joined.splitlines():
-        words = shlex.split(line, comments=True)
+        # Quotes kept while cutting, so a quoted ';' (--sep ';') is an argument, not an operator.
+        lexer = shlex.shlex(line, posix=False, punctuation_chars="|<>&;")
+        lexer.whitespace_split, lexer.commenters = True, "#"
+        tokens = list(lexer)
+        cut = next((i for i, t in enumerate(tokens) if set(t) <= set("|<>&;")), len(tokens))
+        words = shlex.split(" ".join(tokens[:cut]))
         if words and words[0] == "hystkit":
             commands.append(words[1:])
     return commands
