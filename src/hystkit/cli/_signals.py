@@ -14,7 +14,7 @@ just stopped) ends at once.
 from __future__ import annotations
 
 import concurrent.futures.thread  # noqa: F401  (registers its at-fork hooks before ours)
-import logging  # noqa: F401  (the same)
+import logging  # also registers its at-fork hooks before ours
 import os
 import signal
 import sys
@@ -43,6 +43,9 @@ def received_signal() -> int | None:
 
 
 def _stop_workers() -> None:
+    # What the stopped workers' connections log from a cluster's event loop (closed streams,
+    # futures whose exception nobody reads) is the signal's consequence: not shown.
+    logging.disable(logging.CRITICAL)
     multiprocessing = sys.modules.get("multiprocessing")
     if multiprocessing is None:  # never imported: no workers
         return
@@ -161,9 +164,11 @@ def signals_as_exceptions() -> Iterator[None]:
         signal.signal(signal.SIGINT, _on_signal)
     _previous_excepthook, threading.excepthook = threading.excepthook, _quiet_thread_errors
     was_active, _active = _active, True
+    logging_level = logging.root.manager.disable
     try:
         yield
     finally:
+        logging.disable(logging_level)
         _active = was_active
         threading.excepthook = _previous_excepthook
         signal.setitimer(signal.ITIMER_REAL, 0)

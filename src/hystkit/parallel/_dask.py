@@ -129,10 +129,12 @@ def dask_executor(n_workers: int | None, scheduler: str | None) -> Iterator[Dask
             method = _fork_if_possible()
             if method == "fork":
                 warm_kernels()
-            with dask.config.set({"distributed.worker.multiprocessing-method": method}):
-                cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1,
-                                       processes=True, silence_logs=logging.CRITICAL,
-                                       **NO_DASHBOARD)
+            # for the cluster's whole life: a worker the nanny restarts is forked too (a
+            # spawned one would also leave semaphores for multiprocessing's tracker to warn of)
+            stack.enter_context(dask.config.set({"distributed.worker.multiprocessing-method":
+                                                 method}))
+            cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                                   silence_logs=logging.CRITICAL, **NO_DASHBOARD)
             stack.callback(cluster.close, timeout=CLOSE_TIMEOUT)
             client = Client(cluster)
             where = f"local, {method}ed"
