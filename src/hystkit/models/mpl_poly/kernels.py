@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..mpl.kernels import fold_block, mirror_upper
+
 
 @njit(cache=True, inline="always")
 def _cubic(c0, c1, c2, c3, x):
@@ -114,7 +116,7 @@ def simulate_with_jacobian(u, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt, bo
     return y, jac, -1
 
 
-# Jacobian rows gathered before one matrix product folds them into J^T J (as in the mPL's).
+# Jacobian rows gathered, column-major, and folded into J^T J block by block (as in the mPL's).
 NORMAL_BLOCK = 256
 
 
@@ -127,7 +129,7 @@ def normal_equations(u, y_target, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt
     p = 5 * n_cells + 6
     x = x0.copy()
     sens = sens0.copy()
-    rows = np.zeros((NORMAL_BLOCK, p))
+    cols = np.zeros((p, NORMAL_BLOCK))
     res = np.empty(NORMAL_BLOCK)
     jtj = np.zeros((p, p))
     jtr = np.zeros(p)
@@ -141,22 +143,20 @@ def normal_equations(u, y_target, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt
         y, dg = _cubic(gc[0], gc[1], gc[2], gc[3], z)
         zj = 1.0
         for j in range(4):
-            rows[m, col_g + j] = zj
+            cols[col_g + j, m] = zj
             zj *= z
-        rows[m, col_w] = dg * u[n]
-        rows[m, col_vb] = -dg
+        cols[col_w, m] = dg * u[n]
+        cols[col_vb, m] = -dg
         for k in range(n_cells):
-            rows[m, col_w + 1 + k] = dg * x[k]
+            cols[col_w + 1 + k, m] = dg * x[k]
             for j in range(4):
-                rows[m, 4 * k + j] = dg * w[k + 1] * sens[k, j]
+                cols[4 * k + j, m] = dg * w[k + 1] * sens[k, j]
         r = y - y_target[n]
         res[m] = r
         sse += r * r
         m += 1
         if m == NORMAL_BLOCK or n == u.size - 1:
-            block = rows[:m]
-            jtj += block.T @ block
-            jtr += block.T @ res[:m]
+            fold_block(cols, res, m, jtj, jtr)
             m = 0
         for k in range(n_cells):
             v = u[n] - x[k]
@@ -166,8 +166,8 @@ def normal_equations(u, y_target, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt
                 sens[k, j] += (grad[j] - slope * sens[k, j]) * dt
             x[k] += f * dt
             if not abs(x[k]) < bound:
-                return sse, jtj, jtr, n
-    return sse, 0.5 * (jtj + jtj.T), jtr, -1  # symmetric whatever order BLAS summed in
+                return sse, mirror_upper(jtj), jtr, n
+    return sse, mirror_upper(jtj), jtr, -1
 
 
 @njit(cache=True)
