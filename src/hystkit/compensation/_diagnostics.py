@@ -17,7 +17,7 @@ from ..metrics import r2
 from ._param_vector import flatten_params
 
 __all__ = ["BOUND_TOLERANCE", "COLLAPSE_RATIO", "MIN_SAMPLES_PER_PARAM", "bound_flags",
-           "fit_status", "standard_errors"]
+           "error_steps", "errors_from_factor", "fit_status", "standard_errors"]
 
 # A fit needs at least this many samples per fitted number (with fewer, the residual has too
 # few degrees of freedom for the noise level, hence for standard errors).
@@ -44,15 +44,30 @@ def standard_errors(residual: Callable[[np.ndarray], np.ndarray], params: Any,
     """
     theta, rebuild = flatten_params(params)
     r0 = residual(rebuild(theta))
-    steps = 1e-6 * np.maximum(np.abs(theta), 1e-3)
+    steps = error_steps(theta)
     jac = np.empty((r0.size, theta.size))
     for j, h in enumerate(steps):
         shifted = theta.copy()
         shifted[j] += h
         jac[:, j] = (residual(rebuild(shifted)) - r0) / h
+    return errors_from_factor(theta, jac, float(r0 @ r0), n_data)
+
+
+def error_steps(theta: np.ndarray) -> np.ndarray:
+    """Forward-difference steps of the standard errors' Jacobian (relative, floor 1e-9)."""
+    return 1e-6 * np.maximum(np.abs(theta), 1e-3)
+
+
+def errors_from_factor(theta: np.ndarray, factor: np.ndarray, sse: float, n_data: int) -> dict:
+    """:func:`standard_errors`' result from any ``factor`` with ``factor^T factor = J^T J``.
+
+    ``factor`` is the Jacobian itself or its triangular factor ``R`` (``J = Q R``): both have
+    the same singular values and right singular vectors, so the chunked route
+    (:mod:`._chunked_errors`) gives the dense one's numbers without holding ``J``.
+    """
     dof = max(n_data - theta.size, 1)
-    sigma2 = float(r0 @ r0) / dof
-    _u, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    sigma2 = sse / dof
+    _u, sv, vt = np.linalg.svd(factor, full_matrices=False)
     determined = sv > sv[0] * 1e-8 if sv.size and sv[0] > 0 else np.zeros(sv.size, bool)
     inv_sv2 = np.where(determined, 1.0 / np.where(determined, sv, 1.0) ** 2, 0.0)
     variance = sigma2 * np.einsum("kj,k,kj->j", vt, inv_sv2, vt)

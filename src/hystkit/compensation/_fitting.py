@@ -25,9 +25,10 @@ from ._centring import (
     DEFAULT_TARE_SECONDS,
     DEFAULT_TRACK_SECONDS,
 )
+from ._chunked_errors import chunked_standard_errors
 from ._compensator import MODES, Compensator, check_training_data, inverse_is_bounded
 from ._conventions import LinearBaseline, prepare_training_data
-from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status, standard_errors
+from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status
 from ._param_vector import flatten_params, simulate_segments
 from ._training_checks import MIN_SAMPLES, check_fitting_data
 
@@ -117,7 +118,7 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
     check_fitting_data(recs, family, structure)
     conventions, s_list, p_list = prepare_training_data(
         recs, center, tare_seconds=tare_seconds, track_seconds=track_seconds)
-    s, p = np.concatenate(s_list), np.concatenate(p_list)
+    s, p = _joined(s_list), _joined(p_list)
     inputs, targets = (s_list, p_list) if mode == "direct" else (p_list, s_list)
     result = _fit_family(family, structure, mode, s, p, recs[0].source)
     params, joint_note = result.params, ""
@@ -128,8 +129,7 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
         raise InputError(f"{recs[0].source}: column 'position': {s.size} samples for "
                          f"{n_params} parameters of {model}; a fit needs at least "
                          f"{MIN_SAMPLES_PER_PARAM} samples per parameter")
-    slope, intercept = np.polyfit(s, p, 1)
-    baseline = LinearBaseline(float(slope), float(intercept))
+    baseline = LinearBaseline.fit(s, p)
     comp = Compensator(structure=structure, params=params, mode=mode, center=center,
                        baseline=baseline, model=model, tare_seconds=tare_seconds,
                        track_seconds=track_seconds, training_range=(float(s.min()),
@@ -137,7 +137,7 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
                        position_range=(float(min(r.position.min() for r in recs)),
                                        float(max(r.position.max() for r in recs))),
                        **conventions)
-    info = _fit_info(comp, result, recs, s_list, p_list, inputs, targets, diagnose)
+    info = _fit_info(comp, result, recs, s, p, s_list, inputs, targets, diagnose)
     info["n_params"], info["joint_fit"] = n_params, joint_note or None
     object.__setattr__(comp, "fit_info", info)
     return comp
@@ -169,21 +169,35 @@ def _run_fit(family: Family, structure: Any, mode: str, s: np.ndarray,
                                                      "data; use --mode direct or a smaller model")
 
 
-def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording],
-              s_list: list[np.ndarray], p_list: list[np.ndarray], inputs: list[np.ndarray],
+def _joined(columns: list[np.ndarray]) -> np.ndarray:
+    """The recordings' columns end to end (one recording: itself, not a copy)."""
+    return columns[0] if len(columns) == 1 else np.concatenate(columns)
+
+
+def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording], s: np.ndarray,
+              p: np.ndarray, s_list: list[np.ndarray], inputs: list[np.ndarray],
               targets: list[np.ndarray], diagnose: bool) -> dict:
-    """The solver's report plus the guards: status, training R², bounds, AIC/BIC, SEs."""
+    """The solver's report plus the guards: status, training R², bounds, AIC/BIC, SEs.
+
+    ``s``, ``p``: normalised sensor and position of all recordings end to end. Full-length
+    arrays are made only where needed (estimate, straight line); the rest is in place.
+    """
     family, structure = comp.family, comp.structure
     run = family.simulate if comp.mode == "direct" else family.invert
-    p = np.concatenate(p_list)
     estimate = simulate_segments(run, structure, comp.params, s_list)
-    line = comp.baseline(np.concatenate(s_list))
+    line = comp.baseline(s)
     # after a joint polish (no bounds) the family fit's optimum is not the model's
     on_bounds, limit_notes = bound_flags(result) if len(recs) == 1 else (None, [])
     status, message = fit_status(estimate, p, line, on_bounds, result.converged)
+    r2_model, r2_line = r2(p, estimate), r2(p, line)
+    del line
+    # The forward model's misfit; in direct mode the estimate is that forward run.
+    residual = estimate if comp.mode == "direct" else simulate_segments(
+        family.simulate, structure, comp.params, inputs)
+    residual -= _joined(targets)
+    sse = float(residual @ residual)
+    del estimate, residual
     n = p.size
-    forward = simulate_segments(family.simulate, structure, comp.params, inputs)
-    sse = float(np.sum((forward - np.concatenate(targets)) ** 2))
     k = _count_params(comp.params)
     log_term = n * np.log(max(sse, 1e-300) / n)
     info = {"cost": sse, "fit_seconds": result.seconds, "n_evaluations": result.n_evaluations,
@@ -191,13 +205,11 @@ def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording],
             "n_starts": result.n_starts, "training_source": recs[0].source,
             "training_sources": [r.source for r in recs],
             "training_samples": int(n), "status": status, "status_message": message,
-            "training_r2": r2(p, estimate), "training_linear_r2": r2(p, line),
+            "training_r2": r2_model, "training_linear_r2": r2_line,
             "on_bounds": on_bounds, "at_model_limits": limit_notes,
             "aic": float(log_term + 2 * k),
             "bic": float(log_term + k * np.log(n))}
     if diagnose:
-        target = np.concatenate(targets)
-        info["standard_errors"] = standard_errors(
-            lambda params: simulate_segments(family.simulate, structure, params, inputs) - target,
-            comp.params, n)
+        info["standard_errors"] = chunked_standard_errors(family, structure, comp.params,
+                                                          inputs, targets)
     return info

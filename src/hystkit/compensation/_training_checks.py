@@ -60,7 +60,8 @@ def check_excursion(recordings: Sequence[Recording]) -> None:
     """
     source = recordings[0].source
     for column in ("position", "sensor"):
-        x = np.concatenate([getattr(r, column) for r in recordings])
+        columns = [getattr(r, column) for r in recordings]
+        x = columns[0] if len(columns) == 1 else np.concatenate(columns)
         lo, hi = float(np.min(x)), float(np.max(x))
         span, level = hi - lo, max(abs(lo), abs(hi))
         if span == 0:
@@ -70,7 +71,8 @@ def check_excursion(recordings: Sequence[Recording]) -> None:
             raise InputError(f"{source}: column {column!r} varies by only {span:.3g} around "
                              f"{level:.3g}, below what float64 resolves once the offset is "
                              f"removed; nothing to fit (subtract the offset before saving)")
-        moving = int(np.count_nonzero(np.abs(x - np.median(x)) > _REST_BAND * span))
+        away = np.subtract(x, np.median(x))  # one full-length temporary, worked in place
+        moving = int(np.count_nonzero(np.abs(away, out=away) > _REST_BAND * span))
         if moving < MIN_MOVING_SAMPLES:
             raise InputError(f"{source}: column {column!r} leaves its resting level in only "
                              f"{moving} of {x.size} samples (a spike or a glitch, not a "
