@@ -15,8 +15,13 @@ from ..io import Recording
 from ..metrics import e_max_pct, e_rms_pct, loop_area, r2, sinad_db
 from ._centring import ORACLE_CENTER, center_label
 from ._compensator import POSITION_MARGIN, SENSOR_MARGIN, Compensator
+from ._training_checks import MIN_SAMPLES
 
-__all__ = ["SCORE_KEYS", "evaluate", "use_flags"]
+__all__ = ["MIN_SCORED_SAMPLES", "SCORE_KEYS", "evaluate", "use_flags"]
+
+# Scores of fewer samples than a fit needs say nothing (R² of 2 points, a loop of 3): refused.
+# Compensating a short recording is fine (each estimate depends on past samples only).
+MIN_SCORED_SAMPLES = MIN_SAMPLES
 
 SCORE_KEYS = ("r2", "e_rms_pct", "e_max_pct", "sinad_db", "loop_area")
 
@@ -54,9 +59,17 @@ def evaluate(compensator: Compensator, recording: Recording, *,
         ``extrapolated_fraction``, ``n_sensor_outside`` / ``n_estimate_outside`` (use-time
         guards, None if the model file predates them) with their margins. Every number is
         finite; a score that is undefined or overflowed is None.
+
+    Raises
+    ------
+    InputError
+        No position column, or fewer than ``MIN_SCORED_SAMPLES`` samples.
     """
     if not recording.has_position():
         raise InputError(f"{recording.source}: column 'position' is needed to evaluate")
+    if recording.n_samples < MIN_SCORED_SAMPLES:
+        raise InputError(f"{recording.source}: {recording.n_samples} samples; scores need at "
+                         f"least {MIN_SCORED_SAMPLES} (as many as a fit)")
     position, scale = recording.position, compensator.scaling.position_scale
     scores = {"n_samples": recording.n_samples, "center": center_label(compensator.center),
               "center_oracle": center_label(ORACLE_CENTER)}
