@@ -1,7 +1,8 @@
 """Speed of hystkit's mPL forward model and of its fit, against references run in the same process.
 
-Run:  python benchmarks/bench_mpl.py [--fit-only]   (several minutes on 2 cores: the 128k-sample
-      trf fits take up to a minute each; --fit-only skips table 1 and the compile costs)
+Run:  python benchmarks/bench_mpl.py [--fit-only] [--quick]   (several minutes on 2 cores: the
+      128k-sample trf fits take up to a minute each; --fit-only skips table 1 and the compile
+      costs; --quick keeps only N = 1 of the 128k-sample rows, for a loaded machine)
 
 Table 1 -- forward model cost in ns per sample per cell, for N = 1, 3, 10 cells on a
 100 000-sample normalised input (0.5 Hz sine plus white noise, max |u| = 1, dt = 0.025 s):
@@ -74,6 +75,7 @@ FIT_SIZES = (8000, 128_000)  # samples: one recording, 16 recordings joined
 FIT_REPEATS = {8000: 3, 128_000: 2}  # interleaved pairs (tr, trf) per row
 SIM_TIMING_REPEATS = 7
 FIT_ONLY = "--fit-only" in sys.argv
+QUICK = "--quick" in sys.argv
 FIT_SEED = 1  # the demo report's fitting seed (hystkit.reports._demo.FIT_SEED)
 C_FLAGS = ("-O2", "-shared", "-fPIC")
 C_SOURCE = Path(__file__).with_name("_c_reference.c")
@@ -448,7 +450,7 @@ def print_fit_table() -> None:
     print("  " + "-" * (len(head) - 2))
     for size in FIT_SIZES:
         u, y, _ = (u8, y8, dt) if size == u8.size else fit_data(size)
-        for n in FIT_CELLS:
+        for n in FIT_CELLS[:1] if QUICK and size != u8.size else FIT_CELLS:
             print_solver_row(solver_row(n, size, u, y, dt))
     print("  trf/tr = ratio of median wall times (cpu: of median CPU times); "
           "|dcost| = |SSE_tr - SSE_trf| / SSE_trf")

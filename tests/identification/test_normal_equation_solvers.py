@@ -8,6 +8,7 @@ from scipy.optimize import least_squares, lsq_linear
 
 from hystkit.identification import NormalEquations, solve_lm
 from hystkit.identification._trust_region import solve_trust_region
+from hystkit.identification._trust_region_steps import square_root
 
 SOLVERS = pytest.mark.parametrize("solve", [solve_trust_region, solve_lm], ids=["tr", "lm"])
 
@@ -160,3 +161,36 @@ def test_trust_region_takes_scipy_trf_s_path(upper_b):
     assert sol.status == ref.status and sol.nfev == ref.nfev and sol.njev == ref.njev
     assert_allclose(sol.x, ref.x, rtol=1e-9)
     assert_allclose(sol.cost, ref.cost, rtol=1e-12)
+
+
+def test_square_root_of_a_singular_matrix_reproduces_it():
+    """J^T J with a zero column has no Cholesky factor: R comes from the eigendecomposition,
+    and R^T R still equals J^T J (to rounding of the largest entry)."""
+    rng = np.random.default_rng(3)
+    j = rng.normal(size=(30, 4))
+    j[:, 2] = 0.0
+    jtj = j.T @ j
+    with pytest.raises(np.linalg.LinAlgError):
+        np.linalg.cholesky(jtj)
+    root = square_root(jtj)
+    assert_allclose(root.T @ root, jtj, rtol=0, atol=1e-12 * np.max(np.abs(jtj)))
+
+
+def test_trust_region_with_a_parameter_that_does_not_act_matches_scipy_trf():
+    """A coordinate with a zero Jacobian column (rank-deficient J^T J): the fit of the others
+    is scipy trf's (where the idle coordinate ends is arbitrary, for trf too)."""
+    rng = np.random.default_rng(4)
+    a = rng.normal(size=(50, 4))
+    a[:, 1] = 0.0
+    b = rng.normal(size=50)
+    x0 = np.array([0.1, 0.3, -0.2, 0.0])
+    lower, upper = np.full(4, -1.0), np.full(4, 1.0)
+    ref = least_squares(lambda x: a @ x - b, x0, jac=lambda x: a, bounds=(lower, upper),
+                        method="trf", x_scale="jac")
+    sol = solve_trust_region(_linear(a, b), x0, lower, upper)
+    assert sol.success, sol.message
+    assert lower[1] < sol.x[1] < upper[1]
+    # convex in the acting coordinates: same minimiser and cost as trf, to its stopping rules
+    acting = [0, 2, 3]
+    assert_allclose(sol.x[acting], ref.x[acting], atol=1e-4)
+    assert_allclose(sol.cost, ref.cost, rtol=1e-8)

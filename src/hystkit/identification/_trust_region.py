@@ -76,14 +76,12 @@ def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations]
         return _result(x, np.inf, -3, runs, None)
     scale_inv = _column_norms(ne.jtj)
     scale_inv[scale_inv == 0] = 1.0
-    root = _square_root(ne.jtj)
     v, dv = coleman_li(x, ne.jtr, lb, ub)
     v[dv != 0] *= scale_inv[dv != 0]
     delta = _norm(x * scale_inv / v ** 0.5) or 1.0
     alpha, status = 0.0, None
     while True:
-        d, diag_h, g_h, h_h, eig, vecs, sg, g_norm = prepare(x, ne.jtj, root, ne.jtr, lb, ub,
-                                                              scale_inv)
+        d, diag_h, g_h, h_h, eig, vecs, sg, g_norm = prepare(x, ne.jtj, ne.jtr, lb, ub, scale_inv)
         if g_norm < gtol:
             status = 1
         if status is not None or runs.nfev >= max_nfev:
@@ -113,7 +111,6 @@ def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations]
             x = x_new
             ne = trial if trial is not None else runs.normal(normal_equations, x)
             scale_inv = np.maximum(scale_inv, _column_norms(ne.jtj))
-            root = _square_root(ne.jtj)
     return _result(x, ne.cost, 0 if status is None else status, runs, _column_norms(ne.jtj))
 
 
@@ -121,15 +118,6 @@ def _result(x, cost, status, runs, column_norms) -> SolveResult:
     return SolveResult(x=x, cost=float(cost), status=status, message=_MESSAGES[status],
                        nfev=runs.nfev, njev=runs.njev, n_runs=runs.n_runs,
                        column_norms=column_norms)
-
-
-def _square_root(jtj: np.ndarray) -> np.ndarray:
-    """An ``R`` with ``R^T R = J^T J``: the Cholesky factor, else from the eigendecomposition."""
-    try:
-        return np.linalg.cholesky(jtj).T
-    except np.linalg.LinAlgError:
-        eig, vecs = np.linalg.eigh(jtj)
-        return np.sqrt(np.maximum(eig, 0.0))[:, None] * vecs.T
 
 
 def _column_norms(jtj: np.ndarray) -> np.ndarray:

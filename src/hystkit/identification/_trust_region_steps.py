@@ -5,7 +5,8 @@ Each iteration of scipy's ``trf`` does a few dozen small-array operations; as Nu
 samples. Here they are two compiled calls:
 
 * :func:`prepare`: the Coleman-Li scaling at ``x``, the scaled gradient and Gauss-Newton
-  matrix, and the SVD of ``[R diag(d); diag(diag_h)^(1/2)]`` (once per accepted point);
+  matrix, ``R`` with ``R^T R = J^T J`` and the SVD of ``[R diag(d); diag(diag_h)^(1/2)]``
+  (once per accepted point);
 * :func:`propose`: Moré's trust-region step for a radius and scipy's ``select_step`` among
   it, its reflection and the scaled gradient (once per trial point).
 
@@ -19,7 +20,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["coleman_li", "prepare", "propose", "strictly_feasible"]
+__all__ = ["coleman_li", "prepare", "propose", "square_root", "strictly_feasible"]
 
 _EPS = np.finfo(float).eps
 _JIT = {"cache": True, "error_model": "numpy"}
@@ -58,15 +59,27 @@ def strictly_feasible(x, lb, ub):
 
 
 @njit(**_JIT)
-def prepare(x, jtj, root, g, lb, ub, scale_inv):
+def square_root(jtj):
+    """An ``R`` with ``R^T R = J^T J``: the Cholesky factor, else from the eigendecomposition
+    (see the accuracy note in :mod:`._trust_region`)."""
+    try:
+        return np.linalg.cholesky(jtj).T.copy()
+    except Exception:  # noqa: BLE001 -- numba catches no specific class; LinAlgError here
+        eig, vecs = np.linalg.eigh(jtj)
+        return np.sqrt(np.maximum(eig, 0.0)).reshape(-1, 1) * vecs.T
+
+
+@njit(**_JIT)
+def prepare(x, jtj, g, lb, ub, scale_inv):
     """Scaled problem at ``x``: ``(d, diag_h, g_h, h_h, eig, vecs, sg, g_norm)``.
 
     ``d`` the variable scaling, ``diag_h`` the Coleman-Li diagonal, ``g_h = d g``, ``h_h =
     J_h^T J_h``, ``eig`` (descending) and ``vecs`` the squared singular values and right
-    singular vectors of ``[R diag(d); diag(diag_h)^(1/2)]``, ``sg = vecs^T g_h``, ``g_norm =
-    ||v g||_inf`` (the gtol measure).
+    singular vectors of ``[R diag(d); diag(diag_h)^(1/2)]`` (``R^T R = J^T J``), ``sg =
+    vecs^T g_h``, ``g_norm = ||v g||_inf`` (the gtol measure).
     """
     p = x.size
+    root = square_root(jtj)
     v, dv = coleman_li(x, g, lb, ub)
     g_norm = np.max(np.abs(g * v))
     for i in range(p):
