@@ -425,7 +425,10 @@ def invert_step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarra
     lo, hi, _ = output_branch(structure, params)
     a = lo if np.isfinite(lo) else -1e15
     b = hi if np.isfinite(hi) else 1e15
-    z = brentq(lambda z: output_current(params, z) - y, a, b, xtol=1e-15, rtol=1e-15)
+    # from a +-1e15 bracket to a 1e-15 tolerance takes ~101 halvings: more than brentq's
+    # default 100 iterations in the worst case (found by tests/models/test_invert_step_fuzz.py)
+    z = brentq(lambda z: output_current(params, z) - y, a, b, xtol=1e-15, rtol=1e-15,
+               maxiter=200)
     e = (z - params.w[1:] @ x + params.v_b) / params.w[0]
     return float(e), x + resistor_current(structure, params, e - x) * structure.dt
 
