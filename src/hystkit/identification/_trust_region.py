@@ -17,6 +17,9 @@ problems", SIAM J. Sci. Comput. 21(1); scipy's ``optimize/_lsq/trf.py``) with ev
   reflection off the first bound hit, and the scaled gradient -- all as scipy.
 * ``x_scale="jac"``: the running maximum of the column norms ``sqrt(diag(J^T J))``.
 
+The ``p x p`` arithmetic of an iteration is compiled (:mod:`._trust_region_steps`); here
+remain the model runs, the radius update and the stopping rules.
+
 Stopping rules are scipy's (``ftol = xtol = gtol = 1e-8``): ``gtol`` on ``||v g||_inf``;
 ``ftol``: ``dF < ftol F`` with ratio > 0.25; ``xtol``: ``||step|| < xtol (xtol + ||x||)``; status
 0 when ``max_nfev`` model runs are spent (budget exhausted, not converged).
