@@ -18,6 +18,9 @@ from ._common import (
 __all__ = ["add_parallel_options", "executor_for", "register", "say_where"]
 
 
+COMPARE_FILES = ["compare.json", "compare.mat"]
+
+
 def add_parallel_options(p: argparse.ArgumentParser) -> None:
     """``--workers`` and ``--scheduler``: where the command's independent pieces run."""
     g = p.add_argument_group("parallel runs (results are the same as a serial run's)")
@@ -75,18 +78,17 @@ def _sizes(pairs: list[str]) -> dict[str, int]:
 def _compare(args: argparse.Namespace) -> int:
     # Matplotlib and the fits load only for this command.
     from ..compensation import DEFAULT_CENTER
-    from ..io import atomic_folder, check_output_folder, read_recording, write_json
+    from ..io import atomic_folder, check_output_folder, read_recording, write_json, write_mat
     from ..reports import compare_models, format_compare
 
     models = _models(args.models)
     out = args.out
     inputs = [args.data_fit, args.data_val]
     if out is not None:
-        check_output_folder(out, ["compare.json"], args.force, inputs=inputs)
+        check_output_folder(out, COMPARE_FILES, args.force, inputs=inputs)
     sizes = _sizes(args.size)
-    options = read_options(args)
-    fit_rec = read_recording(args.data_fit, options=options)
-    val_rec = read_recording(args.data_val, options=options)
+    fit_rec = read_recording(args.data_fit, options=read_options(args, args.data_fit))
+    val_rec = read_recording(args.data_val, options=read_options(args, args.data_val))
     print(f"comparing {len(models)} models: fit on {args.data_fit}, validate on {args.data_val} "
           f"(deployable centring: {DEFAULT_CENTER}; oracle: recording, the paper's protocol)")
     with executor_for(args, 2 * len(models)) as executor:
@@ -99,29 +101,31 @@ def _compare(args: argparse.Namespace) -> int:
           "with the fitting recording's offsets (deployable), right of it with the validation "
           "recording's own means (oracle)")
     if out is not None:
-        with atomic_folder(out, args.force, ["compare.json"]) as tmp:
+        with atomic_folder(out, args.force, COMPARE_FILES) as tmp:
             write_json(table, tmp / "compare.json")
-        print(f"wrote {out / 'compare.json'}")
+            write_mat(tmp / "compare.mat", table)  # the same table for MATLAB
+        print(f"wrote {out / 'compare.json'}, {out / 'compare.mat'}")
     return failures_exit([name for name, m in table.items() if "error" in m])
 
 
 def _generalize(args: argparse.Namespace) -> int:
     from ..compensation import DEFAULT_CENTER
-    from ..io import atomic_folder, check_output_folder, read_recording, write_json
+    from ..io import atomic_folder, check_output_folder, read_recording, write_json, write_mat
     from ..reports import generalization_matrix, plot_generalization
     from ..sensors import simulate_experiment
     from ..signals import EXPERIMENTS
 
     models = _models(args.models)
     out = args.out or Path("hystkit-generalize")
-    names = ["generalize.json", "generalize.png"]
+    names = ["generalize.json", "generalize.mat", "generalize.png"]
     check_output_folder(out, names, args.force, inputs=args.data)
     sizes = _sizes(args.size)
     if args.data:
         if len(args.data) < 2:
             raise UsageError("generalize needs at least two recordings (train on each, test on "
                              "every other)")
-        recs = {path.stem: read_recording(path) for path in args.data}
+        recs = {path.stem: read_recording(path, options=read_options(args, path))
+                for path in args.data}
         if len(recs) < len(args.data):
             raise UsageError("generalize: recordings need distinct file names (the table uses "
                              "them)")
@@ -152,8 +156,10 @@ def _generalize(args: argparse.Namespace) -> int:
             failed.append(name)
     with atomic_folder(out, args.force, names) as tmp:  # complete or not at all
         write_json(matrix, tmp / "generalize.json")
+        write_mat(tmp / "generalize.mat", matrix)
         plot_generalization(matrix).savefig(tmp / "generalize.png", dpi=110)
-    print(f"\nwrote {out / 'generalize.json'}, {out / 'generalize.png'}")
+    print(f"\nwrote {out / 'generalize.json'}, {out / 'generalize.mat'}, "
+          f"{out / 'generalize.png'}")
     return failures_exit(failed)
 
 
@@ -170,7 +176,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     deferred(p.add_argument("--models"), help=models_help)
     p.add_argument("--size", action="append", default=[], metavar="MODEL=N",
                    help="model size, e.g. --size mpl=3 (repeatable)")
-    p.add_argument("--out", type=Path, help="folder for compare.json")
+    p.add_argument("--out", type=Path, help="folder for compare.json and compare.mat (the same "
+                   "table for MATLAB)")
     add_read_options(p)
     add_parallel_options(p)
     p.set_defaults(run=_compare)
@@ -181,6 +188,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="your recordings (at least two, one rate); default: the virtual sensor")
     deferred(p.add_argument("--models"), help=models_help)
     p.add_argument("--size", action="append", default=[], metavar="MODEL=N")
-    p.add_argument("--out", type=Path, help="output folder (default hystkit-generalize)")
+    p.add_argument("--out", type=Path, help="output folder (default hystkit-generalize): "
+                   "generalize.json, generalize.mat, generalize.png")
+    add_read_options(p)
     add_parallel_options(p)
     p.set_defaults(run=_generalize)

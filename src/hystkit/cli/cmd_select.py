@@ -37,7 +37,7 @@ def _centers(text: str) -> list[str]:
 def _select(args: argparse.Namespace) -> int:
     import pandas as pd  # only this command needs it and matplotlib
 
-    from ..compensation import save_compensator
+    from ..compensation import MODEL_SUFFIXES, save_compensator
     from ..io import (
         atomic_folder,
         check_output_folder,
@@ -47,11 +47,11 @@ def _select(args: argparse.Namespace) -> int:
     )
     from ..reports import candidates, folds, plot_selection, select_model
 
-    check_output_path(args.out, args.force, inputs=args.data)
+    check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
+                      what="a model file")
     report = args.report or args.out.with_name(args.out.stem + "-selection")
     check_output_folder(report, SELECTION_FILES, args.force, inputs=args.data)
-    options = read_options(args)
-    recs = [read_recording(path, options=options) for path in args.data]
+    recs = [read_recording(path, options=read_options(args, path)) for path in args.data]
     cands = candidates(_models(args.models), _centers(args.centers))
     t0 = time.perf_counter()
     print(f"selecting among {len(cands)} candidates on {', '.join(map(str, args.data))} "
