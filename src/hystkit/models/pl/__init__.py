@@ -15,5 +15,6 @@ FAMILY = PlFamily()
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
     {"model": ("*",), "fit": ("default_starts", "fit_pl", "solve_weights"),
-     "search": ("DEFAULT_GRID", "format_search_table", "structural_search")},
+     "grid": ("DEFAULT_GRID",),
+     "search": ("format_search_table", "structural_search")},
     first=("FAMILY", "PlFamily"))

@@ -13,12 +13,10 @@ from ...metrics import e_max_pct, e_rms_pct
 from ...parallel import Executor, SerialExecutor
 from . import model as pl
 from .fit import fit_pl
+from .grid import DEFAULT_GRID
 
 __all__ = ["DEFAULT_GRID", "format_search_table", "structural_search"]
 
-#: Default grid of :func:`structural_search` (16 structures, < ~30 s on 8000 samples).
-DEFAULT_GRID: dict[str, tuple] = {"n": (1, 2, 5, 10), "p": (5.0, 21.0), "m": (1, 5),
-                                  "s": (0.001,)}
 
 
 def structural_search(u: np.ndarray, y: np.ndarray, dt: float,
