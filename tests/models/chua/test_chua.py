@@ -155,6 +155,23 @@ def test_inverse_inside_the_dead_band_returns_its_middle():
     assert_allclose(u_hat, 2.0 * 0.25, rtol=1e-13)  # f(y): the middle of [f(y) -+ delta]
 
 
+@pytest.mark.parametrize("ulps", [-3, -1, 1, 3])
+def test_an_output_constant_to_rounding_stays_in_the_middle_of_the_dead_band(ulps):
+    # y off the state by a few ulps: before, the inverse jumped to f(y) +- delta by the sign of
+    # that rounding (fuzz seeds 1782420 and 62625); now it is constant, readable and compiled
+    p = _linear(2.0, 1.0, delta=0.3)
+    s = chua.ChuaStructure(dt=DT)
+    y = np.full(6, 0.25)
+    y[1:] += ulps * np.spacing(0.25)
+    u_hat, x_end = chua.invert(s, p, y, x0=0.25)
+    assert_allclose(u_hat, 2.0 * 0.25, rtol=1e-13)
+    assert x_end[0] == 0.25  # no element moved
+    u_step, x_step = chua.invert_step(s, p, np.array([0.25]), float(y[1]))
+    assert u_step == pytest.approx(2.0 * 0.25, rel=1e-13) and x_step[0] == 0.25
+    y_back, _ = chua.simulate(s, p, u_hat)  # from rest at u_hat[0] = f(0.25): x = 0.25
+    assert_allclose(y_back, y, rtol=0, atol=1e-14)
+
+
 def test_recovers_known_parameters_from_noise_free_data():
     truth = chua.ChuaParams(k0=[1.2], k_inf=[0.6], y_s=[0.4], g=[3.0], v_g=[0.5], delta=[0.1])
     s = chua.ChuaStructure(dt=DT)

@@ -16,6 +16,8 @@ from collections.abc import Callable
 import numpy as np
 
 HAS_INVERSE = True
+REST_TOL = 1e-12  # kernels.REST_TOL
+FLOAT_TOL = 2e-6  # in float, REST_TOL is below the resolution: ~16 float epsilons instead
 
 
 def extra(comp) -> dict:
@@ -53,7 +55,9 @@ static real rest_input(real y0)
 }}
 """ if plan.inverse else ""
     step = _C_INVERSE if plan.inverse else _C_FORWARD
+    tol = REST_TOL if not lit(0.5).endswith("f") else FLOAT_TOL  # the literal's precision
     return f"""#define N_EL {n}
+#define REST_TOL {lit(tol)}
 #define P(i, k) BODY[2 + (i) * N_EL + (k)]  /* parameter i of element k */
 
 /* Restoring function f: odd, slope k0 at 0 and k_inf far out */
@@ -131,12 +135,18 @@ static real dissipation_inverse(real r, int k, int upper)
    (kernels.solve_input), then the Euler step it gives (kernels.invert_sample) */
 static real model_step(real *x, real y)
 {
-    real fx[N_EL], total = R(0.0), r, lo = (real)HUGE_VAL, hi = -(real)HUGE_VAL, ends[2], e;
+    real fx[N_EL], total = R(0.0), scale = R(0.0), r, lo = (real)HUGE_VAL,
+         hi = -(real)HUGE_VAL, ends[2], e;
     int k, side;
     for (k = 0; k < N_EL; k++) {
         fx[k] = restoring(x[k], k);
         total += x[k];
+        scale += FABS(x[k]);
     }
+    /* the present output to rounding: no element moves (kernels.REST_TOL) */
+    if (FABS(y) > scale) scale = FABS(y);
+    if (scale < R(1.0)) scale = R(1.0);
+    if (FABS(y - total) <= REST_TOL * scale) y = total;
     r = (y - total) / BODY[1];
     for (k = 0; k < N_EL; k++) {
         const real l = fx[k] + dissipation_inverse(r / (real)N_EL, k, 0);
@@ -168,7 +178,7 @@ def m_model(plan, lit: Callable[[float], str]) -> str:
     value = "rest_input(B, value)" if plan.inverse else "value"
     step = (_M_INVERSE.replace("@MAXK@", lit(e["MAX_K"])).replace("@MAXS@",
                                                                    lit(e["MAX_SPREAD"]))
-            if plan.inverse else _M_FORWARD)
+            .replace("@RT@", lit(REST_TOL)) if plan.inverse else _M_FORWARD)
     return f"""function x = model_rest(B, value)
 u = {value};
 n = round(B(1));
@@ -260,11 +270,13 @@ end
 
 function [e, x] = model_step(B, x, y)
 n = round(B(1)); dt = B(2);
-fx = zeros(n, 1); total = 0.0;
+fx = zeros(n, 1); total = 0.0; scale = 0.0;
 for k = 1:n
     fx(k) = restoring(B, x(k), k);
     total = total + x(k);
+    scale = scale + abs(x(k));
 end
+if abs(y - total) <= @RT@ * max([1.0, abs(y), scale]), y = total; end
 r = (y - total) / dt;
 lo = Inf; hi = -Inf;
 for k = 1:n

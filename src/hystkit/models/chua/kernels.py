@@ -10,6 +10,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+# Relative output change (of max(1, |y|, sum |y_k|)) below which the inverse takes the output
+# as constant, ``r = 0``: rounding of the state's sum must not pick a dead band's edge.
+REST_TOL = 1e-12
+
 
 @njit(cache=True, inline="always")
 def restoring(y, k0, k_inf, y_s):
@@ -140,10 +144,13 @@ def invert_sample(x, xn, off, y, k0, k_inf, y_s, g, v_g, band, knee, cap, dt):
     """The input that makes :func:`advance` return ``y``; writes the state it leaves to ``xn``."""
     n_el = k0.size
     fx = np.empty(n_el)
-    total = 0.0
+    total = size = 0.0
     for k in range(n_el):
         fx[k] = restoring(x[off + k], k0[k], k_inf[k], y_s[k])
         total += x[off + k]
+        size += abs(x[off + k])
+    if abs(y - total) <= REST_TOL * max(1.0, abs(y), size):
+        y = total  # the present output to rounding: no element moves (the middle of the band)
     e = solve_input((y - total) / dt, fx, g, v_g, band, knee, cap)
     for k in range(n_el):
         xn[off + k] = x[off + k] + dt * dissipation(e - fx[k], g[k], v_g[k], band[k], knee[k],

@@ -248,11 +248,16 @@ def invert_step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
 
     ``sum_k g_k(u - f_k(x_k)) = (y - sum_k x_k) / dt`` is solved by bisection (its left side is
     non-decreasing in ``u``); where it is flat (no element moves, dead bands) the middle of the
-    flat interval is taken.
+    flat interval is taken. An output within ``REST_TOL max(1, |y|, sum |x_k|)`` of the present
+    ``sum x_k`` is that output (``r = 0``): rounding must not decide which edge of a dead band
+    the input jumps to.
     """
     x = np.asarray(x, dtype=float)
     fx = restoring(params, x)
-    r = (y - np.sum(x)) / structure.dt
+    total = float(np.sum(x))
+    if abs(y - total) <= kernels.REST_TOL * max(1.0, abs(y), float(np.sum(np.abs(x)))):
+        y = total
+    r = (y - total) / structure.dt
     cap, knee = limits(structure, params)
     n_el = x.size
     brackets = [_g_inverse(r / n_el, params, cap, knee, upper) + fx for upper in (False, True)]
@@ -351,7 +356,10 @@ def invert(structure: ChuaStructure, params: ChuaParams, y: np.ndarray,
     Each sample solves the Euler step for its input by bisection (:func:`invert_step`), so
     ``simulate(invert(y))`` returns ``y``. The input is unique wherever some element moves;
     with dead bands and a constant output it is any point of the band, and the middle is
-    returned. The inverse amplifies output noise by ``1 / (dt g')``.
+    returned. An output equal to the present one to rounding (relative ``REST_TOL = 1e-12``
+    of ``max(1, |y|, sum |y_k|)``) counts as constant: otherwise the rounding of the state's
+    sum would pick one edge of the band or the other (a jump of ``2 delta``), and a constant
+    output from the start would not come back from ``simulate``'s rest start. The inverse amplifies output noise by ``1 / (dt g')``.
 
     Parameters
     ----------

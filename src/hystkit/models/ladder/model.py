@@ -264,8 +264,10 @@ def invert(structure: LadderStructure, params: LadderParams, y: np.ndarray,
     Raises
     ------
     FitDivergedError
-        If ``w_0 = 0`` or the inverse leaves the finite range (its stability depends on the
-        weights, so it is checked, not guaranteed).
+        If ``w_0 = 0`` or the inverse leaves the finite range, ``|e| >= 1e6 (1 + max |y|)``
+        (its stability depends on the weights, so it is checked, not guaranteed; an unstable
+        inverse follows the path its rounding picks, so :func:`invert_step` looped over the
+        samples may leave that range where this stays bounded, or the other way round).
     """
     y = _check(structure, params, y, "y")
     if params.w[0] == 0:
