@@ -222,3 +222,19 @@ def test_records_round_trip_and_old_model_files_load():
     assert G.GPreisachStructure.from_dict(old_structure) == STRUCT == \
         G.GPreisachStructure(**json.loads(json.dumps(STRUCT.to_dict())))
     assert G.FAMILY.n_params(STRUCT, PARAMS) == (L - 1) * (L - 2) + 3 + 1
+
+
+def test_a_reversal_one_ulp_inside_an_older_extremum_is_a_valid_state():
+    # fuzz seed 0 (issue 10): the inverse kept -1 + 1 ulp after the maximum 0.98..., whose
+    # falling step rounds to the rising one's length; invert_step then refused that state
+    x = np.array([-1.0, 0.9838709677419355, np.nextafter(-1.0, 0.0)])
+    assert abs(x[2] - x[1]) == abs(x[1] - x[0])  # the lengths round equal, the values differ
+    assert_array_equal(P.check_state(x, 64), x)
+    assert_array_equal(P.update_staircase(x[:2], x[2], 64), x)  # the rule keeps it
+    with pytest.raises(ValueError, match="shrinking steps"):  # reaching -1 wipes it out
+        P.check_state(np.array([-1.0, 0.5, -1.0]), 64)
+    # the inverse continues from it: the present output keeps the present input
+    y_now, _ = G.step(STRUCT, PARAMS, x, x[2])
+    u_hat, x_next = G.invert_step(STRUCT, PARAMS, x, y_now)
+    assert u_hat == x[2]
+    assert_array_equal(x_next, x)
