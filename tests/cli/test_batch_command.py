@@ -89,7 +89,11 @@ def test_a_batch_killed_after_its_first_sensor_resumes_to_the_same_table(manifes
     import sys
 
     out = tmp_path / "killed"
-    proc = subprocess.Popen([sys.executable, "-m", "hystkit", "batch", str(manifest), "--out",
+    # SIGINT handled as in a terminal even when the test session runs as a background job
+    # (which starts with SIGINT ignored, inherited across exec)
+    with_ctrl_c = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler)"
+                   "; from hystkit.cli import main; sys.exit(main())")
+    proc = subprocess.Popen([sys.executable, "-c", with_ctrl_c, "batch", str(manifest), "--out",
                              str(out), "--workers", "2"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, start_new_session=True,
                             env={**os.environ, "PYTHONUNBUFFERED": "1"})

@@ -37,10 +37,17 @@ def lines_of(rec: Recording, n: int) -> list[str]:
                                               strict=True)]
 
 
+# A background job (CI) starts with SIGINT ignored, and an ignored signal stays ignored across
+# exec: the child gets Python's own Ctrl-C handler back first, as in a terminal. (Not
+# preexec_fn: the test session may run threads, e.g. a Dask cluster.)
+WITH_CTRL_C = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+               "from hystkit.cli import main; sys.exit(main())")
+
+
 def command(*args: str, **popen) -> subprocess.Popen:
     """The real command; without PYTHONUNBUFFERED, so only its own flushes push lines out."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
-    return subprocess.Popen([sys.executable, "-m", "hystkit", "stream", *args], env=env,
+    return subprocess.Popen([sys.executable, "-c", WITH_CTRL_C, "stream", *args], env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, **popen)
 
 
