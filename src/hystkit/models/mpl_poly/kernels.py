@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..mpl.kernels import fold_block, mirror_upper
+from ..mpl.kernels import NORMAL_BLOCK, fold_block, mirror_upper
 
 
 @njit(cache=True, inline="always")
@@ -116,8 +116,8 @@ def simulate_with_jacobian(u, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt, bo
     return y, jac, -1
 
 
-# Jacobian rows gathered, column-major, and folded into J^T J block by block (as in the mPL's).
-NORMAL_BLOCK = 256
+# Jacobian rows gathered, column-major, and folded into J^T J block by block: NORMAL_BLOCK and
+# fold_block are the mPL's.
 
 
 @njit(cache=True)
