@@ -8,7 +8,9 @@ from .._lazy import lazy_exports
 
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"_centring": ("CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",
+    {"_adaptive": ("ADAPT_PARAMETERS", "Adaptation", "AdaptiveState", "AdaptiveStream",
+                   "advance_adaptive"),
+     "_centring": ("CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",
                    "DEPLOYABLE_CENTERS", "ORACLE_CENTER", "center_label"),
      "_modes": ("MODES",),
      "_compensator": ("POSITION_MARGIN", "SENSOR_MARGIN", "Compensator"),

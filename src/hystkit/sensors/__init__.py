@@ -1,6 +1,12 @@
 """Simulated sensors that produce the same recordings as the lab, and the virtual sensor's causal
 physics as a loop model (the "real" sensor of the closed loop)."""
 
+from ._drift import (
+    gain_ramp,
+    occasional_references,
+    simulate_drifting_experiment,
+    with_gain_drift,
+)
 from ._loop_model import (
     VIRTUAL_PHYSICS,
     VirtualPhysics,
@@ -12,5 +18,7 @@ from ._raw import RawTruth, ScopeSettings, merged_levels, simulate_raw, with_asy
 from ._virtual import VirtualSensor, simulate_experiment
 
 __all__ = ["VIRTUAL_PHYSICS", "RawTruth", "ScopeSettings", "VirtualPhysics",
-           "VirtualPhysicsParams", "VirtualPhysicsStructure", "VirtualSensor", "merged_levels",
-           "physics_of", "simulate_experiment", "simulate_raw", "with_asymmetry"]
+           "VirtualPhysicsParams", "VirtualPhysicsStructure", "VirtualSensor", "gain_ramp",
+           "merged_levels", "occasional_references", "physics_of",
+           "simulate_drifting_experiment", "simulate_experiment", "simulate_raw",
+           "with_asymmetry", "with_gain_drift"]

@@ -1,0 +1,276 @@
+"""Online adaptation: a stream that re-fits its output's linear parameters from occasional
+reference positions (paper 9.1's proposal), by recursive least squares with forgetting.
+
+The compensator's estimate is linear in a few output parameters, whatever the model's memory:
+
+- ``"gain"`` (any family, either mode): ``estimate = a * y_hat + b`` with ``y_hat`` the plain
+  stream's estimate [mm]; ``theta = (a, b)`` starts at ``(1, 0)``. A drifting sensor gain, a
+  baseline shift and a changed mounting show up (to first order) as a gain and an offset here.
+- ``"weights"`` (direct compensators whose parameters have output weights ``w`` and a bias
+  ``v_b``, eq. 5.2: mPL, mPL-poly, PL, ladder): ``estimate = sum_k a_k c_k + b`` with
+  ``c_k = position_scale * w_k * y_k`` the k-th cell's contribution [mm] (``y_k`` the cell's
+  output, from a run with unit weight ``k``), ``a_k`` its multiplier (starts at 1) and ``b``
+  the offset correction [mm] (starts at 0). The cells' states do not depend on the weights, so
+  the regressors are exact; the linearity is checked on a probe run when the stream is made.
+
+Each sample with a known reference ``r`` [mm] updates ``theta`` (:func:`~._rls.rls_update`)
+*after* that sample's estimate is made: the estimate never sees its own reference (so its
+error against the reference is an honest prediction error). Until the first reference the
+output is the plain stream's, bit for bit; a chunk of any size gives the same bits as the same
+samples one by one.
+
+Not done here: re-fitting the full model (cell dynamics too) on a sliding window.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ._compensator import Compensator
+from ._rls import RlsState, rls_start, rls_update
+from ._stream import (
+    StartUp,
+    StreamOutput,
+    StreamState,
+    _advance,
+    _outside,
+    _Path,
+    _sensor_offset,
+    initial_state,
+)
+
+__all__ = ["ADAPT_PARAMETERS", "Adaptation", "AdaptiveState", "AdaptiveStream",
+           "advance_adaptive"]
+
+ADAPT_PARAMETERS = ("gain", "weights")
+# Relative error allowed between a model's output and its weighted cell outputs on the probe
+# run: rounding of a sum of a few hundred terms, far below any non-linearity in the weights.
+LINEARITY_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True)
+class Adaptation:
+    """How a stream adapts.
+
+    Parameters
+    ----------
+    parameters : {"gain", "weights"}
+        Which output parameters RLS re-fits (module docstring).
+    forgetting : float
+        Forgetting factor ``lambda`` in (0, 1], per reference sample: the estimate remembers
+        about ``1 / (1 - lambda)`` references (1: never forgets).
+    prior_gain : float
+        Prior standard deviation of each multiplier (``a``, ``a_k``), relative (0.1: 10 %).
+    prior_offset : float or None
+        Prior standard deviation of the offset ``b`` [mm]; None: 10 % of the training
+        positions' span (1 mm if the model file does not know it).
+    """
+
+    parameters: str = "gain"
+    forgetting: float = 0.95
+    prior_gain: float = 0.1
+    prior_offset: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.parameters not in ADAPT_PARAMETERS:
+            raise InputError(f"adaptation parameters {self.parameters!r}: use one of "
+                             f"{', '.join(ADAPT_PARAMETERS)}")
+        if not 0.0 < self.forgetting <= 1.0:
+            raise InputError(f"forgetting factor {self.forgetting!r}: must be in (0, 1]")
+        for name in ("prior_gain", "prior_offset"):
+            value = getattr(self, name)
+            if value is not None and not (0.0 < value < float("inf")):
+                raise InputError(f"{name} {value!r}: must be a finite positive number")
+
+
+@dataclass(frozen=True, eq=False)
+class AdaptiveState:
+    """The plain stream's state and the RLS state of the output parameters."""
+
+    stream: StreamState
+    rls: RlsState
+
+
+class _Plan:
+    """Per-stream constants: the plain stream's path, the regressors' recipe, the prior."""
+
+    def __init__(self, comp: Compensator, adaptation: Adaptation,
+                 rest_position: float | None) -> None:
+        self.path = _Path(comp, rest_position)
+        self.adaptation = adaptation
+        if adaptation.parameters == "weights":
+            self.unit_params = _unit_weight_params(comp)
+            scale = comp.scaling.position_scale
+            self.contribution = scale * np.asarray(comp.params.w, dtype=np.float64)
+            # estimate = sum_k c_k + constant, the constant from the bias and the centring
+            self.constant = self.path.position_offset - scale * float(comp.params.v_b)
+            n_mult = self.contribution.size
+        else:
+            self.constant = 0.0
+            n_mult = 1
+        span = (None if comp.position_range is None
+                else comp.position_range[1] - comp.position_range[0])
+        offset_std = adaptation.prior_offset or (0.1 * span if span else 1.0)
+        self.names = (("gain",) if n_mult == 1 else tuple(f"a_{k}" for k in range(n_mult))) \
+            + ("offset_mm",)
+        self.start = rls_start(np.r_[np.ones(n_mult), 0.0],
+                               np.r_[np.full(n_mult, adaptation.prior_gain), offset_std])
+
+    def regressors(self, state: StreamState, sensor: np.ndarray,
+                   estimate: np.ndarray) -> np.ndarray:
+        """Regressors [mm], shape (n, p): the last column is the offset's (ones)."""
+        ones = np.ones(sensor.size)
+        if self.adaptation.parameters == "gain":
+            return np.column_stack([estimate, ones])
+        comp = self.path.comp
+        # the normalised sensor exactly as _advance computes it (same operations, same bits)
+        offset, _ = _sensor_offset(self.path, state, sensor)
+        s = comp.polarity * (sensor - offset) / comp.scaling.sensor_scale
+        x0 = None if state.x is None else np.array(state.x)
+        cells = [comp.family.simulate(comp.structure, p, s, x0)[0] for p in self.unit_params]
+        return np.column_stack([c * y for c, y in zip(self.contribution, cells, strict=True)]
+                               + [ones])
+
+    def predict(self, rls: RlsState, phi: np.ndarray, plain: np.ndarray) -> np.ndarray:
+        """Estimates [mm] from ``theta``: the plain ones until the first reference."""
+        if rls.n_updates == 0:
+            return plain
+        # a sum in a fixed order, element by element: a chunk gives the bits of single samples
+        out = phi[:, 0] * rls.theta[0]
+        for k in range(1, rls.theta.size):
+            out = out + phi[:, k] * rls.theta[k]
+        return out + self.constant
+
+
+def _unit_weight_params(comp: Compensator) -> list[Any]:
+    """The model's parameters with one output weight 1 and the others and the bias 0, after
+    checking on a probe run that the output is linear in ``w`` and ``v_b``."""
+    params = comp.params
+    why = ""
+    if comp.mode != "direct":
+        why = "an inverse compensator's output is not linear in its weights"
+    elif not (hasattr(params, "w") and hasattr(params, "v_b")):
+        why = f"the {comp.model} model has no output weights w and bias v_b"
+    if why:
+        raise InputError(f"{comp.source or 'compensator'}: adaptation 'weights': {why}; "
+                         f"use 'gain'")
+    w = np.asarray(params.w, dtype=np.float64)
+    units = [dataclasses.replace(params, w=np.eye(w.size)[k], v_b=0.0) for k in range(w.size)]
+    probe = np.sin(np.linspace(0.0, 6.0 * np.pi, 300)) * np.linspace(0.2, 1.0, 300)
+    simulate = comp.family.simulate
+    whole = simulate(comp.structure, params, probe)[0]
+    parts = sum(wk * simulate(comp.structure, p, probe)[0] for wk, p in zip(w, units,
+                                                                            strict=True))
+    if not np.allclose(parts - params.v_b, whole, rtol=LINEARITY_TOLERANCE,
+                       atol=LINEARITY_TOLERANCE * np.max(np.abs(whole))):
+        raise InputError(f"{comp.source or 'compensator'}: adaptation 'weights': the "
+                         f"{comp.model} model's output is not linear in w and v_b; use 'gain'")
+    return units
+
+
+def _references(reference: np.ndarray | None, n: int, first: int, label: str) -> np.ndarray:
+    if reference is None:
+        return np.full(n, np.nan)
+    r = np.asarray(reference, dtype=np.float64).reshape(-1)
+    if r.size != n:
+        raise InputError(f"{label}: {r.size} references for {n} sensor samples")
+    bad = np.flatnonzero(np.isinf(r))
+    if bad.size:
+        raise InputError(f"{label}: sample {first + bad[0]}: reference is infinite "
+                         f"(NaN marks an unknown one)")
+    return r
+
+
+def _advance_plan(plan: _Plan, state: AdaptiveState, sensor: np.ndarray,
+                  reference: np.ndarray | None,
+                  label: str) -> tuple[StreamOutput, AdaptiveState]:
+    s_raw = np.ascontiguousarray(sensor, dtype=np.float64).reshape(-1)
+    r = _references(reference, s_raw.size, state.stream.n_samples, label)
+    plain, stream_next = _advance(plan.path, state.stream, s_raw, label)
+    if s_raw.size == 0:
+        return plain, state
+    phi = plan.regressors(state.stream, s_raw, plain.estimate)
+    estimate = np.empty(s_raw.size)
+    rls, begin = state.rls, 0
+    for i in [*np.flatnonzero(np.isfinite(r)).tolist(), s_raw.size]:
+        part = slice(begin, min(i + 1, s_raw.size))
+        estimate[part] = plan.predict(rls, phi[part], plain.estimate[part])
+        if i < s_raw.size:
+            rls = rls_update(rls, phi[i], r[i] - plan.constant, plan.adaptation.forgetting)
+        begin = i + 1
+    out = StreamOutput(estimate, plain.sensor_outside,
+                       _outside(estimate, plan.path.estimate_bounds))
+    return out, AdaptiveState(stream_next, rls)
+
+
+def advance_adaptive(comp: Compensator, adaptation: Adaptation, state: AdaptiveState,
+                     sensor: np.ndarray, reference: np.ndarray | None = None, *,
+                     rest_position: float | None = None,
+                     label: str = "stream") -> tuple[StreamOutput, AdaptiveState]:
+    """Run one chunk of raw sensor samples with references [mm] (NaN: unknown).
+
+    Pure, as :func:`~._stream.advance`; ``state`` comes from :attr:`AdaptiveStream.state`
+    or a previous call.
+    """
+    return _advance_plan(_Plan(comp, adaptation, rest_position), state, sensor, reference,
+                         label)
+
+
+class AdaptiveStream:
+    """A :class:`~._stream.Stream` whose output parameters follow occasional references.
+
+    Parameters
+    ----------
+    compensator : Compensator
+        Any deployable compensator; ``"weights"`` needs a direct one with weights ``w``, ``v_b``.
+    adaptation : Adaptation, optional
+        What to re-fit and how fast to forget (default: gain and offset, lambda = 0.95).
+    start, rest_position, label
+        As :class:`~._stream.Stream`.
+
+    Notes
+    -----
+    Holds only the present :class:`AdaptiveState`; :func:`advance_adaptive` is the same
+    computation without an object.
+    """
+
+    def __init__(self, compensator: Compensator, adaptation: Adaptation | None = None,
+                 start: StartUp = "rest", *, rest_position: float | None = None,
+                 label: str = "stream") -> None:
+        self._plan = _Plan(compensator, adaptation or Adaptation(), rest_position)
+        self._state = AdaptiveState(initial_state(compensator, start), self._plan.start)
+        self.label = label
+
+    @property
+    def compensator(self) -> Compensator:
+        return self._plan.path.comp
+
+    @property
+    def state(self) -> AdaptiveState:
+        """The present state (immutable)."""
+        return self._state
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        """The present output parameters by name (multipliers, then ``offset_mm``)."""
+        return dict(zip(self._plan.names, self._state.rls.theta.tolist(), strict=True))
+
+    def step(self, sensor: float, reference: float = float("nan")) -> float:
+        """Estimate [mm] for one raw sensor sample; then learn from ``reference`` if known."""
+        return float(self.process(np.array([sensor]), np.array([reference]))[0])
+
+    def process(self, sensor: np.ndarray, reference: np.ndarray | None = None) -> np.ndarray:
+        """Estimates [mm] for a chunk; ``reference`` [mm] per sample, NaN where unknown."""
+        return self.process_flagged(sensor, reference).estimate
+
+    def process_flagged(self, sensor: np.ndarray,
+                        reference: np.ndarray | None = None) -> StreamOutput:
+        """Estimates and use-time flags (of the adapted estimate) for a chunk."""
+        out, self._state = _advance_plan(self._plan, self._state, sensor, reference,
+                                         self.label)
+        return out
