@@ -161,7 +161,8 @@ def _compare_piece(piece: tuple[str, int | None, str], *, fit_rec: Recording,
         return {"error": f"{type(exc).__name__}: {exc}"}
 
 
-GRID_KEYS = ("r2", "r2_oracle", "linear_r2")
+# e_rms_pct: the normalised RMS error (eq. 5.11) that table 2.2 takes statistics of
+GRID_KEYS = ("r2", "r2_oracle", "linear_r2", "e_rms_pct", "e_rms_pct_oracle")
 
 
 def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Recording],
@@ -176,8 +177,9 @@ def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Rec
     Returns
     -------
     dict
-        ``{model: {"r2", "r2_oracle", "linear_r2": {train: {test: value}}, "errors": {train:
-        reason}, "notes": {train: reason}}}``: deployable and oracle R²; a failed fit or run
+        ``{model: {"r2", "r2_oracle", "linear_r2", "e_rms_pct", "e_rms_pct_oracle": {train:
+        {test: value}}, "errors": {train: reason}, "notes": {train: reason}}}``: deployable and
+        oracle R² and RMS error (% of the training range, eq. 5.11); a failed fit or run
         gives None and its reason in ``errors``, as does a collapsed fit or one worse than its
         line (its scores are kept); parameters on bounds or an exhausted budget are ``notes``.
     """
