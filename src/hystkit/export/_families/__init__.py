@@ -22,9 +22,9 @@ from types import ModuleType
 
 __all__ = ["REFUSALS", "TRANSLATED", "refusal", "translator"]
 
-TRANSLATED = {"mpl": "mpl", "mpl-poly": "mpl_poly", "pi": "pi", "preisach": "preisach",
-              "gpreisach": "preisach", "ladder": "ladder", "boucwen": "boucwen",
-              "bobbio": "bobbio", "chua": "chua", "pl": "pl"}
+TRANSLATED = {"mpl": "mpl", "mpl-poly": "mpl_poly", "mpl-g": "mpl_g", "pi": "pi",
+              "preisach": "preisach", "gpreisach": "preisach", "ladder": "ladder",
+              "boucwen": "boucwen", "bobbio": "bobbio", "chua": "chua", "pl": "pl"}
 
 REFUSALS: dict[str, str] = {}  # every registered family is translated
 

@@ -182,12 +182,7 @@ def m_model(plan, lit: Callable[[float], str]) -> str:
 x = e0 - {v_rest};
 end
 
-function [v, slope] = cubic(c, x)
-v = c(1) + x * (c(2) + x * (c(3) + x * c(4)));
-slope = c(2) + x * (2.0 * c(3) + 3.0 * c(4) * x);
-end
-
-function x = cells(B, x, drive)
+{M_CUBIC}function x = cells(B, x, drive)
 n = round(B(1)); if_ = 13; ik = if_ + 4 * n;
 for k = 1:n
     v = drive - x(k);
@@ -203,7 +198,45 @@ for k = 1:n
 end
 end
 
-function [z, ok] = solve_output(B, i)
+{M_SOLVE}{step}"""
+
+
+_M_FORWARD = """
+function [y, x] = model_step(B, x, u)
+n = round(B(1)); iw = 14 + 6 * n;
+z = B(iw) * u - B(2);
+for k = 1:n
+    z = z + B(iw + k) * x(k);
+end
+y = cubic(B(10:13), z);
+x = cells(B, x, u);
+end
+"""
+
+_M_INVERSE = """
+function [u_hat, x] = model_step(B, x, y)
+n = round(B(1)); iw = 14 + 6 * n;
+[z, ok] = solve_output(B, y);
+acc = z + B(2);
+for k = 1:n
+    acc = acc - B(iw + k) * x(k);
+end
+if ok, u_hat = acc / B(iw); else, u_hat = NaN; end
+x = cells(B, x, u_hat);
+end
+"""
+
+
+# Shared with translations whose output resistor is this cubic ``g`` (mpl_g.py): plain text,
+# no format fields.
+M_CUBIC = """function [v, slope] = cubic(c, x)
+v = c(1) + x * (c(2) + x * (c(3) + x * c(4)));
+slope = c(2) + x * (2.0 * c(3) + 3.0 * c(4) * x);
+end
+
+"""
+
+M_SOLVE = """function [z, ok] = solve_output(B, i)
 g = B(10:13); lo = B(6); hi = B(7); sign_ = B(8); centre = B(9);
 z = NaN; ok = false;
 width = 1.0;
@@ -240,31 +273,5 @@ for it = 1:200
     z = z_new;
 end
 ok = true;
-end
-{step}"""
-
-
-_M_FORWARD = """
-function [y, x] = model_step(B, x, u)
-n = round(B(1)); iw = 14 + 6 * n;
-z = B(iw) * u - B(2);
-for k = 1:n
-    z = z + B(iw + k) * x(k);
-end
-y = cubic(B(10:13), z);
-x = cells(B, x, u);
-end
-"""
-
-_M_INVERSE = """
-function [u_hat, x] = model_step(B, x, y)
-n = round(B(1)); iw = 14 + 6 * n;
-[z, ok] = solve_output(B, y);
-acc = z + B(2);
-for k = 1:n
-    acc = acc - B(iw + k) * x(k);
-end
-if ok, u_hat = acc / B(iw); else, u_hat = NaN; end
-x = cells(B, x, u_hat);
 end
 """

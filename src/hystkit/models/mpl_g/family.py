@@ -1,0 +1,141 @@
+"""The ch. 7 compensator family (sec. 7.2: sinh cells, eq. 5.1-5.6, with a cubic output
+resistor, eq. 5.16-5.17) behind the family protocol."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..._lazy import lazy
+from ...errors import FitDivergedError
+from .._cells import Cells, cell_report
+from .._protocol import Block, Family
+
+if TYPE_CHECKING:
+    from . import model as mpl_g
+
+__all__ = ["MplGFamily"]
+
+
+class MplGFamily(Family):
+    name = "mpl-g"
+    title = ("ch. 7 compensator: sinh cells with a cubic output resistor g (sec. 7.2, "
+             "eq. 5.1-5.6, 5.16-5.17)")
+    size_help = "cells N (3N + 6 params)"
+    default_size = 1
+    max_size = 50
+    docs = "docs/models/mpl_g.md"
+    # The equations, fit and numba kernels load on first use, not with the registry.
+    Structure = lazy(".model", "MplGStructure")
+    Params = lazy(".model", "MplGParams")
+    model = lazy(".model")  # step, simulate, invert, rest_state
+
+    @staticmethod
+    def fit_function(u, y, structure, **options):
+        """:func:`.fit.fit_mpl_g`."""
+        from .fit import fit_mpl_g
+
+        return fit_mpl_g(u, y, structure, **options)
+
+    def invert(self, structure, params, y, x0=None):
+        return self.model.invert(structure, params, y, x0)
+
+    def invert_step(self, structure, params, x, y):
+        """As :func:`model.invert_step`; NaN input estimate and state when ``y`` is outside
+        the range of ``g``'s branch (no input gives it), as the compiled block."""
+        from . import model as mpl_g
+
+        if not mpl_g._solve(params, y)[1]:
+            return np.nan, np.full(np.size(x), np.nan)
+        return mpl_g.invert_step(structure, params, x, y)
+
+    def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> mpl_g.MplGStructure:
+        return self.Structure(n_cells=size, dt=dt, slope_cap=slope_cap)
+
+    def at(self, structure, dt):
+        """Same cells and slope cap at ``dt``: ``I_S``, ``V_T`` and ``g`` are those of a
+        continuous ODE and a memoryless output; only the Euler knees (``f' = slope_cap / dt``)
+        follow ``dt``, and they are computed from it."""
+        return super().at(structure, dt)
+
+    def random_params(self, structure, rng):
+        """:func:`.fit.random_params`: ``G_k`` log-uniform in ``[1e-4, slope_cap / dt]``,
+        ``V_T`` log-uniform in ``[1e-3, 1e3]``, ``g``, ``w`` uniform in ``[-2, 2]``, ``V_b`` in
+        ``[-1, 1]``; bounded: ``|y| <= sum_j |g_j| Z^j``, ``Z = sum |w| max|u| + |V_b|``."""
+        from .fit import random_params
+
+        return random_params(structure, rng)
+
+    def presets(self):
+        """The sec. 7.2 compensators of paper 9.2's table II sensors, ``ch7-table-ii-COLUMN``,
+        fitted on first use (about 1-3 s each; :mod:`.presets` says why table II's own weights
+        cannot be presets of this family)."""
+        from ..mpl_poly.presets import PAPER_9_2_TABLE_II
+        from .presets import ch7_compensator
+
+        return {f"ch7-table-ii-{column}": ch7_compensator(column)
+                for column in PAPER_9_2_TABLE_II}
+
+    def block(self, structure, params, inverse=False):
+        from . import kernels
+        from . import model as mpl_g
+
+        if inverse:
+            if params.w[0] == 0:
+                raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
+            branch = mpl_g.inverse_branch(params)
+        else:  # the forward model needs no branch (g may have none through the rest point)
+            branch = (-np.inf, np.inf, 0.0, 0.0)
+        body = np.concatenate([[params.n_cells, params.v_b, structure.slope_cap / structure.dt,
+                                structure.dt, 1.0], branch, params.g, params.i_s, params.v_t,
+                               mpl_g.knee_voltage(structure, params), params.w])
+        step = kernels.block_inverse if inverse else kernels.block_forward
+        return Block(step, np.ascontiguousarray(body, dtype=np.float64), structure.n_cells)
+
+    def linearise(self, structure, params, x, u, inverse=False):
+        """Paper 9.2 eq. 2-7. Forward: ``dx+ = (1 - f' dt) dx + f' dt du``,
+        ``dy = g'(z) (w_0 du + w . dx)``. Inverse: ``dz = dy / g'(z)``,
+        ``de = (dz - w . dx) / w_0``, the cells driven by ``e``. ``f'`` is the slope of the
+        limited sinh resistor (eq. 5.29) at the operating point."""
+        from ..mpl.kernels import current
+        from . import model as mpl_g
+
+        x = np.asarray(x, dtype=float)
+        w0, w = params.w[0], params.w[1:]
+        if inverse:
+            z, ok = mpl_g._solve(params, u)
+            if not ok:
+                raise ValueError(f"output {u:.4g} is outside the range of g's branch: the "
+                                 f"inverse is not defined there")
+            drive = (z - w @ x + params.v_b) / w0
+        else:
+            drive = u
+            z = w0 * u + w @ x - params.v_b
+        dg = float(mpl_g.output_slope(params, z))
+        knee = mpl_g.knee_voltage(structure, params)
+        cap = structure.slope_cap / structure.dt
+        g = np.array([current(drive - x[k], params.i_s[k], params.v_t[k], knee[k], cap)[1]
+                      for k in range(structure.n_cells)]) * structure.dt
+        if inverse:
+            return (np.diag(1.0 - g) - np.outer(g, w) / w0, g / (w0 * dg), -w / w0,
+                    float(1.0 / (w0 * dg)))
+        return np.diag(1.0 - g), g, dg * w, float(dg * w0)
+
+    def cells(self, structure, params) -> Cells:
+        """The model as the eq. 5.18-5.28 analysis sees it (sinh cells, cubic output ``g``)."""
+        from ..mpl import FAMILY as MPL
+        from . import model as mpl_g
+
+        sinh = MPL.cells(structure, params)  # duck-typed: the cells read i_s, v_t, w, v_b
+        return Cells(current=sinh.current, slope=sinh.slope,
+                     output=lambda z: mpl_g.output_current(params, z),
+                     output_slope=lambda z: mpl_g.output_slope(params, z), w=params.w,
+                     v_b=params.v_b, dt=structure.dt, knees=sinh.knees,
+                     rest_points=sinh.rest_points,
+                     start=lambda e0: np.full(structure.n_cells, e0),
+                     check=lambda u: mpl_g.simulate(structure, params, u))
+
+    def stability_details(self, structure, params, u):
+        """eq. 5.28 per cell at every rest point and along a run on ``u`` (``_cells``)."""
+        return cell_report(self.cells(structure, params), u)

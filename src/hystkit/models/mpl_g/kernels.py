@@ -1,0 +1,158 @@
+"""Compiled hot loops of the ch. 7 compensator; ``model.py`` holds the reference and the checks.
+
+All arrays are float64 and validated by the caller. The cells are the mPL's (``current``: the
+limited sinh resistor, eq. 5.1 with 5.29), the inverse of the output resistor is the
+mpl-poly's (``solve_output``); ``gc`` (4,) holds ``g``'s cubic coefficients.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..mpl.kernels import current
+from ..mpl_poly.kernels import solve_output
+
+
+@njit(cache=True, inline="always")
+def _output(gc, z):
+    """``g(z)`` and ``g'(z)`` (eq. 5.16-5.17)."""
+    return (gc[0] + z * (gc[1] + z * (gc[2] + z * gc[3])),
+            gc[1] + z * (2.0 * gc[2] + 3.0 * gc[3] * z))
+
+
+@njit(cache=True)
+def simulate(u, x0, gc, w, v_b, i_s, v_t, knee, cap, dt):
+    """Forward model; returns ``(y, x_end)``."""
+    n_cells = x0.size
+    x = x0.copy()
+    y = np.empty(u.size)
+    for n in range(u.size):
+        z = w[0] * u[n] - v_b
+        for k in range(n_cells):
+            z += w[k + 1] * x[k]
+        y[n], _ = _output(gc, z)
+        for k in range(n_cells):
+            f, _ = current(u[n] - x[k], i_s[k], v_t[k], knee[k], cap)
+            x[k] += f * dt
+    return y, x
+
+
+@njit(cache=True)
+def simulate_with_jacobian(u, x0, gc, w, v_b, i_s, v_t, knee, cap, dt):
+    """Forward model output and its exact Jacobian by forward sensitivities.
+
+    Columns follow ``MplGParams.to_vector``: per cell ``log G_k``, ``log V_Tk``, then
+    ``g_0..g_3``, ``w_0..w_N``, ``V_b``. The cells' sensitivities are the mPL's (see
+    ``mpl.kernels.simulate_with_jacobian``); the output multiplies them by ``g'(z)``.
+    """
+    n_cells = x0.size
+    x = x0.copy()
+    sens = np.zeros((n_cells, 2))
+    y = np.empty(u.size)
+    jac = np.empty((u.size, 3 * n_cells + 6))
+    col_g, col_w, col_vb = 2 * n_cells, 2 * n_cells + 4, 3 * n_cells + 5
+    for n in range(u.size):
+        z = w[0] * u[n] - v_b
+        for k in range(n_cells):
+            z += w[k + 1] * x[k]
+        y[n], dg = _output(gc, z)
+        zj = 1.0
+        for j in range(4):
+            jac[n, col_g + j] = zj
+            zj *= z
+        jac[n, col_w] = dg * u[n]
+        jac[n, col_vb] = -dg
+        for k in range(n_cells):
+            jac[n, 2 * k] = dg * w[k + 1] * sens[k, 0]
+            jac[n, 2 * k + 1] = dg * w[k + 1] * sens[k, 1]
+            jac[n, col_w + 1 + k] = dg * x[k]
+        for k in range(n_cells):
+            v = u[n] - x[k]
+            f, slope = current(v, i_s[k], v_t[k], knee[k], cap)
+            if abs(v) <= knee[k]:
+                d_log_g = f
+                d_log_vt = f - v * slope
+            else:  # the knee's own motion cancels (f'(knee) = cap)
+                s = 1.0 if v > 0 else -1.0
+                f_knee = 2.0 * i_s[k] * np.sinh(knee[k] / v_t[k])
+                d_log_g = s * f_knee
+                d_log_vt = s * (f_knee - knee[k] * cap)
+            sens[k, 0] += (d_log_g - slope * sens[k, 0]) * dt
+            sens[k, 1] += (d_log_vt - slope * sens[k, 1]) * dt
+            x[k] += f * dt
+    return y, jac
+
+
+@njit(cache=True)
+def invert(y, x0, gc, lo, hi, sign, centre, w, v_b, i_s, v_t, knee, cap, dt, bound):
+    """Inverse model: ``g(z) = y`` on the branch, ``e`` from the output equation with the
+    present state, then the state update (fig. 5.12). Returns ``(e_hat, x_end, n_bad, why)``:
+    ``why`` 1 when ``y`` is outside the branch's range, 2 when ``|e| >= bound``; ``n_bad = -1``
+    when all went well."""
+    n_cells = x0.size
+    x = x0.copy()
+    e_hat = np.empty(y.size)
+    for n in range(y.size):
+        z, ok = solve_output(y[n], gc, lo, hi, sign, centre)
+        if not ok:
+            return e_hat, x, n, 1
+        acc = z + v_b
+        for k in range(n_cells):
+            acc -= w[k + 1] * x[k]
+        e = acc / w[0]
+        if not abs(e) < bound:
+            return e_hat, x, n, 2
+        e_hat[n] = e
+        for k in range(n_cells):
+            f, _ = current(e - x[k], i_s[k], v_t[k], knee[k], cap)
+            x[k] += f * dt
+    return e_hat, x, -1, 0
+
+
+# Loop blocks (protocol in ``hystkit.models._protocol``): body = [n, v_b, cap, dt, 1.0, lo, hi,
+# sign, centre, g0..g3, i_s (n), v_t (n), knee (n), w (n + 1)]. The head is the mpl-poly's
+# layout (slot 4 is its limit switch, always on here), so that its ``solve_output`` and its C
+# translation read ``lo, hi, sign, centre`` and ``g`` from the same places.
+_IG = 9  # first output-resistor coefficient
+_IC = 13  # first cell parameter
+
+
+@njit(cache=True, inline="always")
+def _block_cells(body, x, xn, off, drive):
+    """The cells' Euler update (eq. 5.6, sinh resistors limited by eq. 5.29) driven by
+    ``drive``."""
+    n = int(body[0])
+    for k in range(n):
+        f, _ = current(drive - x[off + k], body[_IC + k], body[_IC + n + k],
+                       body[_IC + 2 * n + k], body[2])
+        xn[off + k] = x[off + k] + f * body[3]
+
+
+@njit(cache=True)
+def block_forward(body, x, xn, off, u):
+    """``y = g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17), then the cells driven by ``u``."""
+    n = int(body[0])
+    iw = _IC + 3 * n
+    z = body[iw] * u - body[1]
+    for k in range(n):
+        z += body[iw + 1 + k] * x[off + k]
+    y, _ = _output(body[_IG:_IG + 4], z)
+    _block_cells(body, x, xn, off, u)
+    return y
+
+
+@njit(cache=True)
+def block_inverse(body, x, xn, off, y):
+    """``z = g^-1(y)`` on the rest branch, ``u_hat = (z - sum w_k x_k + V_b) / w_0``, cells
+    driven by ``u_hat``. NaN (output and state) when ``y`` is outside the branch's range: no
+    input gives that output, and the loop stops on it."""
+    n = int(body[0])
+    iw = _IC + 3 * n
+    z, ok = solve_output(y, body[_IG:_IG + 4], body[5], body[6], body[7], body[8])
+    acc = z + body[1]
+    for k in range(n):
+        acc -= body[iw + 1 + k] * x[off + k]
+    u_hat = acc / body[iw] if ok else np.nan
+    _block_cells(body, x, xn, off, u_hat)
+    return u_hat

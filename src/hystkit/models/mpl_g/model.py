@@ -1,0 +1,334 @@
+"""The ch. 7 compensator: sinh cells with a cubic output resistor ``g`` (sec. 7.2).
+
+Sec. 7.2 builds ``S_m^comp`` from "the first modification of the original PL model where a
+hyperbolic function is used to describe the non-linear resistor for sub-circuit (a)" (the mPL,
+eq. 5.1-5.6), "extended with a second non-linear resistor at the output, represented by a 3rd
+order polynomial of the form described by 5.16"; the output equation is then eq. 5.17::
+
+    du_k/dt = f_k(e - u_k),          f_k(v) = I_Sk (exp(v/V_Tk) - exp(-v/V_Tk))    # eq. 5.1, 5.5
+    i       = g(w_0 e + sum_k w_k u_k - V_b),   g(z) = g_0 + g_1 z + g_2 z^2 + g_3 z^3  # eq. 5.17
+
+integrated with forward Euler (eq. 5.6) and the cells limited by eq. 5.29 (corrected) exactly
+as in the mPL: the cells, their knees and their limit are the ``mpl`` family's functions, the
+output resistor and its inverse are the ``mpl-poly`` family's, imported, not copied. ``g``
+holds the plain coefficients (the document's ``g_2^2, g_3^3`` form of eq. 5.16 is a
+parametrisation; ``mpl_poly.presets`` converts printed values). The state ``x`` is the vector of
+cell voltages; a sinh cell rests at ``v = 0`` (it is odd and increasing), so at rest
+``u_k = e``.
+
+Inverse (eq. 5.13-5.14 with ``g``): ``z = g^-1(i)`` on the monotone branch of ``g`` through
+the rest point ``z = -V_b`` (the output voltage at rest at ``e = 0``), then
+``e = (z - sum w_k u_k + V_b) / w_0`` with the present state, then the state update
+(fig. 5.12).
+
+Everything here is pure: memory is the explicit state ``x`` passed in and returned.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ...errors import FitDivergedError
+from .._cells import MAX_CELLS, CellStructure
+from .._protocol import Record
+from .._validation import (
+    check_finite_run,
+    check_magnitude,
+    check_range,
+    check_signal,
+    check_size,
+    check_structure_size,
+    finite_floats,
+    freeze_arrays,
+    frozen_shaped,
+    initial_state,
+    run_steps,
+)
+from ..mpl.model import I_S_RANGE, V_T_RANGE, knee_voltage, resistor_current
+from ..mpl_poly.kernels import solve_output
+from ..mpl_poly.model import G_MIN, POLY_MAX, output_current, output_slope
+from . import kernels
+
+__all__ = [
+    "MplGParams",
+    "MplGStructure",
+    "inverse_branch",
+    "invert",
+    "invert_step",
+    "knee_voltage",
+    "output_branch",
+    "output_current",
+    "output_slope",
+    "resistor_current",
+    "rest_state",
+    "simulate",
+    "simulate_reference",
+    "simulate_with_jacobian",
+    "step",
+]
+
+
+@dataclass(frozen=True)
+class MplGStructure(CellStructure):
+    """What does not get fitted: cell count ``N``, sample time and the Euler slope cap
+    (:class:`~hystkit.models._cells.CellStructure`; the cap bounds ``f'(v) dt``)."""
+
+    @property
+    def n_params(self) -> int:
+        """``3N + 6`` fitted parameters (9 for the document's N = 1); ``3N + 4`` identifiable
+        (``fit.canonical``)."""
+        return 3 * self.n_cells + 6
+
+
+@dataclass(frozen=True, eq=False)
+class MplGParams(Record):
+    """Fitted quantities of the ch. 7 compensator.
+
+    Parameters
+    ----------
+    i_s, v_t : array, shape (N,)
+        Saturation current ``I_S`` and voltage scale ``V_T`` of each sinh cell (> 0), eq. 5.1.
+    g : array, shape (4,)
+        Cubic coefficients ``g_0..g_3`` of the output resistor (eq. 5.16-5.17).
+    w : array, shape (N + 1,)
+        VCVS weights ``w_0 .. w_N``.
+    v_b : float
+        Bias voltage ``V_b``.
+
+    Notes
+    -----
+    Domain (checked here): ``I_S``, ``V_T`` as the mPL (1e-12 .. 1e12, 1e-6 .. 1e12),
+    ``|g_j| <= 1e9`` and each ``g_j`` 0 or at least 1e-200 in magnitude (as the mpl-poly's
+    ``g``), ``|w_k|, |V_b| <= 1e6``, at most 1000 cells. With ``slope_cap <= 1`` every cell stays
+    within the range of its inputs and initial state, so the output is bounded by
+    ``sum_j |g_j| Z^j`` with ``Z = sum |w| max|u| + |V_b|``.
+
+    The optimiser sees ``[log G_1, log V_T1, ..., log G_N, log V_TN, g_0..g_3, w_0..w_N, V_b]``
+    with ``G_k = 2 I_Sk / V_Tk`` the cell's small-signal conductance (as the mPL).
+    """
+
+    i_s: np.ndarray
+    v_t: np.ndarray
+    g: np.ndarray
+    w: np.ndarray
+    v_b: float = 0.0
+    n_cells: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        n = np.size(self.i_s)
+        check_structure_size(n, "the number of cells (size of i_s)", MAX_CELLS)  # before copying
+        object.__setattr__(self, "n_cells", int(n))
+        freeze_arrays(self, i_s=n, v_t=n, w=n + 1)
+        object.__setattr__(self, "g", frozen_shaped(self.g, (4,), "g"))
+        finite_floats(self, "v_b")
+        check_range(self.i_s, "i_s", *I_S_RANGE, " (eq. 5.1)")
+        check_range(self.v_t, "v_t", *V_T_RANGE, " (eq. 5.1)")
+        check_magnitude(self.g, "g", POLY_MAX)
+        tiny = (self.g != 0) & (np.abs(self.g) < G_MIN)
+        if np.any(tiny):
+            raise ValueError(f"g must be 0 or at least {G_MIN:g} in magnitude (its roots are "
+                             f"solved for), got {float(self.g[np.argmax(tiny)])!r}")
+        check_magnitude(self.w, "w")
+        check_magnitude(self.v_b, "v_b")
+
+    def to_vector(self) -> np.ndarray:
+        """Optimiser coordinates (see Notes of the class)."""
+        cells = np.column_stack([np.log(2 * self.i_s / self.v_t), np.log(self.v_t)]).reshape(-1)
+        return np.concatenate([cells, self.g, self.w, [self.v_b]])
+
+    @classmethod
+    def from_vector(cls, theta: np.ndarray, n_cells: int) -> MplGParams:
+        """Inverse of :meth:`to_vector`."""
+        theta = np.asarray(theta, dtype=float)
+        cells = theta[: 2 * n_cells].reshape(n_cells, 2)
+        v_t = np.exp(cells[:, 1])
+        rest = theta[2 * n_cells:]
+        return cls(i_s=0.5 * np.exp(cells[:, 0]) * v_t, v_t=v_t, g=rest[:4],
+                   w=rest[4:n_cells + 5], v_b=rest[n_cells + 5])
+
+
+def output_branch(params: MplGParams) -> tuple[float, float, float]:
+    """The monotone branch of ``g`` the inverse uses: ``(lo, hi, sign)``.
+
+    It is the largest interval around the rest point ``z_rest = -V_b`` (the output voltage at
+    rest at ``e = 0``, the centre of centred data) on which ``g'`` keeps its sign; ``+-inf``
+    where ``g'`` has no root on that side.
+
+    Raises
+    ------
+    FitDivergedError
+        If ``g'(z_rest) = 0`` (no monotone branch through the operating point).
+    """
+    z_rest = -params.v_b
+    slope = float(output_slope(params, z_rest))
+    if slope == 0:
+        raise FitDivergedError(f"the output resistor has g'(z) = 0 at the rest point "
+                               f"z = {z_rest:.4g}, so it is not invertible there")
+    roots = np.roots([3 * params.g[3], 2 * params.g[2], params.g[1]])
+    roots = roots[np.abs(roots.imag) <= 1e-12 * np.abs(roots)].real
+    lo = max(roots[roots < z_rest], default=-np.inf)
+    hi = min(roots[roots > z_rest], default=np.inf)
+    return float(lo), float(hi), float(np.sign(slope))
+
+
+def inverse_branch(params: MplGParams) -> tuple[float, float, float, float]:
+    """``(lo, hi, sign, centre)``: :func:`output_branch` and ``z_rest = -V_b``, the
+    arguments of ``mpl_poly.kernels.solve_output``."""
+    return (*output_branch(params), -float(params.v_b))
+
+
+def _solve(params: MplGParams, y: float) -> tuple[float, bool]:
+    return solve_output(float(y), np.ascontiguousarray(params.g), *inverse_branch(params))
+
+
+def rest_state(structure: MplGStructure, params: MplGParams, value: float,
+               inverse: bool = False) -> np.ndarray:
+    """Cells at rest, ``u_k = e_0``, shape (N,).
+
+    Forward: ``e_0`` is the constant input ``value``. Inverse (``value`` a constant output):
+    ``e_0 = (z_0 + V_b) / sum w`` with ``g(z_0) = value`` on the branch, the input at which the
+    model rests with that output; ``e_0 = 0`` if ``value`` is outside the branch's range or
+    ``sum w = 0``. :func:`simulate` / :func:`invert` start here for ``x0=None``.
+    """
+    if inverse:
+        z0, ok = _solve(params, value)
+        w_sum = float(params.w.sum())
+        value = (z0 + params.v_b) / w_sum if ok and w_sum != 0 else 0.0
+    return np.full(structure.n_cells, float(value))
+
+
+def step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
+         u: float) -> tuple[float, np.ndarray]:
+    """One sample of the forward model: output from the present state, then the Euler update.
+
+    Returns
+    -------
+    y : float
+        ``g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17).
+    x_next : array, shape (N,)
+        Cell voltages after ``dt`` (eq. 5.6, sinh resistors limited by eq. 5.29).
+    """
+    x = np.asarray(x, dtype=float)
+    y = output_current(params, params.w[0] * u + params.w[1:] @ x - params.v_b)
+    return float(y), x + resistor_current(structure, params, u - x) * structure.dt
+
+
+def invert_step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
+                y: float) -> tuple[float, np.ndarray]:
+    """One sample of the inverse (readable reference): ``z = g^-1(y)`` on
+    :func:`output_branch` by bracketed root finding, the input from the output equation with
+    the present state (eq. 5.13), then the state update (fig. 5.12).
+
+    Raises
+    ------
+    ValueError
+        If ``y`` is outside the range of the branch (no input gives it).
+    """
+    x = np.asarray(x, dtype=float)
+    lo, hi, _ = output_branch(params)
+    a = lo if np.isfinite(lo) else -1e15
+    b = hi if np.isfinite(hi) else 1e15
+    # a +-1e15 bracket down to 1e-15 takes ~101 halvings: above brentq's default 100
+    z = brentq(lambda z: output_current(params, z) - y, a, b, xtol=1e-15, rtol=1e-15,
+               maxiter=200)
+    e = (z - params.w[1:] @ x + params.v_b) / params.w[0]
+    return float(e), x + resistor_current(structure, params, e - x) * structure.dt
+
+
+def _check(structure: MplGStructure, params: MplGParams, u, name: str) -> np.ndarray:
+    check_size(params.n_cells, structure.n_cells, "cells")
+    return check_signal(u, name)
+
+
+def _cell_args(structure: MplGStructure, params: MplGParams) -> tuple:
+    return (params.i_s, params.v_t, knee_voltage(structure, params),
+            structure.slope_cap / structure.dt, structure.dt)
+
+
+def simulate(structure: MplGStructure, params: MplGParams, u: np.ndarray,
+             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the forward model over an input sequence (compiled kernel).
+
+    Parameters
+    ----------
+    u : array, shape (n,)
+        Model input ``e`` sampled every ``structure.dt`` (normalised units).
+    x0 : array, shape (N,), float or None
+        Initial cell voltages; ``None`` starts at rest at the first input (``u_k = e_0``).
+
+    Returns
+    -------
+    y : array, shape (n,)
+    x_end : array, shape (N,)
+        State after the last sample; feeding it back as ``x0`` continues the run exactly.
+    """
+    u = _check(structure, params, u, "u")
+    x = initial_state(structure.n_cells, x0, u[0])
+    y, x_end = kernels.simulate(u, x, np.ascontiguousarray(params.g), params.w,
+                                float(params.v_b), *_cell_args(structure, params))
+    return check_finite_run(y, "mpl-g"), x_end
+
+
+def simulate_reference(structure: MplGStructure, params: MplGParams, u: np.ndarray,
+                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    u = _check(structure, params, u, "u")
+    return run_steps(step, structure, params, u, initial_state(structure.n_cells, x0, u[0]))
+
+
+def simulate_with_jacobian(structure: MplGStructure, params: MplGParams,
+                           u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Forward output from rest and its exact Jacobian ``dy/dtheta``, shape (n, 3N + 6), columns
+    in the order of :meth:`MplGParams.to_vector` (forward sensitivities)."""
+    u = _check(structure, params, u, "u")
+    x = np.full(structure.n_cells, u[0])
+    return kernels.simulate_with_jacobian(u, x, np.ascontiguousarray(params.g), params.w,
+                                          float(params.v_b), *_cell_args(structure, params))
+
+
+def invert(structure: MplGStructure, params: MplGParams, y: np.ndarray,
+           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run the inverse model (the compensator of a forward fit) over an output sequence.
+
+    Parameters
+    ----------
+    y : array, shape (n,)
+        Model output (e.g. the sensor signal), sampled every ``structure.dt``.
+    x0 : array, shape (N,), float or None
+        ``None`` starts at rest (:func:`rest_state` with ``inverse=True``).
+
+    Returns
+    -------
+    u_hat : array, shape (n,)
+    x_end : array, shape (N,)
+
+    Raises
+    ------
+    FitDivergedError
+        If ``w_0 = 0``, ``g' = 0`` at the rest point, a sample lies outside the range of
+        ``g``'s monotone branch (no input gives it), or the estimate leaves the finite range
+        (the inverse's stability depends on the weights: its cells see ``-(1 + w_k / w_0)``
+        times their own voltage).
+    """
+    y = _check(structure, params, y, "y")
+    if params.w[0] == 0:
+        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
+    lo, hi, sign, centre = inverse_branch(params)
+    x = (rest_state(structure, params, y[0], inverse=True) if x0 is None
+         else initial_state(structure.n_cells, x0, 0.0))
+    bound = min(1e6 * (1.0 + np.max(np.abs(y)) + np.max(np.abs(x))), 1e300)
+    e_hat, x_end, n_bad, why = kernels.invert(y, x, np.ascontiguousarray(params.g), lo, hi,
+                                              sign, centre, params.w, float(params.v_b),
+                                              *_cell_args(structure, params), bound)
+    if why == 1:
+        raise FitDivergedError(
+            f"the inverse failed at sample {n_bad} of {y.size}: output {y[n_bad]:.4g} is outside "
+            f"the range of the output resistor g on its monotone branch [{lo:.4g}, {hi:.4g}]")
+    if why == 2:
+        raise FitDivergedError(
+            f"the inverse model diverged at sample {n_bad} of {y.size} (|e_hat| > 1e6 times the "
+            f"output range); the fitted weights make the compensator unstable on this data")
+    return e_hat, x_end
