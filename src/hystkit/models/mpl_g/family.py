@@ -61,8 +61,12 @@ class MplGFamily(Family):
 
     def random_params(self, structure, rng):
         """:func:`.fit.random_params`: ``G_k`` log-uniform in ``[1e-4, slope_cap / dt]``,
-        ``V_T`` log-uniform in ``[1e-3, 1e3]``, ``g``, ``w`` uniform in ``[-2, 2]``, ``V_b`` in
-        ``[-1, 1]``; bounded: ``|y| <= sum_j |g_j| Z^j``, ``Z = sum |w| max|u| + |V_b|``."""
+        ``V_T`` log-uniform in ``[1e-3, 1e3]``, an increasing cubic ``g`` (``g_1`` in
+        ``[0.1, 2]``, ``g_3`` in ``[0.01, 2]``, ``g_2^2 < 3 g_1 g_3``, ``|g_0| <= 2``),
+        ``0.5 <= |w_0| <= 2``, ``sum |w_k| < 0.9 |w_0|``, ``|V_b| <= 1``. The output is bounded
+        (``|y| <= sum_j |g_j| Z^j``, ``Z = sum |w| max|u| + |V_b|``), and with
+        ``slope_cap <= 1`` the inverse exists for every output and contracts."""
+
         from .fit import random_params
 
         return random_params(structure, rng)

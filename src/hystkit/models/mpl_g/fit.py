@@ -136,24 +136,43 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
         return result
 
 
-# The domain random_params draws from: the mPL's cells over the fit's box, and paper 9.2's range
-# of the output stage with margin (its sets have |g| <= 1.4, |w| <= 1.6, |V_b| <= 0.6, as the
-# mpl-poly family's domain). The mPL's |w| <= 100 box would put z near 200 and g(z) near 1e9.
-_RANDOM_G = 2.0
-_RANDOM_W = 2.0
+# The domain random_params draws from: the mPL's cells over the fit's box, and an output stage
+# within paper 9.2's range (its sets have |g| <= 1.4, |w| <= 1.6, |V_b| <= 0.6) chosen so that
+# the inverse exists and is bounded on any output:
+# - g increasing everywhere (g_1 > 0, g_2^2 < 3 g_1 g_3): a drawn g with a turning point near
+#   the data would refuse outputs beyond it;
+# - sum_k |w_k| < |w_0|: the inverse's cells then contract. Their update is
+#   x+ = x - D (I + 1 a^T) x + ..., a = w[1:] / w_0, D = diag(secant slopes * dt) in (0, 1]
+#   for slope_cap <= 1; by Gershgorin every eigenvalue of D (I + 1 a^T) lies in
+#   d_k (1 +- sum |a|), inside (0, 2), so |1 - mu| < 1.
+# The mPL's |w| <= 100 box would put z near 200 and g(z) near 1e9.
+_RANDOM_G0 = 2.0
+_RANDOM_G1 = (0.1, 2.0)
+_RANDOM_LOG_G3 = (np.log(0.01), np.log(2.0))
+_RANDOM_W0 = (0.5, 2.0)
+_RANDOM_CELL_SHARE = 0.9
 _RANDOM_VB = 1.0
 
 
 def random_params(structure: mpl_g.MplGStructure, rng: np.random.Generator) -> mpl_g.MplGParams:
     """Parameters from the family's documented domain for normalised data: ``log G_k`` and
     ``log V_T,k`` uniform between the fit's bounds (``G`` in ``[1e-4, slope_cap / dt]``,
-    ``V_T`` in ``[1e-3, 1e3]``), ``g_0..g_3`` and ``w_0..w_N`` uniform in ``[-2, 2]``, ``V_b``
-    uniform in ``[-1, 1]``. With ``|u| <= 1`` then ``|z| <= 2 (N + 1) + 1`` and
-    ``|y| <= 2 (1 + |z| + z^2 + |z|^3)``."""
+    ``V_T`` in ``[1e-3, 1e3]``); an increasing output resistor: ``g_0`` uniform in
+    ``[-2, 2]``, ``g_1`` in ``[0.1, 2]``, ``g_3`` log-uniform in ``[0.01, 2]``, ``g_2`` uniform
+    within 0.9 of ``+-sqrt(3 g_1 g_3)``; ``|w_0|`` uniform in ``[0.5, 2]`` with a random sign,
+    ``w_k / w_0`` uniform in ``[-0.9 / N, 0.9 / N]``; ``V_b`` uniform in ``[-1, 1]``.
+
+    With ``|u| <= 1`` then ``|z| <= 2 |w_0| + 1 <= 5`` and ``|y| <= 2 + 2 |z| + 2.2 z^2 +
+    2 |z|^3``; with ``slope_cap <= 1`` the inverse exists for every output and its cells
+    contract (see the comment above), so it is bounded too."""
     n = structure.n_cells
     log_g = rng.uniform(_LOG_G_MIN, np.log(structure.slope_cap / structure.dt), n)
     log_vt = rng.uniform(*_LOG_VT_BOUNDS, n)
-    rest = np.r_[rng.uniform(-_RANDOM_G, _RANDOM_G, 4), rng.uniform(-_RANDOM_W, _RANDOM_W, n + 1),
-                 rng.uniform(-_RANDOM_VB, _RANDOM_VB)]
+    g1, g3 = rng.uniform(*_RANDOM_G1), np.exp(rng.uniform(*_RANDOM_LOG_G3))
+    g2 = 0.9 * np.sqrt(3 * g1 * g3) * rng.uniform(-1.0, 1.0)
+    w0 = rng.uniform(*_RANDOM_W0) * rng.choice([-1.0, 1.0])
+    share = _RANDOM_CELL_SHARE / n
+    rest = np.r_[rng.uniform(-_RANDOM_G0, _RANDOM_G0), g1, g2, g3, w0,
+                 w0 * rng.uniform(-share, share, n), rng.uniform(-_RANDOM_VB, _RANDOM_VB)]
     return mpl_g.MplGParams.from_vector(
         np.r_[np.column_stack([log_g, log_vt]).reshape(-1), rest], n)
