@@ -15,10 +15,12 @@ from ._loop_model import (
     physics_of,
 )
 from ._raw import RawTruth, ScopeSettings, merged_levels, simulate_raw, with_asymmetry
+from ._settling import ANNEALED_BLOCK, PRINTED_BLOCK, SettlingLaw, simulate_settling_log
 from ._virtual import VirtualSensor, simulate_experiment
 
-__all__ = ["VIRTUAL_PHYSICS", "RawTruth", "ScopeSettings", "VirtualPhysics",
+__all__ = ["ANNEALED_BLOCK", "PRINTED_BLOCK", "VIRTUAL_PHYSICS", "RawTruth", "ScopeSettings",
+           "SettlingLaw", "VirtualPhysics",
            "VirtualPhysicsParams", "VirtualPhysicsStructure", "VirtualSensor", "gain_ramp",
            "merged_levels", "occasional_references", "physics_of",
            "simulate_drifting_experiment", "simulate_experiment", "simulate_raw",
-           "with_asymmetry", "with_gain_drift"]
+           "simulate_settling_log", "with_asymmetry", "with_gain_drift"]

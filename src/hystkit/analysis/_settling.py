@@ -1,0 +1,311 @@
+"""Fitting the settling of a freshly printed trace and the rest time before it is usable.
+
+Sec. 3.5.1 logs a printed trace's resistance for days and concludes that 2-3 days of rest are
+needed. Here the log is fitted with the law of :class:`hystkit.sensors.SettlingLaw`,
+
+``R(t) = R_final + drop e^(-t/tau_drop) - rise e^(-t/tau_rise)``  (t in hours),
+
+either whole (``"rise-drop"``, five parameters, ``tau_rise < tau_drop``) or without the rise
+(``"drop"``, three), or both with the one of lower BIC kept (``"auto"``). The time constants
+enter non-linearly, the amplitudes linearly: a coarse grid over the time constants with the
+amplitudes solved by linear least squares gives the start, ``scipy.optimize.least_squares``
+refines all parameters together. Standard errors come from the Jacobian at the optimum,
+``cov = s^2 (J^T J)^-1`` with ``s^2`` the residual variance, times
+``sqrt((1 + rho) / (1 - rho))`` when the residuals' lag-1 autocorrelation ``rho`` is positive
+(slow temperature drift makes neighbouring readings alike, and white-noise errors would then
+be too small; the AR(1) variance inflation).
+
+**Rest time** (the rule): the earliest time after which the fitted drift rate
+``|dR/dt| / R_final`` stays below the threshold (default 0.1 %/h) for good. Its standard
+error is propagated from the parameter covariance (delta method, numerical gradient). When
+it lies after the end of the log it is an extrapolation of the fit, and is flagged so.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["MODELS", "REST_RULE", "RestTime", "SettlingFit", "SettlingFitError", "fit_settling",
+           "rest_time", "settling_curve"]
+
+MODELS = ("auto", "rise-drop", "drop")
+_NAMES = {"rise-drop": ("r_final", "drop", "tau_drop_h", "rise", "tau_rise_h"),
+          "drop": ("r_final", "drop", "tau_drop_h")}
+# Time constants are searched from a tenth of the sampling interval's scale to 10x the log.
+_GRID_POINTS = 24
+
+
+def settling_curve(params: dict[str, float], t_h: npt.ArrayLike) -> np.ndarray:
+    """R(t) [Ohm] of fitted or known parameters (keys of :attr:`SettlingFit.params`)."""
+    t = np.asarray(t_h, dtype=float)
+    r = params["r_final"] + params["drop"] * np.exp(-t / params["tau_drop_h"])
+    if "rise" in params:
+        r = r - params["rise"] * np.exp(-t / params["tau_rise_h"])
+    return r
+
+
+def _drift_rate(params: dict[str, float], t_h: np.ndarray) -> np.ndarray:
+    """dR/dt / R_final [1/h]."""
+    rate = -params["drop"] / params["tau_drop_h"] * np.exp(-t_h / params["tau_drop_h"])
+    if "rise" in params:
+        rate = rate + params["rise"] / params["tau_rise_h"] * np.exp(-t_h / params["tau_rise_h"])
+    return rate / params["r_final"]
+
+
+@dataclass(frozen=True)
+class SettlingFit:
+    """Result of :func:`fit_settling`.
+
+    ``model`` ("rise-drop" or "drop"); ``params`` and ``stderr`` by name (Ohm, hours);
+    ``rms`` the residual RMS [Ohm]; ``rho`` the residuals' lag-1 autocorrelation and
+    ``inflation`` the factor applied to the standard errors; ``bic``; ``converged`` and
+    ``message`` of the optimiser; ``t_end_h`` the log's last time; ``alternatives`` the BIC of
+    every model tried (auto); ``covariance`` of the parameters in the order of ``params``
+    (inflated like ``stderr``).
+    """
+
+    model: str
+    params: dict[str, float]
+    stderr: dict[str, float]
+    rms: float
+    rho: float
+    inflation: float
+    bic: float
+    converged: bool
+    message: str
+    n: int
+    t_end_h: float
+    covariance: np.ndarray = field(repr=False, compare=False, default=None)
+    alternatives: dict[str, float] = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """JSON-ready."""
+        return {"model": self.model, "params": self.params, "stderr": self.stderr,
+                "rms_ohm": self.rms, "residual_lag1_autocorrelation": self.rho,
+                "stderr_inflation": self.inflation, "bic": self.bic,
+                "converged": self.converged, "message": self.message, "n_readings": self.n,
+                "t_end_h": self.t_end_h, "bic_of_models_tried": self.alternatives}
+
+
+class SettlingFitError(ValueError):
+    """The settling law could not be fitted (not converged, or not identifiable)."""
+
+
+def fit_settling(t_h: npt.ArrayLike, r: npt.ArrayLike, model: str = "auto") -> SettlingFit:
+    """Fit the settling law to a resistance log.
+
+    Parameters
+    ----------
+    t_h : array_like, shape (n,)
+        Hours since printing, increasing.
+    r : array_like, shape (n,)
+        Resistance [Ohm], > 0.
+    model : {"auto", "rise-drop", "drop"}
+        Law to fit; auto fits both and keeps the lower BIC (a "rise-drop" that fails or
+        cannot be identified, e.g. on a log without a rise, drops out).
+
+    Returns
+    -------
+    SettlingFit
+
+    Raises
+    ------
+    ValueError
+        Bad input (lengths, non-finite, R <= 0, time not increasing, under 8 readings).
+    SettlingFitError
+        No model converged to identifiable parameters; the message says why.
+    """
+    t, y = _checked(t_h, r)
+    if model not in MODELS:
+        raise ValueError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+    tried = ("rise-drop", "drop") if model == "auto" else (model,)
+    fits, reasons = {}, []
+    for name in tried:
+        try:
+            fits[name] = _fit_one(t, y, name)
+        except SettlingFitError as exc:
+            reasons.append(f"{name}: {exc}")
+    if not fits:
+        raise SettlingFitError("; ".join(reasons))
+    best = min(fits.values(), key=lambda f: f.bic)
+    alternatives = {name: f.bic for name, f in fits.items()}
+    note = "" if not reasons else " (" + "; ".join(reasons) + ")"
+    return SettlingFit(**{**best.__dict__, "alternatives": alternatives,
+                          "message": best.message + note})
+
+
+def _checked(t_h: npt.ArrayLike, r: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    t, y = np.asarray(t_h, dtype=float), np.asarray(r, dtype=float)
+    if t.ndim != 1 or t.shape != y.shape:
+        raise ValueError(f"time and resistance must be 1-D of one length, got {t.shape}, "
+                         f"{y.shape}")
+    if t.size < 8:
+        raise ValueError(f"{t.size} readings; a settling fit needs at least 8")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
+        raise ValueError("time or resistance holds NaN or infinite values")
+    if np.any(np.diff(t) <= 0):
+        row = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
+        raise ValueError(f"time must increase; reading {row + 1} is not after reading {row}")
+    if np.any(y <= 0):
+        raise ValueError(f"resistance must be > 0; reading {int(np.argmax(y <= 0)) + 1} is not")
+    return t, y
+
+
+def _basis(t: np.ndarray, taus: tuple[float, ...]) -> np.ndarray:
+    """Columns 1, e^(-t/tau_drop)[, -e^(-t/tau_rise)]: the amplitudes enter linearly."""
+    cols = [np.ones_like(t), np.exp(-t / taus[0])]
+    if len(taus) > 1:
+        cols.append(-np.exp(-t / taus[1]))
+    return np.column_stack(cols)
+
+
+def _start(t: np.ndarray, y: np.ndarray, name: str) -> np.ndarray:
+    """Best grid point: time constants on a log grid, amplitudes by linear least squares."""
+    step = float(np.median(np.diff(t)))
+    span = float(t[-1] - t[0])
+    grid = np.geomspace(max(step, 1e-3 * span), 10.0 * span, _GRID_POINTS)
+    pairs = ([(td,) for td in grid] if name == "drop"
+             else [(td, tr) for td in grid for tr in grid if tr < td])
+    best, best_cost = None, math.inf
+    for taus in pairs:
+        a = _basis(t, taus)
+        coef, *_ = np.linalg.lstsq(a, y, rcond=None)
+        cost = float(np.sum((a @ coef - y) ** 2))
+        if cost < best_cost and np.all(coef[1:] >= 0):
+            best, best_cost = (coef, taus), cost
+    if best is None:
+        raise SettlingFitError("no starting point with non-negative amplitudes (the log does "
+                               "not settle downwards)")
+    coef, taus = best
+    x0 = [coef[0], coef[1], taus[0]]
+    if name == "rise-drop":
+        x0 += [coef[2], taus[1]]
+    return np.array(x0)
+
+
+def _fit_one(t: np.ndarray, y: np.ndarray, name: str) -> SettlingFit:
+    from scipy.optimize import least_squares
+
+    names = _NAMES[name]
+    x0 = _start(t, y, name)
+    scale = np.array([np.ptp(y) or 1.0, np.ptp(y) or 1.0, 1.0, np.ptp(y) or 1.0, 1.0])[:x0.size]
+
+    def residual(p: np.ndarray) -> np.ndarray:
+        return settling_curve(dict(zip(names, p, strict=True)), t) - y
+
+    lower = [0.0, 0.0, 1e-9] + ([0.0, 1e-9] if name == "rise-drop" else [])
+    x0 = np.maximum(x0, np.array(lower) + 1e-12)
+    res = least_squares(residual, x0, bounds=(lower, np.inf), x_scale=scale, method="trf",
+                        xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=2000)
+    if not res.success:
+        raise SettlingFitError(f"the optimiser did not converge ({res.message})")
+    params = dict(zip(names, (float(v) for v in res.x), strict=True))
+    if name == "rise-drop" and not params["tau_rise_h"] < params["tau_drop_h"]:
+        raise SettlingFitError("the fitted rise is not faster than the drop (tau_rise_h >= "
+                               "tau_drop_h): no rise in this log")
+    n, k = t.size, len(names)
+    rss = float(np.sum(res.fun ** 2))
+    jtj = res.jac.T @ res.jac
+    if np.linalg.cond(jtj) > 1e14:
+        raise SettlingFitError("parameters not identifiable from this log (singular Jacobian; "
+                               "e.g. a rise of amplitude 0, or a log far shorter than the time "
+                               "constants)")
+    cov = np.linalg.inv(jtj) * rss / (n - k)
+    rho = _lag1(res.fun)
+    inflation = math.sqrt((1 + rho) / (1 - rho)) if rho > 0 else 1.0
+    stderr = {p: float(inflation * math.sqrt(max(cov[i, i], 0.0))) for i, p in enumerate(names)}
+    bic = n * math.log(rss / n) + k * math.log(n)
+    return SettlingFit(model=name, params=params, stderr=stderr,
+                       rms=math.sqrt(rss / n), rho=rho, inflation=inflation, bic=bic,
+                       converged=True, message=str(res.message), n=n, t_end_h=float(t[-1]),
+                       covariance=cov * inflation**2)
+
+
+def _lag1(e: np.ndarray) -> float:
+    e = e - e.mean()
+    den = float(np.sum(e * e))
+    return float(np.sum(e[1:] * e[:-1]) / den) if den > 0 else 0.0
+
+
+@dataclass(frozen=True)
+class RestTime:
+    """Rest time of :func:`rest_time`: ``hours`` [h] after printing, its ``stderr_h`` (None
+    when it is 0: already settled at the first reading), the ``threshold_pct_per_hour`` it
+    used, and ``extrapolated`` when it lies after the end of the log."""
+
+    hours: float
+    stderr_h: float | None
+    threshold_pct_per_hour: float
+    extrapolated: bool
+
+    def to_dict(self) -> dict:
+        """JSON-ready, with the rule in words."""
+        return {"hours": self.hours, "days": self.hours / 24.0, "stderr_h": self.stderr_h,
+                "threshold_pct_per_hour": self.threshold_pct_per_hour,
+                "extrapolated": self.extrapolated, "rule": REST_RULE}
+
+
+REST_RULE = ("earliest time after which the fitted drift rate |dR/dt| / R_final stays below "
+             "the threshold for good")
+
+
+def rest_time(fit: SettlingFit, threshold_pct_per_hour: float = 0.1) -> RestTime:
+    """Hours after printing until the fitted drift rate stays below a threshold.
+
+    Parameters
+    ----------
+    fit : SettlingFit
+    threshold_pct_per_hour : float
+        Largest acceptable drift ``|dR/dt| / R_final`` [%/h], > 0.
+
+    Returns
+    -------
+    RestTime
+        The rule: the earliest t after which ``|dR/dt|(t') / R_final < threshold`` for every
+        t' > t. For the plain drop this is ``tau ln(drop / (R_final tau thr))`` (or 0).
+    """
+    if not (math.isfinite(threshold_pct_per_hour) and threshold_pct_per_hour > 0):
+        raise ValueError(f"threshold must be a positive number, got {threshold_pct_per_hour}")
+    thr = threshold_pct_per_hour / 100.0
+    hours = _last_crossing(fit.params, thr)
+    stderr = None
+    if hours > 0:
+        names = list(fit.params)
+        grad = np.empty(len(names))
+        for i, name in enumerate(names):
+            h = 1e-6 * max(abs(fit.params[name]), 1e-9)
+            up = _last_crossing({**fit.params, name: fit.params[name] + h}, thr)
+            down = _last_crossing({**fit.params, name: fit.params[name] - h}, thr)
+            grad[i] = (up - down) / (2 * h)
+        stderr = float(math.sqrt(max(float(grad @ fit.covariance @ grad), 0.0)))
+    return RestTime(hours=hours, stderr_h=stderr, threshold_pct_per_hour=threshold_pct_per_hour,
+                    extrapolated=hours > fit.t_end_h)
+
+
+def _last_crossing(params: dict[str, float], thr: float) -> float:
+    """Last t >= 0 where |dR/dt| / R_final equals `thr` (0 if it never exceeds it)."""
+    from scipy.optimize import brentq
+
+    terms = [(params["drop"], params["tau_drop_h"])]
+    if "rise" in params:
+        terms.append((params["rise"], params["tau_rise_h"]))
+    # Past each term's own t_j its rate is below thr / 2, so past all of them the sum is below
+    # thr: the search ends there.
+    horizon = max([tau * math.log(2 * a / (tau * params["r_final"] * thr))
+                   for a, tau in terms if a > 0] + [0.0])
+    if horizon <= 0.0:
+        return 0.0
+    grid = np.linspace(0.0, horizon, 20001)
+    excess = np.abs(_drift_rate(params, grid)) - thr
+    above = np.flatnonzero(excess > 0)
+    if above.size == 0:
+        return 0.0
+    i = int(above[-1])
+    if i == grid.size - 1:
+        return float(grid[-1])
+    return float(brentq(lambda t: abs(float(_drift_rate(params, np.array(t)))) - thr,
+                        grid[i], grid[i + 1], xtol=1e-12 * max(horizon, 1.0)))

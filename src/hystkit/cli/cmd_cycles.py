@@ -1,0 +1,223 @@
+"""``hystkit cycles INPUT --out DIR``: per-gauge, per-cycle loops, loop area, offset and drift.
+
+The document's figs. 4.13 and 4.16-4.17 and table 3.1 for one recording: the loops of dR1/R1,
+dR2/R2 and dR1/R1 - dR2/R2 against the position for chosen cycles, and for every complete
+cycle (minimum to minimum of the position) the loop area, the offset and its drift per cycle
+and per hour. The input is a recording (``hystkit preprocess`` writes the gauge columns r1, r2,
+dr1, dr2 beside position and sensor; without them only the sensor column is analysed) or, with
+``--raw``, a raw scope recording, preprocessed first with the settings file next to it.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ..errors import InputError
+from ._common import add_read_options, number, read_options, read_recording_args
+
+if TYPE_CHECKING:
+    import numpy as np
+
+__all__ = ["CYCLES_FILES", "register"]
+
+CYCLES_FILES = ("cycles.csv", "cycles.json", "cycles.png", "cycles.svg")
+# Table 3.1 of the document (R1 top, R2 bottom [kOhm], symmetry 2 (R1 - R2) / (R1 + R2) [%]);
+# paper 9.1 gives sample 4 the other way round: 22.4 kOhm top, 15.7 kOhm bottom.
+TABLE_3_1 = {"sample 0": (1.58, 2.78, -55.0), "sample 1": (15.0, 16.82, -11.0),
+             "sample 2": (12.7, 28.2, -75.0), "sample 3": (14.3, 35.8, -86.0),
+             "sample 4": (15.7, 22.4, -35.0)}
+# The figures' default: five cycles spread over the recording (figs. 4.16-4.17).
+_DEFAULT_DRAWN = 5
+
+
+def _cycle_list(text: str) -> tuple[int, ...]:
+    parts = [p.strip() for p in text.split(",")]
+    if not parts or not all(p.isascii() and p.isdigit() and int(p) >= 1 for p in parts):
+        raise argparse.ArgumentTypeError(f"expected cycle numbers 1, 2, ... separated by "
+                                         f"commas, e.g. 1,5,20; got {text!r}")
+    return tuple(sorted({int(p) for p in parts}))
+
+
+def _gauges_from_raw(args: argparse.Namespace) -> tuple[np.ndarray, ...]:
+    """Preprocess the raw file with its settings file: t, x, r1, r2 (or None), sensor."""
+    import warnings
+
+    from ..io import RawFormat, find_raw_config, read_raw_config
+    from ..preprocess import PreprocessSettings, RawDataWarning, preprocess_raw
+
+    config = find_raw_config(args.input)
+    if config is None:
+        raise InputError(f"{args.input}: --raw needs the settings file "
+                         f"{Path(args.input).with_suffix('.toml')} (bridge resistor and "
+                         "supply; 'hystkit simulate-sensor --raw' writes it), or run "
+                         "'hystkit preprocess' with --r-bridge/--v-supply and analyse its output")
+    values = read_raw_config(config)
+    values.pop("simulation", None)
+    fmt_keys = ("fs", "n_samples", "time_unit", "skip_rows")
+    try:
+        fmt = RawFormat(columns=tuple(values.pop("columns", {}).items()),
+                        **{k: values.pop(k) for k in fmt_keys if k in values})
+        if "encoder_levels" in values:
+            values["encoder_levels"] = tuple(values["encoder_levels"])
+        if isinstance(values.get("encoder_states"), str | list):
+            from ..preprocess import parse_states
+
+            values["encoder_states"] = parse_states(values["encoder_states"])
+        settings = PreprocessSettings(**values)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{config}: {exc}") from None
+    print(f"preprocessing {args.input} with the settings in {config} ...", flush=True)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RawDataWarning)
+        result = preprocess_raw(args.input, settings, fmt)
+    for warning in caught:
+        print(f"hystkit: warning: {warning.message}")
+    rec = result.recording
+    return rec.time, rec.position, result.extra["r1"], result.extra["r2"], rec.sensor
+
+
+def _gauges_from_recording(args: argparse.Namespace) -> tuple:
+    """Read a recording and its gauge columns r1, r2 (Ohm) when present."""
+    import numpy as np
+
+    from ..io import read_other_columns
+
+    rec = read_recording_args(args, args.input)
+    other = read_other_columns(args.input, rec.n_samples, read_options(args, args.input))
+    r1, r2 = other.get("r1"), other.get("r2")
+    if r1 is None or r2 is None or r1.dtype.kind != "f" or r2.dtype.kind != "f":
+        return rec.time, rec.position, None, None, rec.sensor
+    for name, r in (("r1", r1), ("r2", r2)):
+        bad = np.flatnonzero(~(np.isfinite(r) & (r > 0)))
+        if bad.size:
+            raise InputError(f"{args.input}: column {name!r} row {bad[0] + 1}: a gauge "
+                             f"resistance must be a positive number, got {r[bad[0]]}")
+    return rec.time, rec.position, r1, r2, rec.sensor
+
+
+def _signals(r1, r2, sensor) -> dict:
+    """dR/R per gauge about its mean (eq. 4.4-4.5) and their difference, else the sensor."""
+    if r1 is None:
+        return {"sensor": sensor}
+    from ..preprocess import relative_change
+
+    dr1, dr2 = relative_change(r1), relative_change(r2)
+    return {"dR1/R1": dr1, "dR2/R2": dr2, "dR1/R1 - dR2/R2": dr1 - dr2}
+
+
+def _drawn(requested: tuple[int, ...] | None, n_cycles: int, source: Path) -> list[int]:
+    import numpy as np
+
+    if requested is None:
+        return sorted({int(k) for k in np.round(np.linspace(1, n_cycles,
+                                                            min(_DEFAULT_DRAWN, n_cycles)))})
+    if requested[-1] > n_cycles:
+        raise InputError(f"{source}: --cycles asks for cycle {requested[-1]}, but the recording "
+                         f"has {n_cycles} complete cycle(s) (minimum to minimum of the position)")
+    return list(requested)
+
+
+def _gauge_summary(r1, r2) -> dict | None:
+    if r1 is None:
+        return None
+    from ..preprocess import gauge_symmetry
+
+    return {"r1_mean_kohm": float(r1.mean()) / 1e3, "r2_mean_kohm": float(r2.mean()) / 1e3,
+            "symmetry_pct": 100.0 * gauge_symmetry(r1, r2),
+            "document_table_3_1": {name: {"r1_kohm": a, "r2_kohm": b, "symmetry_pct": s}
+                                   for name, (a, b, s) in TABLE_3_1.items()}}
+
+
+def _summary(table, signals: dict) -> dict:
+    out = {}
+    for name in signals:
+        drift = table.drift.get(name)
+        out[name] = {
+            "area_mean": float(table.area[name].mean()),
+            "area_pct_mean": float(table.area_pct[name].mean()),
+            "offset_first": float(table.offset[name][0]),
+            "offset_last": float(table.offset[name][-1]),
+            "drift_per_hour": None if drift is None else drift.per_hour,
+            "drift_stderr_per_hour": None if drift is None else drift.stderr_per_hour,
+            "drift_per_cycle": None if drift is None else drift.per_cycle,
+        }
+    return out
+
+
+def _print(table, summary: dict, gauges: dict | None) -> None:
+    print(f"{table.n_cycles} complete cycles (minimum to minimum of the position), "
+          f"{table.t_start[0]:.4g} s to {table.t_stop[-1]:.4g} s")
+    print(f"  {'signal':<18} {'area [mm·%]':>12} {'area eq.5.15':>13} {'drift [%/h]':>12} "
+          f"{'± s.e.':>9} {'[%/cycle]':>10}")
+    for name, s in summary.items():
+        rate, se, per_cycle = (s["drift_per_hour"], s["drift_stderr_per_hour"],
+                               s["drift_per_cycle"])
+        rate_text = "" if rate is None else f"{100 * rate:.4g}"
+        se_text = "" if se is None else f"{100 * se:.2g}"
+        cycle_text = "" if per_cycle is None else f"{100 * per_cycle:.3g}"
+        print(f"  {name:<18} {100 * s['area_mean']:>12.4g} {s['area_pct_mean']:>12.3g}% "
+              f"{rate_text:>12} {se_text:>9} {cycle_text:>10}")
+    if gauges is not None:
+        doc = TABLE_3_1["sample 4"]
+        print(f"  gauges (table 3.1): R1 = {gauges['r1_mean_kohm']:.4g} kOhm, R2 = "
+              f"{gauges['r2_mean_kohm']:.4g} kOhm, 2(R1-R2)/(R1+R2) = "
+              f"{gauges['symmetry_pct']:.3g} % (document, sample 4: R1 = {doc[0]:g}, "
+              f"R2 = {doc[1]:g} kOhm, {doc[2]:g} %)")
+
+
+def _cycles(args: argparse.Namespace) -> int:
+    import pandas as pd
+
+    from ..analysis import cycle_table, plot_cycles
+    from ..io import atomic_folder, check_output_folder, write_json
+
+    check_output_folder(args.out, CYCLES_FILES, args.force, inputs=[args.input])
+    t, x, r1, r2, sensor = (_gauges_from_raw(args) if args.raw
+                            else _gauges_from_recording(args))
+    signals = _signals(r1, r2, sensor)
+    try:
+        table = cycle_table(t, x, signals, args.deadband)
+    except ValueError as exc:
+        raise InputError(f"{args.input}: {exc}") from None
+    drawn = _drawn(args.cycles, table.n_cycles, args.input)
+    summary = _summary(table, signals)
+    gauges = _gauge_summary(r1, r2)
+    _print(table, summary, gauges)
+    fig = plot_cycles(x, signals, table, drawn)
+    report = {"input": str(args.input), "raw": bool(args.raw), "n_samples": int(t.size),
+              "deadband": args.deadband, "n_cycles": table.n_cycles, "cycles_drawn": drawn,
+              "units": {"area": "mm * (dR/R)", "area_pct": "% of the unit square (eq. 5.15)",
+                        "offset": "dR/R (about the recording mean)",
+                        "drift_per_hour": "dR/R per hour", "drift_per_cycle": "dR/R"},
+              "signals": summary, "gauges": gauges}
+    with atomic_folder(args.out, args.force, CYCLES_FILES) as tmp:
+        pd.DataFrame(table.rows()).to_csv(tmp / "cycles.csv", index=False)
+        write_json(report, tmp / "cycles.json")
+        fig.savefig(tmp / "cycles.png", dpi=120)
+        fig.savefig(tmp / "cycles.svg")
+    print(f"wrote {args.out}/: {', '.join(CYCLES_FILES)} (cycles drawn: "
+          f"{', '.join(map(str, drawn))})")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``cycles`` to the ``hystkit`` parser."""
+    p = sub.add_parser("cycles", help="per-gauge loops of chosen cycles; loop area, offset and "
+                       "drift per cycle and per hour (figs. 4.16-4.17, table 3.1)")
+    p.add_argument("input", type=Path, help="recording (time, position, sensor; with r1, r2 "
+                   "from 'hystkit preprocess' per gauge) or, with --raw, a raw scope recording")
+    p.add_argument("--out", type=Path, required=True,
+                   help="folder for cycles.csv, cycles.json, cycles.png, cycles.svg")
+    p.add_argument("--raw", action="store_true",
+                   help="INPUT is a raw scope recording (v1, v2, encoder) with its .toml "
+                        "settings: preprocess it first, as 'hystkit preprocess' would")
+    p.add_argument("--cycles", type=_cycle_list, metavar="K,K,...",
+                   help="cycles to draw, numbered 1.. over the complete cycles (default: 5 "
+                        "spread over the recording)")
+    p.add_argument("--deadband", type=number(0, 0.5, high_open=True), default=0.01,
+                   metavar="F", help="a position reversal counts after the position came back "
+                   "by this fraction of its range (default 0.01)")
+    add_read_options(p)
+    p.set_defaults(run=_cycles)
