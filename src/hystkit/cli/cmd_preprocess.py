@@ -77,6 +77,8 @@ def _settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawFormat, 
         option = getattr(args, key, None)
         if option is not None and option is not False:
             values[key] = option
+    if args.supply_channel is not None:  # --no-supply-channel overrides the settings file
+        values["supply_channel"] = args.supply_channel
     where = f"settings from {config_path} and the options" if config_path else "options"
     for key in ("r_bridge", "v_supply"):
         if key not in values:
@@ -127,6 +129,11 @@ def _preprocess(args: argparse.Namespace) -> int:
           f"(dwell {rep.encoder_dwell_samples} samples)")
     print(f"  gauges: R1 = {rep.r1_mean_ohm:.6g} Ohm, R2 = {rep.r2_mean_ohm:.6g} Ohm, "
           f"symmetry 2(R1-R2)/(R1+R2) = {rep.symmetry:.4f}")
+    if rep.supply == "measured":
+        print(f"  supply: measured v0 used in eq. 4.3: mean {rep.v0_mean_v:.6g} V, range "
+              f"{rep.v0_min_v:.6g} to {rep.v0_max_v:.6g} V (nominal {settings.v_supply:g} V)")
+    else:
+        print(f"  supply: nominal V0 = {settings.v_supply:g} V in eq. 4.3")
     for warning in caught:
         if issubclass(warning.category, RawDataWarning):
             print(f"hystkit: warning: {warning.message}", file=sys.stderr)
@@ -165,6 +172,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "with .toml, if it exists)")
     p.add_argument("--r-bridge", type=_positive, metavar="OHM", help="bridge resistor (eq. 4.2)")
     p.add_argument("--v-supply", type=_positive, metavar="V", help="bridge supply V0 (eq. 4.2)")
+    p.add_argument("--supply-channel", action=argparse.BooleanOptionalAction, default=None,
+                   help="use the measured supply column v0 in eq. 4.3 instead of --v-supply "
+                        "(sec. 4.2.1's reference channel; removes supply drift); "
+                        "--no-supply-channel uses the nominal V0 even if the settings file "
+                        "asks for the column (default: the settings file, else nominal)")
     p.add_argument("--um-per-count", type=_positive, metavar="UM",
                    help="encoder resolution (default 5; eq. 9.16 calibrates 5.1)")
     p.add_argument("--position-offset", dest="position_offset_mm", type=number(), metavar="MM",
@@ -223,11 +235,21 @@ def add_simulation_options(p: argparse.ArgumentParser) -> None:
                    "(default 2)")
     p.add_argument("--glitches", type=_count, metavar="N",
                    help="raw: hide N encoder states (each an illegal double transition)")
+    p.add_argument("--supply-drift", type=number(0, 1, high_open=True), metavar="FRACTION",
+                   help="raw: the bridge supply drifts as V0 (1 + FRACTION sin(2 pi t / P)) "
+                        "(default 0: a steady supply; 0.01 is a 1 %% drift)")
+    p.add_argument("--supply-drift-period", type=_positive, metavar="S",
+                   help="raw: period P of the bridge supply drift (default 30)")
+    p.add_argument("--supply-channel", action="store_true", default=None,
+                   help="raw: also record the bridge supply as a column v0 (sec. 4.2.1's "
+                        "reference channel); the .toml then sets supply_channel = true")
     p.add_argument("--truth", type=Path, metavar="FILE",
-                   help="raw: also write the exact position and dR/R at 40 Hz here")
+                   help="raw: also write the exact position and dR/R (differential and per gauge, "
+                        "dr1, dr2) at 40 Hz here")
 
 
-_RAW_ONLY = ("scope_rate", "duration", "encoder", "r_bridge", "v_supply", "glitches", "truth")
+_RAW_ONLY = ("scope_rate", "duration", "encoder", "r_bridge", "v_supply", "glitches", "truth",
+             "supply_drift", "supply_drift_period", "supply_channel")
 
 
 def sensor_from_args(args: argparse.Namespace) -> VirtualSensor:
@@ -258,7 +280,10 @@ def run_raw_simulation(args: argparse.Namespace) -> int:
     scope = ScopeSettings(
         fs=args.scope_rate or defaults.fs, r_bridge=args.r_bridge or defaults.r_bridge,
         v_supply=args.v_supply or defaults.v_supply, encoder_mode=args.encoder or "merged",
-        n_missed_states=args.glitches or 0)
+        n_missed_states=args.glitches or 0,
+        bridge_supply_drift=args.supply_drift or 0.0,
+        bridge_drift_period=args.supply_drift_period or defaults.bridge_drift_period,
+        supply_channel=bool(args.supply_channel))
     t0 = time.perf_counter()
     try:
         truth = simulate_raw(args.out, args.excitation, args.seed, sensor=sensor, scope=scope,
@@ -272,10 +297,15 @@ def run_raw_simulation(args: argparse.Namespace) -> int:
           f"samples at {scope.fs:.6g} Hz ({truth.n_samples / scope.fs:.6g} s), "
           f"{scope.encoder_mode} encoder, {len(truth.missed)} hidden encoder state(s) "
           f"({time.perf_counter() - t0:.1f} s)")
+    supply = (f", bridge supply drift {100 * scope.bridge_supply_drift:g} % (period "
+              f"{scope.bridge_drift_period:g} s)" if scope.bridge_supply_drift else "")
+    supply += ", measured supply in column v0" if scope.supply_channel else ""
     print(f"wrote {config}: R_br = {scope.r_bridge:g} Ohm, V0 = {scope.v_supply:g} V, "
-          f"fs = {scope.fs:.6g} Hz; 'hystkit preprocess {args.out}' reads it")
+          f"fs = {scope.fs:.6g} Hz{supply}; 'hystkit preprocess {args.out}' reads it")
     if args.truth:
-        write_recording(truth.recording(), args.truth, force=args.force)
-        print(f"wrote {args.truth}: the exact position [mm] and dR1/R1 - dR2/R2 at 40 Hz")
+        write_recording(truth.recording(), args.truth, extra=truth.gauge_changes(),
+                        force=args.force)
+        print(f"wrote {args.truth}: the exact position [mm], dR1/R1 - dR2/R2 and each gauge's "
+              "dR/R (dr1, dr2) at 40 Hz")
     return 0
 

@@ -4,7 +4,8 @@ A raw recording is what the oscilloscope saved (sec. 4.2.1, 4.3): the two half-b
 ``v1``, ``v2`` [V] of gauges R1 (top) and R2 (bottom), measured across the bridge resistor
 (eq. 4.2), and the encoder, either merged into one 4-level channel ``encoder`` [V] or as two
 logic channels ``enc_a``, ``enc_b`` [V]; ``time`` [s] may be left out when the sample rate ``fs``
-is given in the settings. CSV (header row) and Parquet are read in chunks of rows, so memory does
+is given in the settings. A fifth channel ``v0`` [V], the measured bridge supply (the reference
+channel of sec. 4.2.1), is read when asked for (``open_raw(..., extra=("v0",))``). CSV (header row) and Parquet are read in chunks of rows, so memory does
 not grow with the file; MATLAB ``.mat`` files are read whole (scipy cannot stream them).
 
 Settings can sit beside the data in a TOML file with the data file's stem
@@ -37,7 +38,9 @@ from ._writing import atomic_output, check_output_path
 
 __all__ = ["RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter", "open_raw"]
 
-RAW_COLUMNS = ("time", "v1", "v2", "encoder", "enc_a", "enc_b")
+RAW_COLUMNS = ("time", "v1", "v2", "encoder", "enc_a", "enc_b", "v0")
+# Columns read only when the caller asks for them.
+OPTIONAL_COLUMNS = ("v0",)
 _TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 _MAX_STEP_DEVIATION = 0.01  # as for recordings: relative to 1/fs
 _FS_HEAD = 4096  # samples whose mean step gives fs
@@ -94,7 +97,7 @@ class RawChunk:
 
     Arrays are float32 or float64 as stored (other numbers become float64), shape (n,). A
     column not read, or absent (``time`` without a time column, ``encoder`` when the file has
-    ``enc_a``/``enc_b`` and vice versa), is None.
+    ``enc_a``/``enc_b`` and vice versa, ``v0`` unless asked for), is None.
     """
 
     start: int
@@ -104,12 +107,13 @@ class RawChunk:
     encoder: np.ndarray | None = None
     enc_a: np.ndarray | None = None
     enc_b: np.ndarray | None = None
+    v0: np.ndarray | None = None
 
     @property
     def n(self) -> int:
         """Samples in the chunk."""
         return next(int(a.size) for a in (self.time, self.v1, self.v2, self.encoder,
-                                          self.enc_a, self.enc_b) if a is not None)
+                                          self.enc_a, self.enc_b, self.v0) if a is not None)
 
 
 class RawReader:
@@ -118,10 +122,16 @@ class RawReader:
     Opening reads only the header (CSV), the schema (Parquet) or the whole file (.mat), and the
     first rows to measure the sample rate. Attributes: ``source``, ``encoder_kind``
     (``"merged"`` or ``"ab"``), ``has_time``, ``fs`` [Hz], ``n_samples`` (None for CSV until read).
+    `extra` names optional columns (:data:`OPTIONAL_COLUMNS`) that must be present and are read.
     """
 
     def __init__(self, path: str | os.PathLike[str], fmt: RawFormat | None = None,
-                 chunk_size: int = 1 << 18) -> None:
+                 chunk_size: int = 1 << 18, *, extra: tuple[str, ...] = ()) -> None:
+        unknown = [c for c in extra if c not in OPTIONAL_COLUMNS]
+        if unknown:
+            raise ValueError(f"unknown optional column(s) {unknown}; known: "
+                             f"{', '.join(OPTIONAL_COLUMNS)}")
+        self.extra = tuple(extra)
         self.path = Path(path)
         self.source = str(self.path)
         self.fmt = RawFormat() if fmt is None else fmt
@@ -195,19 +205,25 @@ class RawReader:
         missing = [repr(names[c]) for c in need if c not in present]
         if "encoder" not in present and len(encoder) < 2:
             missing.append(f"{names['encoder']!r} or {names['enc_a']!r} and {names['enc_b']!r}")
+        if "v0" in self.extra and "v0" not in present:
+            listed = ", ".join(repr(n) for n in found) or "none"
+            raise self.fail(f"missing {self._where.noun} {names['v0']!r}, the measured bridge "
+                            "supply that supply_channel (--supply-channel) asks for; name it "
+                            f"with columns.v0 in the settings file; found: {listed}")
         if missing:
             listed = ", ".join(repr(n) for n in found) or "none"
             raise self.fail(f"missing required {self._where.noun}(s) {', '.join(missing)}; a raw "
                             "recording needs v1, v2, the encoder (encoder, or enc_a and enc_b) "
                             f"and time (or an fs setting); found: {listed}")
-        for c in ["v1", "v2"] + encoder + (["time"] if "time" in present else []):
+        extra = [c for c in self.extra if c in present]
+        for c in ["v1", "v2"] + encoder + extra + (["time"] if "time" in present else []):
             if found.count(names[c]) > 1:
                 raise self.fail(f"appears {found.count(names[c])} times", c)
             if self.suffix == ".parquet":
                 kind = self._schema.field(names[c]).type
                 if not (pa.types.is_floating(kind) or pa.types.is_integer(kind)):
                     raise self.fail(f"not numeric (type {kind})", c)
-        return tuple(["time"] * ("time" in present) + ["v1", "v2"] + encoder)
+        return tuple(["time"] * ("time" in present) + ["v1", "v2"] + encoder + extra)
 
     def _measure_fs(self) -> float:
         if not self.has_time:
@@ -431,8 +447,11 @@ def _first_bad_step(t, t_prev, fs, tol):
 
 
 def open_raw(path: str | os.PathLike[str], fmt: RawFormat | None = None,
-             chunk_size: int = 1 << 18) -> RawReader:
+             chunk_size: int = 1 << 18, *, extra: tuple[str, ...] = ()) -> RawReader:
     """Open a raw recording (``.csv``, ``.parquet``, ``.mat``) for chunked reading.
+
+    `extra` lists optional channels to read as well (``("v0",)``: the measured supply); each
+    must then be in the file.
 
     Raises
     ------
@@ -440,7 +459,7 @@ def open_raw(path: str | os.PathLike[str], fmt: RawFormat | None = None,
         Missing file or column, unreadable or truncated file, a time column that disagrees
         with the ``fs`` setting. Further problems are raised while iterating chunks.
     """
-    return RawReader(path, fmt, chunk_size)
+    return RawReader(path, fmt, chunk_size, extra=extra)
 
 
 # --------------------------------------------------------------------------- writing

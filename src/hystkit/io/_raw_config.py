@@ -26,6 +26,7 @@ __all__ = ["CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_confi
 CONFIG_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
     "r_bridge": ((int, float), "bridge resistor R_br [Ohm] (eq. 4.2)"),
     "v_supply": ((int, float), "bridge supply V0 [V] (eq. 4.2)"),
+    "supply_channel": ((bool,), "use the measured supply column v0 in eq. 4.3 (sec. 4.2.1)"),
     "um_per_count": ((int, float), "encoder resolution [um per count] (5 in the document)"),
     "position_offset_mm": ((int, float), "added to the position [mm] (eq. 9.16: -0.0656)"),
     "fs_out": ((int, float), "output sample rate [Hz]"),
@@ -67,7 +68,7 @@ CONFIG_RANGES: dict[str, tuple[float, float, bool]] = {
 # Encoder levels are voltages a scope can show.
 _MAX_LEVEL_V = 1e3
 _CHOICES = {"illegal": ("continue", "hold"), "time_unit": ("s", "ms", "us", "ns")}
-_COLUMN_NAMES = ("time", "v1", "v2", "encoder", "enc_a", "enc_b")
+_COLUMN_NAMES = ("time", "v1", "v2", "encoder", "enc_a", "enc_b", "v0")
 
 
 def find_raw_config(data_path: str | os.PathLike[str]) -> Path | None:

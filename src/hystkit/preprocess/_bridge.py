@@ -14,7 +14,7 @@ __all__ = ["bridge_kernel", "bridge_resistance", "bridge_voltage", "clipped_chan
            "first_invalid_bridge_sample", "gauge_symmetry", "relative_change"]
 
 
-def bridge_voltage(r_s: np.ndarray, r_bridge: float, v_supply: float) -> np.ndarray:
+def bridge_voltage(r_s: np.ndarray, r_bridge: float, v_supply: float | np.ndarray) -> np.ndarray:
     """Voltage across the bridge resistor [V], eq. 4.2: ``V_m = R_br / (R_br + R_S) * V0``.
 
     Parameters
@@ -23,13 +23,14 @@ def bridge_voltage(r_s: np.ndarray, r_bridge: float, v_supply: float) -> np.ndar
         Gauge resistance R_S [Ohm], any shape.
     r_bridge : float
         Bridge resistor R_br [Ohm].
-    v_supply : float
-        Supply voltage V0 [V].
+    v_supply : float or array
+        Supply voltage V0 [V]: one nominal value, or the measured supply broadcast against
+        `r_s` (sec. 4.2.1's reference channel).
     """
     return r_bridge / (r_bridge + np.asarray(r_s, dtype=float)) * v_supply
 
 
-def bridge_resistance(v_m: np.ndarray, r_bridge: float, v_supply: float) -> np.ndarray:
+def bridge_resistance(v_m: np.ndarray, r_bridge: float, v_supply: float | np.ndarray) -> np.ndarray:
     """Gauge resistance [Ohm] from the bridge voltage, eq. 4.3: ``R_S = R_br (V0 - V_m) / V_m``.
 
     Defined only for ``0 < V_m < V0``; outside that range the result is negative or infinite,
@@ -39,16 +40,20 @@ def bridge_resistance(v_m: np.ndarray, r_bridge: float, v_supply: float) -> np.n
     ----------
     v_m : array
         Voltage measured across the bridge resistor [V], any shape.
-    r_bridge, v_supply : float
-        R_br [Ohm] and V0 [V].
+    r_bridge : float
+        R_br [Ohm].
+    v_supply : float or array
+        V0 [V]: the nominal supply, or the measured supply of each sample (broadcast against
+        `v_m`), which removes the supply's drift from R_S.
     """
     v_m = np.asarray(v_m, dtype=float)
     # (V0/V_m - 1) costs one division and one subtraction per sample: this runs at scope rate.
     return r_bridge * (v_supply / v_m - 1.0)
 
 
-def first_invalid_bridge_sample(v_m: np.ndarray, v_supply: float) -> int:
-    """Index of the first sample with ``V_m <= 0`` or ``V_m >= V0`` (eq. 4.3 undefined), or -1."""
+def first_invalid_bridge_sample(v_m: np.ndarray, v_supply: float | np.ndarray) -> int:
+    """Index of the first sample with ``V_m <= 0`` or ``V_m >= V0`` (eq. 4.3 undefined), or -1;
+    `v_supply` is one V0 or the measured supply of each sample [V]."""
     v_m = np.asarray(v_m)
     bad = (v_m <= 0.0) | (v_m >= v_supply)
     if not bad.any():
@@ -97,11 +102,14 @@ _OPEN_GAUGE = 1e-12
 
 
 @njit(cache=True, nogil=True)
-def _bridge_row(v, out, r_bridge, v_supply, ext, at):
-    """eq. 4.3 for one channel into `out`; updates [max, n at max, min, n at min] at ext[at:]."""
+def _bridge_row(v, v0, stride, out, r_bridge, ext, at):
+    """eq. 4.3 for one channel into `out`, with supply ``v0[i * stride]`` (stride 0: one nominal
+    V0; 1: the measured supply of each sample); updates [max, n at max, min, n at min] at
+    ext[at:]."""
     hi, n_hi, lo, n_lo = ext[at], ext[at + 1], ext[at + 2], ext[at + 3]
     for i in range(v.size):
         vi = float(v[i])
+        v_supply = float(v0[i * stride])
         # Below 1e-12 V0, R_S = R_br (V0 / V_m - 1) would pass 1e12 R_br (or overflow): an open
         # gauge or a broken sample, not a reading.
         if not (_OPEN_GAUGE * v_supply < vi < v_supply):
@@ -118,7 +126,18 @@ def _bridge_row(v, out, r_bridge, v_supply, ext, at):
 
 
 @njit(cache=True, nogil=True)
-def bridge_kernel(v1, v2, r_bridge, v_supply, ext):
+def _bridge_both(v1, v2, v0, stride, r_bridge, ext):
+    ext = ext.copy()
+    r = np.empty((2, v1.size))
+    bad = np.empty(2, dtype=np.int64)
+    bad[0] = _bridge_row(v1, v0, stride, r[0], r_bridge, ext, 0)
+    bad[1] = _bridge_row(v2, v0, stride, r[1], r_bridge, ext, 4)
+    return r, bad, ext
+
+
+def bridge_kernel(v1: np.ndarray, v2: np.ndarray, r_bridge: float, v_supply: float,
+                  ext: np.ndarray, v0: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """eq. 4.3 for both gauges at the scope rate, fused with the checks.
 
     Parameters
@@ -126,10 +145,13 @@ def bridge_kernel(v1, v2, r_bridge, v_supply, ext):
     v1, v2 : array, shape (n,)
         Bridge voltages [V] (float32 or float64).
     r_bridge, v_supply : float
-        R_br [Ohm] and V0 [V].
+        R_br [Ohm] and the nominal supply V0 [V].
     ext : ndarray, shape (8,)
         Running [max, samples at max, min, samples at min] of v1, then v2; start with
         ``[-inf, 0, inf, 0] * 2``.
+    v0 : array, shape (n,), optional
+        The measured supply [V] of each sample (the reference channel of sec. 4.2.1); used in
+        eq. 4.3 instead of `v_supply` when given.
 
     Returns
     -------
@@ -140,9 +162,8 @@ def bridge_kernel(v1, v2, r_bridge, v_supply, ext):
     ext : ndarray, shape (8,)
         Updated statistics.
     """
-    ext = ext.copy()
-    r = np.empty((2, v1.size))
-    bad = np.empty(2, dtype=np.int64)
-    bad[0] = _bridge_row(v1, r[0], r_bridge, v_supply, ext, 0)
-    bad[1] = _bridge_row(v2, r[1], r_bridge, v_supply, ext, 4)
-    return r, bad, ext
+    if v0 is None:
+        return _bridge_both(v1, v2, np.array([float(v_supply)]), 0, float(r_bridge), ext)
+    if np.shape(v0) != np.shape(v1):
+        raise ValueError(f"v0 has shape {np.shape(v0)}, the bridge voltages {np.shape(v1)}")
+    return _bridge_both(v1, v2, v0, 1, float(r_bridge), ext)

@@ -5,7 +5,9 @@ memory is bounded by the chunk size, not the recording length:
 
 1. read a chunk (:func:`hystkit.io.open_raw`: CSV, Parquet, .mat);
 2. bridge voltages -> gauge resistances R1, R2 at the scope rate (eq. 4.3), after checking
-   ``0 < V_m < V0`` and counting samples stuck at a channel's extreme (clipping);
+   ``0 < V_m < V0`` and counting samples stuck at a channel's extreme (clipping); V0 is the
+   nominal supply, or with ``supply_channel`` the measured supply ``v0`` of each sample (the
+   reference channel of sec. 4.2.1), which removes the supply's drift from R1 and R2;
 3. encoder -> counts (level survey, debounce, quadrature state machine: :mod:`._encoder`);
 4. R1, R2 and the count go through stateful FIR decimation stages (:mod:`._decimate`) to an
    intermediate rate ``fs_mid`` of about ``mid_factor * fs_out`` (400 Hz by default);
@@ -81,6 +83,9 @@ class PreprocessSettings:
     r_bridge, v_supply : float
         Bridge resistor R_br [Ohm] and supply V0 [V] of eq. 4.2 (no defaults: the document used
         10 kOhm / 2 V and 560 Ohm / 1 V, and a wrong value silently scales dR/R).
+    supply_channel : bool
+        Use the file's measured supply column ``v0`` [V] in eq. 4.3 instead of `v_supply`
+        (which is then only the nominal value the report compares the measurement with).
     um_per_count : float
         Encoder resolution [um] (5; eq. 9.16 calibrates it to 5.1).
     position_offset_mm : float
@@ -109,6 +114,7 @@ class PreprocessSettings:
 
     r_bridge: float
     v_supply: float
+    supply_channel: bool = False
     um_per_count: float = 5.0
     position_offset_mm: float = 0.0
     fs_out: float = 40.0
@@ -171,6 +177,10 @@ class PreprocessReport:
     r2_mean_ohm: float
     symmetry: float
     clipped: dict[str, int]
+    supply: str = "nominal"
+    v0_mean_v: float | None = None
+    v0_min_v: float | None = None
+    v0_max_v: float | None = None
     warnings: list[str] = field(default_factory=list)
     seconds: float = 0.0
 
@@ -224,7 +234,8 @@ def preprocess_raw(path: str | os.PathLike[str], settings: PreprocessSettings,
         A channel that looks clipped, or illegal encoder transitions (with their count).
     """
     t_start = _time.perf_counter()
-    reader = open_raw(path, fmt, settings.chunk_size)
+    reader = open_raw(path, fmt, settings.chunk_size,
+                      extra=("v0",) if settings.supply_channel else ())
     fs = reader.fs
     factor = max(1, round(fs / (settings.mid_factor * settings.fs_out)))
     fs_mid = fs / factor
@@ -244,6 +255,7 @@ def preprocess_raw(path: str | os.PathLike[str], settings: PreprocessSettings,
     mid_r: list[np.ndarray] = []
     mid_c: list[np.ndarray] = []
     extremes = np.array([-np.inf, 0, np.inf, 0] * 2, dtype=float)
+    supply = _SupplyStats()
     t0 = 0.0
     bar = tqdm(total=reader.n_samples, unit="sample", unit_scale=True, file=sys.stderr,
                disable=None if progress else True, mininterval=0.5, desc="preprocess")
@@ -251,10 +263,11 @@ def preprocess_raw(path: str | os.PathLike[str], settings: PreprocessSettings,
         if chunk.start == 0 and chunk.time is not None:
             t0 = float(chunk.time[0])
         r, bad, extremes = bridge_kernel(chunk.v1, chunk.v2, float(settings.r_bridge),
-                                          float(settings.v_supply), extremes)
+                                          float(settings.v_supply), extremes, chunk.v0)
         for g in range(2):
             if bad[g] >= 0:
                 _raise_bridge(reader, g, chunk, int(bad[g]), settings.v_supply)
+        supply.add(chunk.v0)
         x = chunk.encoder if logic is None else ab_to_code(chunk.enc_a, chunk.enc_b, *logic)
         counts, enc_state = decode_step(enc_settings, enc_state, x)
         mid_r.append(_run_chain(chain, r_states, r))
@@ -266,7 +279,7 @@ def preprocess_raw(path: str | os.PathLike[str], settings: PreprocessSettings,
     mid_c.append(_flush_chain(chain, c_states, 1))
     mid = np.vstack([np.concatenate(mid_r, axis=1), np.concatenate(mid_c, axis=1)])
     return _finish(reader, settings, mid, t0, reader.fs, factor, chain, enc_settings, enc_state,
-                   levels, logic, extremes, reader.n_samples or 0, t_start)
+                   levels, logic, extremes, supply, reader.n_samples or 0, t_start)
 
 
 # --------------------------------------------------------------------------- pieces
@@ -345,8 +358,42 @@ def _check_levels(reader: RawReader, column: str, survey: LevelSurvey, wanted: i
                           + "? (give --encoder-levels to skip the search)", column)
 
 
+class _SupplyStats:
+    """Running sum, minimum and maximum of the measured supply v0 [V] (nothing when absent)."""
+
+    def __init__(self) -> None:
+        self.n, self.total, self.low, self.high = 0, 0.0, np.inf, -np.inf
+
+    def add(self, v0: np.ndarray | None) -> None:
+        if v0 is not None and v0.size:
+            self.n += v0.size
+            self.total += float(np.sum(v0, dtype=float))
+            self.low, self.high = min(self.low, float(v0.min())), max(self.high, float(v0.max()))
+
+    def fields(self) -> dict:
+        """The report's supply fields."""
+        if not self.n:
+            return {"supply": "nominal"}
+        return {"supply": "measured", "v0_mean_v": self.total / self.n, "v0_min_v": self.low,
+                "v0_max_v": self.high}
+
+
 def _raise_bridge(reader: RawReader, g: int, chunk: RawChunk, i: int, v_supply: float) -> None:
     v = (chunk.v1, chunk.v2)[g][i]
+    if chunk.v0 is not None:
+        v0 = chunk.v0[i]
+        if v0 <= 0:
+            raise reader.fail(f"measured supply {v0:.6g} V is not positive; is this the supply "
+                              "channel, and its polarity right?", "v0", chunk.start + i)
+        if v >= v0:
+            raise reader.fail(f"measured supply {v0:.6g} V is not above the bridge voltage "
+                              f"v{g + 1} = {v:.6g} V, so R_S = R_br (V0 - V_m) / V_m (eq. 4.3) "
+                              "is undefined; is this the supply channel (and v1, v2 the bridge "
+                              "voltages across R_br)?", "v0", chunk.start + i)
+        raise reader.fail(f"bridge voltage {v:.6g} V outside (0, v0 = {v0:.6g} V), where "
+                          "R_S = R_br (V0 - V_m) / V_m (eq. 4.3) is undefined (or, within "
+                          "1e-12 V0 of 0, absurd); check the channel and its polarity",
+                          f"v{g + 1}", chunk.start + i)
     raise reader.fail(f"bridge voltage {v:.6g} V outside (0, V0 = {v_supply:g} V), where "
                       "R_S = R_br (V0 - V_m) / V_m (eq. 4.3) is undefined (or, within 1e-12 V0 "
                       "of 0, absurd); check the channel, its polarity and --v-supply",
@@ -412,7 +459,7 @@ def _flush_chain(chain: tuple[Decimator, ...], states: list, n_rows: int) -> np.
 def _finish(reader: RawReader, settings: PreprocessSettings, mid: np.ndarray, t0: float,
             fs: float, factor: int, chain: tuple[Decimator, ...], enc: EncoderSettings,
             state: EncoderState, levels: np.ndarray, logic: tuple | None, extremes: np.ndarray,
-            n: int, t_start: float) -> PreprocessResult:
+            supply: _SupplyStats, n: int, t_start: float) -> PreprocessResult:
     fs_mid = fs / factor
     notes = []
     n_illegal, n_edges = state.n_illegal, state.n_edges
@@ -480,7 +527,7 @@ def _finish(reader: RawReader, settings: PreprocessSettings, mid: np.ndarray, t0
         first_illegal_s=first_illegal, n_rejected=state.n_rejected,
         r1_mean_ohm=float(r1.mean()), r2_mean_ohm=float(r2.mean()),
         symmetry=gauge_symmetry(r1, r2), clipped={k: c for k, (c, _) in clipped.items()},
-        warnings=notes,
+        **supply.fields(), warnings=notes,
         seconds=_time.perf_counter() - t_start)
     return PreprocessResult(recording, {"r1": r1, "r2": r2, "dr1": dr1, "dr2": dr2}, report)
 

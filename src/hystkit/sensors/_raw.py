@@ -13,6 +13,10 @@ cubic spline (the trajectories have no content above 4 Hz and the resistance noi
   output resistance and logic-low voltage; the logic supply drifts slowly, edges have a finite
   time constant (samples caught mid-edge), and there is white noise. ``enc_a``/``enc_b`` instead
   give the two logic channels.
+* ``v0`` (optional, ``supply_channel``): the bridge supply as a fourth scope channel measures it
+  (the reference channel of sec. 4.2.1), with the same white scope noise. The bridge supply can
+  drift (``bridge_supply_drift``, a slow sine; 0 by default, so the bridge sees exactly V0);
+  the drift then enters v1, v2 through eq. 4.2 and only the v0 channel can remove it.
 
 The file is written chunk by chunk (blocks of 2**20 samples, each with its own noise seed), so
 memory does not grow with the recording and the file does not depend on any chunk size. A
@@ -55,7 +59,10 @@ class ScopeSettings:
     Defaults: the Picoscope set-up of sec. 4.3.1 (R_br = 10 kOhm, V0 = 2 V) at 1 MHz, 0.5 mV
     RMS scope noise, a 5 V hex buffer (4.8 V high, 0.1 V low, 30 Ohm) driving the 1 kOhm / 2 kOhm
     merger into the scope's 1 MOhm, 20 mV noise on the merged channel, 0.5 us edges, 1 %
-    logic-supply drift over 100 s.
+    logic-supply drift over 100 s (``supply_drift``, ``drift_period``: the encoder's buffer).
+    The bridge supply is steady unless ``bridge_supply_drift`` (relative amplitude of a sine of
+    period ``bridge_drift_period`` [s]) is set; ``supply_channel`` adds the measured bridge
+    supply as a column ``v0``.
     """
 
     fs: float = 1e6
@@ -73,18 +80,30 @@ class ScopeSettings:
     edge_tau: float = 0.5e-6
     supply_drift: float = 0.01
     drift_period: float = 100.0
+    bridge_supply_drift: float = 0.0
+    bridge_drift_period: float = 30.0
+    supply_channel: bool = False
     n_missed_states: int = 0
     n_spikes: int = 0
 
     def __post_init__(self) -> None:
         if self.encoder_mode not in ("merged", "ab"):
             raise ValueError(f"encoder_mode must be 'merged' or 'ab', got {self.encoder_mode!r}")
-        for name in ("fs", "r_bridge", "v_supply", "r_d1", "r_d2", "r_scope", "drift_period"):
+        for name in ("fs", "r_bridge", "v_supply", "r_d1", "r_d2", "r_scope", "drift_period",
+                     "bridge_drift_period"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
         if min(self.bridge_noise_v, self.encoder_noise_v, self.edge_tau, self.r_buffer,
                self.supply_drift, self.n_missed_states, self.n_spikes) < 0:
             raise ValueError("noise, edge time, drift and fault counts must be >= 0")
+        if not 0 <= self.bridge_supply_drift < 1:
+            raise ValueError(f"bridge_supply_drift must lie in [0, 1), got "
+                             f"{self.bridge_supply_drift}")
+
+    def bridge_supply(self, t: np.ndarray) -> np.ndarray:
+        """The bridge supply V0(t) [V] at times `t` [s]."""
+        return self.v_supply * (1 + self.bridge_supply_drift
+                                * np.sin(2 * np.pi * np.asarray(t) / self.bridge_drift_period))
 
 
 def merged_levels(scope: ScopeSettings, supply_scale: float = 1.0) -> np.ndarray:
@@ -144,12 +163,21 @@ class RawTruth:
     def recording(self, cutoff: float = 20.0, fs_out: float = 40.0) -> Recording:
         """The truth through the document's chain (eq. 4.1, 4.4-4.5) at `fs_out`: exact
         position [mm] relative to the start and dR1/R1 - dR2/R2, as preprocessing should give."""
+        t, position, dr1, dr2 = self._filtered(cutoff, fs_out)
+        return Recording(time=t, position=position, sensor=dr1 - dr2, source="<raw truth>")
+
+    def gauge_changes(self, cutoff: float = 20.0, fs_out: float = 40.0) -> dict[str, np.ndarray]:
+        """dR/R of each gauge (``dr1``, ``dr2`` [-], eq. 4.4-4.5) on the grid of
+        :meth:`recording`: what preprocessing should give in its ``dr1``, ``dr2`` columns."""
+        _, _, dr1, dr2 = self._filtered(cutoff, fs_out)
+        return {"dr1": dr1, "dr2": dr2}
+
+    def _filtered(self, cutoff: float, fs_out: float) -> tuple[np.ndarray, ...]:
         rows = np.vstack([self.position - self.count0 * self.encoder_mm, self.resistance])
         filtered = lowpass_zero_phase(rows, self.fs_internal, cutoff)
         position, r1, r2 = downsample(filtered, self.fs_internal, fs_out)
         t = downsample(self.time, self.fs_internal, fs_out)
-        sensor = (r1 - r1.mean()) / r1.mean() - (r2 - r2.mean()) / r2.mean()
-        return Recording(time=t, position=position, sensor=sensor, source="<raw truth>")
+        return t, position, (r1 - r1.mean()) / r1.mean(), (r2 - r2.mean()) / r2.mean()
 
     def _coefficients(self, rows: np.ndarray) -> np.ndarray:
         return np.stack([CubicSpline(self.time, r).c for r in rows])
@@ -205,7 +233,7 @@ def simulate_raw(path: str | os.PathLike[str], name: str, seed: int = 0, *,
     spikes = np.sort(n // 100 + fault_rng.choice(n - n // 100, scope.n_spikes, replace=False)) \
         if scope.n_spikes else np.zeros(0, dtype=np.int64)
     columns = ("time", "v1", "v2") + (("encoder",) if scope.encoder_mode == "merged"
-                                      else ("enc_a", "enc_b"))
+                                      else ("enc_a", "enc_b")) + ("v0",) * scope.supply_channel
     edge_state = np.zeros(1 if scope.encoder_mode == "merged" else 2) + np.nan
     a_edge = np.exp(-1.0 / (scope.fs * scope.edge_tau)) if scope.edge_tau > 0 else 0.0
     um = sensor.encoder_mm * 1e3
@@ -213,9 +241,13 @@ def simulate_raw(path: str | os.PathLike[str], name: str, seed: int = 0, *,
               "n_samples": n, "um_per_count": um}
     if scope.encoder_mode == "merged":
         config["encoder_states"] = [format(q, "02b") for q in DEFAULT_STATES]
+    if scope.supply_channel:
+        config["supply_channel"] = True
     notes = {"excitation": name, "seed": seed, "duration_s": float(t[-1]),
              "bridge_noise_v": scope.bridge_noise_v, "encoder_noise_v": scope.encoder_noise_v,
              "edge_tau_s": scope.edge_tau, "supply_drift": scope.supply_drift,
+             "bridge_supply_drift": scope.bridge_supply_drift,
+             "bridge_drift_period_s": scope.bridge_drift_period,
              "missed_states": len(missed), "spikes": int(spikes.size),
              "age_hours": sensor.age_hours,
              "base_resistance_ohm": [float(v) for v in sensor.base_resistance]}
@@ -258,8 +290,11 @@ def _raw_block(ts: np.ndarray, start: int, noise: np.random.Generator, coef: np.
         hide = (counts == hidden) & (np.abs(ts - t_missed) < 0.5 / sensor.fs_internal)
         codes[hide] = count_to_code(np.array([hidden - direction]))[0]
     chunk = {"time": ts}
+    # Without drift the supply is exactly V0 (x 1.0), so the file is the one written before the
+    # drift existed.
+    v_supply = scope.bridge_supply(ts)
     for g, rg in enumerate((r1, r2)):
-        chunk[f"v{g + 1}"] = (bridge_voltage(rg, scope.r_bridge, scope.v_supply)
+        chunk[f"v{g + 1}"] = (bridge_voltage(rg, scope.r_bridge, v_supply)
                               + scope.bridge_noise_v * noise.standard_normal(ts.size))
     scale = 1 + scope.supply_drift * np.sin(2 * np.pi * ts / scope.drift_period)
     local = spikes[(spikes >= start) & (spikes < start + ts.size)] - start
@@ -270,13 +305,15 @@ def _raw_block(ts: np.ndarray, start: int, noise: np.random.Generator, coef: np.
     else:
         signals = [np.where(bit, scope.logic_high, scope.logic_low) * scale
                    for bit in code_to_ab(codes)]
-    for j, (col, ideal) in enumerate(zip(columns[3:], signals)):
+    for j, (col, ideal) in enumerate(zip(columns[3:3 + len(signals)], signals)):
         shaped = _one_pole(ideal, a_edge, edge_state[j])
         edge_state[j] = shaped[-1]
         if local.size and j == 0:  # spikes: one sample jumps to another level
             shaped[local] = ideal[local] + np.where(ideal[local] > ideal.mean(), -1, 1) \
                 * 0.6 * (scope.logic_high - scope.logic_low)
         chunk[col] = shaped + scope.encoder_noise_v * noise.standard_normal(ts.size)
+    if scope.supply_channel:  # drawn last: the other channels' noise is as without it
+        chunk["v0"] = v_supply + scope.bridge_noise_v * noise.standard_normal(ts.size)
     return chunk
 
 
