@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import itertools
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -23,6 +23,7 @@ from ._blocks import (
 )
 from ._loop import ControlLoop, LoopResponse, simulate_loop, tare
 from ._names import EXPERIMENTS
+from ._noise import NoiseSpec
 from ._sensors import SensorModels
 
 __all__ = [
@@ -34,6 +35,8 @@ __all__ = [
     "build_loop",
     "cubic_trajectory",
     "experiment_cases",
+    "measured_sensor_noise",
+    "noise_study",
     "run_experiment",
     "sine_reference",
 ]
@@ -153,6 +156,7 @@ class ExperimentResult:
     cases: dict[str, LoopResponse]
     descriptions: dict[str, str]
     seconds: float
+    noise: NoiseSpec | None = None
 
     def metrics(self) -> dict:
         """``{"experiment", "scheme", "cases": {label: metrics}}``; a single-case experiment
@@ -173,6 +177,7 @@ class ExperimentResult:
                     cases[k][key] = float(sel.max()) if sel.size else None
         out = {"experiment": self.name, "scheme": self.loop.scheme,
                "dob": self.loop.dob is not None, "cases": cases,
+               "noise": None if self.noise is None else self.noise.to_dict(),
                "all_bounded": all(v.bounded for v in self.cases.values()),
                "seconds": sum(v.seconds for v in self.cases.values())}
         if len(self.cases) == 1:
@@ -180,11 +185,53 @@ class ExperimentResult:
         return out
 
 
-def run_experiment(name: str, loop: ControlLoop) -> ExperimentResult:
-    """Run every case of experiment ``name`` from rest; see :func:`experiment_cases`."""
+def run_experiment(name: str, loop: ControlLoop,
+                   noise: NoiseSpec | None = None) -> ExperimentResult:
+    """Run every case of experiment ``name`` from rest; see :func:`experiment_cases`.
+
+    ``noise``: sensor and process noise, case ``k`` drawn by ``noise.draw(n, k)``
+    (:class:`NoiseSpec`); None runs without.
+    """
     t0 = time.perf_counter()
     cases, descriptions = {}, {}
-    for case in experiment_cases(name, loop.ts):
-        cases[case.label] = simulate_loop(loop, case.r, d_out=case.d_out)
+    for k, case in enumerate(experiment_cases(name, loop.ts)):
+        sensor, process = (None, None) if noise is None else noise.draw(case.r.size, k)
+        cases[case.label] = simulate_loop(loop, case.r, d_out=case.d_out, d_in=process,
+                                          noise=sensor)
         descriptions[case.label] = case.description
-    return ExperimentResult(name, loop, cases, descriptions, time.perf_counter() - t0)
+    return ExperimentResult(name, loop, cases, descriptions, time.perf_counter() - t0, noise)
+
+
+def measured_sensor_noise(loop: ControlLoop, response: LoopResponse) -> float:
+    """SD of the noise in the loop's sensor signal [sensor units]: ``s`` minus ``S_r`` run
+    open loop on the plant position the run recorded (the same state from rest)."""
+    clean, _ = loop.sensor.simulate(response.y, loop.ts)
+    return float(np.std(response.s - clean))
+
+
+def noise_study(name: str, loop: ControlLoop, noise: NoiseSpec,
+                dob: DisturbanceObserver) -> list[dict]:
+    """Experiment ``name`` without and with ``noise``, each without and with ``dob``.
+
+    Returns
+    -------
+    rows : list of dict
+        One per (noise, DOB, case): ``noise`` and ``dob`` flags, ``case``, ``e_p_rms``,
+        ``e_p_max`` [m], ``u_rms`` [N] (control effort), ``sensor_noise_sd`` measured in the
+        run's sensor signal [sensor units] and ``bounded``.
+    """
+    rows = []
+    for with_noise in (False, True):
+        for observer in (None, dob):
+            result = run_experiment(name, replace(loop, dob=observer),
+                                    noise if with_noise else None)
+            for label, resp in result.cases.items():
+                m = resp.metrics()
+                rows.append({"noise": with_noise, "dob": observer is not None, "case": label,
+                             "e_p_rms": m.get("e_p_rms"), "e_p_max": m.get("e_p_max"),
+                             "u_rms": float(np.sqrt(np.mean(resp.u ** 2))) if resp.u.size
+                             else None,
+                             "sensor_noise_sd": measured_sensor_noise(loop, resp)
+                             if resp.bounded else None,
+                             "bounded": resp.bounded})
+    return rows

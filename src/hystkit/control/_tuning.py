@@ -1,0 +1,178 @@
+"""PID re-tuning on the non-linear loop itself (beyond sec. 7.2's linear tuning).
+
+The document tunes its PID on the linear plant. Here the gains are tuned on the loop as it
+runs -- hysteretic sensor, compensator, ``S_m``, DOB -- by minimising the plant error of an
+experiment over ``(log Kp, log Ti, log Td)`` with Nelder-Mead, from the current gains. Each
+evaluation is one compiled run (a few ms for the 10 s sine), so a few hundred evaluations take
+seconds. The linearised loop's margins (:func:`~hystkit.control.loop_margins`) are the
+constraints: a candidate that beats the best so far counts only if its phase and gain margins
+reach the minimum and its linearised closed loop has no pole further out than the start's.
+The result is never worse than the start: if nothing better and feasible is found, the start
+is returned.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.optimize import minimize
+
+from ._analysis import LoopMargins, loop_margins
+from ._blocks import PID
+from ._experiments import run_experiment
+from ._loop import ControlLoop
+from ._noise import NoiseSpec
+
+__all__ = ["OBJECTIVES", "TuneResult", "tune_nonlinear"]
+
+OBJECTIVES = ("rms", "max")
+"""Plant-error measures to minimise: ``e_p_rms`` or ``e_p_max`` (eq. 7.6, 7.8), the worst case
+of the experiment."""
+
+
+@dataclass(frozen=True, eq=False)
+class TuneResult:
+    """Gains, costs and margins before and after :func:`tune_nonlinear`.
+
+    Attributes
+    ----------
+    pid_start, pid : PID
+        Start and result (``pid is pid_start`` when nothing better was found).
+    cost_start, cost : float
+        Plant error [m] (``objective`` over the experiment's cases, the worst case).
+    margins_start, margins : LoopMargins
+    n_evaluations : int
+        Simulations of the experiment.
+    n_margin_checks : int
+        Linearisations (only for candidates that beat the best so far).
+    seconds : float
+    improved : bool
+    message : str
+        The optimiser's message.
+    """
+
+    pid_start: PID
+    pid: PID
+    objective: str
+    experiment: str
+    cost_start: float
+    cost: float
+    margins_start: LoopMargins
+    margins: LoopMargins
+    min_phase_margin: float
+    min_gain_margin_db: float
+    n_evaluations: int
+    n_margin_checks: int
+    seconds: float
+    improved: bool
+    message: str
+
+    def to_dict(self) -> dict:
+        def gains(p: PID) -> dict:
+            return {"kp": p.kp, "ti": p.ti if np.isfinite(p.ti) else None, "td": p.td}
+
+        return {"objective": self.objective, "experiment": self.experiment,
+                "pid_start": gains(self.pid_start), "pid": gains(self.pid),
+                "cost_start_m": self.cost_start, "cost_m": self.cost,
+                "margins_start": self.margins_start.to_dict(),
+                "margins": self.margins.to_dict(),
+                "min_phase_margin_deg": self.min_phase_margin,
+                "min_gain_margin_db": self.min_gain_margin_db,
+                "n_evaluations": self.n_evaluations, "n_margin_checks": self.n_margin_checks,
+                "seconds": self.seconds, "improved": self.improved, "message": self.message}
+
+
+def _feasible(m: LoopMargins, limit: float, min_pm: float, min_gm: float) -> bool:
+    return (m.max_pole_radius <= limit
+            and (m.phase_margin_deg is not None and m.phase_margin_deg >= min_pm)
+            and (m.gain_margin_db is None or m.gain_margin_db >= min_gm))
+
+
+def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: str = "rms",
+                   min_phase_margin: float = 30.0, min_gain_margin_db: float = 6.0,
+                   noise: NoiseSpec | None = None, max_evaluations: int = 300) -> TuneResult:
+    """Minimise the plant error of ``experiment`` over the PID gains of ``loop``.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        Its PID is the start; ``Tf`` and anti-windup are kept. A PID without integral action
+        (``Ti = inf``) is tuned over ``Kp`` and ``Td`` only.
+    experiment : str
+        One of :data:`~hystkit.control.EXPERIMENTS`; every case counts, the worst decides.
+    objective : {"rms", "max"}
+        ``e_p_rms`` or ``e_p_max`` [m]; an unbounded run costs infinity.
+    min_phase_margin, min_gain_margin_db : float
+        Constraints on the linearised loop at rest [deg, dB]; also no closed-loop pole
+        further out than the start's (or the unit circle).
+    noise : NoiseSpec, optional
+        Tune with this (fixed-seed) noise in every run.
+    max_evaluations : int
+        Budget of simulations.
+
+    Raises
+    ------
+    ValueError
+        If the start gains violate the constraints or leave the loop unbounded.
+    """
+    if objective not in OBJECTIVES:
+        raise ValueError(f"objective must be one of {OBJECTIVES}, got {objective!r}")
+    t_start = time.perf_counter()
+    start = loop.pid
+    key = "e_p_rms" if objective == "rms" else "e_p_max"
+    counts = {"runs": 0, "checks": 0}
+
+    def gains(x: np.ndarray) -> PID:
+        ti = float(np.exp(x[1])) if np.isfinite(start.ti) else np.inf
+        return replace(start, kp=float(np.copysign(np.exp(x[0]), start.kp)), ti=ti,
+                       td=float(np.exp(x[-1])) if start.td > 0 else 0.0)
+
+    def cost(pid: PID) -> float:
+        counts["runs"] += 1
+        result = run_experiment(experiment, replace(loop, pid=pid), noise)
+        if not all(r.bounded for r in result.cases.values()):
+            return np.inf
+        return max(r.metrics()[key] for r in result.cases.values())
+
+    margins_start = loop_margins(loop)
+    limit = max(1.0, margins_start.max_pole_radius) + 1e-12
+    if not _feasible(margins_start, limit, min_phase_margin, min_gain_margin_db):
+        raise ValueError(f"the start gains break the constraints (phase margin "
+                         f"{margins_start.phase_margin_deg} deg, gain margin "
+                         f"{margins_start.gain_margin_db} dB; need >= {min_phase_margin} deg, "
+                         f">= {min_gain_margin_db} dB): lower the minimums or start elsewhere")
+    cost_start = cost(start)
+    if not np.isfinite(cost_start):
+        raise ValueError(f"the start gains leave the {experiment} run unbounded")
+    best = {"pid": start, "cost": cost_start, "margins": margins_start}
+
+    def objective_of(x: np.ndarray) -> float:
+        pid = gains(x)
+        c = cost(pid)
+        if not c < best["cost"]:
+            return c  # no better than the best: its feasibility does not matter
+        counts["checks"] += 1
+        m = loop_margins(replace(loop, pid=pid))
+        if not _feasible(m, limit, min_phase_margin, min_gain_margin_db):
+            return np.inf
+        best.update(pid=pid, cost=c, margins=m)
+        return c
+
+    x0 = [np.log(abs(start.kp))]
+    if np.isfinite(start.ti):
+        x0.append(np.log(start.ti))
+    if start.td > 0:
+        x0.append(np.log(start.td))
+    x0 = np.array(x0)
+    # first simplex: each gain 30 % up (log steps; Nelder-Mead's default 5 % is too timid)
+    simplex = np.vstack([x0] + [x0 + 0.26 * np.eye(x0.size)[i] for i in range(x0.size)])
+    res = minimize(objective_of, x0, method="Nelder-Mead",
+                   options={"maxfev": max_evaluations, "initial_simplex": simplex,
+                            "xatol": 1e-3, "fatol": 1e-9 * cost_start})
+    improved = best["pid"] is not start
+    return TuneResult(start, best["pid"], objective, experiment, cost_start, best["cost"],
+                      margins_start, best["margins"], min_phase_margin, min_gain_margin_db,
+                      counts["runs"], counts["checks"], time.perf_counter() - t_start,
+                      improved, str(res.message))
