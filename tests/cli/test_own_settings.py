@@ -205,16 +205,16 @@ def test_a_raw_recordings_settings_of_the_same_stem_are_left_alone(files, tmp_pa
         read_recording_config(tmp_path / "run.toml")  # named when read as a recording's
 
 
-def test_compensate_with_resample_says_other_columns_are_not_kept(files, tmp_path, capsys):
+def test_compensate_with_resample_leaves_out_text_and_gappy_columns(files, tmp_path, capsys):
     model = tmp_path / "m.json"
     assert _run(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
     out = tmp_path / "c.csv"
     code, stdout, err = _run(capsys, "compensate", model, files["with_toml"], "--resample", 40,
                              "--out", out)
     assert code == 0, err
-    assert "the input's other columns are not kept" in stdout
+    assert "columns with text or empty cells cannot be and are left out" in stdout
     written = pd.read_csv(out)
-    assert "temp_C" not in written.columns
+    assert "temp_C" not in written.columns and "note" not in written.columns  # empty cell; text
     # the file is uniform at 40 Hz already: resampled at its own rate it is the same recording
     # up to rounding (its times are ms x 1e-3, the grid's t0 + k / 40: a few ulp apart)
     np.testing.assert_allclose(written["sensor"].to_numpy(),

@@ -193,8 +193,8 @@ def _compensate(args: argparse.Namespace) -> int:
           + (f"; units in {sidecar_path(args.out)}" if units and args.out.suffix.lower()
              == ".csv" else ""))
     if options.resample_hz is not None:
-        print("  (resampled: the input's other columns are not kept, they have no values at "
-              "the new times)")
+        print("  (resampled: the input's other numeric columns were resampled like the "
+              "recording; columns with text or empty cells cannot be and are left out)")
     _warn_if_outside(flags, args.data)
     return 0
 

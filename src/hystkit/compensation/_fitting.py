@@ -12,7 +12,6 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..errors import FitDivergedError, HystkitError, InputError
 from ..identification import FitResult
@@ -56,6 +55,8 @@ def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.
         except (ValueError, HystkitError):
             return np.full(target.size, _OUTSIDE)
         return r if np.all(np.isfinite(r)) else np.full(target.size, _OUTSIDE)
+
+    from scipy.optimize import least_squares  # here: only multi-recording fits pay its import
 
     sol = least_squares(residual, theta0, method="trf", x_scale="jac", max_nfev=100)
     start_cost = 0.5 * float(np.sum(residual(theta0) ** 2))

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from hystkit.errors import InputError
+
+if TYPE_CHECKING:  # pandas loads with the first text cell: a clean CSV never needs it
+    import pandas as pd
 
 COLUMNS = ("time", "position", "sensor")  # also the column order of written files
 _SHOWN_CHARS = 40  # of a bad cell in a message: a 10 MB field must not become a 10 MB line
@@ -75,6 +77,8 @@ def text_problems(text: pd.Series) -> tuple[np.ndarray, np.ndarray, pd.Series]:
     stripped : Series of str
         The cells without surrounding whitespace, for the error message.
     """
+    import pandas as pd
+
     missing = text.isna().to_numpy()
     stripped = text.where(~missing, "").astype(str).str.strip()
     empty = missing | (stripped == "").to_numpy()

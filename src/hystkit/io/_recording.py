@@ -22,7 +22,6 @@ from ._cells import Where as _Where  # also imported by _raw
 from ._cells import as_vector
 from ._csv_reader import read_csv
 from ._mat_reader import read_mat
-from ._parquet_reader import read_parquet
 from ._resample import resample_arrays
 
 if TYPE_CHECKING:
@@ -224,9 +223,22 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
         empty or non-finite cell, magnitude above `MAX_MAGNITUDE`, unequal lengths, time not strictly increasing, non-uniform
         sampling, fewer than 2 samples. The message names file, column and row.
     """
-    path = Path(path)
-    source = str(path)
     options = ReadOptions() if options is None else options
+    arrays, where, units = read_unvalidated(Path(path), need_position, options)
+    if options.resample_hz is not None:
+        _validate(arrays, where, uniform=False)
+        arrays = resample_arrays(arrays, options.resample_hz, where)
+    _validate(arrays, where)
+    # time is in seconds once read, whatever the file's unit
+    return _adopt(arrays, str(path), tuple((k, v) for k, v in units.items()
+                                           if k in ("position", "sensor")))
+
+
+def read_unvalidated(path: Path, need_position: bool, options: ReadOptions,
+                     ) -> tuple[dict[str, np.ndarray], _Where, dict[str, str]]:
+    """The recording's arrays as the file holds them, time in seconds, not resampled nor
+    checked; the error locator; the units (the file's own first)."""
+    source = str(path)
     suffix = path.suffix.lower()
     if suffix not in _READERS:
         raise InputError(
@@ -249,13 +261,7 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
     _check_time_unit(units.get("time"), options, where)
     if options.time_scale != 1.0:  # to seconds before the checks, whose messages say "s"
         arrays["time"] = arrays["time"] * options.time_scale
-    if options.resample_hz is not None:
-        _validate(arrays, where, uniform=False)
-        arrays = resample_arrays(arrays, options.resample_hz, where)
-    _validate(arrays, where)
-    # time is in seconds once read, whatever the file's unit
-    return _adopt(arrays, source, tuple((k, v) for k, v in units.items()
-                                        if k in ("position", "sensor")))
+    return arrays, where, units
 
 
 def _check_time_unit(unit: str | None, options: ReadOptions, where: _Where) -> None:
@@ -288,7 +294,13 @@ def _adopt(arrays: dict[str, np.ndarray], source: str,
     return recording
 
 
-_READERS = {".csv": read_csv, ".parquet": read_parquet, ".mat": read_mat}
+def _read_parquet(*args: object) -> tuple[dict[str, np.ndarray], _Where]:
+    from ._parquet_reader import read_parquet  # here: pyarrow loads only for Parquet files
+
+    return read_parquet(*args)
+
+
+_READERS = {".csv": read_csv, ".parquet": _read_parquet, ".mat": read_mat}
 
 
 def _validate(arrays: dict[str, np.ndarray], where: _Where, *, uniform: bool = True) -> None:

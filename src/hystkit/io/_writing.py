@@ -17,14 +17,16 @@ import shutil
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from hystkit.errors import NonFiniteError, OutputError, OutputExistsError
 
 from ._recording import _COLUMNS, Recording
+
+if TYPE_CHECKING:  # pandas loads when a recording is written, not for a model file
+    import pandas as pd
 
 TEMP_MARK = ".tmp-"  # every temporary's name holds this; tests look for strays by it
 
@@ -116,6 +118,8 @@ def write_recording(
 
         return write_mat(path, {}, force=force,
                          verbatim=recording_variables(columns, all_units))
+    import pandas as pd
+
     # flags (bool) as 0/1 in text and Parquet files, as the files hystkit always wrote
     frame = pd.DataFrame({name: values.astype(int) if np.asarray(values).dtype.kind == "b"
                           else values for name, values in columns.items()})
