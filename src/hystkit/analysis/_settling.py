@@ -208,7 +208,8 @@ def _fit_one(t: np.ndarray, y: np.ndarray, name: str) -> SettlingFit:
         raise SettlingFitError("the fitted rise is not faster than the drop (tau_rise_h >= "
                                "tau_drop_h): no rise in this log")
     n, k = t.size, len(names)
-    rss = float(np.sum(res.fun ** 2))
+    # Floored at rounding level, so a noise-free log has a finite BIC (and zero errors).
+    rss = max(float(np.sum(res.fun ** 2)), n * (1e-15 * float(np.max(np.abs(y)))) ** 2)
     jtj = res.jac.T @ res.jac
     if np.linalg.cond(jtj) > 1e14:
         raise SettlingFitError("parameters not identifiable from this log (singular Jacobian; "

@@ -1,0 +1,128 @@
+"""Per-cycle analysis against closed forms and invariants (issue 14.3)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from hystkit.analysis import (
+    cycle_bounds,
+    cycle_table,
+    drift_rate,
+    enclosed_area,
+    input_minima,
+    split_cycles,
+)
+from hystkit.metrics import loop_area
+
+FS = 40.0  # Hz, the recordings' rate
+PERIOD = 2.0  # s, the document's sine (T = 2 s)
+
+
+def _ellipse(a: float, b: float, phi: float, n_periods: int, n_per: int = 400):
+    """x = a sin(w t), y = b sin(w t + phi) over whole periods (ends at a sample of x = 0)."""
+    t = np.arange(n_periods * n_per + 1) / n_per * PERIOD
+    w = 2 * np.pi / PERIOD
+    return t, a * np.sin(w * t), b * np.sin(w * t + phi)
+
+
+def _polygon_area(a: float, b: float, phi: float, n: int) -> float:
+    """Area of the ellipse's inscribed n-gon: the affine image (det a b sin phi) of the regular
+    n-gon in the unit circle, area n/2 sin(2 pi / n); -> pi a b sin(phi) for large n."""
+    return a * b * math.sin(phi) * n / 2 * math.sin(2 * math.pi / n)
+
+
+@pytest.mark.parametrize("phi", [0.3, 1.0, -0.7])
+def test_ellipse_area_is_pi_a_b_sin_phi(phi):
+    a, b = 3.0, 0.15
+    _, x, y = _ellipse(a, b, phi, 1, n_per=4000)
+    # the trapezoid rule of oint y dx is the shoelace area of the sampled polygon, exactly
+    assert_allclose(enclosed_area(x, y), _polygon_area(a, b, phi, 4000), rtol=1e-12)
+    assert_allclose(enclosed_area(x, y), math.pi * a * b * math.sin(phi), rtol=1e-6)
+
+
+def test_per_cycle_areas_are_the_ellipse_and_its_normalised_area():
+    a, b, phi = 3.0, 0.15, 0.4
+    t, x, y = _ellipse(a, b, phi, 6)
+    table = cycle_table(t, x, {"y": y})
+    # Minima at 3/4 period: 5 complete cycles between the 6 minima of 6 periods.
+    assert table.n_cycles == 5
+    # each cycle is the sampled 400-gon (minima fall on samples)
+    assert_allclose(table.area["y"], _polygon_area(a, b, phi, 400), rtol=1e-12)
+    # eq. 5.15 normalises both ranges to 1 (2a, 2b): pi/4 sin(phi) of the unit square, in %;
+    # the polygon and the sampled peak of y (off by up to b (1 - cos(pi/400))) cost ~1e-4.
+    assert_allclose(table.area_pct["y"], 25 * math.pi * math.sin(phi), rtol=2e-4)
+    # and is the metrics module's own number on each closed cycle
+    k = 2
+    lo, hi = table.start[k], table.stop[k] + 1
+    assert table.area_pct["y"][k] == loop_area(x[lo:hi], y[lo:hi])
+
+
+def test_linear_drift_gives_its_slope_per_hour_and_per_cycle():
+    slope = 0.02 / 3600.0  # dR/R per second: 2 % per hour
+    t = np.arange(0, 200, 1 / FS)
+    x = -3 * np.cos(2 * np.pi * t / PERIOD)  # starts at a minimum, like a load cycle
+    y = 0.1 * np.sin(2 * np.pi * t / PERIOD + 0.5) + 0.02 * x**2 + slope * t
+    table = cycle_table(t, x, {"y": y})
+    assert table.n_cycles == 99
+    drift = table.drift["y"]
+    # The periodic part has the same mean over every whole cycle, so only rounding remains.
+    assert_allclose(drift.per_hour, 0.02, rtol=1e-9)
+    assert_allclose(drift.per_cycle, slope * PERIOD, rtol=1e-9)
+    assert_allclose(table.drift_between("y"), slope * PERIOD, rtol=1e-7)
+    assert drift.stderr_per_hour < 1e-9
+
+
+def test_drift_rate_standard_error_is_the_textbook_one():
+    t = np.array([0.0, 3600.0, 7200.0, 10800.0])
+    y = np.array([0.0, 1.0, 1.0, 3.0])
+    rate = drift_rate(t, y, mean_duration=2.0)
+    # closed form of simple regression on hours 0..3: slope 0.9, SE sqrt(RSS/(n-2)/Sxx)
+    assert_allclose(rate.per_hour, 0.9)
+    resid = y - (y.mean() + 0.9 * (np.arange(4) - 1.5))
+    assert_allclose(rate.stderr_per_hour, math.sqrt(np.sum(resid**2) / 2 / 5.0))
+
+
+def test_split_by_cycles_then_concatenated_is_the_whole():
+    rng = np.random.default_rng(3)
+    t = np.arange(0, 60, 1 / FS)
+    x = 2 * np.exp(-t / 40) * np.sin(np.pi * t) + 0.005 * rng.standard_normal(t.size)
+    y = rng.standard_normal(t.size)
+    bounds = cycle_bounds(x)
+    pieces = split_cycles(bounds, t, x, y)
+    for i, whole in enumerate((t, x, y)):
+        assert np.array_equal(np.concatenate([p[i] for p in pieces]), whole)
+    # and the cycles' closed-loop areas add up to the line integral over all of them
+    table = cycle_table(t, x, {"y": y})
+    lo, hi = table.start[0], table.stop[-1] + 1
+    assert_allclose(table.area["y"].sum(), enclosed_area(x[lo:hi], y[lo:hi]), rtol=1e-12)
+
+
+def test_minima_of_a_noisy_decaying_sine_are_its_true_minima():
+    rng = np.random.default_rng(0)
+    t = np.arange(0, 40, 1 / FS)
+    x = 2 * np.exp(-t / 30) * np.sin(np.pi * t - np.pi / 2)  # minima at t = 0, 2, 4, ...
+    noisy = x + 0.01 * rng.standard_normal(t.size)
+    minima = input_minima(noisy)
+    assert minima.size == 20
+    # within a few samples of the true minima despite noise (flat bottoms)
+    assert np.max(np.abs(t[minima] - 2 * np.arange(20))) < 0.2
+
+
+def test_a_sine_started_mid_range_has_no_cycle_before_its_first_minimum():
+    t = np.arange(0, 10, 1 / FS)
+    minima = input_minima(np.sin(np.pi * t))
+    assert_allclose(t[minima], [1.5, 3.5, 5.5, 7.5, 9.5])
+
+
+@pytest.mark.parametrize(("x", "match"), [
+    (np.zeros(10), "constant"),
+    (np.array([0.0, np.nan, 1.0]), "NaN"),
+    (np.sin(np.linspace(0, 3, 50)), "no complete cycle"),
+])
+def test_bad_inputs_are_refused_with_a_reason(x, match):
+    with pytest.raises(ValueError, match=match):
+        cycle_table(np.arange(x.size) / FS, x, {"y": np.arange(x.size, dtype=float)})
