@@ -16,7 +16,7 @@ from ._common import UsageError, check_size, deferred, number, positive_int
 if TYPE_CHECKING:  # the library loads when the command runs
     from ..control import SensorModels
 
-__all__ = ["register"]
+__all__ = ["add_setup_options", "register", "setup_inputs", "setup_loop"]
 
 # eq. 7.6 (scheme a) and eq. 7.8 (scheme b): the document's plant errors on the eq. 7.3 sine
 DOCUMENT_SINE = {"direct": {"e_p_max": 6.94e-4, "e_p_mean": -1.543e-4, "source": "eq. 7.6"},
@@ -122,6 +122,64 @@ def _outputs(args: argparse.Namespace, out: Path) -> list[Path]:
     return [out / n for n in names]
 
 
+def setup_inputs(args: argparse.Namespace) -> list[Path]:
+    """The input files the loop options name (never to be overwritten by an output)."""
+    return [x for x in (args.sensor_data, args.training_data, args.compensator,
+                        args.model_file, Path(args.sensor)) if x is not None]
+
+
+def setup_loop(args: argparse.Namespace):
+    """``(loop, models, fit_seconds)`` from the options of :func:`add_setup_options`: the
+    sensor models fitted (or read) and the loop built; bad combinations are one line."""
+    check_size(args.sensor_model, args.sensor_size, "--sensor-size")
+    check_size(args.model, args.model_size, "--model-size")
+    if args.sensor != "virtual" and args.sensor_data is not None:
+        raise UsageError("--sensor-data fits S_r on a recording; it cannot be combined with "
+                         f"--sensor {args.sensor}")
+    training = args.training or ("recording" if args.sensor in ("virtual", "virtual-physics")
+                                 else "loop")
+    t_start = time.perf_counter()
+    models = _models(training, args.training_excitation, args.sensor_size,
+                     args.model_size, args.sensor_data, args.training_data, args.sensor,
+                     args.sensor_model, args.model)
+    if args.compensator is not None:
+        models = replace(models, compensator=_file_block(
+            _library("compensator_block"), args.compensator, "S_m^comp", "--compensator"),
+            info={**models.info, "compensator_file": str(args.compensator)})
+    if args.model_file is not None:
+        models = replace(models, model=_file_block(_library("sensor_block"), args.model_file,
+                                                   "S_m", "--model-file"),
+                         info={**models.info, "model_file": str(args.model_file)})
+    t_fit = time.perf_counter() - t_start
+    return _loop(args, models), models, t_fit
+
+
+def _tune(args: argparse.Namespace, loop):
+    """``--tune-nonlinear``: the PID tuned on the non-linear loop, before/after printed."""
+    from ..control import tune_nonlinear
+
+    try:
+        res = tune_nonlinear(loop, args.experiment, objective=args.tune_objective,
+                             min_phase_margin=args.min_phase_margin,
+                             min_gain_margin_db=args.min_gain_margin, noise=args.noise)
+    except ValueError as exc:
+        raise UsageError(f"--tune-nonlinear: {exc}") from None
+    a, b = res.pid_start, res.pid
+    print(f"non-linear tuning ({args.experiment}, e_p {res.objective}, phase margin >= "
+          f"{res.min_phase_margin:g} deg, gain margin >= {res.min_gain_margin_db:g} dB): "
+          f"{res.n_evaluations} runs, {res.n_margin_checks} linearisations, "
+          f"{res.seconds:.1f} s")
+    for name, p, cost, m in (("before", a, res.cost_start, res.margins_start),
+                             ("after", b, res.cost, res.margins)):
+        print(f"  {name:<7}Kp = {p.kp:.4g}, Ti = {p.ti:.4g} s, Td = {p.td:.4g} s: e_p "
+              f"{res.objective} {cost:.4g} m; phase margin {_fmt(m.phase_margin_deg)} deg, "
+              f"gain margin {_fmt(m.gain_margin_db) if m.gain_margin_db is not None else 'inf'}"
+              f" dB")
+    if not res.improved:
+        print("  nothing better within the constraints: the start gains are kept")
+    return res
+
+
 def _loop(args: argparse.Namespace, models: SensorModels):
     """The configured loop; a library ValueError here is a bad option combination."""
     from ..control import PID, DisturbanceObserver, Plant, build_loop, design_dob, tune_pid
@@ -166,13 +224,11 @@ def _control(args: argparse.Namespace) -> int:
     from .. import __version__
     from ..control import (
         bode_data,
-        compensator_block,
         loop_margins,
         plot_bode,
         plot_cases,
         plot_response,
         run_experiment,
-        sensor_block,
     )
     from ..io import atomic_folder, check_output_folder, write_json
 
@@ -181,31 +237,17 @@ def _control(args: argparse.Namespace) -> int:
     stamp = time.strftime("%Y%m%d-%H%M%S")
     out = args.out or Path(f"hystkit-control-{args.scheme}-{args.experiment or 'bode'}-{stamp}")
     paths = _outputs(args, out)
-    inputs = [x for x in (args.sensor_data, args.training_data, args.compensator,
-                          args.model_file, Path(args.sensor)) if x is not None]
     # refuse before any work
-    check_output_folder(out, [p.name for p in paths], args.force, inputs=inputs)
-    check_size(args.sensor_model, args.sensor_size, "--sensor-size")
-    check_size(args.model, args.model_size, "--model-size")
-    if args.sensor != "virtual" and args.sensor_data is not None:
-        raise UsageError("--sensor-data fits S_r on a recording; it cannot be combined with "
-                         f"--sensor {args.sensor}")
-    training = args.training or ("recording" if args.sensor in ("virtual", "virtual-physics")
-                                 else "loop")
+    check_output_folder(out, [p.name for p in paths], args.force, inputs=setup_inputs(args))
+    if args.tune_nonlinear and not args.experiment:
+        raise UsageError("--tune-nonlinear tunes on an experiment: give --experiment NAME")
+    if args.noise is not None and not args.experiment:
+        raise UsageError("--noise runs an experiment with noise: give --experiment NAME")
     t_start = time.perf_counter()
-    models = _models(training, args.training_excitation, args.sensor_size,
-                     args.model_size, args.sensor_data, args.training_data, args.sensor,
-                     args.sensor_model, args.model)
-    if args.compensator is not None:
-        models = replace(models, compensator=_file_block(
-            compensator_block, args.compensator, "S_m^comp", "--compensator"),
-            info={**models.info, "compensator_file": str(args.compensator)})
-    if args.model_file is not None:
-        models = replace(models, model=_file_block(sensor_block, args.model_file, "S_m",
-                                                   "--model-file"),
-                         info={**models.info, "model_file": str(args.model_file)})
-    t_fit = time.perf_counter() - t_start
-    loop = _loop(args, models)
+    loop, models, t_fit = setup_loop(args)
+    tuned = _tune(args, loop) if args.tune_nonlinear else None
+    if tuned is not None:
+        loop = replace(loop, pid=tuned.pid)
     margins = loop_margins(loop)
     dob = f"{loop.dob.f_q:.3g} Hz" if loop.dob else "off"
     print(f"hystkit control: scheme {args.scheme}"
@@ -226,18 +268,24 @@ def _control(args: argparse.Namespace) -> int:
         if np.isfinite(loop.plant.u_max) else None,
         "pid": {"kp": p.kp, "ti": p.ti if np.isfinite(p.ti) else None, "td": p.td, "tf": p.tf,
                 "anti_windup": p.anti_windup,
-                "source": "--pid" if args.pid else "--tune" if args.tune else "document"},
+                "source": ("--tune-nonlinear" if tuned is not None else "--pid" if args.pid
+                           else "--tune" if args.tune else "document")},
+        "noise": None if args.noise is None else args.noise.to_dict(),
         "dob_f_q": loop.dob.f_q if loop.dob else None, "zeroed_at_start": not args.no_zero,
         "sensor_gain_m_per_unit": loop.sensor_gain, "models": models.info,
         "sensor_fit": models.sensor.info, "compensator_fit": models.compensator.info,
         "model_fit": models.model.info, "fit_seconds": t_fit}
     linear = {"operating_point": "rest (t = 0)", **margins.to_dict()}
-    result = run_experiment(args.experiment, loop) if args.experiment else None
+    result = run_experiment(args.experiment, loop, args.noise) if args.experiment else None
     if result is not None:
         metrics = {**result.metrics(), "linear": linear}
         if args.experiment == "sine":
             metrics["document"] = DOCUMENT_SINE[args.scheme]
+        if tuned is not None:
+            metrics["tuning"] = tuned.to_dict()
         _print_table(metrics)
+        if args.noise is not None:
+            metrics["noise_study"] = _noise_study(args, loop)
     # Built in a hidden sibling and renamed into place: the folder appears complete or not at all.
     with atomic_folder(out, args.force, [p.name for p in paths]) as tmp:
         if result is not None:
@@ -264,6 +312,29 @@ def _control(args: argparse.Namespace) -> int:
     return 0
 
 
+def _noise_study(args: argparse.Namespace, loop) -> dict:
+    """``--noise``: the experiment without and with the noise, each without and with the DOB
+    (the loop's own, else one from ``design_dob``); the table printed, the rows returned."""
+    from ..control import design_dob, noise_study
+
+    try:
+        dob = loop.dob or design_dob(loop)
+    except ValueError as exc:
+        raise UsageError(f"--noise: the DOB comparison needs a DOB: {exc}") from None
+    rows = noise_study(args.experiment, loop, args.noise, dob)
+    n = args.noise
+    print(f"noise study: sensor SD {n.sensor:g} sensor units (= {n.sensor * loop.sensor_gain:.3g}"
+          f" m through g_s), process SD {n.process:g} N, seed {n.seed}; DOB {dob.f_q:.3g} Hz")
+    print(f"{'noise':<7}{'DOB':<5}{'case':<14}{'e_p,rms [m]':>13}{'e_p,max [m]':>13}"
+          f"{'u rms [N]':>11}{'sensor noise SD':>17}")
+    for r in rows:
+        print(f"{'yes' if r['noise'] else 'no':<7}{'on' if r['dob'] else 'off':<5}"
+              f"{r['case']:<14}{_fmt(r['e_p_rms']):>13}{_fmt(r['e_p_max']):>13}"
+              f"{_fmt(r['u_rms']):>11}{_fmt(r['sensor_noise_sd']):>17}"
+              + ("" if r["bounded"] else "  UNBOUNDED"))
+    return {"dob_f_q": dob.f_q, "noise": n.to_dict(), "rows": rows}
+
+
 def _print_table(metrics: dict) -> None:
     print(f"{'case':<14}{'e_p,max [m]':>12}{'e_p,mean [m]':>14}{'e_p,rms [m]':>13}"
           f"{'tracking rms':>14}{'bounded':>9}{'compile s':>11}{'simulation s':>14}")
@@ -284,6 +355,15 @@ def _print_table(metrics: dict) -> None:
               f"{d['e_p_mean']:.4g} m")
 
 
+def _noise_option(text: str):
+    from ..control import parse_noise
+
+    try:
+        return parse_noise(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def _library(name: str):
     from .. import control  # python-control, scipy, numba: loaded when the command runs
 
@@ -302,21 +382,13 @@ def _excitation_names() -> list[str]:
     return sorted(EXPERIMENTS)
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``hystkit control`` to the ``hystkit`` parser."""
-    p = sub.add_parser("control", help="closed-loop position control with a hysteretic "
-                       "sensor: the document's ch. 7 experiments")
-    deferred(p.add_argument("--scheme", required=True,
+def add_setup_options(p: argparse.ArgumentParser, *, scheme_required: bool = True) -> None:
+    """The options that define a loop (scheme, PID, DOB, plant, sensor models), shared by
+    ``hystkit control`` and ``hystkit stability --control``; :func:`setup_loop` builds it."""
+    deferred(p.add_argument("--scheme", required=scheme_required,
                    help="direct: e = r - compensator(s) (fig. 7.1); weighting: "
                         "e = g_s (S_m(r) - s) (fig. 7.8)"),
              choices=lambda: _library("SCHEMES"))
-    deferred(p.add_argument("--experiment",
-                   help="sine (eq. 7.3), frequency / amplitude sweeps, cubic trajectory, "
-                        "output disturbance steps"),
-             choices=lambda: _library("EXPERIMENTS"))
-    p.add_argument("--bode", action="store_true",
-                   help="write bode.png: the linearised open loop at rest (alone: "
-                        "analysis.json)")
     p.add_argument("--dob", action="store_true", help="add the disturbance observer (sec. 7.4)")
     p.add_argument("--dob-hz", type=number(0, 1e6, low_open=True),
                    help="Q-filter bandwidth [Hz] (default: chosen by design_dob)")
@@ -383,5 +455,35 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "--training loop; else the family's default)")
     p.add_argument("--no-zero", action="store_true",
                    help="do not zero the estimates on the sensor's rest reading at start")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``hystkit control`` to the ``hystkit`` parser."""
+    p = sub.add_parser("control", help="closed-loop position control with a hysteretic "
+                       "sensor: the document's ch. 7 experiments")
+    add_setup_options(p)
+    deferred(p.add_argument("--experiment",
+                   help="sine (eq. 7.3), frequency / amplitude sweeps, cubic trajectory, "
+                        "output disturbance steps"),
+             choices=lambda: _library("EXPERIMENTS"))
+    p.add_argument("--bode", action="store_true",
+                   help="write bode.png: the linearised open loop at rest (alone: "
+                        "analysis.json)")
+    p.add_argument("--noise", type=_noise_option, metavar="sensor=SD,process=SD[,seed=N]",
+                   help="white Gaussian noise in the experiment: SD of the sensor noise "
+                        "[sensor units] and of the plant-input force noise [N], seed (default "
+                        "0); also runs it without noise and with and without the DOB, and "
+                        "prints the comparison")
+    p.add_argument("--tune-nonlinear", action="store_true",
+                   help="re-tune the PID (from the gains given or the document's) on the "
+                        "non-linear loop: minimise the experiment's plant error, keeping the "
+                        "linearised margins")
+    p.add_argument("--tune-objective", choices=("rms", "max"), default="rms",
+                   help="plant error to minimise with --tune-nonlinear: e_p rms or e_p max "
+                        "(default rms; the worst case of the experiment)")
+    p.add_argument("--min-phase-margin", type=number(0, 90, high_open=True), default=30.0,
+                   help="--tune-nonlinear constraint on the linearised loop [deg] (default 30)")
+    p.add_argument("--min-gain-margin", type=number(0, 60), default=6.0,
+                   help="--tune-nonlinear constraint on the linearised loop [dB] (default 6)")
     p.add_argument("--out", type=Path, help="output folder (default: a new timestamped one)")
     p.set_defaults(run=_control)

@@ -1,8 +1,13 @@
-"""``hystkit stability MODEL.json``: local stability of a fitted model of any family.
+"""``hystkit stability MODEL.json``: local stability of a fitted model of any family;
+``hystkit stability --control --scheme ...``: global stability of a control loop.
 
 Every family: eigenvalues of the linearised step (``hystkit.models.stability_report``) at rest
 over the input range and along a driven run. The mPL families add the document's per-cell
 analysis (eq. 5.18-5.28: knees, rest points, ``f' dt``).
+
+With ``--control`` the loop of ``hystkit control`` (same options) is examined beyond its
+linearisation: slope sectors of the hysteretic blocks and the discrete circle criterion
+(``hystkit.control.global_stability``), with a simulation that shows divergence when there is.
 """
 
 from __future__ import annotations
@@ -12,6 +17,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import InputError
+from ._common import UsageError, deferred
+from .cmd_control import add_setup_options, setup_inputs, setup_loop
 
 if TYPE_CHECKING:  # the library loads when the command runs
     import numpy as np
@@ -66,15 +73,66 @@ def _verdict(report: dict) -> str:
     return f"stable (max |lambda| {report['radius_max']:.6g}){marginal}"
 
 
+def _sector_line(name: str, sector) -> str:
+    return (f"  {name:<18}[{sector.k_min:.4g}, {sector.k_max:.4g}] {sector.units} "
+            f"({sector.n_used} of {sector.n_samples} increments; the left-out ones move the "
+            f"output by up to {100 * sector.left_out_step:.3g} % of its largest step)")
+
+
+def _control_stability(args: argparse.Namespace) -> int:
+    from ..control import global_stability, loop_margins
+    from ..io import check_output_path, write_json
+
+    if args.model_json is not None or args.data is not None:
+        raise UsageError("--control examines a loop: give no MODEL.json and no --data")
+    if args.scheme is None:
+        raise UsageError("--control needs --scheme direct|weighting")
+    if args.json is not None:
+        check_output_path(args.json, args.force, inputs=setup_inputs(args))
+    loop, models, _ = setup_loop(args)
+    report = global_stability(loop, args.experiment)
+    margins = loop_margins(loop)
+    p = loop.pid
+    print(f"loop: scheme {loop.scheme}, PID Kp = {p.kp:.4g}, Ti = {p.ti:.4g} s, Td = "
+          f"{p.td:.4g} s, DOB {f'{loop.dob.f_q:.3g} Hz' if loop.dob else 'off'}; S_r "
+          f"{models.info['sensor_model']}, compensator and S_m {models.info['model']}")
+    print("slope sectors (chord slopes of consecutive samples where the input moves by more "
+          "than 1 % of its largest step; the trained sine 0.5 Hz, 3 mm, 6 s at Ts):")
+    for name, sector in report.sectors.items():
+        print(_sector_line(name, sector))
+    if report.loop_sector is not None:
+        print(_sector_line(f"{report.experiment} run", report.loop_sector))
+    c = report.circle
+    if c is not None:
+        top = ("none (condition 1 fails)" if c.k_max_proved is None
+               else f"{c.k_max_proved:.4g} (worst at {c.worst_hz:.4g} Hz)")
+        print(f"circle criterion (discrete): linear loop at k_min "
+              f"{'stable' if c.base_stable else 'NOT asymptotically stable'}; largest proved "
+              f"upper bound {top}")
+    pm = "n/a" if margins.phase_margin_deg is None else f"{margins.phase_margin_deg:.3g}"
+    print(f"linearised at rest (local only): phase margin {pm} deg, "
+          f"closed loop {'stable' if margins.closed_loop_stable else 'not strictly stable'}")
+    print(f"global stability: {report.verdict.upper()}: {report.reason}")
+    if args.json is not None:
+        write_json({"scheme": loop.scheme, **report.to_dict(), "linear": margins.to_dict()},
+                   args.json, force=args.force)
+        print(f"wrote {args.json}")
+    return 0
+
+
 def _stability(args: argparse.Namespace) -> int:
     from ..compensation import load_compensator
     from ..io import check_output_path, write_json
     from ..models import stability_report
 
+    if args.control:
+        return _control_stability(args)
+    if args.model_json is None:
+        raise UsageError("give MODEL.json (a model's local stability) or --control (a loop's)")
     if args.json is not None:
         check_output_path(args.json, args.force,
-                          inputs=[args.model] + ([args.data] if args.data else []))
-    comp = load_compensator(args.model)
+                          inputs=[args.model_json] + ([args.data] if args.data else []))
+    comp = load_compensator(args.model_json)
     family, structure = comp.family, comp.structure
     u = (_probe_input(structure.dt) if args.data is None else _model_input(comp, args.data))
     probe = ("a unit chirp 0.1 -> 3 Hz" if args.data is None else str(args.data))
@@ -84,8 +142,8 @@ def _stability(args: argparse.Namespace) -> int:
                                     _probe_input(structure.dt), inverse=True)
                    if comp.mode == "inverse" else None)
     except ValueError as exc:
-        raise InputError(f"{args.model}: {exc}") from None
-    print(f"{args.model}: {family.name} ({family.title}), dt = {structure.dt:g} s, "
+        raise InputError(f"{args.model_json}: {exc}") from None
+    print(f"{args.model_json}: {family.name} ({family.title}), dt = {structure.dt:g} s, "
           f"{report['n_state']} state(s)")
     details = report["details"]
     if details is not None:
@@ -100,20 +158,36 @@ def _stability(args: argparse.Namespace) -> int:
     if inverse is not None:
         print(f"inverse (the compensator as it runs, driven by a unit chirp): {_verdict(inverse)}")
     if args.json is not None:
-        write_json({"model_file": str(args.model), "model": comp.model, "mode": comp.mode,
+        write_json({"model_file": str(args.model_json), "model": comp.model, "mode": comp.mode,
                     "probe": probe, **report, "inverse_report": inverse}, args.json,
                    force=args.force)
         print(f"wrote {args.json}")
     return 0
 
 
+def _experiments() -> tuple[str, ...]:
+    from ..control import EXPERIMENTS
+
+    return EXPERIMENTS
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``stability`` subcommand to the ``hystkit`` parser."""
     p = sub.add_parser("stability", help="local stability of a fitted model of any family "
-                                         "(linearised step; eq. 5.18-5.28 for the mPL)")
-    p.add_argument("model", type=Path, help="model JSON file written by 'hystkit fit'")
+                                         "(linearised step; eq. 5.18-5.28 for the mPL), or "
+                                         "with --control a loop's global stability")
+    p.add_argument("model_json", type=Path, nargs="?", metavar="MODEL.json",
+                   help="model JSON file written by 'hystkit fit' (not with --control)")
     p.add_argument("--data", type=Path,
                    help="recording whose model input (normalised as at fit time) drives the "
                         "model; default: a unit chirp 0.1 -> 3 Hz")
     p.add_argument("--json", type=Path, help="also write the analysis to this JSON file")
+    p.add_argument("--control", action="store_true",
+                   help="examine the control loop set up by the options below (as 'hystkit "
+                        "control'): slope sectors, circle criterion, a simulation")
+    deferred(p.add_argument("--experiment", default="sine",
+                            help="with --control: the experiment simulated to show divergence "
+                                 "(default sine)"),
+             choices=_experiments)
+    add_setup_options(p, scheme_required=False)
     p.set_defaults(run=_stability)
