@@ -17,11 +17,19 @@ jitter); a sample whose estimate runs away is skipped and the model state kept. 
 of input, a closed port, Ctrl-C or SIGTERM) stderr gets one warning line per kind with its count
 and first line number, and the latency per sample (from the line's arrival until its output
 line is ready: parse, compensate, format; writing it is one system call more).
+
+Online adaptation (``--adapt gain`` or ``--adapt weights``, :mod:`hystkit.compensation._adaptive`):
+a third column ``reference`` (named in the header, or the third field without one) gives the
+true position [mm] now and then, empty when unknown; each known one re-fits the output's gain
+and offset (or cell weights) by recursive least squares with forgetting, after its own sample's
+estimate is made. A reference that is not a number is ignored and counted. At the end stderr
+gets the references used, the a-priori error at them and the adapted parameters.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from collections import deque
@@ -32,7 +40,7 @@ from typing import TYPE_CHECKING, TextIO
 from ..errors import InputError
 
 if TYPE_CHECKING:
-    from ..compensation import Stream, SyncExcitation
+    from ..compensation import AdaptiveStream, Stream, SyncExcitation
 
 __all__ = ["register"]
 
@@ -45,6 +53,17 @@ DEFAULT_BAUD = 115200
 MAX_LINE = 4096
 TOO_LONG = "\0 line too long"
 SERIAL_HINT = 'pip install "hystkit[serial]"'
+# As hystkit.compensation._adaptive (not imported here: building the parser stays light).
+ADAPT_CHOICES = ("gain", "weights")
+DEFAULT_FORGETTING = 0.95
+
+
+# Kinds of problem whose sample is still compensated, and what happened instead of skipping it.
+NOT_SKIPPED = {
+    "irregular step": "compensated, but the step differs from the model's dt = {dt:g} s by more "
+                      f"than {STEP_TOLERANCE:.0%}",
+    "reference not a number": "compensated; the reference ignored",
+}
 
 
 class _Tally:
@@ -60,8 +79,7 @@ class _Tally:
 
     def report(self, source: str, dt: float) -> None:
         for kind, n in self.count.items():
-            what = (f"compensated, but the step differs from the model's dt = {dt:g} s by more "
-                    f"than {STEP_TOLERANCE:.0%}" if kind == "irregular step" else "skipped")
+            what = NOT_SKIPPED.get(kind, "skipped").format(dt=dt)
             print(f"hystkit: warning: {source}: {n} line(s) {kind} ({what}; first at line "
                   f"{self.first[kind]})", file=sys.stderr)
 
@@ -123,18 +141,25 @@ def _serial_lines(port: str, baud: int) -> Iterator[str]:
     return lines()
 
 
-def _columns(fields: list[str]) -> tuple[int, int] | None:
-    """Indices of time and sensor if ``fields`` is a header naming them, else None."""
+Columns = tuple[int, int, int | None]
+# Without a header: time, sensor and (adapting) the reference in this order.
+DEFAULT_COLUMNS: Columns = (0, 1, 2)
+
+
+def _columns(fields: list[str]) -> Columns | None:
+    """Indices of time, sensor and reference (None: no such column) if ``fields`` is a header
+    naming time and sensor, else None."""
     names = [f.strip().lstrip("\ufeff").lower() for f in fields]  # a UTF-8 BOM first
     if "time" in names and "sensor" in names:
-        return names.index("time"), names.index("sensor")
+        reference = names.index("reference") if "reference" in names else None
+        return names.index("time"), names.index("sensor"), reference
     return None
 
 
-def _parse(line: str, columns: tuple[int, int]) -> tuple[str, float, float] | str:
+def _parse(line: str, columns: Columns) -> tuple[str, float, float] | str:
     """``(time text, time, sensor)`` or the kind of problem."""
     fields = line.strip().split(",")
-    if len(fields) <= max(columns) or any(not fields[i].strip() for i in columns):
+    if len(fields) <= max(columns[:2]) or any(not fields[i].strip() for i in columns[:2]):
         return "missing field"
     text = fields[columns[0]].strip()
     try:
@@ -144,6 +169,38 @@ def _parse(line: str, columns: tuple[int, int]) -> tuple[str, float, float] | st
     if not (abs(t) < float("inf") and abs(s) < float("inf")):  # also NaN
         return "not a number"
     return text, t, s
+
+
+def _reference(line: str, columns: Columns) -> float | None:
+    """The line's reference [mm]: NaN when absent or empty, None when not a finite number."""
+    fields = line.strip().split(",")
+    if columns[2] is None or len(fields) <= columns[2] or not fields[columns[2]].strip():
+        return float("nan")
+    try:
+        r = float(fields[columns[2]])
+    except ValueError:
+        return None
+    return r if abs(r) < float("inf") else None
+
+
+class _Learning:
+    """References used by an adapting stream and its a-priori errors at them [mm]."""
+
+    def __init__(self) -> None:
+        self.n = 0
+        self.sum_sq = 0.0
+
+    def add(self, estimate: float, reference: float) -> None:
+        self.n += 1
+        self.sum_sq += (estimate - reference) ** 2
+
+    def summary(self, stream: AdaptiveStream, adapt: str, forgetting: float) -> str:
+        head = f"hystkit stream: adaptation ({adapt}, forgetting {forgetting:g}): "
+        if not self.n:
+            return head + "no reference arrived; the estimates are the plain stream's"
+        values = ", ".join(f"{k} {v:.6g}" for k, v in stream.parameters.items())
+        return (head + f"{self.n} references, rms error at them before learning from each "
+                f"{(self.sum_sq / self.n) ** 0.5:.4g} mm; now {values}")
 
 
 class _Latency:
@@ -172,13 +229,15 @@ class _Latency:
                 f"{self.max * 1e6:.1f} µs{window}")
 
 
-def _run_stream(stream: Stream, lines: Iterator[str], tally: _Tally, latency: _Latency) -> None:
-    """Compensate every line, writing each result at once."""
+def _run_stream(stream: Stream | AdaptiveStream, lines: Iterator[str], tally: _Tally,
+                latency: _Latency, learning: _Learning | None = None) -> None:
+    """Compensate every line, writing each result at once; an adapting stream (``learning``
+    given) also gets each line's reference."""
     from ..errors import FitDivergedError
 
     dt = stream.compensator.structure.dt
     out = sys.stdout
-    columns, previous, first = (0, 1), None, True  # first: no non-empty line yet
+    columns, previous, first = DEFAULT_COLUMNS, None, True  # first: no non-empty line yet
     for line_no, line in enumerate(lines, start=1):
         arrived = time.perf_counter()
         if line is TOO_LONG:
@@ -200,11 +259,18 @@ def _run_stream(stream: Stream, lines: Iterator[str], tally: _Tally, latency: _L
             continue
         if previous is not None and abs(t - previous - dt) > STEP_TOLERANCE * dt:
             tally.add("irregular step", line_no)
+        reference = float("nan")
+        if learning is not None and (reference := _reference(line, columns)) is None:
+            tally.add("reference not a number", line_no)
+            reference = float("nan")
         try:
-            result = stream.step_flagged(s)
+            result = (stream.step_flagged(s) if learning is None
+                      else stream.step_flagged(s, reference))
         except FitDivergedError:
             tally.add("estimate ran away", line_no)
             continue
+        if learning is not None and not math.isnan(reference):
+            learning.add(result.estimate, reference)
         previous = t
         flags = (1 if result.sensor_outside else 0) + (2 if result.estimate_outside else 0)
         row = f"{text},{result.estimate!r},{flags}\n"
@@ -219,22 +285,51 @@ def _stream(args: argparse.Namespace) -> int:
 
     if args.serial is None and args.baud is not None:
         raise InputError("--baud is for --serial")
+    _check_adapt_options(args)
     comp = load_compensator(args.model)
     stream = Stream(comp, label=str(args.model))  # refuses the oracle centring
+    start = "rest"
     if args.start == "sync":
         sync = sync_excitation(comp)
         _print_sync(sync)
-        stream = Stream(comp, sync.state_after, label=str(args.model))
+        start = sync.state_after
+        stream = Stream(comp, start, label=str(args.model))
+    learning = None
+    if args.adapt is not None:
+        stream, learning = _adaptive_stream(args, comp, start), _Learning()
     source, lines = _lines(args)
     sys.stdout.write("time,position_estimate,flags\n")
     sys.stdout.flush()
     tally, latency = _Tally(), _Latency()
     try:
-        _run_stream(stream, lines, tally, latency)
+        _run_stream(stream, lines, tally, latency, learning)
     finally:  # also on Ctrl-C / SIGTERM: the summary, then main's exit 130 / 143
         tally.report(source, comp.structure.dt)
         print(latency.summary(), file=sys.stderr)
+        if learning is not None:
+            print(learning.summary(stream, args.adapt, args.forgetting), file=sys.stderr)
     return 0
+
+
+ADAPT_OPTIONS = ("prior_gain", "prior_offset")
+
+
+def _check_adapt_options(args: argparse.Namespace) -> None:
+    if args.adapt is None:
+        used = [f"--{k.replace('_', '-')}" for k in ("forgetting", *ADAPT_OPTIONS)
+                if getattr(args, k) is not None]
+        if used:
+            raise InputError(f"{', '.join(used)} only apply with --adapt")
+    elif args.forgetting is None:
+        args.forgetting = DEFAULT_FORGETTING
+
+
+def _adaptive_stream(args: argparse.Namespace, comp, start) -> AdaptiveStream:
+    from ..compensation import Adaptation, AdaptiveStream
+
+    options = {k: getattr(args, k) for k in ADAPT_OPTIONS if getattr(args, k) is not None}
+    adaptation = Adaptation(args.adapt, args.forgetting, **options)
+    return AdaptiveStream(comp, adaptation, start, label=str(args.model))
 
 
 def _print_sync(sync: SyncExcitation) -> None:
@@ -253,7 +348,7 @@ def _user_levels(sync: SyncExcitation) -> list[float]:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``stream`` subcommand to the ``hystkit`` parser."""
-    from ._common import positive_int
+    from ._common import number, positive_int
 
     p = sub.add_parser("stream", help="compensate live: time,sensor lines in (stdin, a file or "
                                       "a serial port), time,position_estimate,flags lines out")
@@ -268,4 +363,19 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--start", choices=("rest", "sync"), default="rest",
                    help="rest: model at rest at the first sample (default); sync: after the "
                         "synchronisation excitation e_sync (eq. 2.21-2.22), printed to stderr")
+    adapt = p.add_argument_group("online adaptation (a reference column: the true position "
+                                 "[mm] now and then, empty when unknown)")
+    adapt.add_argument("--adapt", choices=ADAPT_CHOICES,
+                       help="re-fit the output from the references by recursive least squares: "
+                            "gain (gain and offset of the estimate, any model) or weights (cell "
+                            "output weights and offset; direct mpl, pl, ladder)")
+    adapt.add_argument("--forgetting", type=number(0, 1, low_open=True), metavar="LAMBDA",
+                       help=f"forgetting factor per reference, in (0, 1]: remembers about "
+                            f"1/(1-LAMBDA) references (default {DEFAULT_FORGETTING:g})")
+    adapt.add_argument("--prior-gain", type=number(0, 1e6, low_open=True), metavar="STD",
+                       help="prior standard deviation of each gain / weight multiplier "
+                            "(default 0.1: 10 %%)")
+    adapt.add_argument("--prior-offset", type=number(0, 1e9, low_open=True), metavar="MM",
+                       help="prior standard deviation of the offset [mm] (default 10 %% of "
+                            "the training positions' span)")
     p.set_defaults(run=_stream)

@@ -35,11 +35,14 @@ from ._compensator import Compensator
 from ._rls import RlsState, rls_start, rls_update
 from ._stream import (
     StartUp,
+    StepOutput,
     StreamOutput,
     StreamState,
     _advance,
+    _advance_one,
     _outside,
     _Path,
+    _Previous,
     _sensor_offset,
     initial_state,
 )
@@ -244,7 +247,10 @@ class AdaptiveStream:
                  label: str = "stream") -> None:
         self._plan = _Plan(compensator, adaptation or Adaptation(), rest_position)
         self._state = AdaptiveState(initial_state(compensator, start), self._plan.start)
+        self._previous: _Previous | None = None  # speeds up step; never changes a result
         self.label = label
+        if compensator.center == "track":
+            import scipy.signal  # noqa: F401  # now, not ~1 s late on the first sample
 
     @property
     def compensator(self) -> Compensator:
@@ -262,7 +268,28 @@ class AdaptiveStream:
 
     def step(self, sensor: float, reference: float = float("nan")) -> float:
         """Estimate [mm] for one raw sensor sample; then learn from ``reference`` if known."""
-        return float(self.process(np.array([sensor]), np.array([reference]))[0])
+        return self.step_flagged(sensor, reference).estimate
+
+    def step_flagged(self, sensor: float, reference: float = float("nan")) -> StepOutput:
+        """Estimate and use-time flags for one raw sensor sample (the same bits as
+        :meth:`process`); then learn from ``reference`` [mm] if known."""
+        if self._plan.adaptation.parameters != "gain":
+            out = self.process_flagged(np.array([sensor]), np.array([reference]))
+            return StepOutput(float(out.estimate[0]),
+                              *(None if f is None else bool(f[0]) for f in out[1:]))
+        # gain: the plain stream's fast one-sample path (the same bits as its chunks), then
+        # the same prediction and update as a chunk's
+        r = _references(np.array([reference]), 1, self._state.stream.n_samples, self.label)[0]
+        plain, stream_next, self._previous = _advance_one(
+            self._plan.path, self._state.stream, sensor, self.label, self._previous)
+        phi = np.array([[plain.estimate, 1.0]])
+        rls = self._state.rls
+        estimate = float(self._plan.predict(rls, phi, np.array([plain.estimate]))[0])
+        if np.isfinite(r):
+            rls = rls_update(rls, phi[0], r, self._plan.adaptation.forgetting)
+        self._state = AdaptiveState(stream_next, rls)
+        return StepOutput(estimate, plain.sensor_outside,
+                          _outside(estimate, self._plan.path.estimate_bounds))
 
     def process(self, sensor: np.ndarray, reference: np.ndarray | None = None) -> np.ndarray:
         """Estimates [mm] for a chunk; ``reference`` [mm] per sample, NaN where unknown."""
