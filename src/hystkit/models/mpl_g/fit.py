@@ -2,21 +2,29 @@
 
 The model contains the sinh mPL: with ``g(z) = z`` it *is* the mPL. So the fit first fits the
 mPL (``mpl.fit.fit_mpl``, its deterministic multi-start) and starts from that model with a
-linear output resistor; the bounded trust-region solver then moves all ``3N + 6`` parameters
-with the exact Jacobian of the forward sensitivities (``kernels.simulate_with_jacobian``). The
-result is never worse than the mPL's fit on the same data.
+linear output resistor; the bounded trust-region solver then moves the parameters with the
+exact Jacobian of the forward sensitivities (``kernels.simulate_with_jacobian``).
 
-Only ``3N + 4`` parameters are identifiable: an affine change of the output resistor's voltage
-(``z -> alpha z + beta``, ``g`` re-expanded, ``w`` and ``V_b`` rescaled) leaves every
-input-output map unchanged. The result is mapped to the representative with ``w_0 = 1``,
-``V_b = 0`` (:func:`canonical`), so a fitted model file is reproducible. (Unlike the cubic cells
-of mpl-poly, a sinh cell cannot be shifted: it rests at ``v = 0``.)
+Two choices, both about the output resistor ``g``:
+
+- *Gauge.* Only ``3N + 4`` of the ``3N + 6`` parameters are identifiable: an affine change of
+  ``g``'s voltage (``z -> alpha z + beta``, ``g`` re-expanded, ``w`` and ``V_b`` rescaled)
+  leaves every input-output map unchanged (:func:`canonical`). The fit works in the gauge
+  ``w_0 = 1``, ``V_b = 0``, so a fitted model file is reproducible and every fitted number is
+  determined by the data. (A sinh cell cannot be shifted: it rests at ``v = 0``.)
+- *Monotone g.* Unconstrained, the fit bends ``g`` over just outside the training range (on the
+  virtual sensor's noise run: ``g_3 = -0.37``, ``g' = 0`` at ``|z| = 1.1`` for data within
+  about ``|z| <= 1``). A compensator whose output turns back there reverses the loop's sign as
+  soon as a transient leaves the training range: scheme (a) with the document's PID runs away
+  within 0.5 s (docs/models/mpl_g.md). So ``g'`` is parametrised by its Bernstein coefficients
+  on ``|z| <= MONOTONE_RANGE`` (2, twice the range of normalised data, eq. 5.10), all of one
+  sign (that of the mPL start's ``w_0``): ``g`` is strictly monotone there. Paper 9.2's table II
+  resistors are all inside this set (their turning points lie at ``|z| >= 2.5``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
 
 import numpy as np
 
@@ -25,30 +33,63 @@ from ..mpl import model as mpl
 from ..mpl.fit import fit_mpl, theta_limits
 from . import model as mpl_g
 
-__all__ = ["canonical", "fit_mpl_g", "random_params", "theta_names"]
+__all__ = ["MONOTONE_RANGE", "bernstein_slopes", "canonical", "fit_mpl_g", "output_from_slopes",
+           "random_params", "theta_names"]
 
-# Bounds in optimiser coordinates (MplGParams.to_vector): the cells' are the mPL's; |w| <= 100
-# mirrors the document's weight-sum constraint (sec. 5.3.3); g's coefficients only need to
-# stay finite.
+MONOTONE_RANGE = 2.0
+"""Half-width of the interval ``|z| <= R`` (normalised units, gauge ``w_0 = 1``, ``V_b = 0``) on
+which a fitted ``g`` is strictly monotone."""
+
+# Bounds in optimiser coordinates: the cells' are the mPL's; |w| <= 100 mirrors the document's
+# weight-sum constraint (sec. 5.3.3); g_0 only needs to stay finite; the Bernstein slopes of g
+# between 1e-6 (g' near 0 somewhere on |z| <= R: a model limit) and 1e3.
 _LOG_VT_BOUNDS = (np.log(1e-3), np.log(1e3))
 _LOG_G_MIN = np.log(1e-4)
-_G_BOUND = 1e3
+_G0_BOUND = 1e3
+_LOG_SLOPE_BOUNDS = (np.log(1e-6), np.log(1e3))
 _W_BOUND = 100.0
 
 
+def _slope_matrix(r: float) -> np.ndarray:
+    """``M`` with ``(g_1, g_2, g_3) = M b`` for ``g' = b_0 (1-t)^2 + 2 b_1 t (1-t) + b_2 t^2``,
+    ``t = (z + r) / (2 r)`` (expanded in ``z``, then integrated)."""
+    s = 1.0 / (2.0 * r)
+    return np.array([[0.25, 0.5, 0.25],
+                     [-0.5 * s, 0.0, 0.5 * s],
+                     [s * s / 3.0, -2.0 * s * s / 3.0, s * s / 3.0]])
+
+
+def output_from_slopes(g0: float, b: np.ndarray, r: float = MONOTONE_RANGE) -> np.ndarray:
+    """``g_0..g_3`` of the cubic with ``g(0) = g0`` whose slope has Bernstein coefficients
+    ``b`` on ``|z| <= r``; ``g`` is strictly monotone there when all ``b`` share a sign."""
+    return np.r_[g0, _slope_matrix(r) @ np.asarray(b, dtype=float)]
+
+
+def bernstein_slopes(g: np.ndarray, r: float = MONOTONE_RANGE) -> np.ndarray:
+    """Inverse of :func:`output_from_slopes` (without ``g_0``): ``b_0 = g'(-r)``,
+    ``b_2 = g'(r)``, ``b_1 = 2 g'(0) - (b_0 + b_2) / 2``."""
+    g = np.asarray(g, dtype=float)
+    lo, mid, hi = (mpl_g.output_slope(mpl_g.MplGParams(i_s=[1.0], v_t=[1.0], g=g, w=[1.0, 0.0]),
+                                      z) for z in (-r, 0.0, r))
+    return np.array([lo, 2.0 * mid - 0.5 * (lo + hi), hi])
+
+
 def theta_names(n_cells: int) -> list[str]:
-    """Names of the optimiser coordinates (:meth:`MplGParams.to_vector`), cells from 1."""
+    """Names of the optimiser coordinates, cells from 1: per cell ``log G``, ``log V_T``, then
+    ``g_0``, the logs of ``g'``'s Bernstein coefficients on ``|z| <= R``, ``w_1..w_N``."""
     cells = [f"{name}[{k}]" for k in range(1, n_cells + 1) for name in ("log_G", "log_v_t")]
-    return [*cells, *(f"g.c{j}" for j in range(4)), *(f"w[{k}]" for k in range(n_cells + 1)),
-            "v_b"]
+    return [*cells, "g.c0", *(f"g.log_slope{j}" for j in range(3)),
+            *(f"w[{k}]" for k in range(1, n_cells + 1))]
 
 
 def _limits(n_cells: int) -> tuple[list[str | None], list[str | None]]:
-    """The cells' model limits are the mPL's (``mpl.fit.theta_limits``); every other bound
-    is a search box."""
+    """The cells' model limits are the mPL's (``mpl.fit.theta_limits``); the floor of a
+    Bernstein slope is the edge of the monotone set; every other bound is a search box."""
     lower, upper = theta_limits(n_cells)
-    rest = [None] * (n_cells + 6)
-    return lower[:2 * n_cells] + rest, upper[:2 * n_cells] + rest
+    edge = (f"g' reaches about 0 within |z| <= {MONOTONE_RANGE:g}: the output resistor is at "
+            f"the edge of the monotone set the fit allows")
+    return (lower[:2 * n_cells] + [None] + [edge] * 3 + [None] * n_cells,
+            upper[:2 * n_cells] + [None] * (n_cells + 4))
 
 
 def canonical(params: mpl_g.MplGParams) -> mpl_g.MplGParams:
@@ -71,10 +112,34 @@ def canonical(params: mpl_g.MplGParams) -> mpl_g.MplGParams:
                             w=params.w / params.w[0], v_b=0.0)
 
 
-def _start_from_mpl(params: mpl.MplParams) -> mpl_g.MplGParams:
-    """The mPL as the member of this family with ``g(z) = z``."""
-    return mpl_g.MplGParams(i_s=params.i_s, v_t=params.v_t, g=[0.0, 1.0, 0.0, 0.0], w=params.w,
-                            v_b=params.v_b)
+class _Coordinates:
+    """The optimiser's coordinates ``[cells (2N), g_0, log |b| (3), w_1..w_N]`` and the model's
+    parameters, for slopes of sign ``sign``; the Jacobian's chain rule."""
+
+    def __init__(self, n_cells: int, sign: float) -> None:
+        self.n, self.sign = n_cells, sign
+        self.matrix = _slope_matrix(MONOTONE_RANGE)
+
+    def to_params(self, theta: np.ndarray) -> mpl_g.MplGParams:
+        n = self.n
+        cells = theta[:2 * n].reshape(n, 2)
+        v_t = np.exp(cells[:, 1])
+        g = output_from_slopes(theta[2 * n], self.sign * np.exp(theta[2 * n + 1:2 * n + 4]))
+        return mpl_g.MplGParams(i_s=0.5 * np.exp(cells[:, 0]) * v_t, v_t=v_t, g=g,
+                                w=np.r_[1.0, theta[2 * n + 4:]], v_b=0.0)
+
+    def from_params(self, params: mpl_g.MplGParams) -> np.ndarray:
+        """Coordinates of canonical ``params`` whose slopes have this sign (clipped to the
+        floor where one does not)."""
+        b = np.maximum(self.sign * bernstein_slopes(params.g), np.exp(_LOG_SLOPE_BOUNDS[0]))
+        return np.r_[params.to_vector()[:2 * self.n], params.g[0], np.log(b), params.w[1:]]
+
+    def jacobian(self, theta: np.ndarray, jac: np.ndarray) -> np.ndarray:
+        """``dy/dtheta`` from the plain Jacobian (columns of :meth:`MplGParams.to_vector`)."""
+        n = self.n
+        b = self.sign * np.exp(theta[2 * n + 1:2 * n + 4])
+        slopes = jac[:, 2 * n + 1:2 * n + 4] @ (self.matrix * b)
+        return np.column_stack([jac[:, :2 * n + 1], slopes, jac[:, 2 * n + 5:3 * n + 5]])
 
 
 def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
@@ -82,7 +147,8 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
               accept: Callable[[mpl_g.MplGParams], bool] | None = None,
               accept_reason: str = "rejected by the acceptance test",
               solver: str = "tr") -> FitResult:
-    """Fit the ch. 7 compensator mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9).
+    """Fit the ch. 7 compensator mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9), in the
+    gauge ``w_0 = 1``, ``V_b = 0`` with ``g`` monotone on ``|z| <= MONOTONE_RANGE``.
 
     Parameters
     ----------
@@ -105,35 +171,32 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
     u, y = check_fit_data(u, y)
     n = structure.n_cells
     cap = structure.slope_cap / structure.dt
-    lower = np.r_[np.tile([_LOG_G_MIN, _LOG_VT_BOUNDS[0]], n), np.full(4, -_G_BOUND),
-                  np.full(n + 2, -_W_BOUND)]
-    upper = np.r_[np.tile([np.log(cap), _LOG_VT_BOUNDS[1]], n), np.full(4, _G_BOUND),
-                  np.full(n + 2, _W_BOUND)]
+    lower = np.r_[np.tile([_LOG_G_MIN, _LOG_VT_BOUNDS[0]], n), -_G0_BOUND,
+                  np.full(3, _LOG_SLOPE_BOUNDS[0]), np.full(n, -_W_BOUND)]
+    upper = np.r_[np.tile([np.log(cap), _LOG_VT_BOUNDS[1]], n), _G0_BOUND,
+                  np.full(3, _LOG_SLOPE_BOUNDS[1]), np.full(n, _W_BOUND)]
     linear = fit_mpl(u, y, mpl.MplStructure(n_cells=n, dt=structure.dt,
-                                            slope_cap=structure.slope_cap))
+                                            slope_cap=structure.slope_cap)).params
+    # the mPL is this family's member with g(z) = z; in the gauge its g is w_0 z - V_b
+    start = canonical(mpl_g.MplGParams(i_s=linear.i_s, v_t=linear.v_t, g=[0.0, 1.0, 0.0, 0.0],
+                                       w=linear.w, v_b=linear.v_b))
+    coords = _Coordinates(n, 1.0 if linear.w[0] >= 0 else -1.0)
     cache: dict = {}
-
-    def to_params(theta: np.ndarray) -> mpl_g.MplGParams:
-        return mpl_g.MplGParams.from_vector(theta, n)
 
     def run(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         # the residual and then the Jacobian at the same point: one sensitivity pass gives both
         key = theta.tobytes()
         if key not in cache:
             cache.clear()
-            cache[key] = mpl_g.simulate_with_jacobian(structure, to_params(theta), u)
+            y_model, jac = mpl_g.simulate_with_jacobian(structure, coords.to_params(theta), u)
+            cache[key] = y_model, coords.jacobian(theta, jac)
         return cache[key]
 
-    result = fit_multistart(lambda th: run(th)[0] - y, [_start_from_mpl(linear.params)
-                                                         .to_vector()],
-                            (lower, upper), to_params, structure, jac=lambda th: run(th)[1],
-                            solver=solver, max_nfev=max_nfev, screen_nfev=screen_nfev,
-                            n_polish=n_polish, accept=accept, accept_reason=accept_reason,
-                            names=theta_names(n), limits=_limits(n))
-    try:
-        return replace(result, params=canonical(result.params))
-    except ValueError:  # w_0 = 0, or the canonical form leaves the domain (|w / w_0| > 1e6)
-        return result
+    return fit_multistart(lambda th: run(th)[0] - y, [coords.from_params(start)],
+                          (lower, upper), coords.to_params, structure,
+                          jac=lambda th: run(th)[1], solver=solver, max_nfev=max_nfev,
+                          screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
+                          accept_reason=accept_reason, names=theta_names(n), limits=_limits(n))
 
 
 # The domain random_params draws from: the mPL's cells over the fit's box, and an output stage
