@@ -142,3 +142,31 @@ def test_a_missing_trace_column_is_one_line(tmp_path, capsys):
     log.write_text("time_h,r\n0,10\n1,9\n")
     assert main(["settling", str(log), "--out", str(tmp_path / "s"), "--traces", "x"]) == 2
     assert "no column 'x'" in _error_line(capsys)
+
+
+def test_a_trace_that_cannot_be_fitted_is_reported_and_the_others_written(tmp_path, capsys):
+    t = np.linspace(0, 48, 200)
+    log = tmp_path / "log.csv"
+    pd.DataFrame({"time_h": t, "good": 1e3 + 500 * np.exp(-t / 8),
+                  "rising": 1e3 + 10 * t}).to_csv(log, index=False)
+    assert main(["settling", str(log), "--out", str(tmp_path / "s")]) == 3
+    captured = capsys.readouterr()
+    assert "rising: NOT FITTED" in captured.out
+    assert "1 trace(s) failed: rising" in captured.err
+    report = json.loads((tmp_path / "s" / "settling.json").read_text())
+    assert report["traces"]["rising"]["fitted"] is False
+    assert_allclose(report["traces"]["good"]["fit"]["params"]["tau_drop_h"], 8.0, rtol=1e-6)
+
+
+@pytest.mark.parametrize("command", ["cycles", "settling", "simulate-settling"])
+def test_every_option_has_help(command):
+    import argparse
+
+    from hystkit.cli._main import _parser
+
+    action = next(a for a in _parser()._actions if isinstance(a, argparse._SubParsersAction))
+    sub = action.choices[command]
+    sub.format_help()
+    missing = [a.dest for a in sub._actions if not isinstance(a, argparse._HelpAction)
+               and not str(a.help or "").strip()]
+    assert missing == []
