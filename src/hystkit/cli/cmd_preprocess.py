@@ -21,7 +21,8 @@ if TYPE_CHECKING:  # the library loads when a command runs, not when the parser 
     from ..preprocess import PreprocessSettings
     from ..sensors import VirtualSensor
 
-__all__ = ["add_simulation_options", "register", "run_raw_simulation", "sensor_from_args"]
+__all__ = ["SettingsError", "add_simulation_options", "raw_settings", "register",
+           "run_raw_simulation", "sensor_from_args"]
 
 
 class SettingsError(HystkitError, ValueError):
@@ -62,8 +63,11 @@ _OPTIONS = ("r_bridge", "v_supply", "um_per_count", "position_offset_mm", "fs_ou
             "illegal", "remove_mean", "normalise", "chunk_size", "time_unit")
 
 
-def _settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawFormat, Path | None]:
-    """Merge defaults, the settings file and the options; return what preprocessing needs."""
+def raw_settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawFormat, Path | None]:
+    """Merge defaults, the settings file and the options; return what preprocessing needs.
+
+    Reads ``args.raw``, ``args.config``, ``args.supply_channel`` and any of the preprocess
+    options present on `args` (``hystkit spectrum`` shares the bridge ones)."""
     from ..io import CONFIG_KEYS, RawFormat, find_raw_config, read_raw_config
     from ..preprocess import PreprocessSettings, parse_states
 
@@ -77,7 +81,7 @@ def _settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawFormat, 
         option = getattr(args, key, None)
         if option is not None and option is not False:
             values[key] = option
-    if args.supply_channel is not None:  # --no-supply-channel overrides the settings file
+    if getattr(args, "supply_channel", None) is not None:  # --no-supply-channel overrides it
         values["supply_channel"] = args.supply_channel
     where = f"settings from {config_path} and the options" if config_path else "options"
     for key in ("r_bridge", "v_supply"):
@@ -111,7 +115,7 @@ def _preprocess(args: argparse.Namespace) -> int:
     inputs = [args.raw] + ([args.config] if args.config is not None else [])
     check_output_path(args.out, args.force, inputs=inputs)
     check_output_path(report_path, args.force, inputs=inputs)
-    settings, fmt, config_path = _settings(args)
+    settings, fmt, config_path = raw_settings(args)
     print(f"preprocessing {args.raw}" + (f" with settings from {config_path}" if config_path
                                           else "") + " ...", flush=True)
     t0 = time.perf_counter()

@@ -40,12 +40,23 @@ from ._raw import (
     RawDataWarning,
     preprocess_raw,
 )
+from ._spectrum import (
+    CutoffRule,
+    Spectrum,
+    butterworth_response,
+    noise_floor,
+    raw_gauge_changes,
+    spectrum,
+    welch_psd,
+)
 
-__all__ = ["DEFAULT_STATES", "Decimator", "DecimatorState", "EncoderSettings", "EncoderState",
-           "LevelSurvey", "PreprocessReport", "PreprocessResult", "PreprocessSettings",
-           "RawDataWarning", "ab_to_code", "bridge_kernel", "bridge_resistance", "bridge_voltage",
+__all__ = ["DEFAULT_STATES", "CutoffRule", "Decimator", "DecimatorState", "EncoderSettings",
+           "EncoderState", "LevelSurvey", "PreprocessReport", "PreprocessResult",
+           "PreprocessSettings", "RawDataWarning", "Spectrum", "ab_to_code", "bridge_kernel",
+           "bridge_resistance", "bridge_voltage", "butterworth_response",
            "clipped_channels", "code_to_ab",
            "count_to_code", "decimator_flush", "decimator_init", "decimator_step", "decode",
            "decode_flush", "decode_reference", "decode_step", "design_chain", "downsample",
            "encoder_init", "first_invalid_bridge_sample", "gauge_symmetry", "lowpass_zero_phase",
-           "parse_states", "preprocess_raw", "relative_change"]
+           "noise_floor", "parse_states", "preprocess_raw", "raw_gauge_changes",
+           "relative_change", "spectrum", "welch_psd"]

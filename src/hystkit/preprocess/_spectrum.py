@@ -1,0 +1,316 @@
+"""Spectra for choosing the Butterworth cut-off (sec. 4.3.1, fig. 4.10, eq. 4.1).
+
+The document looks at the spectrum of each gauge and picks "a minimum cut-off frequency
+f_c,min >~ 8 Hz ... so that the higher harmonics are included up to the point that the
+magnitude of the highest harmonic is buried under the signal noise", then "conservatively"
+f_c = 20 Hz. Here that reading is a rule with numbers (:class:`CutoffRule`):
+
+* PSD: Welch (Hann window, segments of ``segment_s`` seconds, 50 % overlap), one-sided, of
+  dR/R of each gauge and of the differential signal dR1/R1 - dR2/R2 [1/Hz];
+* local noise floor N(f): the running median of the differential PSD over ``floor_width_hz``
+  (lines narrower than half the window do not move it), divided by the median-to-mean ratio
+  of the Welch estimate (chi-square with nu = 2 K / 1.056 degrees of freedom for K segments,
+  Hann, 50 % overlap), so that N(f) estimates the noise *density*;
+* f_signal: the peak of the highest line (below ``f_search_max``) whose differential PSD
+  exceeds ``10**(margin_db / 10) * N(f)``: the highest harmonic not yet buried in the noise,
+  the document's f_c,min;
+* suggested cut-off ``f_c = safety * f_signal`` (safety 2.5 = the document's 20 Hz / 8 Hz), at
+  which the zero-phase 2nd-order filter passes f_signal with amplitude
+  ``|H|^2 = 1 / (1 + (1/2.5)^4) = 0.975`` (-0.22 dB).
+
+A raw recording is first brought to gauge resistances at the scope rate (eq. 4.3, with the
+measured supply ``v0`` when asked) and decimated to about ``fs_analysis`` (1 kHz) by the same
+streaming FIR stages as preprocessing, flat to 0.4 of that rate; dR/R follows eq. 4.4-4.5.
+
+The proposed filter's response is computed with ``scipy.signal.sosfreqz`` on the designed
+second-order sections; the zero-phase (forward-backward) filter's amplitude response is
+``|H|^2`` and its power response ``|H|^4``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from scipy import ndimage, signal, stats
+
+from ..io import RawFormat, open_raw
+from ._bridge import bridge_kernel
+from ._decimate import decimator_init, design_chain
+from ._raw import PreprocessSettings, _flush_chain, _raise_bridge, _run_chain
+
+__all__ = ["CutoffRule", "Spectrum", "butterworth_response", "noise_floor", "raw_gauge_changes",
+           "spectrum", "welch_psd"]
+
+# Welch with a Hann window and 50 % overlap: adjacent segments correlate with c = 0.167, so
+# the estimate has nu = 2 K / (1 + 2 c^2) = 2 K / 1.056 degrees of freedom (Welch 1967).
+_HANN_HALF_OVERLAP = 1.0 + 2 * 0.167 ** 2
+
+
+@dataclass(frozen=True)
+class CutoffRule:
+    """How :func:`spectrum` suggests a cut-off (see the module docstring).
+
+    Parameters
+    ----------
+    margin_db : float
+        A line counts as signal when it stands this far above the local noise floor [dB].
+    safety : float
+        Suggested cut-off = safety * f_signal (2.5: the document's 20 Hz over its 8 Hz).
+    floor_width_hz : float
+        Width of the running median that gives the local noise floor [Hz].
+    order : int
+        One-way Butterworth order of the proposed filter (2 in eq. 4.1).
+    """
+
+    margin_db: float = 10.0
+    safety: float = 2.5
+    floor_width_hz: float = 4.0
+    order: int = 2
+
+    def __post_init__(self) -> None:
+        if not (self.margin_db > 0 and self.safety >= 1 and self.floor_width_hz > 0
+                and 1 <= self.order <= 10):
+            raise ValueError("margin_db and floor_width_hz must be > 0, safety >= 1 and order "
+                             f"in [1, 10]; got {self}")
+
+    def text(self) -> str:
+        """The rule in one sentence, with its numbers."""
+        return (f"f_signal = peak of the highest line where the differential PSD exceeds "
+                f"{self.margin_db:g} dB over the local noise floor (running median over "
+                f"{self.floor_width_hz:g} Hz, corrected to the mean density); suggested cut-off "
+                f"f_c = {self.safety:g} x f_signal, for a zero-phase order-{self.order} "
+                "Butterworth")
+
+
+@dataclass(frozen=True, eq=False)
+class Spectrum:
+    """Output of :func:`spectrum`.
+
+    ``freq`` [Hz]; ``psd`` name -> one-sided PSD [1/Hz] (``dr1``, ``dr2`` when the gauges are
+    known, ``differential`` always); ``floor`` the differential's local noise floor [1/Hz];
+    ``f_signal`` and ``cutoff`` [Hz] of the rule; ``response`` cut-off label -> zero-phase
+    amplitude response ``|H|^2`` on ``freq``; ``summary`` plain numbers for JSON.
+    """
+
+    freq: np.ndarray
+    psd: dict[str, np.ndarray]
+    floor: np.ndarray
+    f_signal: float
+    cutoff: float
+    response: dict[str, np.ndarray]
+    rule: CutoffRule
+    fs: float
+    summary: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """Everything as plain numbers and lists (the JSON of ``hystkit spectrum``)."""
+        return {**self.summary, "rule": {**asdict(self.rule), "text": self.rule.text()},
+                "freq_hz": self.freq, "psd_per_hz": self.psd, "noise_floor_per_hz": self.floor,
+                "filter_amplitude_response": self.response}
+
+    def plot(self, title: str = ""):
+        """PSDs, floor and threshold on log axes; the filters' zero-phase response (dB) on a
+        second axis; f_signal and the cut-offs marked. Returns the Figure."""
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(8, 5), layout="constrained")
+        ax = fig.add_subplot()
+        keep = self.freq > 0
+        f = self.freq[keep]
+        labels = {"dr1": "gauge 1 dR/R", "dr2": "gauge 2 dR/R",
+                  "differential": "dR1/R1 - dR2/R2"}
+        for name, values in self.psd.items():
+            ax.loglog(f, values[keep], lw=0.8 if name != "differential" else 1.1,
+                      label=labels[name], alpha=0.6 if name != "differential" else 1.0)
+        ax.loglog(f, self.floor[keep], "k--", lw=0.8, label="noise floor (differential)")
+        ax.loglog(f, self.floor[keep] * 10 ** (self.rule.margin_db / 10), "k:", lw=0.8,
+                  label=f"floor + {self.rule.margin_db:g} dB")
+        ax.axvline(self.f_signal, color="tab:red", lw=0.8)
+        ax.text(self.f_signal, 0.02, f" f_signal {self.f_signal:.3g} Hz", color="tab:red",
+                transform=ax.get_xaxis_transform(), rotation=90, va="bottom")
+        ax.set_xlabel("frequency [Hz]")
+        ax.set_ylabel("PSD [1/Hz]")
+        twin = ax.twinx()
+        for (label, h), style in zip(self.response.items(), ("-", "-."), strict=False):
+            twin.semilogx(f, 20 * np.log10(np.maximum(h[keep], 1e-12)), style,
+                          color="tab:purple", lw=1.0, label=f"zero-phase Butterworth {label}")
+        twin.set_ylim(-120, 5)
+        twin.set_ylabel("filter |H|² [dB]")
+        lines = ax.get_legend_handles_labels()
+        more = twin.get_legend_handles_labels()
+        ax.legend(lines[0] + more[0], lines[1] + more[1], fontsize=7, loc="lower left")
+        ax.set_title(title or f"Welch PSD; suggested cut-off {self.cutoff:.3g} Hz")
+        return fig
+
+
+def welch_psd(x: np.ndarray, fs: float, segment_s: float) -> tuple[np.ndarray, np.ndarray, int]:
+    """One-sided Welch PSD [unit²/Hz] of the rows of `x` (Hann, 50 % overlap, mean removed).
+
+    Returns
+    -------
+    freq : ndarray [Hz]
+    psd : ndarray, shape (..., freq.size)
+    n_segments : int
+        Segments averaged (K), which sets the estimate's spread.
+    """
+    n = np.shape(x)[-1]
+    nperseg = min(n, max(8, round(segment_s * fs)))
+    freq, psd = signal.welch(x, fs=fs, window="hann", nperseg=nperseg, noverlap=nperseg // 2,
+                             detrend="constant", scaling="density", axis=-1)
+    n_segments = 1 + (n - nperseg) // (nperseg - nperseg // 2)
+    return freq, psd, n_segments
+
+
+def noise_floor(psd: np.ndarray, df: float, width_hz: float, n_segments: int) -> np.ndarray:
+    """Local noise density [unit²/Hz]: running median of `psd` over `width_hz`, divided by the
+    median of a chi-square with nu = 2 K / 1.056 degrees of freedom over nu (the median of a
+    Welch estimate of white noise lies below its mean by that ratio)."""
+    size = max(3, 2 * round(0.5 * width_hz / df) + 1)
+    nu = 2 * n_segments / _HANN_HALF_OVERLAP
+    return ndimage.median_filter(psd, size=size, mode="nearest") / (stats.chi2.median(nu) / nu)
+
+
+def butterworth_response(freq: np.ndarray, fs: float, cutoff: float, order: int = 2
+                         ) -> np.ndarray:
+    """Amplitude response ``|H(f)|^2`` of the zero-phase (forward-backward) Butterworth that
+    ``lowpass_zero_phase`` applies (eq. 4.1), from ``sosfreqz`` of the designed sections."""
+    if not 0 < cutoff < fs / 2:
+        raise ValueError(f"cutoff {cutoff:g} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
+    sos = signal.butter(order, cutoff, fs=fs, output="sos")
+    _, h = signal.sosfreqz(sos, worN=np.asarray(freq, dtype=float), fs=fs)
+    return np.abs(h) ** 2
+
+
+def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float = 20.0,
+             rule: CutoffRule | None = None, compare_cutoff: float | None = 20.0,
+             f_search_max: float | None = None) -> Spectrum:
+    """Welch PSDs, local noise floor and the suggested cut-off of dR/R signals.
+
+    Parameters
+    ----------
+    rows : dict
+        ``differential`` (dR1/R1 - dR2/R2 [-]) and optionally ``dr1``, ``dr2``, sampled at `fs`.
+    fs : float
+        Sample rate [Hz].
+    segment_s : float
+        Welch segment length [s] (resolution about 1.5 / segment_s Hz with Hann); shortened to
+        the recording when longer.
+    rule : CutoffRule, optional
+    compare_cutoff : float, optional
+        A second cut-off [Hz] whose response is overlaid and summarised (the document's 20 Hz).
+    f_search_max : float, optional
+        Lines are searched below this [Hz] (default 0.4 fs, where decimation filters are flat).
+
+    Raises
+    ------
+    ValueError
+        No line stands `margin_db` above the floor (nothing to keep: pure noise, or a flat
+        signal), or the suggested cut-off is not below fs / 2.
+    """
+    rule = CutoffRule() if rule is None else rule
+    names = [k for k in ("dr1", "dr2", "differential") if k in rows]
+    freq, psd, n_seg = welch_psd(np.vstack([rows[k] for k in names]), fs, segment_s)
+    df = float(freq[1] - freq[0])
+    diff = psd[-1]
+    floor = noise_floor(diff, df, rule.floor_width_hz, n_seg)
+    f_max = 0.4 * fs if f_search_max is None else min(f_search_max, 0.5 * fs)
+    # Above the second bin: the first bins hold what is left of the mean and the drift.
+    search = (freq >= 2 * df) & (freq <= f_max)
+    above = search & (diff > floor * 10 ** (rule.margin_db / 10))
+    if not above.any():
+        raise ValueError(f"no spectral line stands {rule.margin_db:g} dB above the noise floor "
+                         f"between {2 * df:.3g} and {f_max:.3g} Hz: nothing to keep (pure "
+                         "noise or a flat signal?)")
+    f_signal = float(freq[_last_line_peak(above, diff)])
+    cutoff = rule.safety * f_signal
+    if not cutoff < fs / 2:
+        raise ValueError(f"suggested cut-off {cutoff:.3g} Hz is not below fs/2 = {fs / 2:.3g} Hz: "
+                         "the signal reaches the top of the analysed band (analyse the raw file "
+                         "at a higher rate)")
+    cutoffs = {"suggested": cutoff}
+    if compare_cutoff is not None and compare_cutoff != cutoff and compare_cutoff < fs / 2:
+        cutoffs["compare"] = float(compare_cutoff)
+    response = {f"{value:.3g} Hz ({key})": butterworth_response(freq, fs, value, rule.order)
+                for key, value in cutoffs.items()}
+    summary = {
+        "fs_hz": fs, "n_samples": int(np.shape(rows["differential"])[-1]),
+        "segment_s": (2 * (freq.size - 1)) / fs, "n_segments": n_seg, "resolution_hz": df,
+        "f_signal_hz": f_signal, "suggested_cutoff_hz": cutoff,
+        "noise_floor_at_f_signal_per_hz": float(np.interp(f_signal, freq, floor)),
+        "filters": {key: _filter_summary(freq, fs, value, rule.order, f_signal, floor)
+                    for key, value in cutoffs.items()},
+    }
+    return Spectrum(freq=freq, psd=dict(zip(names, psd, strict=True)), floor=floor,
+                    f_signal=f_signal, cutoff=cutoff, response=response, rule=rule, fs=fs,
+                    summary=summary)
+
+
+def _last_line_peak(above: np.ndarray, psd: np.ndarray) -> int:
+    """Bin of the highest PSD within the last run of consecutive bins above the threshold: the
+    centre of the highest line, not the edge of its window main lobe."""
+    last = int(np.flatnonzero(above)[-1])
+    first = last
+    while first > 0 and above[first - 1]:
+        first -= 1
+    return first + int(np.argmax(psd[first:last + 1]))
+
+
+def _filter_summary(freq: np.ndarray, fs: float, cutoff: float, order: int, f_signal: float,
+                    floor: np.ndarray) -> dict:
+    """What a cut-off costs and gains: the zero-phase gain at f_signal and the RMS of the noise
+    floor above f_signal (the band the cut-off decides on) with and without the filter,
+    sqrt(integral of N(f) |H|^4 df) (the power response is |H|^4)."""
+    h2 = butterworth_response(freq, fs, cutoff, order)
+    at_signal = float(butterworth_response(np.array([f_signal]), fs, cutoff, order)[0])
+    band = freq >= f_signal
+    passed = math.sqrt(float(np.trapezoid(floor[band] * h2[band] ** 2, freq[band])))
+    return {"cutoff_hz": cutoff, "gain_at_f_signal_db": 20 * math.log10(at_signal),
+            "noise_rms_above_f_signal_passed": passed,
+            "noise_rms_above_f_signal_unfiltered":
+                math.sqrt(float(np.trapezoid(floor[band], freq[band])))}
+
+
+def raw_gauge_changes(path: str | os.PathLike[str], settings: PreprocessSettings,
+                      fmt: RawFormat | None = None, fs_analysis: float = 1000.0
+                      ) -> tuple[dict[str, np.ndarray], float]:
+    """dR/R of each gauge and the differential from a raw recording, at about `fs_analysis`.
+
+    Eq. 4.3 per sample (with the measured ``v0`` when ``settings.supply_channel``), then the
+    preprocessing's streaming FIR decimation, flat to 0.4 of the output rate; no Butterworth.
+    Only ``r_bridge``, ``v_supply``, ``supply_channel`` and ``chunk_size`` of `settings` are used.
+
+    Returns
+    -------
+    rows : dict
+        ``dr1``, ``dr2``, ``differential`` [-] (eq. 4.4-4.5).
+    fs : float
+        Their sample rate [Hz] (the scope rate over a whole factor).
+
+    Raises
+    ------
+    InputError
+        As :func:`preprocess_raw` for the bridge and supply channels.
+    """
+    reader = open_raw(path, fmt, settings.chunk_size,
+                      extra=("v0",) if settings.supply_channel else ())
+    factor = max(1, round(reader.fs / fs_analysis))
+    fs_a = reader.fs / factor
+    chain = design_chain(reader.fs, factor, 0.4 * fs_a)
+    states = [decimator_init(stage, 2) for stage in chain]
+    ext = np.array([-np.inf, 0, np.inf, 0] * 2, dtype=float)
+    parts = []
+    for chunk in reader.chunks(columns=("v1", "v2", "v0")):
+        r, bad, ext = bridge_kernel(chunk.v1, chunk.v2, float(settings.r_bridge),
+                                    float(settings.v_supply), ext, chunk.v0)
+        for g in range(2):
+            if bad[g] >= 0:
+                _raise_bridge(reader, g, chunk, int(bad[g]), settings.v_supply)
+        parts.append(_run_chain(chain, states, r))
+    parts.append(_flush_chain(chain, states, 2))
+    r = np.concatenate(parts, axis=1)
+    mean = r.mean(axis=1, keepdims=True)
+    dr1, dr2 = (r - mean) / mean
+    return {"dr1": dr1, "dr2": dr2, "differential": dr1 - dr2}, fs_a
