@@ -75,8 +75,9 @@ def _verdict(report: dict) -> str:
 
 def _sector_line(name: str, sector) -> str:
     return (f"  {name:<18}[{sector.k_min:.4g}, {sector.k_max:.4g}] {sector.units} "
-            f"({sector.n_used} of {sector.n_samples} increments; the left-out ones move the "
-            f"output by up to {100 * sector.left_out_step:.3g} % of its largest step)")
+            f"({sector.n_used} of {sector.n_samples} increments; the left-out ones leave the "
+            f"sector by up to {100 * sector.unexplained_step:.3g} % of the largest output "
+            f"step)")
 
 
 def _control_stability(args: argparse.Namespace) -> int:

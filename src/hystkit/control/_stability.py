@@ -20,8 +20,9 @@ unstable only when a simulation shows it (:func:`global_stability`).
 The sector is measured (:func:`measure_sector`): the block is driven over its training range
 (the trained 0.5 Hz, 3 mm sine of sec. 7.2, at the loop's ``Ts``) and the chord slopes of
 consecutive samples are taken where the input moves. A dynamic model (the mPL is an ODE) can
-change its output while its input stands still; those samples are left out and their size is
-reported, so the reader sees how much of the block the sector does not describe.
+change its output while its input stands still; those samples are left out and how far they
+fall outside the sector is reported, so the reader sees how much of the block the sector does
+not describe.
 """
 
 from __future__ import annotations
@@ -54,9 +55,10 @@ class Sector:
         Smallest and largest chord slope ``dv / du`` [output units per input unit].
     n_used, n_samples : int
         Increments the slopes come from, of all.
-    left_out_step : float
-        Largest ``|dv|`` among the left-out increments (input standing still), relative to the
-        largest ``|dv|`` of all: 0 for a memoryless block.
+    unexplained_step : float
+        How far the left-out increments (input nearly still) fall outside the sector: the
+        largest distance of ``dv`` from ``[k_min du, k_max du]``, relative to the largest
+        ``|dv|`` of all. 0 (to rounding) for a memoryless block.
     units : str
     """
 
@@ -64,7 +66,7 @@ class Sector:
     k_max: float
     n_used: int
     n_samples: int
-    left_out_step: float
+    unexplained_step: float
     units: str = ""
 
     def to_dict(self) -> dict:
@@ -87,9 +89,13 @@ def chord_sector(u: np.ndarray, v: np.ndarray, *, relative_step: float = RELATIV
         raise ValueError("the input does not move: no slope to measure")
     used = np.abs(du) > relative_step * np.max(np.abs(du))
     k = dv[used] / du[used]
+    k_min, k_max = float(k.min()), float(k.max())
+    lo = np.minimum(k_min * du[~used], k_max * du[~used])
+    hi = np.maximum(k_min * du[~used], k_max * du[~used])
+    outside = np.maximum(lo - dv[~used], dv[~used] - hi)
     top = np.max(np.abs(dv))
-    left = float(np.max(np.abs(dv[~used])) / top) if np.any(~used) and top > 0 else 0.0
-    return Sector(float(k.min()), float(k.max()), int(used.sum()), int(du.size), left, units)
+    unexplained = (float(max(np.max(outside, initial=0.0), 0.0) / top) if top > 0 else 0.0)
+    return Sector(k_min, k_max, int(used.sum()), int(du.size), unexplained, units)
 
 
 def _training_position(ts: float) -> np.ndarray:
