@@ -8,6 +8,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from hystkit.compensation import (
+    POSITION_MARGIN,
     Adaptation,
     AdaptiveStream,
     Compensator,
@@ -233,3 +234,21 @@ def test_on_a_steady_sensor_adaptation_does_not_hurt(fitted):
                   .process(steady.sensor, reference) - steady.position)
     # the stated bound of docs/live.md: at most 5 % more error than the fixed compensator
     assert adapted < 1.05 * fixed
+
+
+@pytest.mark.parametrize("parameters", ["gain", "weights"])
+def test_step_flags_are_those_of_the_chunk_on_the_adapted_estimate(parameters):
+    comp = drawn("mpl", center="tare")
+    sensor, reference = signals(comp)
+    stream = AdaptiveStream(comp, Adaptation(parameters))
+    steps = [stream.step_flagged(s, r) for s, r in zip(sensor, reference, strict=True)]
+    whole = AdaptiveStream(comp, Adaptation(parameters)).process_flagged(sensor, reference)
+    assert_array_equal([o.estimate for o in steps], whole.estimate)
+    assert_array_equal([o.sensor_outside for o in steps], whole.sensor_outside)
+    assert_array_equal([o.estimate_outside for o in steps], whole.estimate_outside)
+    lo, hi = comp.position_range
+    pad = POSITION_MARGIN * (hi - lo)  # Compensator.estimate_outside's bounds
+    assert whole.estimate_outside.any() and not whole.estimate_outside.all()
+    offset = comp.position_offset() - comp.scaling.position_offset
+    assert_array_equal(whole.estimate_outside, (whole.estimate < lo + offset - pad)
+                       | (whole.estimate > hi + offset + pad))

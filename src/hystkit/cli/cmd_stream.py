@@ -55,7 +55,7 @@ TOO_LONG = "\0 line too long"
 SERIAL_HINT = 'pip install "hystkit[serial]"'
 # As hystkit.compensation._adaptive (not imported here: building the parser stays light).
 ADAPT_CHOICES = ("gain", "weights")
-DEFAULT_FORGETTING = 0.95
+DEFAULT_FORGETTING = 0.9
 
 
 # Kinds of problem whose sample is still compensated, and what happened instead of skipping it.

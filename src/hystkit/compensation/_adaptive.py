@@ -75,7 +75,7 @@ class Adaptation:
     """
 
     parameters: str = "gain"
-    forgetting: float = 0.95
+    forgetting: float = 0.9
     prior_gain: float = 0.1
     prior_offset: float | None = None
 
@@ -232,7 +232,7 @@ class AdaptiveStream:
     compensator : Compensator
         Any deployable compensator; ``"weights"`` needs a direct one with weights ``w``, ``v_b``.
     adaptation : Adaptation, optional
-        What to re-fit and how fast to forget (default: gain and offset, lambda = 0.95).
+        What to re-fit and how fast to forget (default: gain and offset, lambda = 0.9).
     start, rest_position, label
         As :class:`~._stream.Stream`.
 
