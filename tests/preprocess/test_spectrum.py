@@ -83,6 +83,10 @@ def test_pure_noise_has_no_line():
     _, x = _noise(60.0, seed=2)
     with pytest.raises(ValueError, match="no spectral line stands 10 dB above"):
         spectrum({"differential": x}, FS, segment_s=SEGMENT)
+    with pytest.raises(ValueError, match="2 Welch segment"):  # 40 s segments in 60 s
+        spectrum({"differential": x}, FS, segment_s=40.0)
+    assert spectrum({"differential": x + _line(np.arange(x.size) / FS, 3.0, 1e4)},
+                    FS).summary["n_segments"] == 5  # default: 20 s segments, 50 % overlap
 
 
 @pytest.mark.parametrize("cutoff, order", [(20.0, 2), (8.0, 2), (100.0, 4), (3.0, 1)])

@@ -141,8 +141,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--kind", choices=["auto", "raw", "data"], default="auto",
                    help="raw or recording (default auto: raw when bridge settings are given "
                         "or stored beside the file, or the file has v1 and v2)")
-    p.add_argument("--segment", type=_positive, default=20.0, metavar="S",
-                   help="Welch segment length (default 20 s: resolution 0.05 Hz)")
+    p.add_argument("--segment", type=_positive, metavar="S",
+                   help="Welch segment length (default 20 s, bins 0.05 Hz apart, or half the "
+                        "recording when shorter; at least 3 segments are needed)")
     p.add_argument("--margin", type=_positive, default=10.0, metavar="DB",
                    help="a line is signal when this far above the local noise floor "
                         "(default 10 dB)")

@@ -184,7 +184,7 @@ def butterworth_response(freq: np.ndarray, fs: float, cutoff: float, order: int 
     return np.abs(h) ** 2
 
 
-def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float = 20.0,
+def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float | None = None,
              rule: CutoffRule | None = None, compare_cutoff: float | None = 20.0,
              f_search_max: float | None = None) -> Spectrum:
     """Welch PSDs, local noise floor and the suggested cut-off of dR/R signals.
@@ -195,9 +195,9 @@ def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float = 20.0,
         ``differential`` (dR1/R1 - dR2/R2 [-]) and optionally ``dr1``, ``dr2``, sampled at `fs`.
     fs : float
         Sample rate [Hz].
-    segment_s : float
-        Welch segment length [s] (resolution about 1.5 / segment_s Hz with Hann); shortened to
-        the recording when longer.
+    segment_s : float, optional
+        Welch segment length [s] (bins 1 / segment_s apart, Hann main lobe 4 bins wide).
+        Default: 20 s, or half the recording when shorter (at least 3 segments).
     rule : CutoffRule, optional
     compare_cutoff : float, optional
         A second cut-off [Hz] whose response is overlaid and summarised (the document's 20 Hz).
@@ -207,12 +207,18 @@ def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float = 20.0,
     Raises
     ------
     ValueError
-        No line stands `margin_db` above the floor (nothing to keep: pure noise, or a flat
-        signal), or the suggested cut-off is not below fs / 2.
+        Fewer than 3 segments (one or two leave single noise bins a few percent likely to pass
+        10 dB over the floor), no line stands `margin_db` above the floor (nothing to keep:
+        pure noise, or a flat signal), or the suggested cut-off is not below fs / 2.
     """
     rule = CutoffRule() if rule is None else rule
     names = [k for k in ("dr1", "dr2", "differential") if k in rows]
+    duration = np.shape(rows["differential"])[-1] / fs
+    segment_s = min(20.0, duration / 2) if segment_s is None else segment_s
     freq, psd, n_seg = welch_psd(np.vstack([rows[k] for k in names]), fs, segment_s)
+    if n_seg < 3:
+        raise ValueError(f"{n_seg} Welch segment(s) of {segment_s:g} s in {duration:.6g} s: too "
+                         "few for the noise floor; use segments of at most half the recording")
     df = float(freq[1] - freq[0])
     diff = psd[-1]
     floor = noise_floor(diff, df, rule.floor_width_hz, n_seg)
