@@ -161,7 +161,8 @@ def _tune(args: argparse.Namespace, loop):
     try:
         res = tune_nonlinear(loop, args.experiment, objective=args.tune_objective,
                              min_phase_margin=args.min_phase_margin,
-                             min_gain_margin_db=args.min_gain_margin, noise=args.noise)
+                             min_gain_margin_db=args.min_gain_margin, noise=args.noise,
+                             max_evaluations=args.tune_budget)
     except ValueError as exc:
         raise UsageError(f"--tune-nonlinear: {exc}") from None
     a, b = res.pid_start, res.pid
@@ -481,6 +482,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tune-objective", choices=("rms", "max"), default="rms",
                    help="plant error to minimise with --tune-nonlinear: e_p rms or e_p max "
                         "(default rms; the worst case of the experiment)")
+    p.add_argument("--tune-budget", type=positive_int, default=300,
+                   help="most simulations --tune-nonlinear may run (default 300)")
     p.add_argument("--min-phase-margin", type=number(0, 90, high_open=True), default=30.0,
                    help="--tune-nonlinear constraint on the linearised loop [deg] (default 30)")
     p.add_argument("--min-gain-margin", type=number(0, 60), default=6.0,

@@ -1,0 +1,101 @@
+"""PID re-tuning on the non-linear loop (issue 14 item 9)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from hystkit import control as hc
+from hystkit.cli import main
+from hystkit.cli.cmd_control import _models
+
+GAIN = 40.0
+
+
+@pytest.fixture(scope="module")
+def models() -> hc.SensorModels:
+    return _models("recording", "sine", 3, None)  # the CLI's memo: shared with its tests
+
+
+def _ideal(scheme: str) -> hc.ControlLoop:
+    return hc.ControlLoop(scheme, hc.linear_block(GAIN), hc.DOCUMENT_PID_WEIGHTING,
+                          compensator=hc.linear_block(1 / GAIN), model=hc.linear_block(GAIN),
+                          sensor_gain=1 / GAIN)
+
+
+def _check(loop: hc.ControlLoop, res: hc.TuneResult) -> None:
+    """Never worse than the start, the reported cost is the tuned loop's, constraints hold."""
+    assert res.cost <= res.cost_start
+    key = "e_p_rms" if res.objective == "rms" else "e_p_max"
+    result = hc.run_experiment(res.experiment, replace(loop, pid=res.pid))
+    rerun = max(r.metrics()[key] for r in result.cases.values())
+    assert_allclose(rerun, res.cost, rtol=0, atol=0)  # the compiled loop is deterministic
+    start = hc.run_experiment(res.experiment, loop)
+    assert_allclose(max(r.metrics()[key] for r in start.cases.values()), res.cost_start,
+                    rtol=0, atol=0)
+    m = hc.loop_margins(replace(loop, pid=res.pid))
+    assert m.phase_margin_deg >= res.min_phase_margin
+    assert m.gain_margin_db is None or m.gain_margin_db >= res.min_gain_margin_db
+    assert m.max_pole_radius <= max(1.0, res.margins_start.max_pole_radius) + 1e-12
+
+
+@pytest.mark.parametrize("objective", hc.OBJECTIVES)
+def test_tuning_the_linear_loop_improves_and_keeps_the_margins(objective):
+    loop = _ideal("weighting")
+    res = hc.tune_nonlinear(loop, objective=objective, max_evaluations=40)
+    _check(loop, res)
+    assert res.improved and res.cost < res.cost_start
+    assert res.n_evaluations <= 40 + 1  # the start is run once before the search
+
+
+def test_tuning_the_hysteretic_loop_is_never_worse(models):
+    loop = hc.build_loop("weighting", models)
+    res = hc.tune_nonlinear(loop, max_evaluations=40, min_phase_margin=45.0)
+    _check(loop, res)
+
+
+def test_without_budget_the_start_is_kept():
+    loop = _ideal("direct")
+    res = hc.tune_nonlinear(loop, max_evaluations=1)
+    assert not res.improved and res.pid is loop.pid and res.cost == res.cost_start
+
+
+def test_start_gains_that_break_the_constraints_are_refused():
+    loop = _ideal("weighting")
+    pm = hc.loop_margins(loop).phase_margin_deg
+    with pytest.raises(ValueError, match="start gains break the constraints"):
+        hc.tune_nonlinear(loop, min_phase_margin=pm + 1.0)
+
+
+def test_an_integral_free_pid_stays_integral_free():
+    loop = hc.ControlLoop("direct", hc.linear_block(GAIN), hc.PID(kp=500.0, td=0.05),
+                          compensator=hc.linear_block(1 / GAIN))
+    res = hc.tune_nonlinear(loop, max_evaluations=20)
+    assert np.isinf(res.pid.ti) and res.cost <= res.cost_start
+
+
+def test_cli_tune_nonlinear_reports_before_and_after(capsys, tmp_path):
+    out = tmp_path / "tuned"
+    capsys.readouterr()
+    code = main(["control", "--scheme", "weighting", "--experiment", "sine",
+                 "--tune-nonlinear", "--tune-budget", "30", "--out", str(out)])
+    stdout, err = capsys.readouterr()
+    assert code == 0, err
+    tuning = json.loads((out / "metrics.json").read_text())["tuning"]
+    assert tuning["cost_m"] <= tuning["cost_start_m"]
+    config = json.loads((out / "config.json").read_text())
+    assert config["pid"]["kp"] == tuning["pid"]["kp"]
+    assert config["pid"]["source"] == "--tune-nonlinear"
+    assert "before" in stdout and "after" in stdout
+
+
+def test_cli_tune_nonlinear_needs_an_experiment(capsys, tmp_path):
+    capsys.readouterr()
+    code = main(["control", "--scheme", "direct", "--bode", "--tune-nonlinear", "--out",
+                 str(tmp_path / "x")])
+    err = capsys.readouterr().err
+    assert code == 2 and "--experiment" in err
