@@ -16,6 +16,7 @@ from __future__ import annotations
 import functools
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
 
@@ -24,6 +25,7 @@ from scipy.optimize import least_squares
 from threadpoolctl import ThreadpoolController
 
 from ..errors import FitDivergedError
+from ..parallel import Executor, current_executor
 from ._lm import solve_lm
 from ._normal_equations import NormalEquations, dense_normal_equations
 from ._result import FitResult
@@ -32,6 +34,12 @@ from ._trust_region import solve_trust_region
 __all__ = ["check_fit_data", "fit_multistart"]
 
 _SOLVERS = {"tr": solve_trust_region, "lm": solve_lm, "trf": None}
+# A start's screening solve that takes this long or more [s] is worth a task of its own when
+# an executor is open: a task on a local Dask cluster costs ~5-10 ms to submit, send (the
+# closures and the data, ~100 kB at 8000 samples) and collect, and one on a remote cluster
+# more; below this, splitting would spend a tenth or more of the work on moving it. Fits
+# this short (bobbio, pi, the mPL family at 8000 samples: 10-20 ms a start) stay serial.
+SPLIT_MIN_SECONDS = 0.1
 
 
 def check_fit_data(u: np.ndarray, y: np.ndarray,
@@ -78,6 +86,13 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
     to convergence (most starts fall into the same few basins, so polishing all of them would
     repeat work). ``accept(params)`` can veto a candidate (e.g. an unstable inverse); vetoed
     ones are skipped and counted.
+
+    While a parallel executor is open in this process (`hystkit.parallel.open_executor`), a
+    fit whose first screening solve takes `SPLIT_MIN_SECONDS` or more screens its other
+    starts on the workers, and polishes its first ``n_polish`` candidates side by side there;
+    every solve is the same pure function of its start, so the result is the serial one, bit
+    for bit (only ``seconds`` differs). Inside a Dask worker no executor is open: a fit that
+    is itself one piece of a parallel map stays serial.
 
     Parameters
     ----------
@@ -134,41 +149,27 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
                 r = residual(theta)
                 return 0.5 * float(r @ r)
 
-    def solve(theta0: np.ndarray, budget: int) -> SimpleNamespace:
-        # BLAS threads do not pay on (n x n_params) problems, and under load they cost 10-30x
-        # (benchmarks/README.md).
-        with _blas_controller().limit(limits=1, user_api="blas"):
-            if solver != "trf":
-                # lm may stop on a bound, the margin keeps it inside as trf and tr stay
-                shrink = margin if solver == "lm" else 0.0
-                sol = _SOLVERS[solver](normal_equations, theta0, lower + shrink,
-                                       upper - shrink, cost=cost, max_nfev=budget)
-                return SimpleNamespace(x=sol.x, cost=sol.cost, status=sol.status,
-                                       message=sol.message, n_runs=sol.n_runs,
-                                       column_norms=sol.column_norms)
-            sol = least_squares(residual, theta0, jac=jac, bounds=(lower, upper),
-                                method="trf", x_scale="jac", max_nfev=budget)
-        # Keep only what ranking and reporting need: the (n x n_params) Jacobian and the
-        # residuals of every screened start alive together cost GBs on long recordings.
-        return SimpleNamespace(x=sol.x, cost=float(sol.cost), status=sol.status,
-                               message=sol.message, n_runs=sol.nfev + (sol.njev or 0),
-                               column_norms=_column_norms(sol.jac))
-
+    solve = _StartSolver(residual=residual, jac=jac, normal_equations=normal_equations,
+                         cost=cost, solver=solver, lower=lower, upper=upper, margin=margin)
     t_start = time.perf_counter()
-    screened, n_eval = [], 0
-    for theta0 in starts:
-        sol = solve(np.clip(np.asarray(theta0, dtype=float), lower + margin, upper - margin),
-                    screen_nfev)
-        n_eval += sol.n_runs
-        if np.isfinite(sol.cost):
-            screened.append(sol)
-    screened.sort(key=lambda sol: sol.cost)
+    screened, executor = _screen(solve, [np.clip(np.asarray(theta0, dtype=float),
+                                                 lower + margin, upper - margin)
+                                         for theta0 in starts], screen_nfev)
+    n_eval = sum(sol.n_runs for sol in screened)
+    screened = sorted((sol for sol in screened if np.isfinite(sol.cost)),
+                      key=lambda sol: sol.cost)
+    # The first n_polish candidates are polished whatever happens (the loop below stops only
+    # after n_polish accepted ones): on workers they run side by side, ahead of the loop.
+    polished = _solve_on(executor, solve, [sol.x for sol in screened[:n_polish]
+                                            if sol.status == 0], max_nfev)
+    waiting = iter(range(len(polished)))
     best, rejected, n_polished = None, 0, 0
     for sol in screened:
         if best is not None and n_polished >= n_polish:
             break
         if sol.status == 0:  # budget ran out: continue from where it stopped
-            sol = solve(sol.x, max_nfev)
+            i = next(waiting, None)
+            sol = polished[i] if i is not None else solve(sol.x, max_nfev)
             n_eval += sol.n_runs
         if not np.isfinite(sol.cost):
             continue
@@ -188,6 +189,77 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
                      n_starts=len(starts), theta=np.array(best.x),
                      bounds=(lower, upper), names=names, limits=limits,
                      sensitivity=best.column_norms)
+
+
+@dataclass(frozen=True)
+class _StartSolver:
+    """One start's bounded solve, ``(theta0, budget) -> SimpleNamespace(x, cost, status,
+    message, n_runs, column_norms)``; a pure function of its arguments, so a worker process
+    that gets a copy (closures travel by cloudpickle) returns what this process would."""
+
+    residual: Callable[[np.ndarray], np.ndarray]
+    jac: Callable[[np.ndarray], np.ndarray] | str
+    normal_equations: Callable[[np.ndarray], NormalEquations] | None
+    cost: Callable[[np.ndarray], float] | None
+    solver: str
+    lower: np.ndarray
+    upper: np.ndarray
+    margin: np.ndarray
+
+    def __call__(self, theta0: np.ndarray, budget: int) -> SimpleNamespace:
+        # BLAS threads do not pay on (n x n_params) problems, and under load they cost 10-30x
+        # (benchmarks/README.md).
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            if self.solver != "trf":
+                # lm may stop on a bound, the margin keeps it inside as trf and tr stay
+                shrink = self.margin if self.solver == "lm" else 0.0
+                sol = _SOLVERS[self.solver](self.normal_equations, theta0, self.lower + shrink,
+                                            self.upper - shrink, cost=self.cost,
+                                            max_nfev=budget)
+                return SimpleNamespace(x=sol.x, cost=sol.cost, status=sol.status,
+                                       message=sol.message, n_runs=sol.n_runs,
+                                       column_norms=sol.column_norms)
+            sol = least_squares(self.residual, theta0, jac=self.jac,
+                                bounds=(self.lower, self.upper), method="trf", x_scale="jac",
+                                max_nfev=budget)
+        # Keep only what ranking and reporting need: the (n x n_params) Jacobian and the
+        # residuals of every screened start alive together cost GBs on long recordings.
+        return SimpleNamespace(x=sol.x, cost=float(sol.cost), status=sol.status,
+                               message=sol.message, n_runs=sol.nfev + (sol.njev or 0),
+                               column_norms=_column_norms(sol.jac))
+
+
+def _screen(solve: _StartSolver, thetas: list[np.ndarray],
+            budget: int) -> tuple[list[SimpleNamespace], Executor | None]:
+    """Every start's screening solve, in order, and the executor the polish may use.
+
+    The first start runs here, timed; if it took `SPLIT_MIN_SECONDS` or more and an executor
+    is open (`hystkit.parallel.current_executor`), the other starts run on its workers (at
+    least two of them: one would only wait for the other), else here after it.
+    """
+    executor = current_executor()
+    if executor is None or len(thetas) < 3:
+        return [solve(theta, budget) for theta in thetas], None
+    t0 = time.perf_counter()
+    first = solve(thetas[0], budget)
+    if time.perf_counter() - t0 < SPLIT_MIN_SECONDS:
+        return [first, *(solve(theta, budget) for theta in thetas[1:])], None
+    return [first, *_solve_on(executor, solve, thetas[1:], budget)], executor
+
+
+def _solve_on(executor: Executor | None, solve: _StartSolver, thetas: list[np.ndarray],
+              budget: int) -> list[SimpleNamespace]:
+    """``[solve(theta, budget) for theta in thetas]``, on `executor`'s workers if given and
+    there are two or more."""
+    if executor is None or len(thetas) < 2:
+        return [solve(theta, budget) for theta in thetas]
+    return executor.map(_solve_start, [(theta, budget) for theta in thetas],
+                        shared={"solve": solve})
+
+
+def _solve_start(start: tuple[np.ndarray, int], *, solve: _StartSolver) -> SimpleNamespace:
+    """One piece of a parallel multi-start (module level: a worker finds it by name)."""
+    return solve(*start)
 
 
 def _column_norms(jac: Any) -> np.ndarray | None:

@@ -4,10 +4,21 @@ run in order-preserving maps, serially in-process or on Dask.
 `open_executor` chooses: one worker (or a single piece) runs serially in this process and never
 imports Dask; more start a local Dask cluster sized to the machine; a scheduler address connects
 to an existing cluster. Results come back in the order of the pieces, whatever order they
-finish in, so a parallel run gives the same table as the serial one. Dask is imported only when
-a parallel run starts.
+finish in, so a parallel run gives the same table as the serial one; `fit_cost` estimates
+each piece so that the costliest start first. While a parallel executor is open, `current_executor` gives it to
+work that splits itself: a long fit screens its starts on the workers
+(:func:`hystkit.identification.fit_multistart`). Dask is imported only when a parallel run
+starts.
 """
 
-from ._executor import Executor, SerialExecutor, available_cores, open_executor
+from ._cost import fit_cost
+from ._executor import (
+    Executor,
+    SerialExecutor,
+    available_cores,
+    current_executor,
+    open_executor,
+)
 
-__all__ = ["Executor", "SerialExecutor", "available_cores", "open_executor"]
+__all__ = ["Executor", "SerialExecutor", "available_cores", "current_executor", "fit_cost",
+           "open_executor"]

@@ -1,14 +1,16 @@
 """The Dask executor: a local cluster for this command, or a client of a running scheduler.
 
 Imported only when a parallel run starts. A local cluster's workers are forked where the
-platform allows it (Linux): they inherit the libraries this process has imported, so a worker is
-ready in a fraction of a second, where a spawned one re-imports numpy, scipy, numba and hystkit
-(2-3 s on a loaded 2-core machine, more than a small ``compare`` gains). The model kernels are
-loaded from numba's on-disk cache (``cache=True``) once before the fork, so forked workers start
-with them; spawned workers and those of a remote cluster load them at start-up (`WorkerSetup`).
-Either way the first piece a worker runs is timed like the others. Every worker also limits its
-BLAS to one thread: a worker has one core, and idle OpenBLAS threads spin, taking CPU from the
-other workers (measured: ``select`` at 2 workers used 40 % more CPU than serially without it).
+platform allows it (Linux): they inherit the libraries this process has imported and the model
+kernels it loaded from numba's on-disk cache (``cache=True``, `warm_kernels`, once before the
+fork), so a worker is ready in a fraction of a second, where a spawned one re-imports numpy,
+scipy, numba and hystkit (2-3 s on a loaded 2-core machine, more than a small ``compare``
+gains). Spawned workers and those of a remote cluster load the kernels at start-up
+(`WorkerSetup`); forked ones skip that (measured: it cost each of two forked workers 0.6-2.6 s
+of CPU at every start, for kernels they already had). Every worker limits its BLAS to one
+thread: a worker has one core, and idle OpenBLAS threads spin, taking CPU from the other
+workers (measured: ``select`` at 2 workers used 40 % more CPU than serially without it).
+Pieces are submitted with their estimated cost as Dask priority: the costliest run first.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from distributed import Client, LocalCluster, WorkerPlugin, as_completed
 
 from .. import __version__
 from ..errors import HystkitError
-from ._executor import OnDone
+from ._executor import Cost, OnDone
 
 __all__ = ["DaskExecutor", "SchedulerError", "WorkerSetup", "dask_executor"]
 
@@ -52,28 +54,47 @@ class WorkerSetup(WorkerPlugin):
         from threadpoolctl import threadpool_limits
 
         threadpool_limits(1)  # kept for the worker's life (not used as a context manager)
-        warm_kernels()
+        if not _warmed:  # forked from a process that loaded them: the worker has them too
+            warm_kernels()
+
+
+# Whether this process (or the one it was forked from) has run `warm_kernels`.
+_warmed = False
 
 
 def warm_kernels() -> None:
-    """Import the model families, run each one's compiled simulation and fit on a short
-    signal: this loads their kernels from numba's on-disk cache (``cache=True``) once, here,
+    """Import the model families and fit each one to a short hysteretic signal: this loads
+    their simulation and fit kernels from numba's on-disk cache (``cache=True``) once, here,
     instead of in every worker (measured: without the fits' kernels, two forked workers each
-    loaded them again and a 4 s ``compare`` map took as long on 2 workers as on 1)."""
+    loaded them again and a 4 s ``compare`` map took as long on 2 workers as on 1). The
+    signal is a play operator's (every family fits it; a family's own random parameters left
+    Bouc-Wen unfitted, its fit kernels unloaded) and short: loading is what counts here."""
+    global _warmed
     import numpy as np
 
     from ..models import FAMILIES
 
-    u = 0.8 * np.sin(np.linspace(0, 6 * np.pi, 300))
+    u = 0.8 * np.sin(np.linspace(0, 6 * np.pi, 150)) * np.linspace(1.0, 0.5, 150)
+    y = 0.6 * u + 0.4 * _play(u, 0.15)
     for family in FAMILIES.values():
         # Only a head start: a family that cannot run here fails in its own piece, where the
         # command reports it, not in every worker's start-up.
         try:
-            structure = family.make_structure(1 / 40, family.default_size)
-            params = family.random_params(structure, np.random.default_rng(0))
-            family.fit(u, family.simulate(structure, params, u)[0], structure)
+            family.fit(u, y, family.make_structure(1 / 40, family.default_size))
         except Exception:  # noqa: BLE001, S112
             continue
+    _warmed = True
+
+
+def _play(u, radius: float):
+    """A play (backlash) operator of half-width `radius` from 0: a simple hysteretic loop."""
+    import numpy as np
+
+    y, x = np.empty_like(u), 0.0
+    for i, v in enumerate(u):
+        x = min(max(x, v - radius), v + radius)
+        y[i] = x
+    return y
 
 
 def _worker_version() -> str:
@@ -95,15 +116,20 @@ class DaskExecutor:
         return f"{self.n_workers} Dask workers ({self.where})"
 
     def map(self, func: Callable[..., Any], items: Sequence[Any], *,
-            shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None) -> list:
+            shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None,
+            cost: Cost | None = None) -> list:
         # Shared inputs (recordings) travel to each worker once, not with every piece.
         sent = {key: value if value is None else self.client.scatter(value, broadcast=True,
                                                                      hash=False)
                 for key, value in (shared or {}).items()}
         run = uuid.uuid4().hex[:8]
-        futures = [self.client.submit(func, item, **sent, pure=False,
-                                      key=f"{getattr(func, '__name__', 'piece')}-{run}-{i}")
-                   for i, item in enumerate(items)]
+        name = getattr(func, "__name__", "piece")
+        # Submitted costliest first, each with its rank as priority: the scheduler may hand
+        # out the first pieces before it has seen the rest.
+        futures: list = [None] * len(items)
+        for rank, i in enumerate(_cost_order(items, cost)):
+            futures[i] = self.client.submit(func, items[i], **sent, pure=False,
+                                            priority=len(items) - rank, key=f"{name}-{run}-{i}")
         index = {future.key: i for i, future in enumerate(futures)}
         results: list = [None] * len(futures)
         try:
@@ -115,6 +141,14 @@ class DaskExecutor:
         finally:  # an error or a signal: nothing left running for this map
             self.client.cancel(futures)
         return results
+
+
+def _cost_order(items: Sequence[Any], cost: Cost | None) -> list[int]:
+    """Indices of `items`, the costliest first by `cost`; ties, and all without `cost`, in
+    the order of `items`."""
+    if cost is None:
+        return list(range(len(items)))
+    return sorted(range(len(items)), key=lambda i: (-cost(items[i]), i))
 
 
 def _fork_if_possible() -> str:

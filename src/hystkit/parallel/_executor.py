@@ -5,11 +5,19 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Any, Protocol
 
-__all__ = ["Executor", "SerialExecutor", "available_cores", "open_executor"]
+__all__ = ["Executor", "SerialExecutor", "available_cores", "current_executor",
+           "open_executor"]
 
 OnDone = Callable[[int, Any], None]
+Cost = Callable[[Any], float]
+
+# The parallel executor open in this thread of this process, for work that splits itself
+# (the starts of a fit's multi-start). A Dask worker's task threads never see it: a piece
+# running there stays serial inside.
+_CURRENT: ContextVar[Executor | None] = ContextVar("hystkit_executor", default=None)
 
 
 class Executor(Protocol):
@@ -18,9 +26,12 @@ class Executor(Protocol):
     n_workers: int
 
     def map(self, func: Callable[..., Any], items: Sequence[Any], *,
-            shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None) -> list:
+            shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None,
+            cost: Cost | None = None) -> list:
         """``[func(item, **shared) for item in items]``; `on_done(index, result)` is called as
-        each piece finishes (in finishing order). An exception of a piece is raised here."""
+        each piece finishes (in finishing order). `cost(item)` is an estimate of a piece's
+        work: the costliest start first, so that no long piece is left to run alone at the
+        end (the results keep the order of `items`). An exception of a piece is raised here."""
         ...
 
     def describe(self) -> str:
@@ -37,10 +48,11 @@ class SerialExecutor:
     n_workers = 1
 
     def map(self, func: Callable[..., Any], items: Sequence[Any], *,
-            shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None) -> list:
+            shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None,
+            cost: Cost | None = None) -> list:
         from threadpoolctl import threadpool_limits
 
-        results = []
+        results = []  # in the given order: `cost` changes nothing for one worker
         with threadpool_limits(1):
             for i, item in enumerate(items):
                 results.append(func(item, **(shared or {})))
@@ -60,10 +72,19 @@ def available_cores() -> int:
         return os.cpu_count() or 1
 
 
+def current_executor() -> Executor | None:
+    """The parallel executor that `open_executor` holds open here, or None (serial, or inside
+    a Dask worker): work that can split itself, such as a fit's starts, asks this."""
+    return _CURRENT.get()
+
+
 @contextmanager
 def open_executor(workers: int | None = None, scheduler: str | None = None, *,
                   n_pieces: int | None = None) -> Iterator[Executor]:
     """The executor for one command; its cluster or connection is closed on leaving.
+
+    While it is open, a parallel executor is also `current_executor`, so that a long fit run
+    here (such as ``select``'s refit of the winner) screens its starts on the workers.
 
     Parameters
     ----------
@@ -87,4 +108,8 @@ def open_executor(workers: int | None = None, scheduler: str | None = None, *,
     from ._dask import dask_executor  # Dask loads only for a parallel run
 
     with dask_executor(None if scheduler is not None else n, scheduler) as executor:
-        yield executor
+        token = _CURRENT.set(executor)
+        try:
+            yield executor
+        finally:
+            _CURRENT.reset(token)

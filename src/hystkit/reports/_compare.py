@@ -23,7 +23,7 @@ from ..errors import HystkitError
 from ..io import Recording
 from ..metrics import e_max_pct, e_rms_pct, r2
 from ..models import FAMILIES, get_family
-from ..parallel import Executor, SerialExecutor
+from ..parallel import Executor, SerialExecutor, fit_cost
 from ._properties import measure_properties
 
 __all__ = ["compare_models", "format_compare", "generalization_matrix", "plot_generalization"]
@@ -133,7 +133,8 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
                      f"{len(models)})")
 
     results = (executor or SerialExecutor()).map(
-        _compare_piece, pieces, shared={"fit_rec": fit_rec, "val_rec": val_rec}, on_done=done)
+        _compare_piece, pieces, shared={"fit_rec": fit_rec, "val_rec": val_rec}, on_done=done,
+        cost=lambda piece: fit_cost(piece[0], piece[1], fit_rec.sensor.size))
     table = {}
     for k, name in enumerate(models):
         forward, direct = results[2 * k], results[2 * k + 1]
@@ -188,7 +189,8 @@ def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Rec
               for train_name in train]
     results = (executor or SerialExecutor()).map(
         _generalize_piece, pieces, shared={"train": train, "test": test},
-        on_done=lambda i, _: progress(f"  {pieces[i][0]}: trained on {pieces[i][2]}"))
+        on_done=lambda i, _: progress(f"  {pieces[i][0]}: trained on {pieces[i][2]}"),
+        cost=lambda piece: fit_cost(piece[0], piece[1], train[piece[2]].sensor.size))
     out = {}
     for name in models:
         grids = {key: {} for key in GRID_KEYS}

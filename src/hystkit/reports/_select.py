@@ -20,7 +20,7 @@ from ..compensation import DEFAULT_CENTER, check_fitting_data, evaluate, fit_com
 from ..errors import FitDivergedError
 from ..io import Recording
 from ..models import FAMILIES, get_family
-from ..parallel import Executor, SerialExecutor
+from ..parallel import Executor, SerialExecutor, fit_cost
 from ._compare import DISQUALIFYING, FAMILY_FAILURES
 
 __all__ = ["Candidate", "candidates", "folds", "plot_selection", "select_model"]
@@ -156,7 +156,9 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
             progress(f"  {cands[j].label}: cross-validated "
                      f"({folds_left.count(0)}/{len(cands)})")
 
-    fold_rows = executor.map(_score_fold, pieces, shared={"pairs": pairs}, on_done=fold_done)
+    fold_rows = executor.map(_score_fold, pieces, shared={"pairs": pairs}, on_done=fold_done,
+                             cost=lambda piece: fit_cost(piece[0].model, piece[0].size, sum(
+                                 rec.sensor.size for rec in pairs[piece[1]][0])))
     rows = [_candidate_row(c, fold_rows[j * len(pairs):(j + 1) * len(pairs)])
             for j, c in enumerate(cands)]
     rows.sort(key=_rank_key)

@@ -10,7 +10,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ...metrics import e_max_pct, e_rms_pct
-from ...parallel import Executor, SerialExecutor
+from ...parallel import Executor, SerialExecutor, fit_cost
 from . import model as pl
 from .fit import fit_pl
 from .grid import DEFAULT_GRID
@@ -49,8 +49,9 @@ def structural_search(u: np.ndarray, y: np.ndarray, dt: float,
                                  smoothing=float(s), dt=dt, slope_cap=slope_cap)
                   for n, p, m, s in itertools.product(grid["n"], grid["p"], grid["m"],
                                                       grid["s"])]
-    return (executor or SerialExecutor()).map(_fit_structure, structures,
-                                              shared={"u": u, "y": y})
+    return (executor or SerialExecutor()).map(
+        _fit_structure, structures, shared={"u": u, "y": y},
+        cost=lambda s: fit_cost("pl", s.n_cells, u.size) * s.n_basis)
 
 
 def _fit_structure(structure: pl.PlStructure, *, u: np.ndarray, y: np.ndarray) -> dict:
