@@ -170,3 +170,17 @@ def test_every_option_has_help(command):
     missing = [a.dest for a in sub._actions if not isinstance(a, argparse._HelpAction)
                and not str(a.help or "").strip()]
     assert missing == []
+
+
+def test_raw_settings_without_the_bridge_and_reading_options_with_raw_are_one_line(
+        raw_run, tmp_path, capsys):
+    raw, _ = raw_run
+    linked = tmp_path / "nobridge.csv"
+    linked.symlink_to(raw)
+    (tmp_path / "nobridge.toml").write_text("v_supply = 2.0\n")
+    assert main(["cycles", str(linked), "--raw", "--out", str(tmp_path / "o")]) == 2
+    assert "r_bridge not set" in _error_line(capsys)
+    assert main(["cycles", str(raw), "--raw", "--time-unit", "ms",
+                 "--out", str(tmp_path / "o")]) == 2
+    assert "do not apply" in _error_line(capsys)
+    assert not (tmp_path / "o").exists()

@@ -11,11 +11,19 @@ dr1, dr2 beside position and sensor; without them only the sensor column is anal
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import InputError
-from ._common import add_read_options, number, read_options, read_recording_args
+from ._common import (
+    UsageError,
+    add_read_options,
+    given_read_options,
+    number,
+    read_options,
+    read_recording_args,
+)
 
 if TYPE_CHECKING:
     import numpy as np
@@ -55,6 +63,10 @@ def _gauges_from_raw(args: argparse.Namespace) -> tuple[np.ndarray, ...]:
                          "'hystkit preprocess' with --r-bridge/--v-supply and analyse its output")
     values = read_raw_config(config)
     values.pop("simulation", None)
+    missing = [key for key in ("r_bridge", "v_supply") if key not in values]
+    if missing:
+        raise InputError(f"{config}: {' and '.join(missing)} not set; the bridge must be known "
+                         "to turn voltages into resistances (eq. 4.3)")
     fmt_keys = ("fs", "n_samples", "time_unit", "skip_rows")
     try:
         fmt = RawFormat(columns=tuple(values.pop("columns", {}).items()),
@@ -73,7 +85,7 @@ def _gauges_from_raw(args: argparse.Namespace) -> tuple[np.ndarray, ...]:
         warnings.simplefilter("always", RawDataWarning)
         result = preprocess_raw(args.input, settings, fmt)
     for warning in caught:
-        print(f"hystkit: warning: {warning.message}")
+        print(f"hystkit: warning: {warning.message}", file=sys.stderr)
     rec = result.recording
     return rec.time, rec.position, result.extra["r1"], result.extra["r2"], rec.sensor
 
@@ -173,6 +185,9 @@ def _cycles(args: argparse.Namespace) -> int:
     from ..analysis import cycle_table, plot_cycles
     from ..io import atomic_folder, check_output_folder, write_json
 
+    if args.raw and given_read_options(args):
+        raise UsageError("--raw reads the raw file with its .toml settings; the options for "
+                         "reading recordings (--columns, --time-unit, ...) do not apply")
     check_output_folder(args.out, CYCLES_FILES, args.force, inputs=[args.input])
     t, x, r1, r2, sensor = (_gauges_from_raw(args) if args.raw
                             else _gauges_from_recording(args))
