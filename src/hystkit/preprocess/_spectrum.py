@@ -237,7 +237,9 @@ def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float | None 
                          "the signal reaches the top of the analysed band (analyse the raw file "
                          "at a higher rate)")
     cutoffs = {"suggested": cutoff}
-    if compare_cutoff is not None and compare_cutoff != cutoff and compare_cutoff < fs / 2:
+    # fs from time stamps can be 40.000000001 Hz: a 20 Hz comparison would sit at Nyquist.
+    if compare_cutoff is not None and compare_cutoff != cutoff \
+            and compare_cutoff < 0.5 * fs * (1 - 1e-6):
         cutoffs["compare"] = float(compare_cutoff)
     response = {f"{value:.3g} Hz ({key})": butterworth_response(freq, fs, value, rule.order)
                 for key, value in cutoffs.items()}
