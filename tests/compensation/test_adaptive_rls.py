@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from hystkit.compensation._rls import rls_start, rls_update
+from hystkit.compensation._rls import rls_bound, rls_start, rls_update
 
 P = 3
 N = 40
@@ -80,3 +80,22 @@ def test_the_state_is_immutable_and_the_covariance_symmetric():
 def test_a_bad_prior_is_refused():
     with pytest.raises(ValueError, match="prior_std"):
         rls_start(np.zeros(2), np.array([1.0, 0.0]))
+
+
+def test_the_bound_scales_p_down_to_the_trace_and_keeps_theta():
+    phi, r = data(4)
+    state = recursive(phi, r, np.zeros(P), np.ones(P), 0.5)
+    trace = np.trace(state.cov)
+    assert rls_bound(state, 2 * trace) is state
+    bounded = rls_bound(state, 0.25 * trace)
+    assert_allclose(np.trace(bounded.cov), 0.25 * trace, rtol=1e-14)
+    assert_allclose(bounded.cov, 0.25 * state.cov, rtol=1e-14)
+    assert np.array_equal(bounded.theta, state.theta) and bounded.n_updates == state.n_updates
+
+
+def test_without_the_bound_one_repeated_regressor_winds_p_up():
+    # the case the bound is for: the same regressor again and again, lam < 1
+    state = rls_start(np.zeros(2), np.ones(2))
+    for _ in range(200):
+        state = rls_update(state, np.array([1.0, 1.0]), 0.0, 0.9)
+    assert np.trace(state.cov) > 1e8  # ~0.9^-200 along (1, -1)

@@ -252,3 +252,29 @@ def test_step_flags_are_those_of_the_chunk_on_the_adapted_estimate(parameters):
     offset = comp.position_offset() - comp.scaling.position_offset
     assert_array_equal(whole.estimate_outside, (whole.estimate < lo + offset - pad)
                        | (whole.estimate > hi + offset + pad))
+
+
+def test_references_at_one_position_do_not_wind_up_the_covariance():
+    comp = drawn("mpl", center="fit")
+    stream = AdaptiveStream(comp, Adaptation("gain", 0.8))
+    # a device resting at 2 mm, every sample known: one regressor again and again
+    stream.process(np.full(N, 1200.0), np.full(N, 2.0))
+    start = AdaptiveStream(comp, Adaptation("gain", 0.8)).state.rls
+    assert np.trace(stream.state.rls.cov) <= np.trace(start.cov) * (1 + 1e-12)
+    assert np.all(np.isfinite(stream.state.rls.theta))
+
+
+@pytest.mark.parametrize("parameters", ["gain", "weights"])
+def test_a_resumed_stream_continues_exactly(parameters):
+    comp = drawn("mpl", center="track")
+    sensor, reference = signals(comp)
+    adaptation = Adaptation(parameters)
+    whole = AdaptiveStream(comp, adaptation).process(sensor, reference)
+    first = AdaptiveStream(comp, adaptation)
+    head = first.process(sensor[:170], reference[:170])
+    resumed = AdaptiveStream.from_state(comp, adaptation, first.state)
+    assert_array_equal(np.concatenate([head, resumed.process(sensor[170:], reference[170:])]),
+                       whole)
+    with pytest.raises(InputError, match="output parameters"):
+        AdaptiveStream.from_state(comp, Adaptation("weights" if parameters == "gain"
+                                                   else "gain"), first.state)

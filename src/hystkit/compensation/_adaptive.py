@@ -32,10 +32,11 @@ import numpy as np
 
 from ..errors import InputError
 from ._compensator import Compensator
-from ._rls import RlsState, rls_start, rls_update
+from ._rls import RlsState, rls_bound, rls_start, rls_update
 from ._stream import (
     StartUp,
     StepOutput,
+    Stream,
     StreamOutput,
     StreamState,
     _advance,
@@ -123,6 +124,13 @@ class _Plan:
             + ("offset_mm",)
         self.start = rls_start(np.r_[np.ones(n_mult), 0.0],
                                np.r_[np.full(n_mult, adaptation.prior_gain), offset_std])
+        self.max_trace = float(np.trace(self.start.cov))
+
+    def update(self, rls: RlsState, phi: np.ndarray, r: float) -> RlsState:
+        """Learn one reference [mm] (``P`` bounded by the prior's trace: no wind-up while the
+        references repeat one position)."""
+        return rls_bound(rls_update(rls, phi, r - self.constant, self.adaptation.forgetting),
+                         self.max_trace)
 
     def regressors(self, state: StreamState, sensor: np.ndarray,
                    estimate: np.ndarray) -> np.ndarray:
@@ -204,7 +212,7 @@ def _advance_plan(plan: _Plan, state: AdaptiveState, sensor: np.ndarray,
         part = slice(begin, min(i + 1, s_raw.size))
         estimate[part] = plan.predict(rls, phi[part], plain.estimate[part])
         if i < s_raw.size:
-            rls = rls_update(rls, phi[i], r[i] - plan.constant, plan.adaptation.forgetting)
+            rls = plan.update(rls, phi[i], r[i])
         begin = i + 1
     out = StreamOutput(estimate, plain.sensor_outside,
                        _outside(estimate, plan.path.estimate_bounds))
@@ -252,6 +260,20 @@ class AdaptiveStream:
         if compensator.center == "track":
             import scipy.signal  # noqa: F401  # now, not ~1 s late on the first sample
 
+    @classmethod
+    def from_state(cls, compensator: Compensator, adaptation: Adaptation,
+                   state: AdaptiveState, *, rest_position: float | None = None,
+                   label: str = "stream") -> AdaptiveStream:
+        """Resume an adapting stream from a saved :class:`AdaptiveState`."""
+        stream = cls(compensator, adaptation, rest_position=rest_position, label=label)
+        plain = Stream.from_state(compensator, state.stream)  # checks the model state
+        if state.rls.theta.shape != stream._plan.start.theta.shape:
+            raise InputError(f"adaptive stream state: {state.rls.theta.size} output parameters, "
+                             f"the {adaptation.parameters!r} adaptation of this compensator "
+                             f"has {stream._plan.start.theta.size}")
+        stream._state = AdaptiveState(plain.state, state.rls)
+        return stream
+
     @property
     def compensator(self) -> Compensator:
         return self._plan.path.comp
@@ -286,7 +308,7 @@ class AdaptiveStream:
         rls = self._state.rls
         estimate = float(self._plan.predict(rls, phi, np.array([plain.estimate]))[0])
         if np.isfinite(r):
-            rls = rls_update(rls, phi[0], r, self._plan.adaptation.forgetting)
+            rls = self._plan.update(rls, phi[0], r)
         self._state = AdaptiveState(stream_next, rls)
         return StepOutput(estimate, plain.sensor_outside,
                           _outside(estimate, self._plan.path.estimate_bounds))

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["RlsState", "rls_start", "rls_update"]
+__all__ = ["RlsState", "rls_bound", "rls_start", "rls_update"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,3 +80,18 @@ def rls_update(state: RlsState, phi: np.ndarray, r: float, forgetting: float) ->
     error = r - phi @ state.theta
     cov = (state.cov - np.outer(gain, p_phi)) / forgetting
     return RlsState(state.theta + gain * error, 0.5 * (cov + cov.T), state.n_updates + 1)
+
+
+def rls_bound(state: RlsState, max_trace: float) -> RlsState:
+    """``state`` with ``P`` scaled down to trace ``max_trace`` if it is larger (else unchanged).
+
+    With ``lam < 1`` and samples that excite only some directions (a device resting at one
+    position gives the same regressor again and again), ``P`` grows as ``lam^-n`` along the
+    others ("covariance wind-up"); the next different sample would then move ``theta`` by an
+    amount set by noise. Bounding ``P`` by the prior's trace keeps the gain no larger than it
+    was at the start.
+    """
+    trace = float(np.trace(state.cov))
+    if trace <= max_trace:
+        return state
+    return RlsState(state.theta, state.cov * (max_trace / trace), state.n_updates)
