@@ -184,3 +184,9 @@ def test_raw_settings_without_the_bridge_and_reading_options_with_raw_are_one_li
                  "--out", str(tmp_path / "o")]) == 2
     assert "do not apply" in _error_line(capsys)
     assert not (tmp_path / "o").exists()
+
+
+def test_cycles_all_draws_every_complete_cycle(raw_run, tmp_path):
+    _, pre = raw_run
+    assert main(["cycles", str(pre), "--cycles", "all", "--out", str(tmp_path / "o")]) == 0
+    assert json.loads((tmp_path / "o" / "cycles.json").read_text())["cycles_drawn"] == [1, 2, 3]

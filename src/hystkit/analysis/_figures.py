@@ -22,6 +22,8 @@ if TYPE_CHECKING:
 
 __all__ = ["plot_cycles", "plot_settling"]
 
+_MAX_LABELLED = 8  # cycles named in the legend; beyond, only the first and the last
+
 
 def plot_cycles(x: np.ndarray, signals: Mapping[str, np.ndarray], table: CycleTable,
                 cycles: Sequence[int], *, scale: float = 100.0,
@@ -36,7 +38,7 @@ def plot_cycles(x: np.ndarray, signals: Mapping[str, np.ndarray], table: CycleTa
         The signals of `table`, drawn times `scale` in `unit` (dR/R in % by default).
     table : CycleTable
     cycles : sequence of int
-        Cycle numbers (1-based, complete cycles) to draw.
+        Cycle numbers (1-based, complete cycles) to draw, coloured by time (viridis).
     """
     from matplotlib import colormaps
     from matplotlib.figure import Figure
@@ -47,10 +49,13 @@ def plot_cycles(x: np.ndarray, signals: Mapping[str, np.ndarray], table: CycleTa
     colors = colormaps["viridis"](np.linspace(0.0, 0.9, len(cycles)))
     for j, name in enumerate(names):
         ax = fig.add_subplot(grid[0, j])
-        for k, color in zip(cycles, colors, strict=True):
+        for i, (k, color) in enumerate(zip(cycles, colors, strict=True)):
             a, b = table.start[k - 1], table.stop[k - 1] + 1  # closed loop
+            # many cycles (fig. 4.13): the colour gives the time, the legend the two ends
+            labelled = len(cycles) <= _MAX_LABELLED or i in (0, len(cycles) - 1)
             ax.plot(x[a:b], scale * signals[name][a:b], color=color, lw=1.0,
-                    label=f"cycle {k} (t = {table.t_start[k - 1]:.4g} s)")
+                    label=f"cycle {k} (t = {table.t_start[k - 1]:.4g} s)" if labelled
+                    else None)
         ax.set_title(name)
         ax.set_xlabel(x_label)
         ax.set_ylabel(f"{name} [{unit}]")

@@ -40,11 +40,13 @@ TABLE_3_1 = {"sample 0": (1.58, 2.78, -55.0), "sample 1": (15.0, 16.82, -11.0),
 _DEFAULT_DRAWN = 5
 
 
-def _cycle_list(text: str) -> tuple[int, ...]:
+def _cycle_list(text: str) -> tuple[int, ...] | str:
+    if text.strip() == "all":
+        return "all"
     parts = [p.strip() for p in text.split(",")]
     if not parts or not all(p.isascii() and p.isdigit() and int(p) >= 1 for p in parts):
-        raise argparse.ArgumentTypeError(f"expected cycle numbers 1, 2, ... separated by "
-                                         f"commas, e.g. 1,5,20; got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected 'all' or cycle numbers 1, 2, ... "
+                                         f"separated by commas, e.g. 1,5,20; got {text!r}")
     return tuple(sorted({int(p) for p in parts}))
 
 
@@ -119,9 +121,11 @@ def _signals(r1, r2, sensor) -> dict:
     return {"dR1/R1": dr1, "dR2/R2": dr2, "dR1/R1 - dR2/R2": dr1 - dr2}
 
 
-def _drawn(requested: tuple[int, ...] | None, n_cycles: int, source: Path) -> list[int]:
+def _drawn(requested: tuple[int, ...] | str | None, n_cycles: int, source: Path) -> list[int]:
     import numpy as np
 
+    if requested == "all":
+        return list(range(1, n_cycles + 1))
     if requested is None:
         return sorted({int(k) for k in np.round(np.linspace(1, n_cycles,
                                                             min(_DEFAULT_DRAWN, n_cycles)))})
@@ -212,8 +216,9 @@ def _cycles(args: argparse.Namespace) -> int:
         write_json(report, tmp / "cycles.json")
         fig.savefig(tmp / "cycles.png", dpi=120)
         fig.savefig(tmp / "cycles.svg")
-    print(f"wrote {args.out}/: {', '.join(CYCLES_FILES)} (cycles drawn: "
-          f"{', '.join(map(str, drawn))})")
+    shown = (", ".join(map(str, drawn)) if len(drawn) <= 10
+             else f"{len(drawn)} cycles, {drawn[0]} to {drawn[-1]}")
+    print(f"wrote {args.out}/: {', '.join(CYCLES_FILES)} (cycles drawn: {shown})")
     return 0
 
 
@@ -229,8 +234,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="INPUT is a raw scope recording (v1, v2, encoder) with its .toml "
                         "settings: preprocess it first, as 'hystkit preprocess' would")
     p.add_argument("--cycles", type=_cycle_list, metavar="K,K,...",
-                   help="cycles to draw, numbered 1.. over the complete cycles (default: 5 "
-                        "spread over the recording)")
+                   help="cycles to draw, numbered 1.. over the complete cycles, or 'all' "
+                        "(fig. 4.13: every cycle, coloured by time; default: 5 spread over the "
+                        "recording)")
     p.add_argument("--deadband", type=number(0, 0.5, high_open=True), default=0.01,
                    metavar="F", help="a position reversal counts after the position came back "
                    "by this fraction of its range (default 0.01)")
