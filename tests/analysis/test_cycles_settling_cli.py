@@ -94,7 +94,7 @@ def test_outputs_are_not_overwritten_without_force(raw_run, tmp_path, capsys):
 
 @pytest.mark.parametrize(("args", "expected"), [
     (["--cycles", "7"], "asks for cycle 7, but the recording has 3 complete cycle(s)"),
-    (["--cycles", "0,2"], "expected cycle numbers"),
+    (["--cycles", "0,2"], "expected 'all' or cycle numbers"),
     (["--raw"], "--raw needs the settings file"),
 ])
 def test_bad_cycles_input_is_one_line(raw_run, tmp_path, capsys, args, expected):
