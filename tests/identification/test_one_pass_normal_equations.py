@@ -138,3 +138,23 @@ def test_mpl_one_pass_cost_is_the_simulated_cost(rate):
         u, target, np.full(n_cells, u[0]), params.i_s, params.v_t, params.w, params.v_b,
         mpl.knee_voltage(structure, params), cap, structure.dt)[0]
     assert_allclose(sse, np.sum((y_model - target) ** 2), rtol=1e-12)
+
+
+def test_mpl_one_pass_at_optimiser_coordinates():
+    """theta_normal_equations == normal_equations of MplParams.from_vector(theta): the
+    compiled unpacking (exp, knee) may differ from NumPy's by an ulp, hence 1e-10."""
+    structure = mpl.MplStructure(n_cells=3, dt=0.025)
+    rng = np.random.default_rng(8)
+    u = _input(3000, 8)
+    target = np.tanh(2 * np.roll(u, 3))
+    x0 = np.full(3, u[0])
+    for _ in range(4):
+        theta = mpl.fit.random_params(structure, rng).to_vector()
+        params = mpl.MplParams.from_vector(theta, 3)
+        direct = mpl_kernels.normal_equations(
+            u, target, x0, params.i_s, params.v_t, params.w, params.v_b,
+            mpl.knee_voltage(structure, params), structure.slope_cap / structure.dt,
+            structure.dt)
+        _assert_same(mpl_kernels.theta_normal_equations(u, target, x0, theta,
+                                                        structure.slope_cap, structure.dt),
+                     direct)

@@ -144,7 +144,7 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
 
     def kernel_args(theta: np.ndarray) -> tuple:
         # MplParams.from_vector's arithmetic without its validation (bounds keep theta in the
-        # domain): hundreds of calls per fit, each a model run's worth on short recordings
+        # domain), for the trf path; normal_equations does the same in compiled code
         cells = theta[: 2 * n].reshape(n, 2)
         v_t = np.exp(cells[:, 1])
         resistors = SimpleNamespace(i_s=0.5 * np.exp(cells[:, 0]) * v_t, v_t=v_t)
@@ -165,7 +165,8 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     # 1.0-1.4 simulations and ~17 % of trial steps are rejected, so a cost-only trial (1 run)
     # plus a second run at every accepted point would cost more.
     def normal_equations(theta: np.ndarray) -> NormalEquations:
-        sse, jtj, jtr = kernels.normal_equations(u, y, x0, *kernel_args(theta))
+        sse, jtj, jtr = kernels.theta_normal_equations(u, y, x0, theta, structure.slope_cap,
+                                                       structure.dt)
         return NormalEquations(0.5 * sse, jtj, jtr)
 
     thetas = [_linear_init(structure, np.asarray(i_s, float), np.asarray(v_t, float), u,
