@@ -69,8 +69,11 @@ def cycle_bounds(x: npt.ArrayLike, deadband: float = DEFAULT_DEADBAND) -> np.nda
         minimum is the first sample). Complete cycles are ``[m_i, m_{i+1}]``; ``[0, m_1)`` and
         ``[m_k, n)`` are the incomplete head and tail.
     """
-    minima = input_minima(x, deadband)
-    n = np.asarray(x).shape[0]
+    return bounds_of(input_minima(x, deadband), np.asarray(x).shape[0])
+
+
+def bounds_of(minima: np.ndarray, n: int) -> np.ndarray:
+    """``[0, *minima, n]`` without repeating 0 when the first minimum is the first sample."""
     return np.array([0, *(int(m) for m in minima if m > 0), n], dtype=np.int64)
 
 

@@ -28,7 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..metrics import loop_area
-from ._cycles import DEFAULT_DEADBAND, cycle_bounds, input_minima
+from ._cycles import DEFAULT_DEADBAND, bounds_of, input_minima
 
 __all__ = ["CycleTable", "DriftRate", "cycle_table", "drift_rate", "enclosed_area"]
 
@@ -93,7 +93,7 @@ class CycleTable:
     Attributes
     ----------
     bounds : ndarray of int
-        All cut points ``[0, m_1, ..., m_k, n]`` (:func:`cycle_bounds`).
+        All cut points ``[0, m_1, ..., m_k, n]`` (:func:`~hystkit.analysis.cycle_bounds`).
     start, stop : ndarray of int, shape (k - 1,)
         Sample range ``[start, stop)`` of each complete cycle (numbered 1.. in order).
     t_start, t_stop, t_mid : ndarray, shape (k - 1,)
@@ -174,7 +174,7 @@ def cycle_table(t: npt.ArrayLike, x: npt.ArrayLike, signals: Mapping[str, npt.Ar
         if not np.all(np.isfinite(y)):
             raise ValueError(f"{name} contains NaN or infinite values")
     minima = input_minima(xs, deadband)
-    bounds = cycle_bounds(xs, deadband)
+    bounds = bounds_of(minima, xs.size)
     if minima.size < 2:
         raise ValueError(f"the input has {minima.size} confirmed minimum/minima, so no complete "
                          "cycle (minimum to minimum); record at least one full cycle")

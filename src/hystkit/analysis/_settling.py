@@ -35,7 +35,8 @@ __all__ = ["MODELS", "REST_RULE", "RestTime", "SettlingFit", "SettlingFitError",
 MODELS = ("auto", "rise-drop", "drop")
 _NAMES = {"rise-drop": ("r_final", "drop", "tau_drop_h", "rise", "tau_rise_h"),
           "drop": ("r_final", "drop", "tau_drop_h")}
-# Time constants are searched from a tenth of the sampling interval's scale to 10x the log.
+# Points of the log grid of starting time constants, from the reading interval (or 1e-3 of the
+# log) to 10 times the log's length; the refinement does the rest.
 _GRID_POINTS = 24
 
 
@@ -79,7 +80,7 @@ class SettlingFit:
     message: str
     n: int
     t_end_h: float
-    covariance: np.ndarray = field(repr=False, compare=False, default=None)
+    covariance: np.ndarray | None = field(repr=False, compare=False, default=None)
     alternatives: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
