@@ -149,6 +149,19 @@ def test_fitted_g_is_monotone_on_its_range_and_never_worse_than_the_mpl():
     assert result.cost <= linear.cost * (1 + 1e-9)  # it starts from the mPL's optimum
 
 
+def test_a_veto_on_every_curved_g_returns_the_accepted_mpl():
+    # inverse mode vetoes candidates whose inverse diverges; here every curved g is vetoed
+    structure = mpl_g.MplGStructure(n_cells=1, dt=DT)
+    u = _input(2000, seed=6)
+    y, _ = mpl_g.simulate(structure, _known(1), u)
+    result = fit_mpl_g(u, y, structure, accept=lambda p: p.g[2] == 0 and p.g[3] == 0,
+                       accept_reason="curved")
+    assert result.params.g[2] == 0 and result.params.g[3] == 0
+    assert "g kept linear" in result.message and "(curved)" in result.message
+    linear, _ = mpl_g.simulate(structure, result.params, u)
+    assert np.sum((linear - y) ** 2) == pytest.approx(result.cost, rel=1e-9)  # SSE, eq. 5.9
+
+
 @pytest.mark.parametrize("column", ["sine", "chirp", "decay", "noise"])
 def test_preset_training_run_is_the_control_codes_table_ii_sensor(column):
     """The data the sec. 7.2 compensators are fitted on equal, to 1e-12, what the control

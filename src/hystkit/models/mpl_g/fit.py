@@ -25,9 +25,11 @@ Two choices, both about the output resistor ``g``:
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
+from ...errors import FitDivergedError
 from ...identification import FitResult, check_fit_data, fit_multistart
 from ..mpl import model as mpl
 from ..mpl.fit import fit_mpl, theta_limits
@@ -112,6 +114,12 @@ def canonical(params: mpl_g.MplGParams) -> mpl_g.MplGParams:
                             w=params.w / params.w[0], v_b=0.0)
 
 
+def _from_mpl(params: mpl.MplParams) -> mpl_g.MplGParams:
+    """The mPL as this family's member with ``g(z) = z`` (the same model, forward and inverse)."""
+    return mpl_g.MplGParams(i_s=params.i_s, v_t=params.v_t, g=[0.0, 1.0, 0.0, 0.0],
+                            w=params.w, v_b=params.v_b)
+
+
 class _Coordinates:
     """The optimiser's coordinates ``[cells (2N), g_0, log |b| (3), w_1..w_N]`` and the model's
     parameters, for slopes of sign ``sign``; the Jacobian's chain rule."""
@@ -175,12 +183,12 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
                   np.full(3, _LOG_SLOPE_BOUNDS[0]), np.full(n, -_W_BOUND)]
     upper = np.r_[np.tile([np.log(cap), _LOG_VT_BOUNDS[1]], n), _G0_BOUND,
                   np.full(3, _LOG_SLOPE_BOUNDS[1]), np.full(n, _W_BOUND)]
+    mpl_accept = None if accept is None else (lambda p: accept(_from_mpl(p)))
     linear = fit_mpl(u, y, mpl.MplStructure(n_cells=n, dt=structure.dt,
-                                            slope_cap=structure.slope_cap)).params
-    # the mPL is this family's member with g(z) = z; in the gauge its g is w_0 z - V_b
-    start = canonical(mpl_g.MplGParams(i_s=linear.i_s, v_t=linear.v_t, g=[0.0, 1.0, 0.0, 0.0],
-                                       w=linear.w, v_b=linear.v_b))
-    coords = _Coordinates(n, 1.0 if linear.w[0] >= 0 else -1.0)
+                                            slope_cap=structure.slope_cap),
+                     accept=mpl_accept, accept_reason=accept_reason)
+    start = canonical(_from_mpl(linear.params))
+    coords = _Coordinates(n, 1.0 if linear.params.w[0] >= 0 else -1.0)
     cache: dict = {}
 
     def run(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -192,11 +200,20 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
             cache[key] = y_model, coords.jacobian(theta, jac)
         return cache[key]
 
-    return fit_multistart(lambda th: run(th)[0] - y, [coords.from_params(start)],
-                          (lower, upper), coords.to_params, structure,
-                          jac=lambda th: run(th)[1], solver=solver, max_nfev=max_nfev,
-                          screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
-                          accept_reason=accept_reason, names=theta_names(n), limits=_limits(n))
+    try:
+        return fit_multistart(lambda th: run(th)[0] - y, [coords.from_params(start)],
+                              (lower, upper), coords.to_params, structure,
+                              jac=lambda th: run(th)[1], solver=solver, max_nfev=max_nfev,
+                              screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
+                              accept_reason=accept_reason, names=theta_names(n),
+                              limits=_limits(n))
+    except FitDivergedError:
+        if accept is None:
+            raise
+    # Every fit with a curved g was vetoed (an inverse that diverges on the training data);
+    # the accepted mPL start is this family's model with a linear g, and is returned as such.
+    return replace(linear, params=start, message=f"{linear.message}; g kept linear: the fit "
+                                                 f"with a cubic g was rejected ({accept_reason})")
 
 
 # The domain random_params draws from: the mPL's cells over the fit's box, and an output stage
