@@ -131,6 +131,9 @@ class Spectrum:
         ax.axvline(self.f_signal, color="tab:red", lw=0.8)
         ax.text(self.f_signal, 0.02, f" f_signal {self.f_signal:.3g} Hz", color="tab:red",
                 transform=ax.get_xaxis_transform(), rotation=90, va="bottom")
+        # Far below the floor of the flat band only the decimation filter's edge remains.
+        flat = keep & (self.freq <= 0.4 * self.fs)
+        ax.set_ylim(bottom=max(ax.get_ylim()[0], 1e-3 * float(np.min(self.floor[flat]))))
         ax.set_xlabel("frequency [Hz]")
         ax.set_ylabel("PSD [1/Hz]")
         twin = ax.twinx()
