@@ -93,11 +93,15 @@ def test_no_reference_at_all_says_so(model, drifting, tmp_path, capsys):
     comp, path = model
     sensor, _ = drifting
     data = tmp_path / "in.csv"
-    data.write_text(csv_lines(sensor[:50], np.full(50, np.nan), "time,sensor"))
+    rows = csv_lines(sensor[:50], np.full(50, np.nan)).splitlines()
+    assert rows[5].endswith(",")
+    rows[5] += "nan"  # an explicit unknown reference
+    data.write_text("\n".join(rows) + "\n")
     assert main(["stream", str(path), "--in", str(data), "--adapt", "weights"]) == 0
     captured = capsys.readouterr()
     assert_array_equal(estimates(captured.out), Stream(comp).process(sensor[:50]))
     assert "no reference arrived; the estimates are the plain stream's" in captured.err
+    assert "not a number" not in captured.err
 
 
 def test_adapt_options_without_adapt_are_refused(model, capsys):

@@ -20,7 +20,7 @@ line is ready: parse, compensate, format; writing it is one system call more).
 
 Online adaptation (``--adapt gain`` or ``--adapt weights``, :mod:`hystkit.compensation._adaptive`):
 a third column ``reference`` (named in the header, or the third field without one) gives the
-true position [mm] now and then, empty when unknown; each known one re-fits the output's gain
+true position [mm] now and then, empty (or ``nan``) when unknown; each known one re-fits the output's gain
 and offset (or cell weights) by recursive least squares with forgetting, after its own sample's
 estimate is made. A reference that is not a number is ignored and counted. At the end stderr
 gets the references used, the a-priori error at them and the adapted parameters.
@@ -172,7 +172,8 @@ def _parse(line: str, columns: Columns) -> tuple[str, float, float] | str:
 
 
 def _reference(line: str, columns: Columns) -> float | None:
-    """The line's reference [mm]: NaN when absent or empty, None when not a finite number."""
+    """The line's reference [mm]: NaN when absent, empty or ``nan`` (unknown), None when not a
+    number or infinite."""
     fields = line.strip().split(",")
     if columns[2] is None or len(fields) <= columns[2] or not fields[columns[2]].strip():
         return float("nan")
@@ -180,7 +181,7 @@ def _reference(line: str, columns: Columns) -> float | None:
         r = float(fields[columns[2]])
     except ValueError:
         return None
-    return r if abs(r) < float("inf") else None
+    return r if math.isnan(r) or abs(r) < float("inf") else None
 
 
 class _Learning:
