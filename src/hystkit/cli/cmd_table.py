@@ -115,7 +115,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="raw scope rate, at most 2e5 (default 2e4; each 200 s recording takes "
                         "4 kB per Hz of temporary disk: the document's 1.98e6 would need 16 GB)")
     q.add_argument("--quick", action="store_true",
-                   help="40 s of each recording at a 10 kHz scope rate (a few seconds)")
+                   help="40 s of each recording at a 10 kHz scope rate, whatever --scope-rate "
+                        "says (a few seconds)")
     _common(q, "table_5_4")
     q.set_defaults(run=_table_5_4)
 
