@@ -120,8 +120,8 @@ class _Plan:
         span = (None if comp.position_range is None
                 else comp.position_range[1] - comp.position_range[0])
         offset_std = adaptation.prior_offset or (0.1 * span if span else 1.0)
-        self.names = (("gain",) if n_mult == 1 else tuple(f"a_{k}" for k in range(n_mult))) \
-            + ("offset_mm",)
+        multipliers = ("gain",) if n_mult == 1 else tuple(f"a_{k}" for k in range(n_mult))
+        self.names = (*multipliers, "offset_mm")
         self.start = rls_start(np.r_[np.ones(n_mult), 0.0],
                                np.r_[np.full(n_mult, adaptation.prior_gain), offset_std])
         self.max_trace = float(np.trace(self.start.cov))
@@ -171,7 +171,13 @@ def _unit_weight_params(comp: Compensator) -> list[Any]:
         raise InputError(f"{comp.source or 'compensator'}: adaptation 'weights': {why}; "
                          f"use 'gain'")
     w = np.asarray(params.w, dtype=np.float64)
-    units = [dataclasses.replace(params, w=np.eye(w.size)[k], v_b=0.0) for k in range(w.size)]
+    try:
+        units = [dataclasses.replace(params, w=np.eye(w.size)[k], v_b=0.0)
+                 for k in range(w.size)]
+    except ValueError as exc:  # the family's parameter checks refuse unit weights
+        raise InputError(f"{comp.source or 'compensator'}: adaptation 'weights': the "
+                         f"{comp.model} model cannot run one weight at a time ({exc}); "
+                         f"use 'gain'") from None
     probe = np.sin(np.linspace(0.0, 6.0 * np.pi, 300)) * np.linspace(0.2, 1.0, 300)
     simulate = comp.family.simulate
     whole = simulate(comp.structure, params, probe)[0]
