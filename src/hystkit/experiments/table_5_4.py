@@ -27,8 +27,15 @@ import warnings
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..compensation import Compensator
+    from ..io import Recording
+    from ..preprocess import PreprocessResult
+    from ..sensors import ScopeSettings
 
 __all__ = ["DOCUMENT_TABLE_5_4", "TABLE_5_4_COLUMNS", "Table54Settings", "measure_table_5_4",
            "signal_scores"]
@@ -123,8 +130,9 @@ def measure_table_5_4(settings: Table54Settings = Table54Settings(),
             "preprocess_warnings": caught}
 
 
-def _raw_run(folder: Path, name: str, seed: int, settings: Table54Settings, scope,
-             caught: list[str], progress: Callable[[str], None]):
+def _raw_run(folder: Path, name: str, seed: int, settings: Table54Settings,
+             scope: ScopeSettings, caught: list[str],
+             progress: Callable[[str], None]) -> PreprocessResult:
     """Write one raw recording of the virtual sensor and preprocess it as the lab would."""
     from ..preprocess import PreprocessSettings, RawDataWarning, preprocess_raw
     from ..sensors import simulate_raw
@@ -150,7 +158,8 @@ def _row(signal: str, centring: str, position: np.ndarray, y: np.ndarray, fs: fl
             "document_loop_area_pct": area}
 
 
-def signal_scores(comp, recording, dr1: np.ndarray, dr2: np.ndarray) -> list[dict]:
+def signal_scores(comp: Compensator, recording: Recording, dr1: np.ndarray,
+                  dr2: np.ndarray) -> list[dict]:
     """Table 5.4's rows for one recording and an inverse-mode compensator.
 
     Parameters
@@ -171,18 +180,18 @@ def signal_scores(comp, recording, dr1: np.ndarray, dr2: np.ndarray) -> list[dic
     if comp.mode != "inverse":
         raise ValueError("table 5.4's fit row needs a forward model: fit with mode='inverse'")
     x, fs = recording.position, recording.fs
-    label = f"{comp.center} (deployable)" if comp.center != "recording" else "recording (oracle)"
     rows = [_row("encoder", "–", x, x, fs), _row("R1", "–", x, dr1, fs),
             _row("R2", "–", x, dr2, fs), _row("R1 - R2", "–", x, recording.sensor, fs)]
-    oracle = comp.oracle()
-    for c, name in ((comp, label), (oracle, "recording (oracle)")):
-        mean_x = float(np.mean(x))
+    runs = [(comp.oracle(), "recording (oracle)")]
+    if comp.center != "recording":  # the compensator's own centring first
+        runs.insert(0, (comp, f"{comp.center} (deployable)"))
+    for c, name in runs:
         rows.append(_row("fit", name, x, _forward(c, recording), fs))
-        rows.append(_row("compensated", name, x, c.estimate(recording, mean_x), fs))
+        rows.append(_row("compensated", name, x, c.estimate(recording, float(np.mean(x))), fs))
     return rows
 
 
-def _forward(comp, recording) -> np.ndarray:
+def _forward(comp: Compensator, recording: Recording) -> np.ndarray:
     """The forward model's sensor prediction from the recording's position, in sensor units,
     with the centring's offsets (the recording's own means for the oracle)."""
     sc = comp.scaling
