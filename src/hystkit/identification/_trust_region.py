@@ -84,12 +84,14 @@ def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations]
     delta = _norm(x * scale_inv / v ** 0.5) or 1.0
     alpha, status = 0.0, None
     while True:
+        # raises scale_inv to the column norms at x (once per accepted point, as scipy)
         d, diag_h, g_h, h_h, eig, vecs, sg, g_norm = prepare(x, ne.jtj, ne.jtr, lb, ub, scale_inv)
         if g_norm < gtol:
             status = 1
         if status is not None or runs.nfev >= max_nfev:
             break
         theta = max(0.995, 1.0 - g_norm)
+        x_norm = _norm(x)
         actual = -1.0
         while actual <= 0 and runs.nfev < max_nfev:
             x_new, step_norm, step_h_norm, predicted, alpha = propose(
@@ -105,7 +107,7 @@ def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations]
             actual = ne.cost - new_cost
             new_delta, ratio = _update_radius(delta, actual, predicted, step_h_norm,
                                               step_h_norm > 0.95 * delta)
-            status = _termination(actual, ne.cost, step_norm, _norm(x), ratio, ftol, xtol)
+            status = _termination(actual, ne.cost, step_norm, x_norm, ratio, ftol, xtol)
             if status is not None:
                 break
             alpha *= delta / new_delta
@@ -113,7 +115,6 @@ def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations]
         if actual > 0:
             x = x_new
             ne = trial if trial is not None else runs.normal(normal_equations, x)
-            scale_inv = np.maximum(scale_inv, _column_norms(ne.jtj))
     return _result(x, ne.cost, 0 if status is None else status, runs, _column_norms(ne.jtj))
 
 

@@ -73,12 +73,16 @@ def square_root(jtj):
 def prepare(x, jtj, g, lb, ub, scale_inv):
     """Scaled problem at ``x``: ``(d, diag_h, g_h, h_h, eig, vecs, sg, g_norm)``.
 
-    ``d`` the variable scaling, ``diag_h`` the Coleman-Li diagonal, ``g_h = d g``, ``h_h =
-    J_h^T J_h``, ``eig`` (descending) and ``vecs`` the squared singular values and right
-    singular vectors of ``[R diag(d); diag(diag_h)^(1/2)]`` (``R^T R = J^T J``), ``sg =
-    vecs^T g_h``, ``g_norm = ||v g||_inf`` (the gtol measure).
+    ``scale_inv`` is first raised in place to the column norms ``sqrt(diag(J^T J))`` at ``x``
+    (``x_scale="jac"``: their running maximum over the accepted points). ``d`` the variable
+    scaling, ``diag_h`` the Coleman-Li diagonal, ``g_h = d g``, ``h_h = J_h^T J_h``, ``eig``
+    (descending) and ``vecs`` the squared singular values and right singular vectors of
+    ``[R diag(d); diag(diag_h)^(1/2)]`` (``R^T R = J^T J``), ``sg = vecs^T g_h``, ``g_norm =
+    ||v g||_inf`` (the gtol measure).
     """
     p = x.size
+    for i in range(p):
+        scale_inv[i] = max(scale_inv[i], math.sqrt(max(jtj[i, i], 0.0)))
     root = square_root(jtj)
     v, dv = coleman_li(x, g, lb, ub)
     g_norm = np.max(np.abs(g * v))
