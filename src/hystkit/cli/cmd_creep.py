@@ -32,6 +32,14 @@ def _creep(args: argparse.Namespace) -> int:
           f"measurement, {plan.settle_seconds:g} s after the ramp); a model's creep error is "
           "its estimate's drift in % of the true step (the position does not move)")
     print(format_markdown(result["rows"], columns))
+    summary = result["summary"]
+    term = " / ".join(f"{h['physics_creep_pct']:.3g}" for h in summary)
+    print(f"\ncreep error at the end of the holds, % of the step (the sensor's creep term: "
+          f"{term} %):")
+    for m in models:
+        errors = " / ".join(f"{h[f'{m}_creep_error_pct']:.3g}" for h in summary)
+        worst = max(abs(h[f"{m}_creep_error_mm"]) for h in summary)
+        print(f"  {m}: {errors} % (at most {worst:.3g} mm)")
     sensor = result["sensor"]
     print(f"\nthe virtual sensor's creep is exponential (Prony time constants "
           f"{', '.join(f'{t:g}' for t in sensor['prony_taus_s'])} s), not log(t): after "
