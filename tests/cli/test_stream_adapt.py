@@ -126,3 +126,12 @@ def test_weights_on_an_inverse_model_is_one_error_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("hystkit: error: ") and "inverse" in err and "use 'gain'" in err
     assert len(err.splitlines()) == 1
+
+
+def test_the_parser_constants_are_the_library_s():
+    # the parser keeps its own copies so that building it imports no numpy
+    from hystkit.cli import cmd_stream
+    from hystkit.compensation import ADAPT_PARAMETERS
+
+    assert cmd_stream.ADAPT_CHOICES == ADAPT_PARAMETERS
+    assert cmd_stream.DEFAULT_FORGETTING == Adaptation().forgetting

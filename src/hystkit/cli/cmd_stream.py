@@ -18,12 +18,13 @@ of input, a closed port, Ctrl-C or SIGTERM) stderr gets one warning line per kin
 and first line number, and the latency per sample (from the line's arrival until its output
 line is ready: parse, compensate, format; writing it is one system call more).
 
-Online adaptation (``--adapt gain`` or ``--adapt weights``, :mod:`hystkit.compensation._adaptive`):
-a third column ``reference`` (named in the header, or the third field without one) gives the
-true position [mm] now and then, empty (or ``nan``) when unknown; each known one re-fits the output's gain
-and offset (or cell weights) by recursive least squares with forgetting, after its own sample's
-estimate is made. A reference that is not a number is ignored and counted. At the end stderr
-gets the references used, the a-priori error at them and the adapted parameters.
+Online adaptation (``--adapt gain`` or ``--adapt weights``, see
+:mod:`hystkit.compensation._adaptive`): a third column ``reference`` (named in the header, or
+the third field without one) gives the true position [mm] now and then, empty (or ``nan``) when
+unknown; each known one re-fits the output's gain and offset (or cell weights) by recursive
+least squares with forgetting, after its own sample's estimate is made. A reference that is
+not a number is ignored and counted. At the end stderr gets the references used, the a-priori
+error at them and the adapted parameters.
 """
 
 from __future__ import annotations
