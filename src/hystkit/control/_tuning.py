@@ -4,7 +4,9 @@ The document tunes its PID on the linear plant. Here the gains are tuned on the 
 runs -- hysteretic sensor, compensator, ``S_m``, DOB -- by minimising the plant error of an
 experiment over ``(log Kp, log Ti, log Td)`` with Nelder-Mead, from the current gains. Each
 evaluation is one compiled run (a few ms for the 10 s sine), so a few hundred evaluations take
-seconds. The linearised loop's margins (:func:`~hystkit.control.loop_margins`) are the
+seconds. Each gain stays within a factor ``span`` (default 100) of its start: outside it the
+search finds degenerate corners (``Kp -> 0`` with ``Td -> inf``, the same derivative gain
+``Kp Td``) that say more about the objective's flat directions than about a better PID. The linearised loop's margins (:func:`~hystkit.control.loop_margins`) are the
 constraints: a candidate that beats the best so far counts only if its phase and gain margins
 reach the minimum and its linearised closed loop has no pole further out than the start's.
 The result is never worse than the start: if nothing better and feasible is found, the start
@@ -92,7 +94,8 @@ def _feasible(m: LoopMargins, limit: float, min_pm: float, min_gm: float) -> boo
 
 def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: str = "rms",
                    min_phase_margin: float = 30.0, min_gain_margin_db: float = 6.0,
-                   noise: NoiseSpec | None = None, max_evaluations: int = 300) -> TuneResult:
+                   noise: NoiseSpec | None = None, max_evaluations: int = 300,
+                   span: float = 100.0) -> TuneResult:
     """Minimise the plant error of ``experiment`` over the PID gains of ``loop``.
 
     Parameters
@@ -111,12 +114,16 @@ def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: st
         Tune with this (fixed-seed) noise in every run.
     max_evaluations : int
         Budget of simulations.
+    span : float
+        Each gain stays within ``[start / span, start * span]``.
 
     Raises
     ------
     ValueError
         If the start gains violate the constraints or leave the loop unbounded.
     """
+    if not span > 1:
+        raise ValueError(f"span must be > 1, got {span!r}")
     if objective not in OBJECTIVES:
         raise ValueError(f"objective must be one of {OBJECTIVES}, got {objective!r}")
     t_start = time.perf_counter()
@@ -168,7 +175,8 @@ def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: st
     x0 = np.array(x0)
     # first simplex: each gain 30 % up (log steps; Nelder-Mead's default 5 % is too timid)
     simplex = np.vstack([x0] + [x0 + 0.26 * np.eye(x0.size)[i] for i in range(x0.size)])
-    res = minimize(objective_of, x0, method="Nelder-Mead",
+    box = [(x - np.log(span), x + np.log(span)) for x in x0]
+    res = minimize(objective_of, x0, method="Nelder-Mead", bounds=box,
                    options={"maxfev": max_evaluations, "initial_simplex": simplex,
                             "xatol": 1e-3, "fatol": 1e-9 * cost_start})
     improved = best["pid"] is not start
