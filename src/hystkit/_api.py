@@ -253,6 +253,16 @@ def compare(fit_data: Data, val_data: Data, models: Sequence[str] | None = None,
 def load(path: str | os.PathLike) -> Compensator:
     """Load a model file written by :func:`save` or ``hystkit fit --out`` (JSON or ``.mat``).
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.json`` or ``.mat`` model file.
+
+    Returns
+    -------
+    Compensator
+        The fitted compensator; ``source`` names `path`.
+
     Raises
     ------
     InputError

@@ -56,6 +56,47 @@ class Compensator:
     ``rest_position`` [mm] the training position during the tare window; ``position_range``
     [mm] the training position range (use-time guard). ``source`` names the model file it
     was loaded from (for messages; not saved).
+
+    Parameters
+    ----------
+    structure, params : object
+        The family's structure and parameter dataclasses.
+    mode : {"direct", "inverse"}
+        ``direct``: the model maps sensor -> position; ``inverse``: the model maps position ->
+        sensor and its inverse is run on sensor data.
+    center : {"fit", "tare", "track", "recording", "none"}
+        Where a recording's sensor offset comes from (see :mod:`._centring`).
+    scaling : Scaling
+        Offsets and scales of the fitting data (eq. 5.10).
+    baseline : LinearBaseline
+        Straight line position(sensor) in normalised units.
+    fit_info : dict, optional
+        What the fit reported (status, scores, settings).
+    model : str, default "mpl"
+        Family name in the registry.
+    training_range : tuple of float, optional
+        Normalised sensor range seen in training (use-time guard).
+    polarity : {1.0, -1.0}, default 1.0
+        Sign that makes the offset-free sensor rise with position.
+    tare_seconds : float, default 2.0
+        Length [s] of the tare window.
+    track_seconds : float, default 100.0
+        Time constant [s] of the ``track`` low-pass.
+    sensor_reference : float, default 0.0
+        Training sensor level for ``tare`` / ``track`` [sensor units].
+    rest_position : float, optional
+        Training position [mm] during the tare window.
+    position_range : tuple of float, optional
+        Training position range [mm].
+    source : str, optional
+        Model file it was loaded from.
+
+    Raises
+    ------
+    ValueError
+        An unknown mode or centring, an inverse mode for a family without an inverse, params
+        that do not fit the structure, or a non-finite / non-positive scaling, baseline,
+        polarity, window or range.
     """
 
     structure: Any

@@ -38,7 +38,21 @@ _DETAIL_CHARS = 200
 class MatContents:
     """What the child found: every variable's kind (a numpy dtype or ``struct``, ``char``,
     ``cell``, ``sparse``, ``object``) and shape, the fields of 1x1 structs, the requested
-    real arrays (by requested name: ``v`` or ``v.field``) and texts."""
+    real arrays (by requested name: ``v`` or ``v.field``) and texts.
+
+    Parameters
+    ----------
+    variables : dict of str to (str, tuple of int)
+        Kind and shape of every variable in the file.
+    arrays : dict of str to numpy.ndarray
+        The requested real arrays, by requested name.
+    fields : dict, optional
+        Kind and shape of the fields of each 1x1 struct, by struct name.
+    texts : dict of str to str, optional
+        The requested character variables.
+    dtypes : dict of str to str, optional
+        numpy dtype name of each variable and struct field (``v`` or ``v.field``).
+    """
 
     variables: dict[str, tuple[str, tuple[int, ...]]]
     arrays: dict[str, np.ndarray]
@@ -72,6 +86,11 @@ def load_mat(path: Path, names: list[str], source: str, *,
         File name used in error messages.
     texts : tuple of str
         Character variables (or struct fields) wanted as text.
+
+    Returns
+    -------
+    MatContents
+        Every variable's description plus the requested arrays and texts.
 
     Raises
     ------

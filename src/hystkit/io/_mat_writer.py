@@ -31,7 +31,18 @@ _INVALID = re.compile(r"[^A-Za-z0-9_]")
 def matlab_name(name: str) -> str:
     """A valid MATLAB identifier for `name`, as ``matlab.lang.makeValidName`` makes it:
     invalid characters become ``_``, a name not starting with a letter gets an ``x`` in
-    front, at most 63 characters (``'temp C'`` -> ``temp_C``, ``'1st'`` -> ``x1st``)."""
+    front, at most 63 characters (``'temp C'`` -> ``temp_C``, ``'1st'`` -> ``x1st``).
+
+    Parameters
+    ----------
+    name : str
+        Any column or variable name.
+
+    Returns
+    -------
+    str
+        A valid MATLAB identifier.
+    """
     valid = _INVALID.sub("_", str(name).strip()) or "x"
     if not valid[0].isalpha():
         valid = "x" + valid

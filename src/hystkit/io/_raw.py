@@ -98,6 +98,21 @@ class RawChunk:
     Arrays are float32 or float64 as stored (other numbers become float64), shape (n,). A
     column not read, or absent (``time`` without a time column, ``encoder`` when the file has
     ``enc_a``/``enc_b`` and vice versa, ``v0`` unless asked for), is None.
+
+    Parameters
+    ----------
+    start : int
+        Index of the chunk's first sample in the recording (0-based).
+    time : numpy.ndarray, optional
+        Time [s].
+    v1, v2 : numpy.ndarray, optional
+        Bridge voltages [V].
+    encoder : numpy.ndarray, optional
+        Merged encoder signal [V].
+    enc_a, enc_b : numpy.ndarray, optional
+        Encoder channels A and B [V].
+    v0 : numpy.ndarray, optional
+        Measured supply voltage [V].
     """
 
     start: int
@@ -123,6 +138,23 @@ class RawReader:
     first rows to measure the sample rate. Attributes: ``source``, ``encoder_kind``
     (``"merged"`` or ``"ab"``), ``has_time``, ``fs`` [Hz], ``n_samples`` (None for CSV until read).
     `extra` names optional columns (:data:`OPTIONAL_COLUMNS`) that must be present and are read.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.csv``, ``.parquet`` or ``.mat`` raw recording.
+    fmt : RawFormat, optional
+        Column names, time unit, rows to skip, sample rate; the defaults if None.
+    chunk_size : int, default 262144
+        Samples per chunk.
+    extra : tuple of str, optional
+        Optional columns that must be present and are read.
+
+    Raises
+    ------
+    InputError
+        Missing file or column, unreadable or truncated file, a time column that disagrees
+        with the ``fs`` setting.
     """
 
     def __init__(self, path: str | os.PathLike[str], fmt: RawFormat | None = None,
@@ -453,6 +485,22 @@ def open_raw(path: str | os.PathLike[str], fmt: RawFormat | None = None,
     `extra` lists optional channels to read as well (``("v0",)``: the measured supply); each
     must then be in the file.
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The raw recording.
+    fmt : RawFormat, optional
+        Column names, time unit, rows to skip, sample rate; the defaults if None.
+    chunk_size : int, default 262144
+        Samples per chunk.
+    extra : tuple of str, optional
+        Optional channels to read as well.
+
+    Returns
+    -------
+    RawReader
+        The opened recording; iterate its :meth:`RawReader.chunks`.
+
     Raises
     ------
     InputError
@@ -473,6 +521,24 @@ class RawWriter:
     a hidden temporary beside `path` (:func:`atomic_output`), renamed into place when the block
     ends normally: an exception, Ctrl-C or SIGTERM in between leaves no partial file, and
     without `force` a file that appeared meanwhile is not overwritten.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output ``.csv`` or ``.parquet`` file.
+    columns : tuple of str
+        Columns to write, among :data:`RAW_COLUMNS`.
+    force : bool, default False
+        Replace an existing file.
+
+    Raises
+    ------
+    InputError
+        Another file type than ``.csv`` / ``.parquet``.
+    ValueError
+        A column not among :data:`RAW_COLUMNS`.
+    OutputExistsError
+        `path` exists and `force` is False.
     """
 
     def __init__(self, path: str | os.PathLike[str], columns: tuple[str, ...], *,

@@ -72,13 +72,34 @@ _COLUMN_NAMES = ("time", "v1", "v2", "encoder", "enc_a", "enc_b", "v0")
 
 
 def find_raw_config(data_path: str | os.PathLike[str]) -> Path | None:
-    """The settings file stored next to a raw recording (same stem, ``.toml``), if present."""
+    """The settings file stored next to a raw recording (same stem, ``.toml``), if present.
+
+    Parameters
+    ----------
+    data_path : str or os.PathLike
+        The raw recording.
+
+    Returns
+    -------
+    pathlib.Path or None
+        ``<stem>.toml`` beside it, None if there is none.
+    """
     candidate = Path(data_path).with_suffix(".toml")
     return candidate if candidate.is_file() else None
 
 
 def read_raw_config(path: str | os.PathLike[str]) -> dict[str, Any]:
     """Read a raw recording's TOML settings; keys and types as in :data:`CONFIG_KEYS`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The TOML settings file.
+
+    Returns
+    -------
+    dict
+        The checked settings, by key.
 
     Raises
     ------
@@ -144,7 +165,29 @@ def _check_value(path: Path, key: str, value: Any) -> None:
 def write_raw_config(path: str | os.PathLike[str], values: dict[str, Any], *,
                      comment: str = "", force: bool = False) -> Path:
     """Write flat settings (numbers, strings, booleans, lists, one level of tables) as TOML,
-    atomically (a temporary renamed into place); refuses to overwrite unless `force`."""
+    atomically (a temporary renamed into place); refuses to overwrite unless `force`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output ``.toml`` file.
+    values : dict
+        Settings; a dict value becomes a table.
+    comment : str, optional
+        Text written first, each line as a ``#`` comment.
+    force : bool, default False
+        Replace an existing file.
+
+    Returns
+    -------
+    pathlib.Path
+        `path`.
+
+    Raises
+    ------
+    OutputExistsError
+        `path` exists and `force` is False.
+    """
     path = Path(path)
     lines = [f"# {line}" for line in comment.splitlines()]
     tables = {k: v for k, v in values.items() if isinstance(v, dict)}

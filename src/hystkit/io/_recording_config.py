@@ -54,13 +54,34 @@ RECORDING_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
 
 
 def find_recording_config(data_path: str | os.PathLike[str]) -> Path | None:
-    """The settings file of a recording: same folder, same stem, ``.toml``; None if absent."""
+    """The settings file of a recording: same folder, same stem, ``.toml``; None if absent.
+
+    Parameters
+    ----------
+    data_path : str or os.PathLike
+        The recording.
+
+    Returns
+    -------
+    pathlib.Path or None
+        ``<stem>.toml`` beside it, None if there is none.
+    """
     candidate = Path(data_path).with_suffix(".toml")
     return candidate if candidate.is_file() else None
 
 
 def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
     """Read a recording's TOML settings as `ReadOptions` keyword arguments.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The TOML settings file.
+
+    Returns
+    -------
+    dict
+        Keyword arguments for `ReadOptions`; ``columns`` and ``units`` as tuples of pairs.
 
     Raises
     ------

@@ -137,12 +137,34 @@ def write_recording(
 
 
 def sidecar_path(path: str | os.PathLike[str]) -> Path:
-    """The settings file beside a recording (``out.csv`` -> ``out.toml``)."""
+    """The settings file beside a recording (``out.csv`` -> ``out.toml``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The recording.
+
+    Returns
+    -------
+    pathlib.Path
+        The same path with the suffix ``.toml``.
+    """
     return Path(path).with_suffix(".toml")
 
 
 def units_settings_text(units: dict[str, str]) -> str:
-    """A recording's settings file (``out.toml``) that holds only the units of its columns."""
+    """A recording's settings file (``out.toml``) that holds only the units of its columns.
+
+    Parameters
+    ----------
+    units : dict of str to str
+        Unit of each column, by column name.
+
+    Returns
+    -------
+    str
+        The TOML text, one ``[units]`` table.
+    """
     lines = ["# written by hystkit: units of the columns of the file beside this one", "",
              "[units]"]
     lines += [f"{json.dumps(name)} = {json.dumps(unit)}" for name, unit in units.items()]
@@ -175,6 +197,20 @@ def write_json(obj: Any, path: str | os.PathLike[str], *, force: bool = False) -
 
     NumPy scalars and arrays are converted to plain numbers and lists. NaN and infinity are
     refused because standard JSON cannot represent them.
+
+    Parameters
+    ----------
+    obj : object
+        JSON-serialisable data; numpy scalars and arrays allowed.
+    path : str or os.PathLike
+        Output ``.json`` file.
+    force : bool, default False
+        Replace an existing file.
+
+    Returns
+    -------
+    pathlib.Path
+        `path`.
 
     Raises
     ------
@@ -270,6 +306,31 @@ def check_output_path(path: str | os.PathLike[str], force: bool = False, *,
     (permission, read-only or virtual file system: probed by creating and removing a hidden
     file there); with `formats` (accepted extensions, e.g. ``(".json", ".mat")``), an
     extension that does not match (`check_output_format`, `what` names the content).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file.
+    force : bool, default False
+        Allow replacing an existing file.
+    inputs : iterable of str or os.PathLike, optional
+        Input files of the command, which must not be overwritten.
+    formats : iterable of str, optional
+        Accepted extensions; any if None.
+    what : str, default "this output"
+        What the file holds, for the message about a wrong extension.
+
+    Returns
+    -------
+    pathlib.Path
+        `path`.
+
+    Raises
+    ------
+    OutputExistsError
+        `path` exists and `force` is False.
+    OutputError
+        Any other reason listed above.
     """
     path = Path(path)
     if path.is_dir():
@@ -307,7 +368,29 @@ def _check_name_length(path: Path) -> None:
 def check_output_folder(folder: str | os.PathLike[str], names: Iterable[str],
                         force: bool = False, *,
                         inputs: Iterable[str | os.PathLike[str]] = ()) -> Path:
-    """`check_output_path` for a folder output: the folder itself and each file `names`."""
+    """`check_output_path` for a folder output: the folder itself and each file `names`.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The output folder.
+    names : iterable of str
+        Files that will be written into it.
+    force : bool, default False
+        Allow replacing existing files.
+    inputs : iterable of str or os.PathLike, optional
+        Input files of the command, which must not be overwritten.
+
+    Returns
+    -------
+    pathlib.Path
+        `folder`.
+
+    Raises
+    ------
+    OutputError
+        `folder` is a file, or a file in it is refused by :func:`check_output_path`.
+    """
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
         raise OutputError(f"{folder} is a file, not a folder")
@@ -359,6 +442,25 @@ def atomic_output(path: str | os.PathLike[str], force: bool = False) -> Iterator
     is replaced instead (still exclusive; the target is briefly empty). On any exception,
     including KeyboardInterrupt and SystemExit, the temporary is removed and the target left
     as it was. OS errors while writing become one-line `OutputError`s naming `path`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file.
+    force : bool, default False
+        Replace an existing file.
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary file to write to.
+
+    Raises
+    ------
+    OutputExistsError
+        `path` exists (before or on publishing) and `force` is False.
+    OutputError
+        `path` cannot be written.
 
     Examples
     --------
@@ -483,6 +585,20 @@ def atomic_folder(out: str | os.PathLike[str], force: bool = False,
     exclusive creation, and a clash removes the files already moved, so nothing changes).
     On any exception the temporary folder is removed. `names` (files the caller will write)
     are checked first like :func:`check_output_folder`.
+
+    Parameters
+    ----------
+    out : str or os.PathLike
+        The output folder.
+    force : bool, default False
+        Replace same-named files in an existing `out`.
+    names : iterable of str, optional
+        Files the caller will write, checked before the block runs.
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary folder to write into.
     """
     out = Path(out)
     check_output_folder(out, names, force)
@@ -574,6 +690,18 @@ def atomic_outputs(paths: Iterable[str | os.PathLike[str]],
     Yields one temporary per path, in order. When the block ends normally they are published
     in order; if one cannot be (it appeared meanwhile), those already published are undone,
     so all appear or none does. On any exception every temporary is removed.
+
+    Parameters
+    ----------
+    paths : iterable of str or os.PathLike
+        The output files.
+    force : bool, default False
+        Replace existing files.
+
+    Yields
+    ------
+    list of pathlib.Path
+        One temporary per path, in order.
     """
     paths = [Path(p) for p in paths]
     for path in paths:
