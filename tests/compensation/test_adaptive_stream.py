@@ -24,6 +24,7 @@ from hystkit.models import FAMILIES
 from hystkit.sensors import (
     gain_ramp,
     occasional_references,
+    simulate_drifting_experiment,
     simulate_experiment,
     with_gain_drift,
 )
@@ -193,6 +194,7 @@ def test_the_gain_ramp_and_the_references():
     assert ramp[0] == 1.0 and ramp[-1] == pytest.approx(0.9, abs=1e-15)
     assert_allclose(drifted.sensor, rec.sensor * ramp, rtol=0)
     assert_array_equal(drifted.position, rec.position)
+    assert_array_equal(simulate_drifting_experiment("sine", 2, -0.1).sensor, drifted.sensor)
     reference = occasional_references(rec, 5.0, seed=1)
     known = np.flatnonzero(np.isfinite(reference))
     assert_array_equal(reference[known], rec.position[known])
