@@ -34,7 +34,7 @@ class MissingDependencyError(HystkitError, ImportError):
 class Provenance:
     """Where a run comes from, as its ``README.txt`` in the shared data states it.
 
-    Attributes
+    Parameters
     ----------
     repository : str
         Public repository the files were copied from (``github.com/owner/name``).
@@ -229,7 +229,7 @@ class Dataset(Sampled):
 class VariantInfo:
     """One run of a data set as the registry lists it, without reading any file.
 
-    Attributes
+    Parameters
     ----------
     name : str
     n_samples : int
@@ -252,7 +252,7 @@ class VariantInfo:
 class DatasetInfo:
     """A registered data set: its folder in the shared data, signals, licence and runs.
 
-    Attributes
+    Parameters
     ----------
     name : str
         Registry name (``load(name, ...)``, ``hystkit datasets export NAME``).

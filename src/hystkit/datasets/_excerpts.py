@@ -30,7 +30,19 @@ EXCERPT_DIR = Path(__file__).resolve().parent / "excerpts"
 
 @dataclass(frozen=True)
 class ExcerptSpec:
-    """Excerpt `variant` of data set `name`: times [t0, t1) s of run `source_variant`."""
+    """Excerpt `variant` of data set `name`: times [t0, t1) s of run `source_variant`.
+
+    Parameters
+    ----------
+    name : str
+        Data set name in the registry.
+    variant : str
+        Name of the excerpt.
+    source_variant : str
+        Run of the data set it is cut from.
+    t0, t1 : float
+        Start (included) and end (excluded) time [s].
+    """
 
     name: str
     variant: str
@@ -49,7 +61,13 @@ EXCERPTS = (
 
 
 def list_excerpts() -> tuple[ExcerptSpec, ...]:
-    """The shipped excerpts."""
+    """The shipped excerpts.
+
+    Returns
+    -------
+    tuple of ExcerptSpec
+        Every shipped excerpt, in a fixed order.
+    """
     return EXCERPTS
 
 

@@ -19,12 +19,34 @@ DATASETS = MappingProxyType({info.name: info for info in (
 
 
 def list_datasets() -> tuple[DatasetInfo, ...]:
-    """Every registered data set, in a fixed order; reads no file."""
+    """Every registered data set, in a fixed order; reads no file.
+
+    Returns
+    -------
+    tuple of DatasetInfo
+        The registry entries.
+    """
     return tuple(DATASETS.values())
 
 
 def dataset_info(name: str) -> DatasetInfo:
-    """The registry entry of `name`; unknown names list the known ones (`InputError`)."""
+    """The registry entry of `name`; unknown names list the known ones (`InputError`).
+
+    Parameters
+    ----------
+    name : str
+        Registry name.
+
+    Returns
+    -------
+    DatasetInfo
+        Its registry entry.
+
+    Raises
+    ------
+    InputError
+        An unknown name.
+    """
     try:
         return DATASETS[name]
     except KeyError:
@@ -63,7 +85,20 @@ def load(name: str, variant: str | None = None, *,
 
 
 def shared_data_status(root: str | os.PathLike[str] | None = None) -> tuple[Path | None, str]:
-    """Where the shared data root is and how it was found, or (None, why not)."""
+    """Where the shared data root is and how it was found, or (None, why not).
+
+    Parameters
+    ----------
+    root : str or os.PathLike, optional
+        Use this folder instead of searching for the root.
+
+    Returns
+    -------
+    path : pathlib.Path or None
+        The shared data root, None if not found.
+    how : str
+        How it was found, or why not.
+    """
     try:
         path, how = find_root(root)
     except InputError as exc:

@@ -106,7 +106,17 @@ def e_rms_pct(y_true: npt.ArrayLike, y_pred: npt.ArrayLike, scale: float | None 
 def e_max_pct(y_true: npt.ArrayLike, y_pred: npt.ArrayLike, scale: float | None = None) -> float:
     """Normalised maximum absolute error in percent of `scale`, eq. 5.11.
 
-    Parameters are those of `e_rms_pct`; returns ``100 * max|psi - psi_hat|`` in %.
+    Parameters
+    ----------
+    y_true, y_pred : array_like, shape (n,)
+        Measured and predicted signal, same unit, n >= 2.
+    scale : float, optional
+        Normalisation of eq. 5.10 in the unit of the signals; default ``max|y_true|``.
+
+    Returns
+    -------
+    float
+        ``100 * max|psi - psi_hat|`` with ``psi = y_true / scale``, in %.
     """
     d = _normalised_error(y_true, y_pred, scale)
     return 100.0 * float(np.max(np.abs(d)))  # eq. 5.11

@@ -19,7 +19,22 @@ __all__ = [
 
 
 def sine(t: np.ndarray, frequency: float = 0.5, amplitude: float = 3.0) -> np.ndarray:
-    """``amplitude * sin(2 pi f t)`` [mm]; the sine experiment is 0.5 Hz, 3 mm (eq. 9.14)."""
+    """``amplitude * sin(2 pi f t)`` [mm]; the sine experiment is 0.5 Hz, 3 mm (eq. 9.14).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Times [s].
+    frequency : float, default 0.5
+        Frequency [Hz].
+    amplitude : float, default 3.0
+        Amplitude [mm].
+
+    Returns
+    -------
+    numpy.ndarray
+        Position [mm], same shape as `t`.
+    """
     return amplitude * np.sin(2 * np.pi * frequency * np.asarray(t, dtype=float))
 
 
@@ -29,6 +44,22 @@ def decaying_sine(t: np.ndarray, frequency: float = 0.5, start_amplitude: float 
 
     The document's decay experiment: 0.5 Hz, 2 mm to 100 um over 200 s; its shrinking cycles are
     minor loops inside the first, major one.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Times [s].
+    frequency : float, default 0.5
+        Frequency [Hz].
+    start_amplitude, end_amplitude : float, default 2.0 and 0.1
+        Amplitude [mm] at ``t = 0`` and ``t = duration``.
+    duration : float, default 200.0
+        Time [s] over which the amplitude falls from start to end.
+
+    Returns
+    -------
+    numpy.ndarray
+        Position [mm], same shape as `t`.
     """
     t = np.asarray(t, dtype=float)
     envelope = start_amplitude * (end_amplitude / start_amplitude) ** (t / duration)
@@ -37,7 +68,24 @@ def decaying_sine(t: np.ndarray, frequency: float = 0.5, start_amplitude: float 
 
 def exponential_chirp(t: np.ndarray, f0: float = 0.1, f1: float = 3.0, duration: float = 100.0,
                       amplitude: float = 3.0) -> np.ndarray:
-    """Sine sweep whose frequency rises exponentially from ``f0`` to ``f1`` over ``duration``."""
+    """Sine sweep whose frequency rises exponentially from ``f0`` to ``f1`` over ``duration``.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Times [s].
+    f0, f1 : float, default 0.1 and 3.0
+        Start and end frequency [Hz].
+    duration : float, default 100.0
+        Time [s] at which the frequency reaches `f1`.
+    amplitude : float, default 3.0
+        Amplitude [mm].
+
+    Returns
+    -------
+    numpy.ndarray
+        Position [mm], same shape as `t`.
+    """
     from scipy import signal  # here, not at the top: listing the experiments stays light
 
     return amplitude * signal.chirp(np.asarray(t, dtype=float), f0=f0, t1=duration, f1=f1,
@@ -67,6 +115,24 @@ def filtered_noise(t: np.ndarray, seed: int, cutoff: float = 4.0, order: int = 5
 
     Scaled so that max |x| equals ``amplitude``. The filter's start-up transient is discarded by
     generating ``order`` extra samples first.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Evenly spaced times [s].
+    seed : int
+        Seed of the noise generator.
+    cutoff : float, default 4.0
+        -3 dB frequency [Hz] of the low-pass.
+    order : int, default 500
+        Order of the FIR filter.
+    amplitude : float, default 3.0
+        Largest absolute value [mm].
+
+    Returns
+    -------
+    numpy.ndarray
+        Position [mm], same shape as `t`.
     """
     from scipy import signal
 
@@ -80,7 +146,19 @@ def filtered_noise(t: np.ndarray, seed: int, cutoff: float = 4.0, order: int = 5
 
 @dataclass(frozen=True)
 class Experiment:
-    """One of the document's excitation experiments: its duration and its trajectory."""
+    """One of the document's excitation experiments: its duration and its trajectory.
+
+    Parameters
+    ----------
+    name : str
+        Experiment name (``sine``, ``chirp``, ...).
+    duration : float
+        Length [s].
+    description : str
+        One line for listings.
+    trajectory : callable
+        ``trajectory(t, seed) -> position`` [mm] for times `t` [s].
+    """
 
     name: str
     duration: float  # s
@@ -100,7 +178,29 @@ EXPERIMENTS: dict[str, Experiment] = {
 
 
 def excitation(name: str, fs: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Time [s] and position [mm] of experiment ``name`` sampled at ``fs`` [Hz]."""
+    """Time [s] and position [mm] of experiment ``name`` sampled at ``fs`` [Hz].
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`EXPERIMENTS`.
+    fs : float
+        Sample rate [Hz].
+    seed : int, default 0
+        Seed of the random experiments (noise).
+
+    Returns
+    -------
+    t : numpy.ndarray
+        Time [s], ``round(duration * fs)`` samples from 0.
+    position : numpy.ndarray
+        Position [mm].
+
+    Raises
+    ------
+    ValueError
+        An unknown experiment name.
+    """
     if name not in EXPERIMENTS:
         raise ValueError(f"unknown excitation {name!r}; choose one of {sorted(EXPERIMENTS)}")
     exp = EXPERIMENTS[name]
