@@ -62,12 +62,24 @@ def input_minima(x: npt.ArrayLike, deadband: float = DEFAULT_DEADBAND) -> np.nda
 def cycle_bounds(x: npt.ArrayLike, deadband: float = DEFAULT_DEADBAND) -> np.ndarray:
     """Cut points of the record: the input's minima (:func:`input_minima`) with 0 and ``n``.
 
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Input signal (position [mm]), finite, not constant, n >= 2.
+    deadband : float, default 0.01
+        Reversal dead band as a fraction of the input's range (see :func:`input_minima`).
+
     Returns
     -------
     ndarray of int, shape (k + 2,) at most
         ``[0, m_1, ..., m_k, n]``, strictly increasing (0 is not repeated when the first
         minimum is the first sample). Complete cycles are ``[m_i, m_{i+1}]``; ``[0, m_1)`` and
         ``[m_k, n)`` are the incomplete head and tail.
+
+    Raises
+    ------
+    ValueError
+        Bad `x` or `deadband` (see :func:`input_minima`).
     """
     return bounds_of(input_minima(x, deadband), np.asarray(x).shape[0])
 

@@ -39,6 +39,17 @@ def plot_cycles(x: np.ndarray, signals: Mapping[str, np.ndarray], table: CycleTa
     table : CycleTable
     cycles : sequence of int
         Cycle numbers (1-based, complete cycles) to draw, coloured by time (viridis).
+    scale : float, default 100.0
+        Factor the signals are drawn with.
+    unit : str, default "%"
+        Unit of the scaled signals, for the axis labels.
+    x_label : str, default "position [mm]"
+        Label of the loops' horizontal axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The loops, one panel per signal, and every cycle's offset over time.
     """
     from matplotlib import colormaps
     from matplotlib.figure import Figure
@@ -86,6 +97,11 @@ def plot_settling(logs: Mapping[str, tuple[np.ndarray, np.ndarray, SettlingFit |
     ----------
     logs : mapping of str to (t_h, r, fit, rest)
         `fit` and `rest` None for a column that could not be fitted (drawn without a curve).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per log.
     """
     from matplotlib.figure import Figure
 

@@ -39,6 +39,16 @@ def enclosed_area(x: npt.ArrayLike, y: npt.ArrayLike) -> float:
     The path is integrated as given (close it by repeating its first point at the end for a
     loop). Clockwise loops are positive: for ``x = a sin t``, ``y = b sin(t + phi)`` over one
     period the result is ``pi a b sin(phi)``.
+
+    Parameters
+    ----------
+    x, y : array_like, shape (n,)
+        The path's coordinates.
+
+    Returns
+    -------
+    float
+        Signed area [x unit * y unit], positive for a clockwise loop.
     """
     xs, ys = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     return float(np.sum(0.5 * (ys[1:] + ys[:-1]) * np.diff(xs)))
@@ -51,6 +61,17 @@ class DriftRate:
     ``per_hour`` and ``stderr_per_hour`` [signal unit per hour]; ``per_cycle`` the slope
     times the mean cycle duration [signal unit]; ``n_cycles`` the cycles it rests on (the
     standard error needs 3 or more; with 2 it is None).
+
+    Parameters
+    ----------
+    per_hour : float
+        Slope [signal unit per hour].
+    stderr_per_hour : float or None
+        Its standard error [signal unit per hour]; None with 2 cycles.
+    per_cycle : float
+        Slope times the mean cycle duration [signal unit].
+    n_cycles : int
+        Cycles the fit rests on.
     """
 
     per_hour: float
@@ -71,6 +92,16 @@ def drift_rate(t_cycle: npt.ArrayLike, offset: npt.ArrayLike,
         Offset of each cycle, any unit.
     mean_duration : float
         Mean cycle duration [s], for ``per_cycle``.
+
+    Returns
+    -------
+    DriftRate
+        Slope per hour, its standard error (None for k = 2) and slope per cycle.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 2 cycles.
     """
     t, y = np.asarray(t_cycle, dtype=float), np.asarray(offset, dtype=float)
     if t.size < 2:
@@ -90,7 +121,7 @@ def drift_rate(t_cycle: npt.ArrayLike, offset: npt.ArrayLike,
 class CycleTable:
     """Per-cycle results of :func:`cycle_table`.
 
-    Attributes
+    Parameters
     ----------
     bounds : ndarray of int
         All cut points ``[0, m_1, ..., m_k, n]`` (:func:`~hystkit.analysis.cycle_bounds`).

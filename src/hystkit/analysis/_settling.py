@@ -41,7 +41,21 @@ _GRID_POINTS = 24
 
 
 def settling_curve(params: dict[str, float], t_h: npt.ArrayLike) -> np.ndarray:
-    """R(t) [Ohm] of fitted or known parameters (keys of :attr:`SettlingFit.params`)."""
+    """R(t) [Ohm] of fitted or known parameters (keys of :attr:`SettlingFit.params`).
+
+    Parameters
+    ----------
+    params : dict of str to float
+        ``r_final``, ``drop`` [Ohm] and ``tau_drop_h`` [h]; with ``rise`` [Ohm] and
+        ``tau_rise_h`` [h] for the rise-drop model.
+    t_h : array_like
+        Times [h] after printing.
+
+    Returns
+    -------
+    numpy.ndarray
+        Resistance [Ohm], same shape as `t_h`.
+    """
     t = np.asarray(t_h, dtype=float)
     r = params["r_final"] + params["drop"] * np.exp(-t / params["tau_drop_h"])
     if "rise" in params:
@@ -67,6 +81,33 @@ class SettlingFit:
     ``message`` of the optimiser; ``t_end_h`` the log's last time; ``alternatives`` the BIC of
     every model tried (auto); ``covariance`` of the parameters in the order of ``params``
     (inflated like ``stderr``).
+
+    Parameters
+    ----------
+    model : {"rise-drop", "drop"}
+        The model chosen.
+    params, stderr : dict of str to float
+        Parameters and their standard errors by name [Ohm, h].
+    rms : float
+        Residual RMS [Ohm].
+    rho : float
+        Lag-1 autocorrelation of the residuals.
+    inflation : float
+        Factor applied to the standard errors for that autocorrelation.
+    bic : float
+        Bayesian information criterion.
+    converged : bool
+        Whether the optimiser converged.
+    message : str
+        The optimiser's message, with notes on models that dropped out.
+    n : int
+        Readings fitted.
+    t_end_h : float
+        Time [h] of the log's last reading.
+    covariance : numpy.ndarray, optional
+        Covariance of the parameters in the order of `params` (inflated like `stderr`).
+    alternatives : dict of str to float, optional
+        BIC of every model tried.
     """
 
     model: str
@@ -237,7 +278,19 @@ def _lag1(e: np.ndarray) -> float:
 class RestTime:
     """Rest time of :func:`rest_time`: ``hours`` [h] after printing, its ``stderr_h`` (None
     when it is 0: already settled at the first reading), the ``threshold_pct_per_hour`` it
-    used, and ``extrapolated`` when it lies after the end of the log."""
+    used, and ``extrapolated`` when it lies after the end of the log.
+
+    Parameters
+    ----------
+    hours : float
+        Rest time [h] after printing.
+    stderr_h : float or None
+        Its standard error [h]; None when the rest time is 0.
+    threshold_pct_per_hour : float
+        Drift-rate threshold [% per hour] it used.
+    extrapolated : bool
+        True when it lies after the end of the log.
+    """
 
     hours: float
     stderr_h: float | None
