@@ -103,7 +103,7 @@ def _same(a: Any, b: Any) -> bool:
 class Block(NamedTuple):
     """A model compiled for the closed loop (see the module docstring).
 
-    Attributes
+    Parameters
     ----------
     step : numba dispatcher
         ``step(body, x, xn, off, u) -> out``.
@@ -121,8 +121,8 @@ class Block(NamedTuple):
 class Family(ABC):
     """One hysteresis model family. Subclass it once per family; export an instance as FAMILY.
 
-    Class attributes
-    ----------------
+    Attributes
+    ----------
     name : str
         CLI name (``hystkit fit --model NAME``).
     title : str
@@ -301,6 +301,28 @@ def numerical_linearisation(step: Callable[[np.ndarray, float], tuple[float, np.
 
     The step is ``rel_step`` times ``max(1, |value|)`` per coordinate; a piecewise model
     linearised exactly on a kink gets the mean of its two slopes.
+
+    Parameters
+    ----------
+    step : callable
+        ``step(x, u) -> (y, x_next)`` with the parameters bound.
+    x : numpy.ndarray, shape (n,)
+        State to linearise at.
+    u : float
+        Input to linearise at.
+    rel_step : float, default 1e-6
+        Relative finite-difference step.
+
+    Returns
+    -------
+    A : numpy.ndarray, shape (n, n)
+        d x_next / d x.
+    B : numpy.ndarray, shape (n,)
+        d x_next / d u.
+    C : numpy.ndarray, shape (n,)
+        d y / d x.
+    D : float
+        d y / d u.
     """
     x = np.array(x, dtype=float)
     n = x.size

@@ -52,18 +52,56 @@ def _families() -> dict[str, Family]:
 
 
 def register(family: Family) -> Family:
-    """Add ``family`` to the registry (replacing one of the same name); returns it."""
+    """Add ``family`` to the registry (replacing one of the same name); returns it.
+
+    Parameters
+    ----------
+    family : Family
+        The family to add.
+
+    Returns
+    -------
+    Family
+        `family`, so that it can be used as ``FAMILY = register(Family(...))``.
+
+    Raises
+    ------
+    TypeError
+        `family` is not a :class:`Family`.
+    """
     _families()[_check(family, "register").name] = family
     return family
 
 
 def unregister(name: str) -> None:
-    """Remove a family added by :func:`register` (tests clean up with it)."""
+    """Remove a family added by :func:`register` (tests clean up with it).
+
+    Parameters
+    ----------
+    name : str
+        Family name; a name not registered is ignored.
+    """
     _families().pop(name, None)
 
 
 def get_family(name: str) -> Family:
-    """The registered family ``name``; InputError listing the known ones otherwise."""
+    """The registered family ``name``; InputError listing the known ones otherwise.
+
+    Parameters
+    ----------
+    name : str
+        Family name (``"mpl"``, ``"preisach"``, ...).
+
+    Returns
+    -------
+    Family
+        The registered family.
+
+    Raises
+    ------
+    InputError
+        An unknown name.
+    """
     families = _families()
     try:
         return families[name]
@@ -73,7 +111,23 @@ def get_family(name: str) -> Family:
 
 
 def family_of(structure: object) -> Family:
-    """The registered family whose ``Structure`` ``structure`` is; TypeError otherwise."""
+    """The registered family whose ``Structure`` ``structure`` is; TypeError otherwise.
+
+    Parameters
+    ----------
+    structure : object
+        A family's ``Structure`` instance.
+
+    Returns
+    -------
+    Family
+        The family it belongs to.
+
+    Raises
+    ------
+    TypeError
+        `structure` belongs to no registered family.
+    """
     for family in _families().values():
         if isinstance(structure, family.Structure):
             return family

@@ -35,6 +35,10 @@ def stability_report(family: Family, structure: Any, params: Any, u: np.ndarray,
 
     Parameters
     ----------
+    family : Family
+        The model family.
+    structure, params : object
+        The family's structure and parameters.
     u : array, shape (n,)
         Model input (output, for ``inverse``) covering the range of interest, normalised.
     inverse : bool
