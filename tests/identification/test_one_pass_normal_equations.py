@@ -158,3 +158,19 @@ def test_mpl_one_pass_at_optimiser_coordinates():
         _assert_same(mpl_kernels.theta_normal_equations(u, target, x0, theta,
                                                         structure.slope_cap, structure.dt),
                      direct)
+
+
+@pytest.mark.parametrize("p", [1, 2, 3, 4, 11, 12])  # odd and even: pairs and a last column
+@pytest.mark.parametrize("m", [1, 7, mpl_kernels.NORMAL_BLOCK])
+def test_fold_block_adds_the_upper_triangle_of_c_ct(p, m):
+    rng = np.random.default_rng(p * 1000 + m)
+    cols = rng.normal(size=(p, mpl_kernels.NORMAL_BLOCK))  # columns past m must not count
+    res = rng.normal(size=mpl_kernels.NORMAL_BLOCK)
+    jtj, jtr = np.ones((p, p)), np.ones(p)  # the fold adds to what is there
+    mpl_kernels.fold_block(cols, res, m, jtj, jtr)
+    c = cols[:, :m]
+    upper = np.triu_indices(p)
+    # sums of m products in another order than BLAS: 1e-12 relative to the terms' scale
+    assert_allclose(jtj[upper], 1.0 + (c @ c.T)[upper], rtol=1e-12, atol=1e-12 * m)
+    assert np.all(jtj[np.tril_indices(p, -1)] == 1.0)  # the lower triangle is left alone
+    assert_allclose(jtr, 1.0 + c @ res[:m], rtol=1e-12, atol=1e-12 * m)
