@@ -52,7 +52,22 @@ def _cell(x: float | None, spec: str = ".4f") -> str:
 
 
 def format_table(metrics: dict, title: str, reference: dict | None = None) -> str:
-    """Plain-text table per excitation: deployable and oracle R² of the model and the line."""
+    """Plain-text table per excitation: deployable and oracle R² of the model and the line.
+
+    Parameters
+    ----------
+    metrics : dict
+        Per excitation, the scores of :func:`~hystkit.compensation.evaluate`.
+    title : str
+        First line of the table.
+    reference : dict, optional
+        Per excitation, the document's (mPL R², line R²) for a further column.
+
+    Returns
+    -------
+    str
+        The table, one line per excitation.
+    """
     head = (f"{'excitation':<11}{'mPL R²':>9}{'line R²':>9}{'e_rms %':>9}{'loop area %':>13}"
             f"{'oracle: mPL R²':>16}{'line R²':>9}")
     if reference:
@@ -85,6 +100,31 @@ def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
     publishes the folder atomically (:func:`~hystkit.io.atomic_folder`): interrupted or failed,
     it leaves no folder and no file; into an existing folder, the files go in only once all
     were built.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        Output folder.
+    n_cells : int, default 3
+        Cells of the mPL model fitted.
+    force : bool, default False
+        Replace same-named files in an existing folder.
+    progress : callable, default print
+        Called with one line per step.
+    raw : bool, default False
+        Also run the raw-file chain (:func:`run_raw_path`).
+    report : bool, default False
+        Also write ``report.html``.
+
+    Returns
+    -------
+    dict
+        ``metrics``, ``noise_trained`` and ``config`` as written (and ``raw_path`` with `raw`).
+
+    Raises
+    ------
+    OutputExistsError
+        An output file exists and `force` is False.
     """
     out = Path(out_dir)
     names = DEMO_FILES + (RAW_DEMO_FILES if raw else ()) + (REPORT_DEMO_FILES if report else ())

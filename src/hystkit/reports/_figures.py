@@ -91,6 +91,11 @@ def plot_loops(results: Results, *, sensor_label: str = DEFAULT_SENSOR_LABEL,
         The sensor axis' label: the sensor's name and unit where known.
     model_label : str
         The compensator's name in the legend.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Three rows per band of recordings.
     """
     n_cols = min(len(results), LOOP_COLUMNS)
     n_bands = -(-len(results) // n_cols)
@@ -131,6 +136,18 @@ def plot_time_series(results: Results, *, model_label: str = "mPL") -> Figure:
 
     Two rows per recording (positions; errors), the full run on the left and the zoom
     (:func:`zoom_window`) on the right.
+
+    Parameters
+    ----------
+    results : mapping of str to (Recording, numpy.ndarray, numpy.ndarray)
+        Per recording name: the recording, the estimate [mm] and the linear estimate [mm].
+    model_label : str, default "mPL"
+        The compensator's name in the legend.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two rows per recording.
     """
     n = len(results)
     fig = Figure(figsize=(12.0, 3.6 * n + 0.6), layout="constrained")

@@ -34,7 +34,21 @@ FIGURE_DPI = 100  # the page's PNGs and the PNG files: sharp at the page's width
 class ReportContent:
     """What a report shows: a title, sections, and its figures by file stem: ``pngs`` (every
     figure, as embedded in the page) and ``figures`` (those drawn here, which can also be saved
-    as SVG or PDF; a ``control`` run's own PNG files have no Figure)."""
+    as SVG or PDF; a ``control`` run's own PNG files have no Figure).
+
+    Parameters
+    ----------
+    title : str
+        The page title.
+    sections : list of Section, optional
+        The page's sections, in order.
+    pngs : dict of str to bytes, optional
+        Every figure as PNG, by file stem.
+    figures : dict of str to matplotlib.figure.Figure, optional
+        The figures drawn here, by file stem.
+    prefix : str, optional
+        Put before every figure name (several folders on one page).
+    """
 
     title: str
     sections: list[Section] = field(default_factory=list)
@@ -233,7 +247,27 @@ def compensator_sections(comp: Compensator, recordings: Mapping[str, Recording],
 def model_report(model_path: Path, recordings: Mapping[str, Recording], *,
                  sensor_label: str = DEFAULT_SENSOR_LABEL) -> ReportContent:
     """The page of a model file (read with :func:`~hystkit.compensation.load_compensator`,
-    which checks it) on named recordings."""
+    which checks it) on named recordings.
+
+    Parameters
+    ----------
+    model_path : pathlib.Path
+        The model file.
+    recordings : mapping of str to Recording
+        Recordings to score it on, by name.
+    sensor_label : str, default "sensor"
+        The sensor axis' label in the loop figure.
+
+    Returns
+    -------
+    ReportContent
+        The page's title, sections and figures.
+
+    Raises
+    ------
+    InputError
+        A missing, damaged or foreign model file.
+    """
     comp = load_compensator(model_path)
     version = _written_by(Path(model_path))
     content = compensator_sections(comp, recordings, model_path=Path(model_path),

@@ -41,6 +41,18 @@ def build_report(inputs: Sequence[str | os.PathLike[str]], *,
                  options: ReadOptions | None = None) -> ReportContent:
     """The page's content for `inputs`: ``MODEL.json RECORDING...`` or ``FOLDER...``.
 
+    Parameters
+    ----------
+    inputs : sequence of str or os.PathLike
+        A model file and recordings, or result folders.
+    options : ReadOptions, optional
+        How to read the recordings (see :func:`~hystkit.io.read_recording`).
+
+    Returns
+    -------
+    ReportContent
+        The page's title, sections and figures.
+
     Raises
     ------
     InputError
@@ -102,6 +114,31 @@ def write_report(content: ReportContent, out: str | os.PathLike[str], *,
 
     Without `force` an existing file is refused (nothing is written); an interruption leaves
     none of them. Returns the written paths, the page first.
+
+    Parameters
+    ----------
+    content : ReportContent
+        What the page shows (:func:`build_report`).
+    out : str or os.PathLike
+        The HTML page.
+    figures : str or os.PathLike, optional
+        Folder for the figure files; none are written if None.
+    fmt : {"png", "svg", "pdf"}, default "png"
+        Format of the figures drawn here, besides PNG.
+    force : bool, default False
+        Replace existing files.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The written paths, the page first.
+
+    Raises
+    ------
+    InputError
+        An unknown figure format.
+    OutputExistsError
+        A file exists and `force` is False.
     """
     if fmt not in FIGURE_FORMATS:
         raise InputError(f"figure format {fmt!r}: use {', '.join(FIGURE_FORMATS)}")
