@@ -81,6 +81,11 @@ class MplGFamily(Family):
         return {f"ch7-table-ii-{column}": ch7_compensator(column)
                 for column in PAPER_9_2_TABLE_II}
 
+    def n_params(self, structure, params) -> int:
+        """``3N + 4``: ``w_0`` and ``V_b`` are the gauge of ``g``'s voltage (``fit.canonical``),
+        fixed at 1 and 0 by the fit, so they count for no information criterion."""
+        return 3 * structure.n_cells + 4
+
     def block(self, structure, params, inverse=False):
         from . import kernels
         from . import model as mpl_g

@@ -18,8 +18,9 @@ Two choices, both about the output resistor ``g``:
   soon as a transient leaves the training range: scheme (a) with the document's PID runs away
   within 0.5 s (docs/models/mpl_g.md). So ``g'`` is parametrised by its Bernstein coefficients
   on ``|z| <= MONOTONE_RANGE`` (2, twice the range of normalised data, eq. 5.10), all of one
-  sign (that of the mPL start's ``w_0``): ``g`` is strictly monotone there. Paper 9.2's table II
-  resistors are all inside this set (their turning points lie at ``|z| >= 2.5``).
+  sign (that of the mPL start's ``w_0``): ``g`` is strictly monotone there. Three of paper 9.2's
+  table II output resistors are inside this set; the chirp column's turns at ``z = 1.32`` (in
+  the gauge), at the edge of its own data.
 """
 
 from __future__ import annotations
