@@ -22,7 +22,7 @@ class MplGFamily(Family):
     name = "mpl-g"
     title = ("ch. 7 compensator: sinh cells with a cubic output resistor g (sec. 7.2, "
              "eq. 5.1-5.6, 5.16-5.17)")
-    size_help = "cells N (3N + 6 params)"
+    size_help = "cells N (3N + 4 fitted params)"
     default_size = 1
     max_size = 50
     docs = "docs/models/mpl_g.md"
