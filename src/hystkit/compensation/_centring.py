@@ -39,7 +39,18 @@ DEFAULT_TRACK_SECONDS = 100.0
 
 
 def center_label(center: str) -> str:
-    """The name shown next to a score: the oracle mode always says that it is one."""
+    """The name shown next to a score: the oracle mode always says that it is one.
+
+    Parameters
+    ----------
+    center : str
+        A centring mode.
+
+    Returns
+    -------
+    str
+        `center`, with `` (oracle)`` appended for ``recording``.
+    """
     return f"{center} (oracle)" if center == ORACLE_CENTER else center
 
 

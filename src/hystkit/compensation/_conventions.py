@@ -18,7 +18,15 @@ _CHUNK = 65_536  # samples per chunk of the straight line's sums
 
 @dataclass(frozen=True)
 class Scaling:
-    """Offsets and scales of the fitting data (eq. 5.10), sensor units and mm."""
+    """Offsets and scales of the fitting data (eq. 5.10), sensor units and mm.
+
+    Parameters
+    ----------
+    sensor_offset, sensor_scale : float
+        Offset and scale [sensor units] of the sensor.
+    position_offset, position_scale : float
+        Offset and scale [mm] of the position.
+    """
 
     sensor_offset: float
     sensor_scale: float
@@ -28,7 +36,13 @@ class Scaling:
 
 @dataclass(frozen=True)
 class LinearBaseline:
-    """Least-squares straight line position(sensor) in normalised units (MATLAB polyfit)."""
+    """Least-squares straight line position(sensor) in normalised units (MATLAB polyfit).
+
+    Parameters
+    ----------
+    slope, intercept : float
+        The line ``p = slope * s + intercept`` in normalised units.
+    """
 
     slope: float
     intercept: float
@@ -56,6 +70,15 @@ def prepare_training_data(recordings: Sequence[Recording], center: str, *,
                           ) -> tuple[dict, list[np.ndarray], list[np.ndarray]]:
     """Centre, orient and scale fitting recordings exactly as the compensator will at use.
 
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        Fitting recordings with position and sensor, one rate.
+    center : {"fit", "tare", "track", "recording", "none"}
+        Centring mode.
+    tare_seconds, track_seconds : float, default 2.0 and 100.0
+        Tare window and drift-tracker time constant [s].
+
     Returns
     -------
     conventions : dict
@@ -63,6 +86,11 @@ def prepare_training_data(recordings: Sequence[Recording], center: str, *,
         :class:`Compensator`.
     s, p : lists of arrays
         Normalised sensor and position per recording.
+
+    Raises
+    ------
+    InputError
+        A constant position or sensor column (naming the first file).
     """
     dt = recordings[0].dt
     levels = [sensor_level(center, r.sensor, dt, tare_seconds=tare_seconds,
@@ -136,6 +164,26 @@ def _covariance(s: Sequence[np.ndarray], p: Sequence[np.ndarray]) -> float:
 def centre_and_scale(recording: Recording, center: str) -> tuple[Scaling, np.ndarray,
                                                                  np.ndarray]:
     """One recording's scaling and its normalised sensor and position (eq. 5.10), centred
-    by ``center`` as a fit would (compare and the benchmarks use it)."""
+    by ``center`` as a fit would (compare and the benchmarks use it).
+
+    Parameters
+    ----------
+    recording : Recording
+        A recording with position and sensor.
+    center : {"fit", "tare", "track", "recording", "none"}
+        Centring mode.
+
+    Returns
+    -------
+    scaling : Scaling
+        Its offsets and scales.
+    s, p : numpy.ndarray, shape (n,)
+        Normalised sensor and position.
+
+    Raises
+    ------
+    InputError
+        A constant position or sensor column.
+    """
     conventions, s, p = prepare_training_data([recording], center)
     return conventions["scaling"], s[0], p[0]

@@ -29,7 +29,23 @@ SCORE_KEYS = ("r2", "e_rms_pct", "e_max_pct", "sinad_db", "loop_area")
 def use_flags(compensator: Compensator, recording: Recording,
               estimate: np.ndarray) -> dict[str, np.ndarray | None]:
     """Per-sample use-time guards: sensor outside the training range, estimate outside the
-    training position range (margins ``SENSOR_MARGIN`` / ``POSITION_MARGIN``)."""
+    training position range (margins ``SENSOR_MARGIN`` / ``POSITION_MARGIN``).
+
+    Parameters
+    ----------
+    compensator : Compensator
+        The fitted compensator.
+    recording : Recording
+        The recording the estimate was made from.
+    estimate : numpy.ndarray, shape (n,)
+        The compensator's estimate [mm].
+
+    Returns
+    -------
+    dict
+        ``sensor_outside`` and ``estimate_outside``: boolean masks, shape (n,), or None when the
+        model file does not know the range.
+    """
     return {"sensor_outside": compensator.sensor_outside(recording),
             "estimate_outside": compensator.estimate_outside(estimate)}
 
@@ -48,6 +64,16 @@ def evaluate(compensator: Compensator, recording: Recording, *,
     Errors in per cent are relative to the fitting data's max |position| (eq. 5.10-5.11).
     ``loop_area`` is the normalised loop area (eq. 5.15) of the estimate against the measured
     position (0 for a perfect compensator); ``sensor_loop_area`` is that of the raw sensor.
+
+    Parameters
+    ----------
+    compensator : Compensator
+        The fitted compensator.
+    recording : Recording
+        A recording with a position column.
+    rest_position : float, optional
+        Where the device rests during the tare window [mm], if not where it rested in
+        training; used only by the ``tare`` centring.
 
     Returns
     -------

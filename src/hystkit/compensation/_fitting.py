@@ -95,8 +95,12 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
     **structure_options
         Passed to the family's ``make_structure`` (mPL: ``slope_cap``).
 
-    The fit's ``status`` in ``fit_info`` is ``ok`` only if the model is not constant, beats the
-    straight line on the training data, has no parameter on a bound and converged.
+    Returns
+    -------
+    Compensator
+        The fitted compensator. The fit's ``status`` in ``fit_info`` is ``ok`` only if the
+        model is not constant, beats the straight line on the training data, has no parameter
+        on a bound and converged.
     """
     recs = [recordings] if isinstance(recordings, Recording) else list(recordings)
     if not recs:

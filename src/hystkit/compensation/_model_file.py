@@ -47,7 +47,18 @@ SCHEMA_VERSION = 1
 
 
 def compensator_to_dict(comp: Compensator) -> dict:
-    """Plain-JSON form: model type, structure, parameters, normalisation, dt, baseline, fit."""
+    """Plain-JSON form: model type, structure, parameters, normalisation, dt, baseline, fit.
+
+    Parameters
+    ----------
+    comp : Compensator
+        The compensator.
+
+    Returns
+    -------
+    dict
+        Plain JSON (numbers, strings, lists, dicts).
+    """
     return {
         "schema": SCHEMA,
         "schema_version": SCHEMA_VERSION,
@@ -80,6 +91,24 @@ def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
     Every value is checked (type, finiteness, size; :func:`check_model_dict`) before the
     family sees it, and whatever the family's own validation raises becomes an InputError
     naming the key path (``params.a``): a model file is untrusted input.
+
+    Parameters
+    ----------
+    d : dict
+        The plain-JSON form (:func:`compensator_to_dict`).
+    source : str, default "<dict>"
+        Name used in error messages (the file).
+
+    Returns
+    -------
+    Compensator
+        The compensator, with ``source`` set.
+
+    Raises
+    ------
+    InputError
+        Another schema or schema version, a missing key, or a value of the wrong type, size or
+        range.
     """
     if not isinstance(d, dict) or d.get("schema") != SCHEMA:
         found = d.get("schema") if isinstance(d, dict) else type(d).__name__
@@ -168,7 +197,29 @@ MAT_JSON_KEY = "hystkit_json"  # the variable of a .mat model file that hystkit 
 
 def save_compensator(comp: Compensator, path: str | Path, *, force: bool = False) -> Path:
     """Write the model file, JSON or MATLAB by the extension of `path` (``.json``/``.mat``);
-    refuses another extension, and to overwrite unless ``force``."""
+    refuses another extension, and to overwrite unless ``force``.
+
+    Parameters
+    ----------
+    comp : Compensator
+        The compensator.
+    path : str or pathlib.Path
+        Output file, ``.json`` or ``.mat``.
+    force : bool, default False
+        Replace an existing file.
+
+    Returns
+    -------
+    pathlib.Path
+        `path`.
+
+    Raises
+    ------
+    OutputError
+        Another extension.
+    OutputExistsError
+        `path` exists and `force` is False.
+    """
     path = Path(path)
     d = compensator_to_dict(comp)
     if check_output_format(path, MODEL_SUFFIXES, "a model file") == ".json":
@@ -188,6 +239,16 @@ def load_compensator(path: str | Path) -> Compensator:
 
     ``.mat`` files (written by :func:`save_compensator`) are parsed in a child process like
     every MATLAB input.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A ``.json`` or ``.mat`` model file.
+
+    Returns
+    -------
+    Compensator
+        The compensator, with ``source`` naming `path`.
 
     Raises
     ------

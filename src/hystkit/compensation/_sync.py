@@ -55,7 +55,7 @@ _PLAY_THRESHOLD: dict[str, Callable] = {
 class SyncExcitation:
     """A synchronisation excitation and the model state it leaves.
 
-    Attributes
+    Parameters
     ----------
     quantity : {"position", "sensor"}
         What is applied: the position for an inverse compensator, the sensor for a direct one.
@@ -110,6 +110,26 @@ def sync_excitation(comp: Compensator, *, tolerance: float = DEFAULT_TOLERANCE,
                     min_hold_seconds: float = DEFAULT_MIN_HOLD_SECONDS,
                     n_histories: int = 6, seed: int = 0) -> SyncExcitation:
     """Build e_sync for ``comp`` and the state it leaves (module docstring).
+
+    Parameters
+    ----------
+    comp : Compensator
+        The compensator to synchronise.
+    tolerance : float, default 1e-6
+        Largest spread of the final states, relative to ``max(1, max|state|)``.
+    max_seconds : float, default 600.0
+        Longest hold [s] tried before giving up.
+    min_hold_seconds : float, default 0.5
+        First hold [s] tried; doubled until the states agree.
+    n_histories : int, default 6
+        Prior histories the excitation is run from.
+    seed : int, default 0
+        Seed of the random prior histories.
+
+    Returns
+    -------
+    SyncExcitation
+        The excitation, its levels and hold, and the state it leaves.
 
     Raises
     ------

@@ -39,6 +39,15 @@ def check_fitting_data(recordings: Sequence[Recording], family: Family | None = 
     """Every check of this module, before any fit: enough samples (per parameter of `family`
     at `structure` when given) and a position and sensor that move.
 
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        Fitting recordings.
+    family : Family, optional
+        The family to be fitted; without it only a general minimum of samples is required.
+    structure : object, optional
+        The family's structure, whose parameter count sets the samples needed.
+
     Raises
     ------
     InputError
@@ -51,6 +60,11 @@ def check_fitting_data(recordings: Sequence[Recording], family: Family | None = 
 
 def check_excursion(recordings: Sequence[Recording]) -> None:
     """Refuse a position or sensor column without a usable excursion.
+
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        Fitting recordings.
 
     Raises
     ------
