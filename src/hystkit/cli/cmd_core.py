@@ -50,12 +50,26 @@ def _simulate_sensor(args: argparse.Namespace) -> int:
     from ..signals import EXPERIMENTS
 
     if args.raw:
+        if args.gain_drift is not None or args.references_every is not None:
+            raise UsageError("--gain-drift and --references-every apply to the 40 Hz "
+                             "recording, not to --raw")
         return run_raw_simulation(args)
     check_output_path(args.out, args.force)
     rec = simulate_experiment(args.excitation, seed=args.seed, sensor=sensor_from_args(args))
-    write_recording(rec, args.out, force=args.force)
+    if args.gain_drift is not None:
+        from ..sensors import with_gain_drift
+
+        rec = with_gain_drift(rec, args.gain_drift)
+    kept, note = {}, ""
+    if args.references_every is not None:  # empty cells where unknown: kept, not checked
+        from ..sensors import occasional_references
+
+        kept = {"reference": occasional_references(rec, args.references_every, args.seed)}
+        note = f", a 'reference' column (one true position per {args.references_every:g} s)"
+    write_recording(rec, args.out, force=args.force, kept=kept)
+    drift = "" if args.gain_drift is None else f", sensor gain drift {args.gain_drift:+.1%}"
     print(f"wrote {args.out}: {EXPERIMENTS[args.excitation].description}, seed {args.seed}, "
-          f"{rec.n_samples} samples at {rec.fs:g} Hz")
+          f"{rec.n_samples} samples at {rec.fs:g} Hz{drift}{note}")
     return 0
 
 
@@ -390,6 +404,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="random seed, 0 to 2^32 - 1 (default 0)")
     p.add_argument("--out", type=Path, required=True, help="CSV or Parquet file to write")
     add_simulation_options(p)
+    p.add_argument("--gain-drift", type=number(-0.9, 10.0), default=None, metavar="FRACTION",
+                   help="multiply the sensor signal by a gain rising linearly from 1 to "
+                        "1 + FRACTION over the run (0.1: +10 %%; for 'hystkit stream --adapt')")
+    p.add_argument("--references-every", type=number(0, 1e6, low_open=True), default=None,
+                   metavar="S", help="add a 'reference' column: the true position at one random "
+                   "sample in each S seconds, empty elsewhere (the occasional references of "
+                   "'hystkit stream --adapt')")
     p.set_defaults(run=_simulate_sensor)
 
     p = sub.add_parser("fit", help="fit a compensator to a recording")
