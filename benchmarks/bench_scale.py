@@ -1,6 +1,7 @@
 """Scaling of the parallel searches and of ``hystkit batch`` (issue 13).
 
 Run:  python benchmarks/bench_scale.py [--repeats N] [--small] [--out FILE]
+      (writes benchmarks/last_run_scale.txt unless --out names another file)
 
 Whole-process wall time, from starting ``python -m hystkit ...`` to its exit (what a user
 waits for: start-up, reading, the work, writing), of
@@ -12,6 +13,11 @@ waits for: start-up, reading, the work, writing), of
   cores;
 - ``compare`` inside one process, split into start-up, opening the executor (Dask import,
   kernel warm-up, cluster start), the map and closing, to see where the time goes;
+- the pieces of ``compare``, ``generalize`` and ``select``, timed one by one in one process
+  (CPU seconds): their sum, the longest one, and what that allows on 2 workers
+  (``max(longest, sum / 2)``, the critical path of a longest-first schedule's bound);
+- one long fit's multi-start (Bouc-Wen, Chua and PL on 8000 samples) serially and with a
+  2-worker executor open, where its starts are screened on the workers;
 - a fleet of 20 virtual sensors (different seeds; a fit and a validation recording each)
   through ``hystkit batch`` at 1 and 2 workers, against a shell loop that runs ``hystkit fit``
   and ``hystkit evaluate`` for each sensor (the same work: fit, model file, scores).
@@ -20,7 +26,8 @@ Paired and interleaved: every repeat runs each configuration once, the order of 
 counts alternating between repeats, so bursts of load hit both alike; reported are the medians
 and the median of the per-repeat speed-ups. Wall and CPU time (user + system of the command
 and its workers) are both given: on a shared machine the wall time carries the other jobs'
-load. ``--small``: 4000-sample recordings, 8 sensors, ``generalize`` on the two recordings,
+load, and CPU 1 / CPU 2 (the work the serial run does over what the parallel one does, 1.00 =
+no parallel overhead) is the figure that load changes least. ``--small``: 4000-sample recordings, 8 sensors, ``generalize`` on the two recordings,
 fewer select candidates (a quick check, not the issue's numbers).
 """
 
@@ -60,10 +67,92 @@ print(json.dumps({"start-up": t1 - t0, "open": t2 - t1, "map": t3 - t2, "close":
 """
 
 
+# Every piece of compare, generalize and select run serially in one process, each timed (CPU
+# seconds of this process): which piece is the critical path of a parallel map?
+PIECES = """
+import json, time
+from hystkit.io import read_recording
+from hystkit.models import FAMILIES
+from hystkit.parallel import SerialExecutor
+from hystkit.parallel._dask import warm_kernels
+from hystkit.reports import candidates, compare_models, generalization_matrix, select_model
+from hystkit.sensors import simulate_experiment
+from hystkit.signals import EXPERIMENTS
+
+class Timed(SerialExecutor):
+    def map(self, func, items, *, shared=None, on_done=None, cost=None):
+        out = []
+        for item in items:
+            c0 = time.process_time()
+            out.append(func(item, **(shared or {})))
+            self.pieces.append((str(item)[:60], time.process_time() - c0))
+        return out
+
+warm_kernels()  # kernel loading is not a piece's work
+fit, val = read_recording("fit.csv"), read_recording("val.csv")
+small = SMALL
+train = ({"fit": fit, "val": val} if small else
+         {name: simulate_experiment(name, 1) for name in EXPERIMENTS})
+test = ({"fit": fit, "val": val} if small else
+        {name: simulate_experiment(name, 2) for name in EXPERIMENTS})
+select_models = ["mpl", "pi", "bobbio", "chua"] if small else None  # as the commands below
+runs = {"compare": lambda ex: compare_models(fit, val, executor=ex),
+        "generalize": lambda ex: generalization_matrix(train, test, sorted(FAMILIES),
+                                                       executor=ex),
+        "select": lambda ex: select_model([fit], candidates(select_models), executor=ex)}
+report = {}
+for name, run in runs.items():
+    ex = Timed(); ex.pieces = []
+    c0 = time.process_time()
+    run(ex)
+    total = time.process_time() - c0
+    report[name] = {"pieces": ex.pieces, "outside": total - sum(s for _, s in ex.pieces)}
+print(json.dumps(report))
+"""
+
+# One long fit, serially and with a 2-worker executor open (its starts on the workers): wall
+# and CPU (this process and its workers). Each fit runs twice; the second is timed.
+MULTISTART = """
+import json, resource, sys, time
+from hystkit.compensation import centre_and_scale
+from hystkit.io import read_recording
+from hystkit.models import get_family
+from hystkit.parallel import open_executor
+
+def cpu():
+    s, c = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return s.ru_utime + s.ru_stime + c.ru_utime + c.ru_stime
+
+rec = read_recording("fit.csv")
+_, sensor, position = centre_and_scale(rec, "fit")
+out = {}
+def fits(tag):
+    for name in ("boucwen", "chua", "pl"):
+        family = get_family(name)
+        structure = family.make_structure(rec.dt, family.default_size)
+        family.fit(position, sensor, structure)
+        t0 = time.perf_counter()
+        family.fit(position, sensor, structure)
+        out[f"{name} {tag}"] = time.perf_counter() - t0
+if sys.argv[1] == "1":
+    fits("@1")
+else:
+    with open_executor(2) as executor:
+        fits("@2")
+print(json.dumps({**out, "cpu": cpu()}))
+"""
+
+
 def _machine() -> str:
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     return (f"platform {platform.platform()}; cpus {os.cpu_count()}; load average {load}\n"
             f"python {platform.python_version()} ({sys.executable})")
+
+
+def _python(code: str, cwd: Path, *argv: str) -> dict:
+    """The JSON that `code` prints, run in a fresh Python process."""
+    return json.loads(subprocess.run([sys.executable, "-c", code, *argv], cwd=cwd, check=True,
+                                     capture_output=True, text=True).stdout)
 
 
 def _run(argv: list[str], cwd: Path) -> tuple[float, float]:
@@ -122,56 +211,80 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--small", action="store_true")
-    parser.add_argument("--out", type=Path, help="also write the report here")
+    parser.add_argument("--out", type=Path, default=Path(__file__).with_name(
+        "last_run_scale.txt"), help="also write the report here (default: %(default)s)")
     args = parser.parse_args()
     n_samples, n_sensors = (4000, 8) if args.small else (8000, N_SENSORS)
     commands = _commands(args.small)
     times: dict[str, list[tuple[float, float]]] = {}
+    load_before = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         cwd = Path(tmp)
         (cwd / "loop").mkdir()
         _recordings(cwd, n_samples, n_sensors)
+        pieces = _python(PIECES.replace("SMALL", str(args.small)), cwd)
+        print("pieces timed", file=sys.stderr, flush=True)
         for repeat in range(args.repeats):
             order = ("1", "2") if repeat % 2 == 0 else ("2", "1")
             times.setdefault("shell loop", []).append(_run(["bash", "loop.sh"], cwd))
             for workers in order:
-                parts = json.loads(subprocess.run(
-                    [sys.executable, "-c", BREAKDOWN, workers], cwd=cwd, check=True,
-                    capture_output=True, text=True).stdout)
-                for part, seconds in parts.items():
+                for part, seconds in _python(BREAKDOWN, cwd, workers).items():
                     times.setdefault(f"in-process compare {part} @{workers}", []).append(
                         (seconds, 0.0))
+                fits = _python(MULTISTART, cwd, workers)
+                cpu = fits.pop("cpu")
+                for key, seconds in fits.items():
+                    times.setdefault(f"multistart {key}", []).append((seconds, 0.0))
+                times.setdefault(f"multistart cpu @{workers}", []).append((cpu, 0.0))
             for name, argv in commands.items():
                 for workers in order:
                     times.setdefault(f"{name} @{workers}", []).append(
                         _run([*argv, "--workers", workers], cwd))
             print(f"repeat {repeat + 1}/{args.repeats} done", file=sys.stderr, flush=True)
-    report = _report(times, commands, args, n_samples, n_sensors)
+    report = _report(times, commands, args, n_samples, n_sensors, load_before, pieces)
     print(report)
-    if args.out is not None:
-        args.out.write_text(report + "\n")
+    args.out.write_text(report + "\n")
 
 
 def _report(times: dict, commands: dict, args: argparse.Namespace, n_samples: int,
-            n_sensors: int) -> str:
+            n_sensors: int, load_before: tuple, pieces: dict) -> str:
     med = {k: statistics.median(w for w, _ in v) for k, v in times.items()}
     cpu = {k: statistics.median(c for _, c in v) for k, v in times.items()}
+    loads = ", ".join(f"{x:.2f}" for x in load_before)
     lines = [(f"hystkit scaling (issue 13): whole-process wall time [s], median of "
              f"{args.repeats} interleaved repeats{' (--small)' if args.small else ''}"),
-             _machine(), f"recordings of {n_samples} samples; fleet of {n_sensors} sensors", "",
+             _machine() + f" (at the end; at the start {loads})",
+             f"recordings of {n_samples} samples; fleet of {n_sensors} sensors", "",
              (f"{'command':<12}{'1 worker':>10}{'2 workers':>11}{'speed-up':>10}"
-             f"{'(per-repeat median)':>21}{'CPU 1':>8}{'CPU 2':>8}")]
+             f"{'(per-repeat median)':>21}{'CPU 1':>8}{'CPU 2':>8}{'CPU 1/2':>9}")]
     for name in commands:
         one, two = times[f"{name} @1"], times[f"{name} @2"]
         ratio = statistics.median(a[0] / b[0] for a, b in zip(one, two))
         lines.append(f"{name:<12}{med[f'{name} @1']:>10.2f}{med[f'{name} @2']:>11.2f}"
                      f"{med[f'{name} @1'] / med[f'{name} @2']:>9.2f}x{ratio:>20.2f}x"
-                     f"{cpu[f'{name} @1']:>8.1f}{cpu[f'{name} @2']:>8.1f}")
+                     f"{cpu[f'{name} @1']:>8.1f}{cpu[f'{name} @2']:>8.1f}"
+                     f"{cpu[f'{name} @1'] / cpu[f'{name} @2']:>9.2f}")
     lines += ["", "compare in one process [s]: " + "; ".join(
         f"{part} {med[f'in-process compare {part} @1']:.2f} / "
         f"{med[f'in-process compare {part} @2']:.2f}"
         for part in ("start-up", "open", "map", "close")) + " (1 / 2 workers); map efficiency "
         f"{med['in-process compare map @1'] / (2 * med['in-process compare map @2']):.2f}"]
+    lines += ["", ("pieces, each timed alone in one process (CPU s): sum, longest, the bound "
+              "on a 2-worker map max(longest, sum / 2), and work outside the map")]
+    for name, entry in pieces.items():
+        seconds = [s for _, s in entry["pieces"]]
+        label, longest = max(entry["pieces"], key=lambda piece: piece[1])
+        bound = max(longest, sum(seconds) / 2)
+        lines.append(f"  {name:<11}{len(seconds):>3} pieces, sum {sum(seconds):6.2f}, longest "
+                     f"{longest:5.2f} ({label}), bound {bound:5.2f} (at most "
+                     f"{sum(seconds) / bound:.2f}x), outside {entry['outside']:5.2f}")
+    fits = [k.split()[1] for k in times if k.startswith("multistart") and k.endswith("@1")
+            and "cpu" not in k]
+    lines += ["", "one fit on 8000 samples, wall [s] serial / 2-worker executor open (starts "
+              "on the workers): " + "; ".join(
+                  f"{fit} {med[f'multistart {fit} @1']:.2f} / {med[f'multistart {fit} @2']:.2f}"
+                  for fit in fits) + f" (CPU of the process incl. start-up "
+              f"{med['multistart cpu @1']:.1f} / {med['multistart cpu @2']:.1f})"]
     loop = med["shell loop"]
     lines += ["", (f"{n_sensors} sensors: shell loop of hystkit fit + evaluate {loop:.2f} s "
               f"(CPU {cpu['shell loop']:.1f} s, {loop / n_sensors:.2f} s per sensor); "
@@ -180,7 +293,7 @@ def _report(times: dict, commands: dict, args: argparse.Namespace, n_samples: in
               f"({loop / med['batch @2']:.1f}x faster)"),
               "all times: " + "; ".join(f"{k} " + ", ".join(f"{w:.2f}" for w, _ in v)
                                         for k, v in times.items()
-                                        if not k.startswith("in-process"))]
+                                        if not k.startswith(("in-process", "multistart")))]
     return "\n".join(lines)
 
 

@@ -59,7 +59,8 @@ def test_split_multistart_equals_the_serial_fit(name, fit_data, forked_cluster, 
                                                 monkeypatch):
     serial = _fit(name, fit_data)
     assert current_executor() is forked_cluster
-    monkeypatch.setattr(least_squares, "SPLIT_MIN_SECONDS", 0.0)  # split every fit
+    monkeypatch.setattr(least_squares, "SPLIT_MIN_START", 0.0)  # split every fit
+    monkeypatch.setattr(least_squares, "SPLIT_MIN_SECONDS", 0.0)
     split = _fit(name, fit_data)
     assert maps_run and all(func == "_solve_start" for func, _ in maps_run)
     assert np.array_equal(split.theta, serial.theta)
@@ -70,9 +71,20 @@ def test_split_multistart_equals_the_serial_fit(name, fit_data, forked_cluster, 
 
 
 def test_short_fits_stay_serial(fit_data, forked_cluster, maps_run, monkeypatch):
-    monkeypatch.setattr(least_squares, "SPLIT_MIN_SECONDS", float("inf"))
+    monkeypatch.setattr(least_squares, "SPLIT_MIN_START", float("inf"))
     _fit("chua", fit_data)
     assert maps_run == []
+
+
+def test_few_short_starts_polish_side_by_side_only(fit_data, forked_cluster, maps_run,
+                                                   monkeypatch):
+    serial = _fit("chua", fit_data)
+    monkeypatch.setattr(least_squares, "SPLIT_MIN_START", 0.0)
+    monkeypatch.setattr(least_squares, "SPLIT_MIN_SECONDS", float("inf"))
+    polished = _fit("chua", fit_data)
+    assert maps_run and all(func == "_solve_start" and n <= 2 for func, n in maps_run)
+    assert np.array_equal(polished.theta, serial.theta)
+    assert polished.n_evaluations == serial.n_evaluations
 
 
 def test_the_executor_is_current_only_where_it_is_open(forked_cluster):

@@ -34,12 +34,17 @@ from ._trust_region import solve_trust_region
 __all__ = ["check_fit_data", "fit_multistart"]
 
 _SOLVERS = {"tr": solve_trust_region, "lm": solve_lm, "trf": None}
-# A start's screening solve that takes this long or more [s] is worth a task of its own when
-# an executor is open: a task on a local Dask cluster costs ~5-10 ms to submit, send (the
-# closures and the data, ~100 kB at 8000 samples) and collect, and one on a remote cluster
-# more; below this, splitting would spend a tenth or more of the work on moving it. Fits
-# this short (bobbio, pi, the mPL family at 8000 samples: 10-20 ms a start) stay serial.
-SPLIT_MIN_SECONDS = 0.1
+# When an executor is open, a fit's other starts are screened on its workers if the first
+# start's solve took SPLIT_MIN_START or more and all of them together take SPLIT_MIN_SECONDS
+# or more (CPU seconds of this thread, which the machine's load does not inflate). A map on a
+# local 2-worker Dask cluster costs ~30-60 ms (send the closures and the data, ~130-200 kB at
+# 8000 samples, once to each worker; submit; collect), a task ~5 ms more: 0.25 s of starts
+# save ~0.12 s on 2 workers, twice that overhead or more. Fits this short stay serial: the
+# mPL family, PI, Bobbio at 8000 samples (10-20 ms a start); Chua (~50 ms a start, 7 more
+# starts), PL (~90 ms, 11) and Bouc-Wen split. The polishes (up to `max_nfev` evaluations
+# each, against `screen_nfev`) of a fit above SPLIT_MIN_START run side by side.
+SPLIT_MIN_START = 0.02
+SPLIT_MIN_SECONDS = 0.25
 
 
 def check_fit_data(u: np.ndarray, y: np.ndarray,
@@ -88,7 +93,7 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
     ones are skipped and counted.
 
     While a parallel executor is open in this process (`hystkit.parallel.open_executor`), a
-    fit whose first screening solve takes `SPLIT_MIN_SECONDS` or more screens its other
+    fit whose starts are long enough to pay for it (see `SPLIT_MIN_SECONDS`) screens its other
     starts on the workers, and polishes its first ``n_polish`` candidates side by side there;
     every solve is the same pure function of its start, so the result is the serial one, bit
     for bit (only ``seconds`` differs). Inside a Dask worker no executor is open: a fit that
@@ -231,19 +236,24 @@ class _StartSolver:
 
 def _screen(solve: _StartSolver, thetas: list[np.ndarray],
             budget: int) -> tuple[list[SimpleNamespace], Executor | None]:
-    """Every start's screening solve, in order, and the executor the polish may use.
+    """Every start's screening solve, in order, and the executor the polish may use (None
+    for a fit whose first start took less than `SPLIT_MIN_START`).
 
-    The first start runs here, timed; if it took `SPLIT_MIN_SECONDS` or more and an executor
-    is open (`hystkit.parallel.current_executor`), the other starts run on its workers (at
-    least two of them: one would only wait for the other), else here after it.
+    The first start runs here, timed; if it and the others at its cost would take long
+    enough (`SPLIT_MIN_START`, `SPLIT_MIN_SECONDS`) and an executor is open
+    (`hystkit.parallel.current_executor`), the other starts run on its workers (at least two
+    of them: one would only wait for the other), else here after it.
     """
     executor = current_executor()
     if executor is None or len(thetas) < 3:
         return [solve(theta, budget) for theta in thetas], None
-    t0 = time.perf_counter()
+    t0 = time.thread_time()
     first = solve(thetas[0], budget)
-    if time.perf_counter() - t0 < SPLIT_MIN_SECONDS:
+    seconds = time.thread_time() - t0
+    if seconds < SPLIT_MIN_START:
         return [first, *(solve(theta, budget) for theta in thetas[1:])], None
+    if seconds * (len(thetas) - 1) < SPLIT_MIN_SECONDS:  # polishes still pay: longer
+        return [first, *(solve(theta, budget) for theta in thetas[1:])], executor
     return [first, *_solve_on(executor, solve, thetas[1:], budget)], executor
 
 
