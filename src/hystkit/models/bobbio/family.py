@@ -16,6 +16,8 @@ __all__ = ["BobbioFamily"]
 
 
 class BobbioFamily(Family):
+    """The Bobbio-Marrucci spring/piston chain (sec. 2.1.4) as a registered family."""
+
     name = "bobbio"
     title = "Bobbio-Marrucci springs and friction pistons (sec. 2.1.4, eq. 2.5)"
     size_help = "springs N, with N - 1 pistons (2N params)"

@@ -26,7 +26,20 @@ _SPACING = (1.0, 2.0)  # radius of spring k+1 grows like (k / (N - 1)) ** power
 
 
 def candidate_thresholds(structure: bobbio.BobbioStructure, u: np.ndarray) -> list[np.ndarray]:
-    """Threshold sets ``a`` (shape (N - 1,)) tried by :func:`fit_bobbio`."""
+    """Threshold sets ``a`` (shape (N - 1,)) tried by :func:`fit_bobbio`.
+
+    Parameters
+    ----------
+    structure : bobbio.BobbioStructure
+        The chain's structure (``N`` springs).
+    u : numpy.ndarray, shape (n,)
+        Applied force; its range scales the thresholds.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        Threshold sets, each of shape (N - 1,).
+    """
     m = structure.n_springs - 1
     if m == 0:
         return [np.empty(0)]
@@ -63,10 +76,17 @@ def fit_bobbio(u: np.ndarray, y: np.ndarray, structure: bobbio.BobbioStructure, 
     ----------
     u, y : array, shape (n,)
         Centred, normalised data (eq. 5.10).
+    structure : bobbio.BobbioStructure
+        The chain's structure (``N`` springs).
     thresholds : list of arrays, optional
         Candidate threshold sets; default :func:`candidate_thresholds` (14 sets).
     accept, accept_reason
         Candidates with ``accept(params)`` false are skipped, cheapest first.
+
+    Returns
+    -------
+    FitResult
+        The best candidate's parameters and cost.
 
     Raises
     ------

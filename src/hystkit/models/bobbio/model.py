@@ -151,13 +151,45 @@ class BobbioParams(Record):
 
 def output_bound(params: BobbioParams, u_max: float) -> float:
     """``sum(c) u_max + |b|``: no output of a run whose inputs and initial forces stay within
-    ``u_max`` in magnitude exceeds it (every spring force is a play of the input)."""
+    ``u_max`` in magnitude exceeds it (every spring force is a play of the input).
+
+    Parameters
+    ----------
+    params : BobbioParams
+        Its parameters.
+    u_max : float
+        Bound on the magnitude of the inputs and the initial forces.
+
+    Returns
+    -------
+    float
+        ``sum(c) u_max + |b|``.
+    """
     return float(params.compliance.sum() * u_max + abs(params.offset))
 
 
 def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """Apply force ``u``: project the spring forces onto eq. 2.5, then read the deformation."""
+    """Apply force ``u``: project the spring forces onto eq. 2.5, then read the deformation.
+
+    Parameters
+    ----------
+    structure : BobbioStructure
+        The model's structure.
+    params : BobbioParams
+        Its parameters.
+    x : numpy.ndarray
+        State before the sample.
+    u : float
+        Applied force of the sample.
+
+    Returns
+    -------
+    y : float
+        Output from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
+    """
     x_next = np.array(x, dtype=float)
     prev = u
     for k in range(x_next.size):
@@ -170,7 +202,26 @@ def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
 def invert_step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of :func:`invert`: the force that gives ``y`` from the forces ``x``, and the
-    forces it leaves; NaN (and a NaN state) where no force gives ``y``, as the loop block."""
+    forces it leaves; NaN (and a NaN state) where no force gives ``y``, as the loop block.
+
+    Parameters
+    ----------
+    structure : BobbioStructure
+        The model's structure.
+    params : BobbioParams
+        Its parameters.
+    x : numpy.ndarray
+        State before the sample.
+    y : float
+        Output to reach at this sample.
+
+    Returns
+    -------
+    u : float
+        Input that gives `y` from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
+    """
     x = np.array(x, dtype=float)
     x_next = x.copy()
     f = kernels.invert_sample(x, x_next, 0, float(y), params.compliance, params.friction,
@@ -187,7 +238,24 @@ def rest_state(structure: BobbioStructure, params: BobbioParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """Every spring carrying the force ``value`` (``inverse``: the force ``(value - b) / sum(c)``
     that gives the deformation ``value``), no piston loaded: the start of ``simulate`` /
-    ``invert`` with ``x0=None``."""
+    ``invert`` with ``x0=None``.
+
+    Parameters
+    ----------
+    structure : BobbioStructure
+        The model's structure.
+    params : BobbioParams
+        Its parameters.
+    value : float
+        Constant input (with `inverse`: output) the model rests at.
+    inverse : bool, default False
+        Rest state of the inverse: `value` is an output.
+
+    Returns
+    -------
+    numpy.ndarray
+        The state at rest.
+    """
     force = _rest_force(params, value) if inverse else float(value)
     return np.full(params.n_springs - 1, force)
 
@@ -203,6 +271,24 @@ def forces(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
     """Spring forces ``F_2 .. F_N`` after each sample, shape (n, N - 1), and the final state.
 
     The output is linear in them: ``y = c_1 u + forces @ c[1:] + b`` (the fit uses this).
+
+    Parameters
+    ----------
+    structure : BobbioStructure
+        The model's structure.
+    params : BobbioParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Applied force, one value per sample.
+    x0 : numpy.ndarray, float or None, optional
+        Initial forces ``F_2 .. F_N``, as for :func:`simulate`.
+
+    Returns
+    -------
+    forces : numpy.ndarray, shape (n, N - 1)
+        ``F_2 .. F_N`` after each sample.
+    x_end : numpy.ndarray, shape (N - 1,)
+        The forces after the last sample.
     """
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_springs - 1, x0, u[0])
@@ -215,6 +301,10 @@ def simulate(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
 
     Parameters
     ----------
+    structure : BobbioStructure
+        The model's structure.
+    params : BobbioParams
+        Its parameters.
     u : array, shape (n,)
         Applied force, one value per sample (only the values matter, not ``dt``).
     x0 : array, shape (N - 1,), float or None
@@ -236,7 +326,26 @@ def simulate(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
 
 def simulate_reference(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step`."""
+    """Same as :func:`simulate`, as a plain loop over :func:`step`.
+
+    Parameters
+    ----------
+    structure : BobbioStructure
+        The model's structure.
+    params : BobbioParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Input, one value per sample.
+    x0 : numpy.ndarray, float or None, optional
+        Initial forces ``F_2 .. F_N``, as for :func:`simulate`.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Output.
+    x_end : numpy.ndarray
+        State after the last sample.
+    """
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_springs - 1, x0, u[0])
     return run_steps(step, structure, params, u, x)
@@ -255,9 +364,20 @@ def invert(structure: BobbioStructure, params: BobbioParams, y: np.ndarray,
 
     Parameters
     ----------
+    structure : BobbioStructure
+        The model's structure.
+    params : BobbioParams
+        Its parameters.
     y : array, shape (n,)
     x0 : array, shape (N - 1,), float or None
         ``None``: at rest at the force ``(y_0 - b) / sum(c)``.
+
+    Returns
+    -------
+    u : numpy.ndarray, shape (n,)
+        Input that gives `y`.
+    x_end : numpy.ndarray
+        State after the last sample.
 
     Raises
     ------
