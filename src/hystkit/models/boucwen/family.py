@@ -16,6 +16,8 @@ __all__ = ["BoucWenFamily"]
 
 
 class BoucWenFamily(Family):
+    """The Bouc-Wen oscillator (Noel and Schoukens' benchmark) as a registered family."""
+
     name = "boucwen"
     title = ("Bouc-Wen oscillator, m y'' + c y' + k y + z = u (beyond the document; "
              "Noel-Schoukens benchmark)")

@@ -50,6 +50,22 @@ def parameter_bounds(structure: boucwen.BoucWenStructure, u: np.ndarray, y: np.n
     (``duration`` [s]) to ``1 / h`` (the RK4 step ``h = dt / substeps``), the shape parameters
     scaled by the output amplitude ``y_ref = 2 rms(y)``. ``u`` and ``y`` are paired samples.
     ``bounded`` keeps ``beta + gamma`` and ``beta - gamma`` non-negative (bounded ``z``).
+
+    Parameters
+    ----------
+    structure : boucwen.BoucWenStructure
+        The model's structure.
+    u, y : numpy.ndarray, shape (n,)
+        Paired force and displacement samples.
+    duration : float
+        Length [s] of the record.
+    bounded : bool, default False
+        Keep ``beta + gamma`` and ``beta - gamma`` non-negative.
+
+    Returns
+    -------
+    lower, upper : numpy.ndarray, shape (7,)
+        Bounds on the parameter vector (:meth:`BoucWenParams.to_vector`).
     """
     gain = float(np.dot(u, y) / np.dot(u, u))
     k0 = 1.0 / gain if gain > 0 else float(np.std(u) / np.std(y))
@@ -125,11 +141,17 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
     bounded : bool
         Only loops whose ``z`` stays bounded (``beta + gamma >= 0``, ``beta - gamma >= 0``);
         the benchmark's loop stiffens on loading and is outside this class.
+    stride : int, default 1
+        Model samples per data sample (see `y`).
+    discard : int, default 0
+        Leading data samples not compared (see `y`).
     max_nfev, screen_nfev, n_polish : int
         As in :func:`~hystkit.identification.fit_multistart`.
     accept : callable, optional
         A candidate counts only if ``accept(params)`` is true; ``accept_reason`` says why others
         were rejected.
+    accept_reason : str, optional
+        Why candidates were rejected, for the message.
     solver : {"tr", "lm", "trf"}
         See :func:`~hystkit.identification.fit_multistart`. The difference Jacobian is formed
         densely (``n x 7``): the residual's stride, discard and divergence penalty do not split
@@ -239,6 +261,24 @@ def fit_family(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructure
     Unrestricted fits on the virtual sensor chose loops outside that class (stiffening on
     loading or softening on unloading, i.e. ``z`` unbounded), and they generalised worse where
     it mattered most: sine validation R^2 0.875 against 0.938 (docs/models/boucwen.md).
+
+    Parameters
+    ----------
+    u, y : numpy.ndarray, shape (n,)
+        Force and displacement, centred and normalised (eq. 5.10).
+    structure : boucwen.BoucWenStructure
+        The model's structure.
+    accept : callable, optional
+        A candidate counts only if ``accept(params)`` is true.
+    accept_reason : str, optional
+        Why other candidates were rejected, for the message.
+    **options
+        Passed to :func:`fit_boucwen`.
+
+    Returns
+    -------
+    FitResult
+        As :func:`fit_boucwen`.
     """
     options = {"nu": 1.0, "bounded": True, **options}
     return fit_boucwen(u, y, structure, accept=accept, accept_reason=accept_reason, **options)

@@ -249,6 +249,10 @@ def step(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
 
     Parameters
     ----------
+    structure : BoucWenStructure
+        The model's structure.
+    params : BoucWenParams
+        Its parameters.
     x : array, shape (4,)
         ``(y, y', z, u_prev)`` at the previous sample.
     u : float
@@ -277,7 +281,23 @@ def step(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
 
 def initial_state(structure: BoucWenStructure, params: BoucWenParams,
                   u0: float) -> np.ndarray:
-    """``(y, y', z, u0)`` at the first sample of a run without ``x0`` (``structure.start``)."""
+    """``(y, y', z, u0)`` at the first sample of a run without ``x0`` (``structure.start``).
+
+    Parameters
+    ----------
+    structure : BoucWenStructure
+        The model's structure.
+    params : BoucWenParams
+        Its parameters.
+    u0 : float
+        Force at the first sample.
+
+    Returns
+    -------
+    numpy.ndarray, shape (4,)
+        ``(0, 0, 0, u0)`` for ``start="rest"``; the static equilibrium
+        ``(u0 / K0, 0, alpha u0 / K0, u0)`` for ``start="equilibrium"``.
+    """
     if structure.start == "rest":
         return np.array([0.0, 0.0, 0.0, u0])
     with np.errstate(over="ignore"):  # a tiny K0 overflows; simulate_states reports it
@@ -290,6 +310,22 @@ def rest_state(structure: BoucWenStructure, params: BoucWenParams, value: float,
     """The start of :func:`simulate` with ``x0=None`` (:func:`initial_state`) for the force
     ``value``. With ``start="equilibrium"`` (the family's) it is an equilibrium, a fixed point
     of :func:`step`; ``start="rest"`` (``y = z = 0``) is one only for ``value = 0``.
+
+    Parameters
+    ----------
+    structure : BoucWenStructure
+        The model's structure.
+    params : BoucWenParams
+        Its parameters.
+    value : float
+        Constant force.
+    inverse : bool, default False
+        Must be False: the model has no inverse.
+
+    Returns
+    -------
+    numpy.ndarray
+        The state at rest.
 
     Raises
     ------
@@ -319,6 +355,10 @@ def simulate_states(structure: BoucWenStructure, params: BoucWenParams, u: np.nd
 
     Parameters
     ----------
+    structure : BoucWenStructure
+        The model's structure.
+    params : BoucWenParams
+        Its parameters.
     u : array, shape (n,)
         Force sampled every ``structure.dt``.
     x0 : array, shape (4,), or None
@@ -354,7 +394,18 @@ def simulate_states(structure: BoucWenStructure, params: BoucWenParams, u: np.nd
 
 
 def bounded_class(params: BoucWenParams) -> bool:
-    """``beta + gamma >= 0`` and ``beta - gamma >= 0``: ``z`` stays bounded, loops dissipate."""
+    """``beta + gamma >= 0`` and ``beta - gamma >= 0``: ``z`` stays bounded, loops dissipate.
+
+    Parameters
+    ----------
+    params : BoucWenParams
+        The model's parameters.
+
+    Returns
+    -------
+    bool
+        True when both sums are non-negative.
+    """
     return params.beta + params.gamma >= 0 and params.beta - params.gamma >= 0
 
 
@@ -368,6 +419,22 @@ def divergence_bound(structure: BoucWenStructure, params: BoucWenParams, x: np.n
     duration ``T``. Twice that (room for the integration error) is returned; an RK4 run beyond
     it has diverged numerically. Outside the class ``z`` may grow without limit and the bound
     is ``inf`` (only a non-finite state stops the run).
+
+    Parameters
+    ----------
+    structure : BoucWenStructure
+        The model's structure.
+    params : BoucWenParams
+        Its parameters.
+    x : numpy.ndarray, shape (4,)
+        State ``(y, y', z, u_prev)`` at the start of the run.
+    u : numpy.ndarray, shape (n,)
+        The run's force.
+
+    Returns
+    -------
+    float
+        The bound on ``|y|``, ``inf`` outside the bounded class.
     """
     if not bounded_class(params):
         return np.inf
@@ -381,7 +448,28 @@ def divergence_bound(structure: BoucWenStructure, params: BoucWenParams, x: np.n
 
 def divergence_message(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
                         n_bad: int, n: int, bound: float) -> str:
-    """What happened (the state at the sample it diverged) and the likely cause."""
+    """What happened (the state at the sample it diverged) and the likely cause.
+
+    Parameters
+    ----------
+    structure : BoucWenStructure
+        The model's structure.
+    params : BoucWenParams
+        Its parameters.
+    x : numpy.ndarray
+        State at the sample where the run diverged.
+    n_bad : int
+        That sample (0-based).
+    n : int
+        Samples in the run.
+    bound : float
+        The bound of :func:`divergence_bound` (``inf`` for none).
+
+    Returns
+    -------
+    str
+        One line for the error message.
+    """
     w0h = params.omega0 * structure.step_size
     state = f"(y, y', z) = ({x[0]:.3g}, {x[1]:.3g}, {x[2]:.3g})"
     what = (f"the Bouc-Wen state diverged at sample {n_bad + 1} of {n}: {state}"
@@ -405,6 +493,18 @@ def simulate(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
              x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Displacement response to a force sequence (see :func:`simulate_states`).
 
+    Parameters
+    ----------
+    structure : BoucWenStructure
+        The model's structure.
+    params : BoucWenParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Force sampled every ``structure.dt``.
+    x0 : numpy.ndarray, shape (4,), optional
+        State ``(y, y', z, u_prev)`` one sample before ``u[0]``; None starts as
+        ``structure.start`` says (:func:`initial_state`).
+
     Returns
     -------
     y : array, shape (n,)
@@ -417,7 +517,27 @@ def simulate(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
 
 def simulate_reference(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
                        x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
+
+    Parameters
+    ----------
+    structure : BoucWenStructure
+        The model's structure.
+    params : BoucWenParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Force sampled every ``structure.dt``.
+    x0 : numpy.ndarray, shape (4,), optional
+        State ``(y, y', z, u_prev)`` one sample before ``u[0]``; None starts as
+        ``structure.start`` says (:func:`initial_state`).
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Output.
+    x_end : numpy.ndarray
+        State after the last sample.
+    """
     u = check_signal(u, "u")
     x, fresh = _initial_state(structure, params, x0, u[0])
     y = np.empty_like(u)
