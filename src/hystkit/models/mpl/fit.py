@@ -162,8 +162,9 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
         return cache[key]
 
     # Trial points get the normal equations too (no cost-only runs): a one-pass run costs
-    # 1.0-1.4 simulations and ~17 % of trial steps are rejected, so a cost-only trial (1 run)
-    # plus a second run at every accepted point would cost more.
+    # 0.6-0.9 simulations (its sinh from one exp, kernels.sinh_cosh) and ~17 % of trial steps
+    # are rejected, so a cost-only trial (a simulation) plus a pass at every accepted point
+    # would cost more.
     def normal_equations(theta: np.ndarray) -> NormalEquations:
         sse, jtj, jtr = kernels.theta_normal_equations(u, y, x0, theta, structure.slope_cap,
                                                        structure.dt)
