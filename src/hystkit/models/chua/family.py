@@ -17,6 +17,8 @@ __all__ = ["ChuaFamily"]
 
 
 class ChuaFamily(Family):
+    """The Chua-Stromsmoe model (sec. 2.1.3) as a registered family."""
+
     name = "chua"
     title = "Chua-Stromsmoe, dy/dt = g(u - f(y)) (sec. 2.1.3, eq. 2.3)"
     size_help = "elements in series N, output the sum of their states (6N params; 1 = eq. 2.3)"

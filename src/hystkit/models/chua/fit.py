@@ -39,6 +39,18 @@ def default_starts(structure: chua.ChuaStructure, gain: float) -> list[chua.Chua
     """Deterministic starts: linear restoring functions sharing the static ``gain`` (output per
     input), element rates at 5 and 50 per cent of the Euler cap spread by 6x between elements,
     with and without a dead band, strongly and mildly non-linear ``g``.
+
+    Parameters
+    ----------
+    structure : chua.ChuaStructure
+        The model's structure.
+    gain : float
+        Static gain (output per input).
+
+    Returns
+    -------
+    list of chua.ChuaParams
+        The starts.
     """
     n = structure.n_elements
     k = np.full(n, n / gain)
@@ -67,6 +79,8 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
     ----------
     u, y : array, shape (n,)
         Input and target, sampled every ``structure.dt``, centred and normalised (eq. 5.10).
+    structure : chua.ChuaStructure
+        The model's structure (``N`` elements).
     starts : list of ChuaParams, optional
         Default :func:`default_starts` (8 starts) with the least-squares static gain.
     max_nfev, screen_nfev, n_polish : int
@@ -76,6 +90,11 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
         Candidates for which ``accept(params)`` is false are skipped.
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart` ("trf": dense difference Jacobian).
+
+    Returns
+    -------
+    FitResult
+        The best start's fit.
 
     Raises
     ------
@@ -113,6 +132,19 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
 def random_params(structure: chua.ChuaStructure, rng: np.random.Generator) -> chua.ChuaParams:
     """Parameters drawn from the fit's bounds (the family's documented domain), per element:
     ``k_0``, ``k_inf``, ``y_s`` log-uniform in ``[1e-2, 1e2]``, ``G`` log-uniform in
-    ``[1e-3, 100 / dt]``, ``V_g`` log-uniform in ``[1e-3, 1e3]``, ``delta`` uniform in ``[0, 1]``."""
+    ``[1e-3, 100 / dt]``, ``V_g`` log-uniform in ``[1e-3, 1e3]``, ``delta`` uniform in ``[0, 1]``.
+
+    Parameters
+    ----------
+    structure : chua.ChuaStructure
+        The model's structure.
+    rng : numpy.random.Generator
+        Source of the draws.
+
+    Returns
+    -------
+    chua.ChuaParams
+        The drawn parameters.
+    """
     lower, upper = _bounds(structure)
     return chua.ChuaParams.from_vector(rng.uniform(lower, upper), structure.n_elements)

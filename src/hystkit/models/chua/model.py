@@ -185,13 +185,42 @@ def output_bound(structure: ChuaStructure, params: ChuaParams, u_max: float) -> 
     to it by ``1 - dt g' f'`` in ``[1 - s, 1]``: no overshoot for ``s <= 1``; beyond, an
     overshoot of at most ``s - 1`` times the distance, whose worst alternation settles at
     ``s E_k / (2 - s)``.
+
+    Parameters
+    ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
+    u_max : float
+        Bound on the magnitude of the inputs and of the start's restoring forces.
+
+    Returns
+    -------
+    float
+        The bound on ``|y|``.
     """
     q = max(1.0, structure.slope_cap / (2.0 - structure.slope_cap))
     return float(q * np.sum((u_max + params.delta) / np.minimum(params.k0, params.k_inf)))
 
 
 def limits(structure: ChuaStructure, params: ChuaParams) -> tuple[np.ndarray, np.ndarray]:
-    """Per element: the cap on ``g'`` and the knee ``|v|`` beyond which ``g`` is straight."""
+    """Per element: the cap on ``g'`` and the knee ``|v|`` beyond which ``g`` is straight.
+
+    Parameters
+    ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
+
+    Returns
+    -------
+    cap : numpy.ndarray, shape (N,)
+        Largest slope ``g'``: ``slope_cap / (dt max(k_0, k_inf))``.
+    knee : numpy.ndarray, shape (N,)
+        ``|v|`` beyond which ``g`` is a straight line.
+    """
     cap = structure.slope_cap / (structure.dt * np.maximum(params.k0, params.k_inf))
     ratio = cap / params.g
     knee = params.delta + np.where(ratio > 1, params.v_g * np.arccosh(np.maximum(ratio, 1.0)),
@@ -200,7 +229,20 @@ def limits(structure: ChuaStructure, params: ChuaParams) -> tuple[np.ndarray, np
 
 
 def restoring(params: ChuaParams, y: np.ndarray) -> np.ndarray:
-    """``f_k(y_k)``; ``y`` of shape (..., N)."""
+    """``f_k(y_k)``; ``y`` of shape (..., N).
+
+    Parameters
+    ----------
+    params : ChuaParams
+        The model's parameters.
+    y : numpy.ndarray, shape (..., N)
+        Element outputs.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        ``f_k(y_k)``.
+    """
     y = np.asarray(y, dtype=float)
     return params.k_inf * y + (params.k0 - params.k_inf) * params.y_s * np.tanh(y / params.y_s)
 
@@ -209,12 +251,39 @@ def restoring_inverse(params: ChuaParams, u: float) -> np.ndarray:
     """``f_k^-1(u)`` for every element, shape (N,), by bisection to float resolution.
 
     ``|f(y) - k_inf y| <= |k_0 - k_inf| y_s`` brackets the root.
+
+    Parameters
+    ----------
+    params : ChuaParams
+        The model's parameters.
+    u : float
+        Input.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        ``f_k^-1(u)``.
     """
     return kernels.restoring_inverse(float(u), params.k0, params.k_inf, params.y_s)
 
 
 def dissipation(structure: ChuaStructure, params: ChuaParams, v: np.ndarray) -> np.ndarray:
-    """Limited ``g_k(v_k)`` (dead band, sinh, straight line beyond the knee); shape (..., N)."""
+    """Limited ``g_k(v_k)`` (dead band, sinh, straight line beyond the knee); shape (..., N).
+
+    Parameters
+    ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
+    v : numpy.ndarray, shape (..., N)
+        Argument ``u - f_k(y_k)`` per element.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        ``g_k(v_k)``.
+    """
     v = np.asarray(v, dtype=float)
     cap, knee = limits(structure, params)
     a = np.abs(v)
@@ -226,7 +295,22 @@ def dissipation(structure: ChuaStructure, params: ChuaParams, v: np.ndarray) -> 
 def dissipation_slope(structure: ChuaStructure, params: ChuaParams,
                       v: np.ndarray) -> np.ndarray:
     """``g_k'(v_k)`` of the limited dissipation function: 0 in the dead band, the sinh's slope
-    up to the knee, ``cap`` beyond (on a kink, the inner side's)."""
+    up to the knee, ``cap`` beyond (on a kink, the inner side's).
+
+    Parameters
+    ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
+    v : numpy.ndarray, shape (..., N)
+        Argument per element.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        ``g_k'(v_k)``.
+    """
     v = np.asarray(v, dtype=float)
     cap, knee = limits(structure, params)
     a = np.abs(v)
@@ -236,7 +320,26 @@ def dissipation_slope(structure: ChuaStructure, params: ChuaParams,
 
 def step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """One Euler step with input ``u``; the output is the sum of the updated element states."""
+    """One Euler step with input ``u``; the output is the sum of the updated element states.
+
+    Parameters
+    ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
+    x : numpy.ndarray, shape (N,)
+        Element outputs ``y_k`` before the step.
+    u : float
+        Input of the sample.
+
+    Returns
+    -------
+    y : float
+        Output from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
+    """
     x = np.asarray(x, dtype=float)
     x_next = x + structure.dt * dissipation(structure, params, u - restoring(params, x))
     return float(np.sum(x_next)), x_next
@@ -251,6 +354,24 @@ def invert_step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
     flat interval is taken. An output within ``REST_TOL max(1, |y|, sum |x_k|)`` of the present
     ``sum x_k`` is that output (``r = 0``): rounding must not decide which edge of a dead band
     the input jumps to.
+
+    Parameters
+    ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
+    x : numpy.ndarray, shape (N,)
+        Element outputs ``y_k`` before the step.
+    y : float
+        Output to reach at this sample.
+
+    Returns
+    -------
+    u : float
+        Input that gives `y` from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
     """
     x = np.asarray(x, dtype=float)
     fx = restoring(params, x)
@@ -298,7 +419,24 @@ def rest_state(structure: ChuaStructure, params: ChuaParams, value: float,
     """Element outputs at rest (``g = 0``) under a constant input ``value``, ``f_k^-1(value)``;
     with ``inverse``, for a constant output ``value``: the common input ``u`` with
     ``sum_k f_k^-1(u) = value`` first. These are the starts of ``simulate`` / ``invert`` with
-    ``x0=None``."""
+    ``x0=None``.
+
+    Parameters
+    ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
+    value : float
+        Constant input (with `inverse`: output) the model rests at.
+    inverse : bool, default False
+        Rest state of the inverse: `value` is an output.
+
+    Returns
+    -------
+    numpy.ndarray
+        The state at rest.
+    """
     if inverse:
         value = kernels.rest_input(float(value), params.k0, params.k_inf, params.y_s)
     return restoring_inverse(params, value)
@@ -312,6 +450,21 @@ def _initial_state(structure: ChuaStructure, params: ChuaParams,
 
 
 def kernel_args(structure: ChuaStructure, params: ChuaParams) -> tuple:
+    """The compiled kernels' parameter arguments, in their order.
+
+    Parameters
+    ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
+
+    Returns
+    -------
+    tuple
+        ``(k_0, k_inf, y_s, G, V_g, delta, knee, cap, dt)``; knee and cap from :func:`limits`.
+    """
+
     cap, knee = limits(structure, params)
     return (params.k0, params.k_inf, params.y_s, params.g, params.v_g, params.delta, knee, cap,
             structure.dt)
@@ -323,6 +476,10 @@ def simulate(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
 
     Parameters
     ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
     u : array, shape (n,)
         Input sampled every ``structure.dt``.
     x0 : array, shape (N,), float or None
@@ -343,7 +500,26 @@ def simulate(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
 
 def simulate_reference(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step`."""
+    """Same as :func:`simulate`, as a plain loop over :func:`step`.
+
+    Parameters
+    ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Input sampled every ``structure.dt``.
+    x0 : numpy.ndarray, float or None, optional
+        Initial element outputs, as for :func:`simulate`.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Output.
+    x_end : numpy.ndarray
+        State after the last sample.
+    """
     u = _check(structure, params, u, "u")
     x = _initial_state(structure, params, x0, u[0])
     return run_steps(step, structure, params, u, x)
@@ -363,10 +539,21 @@ def invert(structure: ChuaStructure, params: ChuaParams, y: np.ndarray,
 
     Parameters
     ----------
+    structure : ChuaStructure
+        The model's structure.
+    params : ChuaParams
+        Its parameters.
     y : array, shape (n,)
     x0 : array, shape (N,), float or None
         Initial element outputs; ``None`` splits ``y_0`` over the elements as their rest
         state for a common input ``u`` with ``sum_k f_k^-1(u) = y_0``.
+
+    Returns
+    -------
+    u : numpy.ndarray, shape (n,)
+        Input that gives `y`.
+    x_end : numpy.ndarray
+        State after the last sample.
 
     Raises
     ------
