@@ -23,6 +23,8 @@ __all__ = ["GPreisachFamily"]
 
 
 class GPreisachFamily(StaircaseFamily):
+    """The generalised Preisach model (sec. 2.1.2, eq. 2.2) as a registered family."""
+
     name = "gpreisach"
     title = ("generalised (non-linear) Preisach, input-dependent weight and reversible part "
              "(sec. 2.1.2, eq. 2.2)")

@@ -38,6 +38,13 @@ def fit_gpreisach(u: np.ndarray, y: np.ndarray, structure: gpreisach.GPreisachSt
     structure : GPreisachStructure
     accept : callable, optional
         Checked on each solution (one per orientation tried), cheapest first.
+    accept_reason : str, optional
+        Why solutions were rejected, for the message.
+
+    Returns
+    -------
+    FitResult
+        The best accepted solution.
 
     Raises
     ------

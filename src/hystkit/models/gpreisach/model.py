@@ -110,7 +110,20 @@ def reversible_basis(degree: int) -> tuple[Polynomial, ...]:
 
 
 def reversible(nu: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """Reversible part ``int nu(a) lambda_a[u] da`` of eq. 2.2 at inputs ``u`` (clipped)."""
+    """Reversible part ``int nu(a) lambda_a[u] da`` of eq. 2.2 at inputs ``u`` (clipped).
+
+    Parameters
+    ----------
+    nu : numpy.ndarray, shape (d + 1,)
+        Bernstein coefficients of ``nu``.
+    u : numpy.ndarray
+        Inputs; clipped to [-1, 1].
+
+    Returns
+    -------
+    numpy.ndarray
+        The reversible output, same shape as `u`.
+    """
     nu = np.asarray(nu, dtype=float)
     u = np.clip(np.asarray(u, dtype=float), -1.0, 1.0)
     return sum(c * b(u) for c, b in zip(nu, reversible_basis(nu.size - 1)))
@@ -179,7 +192,18 @@ class GPreisachParams(Record):
 
 
 def major_slope(params: GPreisachParams) -> float:
-    """Mean slope of the major loop, ``(y(+sat) - y(-sat)) / 2``: the extension beyond +-1."""
+    """Mean slope of the major loop, ``(y(+sat) - y(-sat)) / 2``: the extension beyond +-1.
+
+    Parameters
+    ----------
+    params : GPreisachParams
+        The model's parameters.
+
+    Returns
+    -------
+    float
+        The mean slope.
+    """
     rise = params.everett_plus[-1, 0] + params.everett_minus[-1, 0]
     return float(0.5 * (rise + reversible(params.nu, 1.0) - reversible(params.nu, -1.0)))
 
@@ -194,7 +218,20 @@ def _mass(params: GPreisachParams) -> float:
 
 def output_bound(params: GPreisachParams, u_max: float) -> float:
     """``|y_0| + B max(1, u_max)`` (class Notes): no output of a run with ``|u| <= u_max``
-    exceeds it."""
+    exceeds it.
+
+    Parameters
+    ----------
+    params : GPreisachParams
+        The model's parameters.
+    u_max : float
+        Largest input magnitude.
+
+    Returns
+    -------
+    float
+        The bound on ``|y|``.
+    """
     return float(abs(params.offset) + _mass(params) * max(1.0, u_max))
 
 
@@ -223,6 +260,17 @@ def step(structure: GPreisachStructure, params: GPreisachParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
     """One sample: update the staircase with ``u``, then the output of eq. 2.2.
 
+    Parameters
+    ----------
+    structure : GPreisachStructure
+        The model's structure.
+    params : GPreisachParams
+        Its parameters.
+    x : numpy.ndarray, shape (k,)
+        Staircase before the sample.
+    u : float
+        Normalised input of the sample.
+
     Returns
     -------
     y : float
@@ -245,7 +293,24 @@ def _check(structure: GPreisachStructure, params: GPreisachParams, v: np.ndarray
 
 def kernel_parts(params: GPreisachParams) -> tuple[np.ndarray, bool, np.ndarray, float]:
     """What the compiled kernels run on: the two tables, weighted (True), the monomial
-    coefficients of ``R(u) + y_0`` and the slope of the straight-line extension."""
+    coefficients of ``R(u) + y_0`` and the slope of the straight-line extension.
+
+    Parameters
+    ----------
+    params : GPreisachParams
+        The model's parameters.
+
+    Returns
+    -------
+    tables : numpy.ndarray
+        The Everett tables of ``mu_-`` and ``mu_+``, stacked (antisymmetric form).
+    weighted : bool
+        True: the relay part is weighted by the present input.
+    poly : numpy.ndarray
+        Monomial coefficients of ``R(u) + y_0``.
+    slope : float
+        Slope of the straight-line extension (:func:`major_slope`).
+    """
     return _tables(params), True, _poly(params), major_slope(params)
 
 
@@ -255,6 +320,10 @@ def simulate(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarr
 
     Parameters
     ----------
+    structure : GPreisachStructure
+        The model's structure.
+    params : GPreisachParams
+        Its parameters.
     u : array, shape (n,)
         Normalised input; values beyond [-1, 1] follow the straight-line extension.
     x0 : array or None
@@ -275,7 +344,26 @@ def simulate(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarr
 
 def simulate_reference(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarray,
                        x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
+
+    Parameters
+    ----------
+    structure : GPreisachStructure
+        The model's structure.
+    params : GPreisachParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Input, one value per sample.
+    x0 : numpy.ndarray, optional
+        Initial staircase; None is the demagnetised state.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Output.
+    x_end : numpy.ndarray
+        State after the last sample.
+    """
     u, x = _check(structure, params, u, "u", x0)
     return run_steps(step, structure, params, u, x)
 
@@ -288,6 +376,24 @@ def invert(structure: GPreisachStructure, params: GPreisachParams, y: np.ndarray
     it is the unique one where the branch is monotone. The input-dependent weight can fold a
     branch even for non-negative weights (the term ``dw/du (P_+ - P_-)``); the search then
     returns the solution nearest to the present input on the side the target lies.
+
+    Parameters
+    ----------
+    structure : GPreisachStructure
+        The model's structure.
+    params : GPreisachParams
+        Its parameters.
+    y : numpy.ndarray, shape (n,)
+        Output, one value per sample.
+    x0 : numpy.ndarray, optional
+        Initial staircase; None is the demagnetised state.
+
+    Returns
+    -------
+    u : numpy.ndarray, shape (n,)
+        Input that gives `y`.
+    x_end : numpy.ndarray
+        State after the last sample.
 
     Raises
     ------
@@ -304,6 +410,25 @@ def invert(structure: GPreisachStructure, params: GPreisachParams, y: np.ndarray
 
 def invert_step(structure: GPreisachStructure, params: GPreisachParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
-    """One sample of :func:`invert` from the staircase ``x``: ``(u_hat, x_next)``."""
+    """One sample of :func:`invert` from the staircase ``x``: ``(u_hat, x_next)``.
+
+    Parameters
+    ----------
+    structure : GPreisachStructure
+        The model's structure.
+    params : GPreisachParams
+        Its parameters.
+    x : numpy.ndarray, shape (k,)
+        Staircase before the sample.
+    y : float
+        Output to reach at this sample.
+
+    Returns
+    -------
+    u : float
+        Input that gives `y` from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
+    """
     u_hat, x_next = invert(structure, params, np.array([float(y)]), x0=x)
     return float(u_hat[0]), x_next
