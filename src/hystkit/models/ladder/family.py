@@ -18,6 +18,8 @@ __all__ = ["LadderFamily"]
 
 
 class LadderFamily(Family):
+    """The PWL ladder circuit (sec. 2.1.5) as a registered family."""
+
     name = "ladder"
     title = "PWL ladder circuit, Parodi-Storace-Cincotti (sec. 2.1.5)"
     size_help = "ladder sections N, a PWL resistor and a capacitor each (3N + 2 params)"

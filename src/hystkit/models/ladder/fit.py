@@ -25,6 +25,16 @@ _W_BOUND = 100.0  # as the mPL's |w| <= 100 (sec. 5.3.3)
 def default_starts(structure: ladder.LadderStructure) -> list[np.ndarray]:
     """Deterministic starts ``[E_1, log G_1, ..]``: bands growing along the ladder (0, 0.05 or
     0.2 of the range per cell) and conductances near the limit or 10 and 100 times slower.
+
+    Parameters
+    ----------
+    structure : ladder.LadderStructure
+        The model's structure.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        The starts, each ``[E_1, log G_1, .., E_N, log G_N]``.
     """
     n = structure.n_cells
     g_max = ladder.conductance_limit(structure)
@@ -49,6 +59,8 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
     ----------
     u, y : array, shape (n,)
         Centred, normalised data (eq. 5.10), sampled every ``structure.dt``.
+    structure : ladder.LadderStructure
+        The model's structure (``N`` sections).
     starts : list of arrays, optional
         Resistor parameters ``[E_1, log G_1, .., E_N, log G_N]``; default
         :func:`default_starts` (9 starts).
@@ -62,6 +74,11 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
         ladder fitted on seed 1 then diverges on seed 2 -- as does trf's own optimum with its
         conductance moved by 1e-9 relative (a knife edge that tests/models/ladder relies on).
         Variable projection keeps the Jacobian at ``n x 2 N``, so trf's cost here is small.
+
+    Returns
+    -------
+    FitResult
+        The best start's fit.
 
     Raises
     ------
@@ -110,7 +127,20 @@ def random_params(structure: ladder.LadderStructure,
                   rng: np.random.Generator) -> ladder.LadderParams:
     """Parameters drawn from the fit's bounds (the family's documented domain): bands ``E_k``
     uniform in ``[0, 1.5]``, ``G_k`` log-uniform in ``[1e-3, slope_cap / (2 dt)]``, ``w_0..w_N``
-    uniform in ``[-100, 100]``, ``V_b`` too (the fit leaves it free)."""
+    uniform in ``[-100, 100]``, ``V_b`` too (the fit leaves it free).
+
+    Parameters
+    ----------
+    structure : ladder.LadderStructure
+        The model's structure.
+    rng : numpy.random.Generator
+        Source of the draws.
+
+    Returns
+    -------
+    ladder.LadderParams
+        The drawn parameters.
+    """
     n = structure.n_cells
     band = rng.uniform(*_BAND, n)
     g = np.exp(rng.uniform(_LOG_G_MIN, np.log(ladder.conductance_limit(structure)), n))

@@ -81,6 +81,15 @@ class LadderStructure(CellStructure):
     the step matrix ``I - dt L`` (``L`` the ladder's conductance Laplacian) has eigenvalues
     down to ``1 - 2 slope_cap``, so beyond 1 a long ladder of conducting resistors oscillates
     and diverges (2 sections from 1.53, 5 from about 1.3), unlike one mPL cell.
+
+    Parameters
+    ----------
+    n_cells : int, default 2
+        Ladder sections ``N``.
+    dt : float, default 0.025
+        Sample time [s].
+    slope_cap : float, default 1.0
+        Largest Euler slope ``dt (G_k + G_k+1)`` at a node.
     """
 
     n_cells: int = 2
@@ -152,23 +161,79 @@ class LadderParams(Record):
 
 def output_bound(params: LadderParams, u_max: float) -> float:
     """``sum |w| u_max + |V_b|``: no output of a run whose inputs and initial voltages stay
-    within ``u_max`` in magnitude exceeds it (``slope_cap <= 1``: monotone Euler steps)."""
+    within ``u_max`` in magnitude exceeds it (``slope_cap <= 1``: monotone Euler steps).
+
+    Parameters
+    ----------
+    params : LadderParams
+        Its parameters.
+    u_max : float
+        Bound on the magnitude of the inputs and the initial voltages.
+
+    Returns
+    -------
+    float
+        ``sum |w| u_max + |V_b|``.
+    """
     return float(np.abs(params.w).sum() * u_max + abs(params.v_b))
 
 
 def conductance_limit(structure: LadderStructure) -> float:
-    """Largest effective ``G`` [1/s]: two conducting resistors at a node reach ``slope_cap``."""
+    """Largest effective ``G`` [1/s]: two conducting resistors at a node reach ``slope_cap``.
+
+    Parameters
+    ----------
+    structure : LadderStructure
+        The model's structure.
+
+    Returns
+    -------
+    float
+        ``slope_cap / (2 dt)`` [1/s].
+    """
     return structure.slope_cap / (2.0 * structure.dt)
 
 
 def effective_conductance(structure: LadderStructure, params: LadderParams) -> np.ndarray:
-    """``G_k`` limited to :func:`conductance_limit`, what the Euler step uses."""
+    """``G_k`` limited to :func:`conductance_limit`, what the Euler step uses.
+
+    Parameters
+    ----------
+    structure : LadderStructure
+        The model's structure.
+    params : LadderParams
+        Its parameters.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        The limited conductances [1/s].
+    """
     return np.minimum(params.conductance, conductance_limit(structure))
 
 
 def step(structure: LadderStructure, params: LadderParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """Output from the present capacitor voltages, then one Euler step with source ``u``."""
+    """Output from the present capacitor voltages, then one Euler step with source ``u``.
+
+    Parameters
+    ----------
+    structure : LadderStructure
+        The model's structure.
+    params : LadderParams
+        Its parameters.
+    x : numpy.ndarray, shape (N,)
+        Capacitor voltages before the sample.
+    u : float
+        Source voltage of the sample.
+
+    Returns
+    -------
+    y : float
+        Output from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
+    """
     x = np.asarray(x, dtype=float)
     y = params.w[0] * u + params.w[1:] @ x - params.v_b
     v = np.concatenate([[u], x[:-1]]) - x
@@ -180,7 +245,26 @@ def step(structure: LadderStructure, params: LadderParams, x: np.ndarray,
 def invert_step(structure: LadderStructure, params: LadderParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of :func:`invert`: ``e = (y + V_b - sum_k w_k U_k) / w_0`` from the present
-    voltages, then the Euler step with ``e``."""
+    voltages, then the Euler step with ``e``.
+
+    Parameters
+    ----------
+    structure : LadderStructure
+        The model's structure.
+    params : LadderParams
+        Its parameters.
+    x : numpy.ndarray, shape (N,)
+        Capacitor voltages before the sample.
+    y : float
+        Output to reach at this sample.
+
+    Returns
+    -------
+    u : float
+        Input that gives `y` from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
+    """
     x = np.asarray(x, dtype=float)
     e = (y + params.v_b - params.w[1:] @ x) / params.w[0]
     return float(e), step(structure, params, x, e)[1]
@@ -195,7 +279,24 @@ def rest_state(structure: LadderStructure, params: LadderParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """Every capacitor at the source voltage ``value``, no current (``inverse``: at the source
     ``(value + V_b) / sum(w)`` that gives the output ``value``): the start of ``simulate`` /
-    ``invert`` with ``x0=None``."""
+    ``invert`` with ``x0=None``.
+
+    Parameters
+    ----------
+    structure : LadderStructure
+        The model's structure.
+    params : LadderParams
+        Its parameters.
+    value : float
+        Constant input (with `inverse`: output) the model rests at.
+    inverse : bool, default False
+        Rest state of the inverse: `value` is an output.
+
+    Returns
+    -------
+    numpy.ndarray
+        The state at rest.
+    """
     return np.full(params.n_cells, _rest_input(params, value) if inverse else float(value))
 
 
@@ -210,6 +311,24 @@ def states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
     """Capacitor voltages seen by each sample's output, shape (n, N), and the final state.
 
     The output is linear in them: ``y = w_0 u + states @ w[1:] - V_b`` (the fit uses this).
+
+    Parameters
+    ----------
+    structure : LadderStructure
+        The model's structure.
+    params : LadderParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Source voltage sampled every ``structure.dt``.
+    x0 : numpy.ndarray, float or None, optional
+        Initial capacitor voltages, as for :func:`simulate`.
+
+    Returns
+    -------
+    states : numpy.ndarray, shape (n, N)
+        Capacitor voltages each sample's output is computed from.
+    x_end : numpy.ndarray, shape (N,)
+        Capacitor voltages after the last sample.
     """
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
@@ -223,6 +342,10 @@ def simulate(structure: LadderStructure, params: LadderParams, u: np.ndarray,
 
     Parameters
     ----------
+    structure : LadderStructure
+        The model's structure.
+    params : LadderParams
+        Its parameters.
     u : array, shape (n,)
         Source voltage ``e`` sampled every ``structure.dt``.
     x0 : array, shape (N,), float or None
@@ -243,7 +366,26 @@ def simulate(structure: LadderStructure, params: LadderParams, u: np.ndarray,
 
 def simulate_reference(structure: LadderStructure, params: LadderParams, u: np.ndarray,
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step`."""
+    """Same as :func:`simulate`, as a plain loop over :func:`step`.
+
+    Parameters
+    ----------
+    structure : LadderStructure
+        The model's structure.
+    params : LadderParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Source voltage sampled every ``structure.dt``.
+    x0 : numpy.ndarray, float or None, optional
+        Initial capacitor voltages, as for :func:`simulate`.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Output.
+    x_end : numpy.ndarray
+        State after the last sample.
+    """
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
     return run_steps(step, structure, params, u, x)
@@ -257,9 +399,20 @@ def invert(structure: LadderStructure, params: LadderParams, y: np.ndarray,
 
     Parameters
     ----------
+    structure : LadderStructure
+        The model's structure.
+    params : LadderParams
+        Its parameters.
     y : array, shape (n,)
     x0 : array, shape (N,), float or None
         ``None``: at rest at ``e_0 = (y_0 + V_b) / sum(w)``.
+
+    Returns
+    -------
+    u : numpy.ndarray, shape (n,)
+        Input that gives `y`.
+    x_end : numpy.ndarray
+        State after the last sample.
 
     Raises
     ------
