@@ -18,6 +18,8 @@ __all__ = ["MplPolyFamily"]
 
 
 class MplPolyFamily(Family):
+    """The polynomial modified Power-Law model (sec. 5.3.5, paper 9.2) as a registered family."""
+
     name = "mpl-poly"
     title = "polynomial modified Power-Law, cubic resistors (sec. 5.3.5, eq. 5.16-5.17, 5.29)"
     size_help = "cells N (5N + 6 params)"

@@ -65,6 +65,18 @@ def canonical(structure: mpl_poly.MplPolyStructure,
     (then ``c_k0 = 0`` unless the rest point lies on a straight continuation), then
     ``w_0 = 1``, ``V_b = 0``.
 
+    Parameters
+    ----------
+    structure : mpl_poly.MplPolyStructure
+        The model's structure.
+    params : mpl_poly.MplPolyParams
+        Parameters to bring to canonical form.
+
+    Returns
+    -------
+    mpl_poly.MplPolyParams
+        The equivalent canonical parameters.
+
     Raises
     ------
     ValueError
@@ -102,6 +114,16 @@ def default_starts(structure: mpl_poly.MplPolyStructure) -> list[np.ndarray]:
     resistor: rates ``G_k`` at geometric spreads around 0.3, 3 and 30 % of the Euler cap, a
     strongly (``V = 0.2``, the document's ``V_T`` start) and a mildly (``V = 2``) non-linear
     shape, for data normalised to max |.| = 1 (eq. 5.10).
+
+    Parameters
+    ----------
+    structure : mpl_poly.MplPolyStructure
+        The model's structure.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        Cell resistor coefficients, each of shape (N, 4).
     """
     g_max = structure.slope_cap / structure.dt
     k = np.arange(structure.n_cells)
@@ -178,8 +200,15 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
         As :func:`hystkit.identification.fit_multistart`.
     accept : callable, optional
         A candidate counts only if ``accept(params)``; ``accept_reason`` says why others failed.
+    accept_reason : str, optional
+        Why candidates were rejected, for the message.
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart` ("trf" works on the dense Jacobian).
+
+    Returns
+    -------
+    FitResult
+        The best start's fit.
 
     Raises
     ------

@@ -98,6 +98,12 @@ class MplPolyStructure(CellStructure):
 
     Parameters
     ----------
+    n_cells : int, default 1
+        Number of cells ``N``.
+    dt : float, default 0.025
+        Sample time [s].
+    slope_cap : float, default 1.0
+        Largest Euler slope ``f' dt`` outside the knees.
     limit : bool
         Apply the stability limit eq. 5.29; ``False`` runs the raw cubic (may diverge).
     """
@@ -220,6 +226,18 @@ def knee_points(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarra
 
     ``s = slope_cap / dt``. With ``c3 > 0`` ``f'`` is an upward parabola, so ``f' > s`` exactly
     outside the knees; when it never drops to ``s`` both knees sit at its vertex.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 2)
+        ``x-, x+`` per cell.
     """
     s = structure.slope_cap / structure.dt
     c1, c2, c3 = params.f[:, 1], params.f[:, 2], params.f[:, 3]
@@ -253,25 +271,75 @@ def resistor_current(structure: MplPolyStructure, params: MplPolyParams,
 
     Parameters
     ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
     v : array, shape (..., N)
         Voltage across each cell's resistor.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        The cell currents.
     """
     return _resistor(structure, params, v)[0]
 
 
 def resistor_slope(structure: MplPolyStructure, params: MplPolyParams,
                    v: np.ndarray) -> np.ndarray:
-    """Slopes ``f'_k,lim(v)``, shape (..., N): the cells' rates in eq. 5.20 and 5.26."""
+    """Slopes ``f'_k,lim(v)``, shape (..., N): the cells' rates in eq. 5.20 and 5.26.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+    v : numpy.ndarray, shape (..., N)
+        Voltage across each cell's resistor.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        The slopes.
+    """
     return _resistor(structure, params, v)[1]
 
 
 def output_current(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
-    """Output resistor current ``g(z)`` (eq. 5.17)."""
+    """Output resistor current ``g(z)`` (eq. 5.17).
+
+    Parameters
+    ----------
+    params : MplPolyParams
+        The model's parameters.
+    z : numpy.ndarray
+        Voltage across the output resistor.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``g(z)``, same shape as `z`.
+    """
     return _cubic(params.g, np.asarray(z, dtype=float))[0]
 
 
 def output_slope(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
-    """Output resistor slope ``g'(z)`` (``g'_0`` of eq. 5.19)."""
+    """Output resistor slope ``g'(z)`` (``g'_0`` of eq. 5.19).
+
+    Parameters
+    ----------
+    params : MplPolyParams
+        The model's parameters.
+    z : numpy.ndarray
+        Voltage across the output resistor.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``g'(z)``, same shape as `z`.
+    """
     return _cubic(params.g, np.asarray(z, dtype=float))[1]
 
 
@@ -279,6 +347,18 @@ def equilibria(structure: MplPolyStructure, params: MplPolyParams) -> list[np.nd
     """Every rest voltage ``v*`` with ``f_k,lim(v*) = 0`` of each cell, ascending.
 
     At rest ``u_k = e - v*``: the rest voltage does not depend on the input.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        Per cell, its rest voltages ``v*``, ascending.
     """
     knees = knee_points(structure, params)
     s = structure.slope_cap / structure.dt
@@ -300,7 +380,20 @@ def equilibria(structure: MplPolyStructure, params: MplPolyParams) -> list[np.nd
 def check_rest(structure: MplPolyStructure, params: MplPolyParams) -> None:
     """Raise FitDivergedError unless every rest voltage of the limited resistors at this
     ``dt`` (:func:`equilibria`) lies within ``REST_MAX``: the straight continuations can move
-    a cell's rest point far beyond its cubic's roots (a steep cubic, a small ``slope_cap``)."""
+    a cell's rest point far beyond its cubic's roots (a steep cubic, a small ``slope_cap``).
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+
+    Raises
+    ------
+    FitDivergedError
+        A rest voltage beyond ``REST_MAX``, naming the cell.
+    """
     for k, v in enumerate(equilibria(structure, params)):
         if v.size and np.max(np.abs(v)) > REST_MAX:
             raise FitDivergedError(
@@ -318,6 +411,20 @@ def output_bound(structure: MplPolyStructure, params: MplPolyParams, u_max: floa
     ``|u_k| <= u_max + R_k`` with ``R_k`` the largest ``|v*|``; then
     ``|z| <= |w_0| u_max + sum |w_k| (u_max + R_k) + |V_b|`` and
     ``|y| <= sum_j |g_j| |z|^j``.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+    u_max : float
+        Largest input magnitude.
+
+    Returns
+    -------
+    float
+        The bound on ``|y|``.
     """
     r = np.array([np.max(np.abs(v), initial=0.0) for v in equilibria(structure, params)])
     z = abs(params.w[0]) * u_max + np.abs(params.w[1:]) @ (u_max + r) + abs(params.v_b)
@@ -331,6 +438,18 @@ def rest_voltages(structure: MplPolyStructure, params: MplPolyParams) -> np.ndar
     cell) the one nearer the cubic's inflection point ``-c2 / (3 c3)`` is taken (the lower on a
     tie): unlike "nearest to 0" this does not depend on how the cell voltage is offset, so
     equivalent parameters (``fit.canonical``) start in the same state.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        One stable rest voltage ``v*`` per cell.
     """
     out = np.empty(params.n_cells)
     centre = -params.f[:, 2] / (3 * params.f[:, 3])
@@ -352,6 +471,20 @@ def output_branch(structure: MplPolyStructure,
     interval around it where ``g'`` keeps its sign (bounds at the roots of ``g'``, ``+-inf``
     where there are none). Defined this way it is the same branch for all equivalent parameters
     (``fit.canonical``).
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+
+    Returns
+    -------
+    lo, hi : float
+        The branch's bounds (``+-inf`` where unbounded).
+    sign : float
+        Sign of ``g'`` on it.
 
     Raises
     ------
@@ -375,7 +508,29 @@ def inverse_branch(structure: MplPolyStructure,
                    params: MplPolyParams) -> tuple[float, float, float, float]:
     """``(lo, hi, sign, centre)``: :func:`output_branch` and the rest point ``z_rest`` inside it,
     where the inverse's Newton search starts widening its bracket (the arguments of
-    ``kernels.solve_output``). Raises as :func:`output_branch`."""
+    ``kernels.solve_output``). Raises as :func:`output_branch`.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+
+    Returns
+    -------
+    lo, hi : float
+        The branch's bounds (``+-inf`` where unbounded).
+    sign : float
+        Sign of ``g'`` on it.
+    centre : float
+        ``z_rest``.
+
+    Raises
+    ------
+    FitDivergedError
+        As :func:`output_branch`.
+    """
     lo, hi, sign = output_branch(structure, params)
     centre = -params.w[1:] @ rest_voltages(structure, params) - params.v_b
     return lo, hi, sign, float(centre)
@@ -390,6 +545,22 @@ def rest_state(structure: MplPolyStructure, params: MplPolyParams, value: float,
     input at which the model rests with that output; ``e_0 = 0`` if ``value`` is outside the
     branch's range or ``sum w = 0``. :func:`simulate` / :func:`invert` start here for
     ``x0=None``.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+    value : float
+        Constant input (with `inverse`: output) the model rests at.
+    inverse : bool, default False
+        Rest state of the inverse: `value` is an output.
+
+    Returns
+    -------
+    numpy.ndarray
+        The state at rest.
     """
     v_rest = rest_voltages(structure, params)
     if not inverse:
@@ -404,6 +575,17 @@ def rest_state(structure: MplPolyStructure, params: MplPolyParams, value: float,
 def step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
     """One sample of the forward model: output from the present state, then the Euler update.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+    x : numpy.ndarray, shape (N,)
+        Cell voltages before the sample.
+    u : float
+        Model input ``e`` of the sample.
 
     Returns
     -------
@@ -420,7 +602,26 @@ def step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarray,
 def invert_step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of the inverse: ``z = g^-1(y)`` on :func:`output_branch`, the input from the
-    output equation with the present state (as eq. 5.13), then the state update (fig. 5.12)."""
+    output equation with the present state (as eq. 5.13), then the state update (fig. 5.12).
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+    x : numpy.ndarray, shape (N,)
+        Cell voltages before the sample.
+    y : float
+        Output to reach at this sample.
+
+    Returns
+    -------
+    u : float
+        Input that gives `y` from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
+    """
     x = np.asarray(x, dtype=float)
     lo, hi, _ = output_branch(structure, params)
     a = lo if np.isfinite(lo) else -1e15
@@ -465,6 +666,10 @@ def simulate(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
 
     Parameters
     ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
     u : array, shape (n,)
         Model input ``e`` sampled every ``structure.dt``.
     x0 : array, shape (N,), float or None
@@ -497,7 +702,26 @@ def simulate(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
 
 def simulate_reference(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate` for bounded runs, as a plain loop over :func:`step`."""
+    """Same as :func:`simulate` for bounded runs, as a plain loop over :func:`step`.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Model input ``e`` sampled every ``structure.dt``.
+    x0 : numpy.ndarray, float or None, optional
+        Initial cell voltages, as for :func:`simulate`.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Output.
+    x_end : numpy.ndarray
+        State after the last sample.
+    """
     u = _check(structure, params, u, "u")
     x = _start(structure, params, x0, u[0])
     return run_steps(step, structure, params, u, x)
@@ -507,7 +731,26 @@ def simulate_with_jacobian(structure: MplPolyStructure, params: MplPolyParams, u
                            x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Forward output and its exact Jacobian ``dy/dtheta``, shape (n, 5N + 6), columns in the
     order of :meth:`MplPolyParams.to_vector`. The rest start (``x0=None``) moves with the
-    parameters: ``du_k(0)/dtheta = (df_k/dtheta)(v*) / f'_k(v*)``. Non-finite on divergence."""
+    parameters: ``du_k(0)/dtheta = (df_k/dtheta)(v*) / f'_k(v*)``. Non-finite on divergence.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Model input ``e`` sampled every ``structure.dt``.
+    x0 : numpy.ndarray, float or None, optional
+        Initial cell voltages, as for :func:`simulate`.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Output.
+    jac : numpy.ndarray, shape (n, 5N + 6)
+        ``dy/dtheta``.
+    """
     u = _check(structure, params, u, "u")
     try:
         check_rest(structure, params)
@@ -539,6 +782,10 @@ def invert(structure: MplPolyStructure, params: MplPolyParams, y: np.ndarray,
 
     Parameters
     ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
     y : array, shape (n,)
         Model output (e.g. the sensor signal), sampled every ``structure.dt``.
     x0 : array, shape (N,), float or None

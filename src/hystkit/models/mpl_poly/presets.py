@@ -39,6 +39,16 @@ def paper_9_2_params(printed: Mapping[str, float]) -> mpl_poly.MplPolyParams:
     printed values, and the same form to ``g``: the squares and cubes are not typos (with them
     every column is a working compensator, without them the chirp column is anti-correlated
     with its input; docs/models/mpl_poly.md).
+
+    Parameters
+    ----------
+    printed : mapping of str to float
+        ``f0 .. f3``, ``g0 .. g3``, ``w0``, ``w1`` and ``V_b`` as printed.
+
+    Returns
+    -------
+    mpl_poly.MplPolyParams
+        One-cell parameters.
     """
     def cubic(p: str) -> list[float]:
         return [printed[f"{p}0"], printed[f"{p}1"], printed[f"{p}2"] ** 2, printed[f"{p}3"] ** 3]
