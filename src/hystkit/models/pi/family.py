@@ -15,6 +15,8 @@ __all__ = ["PiFamily"]
 
 
 class PiFamily(Family):
+    """Kuhnen's modified Prandtl-Ishlinskii model with creep (sec. 2.1.6) as a registered family."""
+
     name = "pi"
     title = "Kuhnen / modified Prandtl-Ishlinskii with creep (sec. 2.1.6, eq. 2.6-2.19)"
     size_help = ("play operators n (thresholds i/n, i < n; plus 2 x 2 dead zones, 4 creep "

@@ -56,6 +56,23 @@ def output_thresholds(y: np.ndarray, n_deadzone: int) -> np.ndarray:
 
     Kuhnen spreads them equidistantly over the output range; a side without data (an output
     that never changes sign) gets the mirror of the other side.
+
+    Parameters
+    ----------
+    y : numpy.ndarray, shape (n,)
+        Target output.
+    n_deadzone : int
+        Dead zones per side, ``m``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (2 m + 1,)
+        The thresholds, ascending.
+
+    Raises
+    ------
+    ValueError
+        If `y` is identically 0.
     """
     hi, lo = float(np.max(y)), float(np.min(y))
     span = max(hi, -lo)
@@ -93,6 +110,8 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
     structure : PiStructure
     accept : callable, optional
         Checked once on the solution; a veto raises FitDivergedError with ``accept_reason``.
+    accept_reason : str, optional
+        The message of a veto.
     d_inv : array, shape (2 n_deadzone + 1,), optional
         Thresholds of ``S^-1`` in output units; default :func:`output_thresholds`.
     ridge : float
@@ -185,6 +204,31 @@ def make_structure(dt: float, size: int, *, n_deadzone: int = 2, n_creep: int = 
     amplitude (``r_max = 1`` for data normalised to max |.| = 1, eq. 5.10). ``n_deadzone``
     dead zones per side. ``a_j = 1 / (tau_min 10^j)`` (j = 0 .. n_creep - 1): by default time
     constants 0.1, 1, 10 and 100 s, from 4 samples at 40 Hz to half a recording.
+
+    Parameters
+    ----------
+    dt : float
+        Sample time [s].
+    size : int
+        Play operators.
+    n_deadzone : int, default 2
+        Dead zones per side.
+    n_creep : int, default 4
+        Creep operators.
+    r_max : float, default 1.0
+        Largest input amplitude the thresholds spread over.
+    tau_min : float, default 0.1
+        Shortest creep time constant [s].
+
+    Returns
+    -------
+    pi.PiStructure
+        The structure.
+
+    Raises
+    ------
+    ValueError
+        A size that is not an integer in ``[1, MAX_PLAYS]``.
     """
     # the caps first, before arange allocates anything (a size of 1e12 or inf)
     if not (isinstance(size, int | float) and 1 <= size <= pi.MAX_PLAYS) or int(size) != size:

@@ -211,19 +211,60 @@ class PiParams(Record):
 
 def output_bound(params: PiParams, u_max: float) -> float:
     """``sum |w_S| ((sum |w_H| + sum |w_K|) u_max + |b|)``: no output of a run whose inputs
-    and initial states stay within ``u_max`` in magnitude exceeds it."""
+    and initial states stay within ``u_max`` in magnitude exceeds it.
+
+    Parameters
+    ----------
+    params : PiParams
+        Its parameters.
+    u_max : float
+        Bound on the magnitude of the inputs and the initial states.
+
+    Returns
+    -------
+    float
+        The bound on ``|y|``.
+    """
     inner = (np.abs(params.w_h).sum() + np.abs(params.w_k).sum()) * u_max + abs(params.b)
     return float(np.abs(params.w_s).sum() * inner)
 
 
 def play(x: np.ndarray | float, y_prev: np.ndarray | float,
          r: np.ndarray | float) -> np.ndarray:
-    """Elementary play operator ``max(x - r, min(x + r, y_prev))`` (eq. 2.11)."""
+    """Elementary play operator ``max(x - r, min(x + r, y_prev))`` (eq. 2.11).
+
+    Parameters
+    ----------
+    x : numpy.ndarray or float
+        Input.
+    y_prev : numpy.ndarray or float
+        Previous play output.
+    r : numpy.ndarray or float
+        Threshold.
+
+    Returns
+    -------
+    numpy.ndarray
+        The play output, the broadcast shape.
+    """
     return np.maximum(np.subtract(x, r), np.minimum(np.add(x, r), y_prev))
 
 
 def deadzone(v: np.ndarray | float, d: np.ndarray | float) -> np.ndarray:
-    """One-sided dead-zone operator ``S_d(v)`` (eq. 2.12); broadcasts over ``v`` and ``d``."""
+    """One-sided dead-zone operator ``S_d(v)`` (eq. 2.12); broadcasts over ``v`` and ``d``.
+
+    Parameters
+    ----------
+    v : numpy.ndarray or float
+        Operator input.
+    d : numpy.ndarray or float
+        Thresholds.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``S_d(v)``, the broadcast shape.
+    """
     v, d = np.broadcast_arrays(np.asarray(v, dtype=float), np.asarray(d, dtype=float))
     return np.where(d > 0, np.maximum(v - d, 0.0), np.where(d < 0, np.minimum(v - d, 0.0), v))
 
@@ -235,6 +276,18 @@ def inverse_pi(r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     of the initial loading curve between ``r_i`` and ``r_{i+1}``) are all positive:
     ``r'_i = sum_{j<=i} w_j (r_i - r_j)`` (the loading curve at ``r_i``), ``w'_0 = 1 / w_0``,
     ``w'_i = -w_i / (W_i W_{i-1})`` (slopes ``1 / W_i``).
+
+    Parameters
+    ----------
+    r : numpy.ndarray, shape (n,)
+        Thresholds, ``0 = r_0 < r_1 < ...``.
+    w : numpy.ndarray, shape (n,)
+        Weights with positive partial sums.
+
+    Returns
+    -------
+    r_inv, w_inv : numpy.ndarray, shape (n,)
+        Thresholds and weights of the inverse.
     """
     r, w = np.asarray(r, dtype=float), np.asarray(w, dtype=float)
     big_w = np.cumsum(w)
@@ -249,6 +302,18 @@ def inverse_superposition(d: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.
     Each side of ``d_0 = 0`` is a PI-like initial loading curve: the inverse has thresholds
     ``d'_k = S(d_k)`` and weights from the inverse slopes, as :func:`inverse_pi`. Needs the
     partial sums ``w_0 + .. + w_k`` (k >= 0) and ``w_0 + .. + w_-k`` all positive.
+
+    Parameters
+    ----------
+    d : numpy.ndarray, shape (2 m + 1,)
+        Dead-zone thresholds, ``d_0 = 0`` in the middle.
+    w : numpy.ndarray, shape (2 m + 1,)
+        Their weights.
+
+    Returns
+    -------
+    d_inv, w_inv : numpy.ndarray, shape (2 m + 1,)
+        Thresholds and weights of ``S^-1``.
     """
     d, w = np.asarray(d, dtype=float), np.asarray(w, dtype=float)
     m = (d.size - 1) // 2
@@ -261,21 +326,59 @@ def inverse_superposition(d: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.
 
 def inverse_play_states(w: np.ndarray, p: np.ndarray) -> np.ndarray:
     """States ``q_i = W_i p_i + sum_{j>i} w_j p_j`` of the inverse plays that continue a PI
-    operator with weights ``w`` and play states ``p`` (both shape (n,))."""
+    operator with weights ``w`` and play states ``p`` (both shape (n,)).
+
+    Parameters
+    ----------
+    w : numpy.ndarray, shape (n,)
+        Weights of the PI operator.
+    p : numpy.ndarray, shape (n,)
+        Its play states.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        The inverse plays' states ``q``.
+    """
     w, p = np.asarray(w, dtype=float), np.asarray(p, dtype=float)
     tail = np.concatenate([np.cumsum((w * p)[::-1])[::-1][1:], [0.0]])
     return np.cumsum(w) * p + tail
 
 
 def instantaneous_weights(structure: PiStructure, params: PiParams) -> np.ndarray:
-    """Play weights of ``H~ = H + kappa x``, the operator one sample of ``H + K`` applies."""
+    """Play weights of ``H~ = H + kappa x``, the operator one sample of ``H + K`` applies.
+
+    Parameters
+    ----------
+    structure : PiStructure
+        The model's structure.
+    params : PiParams
+        Its parameters.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_play,)
+        ``w_H`` with ``kappa = sum_j w_Kj c_j`` added to ``w_0``.
+    """
     w = params.w_h.copy()
     w[0] += params.w_k @ structure.creep_gains
     return w
 
 
 class InverseParts(NamedTuple):
-    """What one inverse sample needs (eq. 2.19 with creep), see :func:`inverse_parts`."""
+    """What one inverse sample needs (eq. 2.19 with creep), see :func:`inverse_parts`.
+
+    Parameters
+    ----------
+    sign : float
+        Polarity of ``H~`` (+1 or -1).
+    w_inst : numpy.ndarray, shape (n_play,)
+        Weights of ``H~`` (:func:`instantaneous_weights`).
+    r_inv, w_inv : numpy.ndarray, shape (n_play,)
+        Thresholds and weights of the inverse of ``sign * H~``.
+    d_inv, ws_inv : numpy.ndarray, shape (2 n_deadzone + 1,)
+        Thresholds and weights of ``S^-1``.
+    """
 
     sign: float
     w_inst: np.ndarray
@@ -287,7 +390,20 @@ class InverseParts(NamedTuple):
 
 def inverse_parts(structure: PiStructure, params: PiParams) -> InverseParts:
     """The inverse operators: polarity ``sign`` of ``H~`` (the polarity lives in ``H``, ``S``
-    increases), its weights ``w_inst``, the inverse plays of ``sign * H~`` and ``S^-1``."""
+    increases), its weights ``w_inst``, the inverse plays of ``sign * H~`` and ``S^-1``.
+
+    Parameters
+    ----------
+    structure : PiStructure
+        The model's structure.
+    params : PiParams
+        Its parameters.
+
+    Returns
+    -------
+    InverseParts
+        The inverse operators.
+    """
     w_inst = instantaneous_weights(structure, params)
     sign = 1.0 if w_inst[0] > 0 else -1.0
     r_inv, w_inv = inverse_pi(np.asarray(structure.play_thresholds), sign * w_inst)
@@ -296,7 +412,25 @@ def inverse_parts(structure: PiStructure, params: PiParams) -> InverseParts:
 
 
 def rest_input(params: PiParams, y0: float) -> float:
-    """The input at rest at output ``y0``: ``(S^-1(y0) - b) / (sum w_H + sum w_K)``."""
+    """The input at rest at output ``y0``: ``(S^-1(y0) - b) / (sum w_H + sum w_K)``.
+
+    Parameters
+    ----------
+    params : PiParams
+        The model's parameters.
+    y0 : float
+        Output at rest.
+
+    Returns
+    -------
+    float
+        The input.
+
+    Raises
+    ------
+    FitDivergedError
+        If the static gain ``sum w_H + sum w_K`` is (nearly) 0.
+    """
     gain = params.w_h.sum() + params.w_k.sum()
     if not abs(gain) >= INVERSE_MIN_SLOPE:  # 1 / gain would leave the domain (or the float range)
         raise FitDivergedError(f"the model's static gain sum(w_H) + sum(w_K) = {gain:g} is "
@@ -309,7 +443,24 @@ def rest_state(structure: PiStructure, params: PiParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """State at rest: every play and creep state at the input ``value`` (where :func:`simulate`
     starts), or for ``inverse`` at the input at rest at the output ``value`` (:func:`invert`'s
-    start, :func:`rest_input`)."""
+    start, :func:`rest_input`).
+
+    Parameters
+    ----------
+    structure : PiStructure
+        The model's structure.
+    params : PiParams
+        Its parameters.
+    value : float
+        Constant input (with `inverse`: output) the model rests at.
+    inverse : bool, default False
+        Rest state of the inverse: `value` is an output.
+
+    Returns
+    -------
+    numpy.ndarray
+        The state at rest.
+    """
     u = rest_input(params, float(value)) if inverse else float(value)
     return np.full(structure.n_play + structure.n_creep, u)
 
@@ -321,6 +472,17 @@ def _superposition(params: PiParams, v: float) -> float:
 def step(structure: PiStructure, params: PiParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
     """One sample of the forward model (the readable reference of the kernel).
+
+    Parameters
+    ----------
+    structure : PiStructure
+        The model's structure.
+    params : PiParams
+        Its parameters.
+    x : numpy.ndarray, shape (n_play + n_creep,)
+        Play outputs then creep states before the sample.
+    u : float
+        Input of the sample.
 
     Returns
     -------
@@ -342,6 +504,24 @@ def invert_step(structure: PiStructure, params: PiParams, x: np.ndarray,
     The instantaneous operator ``H~`` is inverted with inverse plays built from the present
     play states; the estimate then advances the forward state as :func:`step` would.
     Needs an invertible model (see :func:`invert`).
+
+    Parameters
+    ----------
+    structure : PiStructure
+        The model's structure.
+    params : PiParams
+        Its parameters.
+    x : numpy.ndarray, shape (n_play + n_creep,)
+        Play outputs then creep states before the sample. (the forward state)
+    y : float
+        Output to reach at this sample.
+
+    Returns
+    -------
+    u : float
+        Input that gives `y` from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
     """
     x = np.asarray(x, dtype=float)
     n, c = structure.n_play, structure.creep_gains
@@ -372,6 +552,10 @@ def simulate(structure: PiStructure, params: PiParams, u: np.ndarray,
 
     Parameters
     ----------
+    structure : PiStructure
+        The model's structure.
+    params : PiParams
+        Its parameters.
     u : array, shape (n,)
         Input sampled every ``structure.dt``.
     x0 : array, shape (n_play + n_creep,), float or None
@@ -397,7 +581,26 @@ def simulate(structure: PiStructure, params: PiParams, u: np.ndarray,
 
 def simulate_reference(structure: PiStructure, params: PiParams, u: np.ndarray,
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
+
+    Parameters
+    ----------
+    structure : PiStructure
+        The model's structure.
+    params : PiParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Input sampled every ``structure.dt``.
+    x0 : numpy.ndarray, float or None, optional
+        Initial play outputs then creep states, as for :func:`simulate`.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Output.
+    x_end : numpy.ndarray
+        State after the last sample.
+    """
     _check_params(structure, params)
     u = check_signal(u, "u")
     x = _initial_state(structure, x0, u[0])
@@ -411,6 +614,18 @@ def not_invertible_reason(structure: PiStructure, params: PiParams) -> str:
     loading curve, either polarity) and the dead-zone weights partial sums that are positive
     from ``d = 0`` outwards (an increasing ``S``), all at least ``INVERSE_MIN_SLOPE`` (1e-6) in
     magnitude so that the inverse's slopes stay below 1e6 (the fit's are below 100).
+
+    Parameters
+    ----------
+    structure : PiStructure
+        The model's structure.
+    params : PiParams
+        Its parameters.
+
+    Returns
+    -------
+    str
+        The reason, or ``""``.
     """
     _check_params(structure, params)
     sums = np.cumsum(instantaneous_weights(structure, params))
@@ -433,6 +648,10 @@ def invert(structure: PiStructure, params: PiParams, y: np.ndarray,
 
     Parameters
     ----------
+    structure : PiStructure
+        The model's structure.
+    params : PiParams
+        Its parameters.
     y : array, shape (n,)
         Model output (e.g. the sensor signal), sampled every ``structure.dt``.
     x0 : array, shape (n_play + n_creep,), float or None
