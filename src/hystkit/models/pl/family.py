@@ -17,6 +17,8 @@ __all__ = ["PlFamily"]
 
 
 class PlFamily(Family):
+    """The Power-Law model of hysteresis and creep (sec. 2.1.7) as a registered family."""
+
     name = "pl"
     title = "Power-Law model as published, Biggio et al. (sec. 2.1.7, eq. 2.16-2.18)"
     size_help = "cells N (N + M + 4 params; p, M, S via options or 'hystkit pl-search')"

@@ -45,6 +45,8 @@ def solve_weights(structure: pl.PlStructure, x: np.ndarray, u: np.ndarray,
 
     Parameters
     ----------
+    structure : pl.PlStructure
+        The model's structure.
     x : array, shape (n, N)
         Cell voltages at every sample.
     u, y : array, shape (n,)
@@ -87,7 +89,18 @@ def solve_weights(structure: pl.PlStructure, x: np.ndarray, u: np.ndarray,
 def default_starts(structure: pl.PlStructure) -> list[np.ndarray]:
     """Starts ``[log I_T, log V_T]``: a coarse grid of the two, thresholds spanning 0.2 to 2 of
     the normalised range (``N V_T``) and cell-1 creep time constants ``V_T / I_T`` of 0.3, 3
-    and 30 s (12 starts; the cost has several basins in these two coordinates)."""
+    and 30 s (12 starts; the cost has several basins in these two coordinates).
+
+    Parameters
+    ----------
+    structure : pl.PlStructure
+        The model's structure.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        The starts, each ``[log I_T, log V_T]``.
+    """
     starts = []
     for span in (0.2, 0.5, 1.0, 2.0):
         v_t = span / structure.n_cells
@@ -107,6 +120,8 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
     ----------
     u, y : array, shape (n,)
         Centred, normalised data (eq. 5.10) every ``structure.dt``.
+    structure : pl.PlStructure
+        The fixed structure.
     starts : list of arrays ``[log I_T, log V_T]``, optional
         Default :func:`default_starts` (12 starts).
     max_nfev, screen_nfev, n_polish : int
@@ -116,6 +131,11 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart`. Variable projection leaves two
         coordinates, so their difference Jacobian (``n x 2``) is formed densely.
+
+    Returns
+    -------
+    FitResult
+        The best start's fit.
 
     Raises
     ------

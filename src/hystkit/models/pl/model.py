@@ -117,6 +117,8 @@ class PlStructure(Record):
     slope_cap : float
         ``G dt`` of the straight branches, the largest Euler slope (< 2, eq. 5.28; 1: no overshoot).
 
+    Notes
+    -----
     Limits (checked first, before anything is allocated): ``1 <= n_cells <= 1000``,
     ``1 <= n_basis <= MAX_BASIS`` (1000), ``power`` in ``POWER_RANGE`` (1.01 .. 1000), ``dt``
     in 1e-9 .. 1e6 s, ``slope_cap`` at least 1e-6.
@@ -204,14 +206,42 @@ class PlParams(Record):
 def output_bound(structure: PlStructure, params: PlParams, u_max: float,
                  x0_max: float | None = None) -> float:
     """Largest ``|y|`` of a forward run with ``|u| <= u_max`` from ``|x0| <= x0_max``
-    (default: at rest, ``x0_max = u_max``); see the Notes of :class:`PlParams`."""
+    (default: at rest, ``x0_max = u_max``); see the Notes of :class:`PlParams`.
+
+    Parameters
+    ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
+    u_max : float
+        Largest input magnitude.
+    x0_max : float, optional
+        Largest initial state magnitude; default `u_max` (a start at rest).
+
+    Returns
+    -------
+    float
+        The bound on ``|y|``.
+    """
     b = state_bound(u_max if x0_max is None else x0_max, u_max, structure.slope_cap)
     u = abs(params.w[0]) * u_max + np.abs(params.w[1:]).sum() * b + abs(params.v_b)
     return float(u / np.min(params.a))
 
 
 def basis_breakpoints(n_basis: int) -> np.ndarray:
-    """Breakpoints ``b_0 .. b_M`` of the output basis: M equal segments of [-1, 1], eq. 2.17."""
+    """Breakpoints ``b_0 .. b_M`` of the output basis: M equal segments of [-1, 1], eq. 2.17.
+
+    Parameters
+    ----------
+    n_basis : int
+        Number ``M`` of segments.
+
+    Returns
+    -------
+    numpy.ndarray, shape (M + 1,)
+        The breakpoints, from -1 to 1.
+    """
     return np.linspace(-1.0, 1.0, n_basis + 1)
 
 
@@ -231,6 +261,10 @@ def resistor_current(structure: PlStructure, params: PlParams, v: np.ndarray) ->
 
     Parameters
     ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
     v : array, shape (..., N)
         Voltage across each cell's resistor.
 
@@ -248,7 +282,22 @@ def resistor_current(structure: PlStructure, params: PlParams, v: np.ndarray) ->
 
 def resistor_slope(structure: PlStructure, params: PlParams, v: np.ndarray) -> np.ndarray:
     """Slopes ``d'_k(v)``, shape (..., N): ``p I_T / ((p - 1) k V_T) |v / k V_T|^(p - 1)``
-    inside the knee, ``G`` on the straight branches (the cells' rates in a linearisation)."""
+    inside the knee, ``G`` on the straight branches (the cells' rates in a linearisation).
+
+    Parameters
+    ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
+    v : numpy.ndarray, shape (..., N)
+        Voltage across each cell's resistor.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        The slopes.
+    """
     v = np.asarray(v, dtype=float)
     thr, knee, g_lin = _cells(structure, params)
     p = structure.power
@@ -256,7 +305,20 @@ def resistor_slope(structure: PlStructure, params: PlParams, v: np.ndarray) -> n
     return np.where(np.abs(v) <= knee, inside, g_lin)
 
 def output_resistor(params: PlParams, i: np.ndarray) -> np.ndarray:
-    """``u = f(i) = sum_j a_j phi_j(i)`` (eq. 2.17), shape of ``i``."""
+    """``u = f(i) = sum_j a_j phi_j(i)`` (eq. 2.17), shape of ``i``.
+
+    Parameters
+    ----------
+    params : PlParams
+        The model's parameters.
+    i : numpy.ndarray
+        Output current.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``f(i)``, same shape as `i`.
+    """
     i = np.asarray(i, dtype=float)
     brk = basis_breakpoints(params.n_basis)
     lo = np.r_[-np.inf, brk[1:-1]]
@@ -266,7 +328,20 @@ def output_resistor(params: PlParams, i: np.ndarray) -> np.ndarray:
 
 
 def output_resistor_inverse(params: PlParams, u: np.ndarray) -> np.ndarray:
-    """``i = f^-1(u)`` (eq. 2.18), exact: ``f`` is PWL and strictly increasing."""
+    """``i = f^-1(u)`` (eq. 2.18), exact: ``f`` is PWL and strictly increasing.
+
+    Parameters
+    ----------
+    params : PlParams
+        The model's parameters.
+    u : numpy.ndarray
+        Voltage across the output resistor.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``f^-1(u)``, same shape as `u`.
+    """
     u = np.asarray(u, dtype=float)
     if params.n_basis == 1:
         return u / params.a[0]
@@ -279,7 +354,20 @@ def output_resistor_inverse(params: PlParams, u: np.ndarray) -> np.ndarray:
 
 def output_resistor_slope(params: PlParams, i: np.ndarray) -> np.ndarray:
     """``f'(i)``: the slope ``a_j`` of the segment holding ``i`` (the left one at a breakpoint
-    inside, as the outermost segments extend to infinity)."""
+    inside, as the outermost segments extend to infinity).
+
+    Parameters
+    ----------
+    params : PlParams
+        The model's parameters.
+    i : numpy.ndarray
+        Output current.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``f'(i)``, same shape as `i`.
+    """
     i = np.asarray(i, dtype=float)
     seg = np.searchsorted(basis_breakpoints(params.n_basis)[1:-1], i)
     return params.a[seg]
@@ -292,6 +380,22 @@ def rest_state(structure: PlStructure, params: PlParams, value: float,
     Forward: the source is the constant input ``value``. Inverse (``value`` a constant output
     current): ``e_0 = (f(value) + V_b) / sum w`` (0 if ``sum w = 0``), the source at which the
     model rests with that output. :func:`simulate` / :func:`invert` start here for ``x0=None``.
+
+    Parameters
+    ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
+    value : float
+        Constant input (with `inverse`: output) the model rests at.
+    inverse : bool, default False
+        Rest state of the inverse: `value` is an output.
+
+    Returns
+    -------
+    numpy.ndarray
+        The state at rest.
     """
     if inverse:
         w_sum = params.w.sum()
@@ -303,6 +407,17 @@ def step(structure: PlStructure, params: PlParams, x: np.ndarray,
          e: float) -> tuple[float, np.ndarray]:
     """One sample: output ``i = f^-1(w_0 e + sum w_k u_k - V_b)`` from the present state
     (eq. 2.18), then the forward-Euler update of the cell voltages.
+
+    Parameters
+    ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
+    x : numpy.ndarray, shape (N,)
+        Capacitor voltages before the sample.
+    e : float
+        Source voltage of the sample.
 
     Returns
     -------
@@ -318,7 +433,26 @@ def step(structure: PlStructure, params: PlParams, x: np.ndarray,
 def invert_step(structure: PlStructure, params: PlParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of the inverse: ``u = f(i)`` (eq. 2.17), ``e = (u + V_b - sum w_k u_k) / w_0``
-    from the present state (eq. 2.20), then the cell update driven by ``e``."""
+    from the present state (eq. 2.20), then the cell update driven by ``e``.
+
+    Parameters
+    ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
+    x : numpy.ndarray, shape (N,)
+        Capacitor voltages before the sample.
+    y : float
+        Output current to reach at this sample.
+
+    Returns
+    -------
+    u : float
+        Input that gives `y` from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
+    """
     x = np.asarray(x, dtype=float)
     e = (float(output_resistor(params, y)) + params.v_b - params.w[1:] @ x) / params.w[0]
     return e, x + resistor_current(structure, params, e - x) * structure.dt
@@ -331,7 +465,20 @@ def _check(structure: PlStructure, params: PlParams, u: np.ndarray, name: str) -
 
 
 def kernel_args(structure: PlStructure, params: PlParams) -> tuple:
-    """``(I_T, thresholds, knees, p, G, dt)``: the cell arguments of the compiled kernels."""
+    """``(I_T, thresholds, knees, p, G, dt)``: the cell arguments of the compiled kernels.
+
+    Parameters
+    ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
+
+    Returns
+    -------
+    tuple
+        ``(I_T, thresholds, knees, p, G, dt)``.
+    """
     thr, knee, g_lin = _cells(structure, params)
     return params.i_t, thr, knee, float(structure.power), g_lin, structure.dt
 
@@ -342,6 +489,10 @@ def simulate(structure: PlStructure, params: PlParams, u: np.ndarray,
 
     Parameters
     ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
     u : array, shape (n,)
         Source voltage ``e`` every ``structure.dt``.
     x0 : array, shape (N,), float or None
@@ -363,7 +514,26 @@ def simulate(structure: PlStructure, params: PlParams, u: np.ndarray,
 
 def simulate_reference(structure: PlStructure, params: PlParams, u: np.ndarray,
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
+
+    Parameters
+    ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Source voltage sampled every ``structure.dt``.
+    x0 : numpy.ndarray, float or None, optional
+        Initial capacitor voltages, as for :func:`simulate`.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Output.
+    x_end : numpy.ndarray
+        State after the last sample.
+    """
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
     return run_steps(step, structure, params, u, x)
@@ -371,7 +541,26 @@ def simulate_reference(structure: PlStructure, params: PlParams, u: np.ndarray,
 
 def states(structure: PlStructure, params: PlParams, u: np.ndarray,
            x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Capacitor voltages at every sample, shape (n, N), and the final state (weights unused)."""
+    """Capacitor voltages at every sample, shape (n, N), and the final state (weights unused).
+
+    Parameters
+    ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Source voltage sampled every ``structure.dt``.
+    x0 : numpy.ndarray, float or None, optional
+        Initial capacitor voltages, as for :func:`simulate`.
+
+    Returns
+    -------
+    states : numpy.ndarray, shape (n, N)
+        Capacitor voltages at every sample.
+    x_end : numpy.ndarray, shape (N,)
+        Capacitor voltages after the last sample.
+    """
     u = _check(structure, params, u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
     return kernels.states(u, x, *kernel_args(structure, params))
@@ -384,6 +573,10 @@ def invert(structure: PlStructure, params: PlParams, y: np.ndarray,
 
     Parameters
     ----------
+    structure : PlStructure
+        The model's structure.
+    params : PlParams
+        Its parameters.
     y : array, shape (n,)
         Output current ``i`` every ``structure.dt``.
     x0 : array, shape (N,), float or None

@@ -32,8 +32,14 @@ def structural_search(u: np.ndarray, y: np.ndarray, dt: float,
     u, y : array, shape (n,)
         Model input and output every ``dt`` [s]; centred on their means and scaled to
         max |.| = 1 here (eq. 5.10), so the errors are those of eq. 5.11 on normalised data.
+    dt : float
+        Sample time [s].
     grid : mapping with keys "n", "p", "m", "s", optional
         Values to try for each structural parameter; :data:`DEFAULT_GRID` fills missing keys.
+    slope_cap : float, default 1.0
+        Slope cap of every structure tried.
+    executor : hystkit.parallel.Executor, optional
+        Runs the fits; serial if None.
 
     Returns
     -------
@@ -68,7 +74,20 @@ def _fit_structure(structure: pl.PlStructure, *, u: np.ndarray, y: np.ndarray) -
 
 
 def format_search_table(rows: Sequence[dict], best_only_per_n: bool = False) -> str:
-    """The search result laid out like table 5.1 (one line per structure, or the best per N)."""
+    """The search result laid out like table 5.1 (one line per structure, or the best per N).
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Rows of :func:`structural_search`.
+    best_only_per_n : bool, default False
+        Show only the row with the lowest RMS error per cell count.
+
+    Returns
+    -------
+    str
+        The table.
+    """
     if best_only_per_n:
         best: dict[int, dict] = {}
         for r in rows:
