@@ -156,6 +156,8 @@ class StaircaseFamily(Family):
 
 
 class PreisachFamily(StaircaseFamily):
+    """The classical Preisach model (sec. 2.1.1, appendix 9.3-9.5) as a registered family."""
+
     name = "preisach"
     title = "classical Preisach, Everett function on a grid (sec. 2.1.1, eq. 2.1, 9.4-9.13)"
     size_help = "grid levels L over the normalised input (L (L - 1) / 2 Preisach cells)"

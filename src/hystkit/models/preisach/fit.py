@@ -43,7 +43,18 @@ __all__ = ["ORIENTATIONS", "check_data", "everett_from_forcs", "fit_oriented", "
 
 
 def check_data(u: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """1-D, equal length, finite; returned as contiguous float arrays."""
+    """1-D, equal length, finite; returned as contiguous float arrays.
+
+    Parameters
+    ----------
+    u, y : numpy.ndarray, shape (n,)
+        Input and target output.
+
+    Returns
+    -------
+    u, y : numpy.ndarray, shape (n,)
+        The same, contiguous float64.
+    """
     return check_fit_data(u, y, min_size=2)
 
 
@@ -53,6 +64,11 @@ def smoothness_rows(levels: int) -> np.ndarray:
     Squares (density ``m / h^2``) neighbour squares, diagonal segments (density ``m / h``,
     weighted by ``h^-1/2`` for the 1-D integral) neighbour diagonal segments; ``h`` is the grid
     step. Columns follow ``np.tril_indices(levels - 1)``.
+
+    Parameters
+    ----------
+    levels : int
+        Grid levels ``L``.
 
     Returns
     -------
@@ -85,6 +101,17 @@ def solve_regularised(a: np.ndarray, y: np.ndarray, penalty: np.ndarray,
     ``||R x - Q^T y||^2`` plus a constant), so the bounded solver works on a square problem
     whatever the number of samples.
 
+    Parameters
+    ----------
+    a : numpy.ndarray, shape (n, p)
+        Design matrix.
+    y : numpy.ndarray, shape (n,)
+        Target.
+    penalty : numpy.ndarray, shape (m, p)
+        Regularisation rows.
+    nonneg : numpy.ndarray of bool, shape (p,)
+        Entries of `x` constrained to be non-negative.
+
     Returns
     -------
     x : array, shape (p,)
@@ -116,6 +143,39 @@ def fit_oriented(a: np.ndarray, y: np.ndarray, penalty: np.ndarray, hysteretic: 
     The columns ``hysteretic`` (off-diagonal Preisach cells) get the orientation's sign
     before the solve, so ``x[nonneg] >= 0`` means non-negative weights for counter-clockwise
     loops and non-positive ones for clockwise loops; see the module docstring.
+
+    Parameters
+    ----------
+    a : numpy.ndarray, shape (n, p)
+        Design matrix.
+    y : numpy.ndarray, shape (n,)
+        Target output.
+    penalty : numpy.ndarray, shape (m, p)
+        Regularisation rows.
+    hysteretic : numpy.ndarray of bool, shape (p,)
+        Columns whose sign follows the loop orientation.
+    nonneg : numpy.ndarray of bool, shape (p,)
+        Columns constrained to be non-negative (after the orientation's sign).
+    orientation : {"counterclockwise", "clockwise", "auto"}
+        Orientations to try.
+    to_params : callable
+        Coefficients -> the family's parameters.
+    structure : object
+        The family's structure, for the result.
+    accept : callable or None
+        A solution counts only if ``accept(params)`` is true.
+    accept_reason : str
+        The message when every solution is rejected.
+
+    Returns
+    -------
+    FitResult
+        The cheapest accepted solution.
+
+    Raises
+    ------
+    FitDivergedError
+        If every solution is rejected.
     """
     t_start = time.perf_counter()
     candidates = []
@@ -155,6 +215,13 @@ def fit_preisach(u: np.ndarray, y: np.ndarray, structure: preisach.PreisachStruc
     accept : callable, optional
         Checked on each solution (one per orientation tried), cheapest first; vetoed ones are
         skipped.
+    accept_reason : str, optional
+        The message when every solution is rejected.
+
+    Returns
+    -------
+    FitResult
+        The cheapest accepted solution.
 
     Raises
     ------
@@ -203,6 +270,11 @@ def everett_from_forcs(alphas: np.ndarray, betas: np.ndarray, y: np.ndarray,
         FORC outputs; entries with ``betas[j] > alphas[i]`` are ignored.
     levels : int, optional
         Model grid levels; default ``n_a``.
+
+    Returns
+    -------
+    preisach.PreisachParams
+        Everett nodes on the model grid and the offset ``y_0``.
     """
     alphas, betas = np.asarray(alphas, dtype=float), np.asarray(betas, dtype=float)
     y = np.asarray(y, dtype=float)

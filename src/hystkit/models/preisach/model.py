@@ -159,7 +159,18 @@ class PreisachStructure(Record):
 
 
 def grid(levels: int) -> np.ndarray:
-    """The ``L`` equally spaced input levels ``h_i`` over [-1, 1], shape (L,)."""
+    """The ``L`` equally spaced input levels ``h_i`` over [-1, 1], shape (L,).
+
+    Parameters
+    ----------
+    levels : int
+        Number of levels ``L``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (L,)
+        The levels.
+    """
     return np.linspace(-1.0, 1.0, int(levels))
 
 
@@ -169,6 +180,16 @@ def everett_from_masses(masses: np.ndarray) -> np.ndarray:
     ``masses[i, j]`` (``j < i``) is the weight on the square ``alpha in [h_i, h_i+1]``,
     ``beta in [h_j, h_j+1]``; ``masses[i, i]`` the weight along the diagonal segment. Then
     ``E[a, b] = sum of masses[i, j] over b <= j <= i < a`` (eq. 9.6 on the grid).
+
+    Parameters
+    ----------
+    masses : numpy.ndarray, shape (L - 1, L - 1)
+        Cell masses, lower triangle including the diagonal.
+
+    Returns
+    -------
+    numpy.ndarray, shape (L, L)
+        Everett nodes ``E``, strictly lower triangle.
     """
     m = np.tril(np.asarray(masses, dtype=float))
     n_cells = m.shape[0]
@@ -179,14 +200,36 @@ def everett_from_masses(masses: np.ndarray) -> np.ndarray:
 
 
 def masses_from_everett(e: np.ndarray) -> np.ndarray:
-    """Inverse of :func:`everett_from_masses`: mixed second differences of ``E``."""
+    """Inverse of :func:`everett_from_masses`: mixed second differences of ``E``.
+
+    Parameters
+    ----------
+    e : numpy.ndarray, shape (L, L)
+        Everett nodes (lower triangle).
+
+    Returns
+    -------
+    numpy.ndarray, shape (L - 1, L - 1)
+        Cell masses, lower triangle including the diagonal.
+    """
     e = np.tril(np.asarray(e, dtype=float), -1)
     m = e[1:, :-1] - e[1:, 1:] - e[:-1, :-1] + e[:-1, 1:]
     return np.tril(m)
 
 
 def antisymmetric(e: np.ndarray) -> np.ndarray:
-    """``E - E^T``: the extension the bilinear interpolation runs on (zero diagonal)."""
+    """``E - E^T``: the extension the bilinear interpolation runs on (zero diagonal).
+
+    Parameters
+    ----------
+    e : numpy.ndarray, shape (L, L)
+        Everett nodes (lower triangle).
+
+    Returns
+    -------
+    numpy.ndarray, shape (L, L)
+        ``E - E^T``.
+    """
     return e - e.T
 
 
@@ -262,7 +305,20 @@ class PreisachParams(Record):
 
 
 def everett(params: PreisachParams, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    """Interpolated Everett function ``F(alpha, beta)`` (any shapes that broadcast, in [-1, 1])."""
+    """Interpolated Everett function ``F(alpha, beta)`` (any shapes that broadcast, in [-1, 1]).
+
+    Parameters
+    ----------
+    params : PreisachParams
+        The model's parameters.
+    alpha, beta : numpy.ndarray
+        Switching-up and switching-down inputs in [-1, 1].
+
+    Returns
+    -------
+    numpy.ndarray
+        ``F(alpha, beta)``, the broadcast shape.
+    """
     a_ext = antisymmetric(params.everett)
     scale = 0.5 * (params.levels - 1)
     xa, xb = ((np.asarray(v, dtype=float) + 1.0) * scale for v in (alpha, beta))
@@ -278,6 +334,16 @@ def demagnetised_state(n_steps: int) -> np.ndarray:
 
     Minima ``m_k = -1 + k / K``, maxima ``M_k = -(m_k-1 + m_k) / 2`` (the line at each step's
     midpoint), ending at the input 0; shape (2 K + 1,).
+
+    Parameters
+    ----------
+    n_steps : int
+        Steps ``K``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (2 K + 1,)
+        The staircase.
     """
     k = np.arange(1, n_steps + 1)
     x = np.empty(2 * n_steps + 1)
@@ -287,7 +353,25 @@ def demagnetised_state(n_steps: int) -> np.ndarray:
 
 
 def check_state(x: np.ndarray, capacity: int) -> np.ndarray:
-    """Validate a staircase: starts at -1, inside [-1, 1], alternating, strictly nested."""
+    """Validate a staircase: starts at -1, inside [-1, 1], alternating, strictly nested.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The staircase.
+    capacity : int
+        Largest number of entries.
+
+    Returns
+    -------
+    numpy.ndarray
+        `x` as a contiguous float array.
+
+    Raises
+    ------
+    ValueError
+        A staircase that breaks any of these rules.
+    """
     x = np.ascontiguousarray(x, dtype=float)
     if x.ndim != 1 or not 1 <= x.size <= capacity:
         raise ValueError(f"the state must be a 1-D staircase of 1..{capacity} values, got shape "
@@ -311,6 +395,20 @@ def update_staircase(x: np.ndarray, u: float, capacity: int) -> np.ndarray:
     forgotten first. Then a move in the direction of the last segment replaces the last entry,
     a reversal appends one, and each earlier extremum the input reaches or passes is erased
     with the reversal that followed it.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Staircase before the input.
+    u : float
+        The input; clipped to [-1, 1].
+    capacity : int
+        Staircase buffer size.
+
+    Returns
+    -------
+    numpy.ndarray
+        Staircase after the input.
     """
     s = list(x)
     if len(s) >= capacity - 1:
@@ -328,7 +426,25 @@ def update_staircase(x: np.ndarray, u: float, capacity: int) -> np.ndarray:
 
 
 def pack_state(x: np.ndarray, capacity: int) -> np.ndarray:
-    """Staircase -> fixed-length state ``[n, s_0 .. s_{n-1}, 0 ..]``, shape (capacity + 1,)."""
+    """Staircase -> fixed-length state ``[n, s_0 .. s_{n-1}, 0 ..]``, shape (capacity + 1,).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The staircase.
+    capacity : int
+        Staircase buffer size.
+
+    Returns
+    -------
+    numpy.ndarray, shape (capacity + 1,)
+        The packed state.
+
+    Raises
+    ------
+    ValueError
+        A staircase longer than `capacity`.
+    """
     x = np.asarray(x, dtype=float)
     if not 1 <= x.size <= capacity:
         raise ValueError(f"a staircase of {x.size} values does not fit capacity {capacity}")
@@ -339,7 +455,25 @@ def pack_state(x: np.ndarray, capacity: int) -> np.ndarray:
 
 
 def unpack_state(packed: np.ndarray, capacity: int) -> np.ndarray:
-    """Inverse of :func:`pack_state` (the count is rounded, so a float count is safe)."""
+    """Inverse of :func:`pack_state` (the count is rounded, so a float count is safe).
+
+    Parameters
+    ----------
+    packed : numpy.ndarray, shape (capacity + 1,)
+        The packed state.
+    capacity : int
+        Staircase buffer size.
+
+    Returns
+    -------
+    numpy.ndarray
+        The staircase.
+
+    Raises
+    ------
+    ValueError
+        A wrong shape or count.
+    """
     packed = np.asarray(packed, dtype=float)
     if packed.shape != (capacity + 1,):
         raise ValueError(f"the packed Preisach state has shape ({capacity + 1},) = (capacity "
@@ -351,7 +485,20 @@ def unpack_state(packed: np.ndarray, capacity: int) -> np.ndarray:
 
 
 def staircase_terms(e: np.ndarray, x: np.ndarray) -> float:
-    """Relay part of eq. 9.13 for Everett nodes ``e`` and staircase ``x`` (plain sum)."""
+    """Relay part of eq. 9.13 for Everett nodes ``e`` and staircase ``x`` (plain sum).
+
+    Parameters
+    ----------
+    e : numpy.ndarray, shape (L, L)
+        Everett nodes (lower triangle).
+    x : numpy.ndarray
+        The staircase.
+
+    Returns
+    -------
+    float
+        The relay part of the output.
+    """
     probe = PreisachParams(everett=e)
     hi, lo = np.maximum(x[:-1], x[1:]), np.minimum(x[:-1], x[1:])
     signs = np.where(x[1:] >= x[:-1], 1.0, -1.0)
@@ -364,7 +511,24 @@ def _slope(params: PreisachParams) -> float:
 
 def kernel_parts(params: PreisachParams) -> tuple[np.ndarray, bool, np.ndarray, float]:
     """What the compiled kernels run on: tables (1, L, L), weighted (False), output polynomial
-    (the offset) and the slope of the straight-line extension."""
+    (the offset) and the slope of the straight-line extension.
+
+    Parameters
+    ----------
+    params : PreisachParams
+        The model's parameters.
+
+    Returns
+    -------
+    tables : numpy.ndarray, shape (1, L, L)
+        The antisymmetric Everett table.
+    weighted : bool
+        False: no input-dependent weight.
+    poly : numpy.ndarray, shape (1,)
+        The output offset.
+    slope : float
+        Slope of the straight-line extension.
+    """
     return (antisymmetric(params.everett)[None], False, np.array([params.offset]),
             _slope(params))
 
@@ -372,6 +536,17 @@ def kernel_parts(params: PreisachParams) -> tuple[np.ndarray, bool, np.ndarray, 
 def step(structure: PreisachStructure, params: PreisachParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
     """One sample: update the staircase with ``u``, then the output (eq. 9.13 + extension).
+
+    Parameters
+    ----------
+    structure : PreisachStructure
+        The model's structure.
+    params : PreisachParams
+        Its parameters.
+    x : numpy.ndarray, shape (k,)
+        Staircase before the sample.
+    u : float
+        Normalised input of the sample.
 
     Returns
     -------
@@ -397,6 +572,24 @@ def prepare_run(structure, v: np.ndarray, name: str,
 
     Shared with the generalised model, whose structure has the same ``levels`` and
     ``capacity``.
+
+    Parameters
+    ----------
+    structure : PreisachStructure or GPreisachStructure
+        Gives ``levels`` and ``capacity``.
+    v : numpy.ndarray, shape (n,)
+        Input (or output, for an inverse run).
+    name : str
+        Its name in error messages.
+    x0 : numpy.ndarray, optional
+        Initial staircase; None is the demagnetised state.
+
+    Returns
+    -------
+    v : numpy.ndarray, shape (n,)
+        The checked signal.
+    x : numpy.ndarray
+        The checked start staircase.
     """
     v = check_signal(v, name)
     x = demagnetised_state(structure.levels - 1) if x0 is None else x0
@@ -409,6 +602,10 @@ def simulate(structure: PreisachStructure, params: PreisachParams, u: np.ndarray
 
     Parameters
     ----------
+    structure : PreisachStructure
+        The model's structure.
+    params : PreisachParams
+        Its parameters.
     u : array, shape (n,)
         Normalised input; values beyond [-1, 1] follow the straight-line extension.
     x0 : array, shape (k,), or None
@@ -431,7 +628,26 @@ def simulate(structure: PreisachStructure, params: PreisachParams, u: np.ndarray
 
 def simulate_reference(structure: PreisachStructure, params: PreisachParams, u: np.ndarray,
                        x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
+
+    Parameters
+    ----------
+    structure : PreisachStructure
+        The model's structure.
+    params : PreisachParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Input, one value per sample.
+    x0 : numpy.ndarray, optional
+        Initial staircase; None is the demagnetised state.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Output.
+    x_end : numpy.ndarray
+        State after the last sample.
+    """
     u, x = _check(structure, params, u, "u", x0)
     return run_steps(step, structure, params, u, x)
 
@@ -450,6 +666,10 @@ def invert(structure: PreisachStructure, params: PreisachParams, y: np.ndarray,
 
     Parameters
     ----------
+    structure : PreisachStructure
+        The model's structure.
+    params : PreisachParams
+        Its parameters.
     y : array, shape (n,)
     x0 : array or None
         Initial staircase, as in :func:`simulate`.
@@ -474,7 +694,22 @@ def invert(structure: PreisachStructure, params: PreisachParams, y: np.ndarray,
 
 def check_rise(rise: float, mass: float, model: str) -> None:
     """Raise FitDivergedError unless the major loop rises by at least ``MIN_RISE`` of the
-    total mass: the inverse continues beyond saturation with slope ``1 / rise``."""
+    total mass: the inverse continues beyond saturation with slope ``1 / rise``.
+
+    Parameters
+    ----------
+    rise : float
+        Rise of the major loop, ``F(1, -1)``.
+    mass : float
+        Total absolute mass of the weights.
+    model : str
+        Model name for the message.
+
+    Raises
+    ------
+    FitDivergedError
+        The major loop does not rise enough.
+    """
     if not rise >= MIN_RISE * max(mass, 1e-300):
         raise FitDivergedError(f"the {model} model's major loop does not rise (rise {rise:.4g} "
                                f"for a total mass {mass:.4g}, at least {MIN_RISE:g} of it is "
@@ -483,13 +718,45 @@ def check_rise(rise: float, mass: float, model: str) -> None:
 
 def output_bound(params: PreisachParams, u_max: float) -> float:
     """``|y_0| + sum |m| max(1, u_max)``: no output of a run with ``|u| <= u_max`` exceeds it
-    (each cell contributes at most ``|m|``; beyond [-1, 1] the line of slope ``F(1, -1)``)."""
+    (each cell contributes at most ``|m|``; beyond [-1, 1] the line of slope ``F(1, -1)``).
+
+    Parameters
+    ----------
+    params : PreisachParams
+        The model's parameters.
+    u_max : float
+        Largest input magnitude.
+
+    Returns
+    -------
+    float
+        The bound on ``|y|``.
+    """
     return float(abs(params.offset) + np.abs(params.masses()).sum() * max(1.0, u_max))
 
 
 def invert_step(structure: PreisachStructure, params: PreisachParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
-    """One sample of :func:`invert` from the staircase ``x``: ``(u_hat, x_next)``."""
+    """One sample of :func:`invert` from the staircase ``x``: ``(u_hat, x_next)``.
+
+    Parameters
+    ----------
+    structure : PreisachStructure
+        The model's structure.
+    params : PreisachParams
+        Its parameters.
+    x : numpy.ndarray, shape (k,)
+        Staircase before the sample.
+    y : float
+        Output to reach at this sample.
+
+    Returns
+    -------
+    u : float
+        Input that gives `y` from the present state.
+    x_next : numpy.ndarray
+        State after the sample.
+    """
     u_hat, x_next = invert(structure, params, np.array([float(y)]), x0=x)
     return float(u_hat[0]), x_next
 
@@ -502,6 +769,17 @@ def cell_regressors(levels: int, u: np.ndarray, x0: np.ndarray | None = None,
     order (``np.tril_indices(L - 1)``); entry ``2 * (fraction of the cell's mass switched
     up) - 1``, computed by the same staircase kernel as the model. Inputs outside [-1, 1]
     are clipped: the straight-line extension is not part of ``Phi``.
+
+    Parameters
+    ----------
+    levels : int
+        Grid levels ``L``.
+    u : numpy.ndarray, shape (n,)
+        Normalised input.
+    x0 : numpy.ndarray, optional
+        Initial staircase; None is the demagnetised state.
+    capacity : int, default 1024
+        Staircase buffer size.
 
     Returns
     -------
