@@ -31,12 +31,22 @@ DOCUMENTED = (
     "hystkit.io",
     "hystkit.metrics",
     "hystkit.models",
+    "hystkit.models.bobbio",
+    "hystkit.models.boucwen",
+    "hystkit.models.chua",
+    "hystkit.models.gpreisach",
+    "hystkit.models.ladder",
+    "hystkit.models.mpl_poly",
+    "hystkit.models.pi",
+    "hystkit.models.pl",
+    "hystkit.models.preisach",
     "hystkit.reports",
     "hystkit.signals",
 )
 
 # Being documented now, module by module (issue 11); the lead finishes them and moves each
-# package to DOCUMENTED. Until then their public objects are not checked here.
+# package to DOCUMENTED. Until then their public objects are not checked here. (``hystkit.cli``
+# exports only ``main``, whose Parameters and Returns are still missing.)
 NOT_YET = (
     "hystkit.batch",
     "hystkit.cli",
@@ -44,24 +54,15 @@ NOT_YET = (
     "hystkit.experiments",
     "hystkit.export",
     "hystkit.identification",
-    "hystkit.models.bobbio",
-    "hystkit.models.boucwen",
-    "hystkit.models.chua",
-    "hystkit.models.gpreisach",
-    "hystkit.models.ladder",
     "hystkit.models.mpl",
     "hystkit.models.mpl_g",
-    "hystkit.models.mpl_poly",
-    "hystkit.models.pi",
-    "hystkit.models.pl",
-    "hystkit.models.preisach",
     "hystkit.parallel",
     "hystkit.preprocess",
     "hystkit.sensors",
 )
 
-# Modules of DOCUMENTED packages that are being rewritten (issue 11) and documented with
-# that work; their objects are the only ones of those packages not checked yet.
+# Modules of DOCUMENTED packages that other work is changing now (issue 11); they get their
+# sections with it. Their objects are the only ones of those packages not checked yet.
 NOT_YET_MODULES = (
     "hystkit.compensation._adaptive",
     "hystkit.compensation._stream",
