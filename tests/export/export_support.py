@@ -24,6 +24,9 @@ CASES = [("mpl1", "mpl", 1), ("mpl3", "mpl", 3), ("mpl-poly", "mpl-poly", 1), ("
          ("preisach", "preisach", 12), ("gpreisach", "gpreisach", 10), ("ladder", "ladder", 3),
          ("boucwen", "boucwen", 1), ("bobbio", "bobbio", 6),
          ("chua", "chua", 2), ("pl", "pl", 2)]
+# Families whose export is checked by a test file of their own instead (C and Octave against
+# Python, every mode and centring), not through CASES.
+OWN_EXPORT_TESTS = {"mpl-g": "tests/models/test_mpl_g_export.py"}
 # (label, mode) pairs: inverse only where the family has one.
 MODE_CASES = [(label, mode) for label, model, _ in CASES for mode in ("direct", "inverse")
               if mode == "direct" or get_family(model).invert is not None]

@@ -274,3 +274,17 @@ def test_cli_warns_when_float_is_not_enough(compensators, tmp_path, capsys):
     assert "warning" not in capsys.readouterr().err
     assert "WARNING" in (tmp_path / "f" / "README").read_text()
     assert "WARNING" not in (tmp_path / "d" / "README").read_text()
+
+
+def test_every_registered_family_has_its_export_checked():
+    """A new family must join CASES or name its own export test: none slips through untested."""
+    from pathlib import Path
+
+    from hystkit.models import FAMILIES
+
+    from .export_support import CASES, OWN_EXPORT_TESTS
+
+    covered = {model for _, model, _ in CASES} | set(OWN_EXPORT_TESTS)
+    assert set(FAMILIES) <= covered, sorted(set(FAMILIES) - covered)
+    root = Path(__file__).resolve().parents[2]
+    assert all((root / path).is_file() for path in OWN_EXPORT_TESTS.values())
