@@ -186,7 +186,7 @@ def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
     Returns
     -------
     y : float
-        Output from the present state.
+        Deformation with the projected forces.
     x_next : numpy.ndarray
         State after the sample.
     """
@@ -218,7 +218,7 @@ def invert_step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
     Returns
     -------
     u : float
-        Input that gives `y` from the present state.
+        Force that gives `y` from the present forces; NaN where none does.
     x_next : numpy.ndarray
         State after the sample.
     """

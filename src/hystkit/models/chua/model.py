@@ -336,7 +336,7 @@ def step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
     Returns
     -------
     y : float
-        Output from the present state.
+        Output: the sum of the updated element states.
     x_next : numpy.ndarray
         State after the sample.
     """
