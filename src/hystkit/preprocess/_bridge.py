@@ -26,6 +26,11 @@ def bridge_voltage(r_s: np.ndarray, r_bridge: float, v_supply: float | np.ndarra
     v_supply : float or array
         Supply voltage V0 [V]: one nominal value, or the measured supply broadcast against
         `r_s` (sec. 4.2.1's reference channel).
+
+    Returns
+    -------
+    numpy.ndarray
+        V_m [V], `r_s` and `v_supply` broadcast together.
     """
     return r_bridge / (r_bridge + np.asarray(r_s, dtype=float)) * v_supply
 
@@ -45,6 +50,11 @@ def bridge_resistance(v_m: np.ndarray, r_bridge: float, v_supply: float | np.nda
     v_supply : float or array
         V0 [V]: the nominal supply, or the measured supply of each sample (broadcast against
         `v_m`), which removes the supply's drift from R_S.
+
+    Returns
+    -------
+    numpy.ndarray
+        R_S [Ohm], `v_m` and `v_supply` broadcast together.
     """
     v_m = np.asarray(v_m, dtype=float)
     # (V0/V_m - 1) costs one division and one subtraction per sample: this runs at scope rate.
@@ -52,8 +62,20 @@ def bridge_resistance(v_m: np.ndarray, r_bridge: float, v_supply: float | np.nda
 
 
 def first_invalid_bridge_sample(v_m: np.ndarray, v_supply: float | np.ndarray) -> int:
-    """Index of the first sample with ``V_m <= 0`` or ``V_m >= V0`` (eq. 4.3 undefined), or -1;
-    `v_supply` is one V0 or the measured supply of each sample [V]."""
+    """Index of the first sample with ``V_m <= 0`` or ``V_m >= V0`` (eq. 4.3 undefined), or -1.
+
+    Parameters
+    ----------
+    v_m : numpy.ndarray, shape (n,)
+        Voltage measured across the bridge resistor [V].
+    v_supply : float or numpy.ndarray
+        One V0, or the measured supply of each sample [V].
+
+    Returns
+    -------
+    int
+        Index of the first invalid sample, -1 if all are valid.
+    """
     v_m = np.asarray(v_m)
     bad = (v_m <= 0.0) | (v_m >= v_supply)
     if not bad.any():
@@ -68,6 +90,13 @@ def relative_change(r: np.ndarray, axis: int = -1) -> np.ndarray:
     ----------
     r : array
         Resistance [Ohm]; the mean is taken along `axis` (the samples of one recording).
+    axis : int
+        Axis of the samples.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(R - mean R) / mean R`` [-], the shape of `r`.
     """
     r = np.asarray(r, dtype=float)
     mean = r.mean(axis=axis, keepdims=True)
@@ -79,16 +108,41 @@ def gauge_symmetry(r1: float | np.ndarray, r2: float | np.ndarray) -> float:
 
     0 for a perfectly symmetric sensor; the document's paper-9.1 sample (22.4 / 15.7 kOhm)
     gives 0.35.
+
+    Parameters
+    ----------
+    r1, r2 : float or numpy.ndarray
+        Resistances of gauge 1 and gauge 2 [Ohm]; each is averaged over all its entries.
+
+    Returns
+    -------
+    float
+        The symmetry [-].
     """
     m1, m2 = float(np.mean(r1)), float(np.mean(r2))
     return 2.0 * (m1 - m2) / (m1 + m2)
 
 
 def clipped_channels(extremes: np.ndarray, n: int) -> dict[str, tuple[int, float]]:
-    """Clipped channels ``{"v1_max": (samples, value [V]), ...}`` from the extreme statistics
-    of :func:`bridge_kernel`: an extreme holding at least 100 samples and 1e-4 of the `n`
-    samples is a scope channel pinned at its limit. Noise makes the exact extreme of an unclipped channel
-    rare (a coarse 8-bit scope on a slow signal can still trip this)."""
+    """Clipped channels from the extreme statistics of :func:`bridge_kernel`.
+
+    An extreme holding at least 100 samples and 1e-4 of the `n` samples is a scope channel
+    pinned at its limit. Noise makes the exact extreme of an unclipped channel rare (a coarse
+    8-bit scope on a slow signal can still trip this).
+
+    Parameters
+    ----------
+    extremes : numpy.ndarray, shape (8,)
+        The ``ext`` statistics of :func:`bridge_kernel`: [max, samples at max, min, samples
+        at min] of v1, then v2.
+    n : int
+        Samples the statistics were taken over.
+
+    Returns
+    -------
+    dict of str to (int, float)
+        ``{"v1_max": (samples, value [V]), ...}`` for each clipped extreme; empty if none.
+    """
     out = {}
     for g in range(2):
         for side, k in (("max", 0), ("min", 2)):

@@ -77,6 +77,28 @@ def design_chain(fs: float, factor: int, f_pass: float,
     intermediate rate); earlier stages only stop the bands that would fold into what the
     last stage passes. Large factors are split in two (the first stage takes the bulk with a
     wide transition band), which costs about half the multiply-adds of a single stage.
+
+    Parameters
+    ----------
+    fs : float
+        Input sample rate [Hz].
+    factor : int
+        Total decimation factor (>= 1).
+    f_pass : float
+        Upper edge of the protected band [Hz].
+    atten_db : float
+        Stop-band attenuation of each stage [dB].
+
+    Returns
+    -------
+    tuple of Decimator
+        No stage for ``factor == 1``, otherwise one or two stages whose factors multiply to
+        `factor`.
+
+    Raises
+    ------
+    ValueError
+        If `factor` < 1, or the bands do not fit below a stage's Nyquist frequency.
     """
     factor = int(factor)
     if factor < 1:
@@ -108,10 +130,20 @@ def _split(factor: int) -> int:
 class DecimatorState:
     """Input samples a stage still needs, and where its next output is centred.
 
-    ``buffer`` (channels, m) holds input samples from index ``start`` on (negative indices are
-    the extension before the first sample); the next output is centred on input
-    ``next_centre``; ``n_in`` inputs have been consumed; ``primed`` once the start extension
-    exists (it needs the first ``max(half + 1, anchor)`` samples).
+    Parameters
+    ----------
+    buffer : numpy.ndarray, shape (channels, m)
+        Input samples from index `start` on (negative indices are the extension before the
+        first sample).
+    start : int
+        Input index of ``buffer[:, 0]``.
+    next_centre : int
+        Input index the next output is centred on.
+    n_in : int
+        Inputs consumed so far.
+    primed : bool
+        True once the start extension exists (it needs the first ``max(half + 1, anchor)``
+        samples).
     """
 
     buffer: np.ndarray
@@ -122,14 +154,43 @@ class DecimatorState:
 
 
 def decimator_init(stage: Decimator, n_channels: int) -> DecimatorState:
-    """State before the first chunk of a signal with `n_channels` rows."""
+    """State before the first chunk of a signal with `n_channels` rows.
+
+    Parameters
+    ----------
+    stage : Decimator
+        The stage the state is for.
+    n_channels : int
+        Rows (channels) of the signal.
+
+    Returns
+    -------
+    DecimatorState
+        The empty state.
+    """
     return DecimatorState(np.zeros((n_channels, 0)), 0, 0, 0)
 
 
 def decimator_step(stage: Decimator, state: DecimatorState,
                    x: np.ndarray) -> tuple[np.ndarray, DecimatorState]:
-    """Feed a chunk `x` (channels, n); return the outputs now complete, (channels, k), and the
-    new state."""
+    """Feed a chunk `x`; return the outputs now complete and the new state.
+
+    Parameters
+    ----------
+    stage : Decimator
+        The stage.
+    state : DecimatorState
+        State after the previous chunk (:func:`decimator_init` before the first).
+    x : numpy.ndarray, shape (channels, n)
+        The next input samples.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (channels, k)
+        The outputs now complete (k may be 0).
+    state : DecimatorState
+        State for the next chunk.
+    """
     x = np.asarray(x, dtype=float)
     n_in = state.n_in + x.shape[1]
     if stage.factor == 1:
@@ -145,7 +206,20 @@ def decimator_step(stage: Decimator, state: DecimatorState,
 
 
 def decimator_flush(stage: Decimator, state: DecimatorState) -> np.ndarray:
-    """Outputs centred on the last inputs, extending the signal past its end."""
+    """Outputs centred on the last inputs, extending the signal past its end.
+
+    Parameters
+    ----------
+    stage : Decimator
+        The stage.
+    state : DecimatorState
+        State after the last chunk.
+
+    Returns
+    -------
+    numpy.ndarray, shape (channels, k)
+        The remaining outputs, up to the one centred on or before the last input.
+    """
     if stage.factor == 1 or state.n_in == 0:
         return np.zeros((state.buffer.shape[0], 0))
     held, start = state.buffer, state.start

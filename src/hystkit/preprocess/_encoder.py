@@ -48,6 +48,21 @@ def parse_states(text: str | list[str] | tuple) -> tuple[int, int, int, int]:
     """A/B states of the four levels in ascending order from text like ``"00,01,10,11"``.
 
     Each item is ``AB`` with A and B in {0, 1}; the four items must be the four states.
+
+    Parameters
+    ----------
+    text : str or sequence of str
+        Comma-separated ``AB`` pairs, or the pairs themselves.
+
+    Returns
+    -------
+    tuple of 4 int
+        The A/B code ``2 A + B`` of each level, in ascending voltage.
+
+    Raises
+    ------
+    ValueError
+        If there are not four ``AB`` pairs of 0/1, or a state is missing or repeated.
     """
     items = [s.strip() for s in text.split(",")] if isinstance(text, str) else list(text)
     if len(items) != 4 or any(len(str(s)) != 2 or set(str(s)) - {"0", "1"} for s in items):
@@ -98,12 +113,36 @@ class EncoderSettings:
 class EncoderState:
     """Decoder memory between chunks (all counts since the start of the recording).
 
-    ``levels`` [V] ascending; ``stable`` the accepted A/B code (-1 before the first sample);
-    ``count`` the position in counts; ``candidate``/``run`` the level waiting out its dwell and
-    how long it has waited (``run`` samples are pending: not yet emitted); ``direction`` of the
-    last legal step (+1, -1, 0); ``n_edges`` accepted state changes, ``n_illegal`` of them
-    double transitions (the first at sample ``first_illegal``, -1 if none); ``n_rejected``
-    short excursions that returned to the stable level; ``n_seen`` samples consumed.
+    Parameters
+    ----------
+    levels : numpy.ndarray, shape (4,)
+        The four levels [V], ascending (tracked while decoding).
+    stable : int
+        The accepted A/B code (-1 before the first sample).
+    count : int
+        The position [counts].
+    candidate : int
+        The A/B code waiting out its dwell (-1 if none).
+    run : int
+        How long `candidate` has waited [samples]; these samples are pending (not yet
+        emitted).
+    direction : int
+        Direction of the last legal step: +1, -1, or 0 before the first.
+    n_edges : int
+        Accepted state changes.
+    n_illegal : int
+        Accepted changes that were double transitions.
+    n_rejected : int
+        Short excursions that returned to the stable level.
+    in_excursion : int
+        1 while the signal is away from the stable level without an accepted change, else 0.
+    n_seen : int
+        Samples consumed.
+    first_illegal : int
+        Sample of the first double transition, -1 if none.
+    sums, n_firm : numpy.ndarray, shape (4,)
+        Sum [V] and number of the samples firmly on each level in the current tracking
+        block.
     """
 
     levels: np.ndarray
@@ -132,7 +171,23 @@ _INT_FIELDS = ("stable", "count", "candidate", "run", "direction", "n_edges", "n
 
 
 def encoder_init(levels: np.ndarray | list[float]) -> EncoderState:
-    """Fresh decoder state for four ascending `levels` [V] (the first sample sets the state)."""
+    """Fresh decoder state for four ascending `levels` [V] (the first sample sets the state).
+
+    Parameters
+    ----------
+    levels : array_like, shape (4,)
+        The four levels of the merged signal [V], strictly ascending.
+
+    Returns
+    -------
+    EncoderState
+        State before the first sample, at count 0.
+
+    Raises
+    ------
+    ValueError
+        If `levels` are not four strictly ascending values.
+    """
     levels = np.asarray(levels, dtype=float)
     if levels.shape != (4,) or not np.all(np.diff(levels) > 0):
         raise ValueError(f"need four strictly ascending levels, got {levels.tolist()}")
@@ -170,13 +225,41 @@ def decode_step(settings: EncoderSettings, state: EncoderState,
 
 
 def decode_flush(state: EncoderState) -> np.ndarray:
-    """Counts of the pending samples at the end of a recording (a run too short to count)."""
+    """Counts of the pending samples at the end of a recording (a run too short to count).
+
+    Parameters
+    ----------
+    state : EncoderState
+        State after the last chunk.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (state.n_pending,)
+        The stable count, once per pending sample.
+    """
     return np.full(state.run, state.count, dtype=np.int64)
 
 
 def decode(x: np.ndarray, levels: np.ndarray | list[float],
            settings: EncoderSettings | None = None) -> tuple[np.ndarray, EncoderState]:
-    """Decode a whole merged signal: counts for every sample, shape (n,), and the final state."""
+    """Decode a whole merged signal: counts for every sample, and the final state.
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        Encoder samples [V].
+    levels : array_like, shape (4,)
+        The four levels [V], strictly ascending (:class:`LevelSurvey` finds them).
+    settings : EncoderSettings, optional
+        Decoding settings; the defaults when omitted.
+
+    Returns
+    -------
+    counts : numpy.ndarray of int64, shape (n,)
+        Position of each sample [counts].
+    state : EncoderState
+        The final state (edge, double-transition and rejection counts).
+    """
     settings = EncoderSettings() if settings is None else settings
     counts, state = decode_step(settings, encoder_init(levels), x)
     return np.concatenate([counts, decode_flush(state)]), state
@@ -184,18 +267,53 @@ def decode(x: np.ndarray, levels: np.ndarray | list[float],
 
 def ab_to_code(a: np.ndarray, b: np.ndarray, threshold_a: float,
                threshold_b: float) -> np.ndarray:
-    """A/B codes ``2 A + B`` (as float, for :func:`decode` with levels 0, 1, 2, 3) from logic
-    channels; a channel is 1 above its threshold [V]."""
+    """A/B codes ``2 A + B`` from logic channels; a channel is 1 above its threshold.
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray
+        Channels A and B [V].
+    threshold_a, threshold_b : float
+        Logic thresholds of A and B [V].
+
+    Returns
+    -------
+    numpy.ndarray of float
+        The codes (as float, for :func:`decode` with levels 0, 1, 2, 3), the shape of `a`
+        and `b` broadcast.
+    """
     return 2.0 * (np.asarray(a) > threshold_a) + (np.asarray(b) > threshold_b)
 
 
 def count_to_code(counts: np.ndarray) -> np.ndarray:
-    """A/B code ``2 A + B`` an encoder shows at position `counts` (count 0 shows A = B = 0)."""
+    """A/B code ``2 A + B`` an encoder shows at position `counts` (count 0 shows A = B = 0).
+
+    Parameters
+    ----------
+    counts : numpy.ndarray of int
+        Positions [counts].
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        The codes, the shape of `counts`.
+    """
     return _CODE_OF_PHASE[np.mod(np.asarray(counts, dtype=np.int64), 4)]
 
 
 def code_to_ab(codes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Logic levels A and B (0 or 1) of A/B codes."""
+    """Logic levels A and B (0 or 1) of A/B codes.
+
+    Parameters
+    ----------
+    codes : numpy.ndarray of int
+        A/B codes ``2 A + B``.
+
+    Returns
+    -------
+    a, b : numpy.ndarray of int64
+        Levels of A and B, the shape of `codes`.
+    """
     codes = np.asarray(codes, dtype=np.int64)
     return codes >> 1, codes & 1
 
@@ -313,6 +431,16 @@ def decode_reference(x: np.ndarray, levels: np.ndarray | list[float],
     nearest level; runs of one code shorter than ``dwell`` are not states (the first run of the
     recording always is); every long run of a new code is a transition, and all its samples get
     the new count; the samples of short runs get the count of the stable state before them.
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        Encoder samples [V].
+    levels : array_like, shape (4,)
+        The four levels [V], ascending.
+    settings : EncoderSettings, optional
+        Decoding settings (``track_block`` and ``track_gain`` are ignored); the defaults when
+        omitted.
 
     Returns
     -------

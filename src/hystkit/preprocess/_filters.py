@@ -16,10 +16,24 @@ def lowpass_zero_phase(x: np.ndarray, fs: float, cutoff: float = 20.0, order: in
     ----------
     x : array
         Signal(s) sampled at ``fs`` [Hz].
+    fs : float
+        Sample rate [Hz].
     cutoff : float
         -3 dB frequency of the one-way filter [Hz] (20 Hz in the document).
     order : int
         One-way order (2 in the document); the zero-phase result has twice the roll-off.
+    axis : int
+        Axis of the samples.
+
+    Returns
+    -------
+    numpy.ndarray
+        The filtered signal(s), the shape of `x`.
+
+    Raises
+    ------
+    ValueError
+        If `cutoff` is not between 0 and ``fs / 2``.
     """
     if not 0 < cutoff < fs / 2:
         raise ValueError(f"cutoff {cutoff} Hz must lie between 0 and fs/2 = {fs / 2} Hz")
@@ -28,7 +42,29 @@ def lowpass_zero_phase(x: np.ndarray, fs: float, cutoff: float = 20.0, order: in
 
 
 def downsample(x: np.ndarray, fs: float, fs_out: float, axis: int = -1) -> np.ndarray:
-    """Keep every ``fs / fs_out``-th sample (the caller low-passes first, as the lab does)."""
+    """Keep every ``fs / fs_out``-th sample (the caller low-passes first, as the lab does).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Signal(s) sampled at `fs`.
+    fs : float
+        Sample rate of `x` [Hz].
+    fs_out : float
+        Output sample rate [Hz]; `fs` must be an integer multiple of it.
+    axis : int
+        Axis of the samples.
+
+    Returns
+    -------
+    numpy.ndarray
+        Samples 0, ``fs / fs_out``, ... of `x` along `axis`.
+
+    Raises
+    ------
+    ValueError
+        If `fs` is not an integer multiple of `fs_out`.
+    """
     factor = fs / fs_out
     if abs(factor - round(factor)) > 1e-9 or round(factor) < 1:
         raise ValueError(f"fs = {fs} Hz is not an integer multiple of fs_out = {fs_out} Hz")

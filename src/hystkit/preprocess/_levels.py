@@ -22,6 +22,18 @@ class LevelSurvey:
     Use :meth:`add` chunk by chunk (it returns a new survey) until :attr:`n_levels` reaches the
     number wanted. A chunk's clusters are runs of histogram bins holding at least ``min_fraction``
     of the chunk; isolated samples (edges, spikes) never make a cluster.
+
+    Parameters
+    ----------
+    clusters : tuple of (float, float, float, int)
+        (centre [V], low [V], high [V], samples) of each level found, ascending; empty to
+        start.
+    n_samples : int
+        Samples surveyed so far.
+    n_bins : int
+        Histogram bins per chunk.
+    min_fraction : float
+        Share of a chunk's samples a bin must hold to belong to a level.
     """
 
     clusters: tuple[tuple[float, float, float, int], ...] = ()

@@ -155,7 +155,56 @@ class PreprocessSettings:
 
 @dataclass(frozen=True)
 class PreprocessReport:
-    """What :func:`preprocess_raw` found; every field is a plain number, string or list."""
+    """What :func:`preprocess_raw` found; every field is a plain number, string or list.
+
+    Parameters
+    ----------
+    source : str
+        The raw file.
+    n_samples : int
+        Raw samples per channel.
+    fs : float
+        Raw sample rate [Hz].
+    duration_s : float
+        ``n_samples / fs`` [s].
+    fs_mid : float
+        Intermediate rate after the FIR decimation [Hz].
+    fs_out : float
+        Output rate [Hz].
+    n_out : int
+        Output samples.
+    decimation : list of [int, int]
+        (factor, taps) of each FIR decimation stage.
+    encoder_kind : {"merged", "ab"}
+        One merged 4-level channel, or separate A and B channels.
+    encoder_levels, encoder_levels_end : list of float
+        The four levels at the start and, tracked, at the end [V] (for A/B channels the
+        codes 0, 1, 2, 3).
+    encoder_dwell_samples : int
+        The encoder dwell [samples].
+    n_edges : int
+        Accepted encoder state changes.
+    n_illegal : int
+        Of them, double transitions.
+    first_illegal_s : float or None
+        Time of the first double transition [s]; None if there was none.
+    n_rejected : int
+        Short encoder excursions that returned to the stable level.
+    r1_mean_ohm, r2_mean_ohm : float
+        Mean gauge resistances of the output [Ohm].
+    symmetry : float
+        Gauge symmetry ``2 (R1 - R2) / (R1 + R2)`` [-].
+    clipped : dict of str to int
+        Samples at the extreme of each clipped channel, such as ``{"v1_max": 1200}``.
+    supply : {"nominal", "measured"}
+        Whether eq. 4.3 used the nominal V0 or the measured supply column.
+    v0_mean_v, v0_min_v, v0_max_v : float or None
+        Mean, minimum and maximum of the measured supply [V]; None when nominal.
+    warnings : list of str
+        The :class:`RawDataWarning` messages issued.
+    seconds : float
+        Wall time of the run [s].
+    """
 
     source: str
     n_samples: int
@@ -193,9 +242,14 @@ class PreprocessReport:
 class PreprocessResult:
     """Output of :func:`preprocess_raw`.
 
-    ``recording``: time [s], position [mm], sensor dR1/R1 - dR2/R2 [-] at ``fs_out``;
-    ``extra``: ``r1``, ``r2`` [Ohm] and ``dr1``, ``dr2`` [-] on the same time grid;
-    ``report``: counts, levels, symmetry and warnings.
+    Parameters
+    ----------
+    recording : Recording
+        Time [s], position [mm], sensor dR1/R1 - dR2/R2 [-] at ``fs_out``.
+    extra : dict of str to numpy.ndarray
+        ``r1``, ``r2`` [Ohm] and ``dr1``, ``dr2`` [-] on the same time grid.
+    report : PreprocessReport
+        Counts, levels, symmetry and warnings.
     """
 
     recording: Recording

@@ -89,10 +89,25 @@ class CutoffRule:
 class Spectrum:
     """Output of :func:`spectrum`.
 
-    ``freq`` [Hz]; ``psd`` name -> one-sided PSD [1/Hz] (``dr1``, ``dr2`` when the gauges are
-    known, ``differential`` always); ``floor`` the differential's local noise floor [1/Hz];
-    ``f_signal`` and ``cutoff`` [Hz] of the rule; ``response`` cut-off label -> zero-phase
-    amplitude response ``|H|^2`` on ``freq``; ``summary`` plain numbers for JSON.
+    Parameters
+    ----------
+    freq : numpy.ndarray, shape (m,)
+        Frequencies [Hz].
+    psd : dict of str to numpy.ndarray
+        Name -> one-sided PSD [1/Hz] on `freq` (``dr1``, ``dr2`` when the gauges are known,
+        ``differential`` always).
+    floor : numpy.ndarray, shape (m,)
+        The differential's local noise floor [1/Hz].
+    f_signal, cutoff : float
+        The rule's highest signal line and suggested cut-off [Hz].
+    response : dict of str to numpy.ndarray
+        Cut-off label -> zero-phase amplitude response ``|H|^2`` on `freq`.
+    rule : CutoffRule
+        The rule applied.
+    fs : float
+        Sample rate of the analysed signals [Hz].
+    summary : dict
+        Plain numbers for JSON.
     """
 
     freq: np.ndarray
@@ -152,6 +167,15 @@ class Spectrum:
 def welch_psd(x: np.ndarray, fs: float, segment_s: float) -> tuple[np.ndarray, np.ndarray, int]:
     """One-sided Welch PSD [unit²/Hz] of the rows of `x` (Hann, 50 % overlap, mean removed).
 
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (..., n)
+        Signal(s), samples along the last axis.
+    fs : float
+        Sample rate [Hz].
+    segment_s : float
+        Segment length [s] (at least 8 samples, at most the whole signal).
+
     Returns
     -------
     freq : ndarray [Hz]
@@ -168,9 +192,28 @@ def welch_psd(x: np.ndarray, fs: float, segment_s: float) -> tuple[np.ndarray, n
 
 
 def noise_floor(psd: np.ndarray, df: float, width_hz: float, n_segments: int) -> np.ndarray:
-    """Local noise density [unit²/Hz]: running median of `psd` over `width_hz`, divided by the
-    median of a chi-square with nu = 2 K / 1.056 degrees of freedom over nu (the median of a
-    Welch estimate of white noise lies below its mean by that ratio)."""
+    """Local noise density [unit²/Hz]: running median of `psd` over `width_hz`, corrected.
+
+    The running median is divided by the median of a chi-square with nu = 2 K / 1.056 degrees
+    of freedom over nu (the median of a Welch estimate of white noise lies below its mean by
+    that ratio).
+
+    Parameters
+    ----------
+    psd : numpy.ndarray, shape (m,)
+        Welch PSD [unit²/Hz] on bins `df` apart.
+    df : float
+        Bin spacing [Hz].
+    width_hz : float
+        Width of the running median [Hz] (at least 3 bins).
+    n_segments : int
+        Segments K the Welch estimate averaged.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,)
+        The noise floor N(f) [unit²/Hz].
+    """
     size = max(3, 2 * round(0.5 * width_hz / df) + 1)
     nu = 2 * n_segments / _HANN_HALF_OVERLAP
     return ndimage.median_filter(psd, size=size, mode="nearest") / (stats.chi2.median(nu) / nu)
@@ -178,8 +221,32 @@ def noise_floor(psd: np.ndarray, df: float, width_hz: float, n_segments: int) ->
 
 def butterworth_response(freq: np.ndarray, fs: float, cutoff: float, order: int = 2
                          ) -> np.ndarray:
-    """Amplitude response ``|H(f)|^2`` of the zero-phase (forward-backward) Butterworth that
-    ``lowpass_zero_phase`` applies (eq. 4.1), from ``sosfreqz`` of the designed sections."""
+    """Amplitude response ``|H(f)|^2`` of the zero-phase Butterworth of eq. 4.1.
+
+    The forward-backward filter that ``lowpass_zero_phase`` applies, from ``sosfreqz`` of the
+    designed sections.
+
+    Parameters
+    ----------
+    freq : numpy.ndarray
+        Frequencies [Hz].
+    fs : float
+        Sample rate [Hz].
+    cutoff : float
+        -3 dB frequency of the one-way filter [Hz].
+    order : int
+        One-way order.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``|H|^2`` [-] at `freq`.
+
+    Raises
+    ------
+    ValueError
+        If `cutoff` is not between 0 and ``fs / 2``.
+    """
     if not 0 < cutoff < fs / 2:
         raise ValueError(f"cutoff {cutoff:g} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
     sos = signal.butter(order, cutoff, fs=fs, output="sos")
@@ -206,6 +273,11 @@ def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float | None 
         A second cut-off [Hz] whose response is overlaid and summarised (the document's 20 Hz).
     f_search_max : float, optional
         Lines are searched below this [Hz] (default 0.4 fs, where decimation filters are flat).
+
+    Returns
+    -------
+    Spectrum
+        PSDs, noise floor, f_signal, the suggested cut-off and the filters' responses.
 
     Raises
     ------
@@ -292,6 +364,17 @@ def raw_gauge_changes(path: str | os.PathLike[str], settings: PreprocessSettings
     Eq. 4.3 per sample (with the measured ``v0`` when ``settings.supply_channel``), then the
     preprocessing's streaming FIR decimation, flat to 0.4 of the output rate; no Butterworth.
     Only ``r_bridge``, ``v_supply``, ``supply_channel`` and ``chunk_size`` of `settings` are used.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Raw recording (``.csv``, ``.parquet``, ``.mat``); see :mod:`hystkit.io`.
+    settings : PreprocessSettings
+        Bridge and supply settings.
+    fmt : RawFormat, optional
+        Column names, time unit and metadata of the file.
+    fs_analysis : float
+        Wanted output rate [Hz].
 
     Returns
     -------
