@@ -21,7 +21,26 @@ __all__ = ["gain_ramp", "occasional_references", "simulate_drifting_experiment",
 
 
 def gain_ramp(time: np.ndarray, drift: float) -> np.ndarray:
-    """Gain at each time [s]: 1 at the first sample, ``1 + drift`` at the last, linear between."""
+    """Gain at each time [s]: 1 at the first sample, ``1 + drift`` at the last, linear between.
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (n,)
+        Sample times [s], advancing (n >= 2).
+    drift : float
+        Relative gain change over the run [-], above -1.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        The gain [-] at each sample.
+
+    Raises
+    ------
+    ValueError
+        If there are fewer than two samples, time does not advance, or `drift` is not a
+        finite number above -1.
+    """
     t = np.asarray(time, dtype=np.float64)
     if t.size < 2 or not t[-1] > t[0]:
         raise ValueError("a gain ramp needs at least two samples with advancing time")
@@ -31,8 +50,22 @@ def gain_ramp(time: np.ndarray, drift: float) -> np.ndarray:
 
 
 def with_gain_drift(recording: Recording, drift: float = 0.10) -> Recording:
-    """The recording with its sensor signal multiplied by :func:`gain_ramp` (``drift`` 0.1:
-    the gain rises by 10 % over the run); position and time unchanged."""
+    """The recording with its sensor signal multiplied by :func:`gain_ramp`.
+
+    Position and time are unchanged.
+
+    Parameters
+    ----------
+    recording : Recording
+        The recording.
+    drift : float
+        Relative gain change over the run [-] (0.1: the gain rises by 10 %).
+
+    Returns
+    -------
+    Recording
+        A copy with the drifting sensor signal; its source names the drift.
+    """
     sensor = recording.sensor * gain_ramp(recording.time, drift)
     return dataclasses.replace(recording, sensor=sensor,
                                source=f"{recording.source}, gain drift {drift:+.0%}")
@@ -40,7 +73,25 @@ def with_gain_drift(recording: Recording, drift: float = 0.10) -> Recording:
 
 def simulate_drifting_experiment(name: str, seed: int = 0, drift: float = 0.10,
                                  sensor: VirtualSensor | None = None) -> Recording:
-    """:func:`~hystkit.sensors.simulate_experiment` with a sensor gain drift of ``drift``."""
+    """:func:`~hystkit.sensors.simulate_experiment` with a sensor gain drift of ``drift``.
+
+    Parameters
+    ----------
+    name : str
+        Excitation (sine, decay, chirp, noise).
+    seed : int
+        Seeds the noise, the temperature drift and, for ``noise``, the trajectory.
+    drift : float
+        Relative gain change over the run [-].
+    sensor : VirtualSensor, optional
+        The simulated sensor; the defaults when None.
+
+    Returns
+    -------
+    Recording
+        Time [s], position [mm] and the drifting sensor signal dR1/R1 - dR2/R2 [-] at the
+        sensor's ``fs_out``.
+    """
     return with_gain_drift(simulate_experiment(name, seed, sensor), drift)
 
 
@@ -51,6 +102,25 @@ def occasional_references(recording: Recording, every: float, seed: int = 0) -> 
     known end stop). Random times within each interval: references at a fixed period would
     meet a periodic excitation at one phase, one position, and could not tell a gain from an
     offset.
+
+    Parameters
+    ----------
+    recording : Recording
+        A recording with a position column.
+    every : float
+        Interval holding one reference [s], at least one sample long.
+    seed : int
+        Seeds the random sample within each interval.
+
+    Returns
+    -------
+    numpy.ndarray, shape (recording.n_samples,)
+        The position [mm] at the chosen samples, NaN elsewhere.
+
+    Raises
+    ------
+    ValueError
+        If the recording has no position, or `every` is shorter than one sample.
     """
     if recording.position is None:
         raise ValueError(f"{recording.source}: no position column to take references from")

@@ -56,8 +56,19 @@ SIGNS = (1.0, -1.0)  # strain sign of the top and the bottom gauge
 
 @dataclass(frozen=True)
 class VirtualPhysicsStructure(Record):
-    """What sets the state and the sample time: sample time ``dt`` [s], Prony time constants
-    [s] and play radii [strain]. ``decay`` (``exp(-dt / tau)``) is derived from ``dt``."""
+    """What sets the state and the sample time.
+
+    ``decay`` (``exp(-dt / tau)`` per Prony term) is derived from `dt`.
+
+    Parameters
+    ----------
+    dt : float
+        Sample time [s].
+    prony_taus : tuple of float
+        Prony time constants [s].
+    play_radii : tuple of float
+        Play radii [strain].
+    """
 
     dt: float
     prony_taus: tuple[float, ...]
@@ -81,7 +92,23 @@ class VirtualPhysicsStructure(Record):
 @dataclass(frozen=True)
 class VirtualPhysicsParams(Record):
     """The material and gauge quantities of :class:`~hystkit.sensors.VirtualSensor` that reach
-    ``dR/R`` (same names and units)."""
+    ``dR/R`` (same names and units).
+
+    Parameters
+    ----------
+    strain_per_mm : float
+        Surface strain per mm of tip deflection [1/mm].
+    prony_fractions : tuple of float
+        Share of the imposed strain each Prony term retards [-].
+    play_weights : tuple of float
+        Weights of the play operators [-].
+    gauge_factors : (float, float)
+        gamma of R1 and R2 [-].
+    softening : (float, float)
+        Saturated relative resistance rise of R1 and R2 [-].
+    softening_travel : float
+        Accumulated strain travel per e-fold of the softening [strain].
+    """
 
     strain_per_mm: float
     prony_fractions: tuple[float, ...]
@@ -104,6 +131,20 @@ def physics_of(sensor: VirtualSensor | None = None, dt: float | None = None,
     """Structure and parameters of ``sensor``'s causal physics at sample time ``dt``.
 
     Defaults: ``VirtualSensor()`` and its simulation step ``1 / fs_internal``.
+
+    Parameters
+    ----------
+    sensor : VirtualSensor, optional
+        The simulated sensor.
+    dt : float, optional
+        Sample time [s].
+
+    Returns
+    -------
+    structure : VirtualPhysicsStructure
+        `dt`, Prony time constants and play radii.
+    params : VirtualPhysicsParams
+        The sensor's quantities that reach dR/R.
     """
     sensor = VirtualSensor() if sensor is None else sensor
     dt = 1.0 / sensor.fs_internal if dt is None else float(dt)

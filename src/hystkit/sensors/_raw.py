@@ -63,6 +63,51 @@ class ScopeSettings:
     The bridge supply is steady unless ``bridge_supply_drift`` (relative amplitude of a sine of
     period ``bridge_drift_period`` [s]) is set; ``supply_channel`` adds the measured bridge
     supply as a column ``v0``.
+
+    Parameters
+    ----------
+    fs : float
+        Scope sample rate [Hz].
+    r_bridge : float
+        Bridge resistor R_br [Ohm].
+    v_supply : float
+        Bridge supply V0 [V].
+    bridge_noise_v : float
+        RMS scope noise on v1, v2 (and v0) [V].
+    encoder_mode : {"merged", "ab"}
+        One merged 4-level encoder channel, or the logic channels ``enc_a``, ``enc_b``.
+    logic_high, logic_low : float
+        Output voltages of the hex buffer [V].
+    r_d1, r_d2 : float
+        Divider resistors of A and B [Ohm].
+    r_buffer : float
+        Output resistance of the buffer [Ohm].
+    r_scope : float
+        Input resistance of the scope [Ohm].
+    encoder_noise_v : float
+        RMS noise on the encoder channel(s) [V].
+    edge_tau : float
+        Time constant of the encoder edges [s].
+    supply_drift : float
+        Relative amplitude of the logic supply's sine drift [-].
+    drift_period : float
+        Its period [s].
+    bridge_supply_drift : float
+        Relative amplitude of the bridge supply's sine drift [-], in [0, 1).
+    bridge_drift_period : float
+        Its period [s].
+    supply_channel : bool
+        Write the measured bridge supply as a column ``v0``.
+    n_missed_states : int
+        Encoder states to hide (each an illegal double transition).
+    n_spikes : int
+        One-sample spikes to inject into the (first) encoder channel.
+
+    Raises
+    ------
+    ValueError
+        If a resistance, rate or period is not positive, a noise, drift or fault count is
+        negative, `bridge_supply_drift` is not in [0, 1), or `encoder_mode` is unknown.
     """
 
     fs: float = 1e6
@@ -107,7 +152,20 @@ class ScopeSettings:
 
 
 def merged_levels(scope: ScopeSettings, supply_scale: float = 1.0) -> np.ndarray:
-    """Merged encoder voltage [V] of A/B codes 0..3 (``2 A + B``): the divider of sec. 4.2.1."""
+    """Merged encoder voltage [V] of A/B codes 0..3 (``2 A + B``): the divider of sec. 4.2.1.
+
+    Parameters
+    ----------
+    scope : ScopeSettings
+        Buffer voltages and the divider's resistances.
+    supply_scale : float
+        Factor on the logic voltages (the logic supply's drift) [-].
+
+    Returns
+    -------
+    numpy.ndarray, shape (4,)
+        The level of each code [V].
+    """
     g_a, g_b = 1 / (scope.r_d1 + scope.r_buffer), 1 / (scope.r_d2 + scope.r_buffer)
     a, b = code_to_ab(np.arange(4))
     v_a = np.where(a, scope.logic_high, scope.logic_low) * supply_scale
@@ -117,8 +175,28 @@ def merged_levels(scope: ScopeSettings, supply_scale: float = 1.0) -> np.ndarray
 
 def with_asymmetry(sensor: VirtualSensor, asymmetry: float | None = None,
                    age_hours: float | None = None) -> VirtualSensor:
-    """`sensor` with gauge symmetry ``2 (R1 - R2)/(R1 + R2)`` = `asymmetry` of the base
-    resistances (their mean kept) and/or another time since printing [h] (sec. 3.5.1)."""
+    """`sensor` with another gauge symmetry and/or another time since printing (sec. 3.5.1).
+
+    Parameters
+    ----------
+    sensor : VirtualSensor
+        The sensor.
+    asymmetry : float, optional
+        Gauge symmetry ``2 (R1 - R2)/(R1 + R2)`` of the base resistances [-], in (-2, 2);
+        their mean is kept.
+    age_hours : float, optional
+        Time since printing [h], >= 0.
+
+    Returns
+    -------
+    VirtualSensor
+        A copy with the given values; unchanged where an argument is None.
+
+    Raises
+    ------
+    ValueError
+        If `asymmetry` is outside (-2, 2) or `age_hours` is negative.
+    """
     if asymmetry is not None:
         if not -2 < asymmetry < 2:
             raise ValueError(f"asymmetry must lie in (-2, 2), got {asymmetry}")
@@ -136,10 +214,28 @@ def with_asymmetry(sensor: VirtualSensor, asymmetry: float | None = None,
 class RawTruth:
     """What the raw file encodes, at the sensor's internal rate.
 
-    ``time`` [s], ``position`` [mm] and ``resistance`` (2, n) [Ohm] of gauges R1, R2, before
-    scope noise; ``fs_internal`` [Hz]; ``count0`` the encoder count at the first sample;
-    ``encoder_mm`` per count; ``n_samples`` and ``fs`` of the raw file; ``missed`` (time [s],
-    hidden count) of each injected missed state; ``spikes`` their sample indices.
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (n,)
+        Time [s].
+    position : numpy.ndarray, shape (n,)
+        Position [mm].
+    resistance : numpy.ndarray, shape (2, n)
+        Resistances of gauges R1, R2 before scope noise [Ohm].
+    fs_internal : float
+        The sensor's internal rate [Hz].
+    count0 : int
+        The encoder count at the first sample.
+    encoder_mm : float
+        Encoder resolution [mm per count].
+    n_samples : int
+        Samples per channel of the raw file.
+    fs : float
+        Sample rate of the raw file [Hz].
+    missed : numpy.ndarray, shape (k, 2)
+        (time [s], hidden count) of each injected missed state.
+    spikes : numpy.ndarray of int
+        Raw sample indices of the injected spikes.
     """
 
     time: np.ndarray

@@ -53,6 +53,55 @@ class VirtualSensor:
 
     The defaults give a TPU cantilever of about 1 % surface strain at 3 mm tip deflection with
     EEL-like gauges; they are plausible, not fitted to the document's (unpublished) data.
+
+    Parameters
+    ----------
+    strain_per_mm : float
+        Surface strain per mm of tip deflection, kappa [1/mm].
+    prony_fractions : tuple of float
+        Share of the imposed strain each Prony term retards [-].
+    prony_taus : tuple of float
+        Their time constants [s].
+    play_radii : tuple of float
+        Radii of the play operators [strain].
+    play_weights : tuple of float
+        Their weights [-]; Prony fractions and play weights sum to less than 1 (the rest is
+        followed at once).
+    softening : (float, float)
+        Saturated relative resistance rise of cyclic softening, R1 and R2 [-].
+    softening_travel : float
+        Accumulated strain travel per e-fold of the softening [strain].
+    gauge_factors : (float, float)
+        gamma of R1 (top) and R2 (bottom) in ``R = R_0 exp(gamma m)`` [-].
+    base_resistance : (float, float)
+        R_0 of R1 and R2 [Ohm] (paper 9.1).
+    temp_coefficients : (float, float)
+        Temperature coefficients of R1 and R2 [1/K].
+    temp_std : float
+        Standard deviation of the slow temperature excursion [K].
+    temp_tau : float
+        Its time constant [s].
+    age_hours : float
+        Time since printing at the start [h] (sec. 3.5.1).
+    settle_drop : (float, float)
+        Fractional resistance drop of R1 and R2 once settled [-].
+    settle_tau_hours : float
+        Time constant of the settling [h].
+    noise_rel : float
+        Resistance noise, relative, per internal sample [-].
+    encoder_mm : float
+        Encoder resolution [mm per count].
+    fs_internal : float
+        Simulation rate [Hz].
+    fs_out : float
+        Rate of the recordings [Hz] (as in paper 9.2).
+    cutoff : float
+        Cut-off of the zero-phase Butterworth [Hz] (eq. 4.1).
+
+    Raises
+    ------
+    ValueError
+        If the Prony or play tuples differ in length, or their shares sum to 1 or more.
     """
 
     strain_per_mm: float = 3.3e-3                   # surface strain per mm of tip deflection
@@ -136,6 +185,25 @@ def simulate_experiment(name: str, seed: int = 0,
 
     ``seed`` draws the noise, the temperature drift and, for ``noise``, the trajectory itself:
     use different seeds for the fitting and the validation recording.
+
+    Parameters
+    ----------
+    name : str
+        Excitation (sine, decay, chirp, noise).
+    seed : int
+        Seeds the noise, the temperature drift and, for ``noise``, the trajectory.
+    sensor : VirtualSensor, optional
+        The simulated sensor; the defaults when None.
+
+    Returns
+    -------
+    Recording
+        Time [s], position [mm] and sensor dR1/R1 - dR2/R2 [-] at the sensor's ``fs_out``.
+
+    Raises
+    ------
+    ValueError
+        If `name` is not a known excitation.
     """
     sensor = VirtualSensor() if sensor is None else sensor
     if name not in EXPERIMENTS:
