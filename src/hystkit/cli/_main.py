@@ -62,6 +62,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     Run as the program (`argv` None) and stopped by a signal after forking workers, it ends
     the process itself: multiprocessing's exit handlers would otherwise wait forever to flush
     queues to the workers it stopped.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments after the program name (``["fit", "data.csv", ...]``); None reads
+        ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit code: 0 success, 1 stdout closed by its reader, 2 an error the user can fix
+        (one ``hystkit: error:`` line on stderr, bad arguments included), 3 guards failed
+        (`GUARD_EXIT`), 70 an internal error, 130 interrupted, 143 terminated. ``--help`` and
+        ``--version`` print and raise ``SystemExit(0)``, as argparse does.
     """
     code = _main(argv)
     if argv is None and code in (130, 143) and forked_workers():
