@@ -41,6 +41,11 @@ def _check(loop: hc.ControlLoop, res: hc.TuneResult) -> None:
     assert m.phase_margin_deg >= res.min_phase_margin
     assert m.gain_margin_db is None or m.gain_margin_db >= res.min_gain_margin_db
     assert m.max_pole_radius <= max(1.0, res.margins_start.max_pole_radius) + 1e-12
+    # every gain within the search box, a factor 100 (the default span) around the start
+    a, b = res.pid_start, res.pid
+    for start, end in ((a.kp, b.kp), (a.ti, b.ti), (a.td, b.td)):
+        if np.isfinite(start) and start != 0:
+            assert 1 / 100 * (1 - 1e-9) <= end / start <= 100 * (1 + 1e-9)
 
 
 @pytest.mark.parametrize("objective", hc.OBJECTIVES)
