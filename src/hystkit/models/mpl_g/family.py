@@ -19,6 +19,10 @@ __all__ = ["MplGFamily"]
 
 
 class MplGFamily(Family):
+    """The ch. 7 compensator (sec. 7.2: sinh cells with a cubic output resistor) as a registered
+    family.
+    """
+
     name = "mpl-g"
     title = ("ch. 7 compensator: sinh cells with a cubic output resistor g (sec. 7.2, "
              "eq. 5.1-5.6, 5.16-5.17)")

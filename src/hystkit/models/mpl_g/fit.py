@@ -102,6 +102,16 @@ def canonical(params: mpl_g.MplGParams) -> mpl_g.MplGParams:
     gives the same output for every input and state; the inverse's branch maps along (its
     rest point ``z = -V_b`` is ``z' = 0``).
 
+    Parameters
+    ----------
+    params : MplGParams
+        Any parameters of the family.
+
+    Returns
+    -------
+    MplGParams
+        The equivalent parameters with ``w_0 = 1``, ``V_b = 0``.
+
     Raises
     ------
     ValueError
@@ -169,8 +179,16 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
         As :func:`hystkit.identification.fit_multistart`.
     accept : callable, optional
         A candidate counts only if ``accept(params)``; ``accept_reason`` says why others failed.
+    accept_reason : str, optional
+        Why candidates were rejected, for the message.
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart`.
+
+    Returns
+    -------
+    FitResult
+        The best start's fit. If ``accept`` vetoes every fit with a cubic ``g``, the accepted
+        mPL start with a linear ``g`` (its message says so).
 
     Raises
     ------

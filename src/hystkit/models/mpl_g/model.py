@@ -74,7 +74,18 @@ __all__ = [
 @dataclass(frozen=True)
 class MplGStructure(CellStructure):
     """What does not get fitted: cell count ``N``, sample time and the Euler slope cap
-    (:class:`~hystkit.models._cells.CellStructure`; the cap bounds ``f'(v) dt``)."""
+    (:class:`~hystkit.models._cells.CellStructure`; the cap bounds ``f'(v) dt``).
+
+    Parameters
+    ----------
+    n_cells : int, default 1
+        Number of sinh cells ``N``.
+    dt : float, default 0.025
+        Sample time [s].
+    slope_cap : float, default 1.0
+        Largest Euler slope ``f' dt`` of a cell; beyond its knee a sinh resistor goes on straight
+        (eq. 5.29).
+    """
 
     @property
     def n_params(self) -> int:
@@ -157,6 +168,18 @@ def output_branch(params: MplGParams) -> tuple[float, float, float]:
     rest at ``e = 0``, the centre of centred data) on which ``g'`` keeps its sign; ``+-inf``
     where ``g'`` has no root on that side.
 
+    Parameters
+    ----------
+    params : MplGParams
+        Its parameters.
+
+    Returns
+    -------
+    lo, hi : float
+        The branch's bounds (``+-inf`` where unbounded).
+    sign : float
+        Sign of ``g'`` on it.
+
     Raises
     ------
     FitDivergedError
@@ -176,7 +199,25 @@ def output_branch(params: MplGParams) -> tuple[float, float, float]:
 
 def inverse_branch(params: MplGParams) -> tuple[float, float, float, float]:
     """``(lo, hi, sign, centre)``: :func:`output_branch` and ``z_rest = -V_b``, the
-    arguments of ``mpl_poly.kernels.solve_output``."""
+    arguments of ``mpl_poly.kernels.solve_output``.
+
+    Parameters
+    ----------
+    params : MplGParams
+        Its parameters.
+
+    Returns
+    -------
+    lo, hi, sign : float
+        As :func:`output_branch`.
+    centre : float
+        The rest point ``z_rest = -V_b``.
+
+    Raises
+    ------
+    FitDivergedError
+        As :func:`output_branch`.
+    """
     return (*output_branch(params), -float(params.v_b))
 
 
@@ -192,6 +233,22 @@ def rest_state(structure: MplGStructure, params: MplGParams, value: float,
     ``e_0 = (z_0 + V_b) / sum w`` with ``g(z_0) = value`` on the branch, the input at which the
     model rests with that output; ``e_0 = 0`` if ``value`` is outside the branch's range or
     ``sum w = 0``. :func:`simulate` / :func:`invert` start here for ``x0=None``.
+
+    Parameters
+    ----------
+    structure : MplGStructure
+        The model's structure.
+    params : MplGParams
+        Its parameters.
+    value : float
+        Constant input (with `inverse`: output) the model rests at.
+    inverse : bool, default False
+        Rest state of the inverse: `value` is an output.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        Cell voltages at rest.
     """
     if inverse:
         z0, ok = _solve(params, value)
@@ -203,6 +260,17 @@ def rest_state(structure: MplGStructure, params: MplGParams, value: float,
 def step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
     """One sample of the forward model: output from the present state, then the Euler update.
+
+    Parameters
+    ----------
+    structure : MplGStructure
+        The model's structure.
+    params : MplGParams
+        Its parameters.
+    x : numpy.ndarray, shape (N,)
+        Cell voltages before the sample.
+    u : float
+        Model input ``e`` of the sample.
 
     Returns
     -------
@@ -221,6 +289,24 @@ def invert_step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
     """One sample of the inverse (readable reference): ``z = g^-1(y)`` on
     :func:`output_branch` by bracketed root finding, the input from the output equation with
     the present state (eq. 5.13), then the state update (fig. 5.12).
+
+    Parameters
+    ----------
+    structure : MplGStructure
+        The model's structure.
+    params : MplGParams
+        Its parameters.
+    x : numpy.ndarray, shape (N,)
+        Cell voltages before the sample.
+    y : float
+        Output to reach at this sample.
+
+    Returns
+    -------
+    u : float
+        Input that gives `y` from the present state.
+    x_next : numpy.ndarray, shape (N,)
+        Cell voltages after the sample.
 
     Raises
     ------
@@ -254,6 +340,10 @@ def simulate(structure: MplGStructure, params: MplGParams, u: np.ndarray,
 
     Parameters
     ----------
+    structure : MplGStructure
+        The model's structure.
+    params : MplGParams
+        Its parameters.
     u : array, shape (n,)
         Model input ``e`` sampled every ``structure.dt`` (normalised units).
     x0 : array, shape (N,), float or None
@@ -262,6 +352,7 @@ def simulate(structure: MplGStructure, params: MplGParams, u: np.ndarray,
     Returns
     -------
     y : array, shape (n,)
+        Model output.
     x_end : array, shape (N,)
         State after the last sample; feeding it back as ``x0`` continues the run exactly.
     """
@@ -274,15 +365,50 @@ def simulate(structure: MplGStructure, params: MplGParams, u: np.ndarray,
 
 def simulate_reference(structure: MplGStructure, params: MplGParams, u: np.ndarray,
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
+
+    Parameters
+    ----------
+    structure : MplGStructure
+        The model's structure.
+    params : MplGParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Model input ``e`` sampled every ``structure.dt``.
+    x0 : numpy.ndarray, shape (N,), float or None, optional
+        Initial cell voltages, as for :func:`simulate`.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Model output.
+    x_end : numpy.ndarray, shape (N,)
+        State after the last sample.
+    """
     u = _check(structure, params, u, "u")
     return run_steps(step, structure, params, u, initial_state(structure.n_cells, x0, u[0]))
 
 
 def simulate_with_jacobian(structure: MplGStructure, params: MplGParams,
                            u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Forward output from rest and its exact Jacobian ``dy/dtheta``, shape (n, 3N + 6), columns
-    in the order of :meth:`MplGParams.to_vector` (forward sensitivities)."""
+    """Forward output from rest and its exact Jacobian ``dy/dtheta`` (forward sensitivities).
+
+    Parameters
+    ----------
+    structure : MplGStructure
+        The model's structure.
+    params : MplGParams
+        Its parameters.
+    u : numpy.ndarray, shape (n,)
+        Model input ``e`` sampled every ``structure.dt``; the run starts at rest at ``u[0]``.
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (n,)
+        Model output.
+    jacobian : numpy.ndarray, shape (n, 3N + 6)
+        ``dy/dtheta``, columns in the order of :meth:`MplGParams.to_vector`.
+    """
     u = _check(structure, params, u, "u")
     x = np.full(structure.n_cells, u[0])
     return kernels.simulate_with_jacobian(u, x, np.ascontiguousarray(params.g), params.w,
@@ -295,6 +421,10 @@ def invert(structure: MplGStructure, params: MplGParams, y: np.ndarray,
 
     Parameters
     ----------
+    structure : MplGStructure
+        The model's structure.
+    params : MplGParams
+        Its parameters.
     y : array, shape (n,)
         Model output (e.g. the sensor signal), sampled every ``structure.dt``.
     x0 : array, shape (N,), float or None
@@ -303,7 +433,9 @@ def invert(structure: MplGStructure, params: MplGParams, y: np.ndarray,
     Returns
     -------
     u_hat : array, shape (n,)
+        Input estimate, one per sample of ``y``.
     x_end : array, shape (N,)
+        State after the last sample.
 
     Raises
     ------

@@ -31,12 +31,22 @@ TRAINING_SECONDS = 200.0
 def table_ii_response(column: str) -> tuple[np.ndarray, np.ndarray]:
     """Table II ``column`` run as a sensor on the normalised training sine.
 
+    Parameters
+    ----------
+    column : {"sine", "chirp", "decay", "noise"}
+        Column of paper 9.2's table II (one of its four fitted compensators).
+
     Returns
     -------
     position : array, shape (8000,)
         ``sin(pi t)``: eq. 7.3 normalised by its 3 mm amplitude.
     sensor : array, shape (8000,)
         The column's inverse (position -> sensor) from rest, normalised sensor units.
+
+    Raises
+    ------
+    ValueError
+        If table II has no such column.
     """
     presets = MPL_POLY.presets()
     key = f"table-ii-{column}"
