@@ -60,6 +60,7 @@ class NoiseSpec:
         return sensor + 0.0, process + 0.0  # + 0.0: -0.0 from a zero SD becomes 0.0
 
     def to_dict(self) -> dict:
+        """JSON-safe: ``sensor_sd`` [sensor units], ``process_sd_n`` [N], ``seed``."""
         return {"sensor_sd": self.sensor, "process_sd_n": self.process, "seed": self.seed}
 
 

@@ -241,7 +241,8 @@ class StabilityReport:
     sectors : dict of Sector
         Measured on the trained sine (:func:`measure_sector`).
     loop_sector : Sector or None
-        The channel's chord slopes seen in the bounded experiment run (None if it diverged).
+        The channel's chord slopes seen in the experiment's runs, every case pooled (None if
+        a run diverged).
     circle : CircleResult or None
         None when the criterion does not apply (``reason``).
     experiment : str
@@ -288,10 +289,12 @@ def global_stability(loop: ControlLoop, experiment: str = "sine") -> StabilityRe
     bounded = all(r.bounded for r in result.cases.values())
     stop = min((r.stop_time for r in result.cases.values() if not r.bounded), default=None)
     loop_sector = None
-    if bounded:
-        resp = next(iter(result.cases.values()))
-        v = resp.y_hat if loop.scheme == "direct" else resp.s
-        loop_sector = chord_sector(resp.y, v, units=channel.units)
+    if bounded:  # every case's increments, pooled
+        parts = [chord_sector(r.y, r.y_hat if loop.scheme == "direct" else r.s,
+                              units=channel.units) for r in result.cases.values()]
+        loop_sector = Sector(min(p.k_min for p in parts), max(p.k_max for p in parts),
+                             sum(p.n_used for p in parts), sum(p.n_samples for p in parts),
+                             max(p.unexplained_step for p in parts), channel.units)
     if circle is not None and circle.proved:
         verdict = "proved stable"
         reason = (f"circle criterion: the measured sector [{channel.k_min:.4g}, "
