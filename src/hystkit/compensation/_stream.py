@@ -44,19 +44,19 @@ StartUp = str | np.ndarray
 class StreamState:
     """Everything a stream remembers between samples.
 
-    Attributes
+    Parameters
     ----------
     x : array or None
         The model's state vector (for an inverse compensator its forward model's, which every
         family's ``invert`` carries); None before the first sample of a stream that starts at
         rest (the rest state depends on that sample).
-    n_samples : int
+    n_samples : int, default 0
         Samples processed so far (the next sample's index).
-    tare_sum : float
+    tare_sum : float, default 0.0
         Sum of the sensor samples [sensor units] inside the tare window so far (``tare``).
-    track_value : float
+    track_value : float, default 0.0
         Last output of the tracker's un-normalised low-pass [sensor units] (``track``).
-    track_weight : float
+    track_weight : float, default 0.0
         Last output of the same low-pass run on ones: its weight sum (``track``).
     """
 
@@ -78,6 +78,17 @@ class StreamOutput(NamedTuple):
 
     ``sensor_outside`` / ``estimate_outside`` are None when the model file does not know the
     training ranges (files from before they were stored).
+
+    Parameters
+    ----------
+    estimate : numpy.ndarray, shape (n,)
+        Position estimate [mm], one per sensor sample of the chunk.
+    sensor_outside : numpy.ndarray of bool, shape (n,), or None
+        Samples whose normalised sensor lies outside the training range plus its margin
+        (:meth:`Compensator.sensor_outside`).
+    estimate_outside : numpy.ndarray of bool, shape (n,), or None
+        Estimates outside the training positions plus their margin
+        (:meth:`Compensator.estimate_outside`).
     """
 
     estimate: np.ndarray
@@ -86,7 +97,17 @@ class StreamOutput(NamedTuple):
 
 
 class StepOutput(NamedTuple):
-    """One sample's result: estimate [mm] and its use-time guards (None: ranges unknown)."""
+    """One sample's result: estimate [mm] and its use-time guards (None: ranges unknown).
+
+    Parameters
+    ----------
+    estimate : float
+        Position estimate [mm].
+    sensor_outside : bool or None
+        The sensor sample is outside the training range plus its margin.
+    estimate_outside : bool or None
+        The estimate is outside the training positions plus their margin.
+    """
 
     estimate: float
     sensor_outside: bool | None
@@ -164,6 +185,29 @@ def advance(comp: Compensator, state: StreamState, sensor: np.ndarray, *,
     """Run one chunk of raw sensor samples [sensor units] from ``state``.
 
     Pure: nothing is kept anywhere; the returned state continues the stream.
+
+    Parameters
+    ----------
+    comp : Compensator
+        The compensator; not one with the oracle centring ``recording``, which a stream
+        cannot run (:func:`initial_state` refuses it).
+    state : StreamState
+        Where the stream is: :func:`initial_state` for a new one, else the state returned by
+        the previous call.
+    sensor : numpy.ndarray, shape (n,)
+        The chunk's raw sensor samples [sensor units]; may be empty.
+    rest_position : float, optional
+        Where the device rests during the tare window [mm], if not where it rested in
+        training (``tare`` only; as :meth:`Compensator.estimate`).
+    label : str, default "stream"
+        Names the stream in error messages.
+
+    Returns
+    -------
+    output : StreamOutput
+        The chunk's estimates [mm] and use-time flags.
+    state : StreamState
+        The state after the chunk's last sample.
 
     Raises
     ------
