@@ -188,6 +188,7 @@ def test_cli_stability_of_a_control_setup(capsys, tmp_path):
     (["stability", "--control"], "--scheme"),
     (["stability"], "MODEL.json"),
     (["stability", "m.json", "--control", "--scheme", "direct"], "no MODEL.json"),
+    (["stability", "m.json", "--scheme", "direct"], "need --control"),
 ])
 def test_cli_stability_bad_combinations_are_one_line(capsys, argv, fragment):
     code, _, err = _run(capsys, *argv)

@@ -128,6 +128,8 @@ def _stability(args: argparse.Namespace) -> int:
 
     if args.control:
         return _control_stability(args)
+    if args.scheme is not None:
+        raise UsageError("--scheme and the other loop options need --control")
     if args.model_json is None:
         raise UsageError("give MODEL.json (a model's local stability) or --control (a loop's)")
     if args.json is not None:
