@@ -94,7 +94,15 @@ class Adaptation:
 
 @dataclass(frozen=True, eq=False)
 class AdaptiveState:
-    """The plain stream's state and the RLS state of the output parameters."""
+    """The plain stream's state and the RLS state of the output parameters.
+
+    Parameters
+    ----------
+    stream : StreamState
+        The plain (un-adapted) stream's state.
+    rls : RlsState
+        Estimate and covariance of the output parameters (multipliers, then the offset [mm]).
+    """
 
     stream: StreamState
     rls: RlsState
@@ -233,6 +241,40 @@ def advance_adaptive(comp: Compensator, adaptation: Adaptation, state: AdaptiveS
 
     Pure, as :func:`~._stream.advance`; ``state`` comes from :attr:`AdaptiveStream.state`
     or a previous call.
+
+    Parameters
+    ----------
+    comp : Compensator
+        The compensator; ``"weights"`` needs a direct one with weights ``w``, ``v_b``.
+    adaptation : Adaptation
+        What to re-fit and how fast to forget; the same for every chunk of a stream.
+    state : AdaptiveState
+        Where the stream is.
+    sensor : numpy.ndarray, shape (n,)
+        The chunk's raw sensor samples [sensor units]; may be empty.
+    reference : numpy.ndarray, shape (n,), optional
+        Reference position per sample [mm], NaN where unknown; None: none known.
+    rest_position : float, optional
+        Where the device rests during the tare window [mm] (``tare`` only; as
+        :class:`~._stream.Stream`).
+    label : str, default "stream"
+        Names the stream in error messages.
+
+    Returns
+    -------
+    output : StreamOutput
+        The chunk's adapted estimates [mm] and use-time flags (``estimate_outside`` of the
+        adapted estimate).
+    state : AdaptiveState
+        The state after the chunk's last sample and its references.
+
+    Raises
+    ------
+    InputError
+        If ``reference`` has not one value per sensor sample or holds an infinite one, or
+        ``"weights"`` does not apply to ``comp`` (inverse, no weights, or not linear in them).
+    FitDivergedError
+        As :func:`~._stream.advance`.
     """
     return _advance_plan(_Plan(comp, adaptation, rest_position), state, sensor, reference,
                          label)

@@ -25,13 +25,13 @@ __all__ = ["RlsState", "rls_bound", "rls_start", "rls_update"]
 class RlsState:
     """Estimate, its covariance factor and the number of updates so far.
 
-    Attributes
+    Parameters
     ----------
     theta : array, shape (p,)
         Present parameter estimate.
     cov : array, shape (p, p)
         ``P``: the inverse of the weighted normal matrix (symmetric, positive definite).
-    n_updates : int
+    n_updates : int, default 0
         Samples absorbed since the prior.
     """
 
@@ -55,6 +55,16 @@ def rls_start(theta0: np.ndarray, prior_std: np.ndarray) -> RlsState:
         Prior estimate.
     prior_std : array, shape (p,)
         Standard deviation of each parameter's prior (> 0): ``P_0 = diag(prior_std**2)``.
+
+    Returns
+    -------
+    RlsState
+        ``theta0``, ``P_0`` and no updates.
+
+    Raises
+    ------
+    ValueError
+        If ``prior_std`` is not ``p`` finite positive numbers.
     """
     theta0 = np.asarray(theta0, dtype=np.float64)
     std = np.asarray(prior_std, dtype=np.float64)
@@ -73,6 +83,22 @@ def rls_update(state: RlsState, phi: np.ndarray, r: float, forgetting: float) ->
 
     ``P`` is made symmetric again after each update, so rounding cannot make it drift into an
     asymmetric (and eventually indefinite) matrix over a long stream.
+
+    Parameters
+    ----------
+    state : RlsState
+        The state before the sample.
+    phi : array, shape (p,)
+        The sample's regressor.
+    r : float
+        The sample's target.
+    forgetting : float
+        Forgetting factor ``lam`` in (0, 1] (1: never forgets).
+
+    Returns
+    -------
+    RlsState
+        The state after the sample.
     """
     phi = np.asarray(phi, dtype=np.float64)
     p_phi = state.cov @ phi
@@ -90,6 +116,19 @@ def rls_bound(state: RlsState, max_trace: float) -> RlsState:
     others ("covariance wind-up"); the next different sample would then move ``theta`` by an
     amount set by noise. Bounding ``P`` by the prior's trace keeps the gain no larger than it
     was at the start.
+
+    Parameters
+    ----------
+    state : RlsState
+        Any state.
+    max_trace : float
+        Largest trace allowed for ``P``.
+
+    Returns
+    -------
+    RlsState
+        ``state`` itself if the trace of ``P`` is at most ``max_trace``, else a copy with ``P``
+        scaled to that trace.
     """
     trace = float(np.trace(state.cov))
     if trace <= max_trace:
