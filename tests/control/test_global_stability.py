@@ -64,6 +64,27 @@ def test_the_bound_two_over_a_is_where_a_constant_gain_diverges():
         assert (abs(x) > 1) is grows
 
 
+@pytest.mark.parametrize("k1", [5.0, 40.0])
+def test_circle_bound_of_the_double_integrator_loop_by_its_formulas(k1):
+    # Scheme (b) with the document's PID on the 0.25 kg double integrator: G(z) written out by
+    # hand -- exact ZOH P(z) = Ts^2 (z + 1) / (2 m (z - 1)^2), eq. 7.2's
+    # C(z) = Kp (1 + Ts / (Ti (z - 1)) + Td (z - 1) / (Ts z)), times g_s -- and
+    # max(-Re T_1) found on a dense grid, against python-control's interconnection and the
+    # refined search of circle_criterion.
+    loop = _weighting(hc.linear_block(50.0))
+    p, m = loop.pid, loop.plant.mass
+    z = np.exp(1j * np.r_[np.geomspace(1e-7, np.pi, 400000), np.linspace(1e-3, np.pi, 400000)])
+    plant = TS ** 2 * (z + 1) / (2 * m * (z - 1) ** 2)
+    pid = p.kp * (1 + TS / (p.ti * (z - 1)) + p.td * (z - 1) / (TS * z))
+    g = G_S * pid * plant
+    worst = np.max(-(g / (1 + k1 * g)).real)
+    res = hc.circle_criterion(hc.sector_channel(loop), k1, k1)
+    assert res.base_stable
+    # the dense grid can only miss the peak from below: the refined bound is at most the grid's
+    assert res.k_max_proved <= k1 + 1 / worst * (1 + 1e-12)
+    assert_allclose(res.k_max_proved, k1 + 1 / worst, rtol=1e-6)
+
+
 def test_a_lower_bound_that_destabilises_proves_nothing():
     res = hc.circle_criterion(_integrator(0.5), -0.1, 1.0)
     assert not res.proved and not res.base_stable and res.k_max_proved is None
