@@ -9,10 +9,10 @@ waits for: start-up, reading, the work, writing), of
 - ``compare`` (10 families, fit on one recording, validate on another), ``generalize`` (10
   families x the four virtual-sensor excitations) and ``select`` (every family's candidates,
   blocked time folds of one recording) at ``--workers 1`` (serial, in-process, no Dask) and
-  ``--workers 2`` (a local Dask cluster of two forked workers); issue 13 asks for >= 1.7x on 2
+  ``--workers 2`` (Dask, two forked worker processes); issue 13 asks for >= 1.7x on 2
   cores;
 - ``compare`` inside one process, split into start-up, opening the executor (Dask import,
-  kernel warm-up, cluster start), the map and closing, to see where the time goes;
+  kernel warm-up, worker pool), the map and closing, to see where the time goes;
 - the pieces of ``compare``, ``generalize`` and ``select``, timed one by one in one process
   (CPU seconds): their sum, the longest one, and what that allows on 2 workers
   (``max(longest, sum / 2)``, the critical path of a longest-first schedule's bound);
@@ -48,8 +48,9 @@ from pathlib import Path
 N_SENSORS = 20
 
 # compare in a fresh process, timed inside: start-up, opening the executor (Dask import, kernel
-# warm-up, cluster start), the map itself, closing. Serial map / (2 x parallel map) is the
-# efficiency of the 2-worker map; what it lacks is scheduling, transfer and load imbalance.
+# warm-up, worker pool; the workers fork at the first piece), the map itself, closing. Serial
+# map / (2 x parallel map) is the efficiency of the 2-worker map; what it lacks is scheduling,
+# transfer and load imbalance.
 BREAKDOWN = """
 import json, sys, time
 t0 = time.perf_counter()
@@ -74,7 +75,7 @@ import json, time
 from hystkit.io import read_recording
 from hystkit.models import FAMILIES
 from hystkit.parallel import SerialExecutor
-from hystkit.parallel._dask import warm_kernels
+from hystkit.parallel._warm import warm_kernels
 from hystkit.reports import candidates, compare_models, generalization_matrix, select_model
 from hystkit.sensors import simulate_experiment
 from hystkit.signals import EXPERIMENTS

@@ -1,5 +1,6 @@
-"""One real Dask cluster for the parallel tests: two spawned worker processes, as a cluster
-started outside hystkit would have (hystkit reaches it with ``--scheduler``)."""
+"""The parallel tests' executors: one real Dask cluster of two spawned worker processes, as a
+cluster started outside hystkit would have (hystkit reaches it with ``--scheduler``), and
+hystkit's default local executor, two worker processes forked from the test process."""
 
 from __future__ import annotations
 
@@ -20,6 +21,41 @@ def cluster_address() -> Iterator[str]:
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   silence_logs=logging.CRITICAL, **NO_DASHBOARD) as cluster:
         yield cluster.scheduler_address
+
+
+@pytest.fixture(scope="session")
+def forked():
+    """What `open_executor(2)` opens on Linux: Dask's multiprocessing scheduler on two forked
+    workers, kept open (but not made current: see `current`)."""
+    pytest.importorskip("dask")
+    from hystkit.parallel._forked import ForkedExecutor
+
+    executor = ForkedExecutor(2)
+    yield executor
+    executor.close()
+
+
+@pytest.fixture(params=["forked", "cluster"])
+def parallel_executor(request, cluster_address):
+    """Each parallel executor in turn: the forked default and a client of the cluster."""
+    from hystkit.parallel import open_executor
+
+    if request.param == "forked":
+        yield request.getfixturevalue("forked")
+        return
+    with open_executor(scheduler=cluster_address) as executor:
+        yield executor
+
+
+@pytest.fixture
+def current():
+    """Makes an executor current for one test, as `open_executor` does while it is open."""
+    from hystkit.parallel._executor import _CURRENT
+
+    tokens = []
+    yield lambda executor: tokens.append(_CURRENT.set(executor))
+    for token in reversed(tokens):
+        _CURRENT.reset(token)
 
 
 def _head(rec: Recording, n: int) -> Recording:

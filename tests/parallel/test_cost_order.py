@@ -9,9 +9,9 @@ import cloudpickle
 import pytest
 
 from hystkit.models import FAMILIES
-from hystkit.parallel import SerialExecutor, fit_cost, open_executor
+from hystkit.parallel import SerialExecutor, fit_cost
 from hystkit.parallel._cost import MEASURED
-from hystkit.parallel._dask import _cost_order
+from hystkit.parallel._dask import cost_order
 
 cloudpickle.register_pickle_by_value(sys.modules[__name__])
 
@@ -23,20 +23,21 @@ def _started(seconds: float) -> float:
     return t
 
 
-def test_cost_order_is_costliest_first_and_stable():
-    assert _cost_order([3, 1, 4, 1, 5], cost=float) == [4, 2, 0, 1, 3]
-    assert _cost_order("abc", cost=None) == [0, 1, 2]
+def testcost_order_is_costliest_first_and_stable():
+    assert cost_order([3, 1, 4, 1, 5], cost=float) == [4, 2, 0, 1, 3]
+    assert cost_order("abc", cost=None) == [0, 1, 2]
 
 
-def test_the_costliest_pieces_start_first_and_results_keep_their_order(cluster_address):
+def test_the_costliest_pieces_start_first_and_results_keep_their_order(parallel_executor):
     costs = [1.0, 4.0, 2.0, 3.0, 0.5]
-    with open_executor(scheduler=cluster_address) as executor:
-        items = list(range(5))
-        starts = executor.map(_started_item, items, shared={"seconds": 0.4},
-                              cost=lambda i: costs[i])
+    items = list(range(5))
+    done = []
+    starts = parallel_executor.map(_started_item, items, shared={"seconds": 0.4},
+                                   cost=lambda i: costs[i], on_done=lambda i, r: done.append(i))
     by_start = sorted(items, key=lambda i: starts[i][1])
     assert [i for i, _ in starts] == items  # results in the order of the pieces
     assert set(by_start[:2]) == {1, 3}  # the two costliest first, one on each worker
+    assert sorted(done) == items  # each reported once
 
 
 def _started_item(i: int, *, seconds: float) -> tuple[int, float]:

@@ -1,5 +1,6 @@
-"""A fit's multi-start on a real two-process local Dask cluster gives the serial fit bit for
-bit (issue 13); the threshold that keeps short fits serial; where the executor is current."""
+"""A fit's multi-start on two worker processes gives the serial fit bit for bit (issue 13), on
+the default local executor (forked) and on a real two-process Dask cluster; the threshold that
+keeps short fits serial; where the executor is current."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from hystkit.compensation import centre_and_scale
 from hystkit.models import get_family
 from hystkit.parallel import current_executor, open_executor
 from hystkit.parallel._dask import DaskExecutor
+from hystkit.parallel._forked import ForkedExecutor
 
 # Families whose fits run fit_multistart with several starts, one per way of forming the
 # normal equations: chua (finite differences, chunked), pl (variable projection), mpl
@@ -18,13 +20,11 @@ from hystkit.parallel._dask import DaskExecutor
 FAMILIES = ("chua", "pl", "mpl", "boucwen")
 
 
-@pytest.fixture(scope="module")
-def forked_cluster():
-    """`open_executor(2)`: a local cluster of two forked worker processes, kept open."""
-    pytest.importorskip("distributed")
-    with open_executor(2) as executor:
-        assert isinstance(executor, DaskExecutor) and executor.n_workers == 2
-        yield executor
+@pytest.fixture
+def split_on(parallel_executor, current):
+    """A parallel executor (each kind in turn), current for the test as while it is open."""
+    current(parallel_executor)
+    return parallel_executor
 
 
 @pytest.fixture
@@ -36,15 +36,14 @@ def fit_data(short_pair):
 
 @pytest.fixture
 def maps_run(monkeypatch):
-    """Names of the functions each DaskExecutor.map ran, in call order."""
+    """Names of the functions each parallel map ran, with the number of pieces, in order."""
     calls = []
-    original = DaskExecutor.map
+    for kind in (DaskExecutor, ForkedExecutor):
+        def spy(self, func, items, _original=kind.map, **kwargs):
+            calls.append((func.__name__, len(items)))
+            return _original(self, func, items, **kwargs)
 
-    def spy(self, func, items, **kwargs):
-        calls.append((func.__name__, len(items)))
-        return original(self, func, items, **kwargs)
-
-    monkeypatch.setattr(DaskExecutor, "map", spy)
+        monkeypatch.setattr(kind, "map", spy)
     return calls
 
 
@@ -55,10 +54,11 @@ def _fit(name: str, data) -> object:
 
 
 @pytest.mark.parametrize("name", FAMILIES)
-def test_split_multistart_equals_the_serial_fit(name, fit_data, forked_cluster, maps_run,
+def test_split_multistart_equals_the_serial_fit(name, fit_data, split_on, maps_run,
                                                 monkeypatch):
+    monkeypatch.setattr(least_squares, "SPLIT_MIN_START", float("inf"))  # serial
     serial = _fit(name, fit_data)
-    assert current_executor() is forked_cluster
+    assert current_executor() is split_on and maps_run == []
     monkeypatch.setattr(least_squares, "SPLIT_MIN_START", 0.0)  # split every fit
     monkeypatch.setattr(least_squares, "SPLIT_MIN_SECONDS", 0.0)
     split = _fit(name, fit_data)
@@ -70,14 +70,15 @@ def test_split_multistart_equals_the_serial_fit(name, fit_data, forked_cluster, 
     assert np.array_equal(split.sensitivity, serial.sensitivity)
 
 
-def test_short_fits_stay_serial(fit_data, forked_cluster, maps_run, monkeypatch):
+def test_short_fits_stay_serial(fit_data, split_on, maps_run, monkeypatch):
     monkeypatch.setattr(least_squares, "SPLIT_MIN_START", float("inf"))
     _fit("chua", fit_data)
     assert maps_run == []
 
 
-def test_few_short_starts_polish_side_by_side_only(fit_data, forked_cluster, maps_run,
+def test_few_short_starts_polish_side_by_side_only(fit_data, split_on, maps_run,
                                                    monkeypatch):
+    monkeypatch.setattr(least_squares, "SPLIT_MIN_START", float("inf"))  # serial
     serial = _fit("chua", fit_data)
     monkeypatch.setattr(least_squares, "SPLIT_MIN_START", 0.0)
     monkeypatch.setattr(least_squares, "SPLIT_MIN_SECONDS", float("inf"))
@@ -87,18 +88,21 @@ def test_few_short_starts_polish_side_by_side_only(fit_data, forked_cluster, map
     assert polished.n_evaluations == serial.n_evaluations
 
 
-def test_the_executor_is_current_only_where_it_is_open(forked_cluster):
-    # inside a piece (a worker's thread) nothing is open: a fit there stays serial
-    assert forked_cluster.map(_current, [0, 1]) == [None, None]
-    with open_executor(1) as serial:
-        assert current_executor() is forked_cluster and serial is not forked_cluster
+def test_no_executor_is_current_inside_a_piece(split_on):
+    # a piece runs in a worker, where nothing is open: a fit there stays serial
+    assert current_executor() is split_on
+    assert split_on.map(_current, [0, 1]) == [None, None]
 
 
-def test_the_executor_is_current_while_it_is_open(cluster_address):
-    before = current_executor()
-    with open_executor(scheduler=cluster_address) as executor:
+@pytest.mark.parametrize("where", ["forked", "cluster"])
+def test_the_executor_is_current_while_it_is_open(where, cluster_address):
+    assert current_executor() is None
+    with open_executor(**({"workers": 2} if where == "forked" else
+                          {"scheduler": cluster_address})) as executor:
         assert current_executor() is executor
-    assert current_executor() is before
+        with open_executor(1) as serial:  # a serial executor is never current
+            assert current_executor() is executor and serial is not executor
+    assert current_executor() is None
 
 
 def _current(_: int):

@@ -53,10 +53,10 @@ def test_dask_map_keeps_the_order_of_the_pieces(cluster_address):
     assert sorted(finished) == [(0, 0), (1, 1), (2, 4), (3, 9)]  # each reported once
 
 
-def test_a_failing_piece_raises_in_the_caller(cluster_address):
-    with open_executor(scheduler=cluster_address) as executor, \
-            pytest.raises(TypeError):
-        executor.map(pow, [2, "x"], shared={"exp": 2})
+def test_a_failing_piece_raises_in_the_caller(parallel_executor):
+    with pytest.raises(TypeError):
+        parallel_executor.map(pow, [2, "x"], shared={"exp": 2})
+    assert parallel_executor.map(pow, [2, 3], shared={"exp": 2}) == [4, 9]  # still usable
 
 
 def test_an_unreachable_scheduler_is_one_error(monkeypatch):

@@ -1,5 +1,6 @@
 """A parallel run gives the serial run's table, bit for bit (issue 13): compare, generalize,
-select and pl-search on a real two-process Dask cluster, and ``--scheduler`` on the CLI.
+select and pl-search on two forked worker processes (the default local executor) and on a real
+two-process Dask cluster, and ``--scheduler`` and ``--workers 2`` on the CLI.
 
 Only the fits' own wall times (``fit_seconds``, ``seconds``) may differ.
 """
@@ -33,34 +34,31 @@ def _untimed(tree):
 
 
 
-def test_compare_on_the_cluster_equals_the_serial_run(cluster_address, short_pair):
+def test_compare_in_parallel_equals_the_serial_run(parallel_executor, short_pair):
     models, sizes = ["mpl", "pi", "bobbio"], {"mpl": 1}
     serial = compare_models(*short_pair, models, sizes)
-    with open_executor(scheduler=cluster_address) as executor:
-        parallel = compare_models(*short_pair, models, sizes, executor=executor)
+    parallel = compare_models(*short_pair, models, sizes, executor=parallel_executor)
     assert list(parallel) == models
     assert _untimed(parallel) == _untimed(serial)
     assert all("error" not in row for row in serial.values())
 
 
-def test_generalize_on_the_cluster_equals_the_serial_run(cluster_address, short_pair):
+def test_generalize_in_parallel_equals_the_serial_run(parallel_executor, short_pair):
     fit, val = short_pair
     train, test = {"a": fit, "b": val}, {"b": val, "a": fit}
     serial = generalization_matrix(train, test, ["mpl", "pi"], {"mpl": 1})
-    with open_executor(scheduler=cluster_address) as executor:
-        parallel = generalization_matrix(train, test, ["mpl", "pi"], {"mpl": 1},
-                                         executor=executor)
+    parallel = generalization_matrix(train, test, ["mpl", "pi"], {"mpl": 1},
+                                     executor=parallel_executor)
     assert json.dumps(parallel) == json.dumps(serial)  # values and the order of every key
     assert serial["mpl"]["r2"]["a"]["b"] is not None
 
 
-def test_select_on_the_cluster_equals_the_serial_run(cluster_address, short_pair):
+def test_select_in_parallel_equals_the_serial_run(parallel_executor, short_pair):
     # fast candidates; mpl:1:inverse fails in one fold (its inverse diverges): an error row
     cands = [Candidate("mpl", 1, mode, DEFAULT_CENTER) for mode in ("direct", "inverse")]
     cands.append(Candidate("bobbio", 10, "direct", DEFAULT_CENTER))
     serial = select_model([short_pair[0]], cands)
-    with open_executor(scheduler=cluster_address) as executor:
-        parallel = select_model([short_pair[0]], cands, executor=executor)
+    parallel = select_model([short_pair[0]], cands, executor=parallel_executor)
     assert _untimed(parallel["ranking"]) == _untimed(serial["ranking"])
     assert parallel["winner"]["candidate"] == serial["winner"]["candidate"]
     assert parallel["compensator"].params == serial["compensator"].params
@@ -68,12 +66,12 @@ def test_select_on_the_cluster_equals_the_serial_run(cluster_address, short_pair
     assert [r["candidate"] for r in serial["ranking"] if "error" in r] == ["mpl:1:inverse:fit"]
 
 
-def test_pl_search_on_the_cluster_equals_the_serial_run(cluster_address, short_pair):
+def test_pl_search_in_parallel_equals_the_serial_run(parallel_executor, short_pair):
     rec = short_pair[0]
     grid = {"n": (1, 2), "p": (5.0,), "m": (1, 2), "s": (0.001,)}
     serial = structural_search(rec.position, rec.sensor, rec.dt, grid)
-    with open_executor(scheduler=cluster_address) as executor:
-        parallel = structural_search(rec.position, rec.sensor, rec.dt, grid, executor=executor)
+    parallel = structural_search(rec.position, rec.sensor, rec.dt, grid,
+                                 executor=parallel_executor)
     assert [(r["n_cells"], r["n_basis"]) for r in parallel] == [(1, 1), (1, 2), (2, 1), (2, 2)]
     assert _untimed(parallel) == _untimed(serial)
 
@@ -91,6 +89,11 @@ def test_compare_cli_with_scheduler_writes_the_serial_table(cluster_address, sho
               for name in ("serial", "dask")]
     assert list(tables[1]) == ["pi", "mpl"]
     assert _untimed(tables[1]) == _untimed(tables[0])
+    assert main([*args, "--workers", "2", "--out", str(tmp_path / "forked")]) == 0
+    assert "4 pieces of work on 2 Dask workers (local, forked processes)" in \
+        capsys.readouterr().out
+    forked = json.loads((tmp_path / "forked" / "compare.json").read_text())
+    assert _untimed(forked) == _untimed(tables[0])
 
 
 def test_workers_and_scheduler_exclude_each_other(capsys):

@@ -10,7 +10,10 @@ median.
 
 from __future__ import annotations
 
-__all__ = ["fit_cost"]
+from collections.abc import Callable, Sequence
+from typing import Any
+
+__all__ = ["cost_order", "fit_cost"]
 
 # family: (seconds of fit and scoring on 8000 samples, the size they were measured at)
 MEASURED = {
@@ -29,3 +32,11 @@ def fit_cost(model: str, size: int | None, n_samples: int) -> float:
     seconds, measured_size = MEASURED.get(model, (_MEDIAN, None))
     ratio = 1.0 if size is None or measured_size is None else size / measured_size
     return seconds * ratio * ratio * n_samples / 8000
+
+
+def cost_order(items: Sequence[Any], cost: Callable[[Any], float] | None) -> list[int]:
+    """Indices of `items`, the costliest first by `cost`; ties, and all without `cost`, in
+    the order of `items`."""
+    if cost is None:
+        return list(range(len(items)))
+    return sorted(range(len(items)), key=lambda i: (-cost(items[i]), i))

@@ -1,23 +1,21 @@
-"""The Dask executor: a local cluster for this command, or a client of a running scheduler.
+"""The ``distributed`` executor: a client of a running scheduler (``--scheduler``), or a local
+cluster where the platform cannot fork (elsewhere `._forked` starts faster).
 
-Imported only when a parallel run starts. A local cluster's workers are forked where the
-platform allows it (Linux): they inherit the libraries this process has imported and the model
-kernels it loaded from numba's on-disk cache (``cache=True``, `warm_kernels`, once before the
-fork), so a worker is ready in a fraction of a second, where a spawned one re-imports numpy,
-scipy, numba and hystkit (2-3 s on a loaded 2-core machine, more than a small ``compare``
-gains). Spawned workers and those of a remote cluster load the kernels at start-up
-(`WorkerSetup`); forked ones skip that (measured: it cost each of two forked workers 0.6-2.6 s
-of CPU at every start, for kernels they already had). Every worker limits its BLAS to one
-thread: a worker has one core, and idle OpenBLAS threads spin, taking CPU from the other
-workers (measured: ``select`` at 2 workers used 40 % more CPU than serially without it).
-Pieces are submitted with their estimated cost as Dask priority: the costliest run first.
+Imported only when such a run starts. A local cluster's workers are forked where possible:
+they inherit the libraries this process has imported and the model kernels it loaded from
+numba's on-disk cache (``cache=True``, `warm_kernels`, once before the fork), so a worker is
+ready in a fraction of a second, where a spawned one re-imports numpy, scipy, numba and hystkit
+(2-3 s on a loaded 2-core machine). Spawned workers and those of a remote cluster load the
+kernels at start-up (`WorkerSetup`); forked ones skip that (measured: it cost each of two forked
+workers 0.6-2.6 s of CPU at every start, for kernels they already had). Every worker limits its
+BLAS to one thread: a worker has one core, and idle OpenBLAS threads spin, taking CPU from the
+other workers (measured: ``select`` at 2 workers used 40 % more CPU than serially without it).
+Pieces are submitted costliest first, with their rank as Dask priority.
 """
 
 from __future__ import annotations
 
 import logging
-import multiprocessing
-import sys
 import uuid
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import ExitStack, contextmanager
@@ -28,7 +26,9 @@ from distributed import Client, LocalCluster, WorkerPlugin, as_completed
 
 from .. import __version__
 from ..errors import HystkitError
-from ._executor import Cost, OnDone
+from . import _warm
+from ._cost import cost_order
+from ._executor import Cost, OnDone, can_fork
 
 __all__ = ["DaskExecutor", "SchedulerError", "WorkerSetup", "dask_executor"]
 
@@ -54,51 +54,8 @@ class WorkerSetup(WorkerPlugin):
         from threadpoolctl import threadpool_limits
 
         threadpool_limits(1)  # kept for the worker's life (not used as a context manager)
-        if not _warmed:  # forked from a process that loaded them: the worker has them too
-            warm_kernels()
-
-
-# Whether this process (or the one it was forked from) has run `warm_kernels`.
-_warmed = False
-
-
-def warm_kernels() -> None:
-    """Import the model families, fit each one to a short hysteretic signal and invert it:
-    this loads their simulation, fit and inverse kernels from numba's on-disk cache
-    (``cache=True``) once, here, instead of in every worker (measured: without the fits'
-    kernels, two forked workers each loaded them again and a 4 s ``compare`` map took as long
-    on 2 workers as on 1). The signal is a play operator's (every family fits it; a family's
-    own random parameters left Bouc-Wen unfitted, its fit kernels unloaded) and short:
-    loading is what counts here (~1.5 s of CPU, of which ~0.7 s runs the fits)."""
-    global _warmed
-    import numpy as np
-
-    from ..models import FAMILIES
-
-    u = 0.8 * np.sin(np.linspace(0, 6 * np.pi, 150)) * np.linspace(1.0, 0.5, 150)
-    y = 0.6 * u + 0.4 * _play(u, 0.15)
-    for family in FAMILIES.values():
-        # Only a head start: a family that cannot run here fails in its own piece, where the
-        # command reports it, not in every worker's start-up.
-        try:
-            structure = family.make_structure(1 / 40, family.default_size)
-            params = family.fit(u, y, structure).params
-            if family.invert is not None:  # compare and select score the inverse too
-                family.invert(structure, params, y)
-        except Exception:  # noqa: BLE001, S112
-            continue
-    _warmed = True
-
-
-def _play(u, radius: float):
-    """A play (backlash) operator of half-width `radius` from 0: a simple hysteretic loop."""
-    import numpy as np
-
-    y, x = np.empty_like(u), 0.0
-    for i, v in enumerate(u):
-        x = min(max(x, v - radius), v + radius)
-        y[i] = x
-    return y
+        if not _warm.warmed():  # forked from a process that loaded them: it has them too
+            _warm.warm_kernels()
 
 
 def _worker_version() -> str:
@@ -131,7 +88,7 @@ class DaskExecutor:
         # Submitted costliest first, each with its rank as priority: the scheduler may hand
         # out the first pieces before it has seen the rest.
         futures: list = [None] * len(items)
-        for rank, i in enumerate(_cost_order(items, cost)):
+        for rank, i in enumerate(cost_order(items, cost)):
             futures[i] = self.client.submit(func, items[i], **sent, pure=False,
                                             priority=len(items) - rank, key=f"{name}-{run}-{i}")
         index = {future.key: i for i, future in enumerate(futures)}
@@ -147,17 +104,8 @@ class DaskExecutor:
         return results
 
 
-def _cost_order(items: Sequence[Any], cost: Cost | None) -> list[int]:
-    """Indices of `items`, the costliest first by `cost`; ties, and all without `cost`, in
-    the order of `items`."""
-    if cost is None:
-        return list(range(len(items)))
-    return sorted(range(len(items)), key=lambda i: (-cost(items[i]), i))
-
-
 def _fork_if_possible() -> str:
-    return "fork" if "fork" in multiprocessing.get_all_start_methods() and \
-        sys.platform.startswith("linux") else "spawn"
+    return "fork" if can_fork() else "spawn"
 
 
 @contextmanager
@@ -168,7 +116,7 @@ def dask_executor(n_workers: int | None, scheduler: str | None) -> Iterator[Dask
         if scheduler is None:
             method = _fork_if_possible()
             if method == "fork":
-                warm_kernels()
+                _warm.warm_kernels()
             # for the cluster's whole life: a worker the nanny restarts is forked too (a
             # spawned one would also leave semaphores for multiprocessing's tracker to warn of)
             stack.enter_context(dask.config.set({"distributed.worker.multiprocessing-method":

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -89,8 +90,9 @@ def open_executor(workers: int | None = None, scheduler: str | None = None, *,
     Parameters
     ----------
     workers : int, optional
-        Worker processes of a local cluster (default: one per available core). 1 runs
-        serially in this process, without Dask.
+        Worker processes of a local cluster (default: one per available core), forked from
+        this process where the platform forks (Dask's multiprocessing scheduler), else a
+        ``distributed`` LocalCluster. 1 runs serially in this process, without Dask.
     scheduler : str, optional
         Address of a running Dask scheduler (``tcp://host:8786``); its workers run the
         pieces and `workers` is ignored.
@@ -105,11 +107,37 @@ def open_executor(workers: int | None = None, scheduler: str | None = None, *,
         if n <= 1:
             yield SerialExecutor()
             return
-    from ._dask import dask_executor  # Dask loads only for a parallel run
-
-    with dask_executor(None if scheduler is not None else n, scheduler) as executor:
+    with _parallel_executor(n if scheduler is None else None, scheduler) as executor:
         token = _CURRENT.set(executor)
         try:
             yield executor
         finally:
             _CURRENT.reset(token)
+
+
+@contextmanager
+def _parallel_executor(n_workers: int | None, scheduler: str | None) -> Iterator[Executor]:
+    """Dask's multiprocessing scheduler on forked processes where the platform forks (the
+    fastest to start, `._forked`); elsewhere a `distributed` LocalCluster of spawned workers,
+    and for a scheduler address a client of it (`._dask`). Dask loads only here."""
+    if scheduler is None and can_fork():
+        from ._forked import ForkedExecutor
+
+        executor = ForkedExecutor(n_workers)
+        try:
+            yield executor
+        finally:
+            executor.close()
+        return
+    from ._dask import dask_executor
+
+    with dask_executor(n_workers, scheduler) as executor:
+        yield executor
+
+
+def can_fork() -> bool:
+    """Whether worker processes can be forked from this one (Linux)."""
+    import multiprocessing  # only for a parallel run
+
+    return sys.platform.startswith("linux") and \
+        "fork" in multiprocessing.get_all_start_methods()
