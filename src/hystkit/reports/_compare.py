@@ -101,6 +101,21 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
     Each family is two pieces of work for `executor` (default: serial), its forward model and
     its direct compensator; the table is the same whichever executor ran them.
 
+    Parameters
+    ----------
+    fit_rec : Recording
+        The recording every family is fitted on.
+    val_rec : Recording
+        The recording every fit is scored on.
+    models : sequence of str, optional
+        Family names; None: every registered family (``hystkit.models.FAMILIES``), sorted.
+    sizes : mapping of str to int, optional
+        Size per family name; a family not in it gets its default size.
+    progress : callable, optional
+        Called with one line of text as each family is done (default: nothing).
+    executor : Executor, optional
+        Runs the pieces of work; None: serially, here.
+
     Returns
     -------
     dict
@@ -175,6 +190,22 @@ def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Rec
     One piece of work for `executor` (default: serial) per model and training recording: its
     fit and its tests; the matrix is the same whichever executor ran them.
 
+    Parameters
+    ----------
+    train : mapping of str to Recording
+        Training recordings by name (the matrix's rows).
+    test : mapping of str to Recording
+        Test recordings by name (its columns).
+    models : sequence of str
+        Family names.
+    sizes : mapping of str to int, optional
+        Size per family name; a family not in it gets its default size.
+    progress : callable, optional
+        Called with one line of text as each model is trained on a recording (default:
+        nothing).
+    executor : Executor, optional
+        Runs the pieces of work; None: serially, here.
+
     Returns
     -------
     dict
@@ -236,7 +267,18 @@ def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
     """One heat map per model: rows = trained on, columns = tested on, each cell's R² written
     in it. The colour is the unexplained fraction 1 - R² on a log scale shared by all panels,
     so 0.99, 0.876 and -2390 all look different (a linear scale clipped at 0.9 made the last
-    two alike); failed cells stay blank."""
+    two alike); failed cells stay blank.
+
+    Parameters
+    ----------
+    matrix : mapping of str to dict
+        :func:`generalization_matrix`'s result (its ``"r2"`` grids are drawn).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Up to three panels a row, one per model, with a shared colour bar.
+    """
     n_cols = min(3, len(matrix))
     n_rows = -(-len(matrix) // n_cols)
     fig = Figure(figsize=(3.6 * n_cols, 3.2 * n_rows), layout="constrained")
@@ -289,7 +331,19 @@ def _yes_no(flag: bool | None) -> str:
 
 
 def format_compare(table: Mapping[str, dict]) -> str:
-    """Plain-text table of :func:`compare_models`' result: deployable, then oracle scores."""
+    """Plain-text table of :func:`compare_models`' result: deployable, then oracle scores.
+
+    Parameters
+    ----------
+    table : mapping of str to dict
+        :func:`compare_models`' result.
+
+    Returns
+    -------
+    str
+        One line per model (``FAILED`` and its error for a failed one), then why R² inv is
+        missing where it is.
+    """
     head = (f"{'model':<10}{'params':>7}{'fit s':>7}{'R² fwd':>8}{'R² inv':>8}{'R² dir':>8}"
             f"{'line':>8} | oracle:{'R² inv':>8}{'R² dir':>8}{'line':>8}{'e_rms%':>8}"
             f"  rate-dep  ret.point  minor  direct fit")

@@ -30,6 +30,20 @@ N_TIME_FOLDS = 3
 
 @dataclass(frozen=True)
 class Candidate:
+    """One model configuration that :func:`select_model` cross-validates.
+
+    Parameters
+    ----------
+    model : str
+        Registered family name.
+    size : int
+        The family's size (mPL: cells N).
+    mode : {"direct", "inverse"}
+        Compensator mode.
+    center : {"fit", "tare", "track", "recording", "none"}
+        Centring (:func:`hystkit.compensation.fit_compensator`).
+    """
+
     model: str
     size: int
     mode: str
@@ -43,7 +57,27 @@ class Candidate:
 def candidates(models: Sequence[str] | None = None, centers: Sequence[str] = (DEFAULT_CENTER,),
                extra_sizes: dict[str, Sequence[int]] | None = None) -> list[Candidate]:
     """Every family at its default size (and ``extra_sizes``), direct and, where one exists,
-    inverse mode, for each centring."""
+    inverse mode, for each centring.
+
+    Parameters
+    ----------
+    models : sequence of str, optional
+        Family names; None: every registered family, sorted.
+    centers : sequence of str, default ("fit",)
+        Centrings to try (as :class:`Candidate`).
+    extra_sizes : dict of str to sequence of int, optional
+        Sizes to try beside the default, per family name; None: ``{"mpl": (1, 3)}``.
+
+    Returns
+    -------
+    list of Candidate
+        By family, then centring, size and mode.
+
+    Raises
+    ------
+    InputError
+        If a name in ``models`` is not a registered family.
+    """
     extra = {"mpl": (1, 3)} if extra_sizes is None else extra_sizes
     out = []
     for name in sorted(FAMILIES) if models is None else models:
@@ -56,7 +90,19 @@ def candidates(models: Sequence[str] | None = None, centers: Sequence[str] = (DE
 
 
 def folds(recordings: Sequence[Recording]) -> list[tuple[list[Recording], Recording]]:
-    """(training recordings, held-out recording) pairs; see the module docstring."""
+    """(training recordings, held-out recording) pairs; see the module docstring.
+
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        The training recordings (at least one).
+
+    Returns
+    -------
+    list of (list of Recording, Recording)
+        Leave-one-recording-out pairs for several recordings; for one, three blocked time
+        folds (a block without motion only trains, it is never held out).
+    """
     if len(recordings) > 1:
         return [([r for j, r in enumerate(recordings) if j != i], held)
                 for i, held in enumerate(recordings)]
@@ -128,6 +174,21 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
     Every candidate x fold is one piece of work for `executor` (default: serial); the ranking
     is the same whichever executor ran them. The winner's refit runs here.
 
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        The training recordings; the folds are made from them (:func:`folds`).
+    cands : sequence of Candidate
+        The candidates (:func:`candidates`).
+    executor : Executor, optional
+        Runs the pieces of work; None: serially, here.
+    progress : callable, optional
+        Called with one line of text at the start and as each candidate is cross-validated
+        (default: nothing).
+    **options
+        Passed to :func:`hystkit.compensation.fit_compensator` for every fit (e.g.
+        ``tare_seconds``, ``slope_cap``).
+
     Returns
     -------
     dict
@@ -181,7 +242,19 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
 
 
 def plot_selection(ranking: Sequence[dict]) -> Figure:
-    """Held-out deployable R² per candidate (oracle and straight line as markers)."""
+    """Held-out deployable R² per candidate (oracle and straight line as markers).
+
+    Parameters
+    ----------
+    ranking : sequence of dict
+        The ``ranking`` rows of :func:`select_model`; rows with an error are left out.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One bar per candidate, grey where its fit failed its guards; R² below -0.5 is drawn
+        at -0.5.
+    """
     rows = [r for r in ranking if "error" not in r]
     fig = Figure(figsize=(7, 0.3 * len(rows) + 1.5), layout="constrained")
     ax = fig.subplots()
