@@ -158,7 +158,26 @@ def check_streamable(comp: Compensator) -> None:
 
 def initial_state(comp: Compensator, start: StartUp = "rest") -> StreamState:
     """The state a stream starts from: ``"rest"``, ``"sync"`` (eq. 2.21-2.22) or a model
-    state vector (its length is the family's state size)."""
+    state vector (its length is the family's state size).
+
+    Parameters
+    ----------
+    comp : Compensator
+        The compensator the stream runs.
+    start : "rest", "sync" or array, default "rest"
+        Start-up (module docstring).
+
+    Returns
+    -------
+    StreamState
+        No samples seen; the model state of ``start`` (None for ``"rest"``).
+
+    Raises
+    ------
+    InputError
+        If ``comp`` uses the oracle centring, ``start`` is another string, or a state vector
+        has the wrong size or a non-finite value.
+    """
     check_streamable(comp)
     if isinstance(start, str):
         if start == "rest":

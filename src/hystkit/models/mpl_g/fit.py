@@ -64,13 +64,41 @@ def _slope_matrix(r: float) -> np.ndarray:
 
 def output_from_slopes(g0: float, b: np.ndarray, r: float = MONOTONE_RANGE) -> np.ndarray:
     """``g_0..g_3`` of the cubic with ``g(0) = g0`` whose slope has Bernstein coefficients
-    ``b`` on ``|z| <= r``; ``g`` is strictly monotone there when all ``b`` share a sign."""
+    ``b`` on ``|z| <= r``; ``g`` is strictly monotone there when all ``b`` share a sign.
+
+    Parameters
+    ----------
+    g0 : float
+        ``g(0)``.
+    b : array, shape (3,)
+        Bernstein coefficients of ``g'`` on ``[-r, r]``.
+    r : float, default MONOTONE_RANGE
+        Half-width of the interval.
+
+    Returns
+    -------
+    numpy.ndarray, shape (4,)
+        ``g_0..g_3``.
+    """
     return np.r_[g0, _slope_matrix(r) @ np.asarray(b, dtype=float)]
 
 
 def bernstein_slopes(g: np.ndarray, r: float = MONOTONE_RANGE) -> np.ndarray:
     """Inverse of :func:`output_from_slopes` (without ``g_0``): ``b_0 = g'(-r)``,
-    ``b_2 = g'(r)``, ``b_1 = 2 g'(0) - (b_0 + b_2) / 2``."""
+    ``b_2 = g'(r)``, ``b_1 = 2 g'(0) - (b_0 + b_2) / 2``.
+
+    Parameters
+    ----------
+    g : array, shape (4,)
+        ``g_0..g_3``.
+    r : float, default MONOTONE_RANGE
+        Half-width of the interval.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        ``b_0, b_1, b_2``.
+    """
     g = np.asarray(g, dtype=float)
     lo, mid, hi = (mpl_g.output_slope(mpl_g.MplGParams(i_s=[1.0], v_t=[1.0], g=g, w=[1.0, 0.0]),
                                       z) for z in (-r, 0.0, r))
@@ -79,7 +107,18 @@ def bernstein_slopes(g: np.ndarray, r: float = MONOTONE_RANGE) -> np.ndarray:
 
 def theta_names(n_cells: int) -> list[str]:
     """Names of the optimiser coordinates, cells from 1: per cell ``log G``, ``log V_T``, then
-    ``g_0``, the logs of ``g'``'s Bernstein coefficients on ``|z| <= R``, ``w_1..w_N``."""
+    ``g_0``, the logs of ``g'``'s Bernstein coefficients on ``|z| <= R``, ``w_1..w_N``.
+
+    Parameters
+    ----------
+    n_cells : int
+        Number of cells ``N``.
+
+    Returns
+    -------
+    list of str
+        ``3N + 4`` names (``log_G[1]``, ``log_v_t[1]``, ..., ``g.c0``, ``g.log_slope0``, ...).
+    """
     cells = [f"{name}[{k}]" for k in range(1, n_cells + 1) for name in ("log_G", "log_v_t")]
     return [*cells, "g.c0", *(f"g.log_slope{j}" for j in range(3)),
             *(f"w[{k}]" for k in range(1, n_cells + 1))]
@@ -263,7 +302,20 @@ def random_params(structure: mpl_g.MplGStructure, rng: np.random.Generator) -> m
 
     With ``|u| <= 1`` then ``|z| <= 2 |w_0| + 1 <= 5`` and ``|y| <= 2 + 2 |z| + 2.2 z^2 +
     2 |z|^3``; with ``slope_cap <= 1`` the inverse exists for every output and its cells
-    contract (see the comment above), so it is bounded too."""
+    contract (see the comment above), so it is bounded too.
+
+    Parameters
+    ----------
+    structure : MplGStructure
+        The model's structure (its ``N``, ``dt`` and ``slope_cap`` set the cells' range).
+    rng : numpy.random.Generator
+        Source of the draws.
+
+    Returns
+    -------
+    MplGParams
+        One draw.
+    """
     n = structure.n_cells
     log_g = rng.uniform(_LOG_G_MIN, np.log(structure.slope_cap / structure.dt), n)
     log_vt = rng.uniform(*_LOG_VT_BOUNDS, n)

@@ -68,6 +68,26 @@ def ch7_compensator(column: str = "noise") -> tuple[MplGStructure, MplGParams, d
     holds the centres and scales (to use the model on raw signals) and the fit's R^2 (the
     document: 0.995 for its compensator of the noise column, fig. 7.3b). About 1-3 s per
     column, cached.
+
+    Parameters
+    ----------
+    column : {"sine", "chirp", "decay", "noise"}, default "noise"
+        Column of paper 9.2's table II (as :func:`table_ii_response`).
+
+    Returns
+    -------
+    structure : MplGStructure
+        ``N = 1`` at ``TRAINING_DT``.
+    params : MplGParams
+        The fitted parameters (normalised units).
+    info : dict
+        Source, direction, ``fit_dt``, ``r2``, ``converged`` and the centres and scales of
+        sensor and position.
+
+    Raises
+    ------
+    ValueError
+        If table II has no such column.
     """
     position, sensor = table_ii_response(column)
     s_mean, p_mean = float(sensor.mean()), float(position.mean())
