@@ -71,10 +71,17 @@ def open_loop(loop: ControlLoop, state: LoopState | None = None) -> control.Stat
 
     Parameters
     ----------
+    loop : ControlLoop
+        The loop to linearise.
     state : LoopState, optional
         Operating point; default :func:`rest_state` at ``r = 0``. The sensor blocks'
         slopes are taken at their state and at the inputs that state implies (the plant
         position, then the sensor's output).
+
+    Returns
+    -------
+    control.StateSpace
+        ``L(z)``, input ``u_p`` [N], output ``v`` [N], sample time ``loop.ts``.
     """
     state = rest_state(loop) if state is None else state
     ts = loop.ts
@@ -111,17 +118,20 @@ def open_loop(loop: ControlLoop, state: LoopState | None = None) -> control.Stat
 class LoopMargins:
     """Crossover and stability margins of the linearised loop.
 
-    Attributes
+    Parameters
     ----------
     crossover_hz : float or None
         Gain-crossover frequency ``|L| = 1`` [Hz] (None if ``|L|`` never crosses 1).
     phase_margin_deg : float or None
+        Phase margin at the crossover [deg]; None without a crossover.
     gain_margin_db : float or None
-        None when the phase never crosses -180 deg (infinite gain margin).
+        Gain margin [dB]; None when the phase never crosses -180 deg (infinite gain margin).
     phase_crossover_hz : float or None
+        Phase-crossover frequency [Hz] at which the gain margin is read.
     closed_loop_stable : bool
         All poles of ``feedback(L, 1)`` strictly inside the unit circle.
     max_pole_radius : float
+        Largest ``|pole|`` of the closed loop.
     growth_time_s : float or None
         For an unstable loop, the e-folding time ``Ts / ln max|pole|`` [s] of its fastest
         growing mode: a slow drift (hours) and a blow-up (milliseconds) both count as unstable.
@@ -143,6 +153,7 @@ class LoopMargins:
     marginal: bool = False
 
     def to_dict(self) -> dict:
+        """The fields as a dict (JSON-safe: floats, bools and None)."""
         return dict(vars(self))
 
 
@@ -160,6 +171,22 @@ def classify_poles(a: np.ndarray) -> tuple[float, bool, bool, float]:
     1 + 6e-10. The tolerance is capped at a double pole's rounding, ``10 sqrt(eps ||A||)``.
     A pole is on the circle when not beyond it and within that rounding below 1. The growth
     radius is the largest radius beyond the circle (1.0 when there is none).
+
+    Parameters
+    ----------
+    a : numpy.ndarray, shape (n, n)
+        State matrix of the discrete system (an empty matrix is a stable system).
+
+    Returns
+    -------
+    growth : float
+        Largest pole radius beyond the unit circle, 1.0 when there is none.
+    stable : bool
+        Every pole strictly inside the circle (beyond its rounding).
+    marginal : bool
+        No pole beyond the circle and at least one on it.
+    max_radius : float
+        Largest ``|pole|`` (0.0 for an empty matrix).
     """
     a = np.atleast_2d(np.asarray(a, dtype=float))
     if a.size == 0:
@@ -196,6 +223,18 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
     python-control's ``stability_margins`` is not used: the loop's three poles at ``z = 1``
     (plant and integrator) make its polynomial method fall back to a grid that returns
     spurious low-frequency crossings.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop to analyse.
+    state : LoopState, optional
+        Operating point; default :func:`rest_state` at ``r = 0``.
+
+    Returns
+    -------
+    LoopMargins
+        Crossover, margins and the closed-loop pole classification.
     """
     lsys = open_loop(loop, state)
     growth, stable, marginal, radius = classify_poles(control.feedback(lsys, 1).A)
@@ -235,6 +274,24 @@ def bode_data(loop: ControlLoop, state: LoopState | None = None,
     Default grid: 400 log-spaced points from 0.05 Hz to 0.95 of the Nyquist frequency. The
     unwrapped phase is shifted by whole turns so that it lies in (-360, 0] where ``|L|`` is
     closest to 1 (the crossover reads as ``-180 + phase margin``).
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop to analyse.
+    state : LoopState, optional
+        Operating point; default :func:`rest_state` at ``r = 0``.
+    f : numpy.ndarray, optional
+        Frequencies [Hz]; default the grid above.
+
+    Returns
+    -------
+    f : numpy.ndarray, shape (n,)
+        Frequency [Hz].
+    magnitude_db : numpy.ndarray, shape (n,)
+        ``20 log10 |L|`` [dB].
+    phase_deg : numpy.ndarray, shape (n,)
+        Unwrapped phase of ``L`` [deg].
     """
     if f is None:
         f = np.geomspace(0.05, 0.95 * 0.5 / loop.ts, 400)
@@ -263,6 +320,28 @@ def tune_pid(f_c: float, phase_margin: float = 60.0, *, loop: ControlLoop | None
     ``f_c`` (the PID's phase rises monotonically with ``Td``), then ``Kp`` so that
     ``|C G| = 1`` there. Check the result with :func:`loop_margins`: a path with its own
     dynamics can add crossings elsewhere.
+
+    Parameters
+    ----------
+    f_c : float
+        Target crossover frequency [Hz].
+    phase_margin : float, default 60.0
+        Target phase margin [deg].
+    loop : ControlLoop, optional
+        Tune on this loop's linearised open loop at rest; default the plant alone.
+    plant : Plant, optional
+        Plant to tune on when `loop` is None; default :class:`Plant` ().
+    ts : float, default TS
+        Sample time [s] when `loop` is None (a loop brings its own).
+    ti_over_td : float, default 4.0
+        Ratio ``Ti / Td``.
+    tf_over_td : float, default 0.0
+        Ratio ``Tf / Td`` (derivative filter; 0 is eq. 7.2 exactly).
+
+    Returns
+    -------
+    PID
+        The tuned controller.
 
     Raises
     ------
@@ -315,6 +394,24 @@ def design_dob(loop: ControlLoop, *, min_phase_margin: float = 30.0,
     out than the loop without the DOB (or than the unit circle, whichever is larger): the DOB
     must not destabilise. A higher bandwidth rejects more disturbance but feeds more of the
     sensor-compensator mismatch back into the plant.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop (its own DOB, if any, is replaced by each candidate).
+    min_phase_margin : float, default 30.0
+        Least phase margin [deg].
+    min_gain_margin_db : float, default 6.0
+        Least gain margin [dB].
+    candidates_hz : sequence of float, default DOB_CANDIDATES_HZ
+        Q-filter bandwidths to try [Hz].
+    state : LoopState, optional
+        Operating point of the linearisation; default :func:`rest_state` at ``r = 0``.
+
+    Returns
+    -------
+    DisturbanceObserver
+        The DOB with the highest admissible bandwidth and the loop's nominal mass.
 
     Raises
     ------

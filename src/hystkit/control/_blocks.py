@@ -68,11 +68,26 @@ def plant_matrices(mass: float, ts: float) -> tuple[np.ndarray, np.ndarray, np.n
     ``A = [[1, Ts], [0, 1]]``, ``B = [Ts^2 / (2 m), Ts / m]``, ``C = [1, 0]``, ``D = 0``; this
     is what ``scipy.signal.cont2discrete(..., method="zoh")`` returns, without round-off.
 
+    Parameters
+    ----------
+    mass : float
+        Moving mass ``m`` [kg].
+    ts : float
+        Sample time [s].
+
     Returns
     -------
     A : array, shape (2, 2)
+        State matrix.
     B : array, shape (2,)
+        Input vector (force [N] in).
     C : array, shape (2,)
+        Output vector (position [m] out).
+
+    Raises
+    ------
+    ValueError
+        If `mass` or `ts` is not a positive number.
     """
     _positive("ts", ts)
     _positive("mass", mass)
