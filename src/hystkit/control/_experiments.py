@@ -50,7 +50,19 @@ TRAINED = (0.5, 3.0)  # Hz, mm: the compensator's and S_m's training sine (sec. 
 
 @dataclass(frozen=True, eq=False)
 class Case:
-    """One run: reference ``r`` [m] at ``Ts``, optional output disturbance ``d_out`` [m]."""
+    """One run: reference ``r`` [m] at ``Ts``, optional output disturbance ``d_out`` [m].
+
+    Parameters
+    ----------
+    label : str
+        Name of the case (key of :attr:`ExperimentResult.cases`).
+    r : numpy.ndarray, shape (n,)
+        Reference position [m], one value per sample.
+    d_out : numpy.ndarray, shape (n,), optional
+        Output disturbance [m] added to the plant position.
+    description : str, default ""
+        One line saying what the case is.
+    """
 
     label: str
     r: np.ndarray
@@ -60,7 +72,24 @@ class Case:
 
 def sine_reference(n_steps: int, ts: float = TS, amplitude: float = 3e-3,
                    frequency: float = 0.5) -> np.ndarray:
-    """``amplitude sin(2 pi f t)`` [m]; the defaults are eq. 7.3, ``0.003 sin(pi t)``."""
+    """``amplitude sin(2 pi f t)`` [m]; the defaults are eq. 7.3, ``0.003 sin(pi t)``.
+
+    Parameters
+    ----------
+    n_steps : int
+        Number of samples.
+    ts : float, default TS
+        Sample time [s]; the first sample is at ``t = 0``.
+    amplitude : float, default 3e-3
+        Amplitude [m].
+    frequency : float, default 0.5
+        Frequency [Hz].
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_steps,)
+        Reference position [m].
+    """
     return amplitude * np.sin(2 * np.pi * frequency * np.arange(n_steps) * ts)
 
 
@@ -75,6 +104,19 @@ def cubic_trajectory(waypoints_mm: tuple[float, ...] = (0.0, 3.0, -3.0, 1.5, -1.
     Peak speed ``1.5 |D| / T`` and peak acceleration ``6 |D| / T^2`` set the shortest ``T``
     within ``v_max`` [m/s] and ``a_max`` [m/s^2] (sec. 7.3.1: 7.5 mm/s, 0.15 m/s^2), rounded
     up to whole samples; the plant dwells ``dwell`` seconds at every waypoint.
+
+    Parameters
+    ----------
+    waypoints_mm : tuple of float
+        Positions to visit [mm], the first one is the start.
+    v_max : float, default 7.5e-3
+        Velocity bound [m/s].
+    a_max : float, default 0.15
+        Acceleration bound [m/s^2].
+    dwell : float, default 0.5
+        Time at rest at every waypoint, the first included [s].
+    ts : float, default TS
+        Sample time [s].
 
     Returns
     -------
@@ -105,6 +147,23 @@ def experiment_cases(name: str, ts: float = TS) -> list[Case]:
     - ``cubic``: :func:`cubic_trajectory` (sec. 7.3.1);
     - ``disturbance``: the eq. 7.3 sine for 5 s with an output step of 0 (baseline), 1 and
       3 mm from 1.7 s to 2.2 s (sec. 7.3.2; the document does not state its reference there).
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`EXPERIMENTS`.
+    ts : float, default TS
+        Sample time [s] of the references.
+
+    Returns
+    -------
+    list of Case
+        The experiment's runs, in order.
+
+    Raises
+    ------
+    ValueError
+        If `name` is not an experiment.
     """
     if name == "sine":
         return [Case("sine", sine_reference(_steps(10.0, ts), ts),
@@ -136,8 +195,27 @@ def build_loop(scheme: str, models: SensorModels, *, pid: PID | None = None,
                zero_at_start: bool = True, ts: float = TS) -> ControlLoop:
     """A loop of scheme ``direct`` or ``weighting`` from fitted models, document gains default.
 
-    ``zero_at_start`` applies :func:`tare` (estimates zeroed on the sensor's rest reading at
-    ``y = 0``).
+    Parameters
+    ----------
+    scheme : {"direct", "weighting"}
+        Loop scheme (fig. 7.1 or fig. 7.8).
+    models : SensorModels
+        Sensor ``S_r``, compensator, ``S_m`` and sensor gain of the loop.
+    pid : PID, optional
+        Controller; default :data:`DOCUMENT_PID_DIRECT` or :data:`DOCUMENT_PID_WEIGHTING`.
+    plant : Plant, optional
+        Plant; default :class:`Plant` ().
+    dob : DisturbanceObserver, optional
+        Disturbance observer; default none.
+    zero_at_start : bool, default True
+        Apply :func:`tare` (estimates zeroed on the sensor's rest reading at ``y = 0``).
+    ts : float, default TS
+        Sample time [s].
+
+    Returns
+    -------
+    ControlLoop
+        The assembled loop.
     """
     if pid is None:
         pid = DOCUMENT_PID_DIRECT if scheme == "direct" else DOCUMENT_PID_WEIGHTING
@@ -149,7 +227,23 @@ def build_loop(scheme: str, models: SensorModels, *, pid: PID | None = None,
 
 @dataclass(frozen=True, eq=False)
 class ExperimentResult:
-    """Responses of every case of one experiment on one loop."""
+    """Responses of every case of one experiment on one loop.
+
+    Parameters
+    ----------
+    name : str
+        Experiment name (one of :data:`EXPERIMENTS`).
+    loop : ControlLoop
+        The loop every case ran on.
+    cases : dict of str to LoopResponse
+        Response of each case, by label.
+    descriptions : dict of str to str
+        Description of each case, by label.
+    seconds : float
+        Wall time of the whole experiment [s].
+    noise : NoiseSpec, optional
+        Noise the cases ran with; None for none.
+    """
 
     name: str
     loop: ControlLoop
@@ -189,8 +283,24 @@ def run_experiment(name: str, loop: ControlLoop,
                    noise: NoiseSpec | None = None) -> ExperimentResult:
     """Run every case of experiment ``name`` from rest; see :func:`experiment_cases`.
 
-    ``noise``: sensor and process noise, case ``k`` drawn by ``noise.draw(n, k)``
-    (:class:`NoiseSpec`); None runs without.
+    Parameters
+    ----------
+    name : str
+        One of :data:`EXPERIMENTS`.
+    loop : ControlLoop
+        The loop to run.
+    noise : NoiseSpec, optional
+        Sensor and process noise, case ``k`` drawn by ``noise.draw(n, k)``; None runs without.
+
+    Returns
+    -------
+    ExperimentResult
+        Every case's response and the total wall time.
+
+    Raises
+    ------
+    ValueError
+        If `name` is not an experiment.
     """
     t0 = time.perf_counter()
     cases, descriptions = {}, {}
@@ -203,8 +313,23 @@ def run_experiment(name: str, loop: ControlLoop,
 
 
 def measured_sensor_noise(loop: ControlLoop, response: LoopResponse) -> float:
-    """SD of the noise in the loop's sensor signal [sensor units]: ``s`` minus ``S_r`` run
-    open loop on the plant position the run recorded (the same state from rest)."""
+    """SD of the noise in the loop's sensor signal [sensor units].
+
+    The noise is ``s`` minus ``S_r`` run open loop on the plant position the run recorded
+    (the same state from rest).
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop the run used (its sensor ``S_r`` and sample time).
+    response : LoopResponse
+        The run, started from rest.
+
+    Returns
+    -------
+    float
+        Standard deviation of ``s - S_r(y)`` [sensor units].
+    """
     clean, _ = loop.sensor.simulate(response.y, loop.ts)
     return float(np.std(response.s - clean))
 
@@ -212,6 +337,17 @@ def measured_sensor_noise(loop: ControlLoop, response: LoopResponse) -> float:
 def noise_study(name: str, loop: ControlLoop, noise: NoiseSpec,
                 dob: DisturbanceObserver) -> list[dict]:
     """Experiment ``name`` without and with ``noise``, each without and with ``dob``.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`EXPERIMENTS`.
+    loop : ControlLoop
+        The loop (its own DOB is replaced by none, then by `dob`).
+    noise : NoiseSpec
+        Noise of the noisy runs.
+    dob : DisturbanceObserver
+        Observer of the runs with a DOB.
 
     Returns
     -------
