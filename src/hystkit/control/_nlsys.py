@@ -45,6 +45,12 @@ def as_nlsys(model: Model, dt: float = TS, *, name: str | None = None, input: st
         physical units (a compensator: sensor in, position [m] out).
     dt : float
         Sample time [s]; the model is re-stepped at it (``family.at``).
+    name : str, optional
+        System name and state prefix; default the block's name.
+    input : str, default "u"
+        Name of the input signal.
+    output : str, default "y"
+        Name of the output signal.
 
     Returns
     -------
@@ -122,6 +128,16 @@ def loop_nlsys(loop: ControlLoop) -> control.InterconnectedSystem:
     and, with ``S_m``, ``s_hat`` (``y_hat`` is 0 without a compensator). State order: plant,
     S_r, compensator, S_m, controller; :func:`loop_initial_state` builds it from a
     :class:`LoopState`.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop to convert.
+
+    Returns
+    -------
+    control.InterconnectedSystem
+        Discrete-time system with sample time ``loop.ts``.
     """
     ts = loop.ts
     systems = [_plant(loop), as_nlsys(loop.sensor, ts, name="S_r", input="y", output="s")]
@@ -148,7 +164,22 @@ def loop_nlsys(loop: ControlLoop) -> control.InterconnectedSystem:
 
 def loop_initial_state(loop: ControlLoop, state: LoopState | None = None,
                        r0: float = 0.0) -> np.ndarray:
-    """:class:`LoopState` (default: at rest at ``r0``) in :func:`loop_nlsys` state order."""
+    """:class:`LoopState` (default: at rest at ``r0``) in :func:`loop_nlsys` state order.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop the state belongs to.
+    state : LoopState, optional
+        State to convert; default :func:`rest_state` at `r0`.
+    r0 : float, default 0.0
+        Reference at rest [m] when `state` is None.
+
+    Returns
+    -------
+    numpy.ndarray
+        Plant, S_r, compensator, S_m, PID, plant-estimate and DOB states, concatenated.
+    """
     state = rest_state(loop, r0) if state is None else state
     return np.concatenate([state.plant, state.sensor, state.compensator, state.model,
                            state.pid, state.estimate, state.dob])

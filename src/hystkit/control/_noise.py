@@ -67,6 +67,17 @@ class NoiseSpec:
 def parse_noise(text: str) -> NoiseSpec:
     """``"sensor=SD,process=SD[,seed=N]"`` (any subset, any order) as a :class:`NoiseSpec`.
 
+    Parameters
+    ----------
+    text : str
+        Comma-separated ``key=value`` items: ``sensor`` [sensor units] and ``process`` [N]
+        standard deviations, ``seed`` an integer; a key left out keeps its default.
+
+    Returns
+    -------
+    NoiseSpec
+        The parsed specification.
+
     Raises
     ------
     ValueError
