@@ -49,7 +49,7 @@ RELATIVE_STEP = 1e-2
 class Sector:
     """Measured slope sector ``[k_min, k_max]`` of a block's increments.
 
-    Attributes
+    Parameters
     ----------
     k_min, k_max : float
         Smallest and largest chord slope ``dv / du`` [output units per input unit].
@@ -59,7 +59,8 @@ class Sector:
         How far the left-out increments (input nearly still) fall outside the sector: the
         largest distance of ``dv`` from ``[k_min du, k_max du]``, relative to the largest
         ``|dv|`` of all. 0 (to rounding) for a memoryless block.
-    units : str
+    units : str, default ""
+        Units of the slopes, e.g. ``"m / m"``.
     """
 
     k_min: float
@@ -70,6 +71,7 @@ class Sector:
     units: str = ""
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-safe dict."""
         return dict(vars(self))
 
 
@@ -83,6 +85,18 @@ def chord_sector(u: np.ndarray, v: np.ndarray, *, relative_step: float = RELATIV
         Input and output of one run.
     relative_step : float
         Increments with ``|du| <= relative_step * max |du|`` are left out (see :class:`Sector`).
+    units : str, default ""
+        Units of the slopes, stored in the result.
+
+    Returns
+    -------
+    Sector
+        Slopes of the used increments and how far the others fall outside.
+
+    Raises
+    ------
+    ValueError
+        If the input does not move (no increment to take a slope of).
     """
     du, dv = np.diff(np.asarray(u, dtype=float)), np.diff(np.asarray(v, dtype=float))
     if du.size == 0 or not np.any(du):
@@ -110,6 +124,24 @@ def measure_sector(loop: ControlLoop, y: np.ndarray | None = None) -> dict[str, 
     of ``S_r`` (position -> sensor), of the compensator (sensor -> position, on ``S_r``'s
     output) when present, and of the channel the circle criterion uses: ``y -> y_hat``
     (compensator after ``S_r``) in scheme ``direct``, ``S_r`` itself in ``weighting``.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop whose blocks are measured (run open loop, each from rest).
+    y : numpy.ndarray, shape (n,), optional
+        Plant position [m] driving ``S_r``; default the trained sine.
+
+    Returns
+    -------
+    dict of str to Sector
+        ``"sensor"``, ``"compensator"`` (with a compensator) and ``"channel"`` (scheme
+        ``direct`` with a compensator, or ``weighting``).
+
+    Raises
+    ------
+    ValueError
+        If `y` does not move.
     """
     y = _training_position(loop.ts) if y is None else np.asarray(y, dtype=float)
     s, _ = loop.sensor.simulate(y, loop.ts)
@@ -130,6 +162,16 @@ def sector_channel(loop: ControlLoop) -> control.StateSpace:
     ``phi`` is ``y -> y_hat`` (compensator after ``S_r``) in scheme ``direct`` and ``S_r``
     (``y -> s``) in ``weighting``; ``G`` holds PID, plant and, in ``direct``, the DOB (fed by
     ``y_hat``). The reference is held constant (increments). Discrete, ``dt = loop.ts``.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop.
+
+    Returns
+    -------
+    control.StateSpace
+        ``G(z)``, input ``v``, output ``y`` [m].
 
     Raises
     ------
@@ -166,8 +208,10 @@ def sector_channel(loop: ControlLoop) -> control.StateSpace:
 class CircleResult:
     """Verdict of the discrete circle criterion for ``G`` and the sector ``[k_min, k_max]``.
 
-    Attributes
+    Parameters
     ----------
+    k_min, k_max : float
+        The sector tested.
     proved : bool
         Conditions 1 and 2 of the module docstring hold.
     base_stable : bool
@@ -188,6 +232,7 @@ class CircleResult:
     worst_hz: float | None
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-safe dict (an infinite ``k_max_proved`` as ``"inf"``)."""
         out = dict(vars(self))
         if out["k_max_proved"] is not None and not np.isfinite(out["k_max_proved"]):
             out["k_max_proved"] = "inf"
@@ -201,6 +246,25 @@ def circle_criterion(g: control.StateSpace, k_min: float, k_max: float, *,
     ``max(-Re T_1)`` is searched on ``n_grid`` frequencies (log-spaced from 1e-6 of the
     Nyquist frequency, plus 0 and Nyquist) and refined by a bounded scalar search between the
     neighbours of the best grid point; ``T_1``'s frequency response is python-control's.
+
+    Parameters
+    ----------
+    g : control.StateSpace
+        Discrete-time linear part ``G(z)`` (:func:`sector_channel`).
+    k_min, k_max : float
+        Sector of the nonlinearity, ``k_min <= k_max``.
+    n_grid : int, default 20000
+        Number of log-spaced frequencies searched.
+
+    Returns
+    -------
+    CircleResult
+        Whether the sector is proved, and the largest ``k_max`` that would be.
+
+    Raises
+    ------
+    ValueError
+        If the sector is not finite and ordered, or `g` is not discrete-time.
     """
     if not (np.isfinite(k_min) and np.isfinite(k_max) and k_min <= k_max):
         raise ValueError(f"need finite k_min <= k_max, got [{k_min}, {k_max}]")
@@ -236,7 +300,7 @@ def circle_criterion(g: control.StateSpace, k_min: float, k_max: float, *,
 class StabilityReport:
     """What :func:`global_stability` found; ``verdict`` is the one line to print.
 
-    Attributes
+    Parameters
     ----------
     sectors : dict of Sector
         Measured on the trained sine (:func:`measure_sector`).
@@ -246,12 +310,15 @@ class StabilityReport:
     circle : CircleResult or None
         None when the criterion does not apply (``reason``).
     experiment : str
+        Name of the experiment simulated (:func:`experiment_cases`).
     bounded : bool
         The experiment run stayed bounded.
     stop_time : float or None
         When the run diverged [s].
     verdict : {"proved stable", "not proved", "unstable"}
+        The conclusion.
     reason : str
+        One line saying why.
     """
 
     sectors: dict
@@ -264,6 +331,7 @@ class StabilityReport:
     reason: str
 
     def to_dict(self) -> dict:
+        """The report as a JSON-safe dict."""
         return {"sectors": {k: v.to_dict() for k, v in self.sectors.items()},
                 "loop_sector": None if self.loop_sector is None else self.loop_sector.to_dict(),
                 "circle": None if self.circle is None else self.circle.to_dict(),
@@ -277,6 +345,23 @@ def global_stability(loop: ControlLoop, experiment: str = "sine") -> StabilityRe
     Verdicts: ``proved stable`` when the circle criterion proves the measured channel sector;
     ``unstable`` only when the experiment's run diverges (shown, not inferred); otherwise
     ``not proved``.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop.
+    experiment : str, default "sine"
+        Experiment to simulate (one of :data:`EXPERIMENTS`).
+
+    Returns
+    -------
+    StabilityReport
+        Sectors, circle-criterion result, simulation outcome and verdict.
+
+    Raises
+    ------
+    ValueError
+        If `experiment` is not an experiment.
     """
     sectors = measure_sector(loop)
     channel = sectors["channel"]
