@@ -38,19 +38,30 @@ of the experiment."""
 class TuneResult:
     """Gains, costs and margins before and after :func:`tune_nonlinear`.
 
-    Attributes
+    Parameters
     ----------
     pid_start, pid : PID
         Start and result (``pid is pid_start`` when nothing better was found).
+    objective : {"rms", "max"}
+        The plant-error measure minimised.
+    experiment : str
+        The experiment whose cases were run.
     cost_start, cost : float
         Plant error [m] (``objective`` over the experiment's cases, the worst case).
     margins_start, margins : LoopMargins
+        Margins of the linearised loop at rest with the start and the result.
+    min_phase_margin : float
+        Phase-margin constraint [deg].
+    min_gain_margin_db : float
+        Gain-margin constraint [dB].
     n_evaluations : int
         Simulations of the experiment.
     n_margin_checks : int
         Linearisations (only for candidates that beat the best so far).
     seconds : float
+        Wall time of the tuning [s].
     improved : bool
+        A better feasible PID was found.
     message : str
         The optimiser's message.
     """
@@ -72,6 +83,8 @@ class TuneResult:
     message: str
 
     def to_dict(self) -> dict:
+        """The result as a JSON-safe dict (costs in m, ``ti = inf`` as None)."""
+
         def gains(p: PID) -> dict:
             return {"kp": p.kp, "ti": p.ti if np.isfinite(p.ti) else None, "td": p.td}
 
@@ -117,10 +130,16 @@ def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: st
     span : float
         Each gain stays within ``[start / span, start * span]``.
 
+    Returns
+    -------
+    TuneResult
+        Best feasible gains found (the start if none beat it), costs and margins.
+
     Raises
     ------
     ValueError
-        If the start gains violate the constraints or leave the loop unbounded.
+        If `span` is not above 1, `objective` is unknown, or the start gains violate the
+        constraints or leave the loop unbounded.
     """
     if not span > 1:
         raise ValueError(f"span must be > 1, got {span!r}")
