@@ -125,13 +125,23 @@ class ControlLoop:
 class LoopState:
     """Memory of every block; what a run needs to continue exactly where another stopped.
 
-    Attributes
+    Parameters
     ----------
-    plant : (2,) position [m], velocity [m/s]
-    pid : (3,) integral term, previous error, derivative term (eq. 7.2)
-    estimate : (2,) nominal-plant position and velocity (fig. 7.11)
-    dob : (3,) observer estimates of position, velocity, input force [N]
-    sensor, compensator, model : states of S_r, compensator, S_m (normalised units)
+    plant : array_like, shape (2,)
+        Position [m], velocity [m/s].
+    pid : array_like, shape (3,)
+        Integral term, previous error, derivative term (eq. 7.2).
+    estimate : array_like, shape (2,)
+        Nominal-plant position [m] and velocity [m/s] (fig. 7.11).
+    dob : array_like, shape (3,)
+        Observer estimates of position [m], velocity [m/s], input force [N].
+    sensor, compensator, model : array_like
+        States of S_r, compensator, S_m (normalised units; empty for an absent block).
+
+    Raises
+    ------
+    ValueError
+        If a value is not finite.
     """
 
     plant: np.ndarray
@@ -151,11 +161,13 @@ class LoopState:
             object.__setattr__(self, name, arr)
 
     def to_vector(self) -> np.ndarray:
+        """Every block's state, concatenated in the order of the fields (the kernel's)."""
         return np.concatenate([self.plant, self.pid, self.estimate, self.dob, self.sensor,
                                self.compensator, self.model])
 
     @classmethod
     def from_vector(cls, loop: ControlLoop, v: np.ndarray) -> LoopState:
+        """Inverse of :meth:`to_vector` for the blocks of `loop`."""
         n_r, n_c, n_m = loop.sizes()
         i = _kernel.N_FIXED
         return cls(v[0:2], v[2:5], v[5:7], v[7:10], v[i:i + n_r], v[i + n_r:i + n_r + n_c],
@@ -167,6 +179,20 @@ def rest_state(loop: ControlLoop, r0: float = 0.0, y0: float = 0.0) -> LoopState
 
     The PID's previous error is the error at rest, so the first derivative has no kick; the
     integral starts at zero (the double integrator needs no force at rest).
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop whose blocks are put at rest.
+    r0 : float, default 0.0
+        Reference at rest [m]: ``S_m``'s input and the PID's previous error.
+    y0 : float, default 0.0
+        Plant position at rest [m].
+
+    Returns
+    -------
+    LoopState
+        The state at rest.
     """
     x_r = loop.sensor.rest_state(y0)
     s0, _ = loop.sensor.step(x_r, y0, loop.ts)
@@ -189,6 +215,18 @@ def tare(loop: ControlLoop, y0: float = 0.0) -> ControlLoop:
     compensator's output offset so that it returns ``y0`` for ``s0`` at rest, and ``S_m``'s so
     that it returns ``s0`` for ``y0`` at rest. Only constant offsets change. (The document's
     future work asks for such a synchronisation of model and sensor, sec. 8.1.)
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop to zero.
+    y0 : float, default 0.0
+        Plant position at rest [m].
+
+    Returns
+    -------
+    ControlLoop
+        A copy with the compensator's and ``S_m``'s ``out_offset`` shifted.
     """
     s0, _ = loop.sensor.step(loop.sensor.rest_state(y0), y0, loop.ts)
     changes = {}
@@ -212,13 +250,41 @@ class LoopResponse:
     None (a diverged run cannot be continued). ``y_hat`` is None
     without a compensator, ``s_hat`` without ``S_m``, ``d_hat`` without a DOB.
 
-    Attributes
+    Parameters
     ----------
-    t : time [s]; r, y, y_hat, y_hat_plant : positions [m]; s, s_hat : sensor units;
-    e : tracking error the PID sees [m]; u : applied force [N]; d_hat : DOB force [N]
-    seconds : wall time of the simulation [s], JIT compilation excluded
-    compile_seconds : JIT compilation of the loop kernel before the run [s] (0 when this
-        combination of blocks was compiled before in the process)
+    scheme : {"direct", "weighting"}
+        Scheme of the loop that ran.
+    t : numpy.ndarray, shape (n,)
+        Time [s].
+    r, y : numpy.ndarray, shape (n,)
+        Reference and plant position [m] (``y`` includes the output disturbance).
+    s : numpy.ndarray, shape (n,)
+        Sensor signal [sensor units].
+    y_hat : numpy.ndarray or None
+        Compensator's position estimate [m].
+    s_hat : numpy.ndarray or None
+        ``S_m``'s output [sensor units].
+    y_hat_plant : numpy.ndarray, shape (n,)
+        Nominal-plant position estimate [m] (fig. 7.11).
+    e : numpy.ndarray, shape (n,)
+        Tracking error the PID sees [m].
+    u : numpy.ndarray, shape (n,)
+        Applied force [N].
+    d_hat : numpy.ndarray or None
+        DOB force estimate [N].
+    state : LoopState or None
+        State after the last step; None when the run was cut.
+    bounded : bool
+        Every requested step ran.
+    n_requested : int
+        Steps asked for (``r.size`` of the call).
+    stop_step, stop_time, stop_reason : int, float, str or None
+        First step not run, its time [s] and why; None when bounded.
+    seconds : float
+        Wall time of the simulation [s], JIT compilation excluded.
+    compile_seconds : float
+        JIT compilation of the loop kernel before the run [s] (0 when this combination of
+        blocks was compiled before in the process).
     """
 
     scheme: str
@@ -344,6 +410,12 @@ def simulate_loop(loop: ControlLoop, r: np.ndarray, *, state: LoopState | None =
     LoopResponse
         ``bounded`` is False if a value left the finite range or ``|y| > loop.y_limit``;
         the signals then stop before that step.
+
+    Raises
+    ------
+    ValueError
+        If `r` is empty, not 1-D or not finite, a disturbance is not shaped like `r`, or
+        `state` does not match the loop's blocks.
     """
     r, (d_out, d_in, noise), state = _prepare(loop, r, state, d_out, d_in, noise)
     args = (r, d_out, d_in, noise, state.to_vector(), *loop.kernel_arguments())
@@ -358,7 +430,36 @@ def simulate_loop_reference(loop: ControlLoop, r: np.ndarray, *,
                             state: LoopState | None = None, t0: float = 0.0,
                             d_out: np.ndarray | None = None, d_in: np.ndarray | None = None,
                             noise: np.ndarray | None = None) -> LoopResponse:
-    """Same as :func:`simulate_loop` as a plain Python loop over readable block steps."""
+    """Same as :func:`simulate_loop` as a plain Python loop over readable block steps.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop to run.
+    r : array, shape (n,)
+        Reference position [m], one value per sample ``Ts``.
+    state : LoopState, optional
+        Start here; default :func:`rest_state` at ``r[0]``.
+    t0 : float
+        Time of the first sample [s] (only labels ``t``).
+    d_out : array, optional
+        Output disturbance [m] added to the plant position.
+    d_in : array, optional
+        Input force disturbance [N].
+    noise : array, optional
+        Additive sensor noise [sensor units].
+
+    Returns
+    -------
+    LoopResponse
+        As :func:`simulate_loop`'s (``compile_seconds`` is 0).
+
+    Raises
+    ------
+    ValueError
+        If `r` is empty, not 1-D or not finite, a disturbance is not shaped like `r`, or
+        `state` does not match the loop's blocks.
+    """
     r, (d_out, d_in, noise), state = _prepare(loop, r, state, d_out, d_in, noise)
     ts, p = loop.ts, loop.pid
     _, b, _ = plant_matrices(loop.plant.mass, ts)
