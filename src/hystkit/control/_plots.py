@@ -26,7 +26,20 @@ def _mark_stop(ax, resp: LoopResponse) -> None:
 
 
 def plot_response(resp: LoopResponse, title: str = "") -> Figure:
-    """Four panels as fig. 7.5 / 7.10: positions; sensor; tracking error; plant error."""
+    """Four panels as fig. 7.5 / 7.10: positions; sensor; tracking error; plant error.
+
+    Parameters
+    ----------
+    resp : LoopResponse
+        The run to show; a cut run is marked where it stopped.
+    title : str, default ""
+        Figure title (none when empty).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, positions and errors in mm.
+    """
     fig = Figure(figsize=(8.5, 8.0), layout="constrained")
     axes = fig.subplots(4, 1, sharex=True)
     t = resp.t
@@ -67,8 +80,20 @@ def plot_response(resp: LoopResponse, title: str = "") -> Figure:
 
 
 def plot_cases(result: ExperimentResult) -> Figure:
-    """One row per case: reference and plant position, and plant error (fig. 7.6, 7.7, 7.12,
-    7.13, 7.16, 7.17)."""
+    """One row per case: reference and plant position, and plant error.
+
+    As fig. 7.6, 7.7, 7.12, 7.13, 7.16 and 7.17.
+
+    Parameters
+    ----------
+    result : ExperimentResult
+        The experiment to show.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, positions and errors in mm.
+    """
     n = len(result.cases)
     fig = Figure(figsize=(10, 1.9 * n + 0.8), layout="constrained")
     axes = fig.subplots(n, 2, squeeze=False, width_ratios=(3, 2))
@@ -94,7 +119,26 @@ def plot_cases(result: ExperimentResult) -> Figure:
 
 def plot_bode(f: np.ndarray, mag_db: np.ndarray, phase_deg: np.ndarray,
               margins: LoopMargins | None = None, title: str = "") -> Figure:
-    """Magnitude and phase of the linearised open loop (fig. 7.4, 7.9) with the crossover."""
+    """Magnitude and phase of the linearised open loop (fig. 7.4, 7.9) with the crossover.
+
+    Parameters
+    ----------
+    f : numpy.ndarray, shape (n,)
+        Frequency [Hz].
+    mag_db : numpy.ndarray, shape (n,)
+        Magnitude [dB].
+    phase_deg : numpy.ndarray, shape (n,)
+        Phase [deg].
+    margins : LoopMargins, optional
+        Marks the crossover and titles the margins when given.
+    title : str, default ""
+        Figure title (none when empty).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The two-panel figure.
+    """
     fig = Figure(figsize=(7.5, 5.5), layout="constrained")
     ax_m, ax_p = fig.subplots(2, 1, sharex=True)
     ax_m.semilogx(f, mag_db, color="C0")
