@@ -53,7 +53,18 @@ def _array(name: str, values: np.ndarray, lit: Callable[[float], str]) -> str:
 
 
 def float_warning(plan: ExportPlan) -> str:
-    """Why a float export of this model will not follow the double reference ("" if it will)."""
+    """Why a float export of this model will not follow the double reference.
+
+    Parameters
+    ----------
+    plan : ExportPlan
+        The export plan.
+
+    Returns
+    -------
+    str
+        The reason on one line, or "" if float is enough.
+    """
     if plan.float_is_enough:
         return ""
     return (f"float is not enough for this model: rounding its input to float moves its output "
@@ -287,6 +298,19 @@ Feed samples at the model's sample time, dt = {plan.constants['DT']:g} s.
 
 
 def c_files(plan: ExportPlan, double: bool = False) -> dict[str, str]:
-    """File name -> text of the C export."""
+    """File name -> text of the C export.
+
+    Parameters
+    ----------
+    plan : ExportPlan
+        The export plan.
+    double : bool
+        Compute in double instead of float.
+
+    Returns
+    -------
+    dict of str to str
+        ``NAME.h``, ``NAME.c``, ``example_main.c`` and ``README``.
+    """
     return {f"{plan.name}.h": _header(plan, double), f"{plan.name}.c": _source(plan, double),
             "example_main.c": _example(plan, double), "README": _readme(plan, double)}

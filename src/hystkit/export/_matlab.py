@@ -180,7 +180,19 @@ end
 
 
 def matlab_files(plan: ExportPlan) -> dict[str, str]:
-    """File name -> text of the MATLAB export."""
+    """File name -> text of the MATLAB export.
+
+    Parameters
+    ----------
+    plan : ExportPlan
+        The export plan.
+
+    Returns
+    -------
+    dict of str to str
+        ``NAME.m``, ``NAME_init.m``, ``NAME_block.m``, and ``NAME_sync.m`` when the plan has
+        a sync state.
+    """
     files = {f"{plan.name}.m": _chunk(plan), f"{plan.name}_init.m": _init(plan),
              f"{plan.name}_block.m": _block(plan)}
     if plan.sync_state is not None:

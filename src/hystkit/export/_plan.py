@@ -56,7 +56,7 @@ _DATE_KEYS = ("fit_date", "fitted_at", "date", "created")
 class ExportPlan:
     """The numbers of one compensator, ready to be written as code.
 
-    Attributes
+    Parameters
     ----------
     name : str
         Identifier the generated functions are named after (C and MATLAB safe).
@@ -73,10 +73,13 @@ class ExportPlan:
         Family-specific arrays and numbers the translation needs beyond ``body``.
     sync_state : array or None
         Model state after the synchronisation excitation, when it is known.
-    sync_note : str
-        What the sync start-up is, or why there is none.
     provenance : dict
         Strings for the generated comments: family title, structure, source, fit date, version.
+    float_sensitivity : float
+        Change of the model's output, relative to its range, when run in float32 (see
+        :func:`float_sensitivity`).
+    sync_note : str
+        What the sync start-up is, or why there is none.
     """
 
     name: str
@@ -110,8 +113,20 @@ class ExportPlan:
 
 
 def identifier(text: str) -> str:
-    """A C and MATLAB identifier from a file name: letters, digits and ``_``, starting with a
-    letter, at most 40 characters; C keywords and clashes get a ``_model`` suffix."""
+    """A C and MATLAB identifier from a file name.
+
+    Parameters
+    ----------
+    text : str
+        A file name or any text.
+
+    Returns
+    -------
+    str
+        Lower-case letters, digits and ``_`` of `text` (at most 40 of them), starting with a
+        letter (``m_`` is put in front otherwise); C and Python keywords and names the
+        generated code calls get a ``_model`` suffix.
+    """
     name = re.sub(r"[^0-9A-Za-z_]+", "_", text).strip("_").lower()[:40].strip("_")
     if not name or not name[0].isalpha():
         name = f"m_{name}".rstrip("_")
@@ -123,6 +138,23 @@ def identifier(text: str) -> str:
 def make_plan(comp: Compensator, name: str | None = None, *,
               sync_state: np.ndarray | None = None, sync_note: str = "") -> ExportPlan:
     """Gather what an exported ``comp`` needs; refuse (InputError) what cannot be exported.
+
+    Parameters
+    ----------
+    comp : Compensator
+        The fitted compensator.
+    name : str, optional
+        Identifier of the generated functions; by default from the model file's name (or the
+        family's name when there is no file).
+    sync_state : numpy.ndarray, optional
+        Model state after the synchronisation excitation.
+    sync_note : str
+        What the sync start-up is, or why there is none.
+
+    Returns
+    -------
+    ExportPlan
+        The numbers to write.
 
     Raises
     ------

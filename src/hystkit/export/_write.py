@@ -39,6 +39,28 @@ def export_compensator(comp: Compensator, out: str | Path, lang: str = "c", *,
                        force: bool = False) -> tuple[ExportPlan, dict[str, str]]:
     """Write ``comp`` as code into the folder ``out``; returns the plan and file name -> text.
 
+    Parameters
+    ----------
+    comp : Compensator
+        The fitted compensator.
+    out : str or Path
+        Output folder, written atomically.
+    lang : {"c", "matlab"}
+        Target language.
+    double : bool
+        C only: compute in double instead of float (the MATLAB code is always double).
+    name : str, optional
+        Identifier of the generated functions (see :func:`make_plan`).
+    force : bool
+        Write into an existing folder, replacing same-named files.
+
+    Returns
+    -------
+    plan : ExportPlan
+        The numbers written.
+    files : dict of str to str
+        File name -> text of each file written.
+
     Raises
     ------
     InputError
