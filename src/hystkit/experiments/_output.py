@@ -24,7 +24,22 @@ def _cell(value: object, digits: int) -> str:
 
 def format_markdown(rows: Sequence[dict], columns: Sequence[tuple[str, str]],
                     digits: int = 4) -> str:
-    """A markdown table of `rows`; `columns` are (key, header) pairs; None prints as "–"."""
+    """A markdown table of `rows`; `columns` are (key, header) pairs; None prints as "–".
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        One dict per table row; a missing key, None or a non-finite float prints as "–".
+    columns : sequence of (str, str)
+        (key in the rows, column header) pairs, in order.
+    digits : int
+        Significant digits of floats.
+
+    Returns
+    -------
+    str
+        The table, one line per row after the header and separator lines.
+    """
     lines = ["| " + " | ".join(header for _, header in columns) + " |",
              "|" + "|".join(" --- " for _ in columns) + "|"]
     for row in rows:
@@ -34,7 +49,18 @@ def format_markdown(rows: Sequence[dict], columns: Sequence[tuple[str, str]],
 
 
 def output_names(stem: str) -> list[str]:
-    """The files an experiment writes into its output folder."""
+    """The files an experiment writes into its output folder.
+
+    Parameters
+    ----------
+    stem : str
+        File name without extension.
+
+    Returns
+    -------
+    list of str
+        ``STEM.json`` and ``STEM.csv``.
+    """
     return [f"{stem}.json", f"{stem}.csv"]
 
 
@@ -44,6 +70,32 @@ def write_table(out: str | os.PathLike[str], stem: str, result: dict, rows: Sequ
 
     Both appear together or not at all (:func:`hystkit.io.atomic_folder`); existing files are
     kept unless `force`.
+
+    Parameters
+    ----------
+    out : str or path-like
+        Output folder.
+    stem : str
+        File name without extension.
+    result : dict
+        Everything the experiment returns, written as JSON.
+    rows : sequence of dict
+        The table rows, written as CSV (columns: every key in order of first appearance; None
+        as an empty cell).
+    force : bool
+        Replace existing files of the same names.
+
+    Returns
+    -------
+    list of Path
+        The JSON and CSV file written.
+
+    Raises
+    ------
+    OutputExistsError
+        If a file exists and `force` is not given.
+    OutputError
+        If `out` is a file or cannot be written.
     """
     from ..io import atomic_folder, write_json
 

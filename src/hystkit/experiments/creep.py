@@ -80,6 +80,22 @@ def creep_trajectory(plan: CreepPlan, fs: float) -> tuple[np.ndarray, np.ndarray
 
     Each hold is a dict: ``level`` and ``before`` [mm], ``ramp_start``, ``ramp_end`` and
     ``end`` [s].
+
+    Parameters
+    ----------
+    plan : CreepPlan
+        The trajectory's timing and amplitude.
+    fs : float
+        Sample rate [Hz].
+
+    Returns
+    -------
+    time : numpy.ndarray, shape (n,)
+        Time [s] from 0 to the end of the last hold.
+    position : numpy.ndarray, shape (n,)
+        Position [mm]: rest at 0, then linear ramps to the held levels +A, -A, 0.
+    holds : list of dict
+        The three holds.
     """
     levels = (plan.amplitude_mm, -plan.amplitude_mm, 0.0)
     knots_t, knots_x, holds = [0.0, plan.rest_seconds], [0.0, 0.0], []
@@ -101,7 +117,29 @@ def hold_levels(time: np.ndarray, y: np.ndarray, hold: dict, settle_seconds: flo
                 ) -> tuple[float, float, dict[float, float]]:
     """Levels of `y` around one hold: before the ramp, at ``t_a`` and at each checkpoint.
 
-    Returns ``(before, at_a, {t - t_a: level})``; the last checkpoint is the hold's end.
+    Each level is the mean of `y` over a 1 s window. ``t_a`` is `settle_seconds` after the
+    ramp's end (plus half a window); the checkpoints lie 1, 10, 100, ... s after it, while
+    their window fits inside the hold; the last checkpoint is the hold's end.
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (n,)
+        Time [s].
+    y : numpy.ndarray, shape (n,)
+        The signal.
+    hold : dict
+        One hold of :func:`creep_trajectory`.
+    settle_seconds : float
+        Wait after the ramp before ``t_a`` [s].
+
+    Returns
+    -------
+    before : float
+        Level in the window just before the ramp.
+    at_a : float
+        Level at ``t_a``.
+    levels : dict of float to float
+        ``{t - t_a [s]: level}`` at each checkpoint.
     """
     def level(centre: float) -> float:
         inside = np.abs(time - centre) <= _WINDOW / 2

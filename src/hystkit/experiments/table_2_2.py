@@ -44,6 +44,17 @@ def rmse_statistics(values: Sequence[float]) -> dict:
     """Minimum, mean and sample variance (ddof = 1) of RMSE values; ``n`` counts them.
 
     None entries (failed repeats) are left out; fewer than two values give variance None.
+
+    Parameters
+    ----------
+    values : sequence of float or None
+        RMSE of each repeat.
+
+    Returns
+    -------
+    dict
+        ``n``, ``min_rmse``, ``mean_rmse``, ``variance_rmse`` (None when not defined), in the
+        units of `values`.
     """
     v = np.array([x for x in values if x is not None], dtype=float)
     return {"n": int(v.size), "min_rmse": float(v.min()) if v.size else None,
