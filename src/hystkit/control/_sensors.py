@@ -217,7 +217,25 @@ def _r2(y: np.ndarray, target: np.ndarray) -> float:
 
 def forward_block(structure: Any, params: Any, scaling: Scaling, *, name: str = "sensor",
                   info: dict | None = None) -> SensorBlock:
-    """Forward model position [m] -> sensor from a fit on normalised mm data."""
+    """Forward model position [m] -> sensor from a fit on normalised mm data.
+
+    Parameters
+    ----------
+    structure, params
+        A registered family's structure and parameters, fitted position -> sensor on
+        normalised data.
+    scaling : Scaling
+        The normalisation of the fit (position offset and scale in mm).
+    name : str, default "sensor"
+        Block name.
+    info : dict, optional
+        Provenance, copied into the block.
+
+    Returns
+    -------
+    SensorBlock
+        Position [m] in, sensor signal out.
+    """
     return SensorBlock(structure, params, False, scaling.position_offset * MM,
                        scaling.position_scale * MM, scaling.sensor_offset, scaling.sensor_scale,
                        name=name, info=dict(info or {}))
@@ -232,6 +250,29 @@ def fit_forward_sensor(recording: Recording, size: int | None = 3, *, model: str
     ``info`` records the source, the SSE, the R^2 on the fitting data and the straight-line
     gain ``position per sensor unit`` [m / sensor unit], which scheme (b) uses to express the
     sensor error in metres.
+
+    Parameters
+    ----------
+    recording : Recording
+        Sensor recording with a ``position`` column [mm].
+    size : int or None, default 3
+        The family's size knob; None for its default.
+    model : str, default "mpl"
+        Registered family to fit.
+    name : str, default "sensor"
+        Block name.
+    **structure_options
+        Passed to the family's ``make_structure`` (mPL: ``slope_cap``).
+
+    Returns
+    -------
+    SensorBlock
+        The fitted forward block, position [m] in, sensor signal out.
+
+    Raises
+    ------
+    InputError
+        If the recording has no position column or a constant signal, or `model` is unknown.
     """
     if not recording.has_position():
         raise InputError(f"{recording.source}: column 'position' is needed to fit a sensor")
@@ -275,6 +316,18 @@ def compensator_block(compensator: Compensator, *, name: str = "compensator") ->
 
     Direct mode runs the fitted model; inverse mode runs the inverse of the forward model it
     holds. Offsets: see :func:`_offsets`.
+
+    Parameters
+    ----------
+    compensator : Compensator
+        A fitted compensator (a model file).
+    name : str, default "compensator"
+        Block name.
+
+    Returns
+    -------
+    SensorBlock
+        Sensor signal in, position estimate [m] out.
     """
     s_off, p_off = _offsets(compensator)
     return SensorBlock(compensator.structure, compensator.params,
@@ -289,6 +342,23 @@ def sensor_block(compensator: Compensator, *, name: str = "S_r") -> SensorBlock:
     An inverse-mode file holds a forward model (position -> sensor): it runs as is. A
     direct-mode file holds sensor -> position: it runs backwards through its family's inverse,
     and a family without one is refused with the reason (``ValueError``).
+
+    Parameters
+    ----------
+    compensator : Compensator
+        A fitted compensator (a model file).
+    name : str, default "S_r"
+        Block name.
+
+    Returns
+    -------
+    SensorBlock
+        Position [m] in, sensor signal out.
+
+    Raises
+    ------
+    ValueError
+        If the file is in direct mode and its family has no inverse.
     """
     s_off, p_off = _offsets(compensator)
     return SensorBlock(compensator.structure, compensator.params,
@@ -303,6 +373,25 @@ def linear_block(gain: float, offset: float = 0.0, *, name: str = "linear") -> S
 
     The property tests' ideal sensor and exact compensator; it runs through the same compiled
     loop as the fitted models.
+
+    Parameters
+    ----------
+    gain : float
+        Slope, output units per input unit; finite and non-zero.
+    offset : float, default 0.0
+        Output at zero input.
+    name : str, default "linear"
+        Block name.
+
+    Returns
+    -------
+    SensorBlock
+        The memoryless block.
+
+    Raises
+    ------
+    ValueError
+        If `gain` is zero or not finite.
     """
     if not (np.isfinite(gain) and gain != 0):
         raise ValueError(f"gain must be finite and non-zero, got {gain!r}")
@@ -316,7 +405,7 @@ def linear_block(gain: float, offset: float = 0.0, *, name: str = "linear") -> S
 class SensorModels:
     """The three models of ch. 7, fitted separately (never one object twice, sec. 6.2.2).
 
-    Attributes
+    Parameters
     ----------
     sensor : SensorBlock
         ``S_r``, the "real" sensor: position [m] -> sensor.
@@ -328,6 +417,7 @@ class SensorModels:
         Straight-line gain [m per sensor unit] of ``S_m``'s training data; scheme (b) multiplies
         its sensor-unit error by it so that the PID sees metres, as in scheme (a).
     info : dict
+        Provenance: training kind and sources, families and sizes.
     """
 
     sensor: SensorBlock
@@ -367,10 +457,18 @@ def fit_sensor_models(*, training: str = "recording", sensor_cells: int | None =
 
     Parameters
     ----------
+    training : {"recording", "loop"}, default "recording"
+        Training data of the compensator and ``S_m``, as above.
     sensor_cells, model_cells : int, optional
         Size knob of ``S_r`` and of the compensator / ``S_m``. Defaults: for the mPL 3 cells
         (1 for the compensator and ``S_m`` with ``training="loop"``), for other families their
         default size.
+    sensor_seed : int, default 1
+        Seed of the virtual sensor's noise experiment ``S_r`` is fitted on.
+    training_seed : int, default 2
+        Seed of the virtual sensor's training recording (``training="recording"``).
+    training_excitation : str, default "sine"
+        Excitation of that training recording (:func:`~hystkit.sensors.simulate_experiment`).
     sensor_recording, training_recording : Recording, optional
         Use these instead of the virtual sensor's.
     sensor : SensorBlock, optional
@@ -379,10 +477,18 @@ def fit_sensor_models(*, training: str = "recording", sensor_cells: int | None =
     sensor_model, model : str
         Registered families of ``S_r`` and of the compensator and ``S_m``.
 
+    Returns
+    -------
+    SensorModels
+        ``S_r``, compensator, ``S_m``, the sensor gain of scheme (b) and provenance.
+
     Raises
     ------
+    ValueError
+        If `training` or `training_excitation` is unknown.
     InputError
-        ``S_m`` reproduces ``S_r`` (max difference < 1e-6 in normalised units).
+        ``S_m`` reproduces ``S_r`` (max difference < 1e-6 in normalised units), or a family
+        name is unknown.
     """
     if training not in TRAININGS:
         raise ValueError(f"training must be one of {TRAININGS}, got {training!r}")
@@ -432,7 +538,13 @@ TABLE_II_POSITION_SCALE = 3e-3
 
 
 def table_ii_sensors() -> tuple[str, ...]:
-    """Columns of paper 9.2's table II that can run as ``S_r`` (the mpl-poly family's presets)."""
+    """Columns of paper 9.2's table II that can run as ``S_r`` (the mpl-poly family's presets).
+
+    Returns
+    -------
+    tuple of str
+        Column names accepted by :func:`table_ii_sensor`.
+    """
     presets = get_family("mpl-poly").presets()
     return tuple(k.removeprefix(TABLE_II_PREFIX) for k in presets if k.startswith(TABLE_II_PREFIX))
 
@@ -447,6 +559,25 @@ def table_ii_sensor(column: str = "noise", *, sensor_scale: float = 1.0,
     out -- the signal whose compensator the column is. ``sensor_scale`` and ``sensor_offset``
     only choose the sensor's physical units (default: the normalised sensor itself, which spans
     about +-1 on full-range motion, as the paper's normalised data did; docs/control.md).
+
+    Parameters
+    ----------
+    column : str, default "noise"
+        One of :func:`table_ii_sensors`.
+    sensor_scale : float, default 1.0
+        Sensor units per normalised sensor unit.
+    sensor_offset : float, default 0.0
+        Sensor signal at normalised zero [sensor units].
+
+    Returns
+    -------
+    SensorBlock
+        Position [m] in, sensor signal out.
+
+    Raises
+    ------
+    ValueError
+        If `column` is not a column of table II.
     """
     presets = get_family("mpl-poly").presets()
     key = TABLE_II_PREFIX + column
@@ -464,13 +595,27 @@ def table_ii_sensor(column: str = "noise", *, sensor_scale: float = 1.0,
 
 def virtual_sensor_block(sensor: VirtualSensor | None = None, *,
                          name: str = "S_r") -> SensorBlock:
-    """The virtual sensor's own causal physics as the "real" sensor ``S_r``: position [m] ->
-    ``dR1/R1 - dR2/R2``, the units of its recordings (:mod:`hystkit.sensors._loop_model`).
+    """The virtual sensor's own causal physics as the "real" sensor ``S_r``.
+
+    Position [m] in, ``dR1/R1 - dR2/R2`` out, the units of its recordings
+    (:mod:`hystkit.sensors._loop_model`).
 
     The stand-in for the FEM model the document lacked (ch. 6): a compensator fitted on
     :func:`~hystkit.sensors.simulate_experiment` recordings meets the sensor itself, not a model
     of it. Deterministic (no noise, temperature or settling); ``fit_dt`` is the recordings'
     rate, at which ``fit_sensor_models(training="loop")`` runs it.
+
+    Parameters
+    ----------
+    sensor : VirtualSensor, optional
+        The simulated sensor; default :class:`~hystkit.sensors.VirtualSensor` ().
+    name : str, default "S_r"
+        Block name.
+
+    Returns
+    -------
+    SensorBlock
+        Position [m] in, sensor signal out.
     """
     sensor = VirtualSensor() if sensor is None else sensor
     structure, params = physics_of(sensor)
