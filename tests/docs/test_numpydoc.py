@@ -28,6 +28,7 @@ DOCUMENTED = (
     "hystkit.analysis",
     "hystkit.cli",
     "hystkit.compensation",
+    "hystkit.control",
     "hystkit.datasets",
     "hystkit.io",
     "hystkit.metrics",
@@ -49,7 +50,6 @@ DOCUMENTED = (
 # package to DOCUMENTED. Until then their public objects are not checked here.
 NOT_YET = (
     "hystkit.batch",
-    "hystkit.control",
     "hystkit.experiments",
     "hystkit.export",
     "hystkit.identification",
