@@ -160,6 +160,41 @@ def test_hysteretic_loop_is_proved_and_its_run_stays_inside_the_sector(preisach_
     assert rep.bounded
     # the closed-loop run's own increments lie in the sector measured on the trained sine
     assert ch.k_min - 1e-9 <= rep.loop_sector.k_min <= rep.loop_sector.k_max <= ch.k_max + 1e-9
+    assert rep.sector.k_max < rep.circle.k_max_proved  # the hull of both, tested
+
+
+@pytest.fixture(scope="module")
+def noise_preisach() -> hc.SensorBlock:
+    """Preisach S_r (8 levels) fitted on the virtual sensor's noise run: in the cubic run's
+    closed loop its slopes go below those of the trained sine (about 1.3 s to fit)."""
+    return hc.fit_forward_sensor(simulate_experiment("noise", 2), 8, model="preisach",
+                                 name="S_r")
+
+
+def test_run_leaving_the_training_sector_widens_the_sector_tested(noise_preisach):
+    loop = _weighting(noise_preisach)
+    rep = hc.global_stability(loop, "cubic")
+    ch, run = rep.sectors["channel"], rep.loop_sector
+    assert run.k_min < ch.k_min - 1.0  # the run leaves the trained sine's sector (15.6 < 18.4)
+    # the sector tested is the hull of both, and the circle result is that of the hull
+    assert (rep.sector.k_min, rep.sector.k_max) == (min(ch.k_min, run.k_min),
+                                                    max(ch.k_max, run.k_max))
+    assert len(rep.sector_sources) == 2
+    hull = hc.circle_criterion(hc.sector_channel(loop), rep.sector.k_min, rep.sector.k_max)
+    assert rep.circle.to_dict() == hull.to_dict()
+    assert rep.verdict == "proved stable" and "leave the trained sine" in rep.reason
+    assert "constant reference" in rep.reason
+
+
+def test_a_hull_beyond_the_proved_bound_is_not_proved(noise_preisach):
+    # Kp x 85: the trained sine's sector alone would be proved (bound 64.0 > k_max 63.6),
+    # the hull with the cubic run's lower slopes is not (bound 62.5 < 63.6)
+    loop = _weighting(noise_preisach, kp_factor=85.0)
+    rep = hc.global_stability(loop, "cubic")
+    ch = rep.sectors["channel"]
+    assert hc.circle_criterion(hc.sector_channel(loop), ch.k_min, ch.k_max).proved
+    assert rep.sector.k_min < ch.k_min and not rep.circle.proved
+    assert rep.verdict == "not proved" and rep.bounded
 
 
 def test_linear_sensor_inside_the_proved_sector_is_proved(preisach_sensor):
@@ -200,7 +235,11 @@ def test_cli_stability_of_a_control_setup(capsys, tmp_path):
                              "--json", out)
     assert code == 0, err
     report = json.loads(out.read_text())
-    assert report["verdict"] in ("proved stable", "not proved", "unstable")
+    # the docs' table: the default direct loop's channel has slopes below 0, so condition 1
+    # fails at k_min and nothing is proved; its sine run stays bounded
+    assert report["verdict"] == "not proved" and report["bounded"]
+    assert report["sector"]["k_min"] < 0 and report["circle"]["base_stable"] is False
+    assert report["sectors"]["channel"]["k_min"] < 0
     assert {"sensor", "compensator", "channel"} <= set(report["sectors"])
     assert "global stability:" in stdout and "circle criterion" in stdout
 

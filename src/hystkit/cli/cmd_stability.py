@@ -103,6 +103,8 @@ def _control_stability(args: argparse.Namespace) -> int:
         print(_sector_line(name, sector))
     if report.loop_sector is not None:
         print(_sector_line(f"{report.experiment} run", report.loop_sector))
+    print(_sector_line("tested (hull)", report.sector)
+          + f"; covers the {' and the '.join(report.sector_sources)}")
     c = report.circle
     if c is not None:
         top = ("none (condition 1 fails)" if c.k_max_proved is None
@@ -113,7 +115,9 @@ def _control_stability(args: argparse.Namespace) -> int:
     pm = "n/a" if margins.phase_margin_deg is None else f"{margins.phase_margin_deg:.3g}"
     print(f"linearised at rest (local only): phase margin {pm} deg, "
           f"closed loop {'stable' if margins.closed_loop_stable else 'not strictly stable'}")
-    print(f"global stability: {report.verdict.upper()}: {report.reason}")
+    scope = (" (constant reference, slopes inside the tested sector)"
+             if report.verdict == "proved stable" else "")
+    print(f"global stability: {report.verdict.upper()}{scope}: {report.reason}")
     if args.json is not None:
         write_json({"scheme": loop.scheme, **report.to_dict(), "linear": margins.to_dict()},
                    args.json, force=args.force)

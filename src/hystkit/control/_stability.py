@@ -307,6 +307,12 @@ class StabilityReport:
     loop_sector : Sector or None
         The channel's chord slopes seen in the experiment's runs, every case pooled (None if
         a run diverged).
+    sector : Sector
+        The sector the circle criterion is tested on: the hull of the channel's sector on the
+        trained sine and ``loop_sector`` (every trajectory computed).
+    sector_sources : tuple of str
+        The trajectories ``sector`` covers, e.g. ``("trained sine (open loop)",
+        "amplitude run (closed loop)")``.
     circle : CircleResult or None
         None when the criterion does not apply (``reason``).
     experiment : str
@@ -316,13 +322,16 @@ class StabilityReport:
     stop_time : float or None
         When the run diverged [s].
     verdict : {"proved stable", "not proved", "unstable"}
-        The conclusion.
+        The conclusion. "proved stable" is for a constant reference, and only for slopes
+        inside ``sector``: a trajectory not among ``sector_sources`` may leave it.
     reason : str
         One line saying why.
     """
 
     sectors: dict
     loop_sector: Sector | None
+    sector: Sector
+    sector_sources: tuple
     circle: CircleResult | None
     experiment: str
     bounded: bool
@@ -334,17 +343,32 @@ class StabilityReport:
         """The report as a JSON-safe dict."""
         return {"sectors": {k: v.to_dict() for k, v in self.sectors.items()},
                 "loop_sector": None if self.loop_sector is None else self.loop_sector.to_dict(),
+                "sector": self.sector.to_dict(), "sector_sources": list(self.sector_sources),
                 "circle": None if self.circle is None else self.circle.to_dict(),
                 "experiment": self.experiment, "bounded": self.bounded,
                 "stop_time": self.stop_time, "verdict": self.verdict, "reason": self.reason}
 
 
+def _hull(parts: list[Sector], units: str) -> Sector:
+    """The smallest sector holding every one of ``parts`` (their increments pooled)."""
+    return Sector(min(p.k_min for p in parts), max(p.k_max for p in parts),
+                  sum(p.n_used for p in parts), sum(p.n_samples for p in parts),
+                  max(p.unexplained_step for p in parts), units)
+
+
+def _interval(s: Sector) -> str:
+    return f"[{s.k_min:.4g}, {s.k_max:.4g}] {s.units}"
+
+
 def global_stability(loop: ControlLoop, experiment: str = "sine") -> StabilityReport:
     """Sectors, circle criterion and a simulation of ``experiment`` for one loop.
 
-    Verdicts: ``proved stable`` when the circle criterion proves the measured channel sector;
-    ``unstable`` only when the experiment's run diverges (shown, not inferred); otherwise
-    ``not proved``.
+    The channel's slopes are measured on the trained sine (open loop) and in the experiment's
+    closed-loop runs; the circle criterion is tested on the hull of both. Verdicts:
+    ``unstable`` when the experiment's run diverges (shown, not inferred); ``proved stable``
+    when the criterion proves the hull -- for a constant reference (the criterion is about
+    increments), and only as long as the blocks' slopes stay inside the hull, which is
+    measured on these trajectories, not established for all; otherwise ``not proved``.
 
     Parameters
     ----------
@@ -365,40 +389,45 @@ def global_stability(loop: ControlLoop, experiment: str = "sine") -> StabilityRe
     """
     sectors = measure_sector(loop)
     channel = sectors["channel"]
-    circle, why = None, ""
-    try:
-        circle = circle_criterion(sector_channel(loop), channel.k_min, channel.k_max)
-    except ValueError as exc:
-        why = str(exc)
     result = run_experiment(experiment, loop)
     bounded = all(r.bounded for r in result.cases.values())
     stop = min((r.stop_time for r in result.cases.values() if not r.bounded), default=None)
-    loop_sector = None
+    loop_sector, sources = None, ["trained sine (open loop)"]
+    sector = channel
     if bounded:  # every case's increments, pooled
-        parts = [chord_sector(r.y, r.y_hat if loop.scheme == "direct" else r.s,
-                              units=channel.units) for r in result.cases.values()]
-        loop_sector = Sector(min(p.k_min for p in parts), max(p.k_max for p in parts),
-                             sum(p.n_used for p in parts), sum(p.n_samples for p in parts),
-                             max(p.unexplained_step for p in parts), channel.units)
-    if circle is not None and circle.proved:
-        verdict = "proved stable"
-        reason = (f"circle criterion: the measured sector [{channel.k_min:.4g}, "
-                  f"{channel.k_max:.4g}] {channel.units} lies inside [{channel.k_min:.4g}, "
-                  f"{circle.k_max_proved:.4g}), for increments that obey it")
-    elif not bounded:
+        loop_sector = _hull([chord_sector(r.y, r.y_hat if loop.scheme == "direct" else r.s)
+                             for r in result.cases.values()], channel.units)
+        sector = _hull([channel, loop_sector], channel.units)
+        sources.append(f"{experiment} run (closed loop)")
+    circle, why = None, ""
+    try:
+        circle = circle_criterion(sector_channel(loop), sector.k_min, sector.k_max)
+    except ValueError as exc:
+        why = str(exc)
+    left = (loop_sector is not None
+            and (loop_sector.k_min < channel.k_min or loop_sector.k_max > channel.k_max))
+    note = (f"the {experiment} run's slopes {_interval(loop_sector)} leave the trained sine's "
+            f"{_interval(channel)}, so their hull is tested; " if left else "")
+    if not bounded:
         verdict = "unstable"
         reason = f"the {experiment} run diverged at t = {stop:.4g} s"
+    elif circle is not None and circle.proved:
+        verdict = "proved stable"
+        reason = (f"{note}circle criterion: with a constant reference every increment decays "
+                  f"for slopes in {_interval(sector)} (measured on the "
+                  f"{' and the '.join(sources)}), inside the proved [{sector.k_min:.4g}, "
+                  f"{circle.k_max_proved:.4g}); sufficient only while the slopes stay in that "
+                  f"sector, which other trajectories may leave")
     else:
         verdict = "not proved"
         if circle is None:
             reason = why
         elif not circle.base_stable:
-            reason = (f"the linear loop at the sector's lower bound {channel.k_min:.4g} is not "
-                      f"asymptotically stable (condition 1)")
+            reason = (f"{note}the linear loop at the sector's lower bound {sector.k_min:.4g} "
+                      f"is not asymptotically stable (condition 1)")
         else:
-            reason = (f"the measured sector's upper bound {channel.k_max:.4g} reaches beyond "
-                      f"the {circle.k_max_proved:.4g} the criterion proves")
+            reason = (f"{note}the sector's upper bound {sector.k_max:.4g} reaches beyond the "
+                      f"{circle.k_max_proved:.4g} the criterion proves")
         reason += f"; the {experiment} run stayed bounded"
-    return StabilityReport(sectors, loop_sector, circle, experiment, bounded, stop, verdict,
-                           reason)
-
+    return StabilityReport(sectors, loop_sector, sector, tuple(sources), circle, experiment,
+                           bounded, stop, verdict, reason)
