@@ -190,3 +190,31 @@ def test_cycles_all_draws_every_complete_cycle(raw_run, tmp_path):
     _, pre = raw_run
     assert main(["cycles", str(pre), "--cycles", "all", "--out", str(tmp_path / "o")]) == 0
     assert json.loads((tmp_path / "o" / "cycles.json").read_text())["cycles_drawn"] == [1, 2, 3]
+
+
+def test_a_collapsed_settling_fit_exits_3_and_is_not_fitted_in_json(tmp_path, capsys):
+    """Review 14, sec. 2: the drop law on the printed block was reported as a fit, exit 0."""
+    log, out = tmp_path / "settle.csv", tmp_path / "st"
+    assert main(["simulate-settling", "--out", str(log), "--hours", "24"]) == 0
+    assert main(["settling", str(log), "--out", str(out), "--model", "drop",
+                 "--traces", "block"]) == 3
+    printed = capsys.readouterr().out
+    assert "block: NOT FITTED: drop: collapsed: r_final" in printed
+    block = json.loads((out / "settling.json").read_text())["traces"]["block"]
+    assert block["fitted"] is False and "r_final ended at its lower bound" in block["reason"]
+
+
+def test_a_time_unit_that_contradicts_the_column_suffix_is_one_warning(tmp_path, capsys):
+    log = tmp_path / "settle.csv"
+    assert main(["simulate-settling", "--out", str(log), "--hours", "24",
+                 "--interval", "30"]) == 0
+    capsys.readouterr()
+    assert main(["settling", str(log), "--out", str(tmp_path / "d"), "--time-unit", "d",
+                 "--traces", "block_annealed"]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert err[0].startswith("hystkit: warning: column 'time_h' looks like 'h' but --time-unit "
+                             "is 'd'")
+    assert main(["settling", str(log), "--out", str(tmp_path / "h"),
+                 "--traces", "block_annealed"]) == 0
+    assert capsys.readouterr().err == ""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -119,3 +120,41 @@ def test_a_log_that_rises_for_good_is_reported_as_not_fitted():
     t = np.linspace(0, 48, 200)
     with pytest.raises(SettlingFitError):
         fit_settling(t, 1e3 + 10 * t, "drop")
+
+
+def test_a_rise_then_drop_log_fitted_as_a_plain_drop_is_not_fitted():
+    """Review 14, sec. 2: the drop law on the printed block collapses to R_final = 0."""
+    log = simulate_settling_log(24, 1, seed=0)
+    with pytest.raises(SettlingFitError, match="r_final ended at its lower bound"):
+        fit_settling(log["time_h"], log["block"], "drop")
+    # the whole law fits the same log; auto keeps it, and the drop's failure is noted
+    fit = fit_settling(log["time_h"], log["block"])
+    assert fit.model == "rise-drop" and "drop: collapsed" in fit.message
+    assert abs(fit.params["r_final"] - PRINTED_BLOCK.r_final) < 3 * fit.stderr["r_final"]
+
+
+def test_a_time_constant_the_log_cannot_determine_is_not_fitted():
+    # 2 h of a 40 h drop in noise of 20 Ohm: the curvature, hence drop and tau, is lost
+    t = np.linspace(0, 2, 200)
+    law = SettlingLaw(r_final=1e4, drop=5e3, tau_drop_h=40.0)
+    r = law.resistance(t) + np.random.default_rng(1).normal(0, 20, t.size)
+    with pytest.raises(SettlingFitError, match="not determined: .*tau_drop_h = "):
+        fit_settling(t, r, "drop")
+
+
+def test_residuals_far_above_the_reading_noise_are_not_fitted():
+    # a daily temperature swing of 60 Ohm on a drop in 5 Ohm noise: the law misses the shape
+    t = np.linspace(0, 96, 400)
+    law = SettlingLaw(r_final=1e4, drop=5e3, tau_drop_h=12.0)
+    noise = np.random.default_rng(0).normal(0, 5, t.size)
+    with pytest.raises(SettlingFitError, match="does not describe this log"):
+        fit_settling(t, law.resistance(t) + noise + 60 * np.sin(2 * np.pi * t / 24), "drop")
+    fit = fit_settling(t, law.resistance(t) + noise, "drop")  # the same log without the swing
+    assert abs(fit.params["tau_drop_h"] - 12.0) < 3 * fit.stderr["tau_drop_h"]
+
+
+def test_no_rest_time_without_a_determined_final_resistance():
+    fit = fit_settling(*_noiseless(SettlingLaw(r_final=1e4, drop=5e3, tau_drop_h=12.0)), "drop")
+    vague = dataclasses.replace(fit, stderr={**fit.stderr, "r_final": 2e4})
+    with pytest.raises(SettlingFitError, match="R_final = 1e.04 ± 2e.04 Ohm"):
+        rest_time(vague, 0.1)

@@ -29,6 +29,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
+from ._autocorr import ar1_inflation, lag1
+
 __all__ = ["MODELS", "REST_RULE", "RestTime", "SettlingFit", "SettlingFitError", "fit_settling",
            "rest_time", "settling_curve"]
 
@@ -38,6 +40,10 @@ _NAMES = {"rise-drop": ("r_final", "drop", "tau_drop_h", "rise", "tau_rise_h"),
 # Points of the log grid of starting time constants, from the reading interval (or 1e-3 of the
 # log) to 10 times the log's length; the refinement does the rest.
 _GRID_POINTS = 24
+# A fit whose residuals have lag-1 autocorrelation above this and an RMS this many times the
+# reading noise misses the log's shape (a drop fitted to a rise-then-drop: 0.99 and 25 times).
+_MISFIT_RHO = 0.9
+_MISFIT_RATIO = 3.0
 
 
 def settling_curve(params: dict[str, float], t_h: npt.ArrayLike) -> np.ndarray:
@@ -134,7 +140,9 @@ class SettlingFit:
 
 
 class SettlingFitError(ValueError):
-    """The settling law could not be fitted (not converged, or not identifiable)."""
+    """The settling law could not be fitted: not converged, not identifiable, collapsed onto a
+    bound, a parameter not determined (standard error above its value), or residuals that show
+    the law misses the log's shape."""
 
 
 def fit_settling(t_h: npt.ArrayLike, r: npt.ArrayLike, model: str = "auto") -> SettlingFit:
@@ -159,7 +167,9 @@ def fit_settling(t_h: npt.ArrayLike, r: npt.ArrayLike, model: str = "auto") -> S
     ValueError
         Bad input (lengths, non-finite, R <= 0, time not increasing, under 8 readings).
     SettlingFitError
-        No model converged to identifiable parameters; the message says why.
+        No model gave a usable fit; the message says why for each (not converged, singular,
+        a parameter at its bound, a standard error above its value, or residuals far above
+        the reading noise with lag-1 autocorrelation > 0.9).
     """
     t, y = _checked(t_h, r)
     if model not in MODELS:
@@ -258,9 +268,11 @@ def _fit_one(t: np.ndarray, y: np.ndarray, name: str) -> SettlingFit:
                                "e.g. a rise of amplitude 0, or a log far shorter than the time "
                                "constants)")
     cov = np.linalg.inv(jtj) * rss / (n - k)
-    rho = _lag1(res.fun)
-    inflation = math.sqrt((1 + rho) / (1 - rho)) if rho > 0 else 1.0
+    rho = lag1(res.fun)
+    inflation = ar1_inflation(rho)
     stderr = {p: float(inflation * math.sqrt(max(cov[i, i], 0.0))) for i, p in enumerate(names)}
+    _check_determined(params, stderr, res.active_mask, y)
+    _check_describes(math.sqrt(rss / n), rho, y)
     bic = n * math.log(rss / n) + k * math.log(n)
     return SettlingFit(model=name, params=params, stderr=stderr,
                        rms=math.sqrt(rss / n), rho=rho, inflation=inflation, bic=bic,
@@ -268,10 +280,40 @@ def _fit_one(t: np.ndarray, y: np.ndarray, name: str) -> SettlingFit:
                        covariance=cov * inflation**2)
 
 
-def _lag1(e: np.ndarray) -> float:
-    e = e - e.mean()
-    den = float(np.sum(e * e))
-    return float(np.sum(e[1:] * e[:-1]) / den) if den > 0 else 0.0
+def _check_determined(params: dict[str, float], stderr: dict[str, float],
+                      active_mask: np.ndarray, y: np.ndarray) -> None:
+    """Refuse a fit that collapsed onto a bound or leaves a parameter undetermined.
+
+    The optimiser "converges" there too (its cost stops falling), but e.g. a drop fitted to a
+    log that rises first ends with R_final = 0 and every error larger than its value.
+    """
+    at_bound = [p for p, active in zip(params, active_mask, strict=True) if active != 0]
+    if params["r_final"] <= 1e-9 * float(np.max(y)) and "r_final" not in at_bound:
+        at_bound.append("r_final")
+    if at_bound:
+        raise SettlingFitError(f"collapsed: {', '.join(at_bound)} ended at its lower bound "
+                               "(about 0), so this law does not describe the log")
+    vague = [f"{p} = {v:.3g} ± {stderr[p]:.2g}" for p, v in params.items()
+             if not stderr[p] < abs(v)]
+    if vague:
+        raise SettlingFitError("fitted but not determined: standard error above the value "
+                               f"for {'; '.join(vague)}")
+
+
+def _check_describes(rms: float, rho: float, y: np.ndarray) -> None:
+    """Refuse a fit whose residuals are a smooth curve far above the reading noise.
+
+    The noise is estimated from reading-to-reading differences (robustly, MAD), which the slow
+    settling barely touches; a residual RMS several times larger with lag-1 autocorrelation
+    near 1 means the law misses the shape of the log.
+    """
+    d = np.diff(y)
+    noise = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(2)
+    # the floor keeps a noise-free log's rounding-level residuals from counting
+    if rho > _MISFIT_RHO and rms > max(_MISFIT_RATIO * noise, 1e-9 * float(np.max(y))):
+        raise SettlingFitError("the law does not describe this log: residual rms "
+                               f"{rms:.3g} Ohm against a reading noise of {noise:.3g} Ohm, "
+                               f"residual lag-1 autocorrelation {rho:.2f}")
 
 
 @dataclass(frozen=True)
@@ -322,9 +364,18 @@ def rest_time(fit: SettlingFit, threshold_pct_per_hour: float = 0.1) -> RestTime
     RestTime
         The rule: the earliest t after which ``|dR/dt|(t') / R_final < threshold`` for every
         t' > t. For the plain drop this is ``tau ln(drop / (R_final tau thr))`` (or 0).
+
+    Raises
+    ------
+    SettlingFitError
+        R_final not positive or not determined (standard error >= its value).
     """
     if not (math.isfinite(threshold_pct_per_hour) and threshold_pct_per_hour > 0):
         raise ValueError(f"threshold must be a positive number, got {threshold_pct_per_hour}")
+    r_final, se = fit.params["r_final"], fit.stderr["r_final"]
+    if not (r_final > 0 and se < r_final):
+        raise SettlingFitError(f"no rest time: R_final = {r_final:.3g} ± {se:.2g} Ohm is not "
+                               "positive and determined, and the drift is relative to it")
     thr = threshold_pct_per_hour / 100.0
     hours = _last_crossing(fit.params, thr)
     stderr = None

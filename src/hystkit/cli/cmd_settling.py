@@ -10,6 +10,7 @@ the end of printing, and a printed and an annealed block of conductive filament.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -68,8 +69,18 @@ def read_log(path: Path, time_column: str | None, time_unit: str,
             raise InputError(f"{path}: column {name!r} row {bad[0] + 2}: expected a finite "
                              f"number, got {frame[name].iloc[bad[0]]!r}")
         columns[name] = values
+    _warn_unit_suffix(time_column, time_unit)
     t_h = columns.pop(time_column) * _HOURS_PER[time_unit]
     return t_h, columns
+
+
+def _warn_unit_suffix(time_column: str, time_unit: str) -> None:
+    """One warning line when the time column's suffix (``_h``, ``_s``...) names another unit."""
+    suffix = time_column.rsplit("_", 1)[-1] if "_" in time_column else ""
+    if suffix in _HOURS_PER and suffix != time_unit:
+        print(f"hystkit: warning: column {time_column!r} looks like {suffix!r} but "
+              f"--time-unit is {time_unit!r}; times are read as {time_unit!r} (give "
+              f"--time-unit {suffix} if the column's name is right)", file=sys.stderr)
 
 
 def _settling(args: argparse.Namespace) -> int:
