@@ -17,6 +17,8 @@ __all__ = ["MplFamily"]
 
 
 class MplFamily(Family):
+    """The modified Power-Law model with sinh resistors (sec. 5.3.1) as a registered family."""
+
     name = "mpl"
     title = "modified Power-Law, sinh resistors (sec. 5.3.1, eq. 5.1-5.6)"
     size_help = "cells N (3N + 2 params)"

@@ -88,6 +88,16 @@ def default_starts(structure: mpl.MplStructure) -> list[tuple[np.ndarray, np.nda
     Cell rates ``G = 2 I_S / V_T`` start at geometric spreads around 0.3, 3 and 30 per cent of
     the Euler cap, with a strongly (V_T = 0.2, the document's initial value) and a mildly
     (V_T = 2) non-linear resistor, for data normalised to max |.| = 1 (eq. 5.10).
+
+    Parameters
+    ----------
+    structure : MplStructure
+        The model's structure (cell count, ``dt`` and slope cap set the rates).
+
+    Returns
+    -------
+    list of (numpy.ndarray, numpy.ndarray)
+        Six ``(i_s, v_t)`` pairs, each of shape (N,), with every ``G`` at most 0.9 of the cap.
     """
     g_max = structure.slope_cap / structure.dt
     k = np.arange(structure.n_cells)
@@ -115,6 +125,7 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
         Model input and target output, sampled every ``structure.dt``, already centred and
         normalised (eq. 5.10) by the caller.
     structure : MplStructure
+        Cell count, sample time and Euler slope cap of the model to fit.
     starts : list of (i_s, v_t) pairs, optional
         Initial resistor shapes; the default is :func:`default_starts`.
     max_nfev : int
@@ -124,14 +135,24 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
         to convergence.
     accept : callable, optional
         A candidate solution counts only if ``accept(params)`` is true (inverse mode uses it to
-        require a bounded inverse); ``accept_reason`` says why others were rejected.
+        require a bounded inverse).
+    accept_reason : str
+        Says in the error message why candidates were rejected by `accept`.
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart`.
 
+    Returns
+    -------
+    FitResult
+        The lowest-cost accepted candidate's :class:`MplParams`, its SSE, whether it converged,
+        and the optimiser coordinates, bounds and bound notes (:func:`theta_limits`).
+
     Raises
     ------
+    ValueError
+        If `u` and `y` are not 1-D, differ in length or are not finite, or `solver` is unknown.
     FitDivergedError
-        If no start gives a finite cost.
+        If no start gives a finite cost, or `accept` rejects every candidate.
     """
     u, y = check_fit_data(u, y)
     n = structure.n_cells

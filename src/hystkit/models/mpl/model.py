@@ -72,7 +72,18 @@ V_T_RANGE = (1e-6, 1e12)
 @dataclass(frozen=True)
 class MplStructure(CellStructure):
     """What does not get fitted: cell count ``N``, sample time and the Euler slope cap
-    (:class:`~hystkit.models._cells.CellStructure`; the cap bounds ``f'(v) dt``)."""
+    (:class:`~hystkit.models._cells.CellStructure`; the cap bounds ``f'(v) dt``).
+
+    Parameters
+    ----------
+    n_cells : int, default 1
+        Number of cells ``N`` (1 .. ``MAX_CELLS``).
+    dt : float, default 0.025
+        Sample time [s] (1e-9 .. 1e6).
+    slope_cap : float, default 1.0
+        Largest Euler slope ``f'(v) dt`` of a cell resistor (below 2, eq. 5.28; 1 gives
+        overshoot-free cells).
+    """
 
     @property
     def n_params(self) -> int:
@@ -145,7 +156,24 @@ class MplParams(Record):
 def output_bound(structure: MplStructure, params: MplParams, u_max: float,
                  x0_max: float | None = None) -> float:
     """Largest ``|y|`` of a forward run with ``|u| <= u_max`` from ``|x0| <= x0_max``
-    (default: at rest, ``x0_max = u_max``); see the Notes of :class:`MplParams`."""
+    (default: at rest, ``x0_max = u_max``); see the Notes of :class:`MplParams`.
+
+    Parameters
+    ----------
+    structure : MplStructure
+        The model's structure.
+    params : MplParams
+        Its parameters.
+    u_max : float
+        Bound on ``|u|`` over the run.
+    x0_max : float or None, optional
+        Bound on the initial cell voltages ``|x0|``; None means ``u_max``.
+
+    Returns
+    -------
+    float
+        ``|w_0| u_max + sum_k |w_k| B + |V_b|`` with ``B`` the cells' state bound.
+    """
     b = state_bound(u_max if x0_max is None else x0_max, u_max, structure.slope_cap)
     return float(abs(params.w[0]) * u_max + np.abs(params.w[1:]).sum() * b + abs(params.v_b))
 
@@ -155,6 +183,18 @@ def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:
 
     Solves ``f'(x) = slope_cap / dt`` for the sinh resistor, ``f'(v) = G cosh(v / V_T)``;
     zero when even the small-signal slope ``G`` exceeds the cap (the cell is then linear).
+
+    Parameters
+    ----------
+    structure : MplStructure
+        The model's structure.
+    params : MplParams
+        Its parameters.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N,)
+        ``x+`` of each cell (>= 0).
     """
     g = 2 * params.i_s / params.v_t
     ratio = structure.slope_cap / (structure.dt * g)
@@ -166,12 +206,18 @@ def resistor_current(structure: MplStructure, params: MplParams, v: np.ndarray) 
 
     Parameters
     ----------
+    structure : MplStructure
+        The model's structure.
+    params : MplParams
+        Its parameters.
     v : array, shape (..., N)
         Voltage across each cell's resistor.
 
     Returns
     -------
     array, shape (..., N)
+        Current through each cell's resistor: ``2 I_S sinh(v / V_T)`` inside the knees, the
+        straight line of slope ``slope_cap / dt`` beyond.
     """
     v = np.asarray(v, dtype=float)
     knee = knee_voltage(structure, params)
@@ -185,6 +231,17 @@ def resistor_current(structure: MplStructure, params: MplParams, v: np.ndarray) 
 def step(structure: MplStructure, params: MplParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
     """One sample of the forward model: output from the present state, then the Euler update.
+
+    Parameters
+    ----------
+    structure : MplStructure
+        The model's structure.
+    params : MplParams
+        Its parameters.
+    x : array, shape (N,)
+        Cell voltages before the sample.
+    u : float
+        Model input ``e`` of the sample.
 
     Returns
     -------
@@ -205,6 +262,24 @@ def invert_step(structure: MplStructure, params: MplParams, x: np.ndarray,
 
     The input estimate is solved from the output equation with the present state first, and
     only then does the state advance with that estimate.
+
+    Parameters
+    ----------
+    structure : MplStructure
+        The model's structure.
+    params : MplParams
+        Its parameters.
+    x : array, shape (N,)
+        Cell voltages before the sample.
+    y : float
+        Output to reach at this sample.
+
+    Returns
+    -------
+    u_hat : float
+        ``(y - sum w_k x_k + V_b) / w_0`` (eq. 5.13).
+    x_next : array, shape (N,)
+        Cell voltages after ``dt``, driven by ``u_hat`` (eq. 5.14).
     """
     x = np.asarray(x, dtype=float)
     u_hat = (y - params.w[1:] @ x + params.v_b) / params.w[0]
@@ -218,6 +293,10 @@ def simulate(structure: MplStructure, params: MplParams, u: np.ndarray,
 
     Parameters
     ----------
+    structure : MplStructure
+        The model's structure.
+    params : MplParams
+        Its parameters.
     u : array, shape (n,)
         Model input ``e`` sampled every ``structure.dt``.
     x0 : array, shape (N,), float or None
@@ -227,8 +306,17 @@ def simulate(structure: MplStructure, params: MplParams, u: np.ndarray,
     Returns
     -------
     y : array, shape (n,)
+        Model output (eq. 5.2).
     x_end : array, shape (N,)
         State after the last sample; feeding it back as ``x0`` continues the run exactly.
+
+    Raises
+    ------
+    ValueError
+        If `params` and `structure` differ in the number of cells, `u` is empty, not 1-D or
+        not finite, or `x0` does not fit the cells.
+    FitDivergedError
+        If the output leaves the finite range (inputs near the float limit).
     """
     _check_params(structure, params)
     u = check_signal(u, "u")
@@ -241,7 +329,31 @@ def simulate(structure: MplStructure, params: MplParams, u: np.ndarray,
 
 def simulate_reference(structure: MplStructure, params: MplParams, u: np.ndarray,
                        x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference)."""
+    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
+
+    Parameters
+    ----------
+    structure : MplStructure
+        The model's structure.
+    params : MplParams
+        Its parameters.
+    u : array, shape (n,)
+        Model input ``e`` sampled every ``structure.dt``.
+    x0 : array, shape (N,), float or None
+        Initial cell voltages, as for :func:`simulate`.
+
+    Returns
+    -------
+    y : array, shape (n,)
+        Model output (eq. 5.2).
+    x_end : array, shape (N,)
+        State after the last sample.
+
+    Raises
+    ------
+    ValueError
+        As :func:`simulate`.
+    """
     _check_params(structure, params)
     u = check_signal(u, "u")
     x = initial_state(structure.n_cells, x0, u[0])
@@ -254,6 +366,10 @@ def invert(structure: MplStructure, params: MplParams, y: np.ndarray,
 
     Parameters
     ----------
+    structure : MplStructure
+        The model's structure.
+    params : MplParams
+        Its parameters.
     y : array, shape (n,)
         Measured model output (e.g. the sensor signal), sampled every ``structure.dt``.
     x0 : array, shape (N,), float or None
@@ -265,11 +381,15 @@ def invert(structure: MplStructure, params: MplParams, y: np.ndarray,
     u_hat : array, shape (n,)
         Estimated input.
     x_end : array, shape (N,)
+        State after the last sample.
 
     Raises
     ------
+    ValueError
+        If `params` and `structure` differ in the number of cells, `y` is empty, not 1-D or
+        not finite, or `x0` does not fit the cells.
     FitDivergedError
-        If the inverse leaves the finite range. Unlike the forward model, the inverse's
+        If ``w_0 = 0`` (no inverse exists) or if the inverse leaves the finite range. Unlike the forward model, the inverse's
         stability also depends on the weights (its cells see ``-(1 + w_k / w_0)`` times their own
         voltage), so it is checked rather than guaranteed.
     """
