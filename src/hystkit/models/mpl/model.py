@@ -389,9 +389,9 @@ def invert(structure: MplStructure, params: MplParams, y: np.ndarray,
         If `params` and `structure` differ in the number of cells, `y` is empty, not 1-D or
         not finite, or `x0` does not fit the cells.
     FitDivergedError
-        If ``w_0 = 0`` (no inverse exists) or if the inverse leaves the finite range. Unlike the forward model, the inverse's
-        stability also depends on the weights (its cells see ``-(1 + w_k / w_0)`` times their own
-        voltage), so it is checked rather than guaranteed.
+        If ``w_0 = 0`` (no inverse exists) or if the inverse leaves the finite range. Unlike
+        the forward model, the inverse's stability also depends on the weights (its cells see
+        ``-(1 + w_k / w_0)`` times their own voltage), so it is checked rather than guaranteed.
     """
     _check_params(structure, params)
     y = check_signal(y, "y")
