@@ -94,6 +94,12 @@ def solve_lm(normal_equations: Callable[[np.ndarray], NormalEquations],
         Jacobians).
     ftol, xtol, gtol : float
         Tolerances (see the module docstring).
+
+    Returns
+    -------
+    SolveResult
+        The final point, its cost, the stopping ``status`` (> 0: converged) and the
+        evaluation counts.
     """
     lower = np.asarray(lower, dtype=float)
     upper = np.asarray(upper, dtype=float)

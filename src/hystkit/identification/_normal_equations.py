@@ -29,7 +29,7 @@ CHUNK = 65_536  # samples per chunk: (p + 1) runs of this many samples stay a fe
 class NormalEquations:
     """A least-squares problem's local model at one point.
 
-    Attributes
+    Parameters
     ----------
     cost : float
         ``0.5 * sum(r**2)`` (scipy's convention).
@@ -49,10 +49,22 @@ class SolveResult:
     """Outcome of :func:`~._lm.solve_lm` or :func:`~._trust_region.solve_trust_region`
     (field names as scipy's ``OptimizeResult``).
 
-    ``status``: -3 no finite start, -2 stalled (LM only), 0 budget exhausted, 1 gtol, 2 ftol,
-    3 xtol, 4 ftol and xtol. ``nfev``, ``njev``, ``n_runs``: see :class:`RunCounter` (the
-    budget ``max_nfev`` applies to ``nfev``, as in scipy). ``column_norms`` is
-    ``sqrt(diag(J^T J))`` at ``x``.
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (p,)
+        The final point (the start, moved into the box, if no step was accepted).
+    cost : float
+        ``0.5 * sum(r**2)`` at ``x`` (inf if the start was not finite).
+    status : int
+        -3 no finite start, -2 stalled (LM only), 0 budget exhausted, 1 gtol, 2 ftol, 3 xtol,
+        4 ftol and xtol.
+    message : str
+        What ``status`` means, in words.
+    nfev, njev, n_runs : int
+        Cost evaluations, normal-equation formations and model runs, see :class:`RunCounter`
+        (the budget ``max_nfev`` applies to ``nfev``, as in scipy).
+    column_norms : numpy.ndarray, shape (p,), or None
+        ``sqrt(diag(J^T J))`` at ``x``; None when the start was not finite.
     """
 
     x: np.ndarray
@@ -109,7 +121,24 @@ def dense_normal_equations(residual: Callable[[np.ndarray], np.ndarray],
                            jac: Callable[[np.ndarray], np.ndarray] | str,
                            lower: np.ndarray, upper: np.ndarray,
                            ) -> Callable[[np.ndarray], NormalEquations]:
-    """``x -> NormalEquations`` from ``residual(x)`` and ``jac(x)`` (or '2-point' differences)."""
+    """``x -> NormalEquations`` from ``residual(x)`` and ``jac(x)`` (or '2-point' differences).
+
+    Parameters
+    ----------
+    residual : callable
+        ``x -> r``, shape (n,).
+    jac : callable or str
+        ``x -> J``, shape (n, p); anything else (``"2-point"``) means forward differences with
+        scipy's steps.
+    lower, upper : numpy.ndarray, shape (p,)
+        Bounds; difference steps are flipped where they would leave the box.
+
+    Returns
+    -------
+    callable
+        ``x -> NormalEquations``; a point whose cost is not finite gets ``cost = inf`` (and
+        NaN ``J^T J``, ``J^T r``), which the solvers reject.
+    """
 
     def normal_equations(x: np.ndarray) -> NormalEquations:
         r = residual(x)

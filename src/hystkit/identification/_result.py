@@ -18,13 +18,14 @@ INSENSITIVE = 1e-10
 class BoundHit:
     """An optimiser coordinate on (or within a tolerance of) one of its bounds.
 
-    Attributes
+    Parameters
     ----------
     index : int
         Position in ``theta``.
     name : str
         The coordinate's name if the fit gave names, else ``theta[index]``.
     side : {"lower", "upper"}
+        Which bound it is on.
     limit : str or None
         Why this hit is not a failure: for a bound that is the model's own limit (e.g. the
         mPL's Euler slope cap, eq. 5.28-5.29) the family's note on what it means; for a
@@ -42,9 +43,9 @@ class BoundHit:
 class FitResult:
     """Outcome of a fit.
 
-    Attributes
+    Parameters
     ----------
-    structure, params
+    structure, params : object
         The fitted model (the family's frozen dataclasses).
     cost : float
         Sum of squared errors (eq. 5.9) on the data as given (normalised by the caller).
@@ -59,6 +60,7 @@ class FitResult:
     message : str
         The solver's message for the best start.
     n_starts : int
+        Number of starts the fit was given.
     theta : array or None
         The optimum in optimiser coordinates, when the fit used a bounded solver.
     bounds : (lower, upper) or None
