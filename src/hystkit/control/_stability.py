@@ -22,7 +22,9 @@ The sector is measured (:func:`measure_sector`): the block is driven over its tr
 consecutive samples are taken where the input moves. A dynamic model (the mPL is an ODE) can
 change its output while its input stands still; those samples are left out and how far they
 fall outside the sector is reported, so the reader sees how much of the block the sector does
-not describe.
+not describe. :func:`global_stability` widens it to the hull with the slopes of the experiment's
+own closed-loop runs: a sector is only as good as the trajectories it was measured on, and the
+proof holds only for slopes inside it.
 """
 
 from __future__ import annotations
