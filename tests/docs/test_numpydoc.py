@@ -32,6 +32,7 @@ DOCUMENTED = (
     "hystkit.datasets",
     "hystkit.experiments",
     "hystkit.export",
+    "hystkit.identification",
     "hystkit.io",
     "hystkit.metrics",
     "hystkit.models",
@@ -40,6 +41,7 @@ DOCUMENTED = (
     "hystkit.models.chua",
     "hystkit.models.gpreisach",
     "hystkit.models.ladder",
+    "hystkit.models.mpl",
     "hystkit.models.mpl_poly",
     "hystkit.models.pi",
     "hystkit.models.pl",
@@ -54,15 +56,13 @@ DOCUMENTED = (
 # package to DOCUMENTED. Until then their public objects are not checked here.
 NOT_YET = (
     "hystkit.batch",
-    "hystkit.identification",
-    "hystkit.models.mpl",
     "hystkit.models.mpl_g",
     "hystkit.parallel",
 )
 
 # Modules of DOCUMENTED packages that other work is changing now (issue 11); they get their
 # sections with it. Their objects are the only ones of those packages not checked yet.
-NOT_YET_MODULES = ()
+NOT_YET_MODULES = ("hystkit.identification._least_squares",)
 
 
 def public_objects(package: str) -> list[str]:
