@@ -86,6 +86,53 @@ def test_drift_rate_standard_error_is_the_textbook_one():
     assert_allclose(rate.stderr_per_hour, math.sqrt(np.sum(resid**2) / 2 / 5.0))
 
 
+def _ar1(rng: np.random.Generator, phi: float, n: int) -> np.ndarray:
+    """Stationary AR(1) series of unit innovation variance: e_i = phi e_(i-1) + w_i."""
+    e = np.empty(n)
+    e[0] = rng.normal() / math.sqrt(1 - phi**2)
+    for i in range(1, n):
+        e[i] = phi * e[i - 1] + rng.normal()
+    return e
+
+
+def test_drift_standard_error_matches_the_true_spread_under_ar1_offsets():
+    """Review 14, sec. 6: the i.i.d. error was ~7 times too small on autocorrelated offsets."""
+    n, phi, slope = 200, 0.6, 1e-3  # cycles, lag-1 correlation, offset unit per s
+    t = 2.0 * np.arange(n)  # s, one 2 s cycle each
+    # Exact standard deviation of the least-squares slope: c^T Sigma c, c = (t - mean) / Sxx,
+    # Sigma_ij = phi^|i-j| / (1 - phi^2) for unit innovations.
+    c = (t - t.mean()) / np.sum((t - t.mean()) ** 2)
+    lag = np.abs(np.subtract.outer(np.arange(n), np.arange(n)))
+    true_sd = 3600.0 * math.sqrt(c @ (phi**lag / (1 - phi**2)) @ c)  # per hour
+    rng = np.random.default_rng(0)
+    fits = [drift_rate(t, slope * t + _ar1(rng, phi, n), 2.0) for _ in range(200)]
+    est = np.array([f.per_hour for f in fits])
+    se = np.array([f.stderr_per_hour for f in fits])
+    iid = se * np.sqrt([(1 - f.residual_lag1) / (1 + f.residual_lag1) for f in fits])
+    # 200 draws estimate a standard deviation to about +-5 % (1 sigma): 15 % is 3 sigma.
+    assert abs(est.std() / true_sd - 1) < 0.15
+    assert abs(math.sqrt(np.mean(se**2)) / true_sd - 1) < 0.15
+    assert np.mean(iid) < 0.6 * true_sd  # what the i.i.d. error said: about half (phi 0.6)
+    coverage = np.mean(np.abs(est - 3600.0 * slope) < 2 * se)
+    assert 0.88 < coverage < 0.99  # 0.954 for a calibrated error; binomial sd 0.015
+    assert_allclose(np.mean([f.n_effective for f in fits]), n * 0.4 / 1.6, rtol=0.15)
+    # a straight line is rarely called not linear (3-sigma rule; a few % from optimistic halves)
+    assert np.mean([not f.linear for f in fits]) < 0.06
+
+
+def test_a_decaying_drift_is_flagged_as_not_linear():
+    # creep-like offsets: fast early, slow late (the review's sine: 38 then 6 %/h)
+    t = 2.0 * np.arange(100)
+    y = 0.02 * (1 - np.exp(-t / 60.0)) + 1e-4 * _ar1(np.random.default_rng(1), 0.5, 100)
+    drift = drift_rate(t, y, 2.0)
+    first, first_se, second, second_se = drift.half_slopes_per_hour
+    assert drift.linear is False and first > second + 3 * math.hypot(first_se, second_se)
+    # halves of a straight line agree with the whole
+    line = drift_rate(t, 1e-3 * t, 2.0)
+    assert line.linear is True
+    assert_allclose(line.half_slopes_per_hour[::2], [3.6, 3.6], rtol=1e-9)
+
+
 def test_split_by_cycles_then_concatenated_is_the_whole():
     rng = np.random.default_rng(3)
     t = np.arange(0, 60, 1 / FS)

@@ -13,9 +13,11 @@ minimum) and every output signal (dR1/R1, dR2/R2 and their difference, or any ot
 * ``drift_from_previous``: the offset minus the previous cycle's (None for the first cycle).
 
 The drift rate over the recording is the least-squares slope of the offsets against the cycle
-times (the mean time of each cycle's samples), per hour, with its standard error; a drift that
-is linear in time gives exactly its slope whatever the loop shape, since a whole cycle's mean
-of the periodic part does not depend on the cycle.
+times (the mean time of each cycle's samples), per hour, with its standard error inflated for
+autocorrelated offsets (:func:`drift_rate`); a drift that is linear in time gives exactly its
+slope whatever the loop shape, since a whole cycle's mean of the periodic part does not depend
+on the cycle. A drift that is not a line (a decaying creep transient) is flagged: the slope is
+then an average over the record.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..metrics import loop_area
+from ._autocorr import ar1_inflation, lag1
 from ._cycles import DEFAULT_DEADBAND, bounds_of, input_minima
 
 __all__ = ["CycleTable", "DriftRate", "cycle_table", "drift_rate", "enclosed_area"]
@@ -56,11 +59,14 @@ def enclosed_area(x: npt.ArrayLike, y: npt.ArrayLike) -> float:
 
 @dataclass(frozen=True)
 class DriftRate:
-    """Least-squares slope of the cycle offsets against time.
+    """Least-squares slope of the cycle offsets against time, with an honest error.
 
     ``per_hour`` and ``stderr_per_hour`` [signal unit per hour]; ``per_cycle`` the slope
     times the mean cycle duration [signal unit]; ``n_cycles`` the cycles it rests on (the
-    standard error needs 3 or more; with 2 it is None).
+    standard error needs 3 or more; with 2 it is None). The standard error allows for
+    autocorrelated offsets (see :func:`drift_rate`): ``residual_lag1`` and ``n_effective``
+    say by how much. ``half_slopes_per_hour`` and ``linear`` compare the slopes of the first
+    and second half of the cycles (6 cycles or more, else None).
 
     Parameters
     ----------
@@ -72,17 +78,62 @@ class DriftRate:
         Slope times the mean cycle duration [signal unit].
     n_cycles : int
         Cycles the fit rests on.
+    residual_lag1 : float or None
+        Lag-1 autocorrelation of the residuals about the line; None with 2 cycles.
+    n_effective : float or None
+        Effective number of independent cycles, ``n (1 - r1) / (1 + r1)`` (``n`` for
+        ``r1 <= 0``); None with 2 cycles.
+    half_slopes_per_hour : tuple of (float, float, float, float) or None
+        Slope and standard error of the first half, then of the second half [per hour].
+    linear : bool or None
+        False when the two half slopes differ by more than three standard errors of their
+        difference: the drift is not a line and ``per_hour`` is an average.
     """
 
     per_hour: float
     stderr_per_hour: float | None
     per_cycle: float
     n_cycles: int
+    residual_lag1: float | None = None
+    n_effective: float | None = None
+    half_slopes_per_hour: tuple[float, float, float, float] | None = None
+    linear: bool | None = None
+
+
+# Cycles each half needs for its own slope and error in the linearity check.
+_MIN_HALF = 3
+# Half slopes further apart than this many standard errors of their difference mark the drift
+# as not linear. 3 rather than 2: each half's error comes from half the cycles and is itself
+# optimistic under autocorrelation (tests/analysis/test_cycle_analysis.py measures the rate
+# of false alarms on straight lines in AR(1) noise).
+_LINE_SIGMAS = 3.0
+
+
+def _slope(t: np.ndarray, y: np.ndarray) -> tuple[float, float | None, float | None]:
+    """Least-squares slope [per s], its AR(1)-inflated standard error and the residual lag-1."""
+    tc = t - t.mean()
+    sxx = float(np.sum(tc * tc))
+    slope = float(np.sum(tc * (y - y.mean())) / sxx)
+    if t.size <= 2:
+        return slope, None, None
+    resid = y - y.mean() - slope * tc
+    rho = lag1(resid)
+    iid = math.sqrt(float(np.sum(resid * resid)) / (t.size - 2) / sxx)
+    return slope, ar1_inflation(rho) * iid, rho
 
 
 def drift_rate(t_cycle: npt.ArrayLike, offset: npt.ArrayLike,
                mean_duration: float) -> DriftRate:
-    """Slope of `offset` against `t_cycle` [s], per hour, and its standard error.
+    """Slope of `offset` against `t_cycle` [s], per hour, its standard error and a line check.
+
+    The offsets of neighbouring cycles are alike (creep, temperature), so the i.i.d. standard
+    error of the slope is too small. It is multiplied by ``sqrt((1 + r1) / (1 - r1))``, with
+    ``r1`` the lag-1 autocorrelation of the residuals about the line: the AR(1) effective
+    sample size ``n_eff = n (1 - r1) / (1 + r1)`` (positive ``r1`` only; the same inflation as
+    the settling fit). ``r1`` from few cycles is biased low, so the error stays somewhat
+    optimistic for short records. The first and second half of the cycles are fitted apart,
+    each with its own inflated error; slopes that differ by more than three times the error of
+    their difference mark the drift as not linear.
 
     Parameters
     ----------
@@ -96,7 +147,8 @@ def drift_rate(t_cycle: npt.ArrayLike, offset: npt.ArrayLike,
     Returns
     -------
     DriftRate
-        Slope per hour, its standard error (None for k = 2) and slope per cycle.
+        Slope per hour, its standard error (None for k = 2), slope per cycle, the residual
+        lag-1 autocorrelation and effective sample size, the half slopes and the line check.
 
     Raises
     ------
@@ -106,15 +158,19 @@ def drift_rate(t_cycle: npt.ArrayLike, offset: npt.ArrayLike,
     t, y = np.asarray(t_cycle, dtype=float), np.asarray(offset, dtype=float)
     if t.size < 2:
         raise ValueError("a drift rate needs at least 2 cycles")
-    tc = t - t.mean()
-    sxx = float(np.sum(tc * tc))
-    slope = float(np.sum(tc * (y - y.mean())) / sxx)
-    stderr = None
-    if t.size > 2:
-        resid = y - y.mean() - slope * tc
-        stderr = 3600.0 * math.sqrt(float(np.sum(resid * resid)) / (t.size - 2) / sxx)
-    return DriftRate(per_hour=3600.0 * slope, stderr_per_hour=stderr,
-                     per_cycle=slope * mean_duration, n_cycles=int(t.size))
+    slope, stderr, rho = _slope(t, y)
+    n_eff = None if rho is None else t.size * (1 - max(rho, 0.0)) / (1 + max(rho, 0.0))
+    halves, linear = None, None
+    if t.size >= 2 * _MIN_HALF:
+        h = t.size // 2
+        (s1, e1, _), (s2, e2, _) = _slope(t[:h], y[:h]), _slope(t[h:], y[h:])
+        halves = tuple(3600.0 * v for v in (s1, e1, s2, e2))
+        rounding = 1e-9 * max(abs(s1), abs(s2))  # a noise-free line has zero errors
+        linear = bool(abs(s1 - s2) <= _LINE_SIGMAS * math.hypot(e1, e2) + rounding)
+    return DriftRate(per_hour=3600.0 * slope,
+                     stderr_per_hour=None if stderr is None else 3600.0 * stderr,
+                     per_cycle=slope * mean_duration, n_cycles=int(t.size), residual_lag1=rho,
+                     n_effective=n_eff, half_slopes_per_hour=halves, linear=linear)
 
 
 @dataclass(frozen=True, eq=False)

@@ -158,23 +158,44 @@ def _summary(table, signals: dict) -> dict:
             "drift_per_hour": None if drift is None else drift.per_hour,
             "drift_stderr_per_hour": None if drift is None else drift.stderr_per_hour,
             "drift_per_cycle": None if drift is None else drift.per_cycle,
+            "drift_stderr_method": _SE_METHOD,
+            "drift_residual_lag1": None if drift is None else drift.residual_lag1,
+            "drift_n_effective": None if drift is None else drift.n_effective,
+            "drift_half_slopes_per_hour": (None if drift is None or drift.linear is None else
+                                           dict(zip(("first", "first_stderr", "second",
+                                                     "second_stderr"),
+                                                    drift.half_slopes_per_hour, strict=True))),
+            "drift_linear": None if drift is None else drift.linear,
         }
     return out
+
+
+_SE_METHOD = ("least-squares slope; i.i.d. standard error times sqrt((1 + r1) / (1 - r1)), "
+              "r1 the residuals' lag-1 autocorrelation (AR(1) effective sample size)")
 
 
 def _print(table, summary: dict, gauges: dict | None) -> None:
     print(f"{table.n_cycles} complete cycles (minimum to minimum of the position), "
           f"{table.t_start[0]:.4g} s to {table.t_stop[-1]:.4g} s")
     print(f"  {'signal':<18} {'area [mm·%]':>12} {'area eq.5.15':>13} {'drift [%/h]':>12} "
-          f"{'± s.e.':>9} {'[%/cycle]':>10}")
+          f"{'± s.e.':>9} {'[%/cycle]':>10} {'resid. r1':>9}")
     for name, s in summary.items():
-        rate, se, per_cycle = (s["drift_per_hour"], s["drift_stderr_per_hour"],
-                               s["drift_per_cycle"])
+        rate, se, per_cycle, rho = (s["drift_per_hour"], s["drift_stderr_per_hour"],
+                                    s["drift_per_cycle"], s["drift_residual_lag1"])
         rate_text = "" if rate is None else f"{100 * rate:.4g}"
         se_text = "" if se is None else f"{100 * se:.2g}"
         cycle_text = "" if per_cycle is None else f"{100 * per_cycle:.3g}"
+        rho_text = "" if rho is None else f"{rho:.2f}"
         print(f"  {name:<18} {100 * s['area_mean']:>12.4g} {s['area_pct_mean']:>12.3g}% "
-              f"{rate_text:>12} {se_text:>9} {cycle_text:>10}")
+              f"{rate_text:>12} {se_text:>9} {cycle_text:>10} {rho_text:>9}")
+    print("  (± s.e. allows for the residual lag-1 autocorrelation r1: AR(1) effective sample "
+          "size n (1 - r1) / (1 + r1))")
+    for name, s in summary.items():
+        if s["drift_linear"] is False:
+            h = s["drift_half_slopes_per_hour"]
+            print(f"  {name}: drift not linear over the record; the rate is an average "
+                  f"(first half {100 * h['first']:.3g} ± {100 * h['first_stderr']:.2g}, second "
+                  f"half {100 * h['second']:.3g} ± {100 * h['second_stderr']:.2g} %/h)")
     if gauges is not None:
         doc = TABLE_3_1["sample 4"]
         print(f"  gauges (table 3.1): R1 = {gauges['r1_mean_kohm']:.4g} kOhm, R2 = "
