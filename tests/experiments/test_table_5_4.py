@@ -12,7 +12,12 @@ from numpy.testing import assert_allclose
 
 from hystkit.cli import main
 from hystkit.compensation import evaluate, fit_compensator
-from hystkit.experiments import Table54Settings, measure_table_5_4, signal_scores
+from hystkit.experiments import (
+    SAME_CENTRING_NOTE,
+    Table54Settings,
+    measure_table_5_4,
+    signal_scores,
+)
 from hystkit.experiments.table_5_4 import _forward
 from hystkit.io import Recording
 from hystkit.metrics import loop_area, sinad_db
@@ -63,17 +68,57 @@ def inverse_pair():
 
 
 def test_compensated_rows_are_evaluates_scores(inverse_pair):
-    """The compensated row, deployable and oracle, is what ``hk.evaluate`` reports."""
+    """The compensated row is what ``hk.evaluate`` reports, deployable and oracle alike: both
+    recordings are centred on their own means, so the two centrings are one row here."""
     comp, rec = inverse_pair
     scores = evaluate(comp, rec)
     rows = _rows({"rows": signal_scores(comp, rec, rec.sensor, -rec.sensor)})
-    for centring, suffix in (("fit (deployable)", ""), ("recording (oracle)", "_oracle")):
-        row = rows[("compensated", centring)]
+    assert [key for key in rows if key[0] in ("fit", "compensated")] == \
+        [("fit", "fit = oracle, see note"), ("compensated", "fit = oracle, see note")]
+    row = rows[("compensated", "fit = oracle, see note")]
+    assert row["note"] == SAME_CENTRING_NOTE
+    for suffix in ("", "_oracle"):
         assert_allclose(row["sinad_db"], scores[f"sinad_db{suffix}"], rtol=1e-12)
         assert_allclose(row["loop_area_pct"], scores[f"loop_area{suffix}"], rtol=1e-12)
     # the hysteresis is taken out: far less loop than the sensor's own
-    assert abs(rows[("compensated", "fit (deployable)")]["loop_area_pct"]) < \
-        0.1 * abs(scores["sensor_loop_area"])
+    assert abs(row["loop_area_pct"]) < 0.1 * abs(scores["sensor_loop_area"])
+
+
+def test_deployable_equals_oracle_on_centred_recordings(inverse_pair):
+    """Why the rows are one: the fitting recording's offsets are the validation recording's
+    means (both centred on their own means, the same sine position), so the two centrings'
+    signals differ by a constant at most, which SINAD and loop area ignore."""
+    comp, rec = inverse_pair
+    assert_allclose(comp.scaling.sensor_offset, np.mean(rec.sensor), atol=1e-12)
+    assert_allclose(comp.position_offset(), np.mean(rec.position), atol=1e-12)
+    oracle = comp.oracle()
+    for own, other in ((_forward(comp, rec), _forward(oracle, rec)),
+                       (comp.estimate(rec, float(np.mean(rec.position))),
+                        oracle.estimate(rec, float(np.mean(rec.position))))):
+        assert np.ptp(own - other) < 1e-9
+
+
+def test_an_offset_sensor_gets_both_centrings(inverse_pair):
+    """A validation sensor offset by 10 % of its range is no longer centred like the fitting
+    recording. The mPL's cells depend on ``e - v`` only, so its inverse just shifts with the
+    offset (same scores); the Preisach grid does not: its deployable rows differ from the
+    oracle ones and both are shown."""
+    _, rec = inverse_pair
+    comp = fit_compensator(simulate_experiment("sine", 1), 8, model="preisach",
+                           mode="inverse", diagnose=False)
+    shifted = Recording(time=rec.time, position=rec.position,
+                        sensor=rec.sensor + 0.1 * np.ptp(rec.sensor))
+    rows = _rows({"rows": signal_scores(comp, shifted, rec.sensor, -rec.sensor)})
+    assert [key for key in rows if key[0] in ("fit", "compensated")] == \
+        [("fit", "fit (deployable)"), ("compensated", "fit (deployable)"),
+         ("fit", "recording (oracle)"), ("compensated", "recording (oracle)")]
+    assert not any("note" in row for row in rows.values())
+    # the oracle centres the shifted sensor back: its compensated row is the unshifted one's
+    scores = evaluate(comp, rec)
+    assert_allclose(rows[("compensated", "recording (oracle)")]["sinad_db"],
+                    scores["sinad_db_oracle"], rtol=1e-9)
+    assert abs(rows[("compensated", "fit (deployable)")]["sinad_db"]
+               - scores["sinad_db_oracle"]) > 1.0
 
 
 def test_fit_row_is_the_forward_model_in_sensor_units(inverse_pair):
@@ -119,3 +164,15 @@ def test_cli_refuses_a_model_without_inverse(capsys):
     assert main(["table", "5.4", "--model", "boucwen"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("hystkit: error:") and "boucwen" in err and err.count("\n") == 1
+
+
+def test_cli_size_defaults_to_the_familys(capsys):
+    """No --size: the document's 1 cell for mpl, the family's default size otherwise."""
+    from hystkit.models import get_family
+
+    code = main(["table", "5.4", "--model", "preisach", "--quick"])
+    printed = capsys.readouterr().out
+    size = get_family("preisach").default_size
+    assert f"model preisach, size {size}: " in printed
+    assert f"fitting preisach (size {size})" in printed
+    assert code == 0 and "| compensated |" in printed

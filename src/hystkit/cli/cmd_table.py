@@ -41,8 +41,13 @@ def _table_5_4(args: argparse.Namespace) -> int:
                          f"and {args.model} has none ({family.no_inverse_reason})")
     check_size(args.model, args.size)
     _check_out(args, "table_5_4")
+    # the document's mPL has one cell; another family gets its own default size
+    size = args.size if args.size is not None else 1 if args.model == "mpl" \
+        else family.default_size
+    print(f"model {args.model}, size {size}: {family.size_help}"
+          f"{'' if args.size is not None else ' (default)'}")
     settings = Table54Settings(fit_seed=args.fit_seed, val_seed=args.val_seed, model=args.model,
-                               size=args.size, scope_rate=10e3 if args.quick else args.scope_rate,
+                               size=size, scope_rate=10e3 if args.quick else args.scope_rate,
                                duration=40.0 if args.quick else None)
     result = measure_table_5_4(settings, progress=print)
     fit = result["fit"]
@@ -51,8 +56,10 @@ def _table_5_4(args: argparse.Namespace) -> int:
           f"{settings.scope_rate:g} Hz); {fit['model']} fitted position -> sensor, inverse as "
           f"compensator: fit {fit['status']} ({fit['status_message']})")
     print("loop area: eq. 5.15 against the encoder position, % per cycle, signed (an output that "
-          "lags gives < 0); the oracle rows use the validation recording's own means")
+          "lags gives < 0); oracle centring: the validation recording's own means")
     _finish(args, "table_5_4", result, TABLE_5_4_COLUMNS)
+    if result["centring_note"]:
+        print(f"note: {result['centring_note']}")
     for note in result["preprocess_warnings"]:
         print(f"hystkit: warning: {note}")
     return 0 if fit["status"] == "ok" else GUARD_EXIT
@@ -107,8 +114,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                                       "model and compensated signal (raw recordings)")
     q.add_argument("--model", default="mpl",
                    help="model family with an inverse (default mpl, as the document)")
-    q.add_argument("--size", type=positive_int, default=1,
-                   help="model size (mpl: cells; default 1, as the document)")
+    q.add_argument("--size", type=positive_int, default=None,
+                   help="model size (default: 1 cell for mpl, as the document; the family's "
+                        "default size for another model)")
     q.add_argument("--fit-seed", type=_SEED, default=1, help="seed of the fitting recording")
     q.add_argument("--val-seed", type=_SEED, default=2, help="seed of the validation recording")
     q.add_argument("--scope-rate", type=number(2e3, 2e5), default=20e3, metavar="HZ",

@@ -14,8 +14,8 @@ from .._lazy import lazy_exports
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
     {"_output": ("format_markdown", "output_names", "write_table"),
-     "table_5_4": ("DOCUMENT_TABLE_5_4", "TABLE_5_4_COLUMNS", "Table54Settings",
-                   "measure_table_5_4", "signal_scores"),
+     "table_5_4": ("DOCUMENT_TABLE_5_4", "SAME_CENTRING_NOTE", "TABLE_5_4_COLUMNS",
+                   "Table54Settings", "measure_table_5_4", "signal_scores"),
      "table_2_2": ("DOCUMENT_TABLE_2_2", "TABLE_2_2_COLUMNS", "measure_table_2_2",
                    "rmse_statistics"),
      "creep": ("CREEP_COLUMNS", "CreepPlan", "creep_experiment", "creep_trajectory",
