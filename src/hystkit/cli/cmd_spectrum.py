@@ -117,6 +117,8 @@ def _spectrum(args: argparse.Namespace) -> int:
         print(f"  {key} {f['cutoff_hz']:.4g} Hz: gain at f_signal {f['gain_at_f_signal_db']:.3g} "
               f"dB, noise floor above f_signal passed {f['noise_rms_above_f_signal_passed']:.3g}"
               f" RMS (of {f['noise_rms_above_f_signal_unfiltered']:.3g} unfiltered)")
+    if s["compare_skipped"]:
+        print(f"  {s['compare_skipped']}")
     report = {"source": str(args.input), "kind": kind, **result.to_dict(),
               "document": {"f_c_min_hz": 8.0, "f_c_hz": 20.0, "where": "sec. 4.3.1, fig. 4.10, "
                            "eq. 4.1"},

@@ -29,24 +29,20 @@ from __future__ import annotations
 
 import math
 import os
-import queue
 import sys
-import threading
 import time as _time
 import warnings
-from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from tqdm import tqdm
 
-from ..io import RawChunk, RawFormat, RawReader, Recording, open_raw
-from ._bridge import bridge_kernel, clipped_channels, gauge_symmetry
+from ..io import RawFormat, RawReader, Recording, open_raw
+from ._bridge import clipped_channels, gauge_symmetry
+from ._chain import SupplyStats, bridge_resistances, flush_chain, prefetch, run_chain
 from ._decimate import (
     Decimator,
-    decimator_flush,
     decimator_init,
-    decimator_step,
     design_chain,
 )
 from ._encoder import (
@@ -58,14 +54,12 @@ from ._encoder import (
     decode_step,
     encoder_init,
 )
+from ._encoder_survey import encoder_setup
 from ._filters import lowpass_zero_phase
-from ._levels import LevelSurvey
 
 __all__ = ["MAX_CHUNK_SIZE", "PreprocessReport", "PreprocessResult", "PreprocessSettings",
            "RawDataWarning", "preprocess_raw"]
 
-# Encoder levels are surveyed in blocks of this many samples, whatever the chunk size.
-SURVEY_BLOCK = 1 << 16
 # Memory is about 200 bytes per chunk sample; as the CLI's --chunk-size limit.
 MAX_CHUNK_SIZE = 1 << 27
 
@@ -298,7 +292,7 @@ def preprocess_raw(path: str | os.PathLike[str], settings: PreprocessSettings,
                           f"{settings.fs_out:g} Hz (need at least {4 * settings.fs_out:g} Hz)")
     chain = design_chain(fs, factor, min(2 * settings.cutoff, fs_mid / 4))
     dwell = max(2, math.ceil(settings.encoder_dwell_us * 1e-6 * fs - 1e-9))
-    enc_settings, levels, logic = _encoder_setup(reader, settings, dwell)
+    enc_settings, levels, logic = encoder_setup(reader, settings, dwell)
     enc_state = encoder_init(levels)
 
     # R and the count run through separate decimator states: each stream's output k is centred
@@ -309,28 +303,25 @@ def preprocess_raw(path: str | os.PathLike[str], settings: PreprocessSettings,
     mid_r: list[np.ndarray] = []
     mid_c: list[np.ndarray] = []
     extremes = np.array([-np.inf, 0, np.inf, 0] * 2, dtype=float)
-    supply = _SupplyStats()
+    supply = SupplyStats()
     t0 = 0.0
     bar = tqdm(total=reader.n_samples, unit="sample", unit_scale=True, file=sys.stderr,
                disable=None if progress else True, mininterval=0.5, desc="preprocess")
-    for chunk in _prefetch(reader.chunks()):
+    for chunk in prefetch(reader.chunks()):
         if chunk.start == 0 and chunk.time is not None:
             t0 = float(chunk.time[0])
-        r, bad, extremes = bridge_kernel(chunk.v1, chunk.v2, float(settings.r_bridge),
-                                          float(settings.v_supply), extremes, chunk.v0)
-        for g in range(2):
-            if bad[g] >= 0:
-                _raise_bridge(reader, g, chunk, int(bad[g]), settings.v_supply)
+        r, extremes = bridge_resistances(reader, chunk, settings.r_bridge, settings.v_supply,
+                                         extremes)
         supply.add(chunk.v0)
         x = chunk.encoder if logic is None else ab_to_code(chunk.enc_a, chunk.enc_b, *logic)
         counts, enc_state = decode_step(enc_settings, enc_state, x)
-        mid_r.append(_run_chain(chain, r_states, r))
-        mid_c.append(_run_chain(chain, c_states, counts[np.newaxis].astype(float)))
+        mid_r.append(run_chain(chain, r_states, r))
+        mid_c.append(run_chain(chain, c_states, counts[np.newaxis].astype(float)))
         bar.update(chunk.n)
     bar.close()
-    mid_c.append(_run_chain(chain, c_states, decode_flush(enc_state)[np.newaxis].astype(float)))
-    mid_r.append(_flush_chain(chain, r_states, 2))
-    mid_c.append(_flush_chain(chain, c_states, 1))
+    mid_c.append(run_chain(chain, c_states, decode_flush(enc_state)[np.newaxis].astype(float)))
+    mid_r.append(flush_chain(chain, r_states, 2))
+    mid_c.append(flush_chain(chain, c_states, 1))
     mid = np.vstack([np.concatenate(mid_r, axis=1), np.concatenate(mid_c, axis=1)])
     return _finish(reader, settings, mid, t0, reader.fs, factor, chain, enc_settings, enc_state,
                    levels, logic, extremes, supply, reader.n_samples or 0, t_start)
@@ -339,181 +330,10 @@ def preprocess_raw(path: str | os.PathLike[str], settings: PreprocessSettings,
 # --------------------------------------------------------------------------- pieces
 
 
-def _encoder_setup(reader: RawReader, settings: PreprocessSettings, dwell: int
-                   ) -> tuple[EncoderSettings, np.ndarray, tuple[float, float] | None]:
-    """Decoder settings, starting levels and, for logic channels, their thresholds [V]."""
-    if reader.encoder_kind == "ab":
-        thresholds = tuple(_logic_threshold(reader, c) for c in ("enc_a", "enc_b"))
-        # Codes 2A + B are decoded as four fixed levels 0..3 in code order.
-        return (EncoderSettings(states=(0, 1, 2, 3), dwell=dwell, illegal=settings.illegal,
-                                track_block=0),
-                np.arange(4.0), thresholds)  # type: ignore[return-value]
-    enc = EncoderSettings(states=settings.encoder_states, dwell=dwell, illegal=settings.illegal)
-    if settings.encoder_levels is not None:
-        return enc, np.asarray(settings.encoder_levels, dtype=float), None
-    survey = _survey(reader, "encoder", 4)
-    _check_levels(reader, "encoder", survey, 4)
-    return enc, survey.centres, None
-
-
-def _logic_threshold(reader: RawReader, column: str) -> float:
-    survey = _survey(reader, column, 2)
-    _check_levels(reader, column, survey, 2)
-    return float(survey.centres.mean())
-
-
-def _survey(reader: RawReader, column: str, wanted: int) -> LevelSurvey:
-    """Levels of `column`, surveyed in blocks of ``SURVEY_BLOCK`` samples from the start until
-    `wanted` levels each hold 100 samples. The blocks do not depend on the reader's chunk size,
-    so neither do the levels found (nor anything decoded with them)."""
-    survey = LevelSurvey()
-    for block in _blocks(reader.chunks(columns=(column,)), column, SURVEY_BLOCK):
-        survey = survey.add(block)
-        if survey.n_levels >= wanted and min(c[3] for c in survey.clusters) >= 100:
-            break
-    return survey
-
-
-def _blocks(chunks: Iterator[RawChunk], column: str, size: int) -> Iterator[np.ndarray]:
-    """`column` of consecutive chunks, re-cut into blocks of `size` samples (the last shorter)."""
-    pending: list[np.ndarray] = []
-    n = 0
-    for chunk in chunks:
-        pending.append(getattr(chunk, column))
-        n += pending[-1].size
-        while n >= size:
-            joined = np.concatenate(pending)
-            yield joined[:size]
-            pending, n = [joined[size:]], n - size
-    if n:
-        yield np.concatenate(pending)
-
-
-def _check_levels(reader: RawReader, column: str, survey: LevelSurvey, wanted: int) -> None:
-    found = ", ".join(f"{c:.4g}" for c in survey.centres)
-    if survey.n_levels == 0:  # no level held 2 samples: far too short to survey
-        raise reader.fail(f"only {survey.n_samples} samples: too few to find the "
-                          f"{wanted} levels of the channel (give --encoder-levels, or record "
-                          "longer)", column)
-    if survey.n_levels <= 1:
-        lo, hi = survey.clusters[0][1], survey.clusters[0][2]
-        raise reader.fail(f"flat: one level ({found} V, range {lo:.4g} to {hi:.4g} V) in "
-                          f"{survey.n_samples} samples, so no encoder edges and no position; "
-                          "is the encoder connected and did the actuator move?", column)
-    if survey.n_levels < wanted:
-        raise reader.fail(f"only {survey.n_levels} of {wanted} levels found ({found} V) in the "
-                          "whole recording; the actuator never visited all A/B states or this "
-                          "is not the encoder" + (", give --encoder-levels"
-                                                  if wanted == 4 else ""), column)
-    if survey.n_levels > wanted:
-        raise reader.fail(f"{survey.n_levels} distinct levels ({found} V) where {wanted} were "
-                          "expected; is this the " + ("merged encoder signal"
-                                                      if wanted == 4 else "logic channel")
-                          + "? (give --encoder-levels to skip the search)", column)
-
-
-class _SupplyStats:
-    """Running sum, minimum and maximum of the measured supply v0 [V] (nothing when absent)."""
-
-    def __init__(self) -> None:
-        self.n, self.total, self.low, self.high = 0, 0.0, np.inf, -np.inf
-
-    def add(self, v0: np.ndarray | None) -> None:
-        if v0 is not None and v0.size:
-            self.n += v0.size
-            self.total += float(np.sum(v0, dtype=float))
-            self.low, self.high = min(self.low, float(v0.min())), max(self.high, float(v0.max()))
-
-    def fields(self) -> dict:
-        """The report's supply fields."""
-        if not self.n:
-            return {"supply": "nominal"}
-        return {"supply": "measured", "v0_mean_v": self.total / self.n, "v0_min_v": self.low,
-                "v0_max_v": self.high}
-
-
-def _raise_bridge(reader: RawReader, g: int, chunk: RawChunk, i: int, v_supply: float) -> None:
-    v = (chunk.v1, chunk.v2)[g][i]
-    if chunk.v0 is not None:
-        v0 = chunk.v0[i]
-        if v0 <= 0:
-            raise reader.fail(f"measured supply {v0:.6g} V is not positive; is this the supply "
-                              "channel, and its polarity right?", "v0", chunk.start + i)
-        if v >= v0:
-            raise reader.fail(f"measured supply {v0:.6g} V is not above the bridge voltage "
-                              f"v{g + 1} = {v:.6g} V, so R_S = R_br (V0 - V_m) / V_m (eq. 4.3) "
-                              "is undefined; is this the supply channel (and v1, v2 the bridge "
-                              "voltages across R_br)?", "v0", chunk.start + i)
-        raise reader.fail(f"bridge voltage {v:.6g} V outside (0, v0 = {v0:.6g} V), where "
-                          "R_S = R_br (V0 - V_m) / V_m (eq. 4.3) is undefined (or, within "
-                          "1e-12 V0 of 0, absurd); check the channel and its polarity",
-                          f"v{g + 1}", chunk.start + i)
-    raise reader.fail(f"bridge voltage {v:.6g} V outside (0, V0 = {v_supply:g} V), where "
-                      "R_S = R_br (V0 - V_m) / V_m (eq. 4.3) is undefined (or, within 1e-12 V0 "
-                      "of 0, absurd); check the channel, its polarity and --v-supply",
-                      f"v{g + 1}", chunk.start + i)
-
-
-def _prefetch(chunks: Iterator[RawChunk]) -> Iterator[RawChunk]:
-    """Read the next chunk in a thread while this one is processed (parsing and decoding
-    release the GIL, as do the numba kernels), so two cores share the work."""
-    done = object()
-    box: queue.Queue = queue.Queue(maxsize=1)
-    stop = threading.Event()
-
-    def put(item: object) -> bool:
-        while not stop.is_set():
-            try:
-                box.put(item, timeout=0.1)
-                return True
-            except queue.Full:
-                continue
-        return False  # the consumer has gone
-
-    def work() -> None:
-        try:
-            for item in chunks:
-                if not put(item):
-                    return
-            put(done)
-        except Exception as exc:  # noqa: BLE001 -- handed to the consumer, raised there
-            put(exc)
-
-    thread = threading.Thread(target=work, daemon=True, name="hystkit-raw-reader")
-    thread.start()
-    try:
-        while True:
-            item = box.get()
-            if item is done:
-                return
-            if isinstance(item, Exception):
-                raise item
-            yield item
-    finally:
-        stop.set()
-        thread.join(timeout=5)
-
-
-def _run_chain(chain: tuple[Decimator, ...], states: list, x: np.ndarray) -> np.ndarray:
-    for i, stage in enumerate(chain):
-        x, states[i] = decimator_step(stage, states[i], x)
-    return x
-
-
-def _flush_chain(chain: tuple[Decimator, ...], states: list, n_rows: int) -> np.ndarray:
-    """Flush stage by stage: each stage's tail runs through the stages after it."""
-    tail = np.zeros((n_rows, 0))
-    for i, stage in enumerate(chain):
-        if tail.shape[1]:
-            tail, states[i] = decimator_step(stage, states[i], tail)
-        tail = np.concatenate([tail, decimator_flush(stage, states[i])], axis=1)
-    return tail
-
-
 def _finish(reader: RawReader, settings: PreprocessSettings, mid: np.ndarray, t0: float,
             fs: float, factor: int, chain: tuple[Decimator, ...], enc: EncoderSettings,
             state: EncoderState, levels: np.ndarray, logic: tuple | None, extremes: np.ndarray,
-            supply: _SupplyStats, n: int, t_start: float) -> PreprocessResult:
+            supply: SupplyStats, n: int, t_start: float) -> PreprocessResult:
     fs_mid = fs / factor
     notes = []
     n_illegal, n_edges = state.n_illegal, state.n_edges

@@ -37,9 +37,10 @@ import numpy as np
 from scipy import ndimage, signal, stats
 
 from ..io import RawFormat, open_raw
-from ._bridge import bridge_kernel
+from ._bridge import relative_change
+from ._chain import bridge_resistances, flush_chain, run_chain
 from ._decimate import decimator_init, design_chain
-from ._raw import PreprocessSettings, _flush_chain, _raise_bridge, _run_chain
+from ._raw import PreprocessSettings
 
 __all__ = ["CutoffRule", "Spectrum", "butterworth_response", "noise_floor", "raw_gauge_changes",
            "spectrum", "welch_psd"]
@@ -303,19 +304,22 @@ def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float | None 
     above = search & (diff > floor * 10 ** (rule.margin_db / 10))
     if not above.any():
         raise ValueError(f"no spectral line stands {rule.margin_db:g} dB above the noise floor "
-                         f"between {2 * df:.3g} and {f_max:.3g} Hz: nothing to keep (pure "
-                         "noise or a flat signal?)")
+                         f"between {2 * df:.3g} and {f_max:.3g} Hz: "
+                         + _why_no_line(duration, df, rule.floor_width_hz))
     f_signal = float(freq[_last_line_peak(above, diff)])
     cutoff = rule.safety * f_signal
     if not cutoff < fs / 2:
         raise ValueError(f"suggested cut-off {cutoff:.3g} Hz is not below fs/2 = {fs / 2:.3g} Hz: "
                          "the signal reaches the top of the analysed band (analyse the raw file "
                          "at a higher rate)")
-    cutoffs = {"suggested": cutoff}
+    cutoffs, compare_skipped = {"suggested": cutoff}, None
     # fs from time stamps can be 40.000000001 Hz: a 20 Hz comparison would sit at Nyquist.
-    if compare_cutoff is not None and compare_cutoff != cutoff \
-            and compare_cutoff < 0.5 * fs * (1 - 1e-6):
-        cutoffs["compare"] = float(compare_cutoff)
+    if compare_cutoff is not None and compare_cutoff != cutoff:
+        if compare_cutoff < 0.5 * fs * (1 - 1e-6):
+            cutoffs["compare"] = float(compare_cutoff)
+        else:
+            compare_skipped = (f"{compare_cutoff:g} Hz comparison skipped: at or above fs/2 = "
+                               f"{fs / 2:.4g} Hz")
     response = {f"{value:.3g} Hz ({key})": butterworth_response(freq, fs, value, rule.order)
                 for key, value in cutoffs.items()}
     summary = {
@@ -325,10 +329,27 @@ def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float | None 
         "noise_floor_at_f_signal_per_hz": float(np.interp(f_signal, freq, floor)),
         "filters": {key: _filter_summary(freq, fs, value, rule.order, f_signal, floor)
                     for key, value in cutoffs.items()},
+        "compare_skipped": compare_skipped,
     }
     return Spectrum(freq=freq, psd=dict(zip(names, psd, strict=True)), floor=floor,
                     f_signal=f_signal, cutoff=cutoff, response=response, rule=rule, fs=fs,
                     summary=summary)
+
+
+# A running median over fewer bins than this is filled by the harmonics of a short record.
+_FEW_FLOOR_BINS = 20
+
+
+def _why_no_line(duration: float, df: float, floor_width_hz: float) -> str:
+    """The likely cause of finding no line: a record too short to resolve it, or no signal."""
+    bins = floor_width_hz / df
+    if bins >= _FEW_FLOOR_BINS:
+        return "nothing to keep (pure noise or a flat signal?)"
+    return (f"the record is short ({duration:.3g} s, frequency resolution {df:.2g} Hz): a "
+            f"fundamental below {2 * df:.2g} Hz is outside the search, and the "
+            f"{floor_width_hz:g} Hz running median spans only {bins:.0f} bins, which the "
+            f"harmonics fill (or the signal is pure noise); a record of "
+            f"{2 * _FEW_FLOOR_BINS / floor_width_hz:.3g} s or more gives segments long enough")
 
 
 def _last_line_peak(above: np.ndarray, psd: np.ndarray) -> int:
@@ -397,14 +418,8 @@ def raw_gauge_changes(path: str | os.PathLike[str], settings: PreprocessSettings
     ext = np.array([-np.inf, 0, np.inf, 0] * 2, dtype=float)
     parts = []
     for chunk in reader.chunks(columns=("v1", "v2", "v0")):
-        r, bad, ext = bridge_kernel(chunk.v1, chunk.v2, float(settings.r_bridge),
-                                    float(settings.v_supply), ext, chunk.v0)
-        for g in range(2):
-            if bad[g] >= 0:
-                _raise_bridge(reader, g, chunk, int(bad[g]), settings.v_supply)
-        parts.append(_run_chain(chain, states, r))
-    parts.append(_flush_chain(chain, states, 2))
-    r = np.concatenate(parts, axis=1)
-    mean = r.mean(axis=1, keepdims=True)
-    dr1, dr2 = (r - mean) / mean
+        r, ext = bridge_resistances(reader, chunk, settings.r_bridge, settings.v_supply, ext)
+        parts.append(run_chain(chain, states, r))
+    parts.append(flush_chain(chain, states, 2))
+    dr1, dr2 = relative_change(np.concatenate(parts, axis=1), axis=1)
     return {"dr1": dr1, "dr2": dr2, "differential": dr1 - dr2}, fs_a
