@@ -7,7 +7,8 @@ The compensator's estimate is linear in a few output parameters, whatever the mo
   stream's estimate [mm]; ``theta = (a, b)`` starts at ``(1, 0)``. A drifting sensor gain, a
   baseline shift and a changed mounting show up (to first order) as a gain and an offset here.
 - ``"weights"`` (direct compensators whose parameters have output weights ``w`` and a bias
-  ``v_b``, eq. 5.2: mPL, mPL-poly, PL, ladder): ``estimate = sum_k a_k c_k + b`` with
+  ``v_b``, eq. 5.2: mPL, PL, ladder; not mPL-poly, whose output passes the cubic ``g`` of
+  eq. 5.17 and fails the probe run below): ``estimate = sum_k a_k c_k + b`` with
   ``c_k = position_scale * w_k * y_k`` the k-th cell's contribution [mm] (``y_k`` the cell's
   output, from a run with unit weight ``k``), ``a_k`` its multiplier (starts at 1) and ``b``
   the offset correction [mm] (starts at 0). The cells' states do not depend on the weights, so
