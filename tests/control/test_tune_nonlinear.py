@@ -71,9 +71,45 @@ def test_without_budget_the_start_is_kept():
 
 def test_start_gains_that_break_the_constraints_are_refused():
     loop = _ideal("weighting")
-    pm = hc.loop_margins(loop).phase_margin_deg
-    with pytest.raises(ValueError, match="start gains break the constraints"):
-        hc.tune_nonlinear(loop, min_phase_margin=pm + 1.0)
+    m = hc.loop_margins(loop)
+    with pytest.raises(ValueError, match="start gains break the constraints") as info:
+        hc.tune_nonlinear(loop, min_phase_margin=m.phase_margin_deg + 1.0)
+    # numbers to 3 digits, and no crossover said in words rather than "None"
+    gm = "inf (no crossover)" if m.gain_margin_db is None else f"{m.gain_margin_db:.3g}"
+    assert (f"phase margin {m.phase_margin_deg:.3g} deg, gain margin {gm} dB"
+            in str(info.value))
+    assert "None" not in str(info.value)
+
+
+def _case_errors(loop: hc.ControlLoop, experiment: str, noise=None) -> dict:
+    result = hc.run_experiment(experiment, loop, noise)
+    return {k: r.metrics()["e_p_rms"] for k, r in result.cases.items()}
+
+
+def test_held_out_errors_are_those_of_independent_runs():
+    loop = _ideal("weighting")
+    res = hc.tune_nonlinear(loop, max_evaluations=20)
+    assert res.improved
+    rows = res.held_out
+    assert [r["experiment"] for r in rows] == ["frequency"] * 5 + ["amplitude"] * 5
+    for name in hc.HELD_OUT:
+        before = _case_errors(loop, name)
+        after = _case_errors(replace(loop, pid=res.pid), name)
+        got = {r["case"]: (r["before"], r["after"]) for r in rows if r["experiment"] == name}
+        assert got == {k: (before[k], after[k]) for k in before}  # deterministic: bit for bit
+    assert json.dumps(res.to_dict(), allow_nan=False)
+
+
+def test_with_noise_the_tuned_experiment_is_rescored_on_the_next_seed():
+    loop = _ideal("weighting")
+    noise = hc.NoiseSpec(sensor=0.01, seed=3)
+    res = hc.tune_nonlinear(loop, noise=noise, max_evaluations=10, held_out=())
+    (row,) = res.held_out
+    assert (row["experiment"], row["seed"]) == ("sine", 4)
+    other = replace(noise, seed=4)
+    assert row["before"] == _case_errors(loop, "sine", other)["sine"]
+    assert row["after"] == _case_errors(replace(loop, pid=res.pid), "sine", other)["sine"]
+    assert row["before"] != res.cost_start  # another noise draw than the in-sample one
 
 
 def test_an_integral_free_pid_stays_integral_free():
@@ -95,7 +131,9 @@ def test_cli_tune_nonlinear_reports_before_and_after(capsys, tmp_path):
     config = json.loads((out / "config.json").read_text())
     assert config["pid"]["kp"] == tuning["pid"]["kp"]
     assert config["pid"]["source"] == "--tune-nonlinear"
-    assert "before" in stdout and "after" in stdout
+    assert "before" in stdout and "after" in stdout and "held-out" in stdout
+    assert {r["experiment"] for r in tuning["held_out"]} == set(hc.HELD_OUT)
+    assert "margins at rest only" in tuning["constraint"]
 
 
 def test_cli_tune_nonlinear_needs_an_experiment(capsys, tmp_path):
@@ -104,3 +142,16 @@ def test_cli_tune_nonlinear_needs_an_experiment(capsys, tmp_path):
                  str(tmp_path / "x")])
     err = capsys.readouterr().err
     assert code == 2 and "--experiment" in err
+
+
+@pytest.mark.parametrize("option,value", [("--tune-budget", "5"), ("--tune-objective", "max"),
+                                          ("--min-phase-margin", "40"),
+                                          ("--min-gain-margin", "3")])
+def test_cli_tune_options_without_tune_nonlinear_are_refused(capsys, tmp_path, option, value):
+    capsys.readouterr()
+    code = main(["control", "--scheme", "direct", "--experiment", "sine", option, value,
+                 "--out", str(tmp_path / "x")])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(lines) == 1
+    assert lines[0] == f"hystkit: error: {option} only applies with --tune-nonlinear"
+    assert not (tmp_path / "x").exists()

@@ -11,7 +11,9 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from . import _control_report as report
 from ._common import UsageError, check_size, deferred, number, positive_int
+from ._control_options import PID_TYPES, TUNE_TYPES, Checked
 
 if TYPE_CHECKING:  # the library loads when the command runs
     from ..control import SensorModels
@@ -21,39 +23,6 @@ __all__ = ["add_setup_options", "register", "setup_inputs", "setup_loop"]
 # eq. 7.6 (scheme a) and eq. 7.8 (scheme b): the document's plant errors on the eq. 7.3 sine
 DOCUMENT_SINE = {"direct": {"e_p_max": 6.94e-4, "e_p_mean": -1.543e-4, "source": "eq. 7.6"},
                  "weighting": {"e_p_max": 1.86e-4, "e_p_mean": -2.29e-5, "source": "eq. 7.8"}}
-
-
-# PID gains (eq. 7.2): 0 < Kp <= 1e9, 1 us <= Ti <= 1e6 s (inf: no integral action),
-# 0 <= Td <= 1000 s; one type per slot. Far beyond any tuning of a 0.25 kg stage, and the range
-# in which the loop's linearisation and simulation stay well conditioned.
-def _gain(text: str) -> float:
-    """KP: finite, nonzero, |KP| <= 1e9. A negative gain is allowed: a sign error is an
-    experiment worth running (the loop then reports itself unbounded)."""
-    value = number(-1e9, 1e9)(text)
-    if value == 0:
-        raise argparse.ArgumentTypeError("must not be 0 (no feedback at all)")
-    return value
-
-
-_PID_TYPES = (_gain, number(1e-6, 1e6, allow_inf=True), number(0, 1e3))
-_TUNE_TYPES = (number(0, 1e4, low_open=True), number(0, 90, low_open=True, high_open=True))
-
-
-class _Checked(argparse.Action):
-    """``nargs`` values, each parsed by its own type (argparse gives all one type)."""
-
-    def __init__(self, *args, types=(), **kwargs) -> None:
-        self.types = types
-        super().__init__(*args, **kwargs)
-
-    def __call__(self, parser, namespace, values, option_string=None) -> None:
-        parsed = []
-        for meta, parse, text in zip(self.metavar, self.types, values, strict=True):
-            try:
-                parsed.append(parse(text))
-            except argparse.ArgumentTypeError as exc:
-                raise UsageError(f"argument {option_string} {meta}: {exc}") from None
-        setattr(namespace, self.dest, parsed)
 
 
 def _sensor(sensor: str):
@@ -154,33 +123,6 @@ def setup_loop(args: argparse.Namespace):
     return _loop(args, models), models, t_fit
 
 
-def _tune(args: argparse.Namespace, loop):
-    """``--tune-nonlinear``: the PID tuned on the non-linear loop, before/after printed."""
-    from ..control import tune_nonlinear
-
-    try:
-        res = tune_nonlinear(loop, args.experiment, objective=args.tune_objective,
-                             min_phase_margin=args.min_phase_margin,
-                             min_gain_margin_db=args.min_gain_margin, noise=args.noise,
-                             max_evaluations=args.tune_budget)
-    except ValueError as exc:
-        raise UsageError(f"--tune-nonlinear: {exc}") from None
-    a, b = res.pid_start, res.pid
-    print(f"non-linear tuning ({args.experiment}, e_p {res.objective}, phase margin >= "
-          f"{res.min_phase_margin:g} deg, gain margin >= {res.min_gain_margin_db:g} dB): "
-          f"{res.n_evaluations} runs, {res.n_margin_checks} linearisations, "
-          f"{res.seconds:.1f} s")
-    for name, p, cost, m in (("before", a, res.cost_start, res.margins_start),
-                             ("after", b, res.cost, res.margins)):
-        print(f"  {name:<7}Kp = {p.kp:.4g}, Ti = {p.ti:.4g} s, Td = {p.td:.4g} s: e_p "
-              f"{res.objective} {cost:.4g} m; phase margin {_fmt(m.phase_margin_deg)} deg, "
-              f"gain margin {_fmt(m.gain_margin_db) if m.gain_margin_db is not None else 'inf'}"
-              f" dB")
-    if not res.improved:
-        print("  nothing better within the constraints: the start gains are kept")
-    return res
-
-
 def _loop(args: argparse.Namespace, models: SensorModels):
     """The configured loop; a library ValueError here is a bad option combination."""
     from ..control import PID, DisturbanceObserver, Plant, build_loop, design_dob, tune_pid
@@ -204,21 +146,6 @@ def _loop(args: argparse.Namespace, models: SensorModels):
     return loop
 
 
-def _closed_loop(margins) -> str:
-    if margins.closed_loop_stable:
-        return "stable"
-    if margins.marginal:
-        return ("marginally stable (a pole on the unit circle, to within the rounding of its "
-                "eigenvalue: a state the linearised loop neither corrects nor amplifies, e.g. a "
-                "sticking element at rest or a double integrator)")
-    return (f"UNSTABLE (max |pole| {margins.max_pole_radius:.10f}: grows e-fold in "
-            f"{margins.growth_time_s:.3g} s)")
-
-
-def _fmt(x) -> str:
-    return "n/a" if x is None else f"{x:.3g}"
-
-
 def _control(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -240,13 +167,14 @@ def _control(args: argparse.Namespace) -> int:
     paths = _outputs(args, out)
     # refuse before any work
     check_output_folder(out, [p.name for p in paths], args.force, inputs=setup_inputs(args))
+    report.resolve_tune_options(args)
     if args.tune_nonlinear and not args.experiment:
         raise UsageError("--tune-nonlinear tunes on an experiment: give --experiment NAME")
     if args.noise is not None and not args.experiment:
         raise UsageError("--noise runs an experiment with noise: give --experiment NAME")
     t_start = time.perf_counter()
     loop, models, t_fit = setup_loop(args)
-    tuned = _tune(args, loop) if args.tune_nonlinear else None
+    tuned = report.tune(args, loop) if args.tune_nonlinear else None
     if tuned is not None:
         loop = replace(loop, pid=tuned.pid)
     margins = loop_margins(loop)
@@ -258,11 +186,11 @@ def _control(args: argparse.Namespace) -> int:
           f"{models.info['training_source']})")
     p = loop.pid
     print(f"PID Kp = {p.kp:.4g}, Ti = {p.ti:.4g} s, Td = {p.td:.4g} s, Tf = {p.tf:.3g} s; "
-          f"linearised at rest: crossover {_fmt(margins.crossover_hz)} Hz, phase margin "
-          f"{_fmt(margins.phase_margin_deg)} deg, gain margin "
-          f"{_fmt(margins.gain_margin_db) if margins.gain_margin_db is not None else 'inf'} dB,"
+          f"linearised at rest: crossover {report.fmt(margins.crossover_hz)} Hz, phase margin "
+          f"{report.fmt(margins.phase_margin_deg)} deg, gain margin "
+          f"{report.fmt(margins.gain_margin_db, 'inf')} dB,"
           f" closed loop "
-          + _closed_loop(margins))
+          + report.closed_loop(margins))
     config = {
         "hystkit_version": __version__, "scheme": args.scheme, "sensor": args.sensor, "experiment": args.experiment,
         "ts": loop.ts, "mass": loop.plant.mass, "u_max": loop.plant.u_max
@@ -284,9 +212,9 @@ def _control(args: argparse.Namespace) -> int:
             metrics["document"] = DOCUMENT_SINE[args.scheme]
         if tuned is not None:
             metrics["tuning"] = tuned.to_dict()
-        _print_table(metrics)
+        report.print_table(metrics)
         if args.noise is not None:
-            metrics["noise_study"] = _noise_study(args, loop)
+            metrics["noise_study"] = report.noise_study(args, loop)
     # Built in a hidden sibling and renamed into place: the folder appears complete or not at all.
     with atomic_folder(out, args.force, [p.name for p in paths]) as tmp:
         if result is not None:
@@ -311,49 +239,6 @@ def _control(args: argparse.Namespace) -> int:
     print(f"wrote {out}/: {', '.join(x.name for x in paths)} "
           f"({config['seconds']:.1f} s)")
     return 0
-
-
-def _noise_study(args: argparse.Namespace, loop) -> dict:
-    """``--noise``: the experiment without and with the noise, each without and with the DOB
-    (the loop's own, else one from ``design_dob``); the table printed, the rows returned."""
-    from ..control import design_dob, noise_study
-
-    try:
-        dob = loop.dob or design_dob(loop)
-    except ValueError as exc:
-        raise UsageError(f"--noise: the DOB comparison needs a DOB: {exc}") from None
-    rows = noise_study(args.experiment, loop, args.noise, dob)
-    n = args.noise
-    print(f"noise study: sensor SD {n.sensor:g} sensor units (= {n.sensor * loop.sensor_gain:.3g}"
-          f" m through g_s), process SD {n.process:g} N, seed {n.seed}; DOB {dob.f_q:.3g} Hz")
-    print(f"{'noise':<7}{'DOB':<5}{'case':<14}{'e_p,rms [m]':>13}{'e_p,max [m]':>13}"
-          f"{'u rms [N]':>11}{'sensor noise SD':>17}")
-    for r in rows:
-        print(f"{'yes' if r['noise'] else 'no':<7}{'on' if r['dob'] else 'off':<5}"
-              f"{r['case']:<14}{_fmt(r['e_p_rms']):>13}{_fmt(r['e_p_max']):>13}"
-              f"{_fmt(r['u_rms']):>11}{_fmt(r['sensor_noise_sd']):>17}"
-              + ("" if r["bounded"] else "  UNBOUNDED"))
-    return {"dob_f_q": dob.f_q, "noise": n.to_dict(), "rows": rows}
-
-
-def _print_table(metrics: dict) -> None:
-    print(f"{'case':<14}{'e_p,max [m]':>12}{'e_p,mean [m]':>14}{'e_p,rms [m]':>13}"
-          f"{'tracking rms':>14}{'bounded':>9}{'compile s':>11}{'simulation s':>14}")
-    for label, m in metrics["cases"].items():
-        row = (f"{label:<14}{_fmt(m.get('e_p_max')):>12}{_fmt(m.get('e_p_mean')):>14}"
-               f"{_fmt(m.get('e_p_rms')):>13}{_fmt(m.get('tracking_rms')):>14}"
-               f"{'yes' if m['bounded'] else 'NO':>9}{m['compile_seconds']:>11.3f}"
-               f"{m['seconds']:>14.4f}")
-        if "e_p_max_during" in m:
-            row += (f"  |e_p| max 2.0-2.2 s {_fmt(m['e_p_max_during'])} m, "
-                    f"after 2.5 s {_fmt(m['e_p_max_after'])} m")
-        if not m["bounded"]:
-            row += f"  stopped at t = {m['stop_time']:.3f} s: {m['stop_reason']}"
-        print(row)
-    if "document" in metrics:
-        d = metrics["document"]
-        print(f"document ({d['source']}): e_p,max {d['e_p_max']:.3g} m, e_p,mean "
-              f"{d['e_p_mean']:.4g} m")
 
 
 def _noise_option(text: str):
@@ -393,11 +278,11 @@ def add_setup_options(p: argparse.ArgumentParser, *, scheme_required: bool = Tru
     p.add_argument("--dob", action="store_true", help="add the disturbance observer (sec. 7.4)")
     p.add_argument("--dob-hz", type=number(0, 1e6, low_open=True),
                    help="Q-filter bandwidth [Hz] (default: chosen by design_dob)")
-    p.add_argument("--pid", nargs=3, action=_Checked, types=_PID_TYPES,
+    p.add_argument("--pid", nargs=3, action=Checked, types=PID_TYPES,
                    metavar=("KP", "TI", "TD"),
                    help="PID gains: KP nonzero (|KP| <= 1e9), TI > 0 [s] (inf: no integral action), TD >= 0 [s] "
                         "(default: the document's for the scheme)")
-    p.add_argument("--tune", nargs=2, action=_Checked, types=_TUNE_TYPES,
+    p.add_argument("--tune", nargs=2, action=Checked, types=TUNE_TYPES,
                    metavar=("FC_HZ", "PM_DEG"),
                    help="tune the PID for this crossover (> 0 Hz) and phase margin (between 0 "
                         "and 90 deg) on the linearised loop")
@@ -479,14 +364,14 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="re-tune the PID (from the gains given or the document's) on the "
                         "non-linear loop: minimise the experiment's plant error, keeping the "
                         "linearised margins")
-    p.add_argument("--tune-objective", choices=("rms", "max"), default="rms",
+    p.add_argument("--tune-objective", choices=("rms", "max"),
                    help="plant error to minimise with --tune-nonlinear: e_p rms or e_p max "
                         "(default rms; the worst case of the experiment)")
-    p.add_argument("--tune-budget", type=positive_int, default=300,
+    p.add_argument("--tune-budget", type=positive_int,
                    help="most simulations --tune-nonlinear may run (default 300)")
-    p.add_argument("--min-phase-margin", type=number(0, 90, high_open=True), default=30.0,
+    p.add_argument("--min-phase-margin", type=number(0, 90, high_open=True),
                    help="--tune-nonlinear constraint on the linearised loop [deg] (default 30)")
-    p.add_argument("--min-gain-margin", type=number(0, 60), default=6.0,
+    p.add_argument("--min-gain-margin", type=number(0, 60),
                    help="--tune-nonlinear constraint on the linearised loop [dB] (default 6)")
     p.add_argument("--out", type=Path, help="output folder (default: a new timestamped one)")
     p.set_defaults(run=_control)

@@ -19,7 +19,7 @@ __getattr__, __dir__ = lazy_exports(
      "_noise": ("NoiseSpec", "parse_noise"),
      "_stability": ("CircleResult", "Sector", "StabilityReport", "chord_sector",
                     "circle_criterion", "global_stability", "measure_sector", "sector_channel"),
-     "_tuning": ("OBJECTIVES", "TuneResult", "tune_nonlinear"),
+     "_tuning": ("HELD_OUT", "OBJECTIVES", "TuneResult", "tune_nonlinear"),
      "_loop": ("ControlLoop", "LoopResponse", "LoopState", "rest_state", "simulate_loop",
                "simulate_loop_reference", "tare"),
      "_nlsys": ("as_nlsys", "loop_initial_state", "loop_nlsys"),

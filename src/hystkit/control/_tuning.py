@@ -10,7 +10,10 @@ search finds degenerate corners (``Kp -> 0`` with ``Td -> inf``, the same deriva
 constraints: a candidate that beats the best so far counts only if its phase and gain margins
 reach the minimum and its linearised closed loop has no pole further out than the start's.
 The result is never worse than the start: if nothing better and feasible is found, the start
-is returned.
+is returned. These margins at rest are the only stability check during the search (sec. 12 of
+docs/control.md shows a loop they call stable diverge). The costs are in-sample; the result also
+carries the start's and the result's errors on experiments the search never saw (:data:`HELD_OUT`,
+and with noise another seed).
 """
 
 from __future__ import annotations
@@ -27,11 +30,15 @@ from ._experiments import run_experiment
 from ._loop import ControlLoop
 from ._noise import NoiseSpec
 
-__all__ = ["OBJECTIVES", "TuneResult", "tune_nonlinear"]
+__all__ = ["HELD_OUT", "OBJECTIVES", "TuneResult", "tune_nonlinear"]
 
 OBJECTIVES = ("rms", "max")
 """Plant-error measures to minimise: ``e_p_rms`` or ``e_p_max`` (eq. 7.6, 7.8), the worst case
 of the experiment."""
+
+HELD_OUT = ("frequency", "amplitude")
+"""Experiments the tuned gains are scored on besides the one they were tuned on (that one
+itself is skipped; with noise the tuned experiment is re-run on the next seed as well)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,11 +66,15 @@ class TuneResult:
     n_margin_checks : int
         Linearisations (only for candidates that beat the best so far).
     seconds : float
-        Wall time of the tuning [s].
+        Wall time of the search [s] (the held-out runs not included).
     improved : bool
         A better feasible PID was found.
     message : str
         The optimiser's message.
+    held_out : tuple of dict
+        Out-of-sample check: per case of each held-out experiment, ``experiment``, ``case``,
+        ``seed`` (None without noise) and the plant error ``before`` / ``after`` [m] (None for
+        an unbounded run). Never used by the search.
     """
 
     pid_start: PID
@@ -81,6 +92,7 @@ class TuneResult:
     seconds: float
     improved: bool
     message: str
+    held_out: tuple = ()
 
     def to_dict(self) -> dict:
         """The result as a JSON-safe dict (costs in m, ``ti = inf`` as None)."""
@@ -96,7 +108,9 @@ class TuneResult:
                 "min_phase_margin_deg": self.min_phase_margin,
                 "min_gain_margin_db": self.min_gain_margin_db,
                 "n_evaluations": self.n_evaluations, "n_margin_checks": self.n_margin_checks,
-                "seconds": self.seconds, "improved": self.improved, "message": self.message}
+                "seconds": self.seconds, "improved": self.improved, "message": self.message,
+                "held_out": [dict(r) for r in self.held_out],
+                "constraint": "linearised margins at rest only (no global stability check)"}
 
 
 def _feasible(m: LoopMargins, limit: float, min_pm: float, min_gm: float) -> bool:
@@ -105,10 +119,39 @@ def _feasible(m: LoopMargins, limit: float, min_pm: float, min_gm: float) -> boo
             and (m.gain_margin_db is None or m.gain_margin_db >= min_gm))
 
 
+def _fmt(x: float | None, none: str) -> str:
+    return none if x is None else f"{x:.3g}"
+
+
+def _case_errors(loop: ControlLoop, experiment: str, key: str,
+                 noise: NoiseSpec | None) -> dict[str, float | None]:
+    """Plant error ``key`` [m] of each case of ``experiment``; None for an unbounded run."""
+    result = run_experiment(experiment, loop, noise)
+    return {label: (r.metrics()[key] if r.bounded else None)
+            for label, r in result.cases.items()}
+
+
+def _held_out(loop: ControlLoop, tuned: PID, experiment: str, key: str,
+              noise: NoiseSpec | None, experiments: tuple[str, ...]) -> tuple[dict, ...]:
+    """Before/after plant errors on experiments (and a noise seed) the search never saw."""
+    runs = [(e, noise) for e in experiments if e != experiment]
+    if noise is not None and not noise.silent:
+        runs = [(experiment, replace(noise, seed=noise.seed + 1))] + [
+            (e, replace(noise, seed=noise.seed + 1)) for e, _ in runs]
+    rows = []
+    for name, spec in runs:
+        before = _case_errors(loop, name, key, spec)
+        after = _case_errors(replace(loop, pid=tuned), name, key, spec)
+        rows += [{"experiment": name, "case": label, "seed": None if spec is None else spec.seed,
+                  "before": before[label], "after": after[label]} for label in before]
+    return tuple(rows)
+
+
 def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: str = "rms",
                    min_phase_margin: float = 30.0, min_gain_margin_db: float = 6.0,
                    noise: NoiseSpec | None = None, max_evaluations: int = 300,
-                   span: float = 100.0) -> TuneResult:
+                   span: float = 100.0,
+                   held_out: tuple[str, ...] = HELD_OUT) -> TuneResult:
     """Minimise the plant error of ``experiment`` over the PID gains of ``loop``.
 
     Parameters
@@ -129,6 +172,10 @@ def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: st
         Budget of simulations.
     span : float
         Each gain stays within ``[start / span, start * span]``.
+    held_out : tuple of str, default :data:`HELD_OUT`
+        Experiments to score the start and the result on afterwards (``experiment`` itself is
+        skipped; ``()`` for none). With noise, on seed ``noise.seed + 1``, and the tuned
+        experiment too.
 
     Returns
     -------
@@ -166,9 +213,10 @@ def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: st
     limit = max(1.0, margins_start.max_pole_radius) + 1e-12
     if not _feasible(margins_start, limit, min_phase_margin, min_gain_margin_db):
         raise ValueError(f"the start gains break the constraints (phase margin "
-                         f"{margins_start.phase_margin_deg} deg, gain margin "
-                         f"{margins_start.gain_margin_db} dB; need >= {min_phase_margin} deg, "
-                         f">= {min_gain_margin_db} dB): lower the minimums or start elsewhere")
+                         f"{_fmt(margins_start.phase_margin_deg, 'none')} deg, gain margin "
+                         f"{_fmt(margins_start.gain_margin_db, 'inf (no crossover)')} dB; "
+                         f"need >= {min_phase_margin:.3g} deg, >= {min_gain_margin_db:.3g} dB): "
+                         f"lower the minimums or start elsewhere")
     cost_start = cost(start)
     if not np.isfinite(cost_start):
         raise ValueError(f"the start gains leave the {experiment} run unbounded")
@@ -178,7 +226,10 @@ def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: st
         pid = gains(x)
         c = cost(pid)
         if not c < best["cost"]:
-            return c  # no better than the best: its feasibility does not matter
+            # No better than the best: returned unchecked (a margin check per run would
+            # double the cost). Nelder-Mead then sees an infeasible point as finite when worse
+            # and inf when better; only checked, feasible points are ever kept as the result.
+            return c
         counts["checks"] += 1
         m = loop_margins(replace(loop, pid=pid))
         if not _feasible(m, limit, min_phase_margin, min_gain_margin_db):
@@ -199,7 +250,9 @@ def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: st
                    options={"maxfev": max_evaluations, "initial_simplex": simplex,
                             "xatol": 1e-3, "fatol": 1e-9 * cost_start})
     improved = best["pid"] is not start
+    seconds = time.perf_counter() - t_start
+    rows = _held_out(loop, best["pid"], experiment, key, noise, tuple(held_out))
     return TuneResult(start, best["pid"], objective, experiment, cost_start, best["cost"],
                       margins_start, best["margins"], min_phase_margin, min_gain_margin_db,
-                      counts["runs"], counts["checks"], time.perf_counter() - t_start,
-                      improved, str(res.message))
+                      counts["runs"], counts["checks"], seconds, improved, str(res.message),
+                      rows)
