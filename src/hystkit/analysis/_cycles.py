@@ -1,10 +1,10 @@
 """Splitting a recording into load-unload cycles of its input (figs. 4.16-4.17).
 
 A cycle runs from one minimum of the input (the position) to the next: loading from the
-minimum to the maximum, unloading back. Minima are found with a hysteresis comparator, as the
-loop-area metric counts sweeps (:func:`hystkit.metrics.loop_area`): a reversal counts only
-after the input has come back by a dead band (1 % of its range by default), so sensor noise
-and the flat runs of a quantised encoder make no spurious cycles. The bounds partition the
+minimum to the maximum, unloading back. Minima are found with the hysteresis comparator the
+loop-area metric counts sweeps with (:func:`hystkit.metrics.confirmed_reversals`): a reversal
+counts only after the input has come back by a dead band (1 % of its range by default), so
+sensor noise and the flat runs of a quantised encoder make no spurious cycles. The bounds partition the
 record: the part before the first minimum and after the last are kept as incomplete pieces,
 so the pieces put back together give the whole recording.
 """
@@ -16,11 +16,13 @@ from itertools import pairwise
 import numpy as np
 import numpy.typing as npt
 
+from ..metrics import REVERSAL_DEADBAND, confirmed_reversals
+
 __all__ = ["DEFAULT_DEADBAND", "cycle_bounds", "input_minima", "split_cycles"]
 
-# Fraction of the input range the input must come back by before a reversal counts; the same
-# rule and value as the loop-area metric's cycle count (metrics._REVERSAL_DEADBAND).
-DEFAULT_DEADBAND = 0.01
+# Fraction of the input range the input must come back by before a reversal counts: the
+# loop-area metric's, with the same comparator (hystkit.metrics.confirmed_reversals).
+DEFAULT_DEADBAND = REVERSAL_DEADBAND
 
 
 def input_minima(x: npt.ArrayLike, deadband: float = DEFAULT_DEADBAND) -> np.ndarray:
@@ -90,34 +92,19 @@ def bounds_of(minima: np.ndarray, n: int) -> np.ndarray:
 
 
 def _confirmed_minima(x: np.ndarray, band: float) -> list[int]:
-    """Indices of the minima a hysteresis comparator with dead band `band` confirms.
+    """Indices of the minima the hysteresis comparator with dead band `band` confirms.
 
-    The direction is unknown until `x` leaves the band around its first value; the running
-    extremum is then followed, and a minimum is confirmed when `x` rises above it by more
-    than `band` (strictly, so a zero band still needs a rise). A record that starts by rising
-    starts at a minimum only if that start lies no higher than the first confirmed minimum
-    (plus the band): a sine started at mid-range has no cycle before its first minimum.
+    The comparator is the loop-area metric's (:func:`hystkit.metrics.confirmed_reversals`).
+    A record that starts by rising starts at a minimum only if that start (the lowest sample
+    before the input left the band) lies no higher than the first confirmed minimum (plus the
+    band): a sine started at mid-range has no cycle before its first minimum.
     """
-    minima: list[int] = []
-    direction, ext_i, start = 0, 0, -1
-    for i in range(1, x.size):
-        if direction == 0:
-            if abs(x[i] - x[0]) > band:
-                direction = 1 if x[i] > x[0] else -1
-                start = int(np.argmin(x[: i + 1])) if direction == 1 else -1
-                ext_i = i
-        elif direction == 1:
-            if x[i] > x[ext_i]:
-                ext_i = i
-            elif x[ext_i] - x[i] > band:
-                direction, ext_i = -1, i
-        elif x[i] < x[ext_i]:
-            ext_i = i
-        elif x[i] - x[ext_i] > band:
-            minima.append(ext_i)
-            direction, ext_i = 1, i
-    if start >= 0 and minima and x[start] <= x[minima[0]] + band:
-        minima.insert(0, start)
+    rev = confirmed_reversals(x, band)
+    minima = rev.index[~rev.is_max].tolist()
+    if rev.onset >= 0 and rev.rising_first and minima:
+        start = int(np.argmin(x[: rev.onset + 1]))
+        if x[start] <= x[minima[0]] + band:
+            minima.insert(0, start)
     return minima
 
 

@@ -7,6 +7,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from ._reversals import REVERSAL_DEADBAND, confirmed_reversals
+
 # Kaiser beta of MATLAB's ``sinad``: its side lobes (~ -350 dB) sit below double
 # precision, so no leakage escapes the main lobes of the DC and the fundamental.
 _KAISER_BETA = 38.0
@@ -17,9 +19,6 @@ _KAISER_BETA = 38.0
 # (Checked numerically: the zero-padded power spectrum of the window drops to the rounding
 # floor, ~1e-32 of its peak, exactly at 12.14 bins.)
 _LOBE_HALF_WIDTH = math.ceil(math.sqrt(1.0 + (_KAISER_BETA / math.pi) ** 2) + 0.5)
-# A reversal of x counts only after x came back by this fraction of its range,
-# so sensor noise and flat runs do not create spurious cycles.
-_REVERSAL_DEADBAND = 0.01
 
 
 def _as_signal(a: npt.ArrayLike, name: str) -> np.ndarray:
@@ -181,22 +180,7 @@ def _sweep_total(x: np.ndarray, deadband: float) -> float:
     A reversal is confirmed once `x` has moved back by more than `deadband` from its
     running extremum (a hysteresis comparator), so noise and flat runs add nothing.
     """
-    v = x[np.r_[True, np.diff(x) != 0.0]]  # collapse flat runs
-    # Only sign changes of the slope can be reversals; this keeps the loop short.
-    d = np.sign(np.diff(v))
-    v = np.r_[v[0], v[1:-1][d[1:] != d[:-1]], v[-1]]
-    turns = [v[0]]
-    direction, ext = 0, v[0]
-    for val in v[1:]:
-        if direction == 0:  # the first sweep's direction is unknown until x leaves the band
-            if abs(val - v[0]) > deadband:
-                direction, ext = (1 if val > v[0] else -1), val
-        elif direction * (val - ext) > 0.0:
-            ext = val  # still moving the same way
-        elif abs(val - ext) > deadband:
-            turns.append(ext)
-            direction, ext = -direction, val
-    turns.append(v[-1])
+    turns = x[np.r_[0, confirmed_reversals(x, deadband).index, x.size - 1]]
     return float(np.sum(np.abs(np.diff(turns))))
 
 
@@ -239,7 +223,7 @@ def loop_area(x: npt.ArrayLike, y: npt.ArrayLike) -> float:
         raise ValueError("x and y must not be constant; the loop cannot be normalised")
     x_hat = (xs - xs.min()) / x_rng
     y_hat = (ys - ys.min()) / y_rng
-    n_cycles = max(1.0, _sweep_total(x_hat, _REVERSAL_DEADBAND) / 2.0)
+    n_cycles = max(1.0, _sweep_total(x_hat, REVERSAL_DEADBAND) / 2.0)
     from scipy.integrate import trapezoid
 
     return 100.0 / n_cycles * float(trapezoid(y_hat, x_hat))  # eq. 5.15
