@@ -142,7 +142,8 @@ class SettlingFit:
 class SettlingFitError(ValueError):
     """The settling law could not be fitted: not converged, not identifiable, collapsed onto a
     bound, a parameter not determined (standard error above its value), or residuals that show
-    the law misses the log's shape."""
+    the law misses the log's shape.
+    """
 
 
 def fit_settling(t_h: npt.ArrayLike, r: npt.ArrayLike, model: str = "auto") -> SettlingFit:
