@@ -161,10 +161,12 @@ def _print_standard_errors(se: dict | None) -> None:
     if not se:
         return
     rel = [r for r in se["relative"] if r is not None]
-    n_blind = sum(r is None for r in se["standard_errors"])
+    fixed = se.get("fixed", [])  # held fixed by the fit (a gauge): no SE, not undetermined
+    n_blind = sum(r is None for r in se["standard_errors"]) - len(fixed)
     worst = f"largest relative SE {max(rel):.3g}" if rel else "no finite SE"
     print(f"  standard errors (Gauss-Newton, finite-difference Jacobian): {worst}"
-          f"{f'; {n_blind} parameter(s) not determined by the data' if n_blind else ''}")
+          f"{f'; {n_blind} parameter(s) not determined by the data' if n_blind else ''}"
+          f"{'; fixed by the fit: ' + ', '.join(fixed) if fixed else ''}")
 
 
 def _compensate(args: argparse.Namespace) -> int:

@@ -8,7 +8,9 @@ chunk's Jacobian rows are folded into the triangular factor of a running QR deco
 (``R <- qr([R; J_chunk])``, TSQR). ``R`` has the Jacobian's singular values and right singular
 vectors, so the standard errors, the undetermined parameters and the condition number are the
 dense route's, with memory ``O(chunk x n_params)``. Forward differences (not a family's exact
-sensitivities) keep the numbers those of the dense route.
+sensitivities) keep the numbers those of the dense route. Parameters the family's fit holds
+fixed (:meth:`hystkit.models.Family.fixed_params`, a gauge) are not differentiated: they are
+reported as fixed, not as undetermined.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..models import Family
-from ._diagnostics import error_steps, errors_from_factor
+from ._diagnostics import error_steps, errors_from_factor, fixed_mask, parameter_names
 from ._param_vector import flatten_params
 
 __all__ = ["chunked_standard_errors"]
@@ -36,7 +38,8 @@ def chunked_standard_errors(family: Family, structure: Any, params: Any,
     Parameters
     ----------
     family, structure, params
-        The fitted model; ``params``' float entries (``to_dict`` order) are differentiated.
+        The fitted model; ``params``' float entries (``to_dict`` order) are differentiated,
+        except those the family's fit holds fixed (``family.fixed_params``).
     inputs, targets : sequences of arrays
         Input and target per recording; each recording runs from the family's rest state.
     chunk : int, optional
@@ -48,16 +51,17 @@ def chunked_standard_errors(family: Family, structure: Any, params: Any,
         As :func:`~._diagnostics.standard_errors`.
     """
     theta, rebuild = flatten_params(params)
-    steps = error_steps(theta)
-    shifted = [params] + [rebuild(theta + h * e) for h, e in zip(steps, np.eye(theta.size))]
-    rows = chunk or max(256, _CHUNK_ENTRIES // max(theta.size, 1))
-    r_factor, sse, n = np.zeros((0, theta.size)), 0.0, 0
+    free = ~fixed_mask(family, structure, params)
+    steps = error_steps(theta)[free]
+    shifted = [params] + [rebuild(theta + h * e) for h, e in zip(steps, np.eye(theta.size)[free])]
+    rows = chunk or max(256, _CHUNK_ENTRIES // max(steps.size, 1))
+    r_factor, sse, n = np.zeros((0, steps.size)), 0.0, 0
     for u, target in zip(inputs, targets, strict=True):
         for r0, jac in _jacobian_chunks(family, structure, shifted, steps, u, target, rows):
             sse += float(r0 @ r0)
             n += r0.size
             r_factor = np.linalg.qr(np.vstack([r_factor, jac]), mode="r")
-    return errors_from_factor(theta, r_factor, sse, n)
+    return errors_from_factor(theta, r_factor, sse, n, free, parameter_names(params))
 
 
 def _jacobian_chunks(family: Family, structure: Any, shifted: list, steps: np.ndarray,

@@ -14,10 +14,12 @@ import numpy as np
 
 from ..identification import FitResult
 from ..metrics import r2
+from ..models import Family
 from ._param_vector import flatten_params
 
 __all__ = ["BOUND_TOLERANCE", "COLLAPSE_RATIO", "MIN_SAMPLES_PER_PARAM", "bound_flags",
-           "error_steps", "errors_from_factor", "fit_status", "standard_errors"]
+           "error_steps", "errors_from_factor", "fit_status", "fixed_mask", "parameter_names",
+           "standard_errors"]
 
 # A fit needs at least this many samples per fitted number (with fewer, the residual has too
 # few degrees of freedom for the noise level, hence for standard errors).
@@ -29,28 +31,68 @@ BOUND_TOLERANCE = 1e-4
 
 
 def standard_errors(residual: Callable[[np.ndarray], np.ndarray], params: Any,
-                    n_data: int) -> dict:
+                    n_data: int, fixed: np.ndarray | None = None) -> dict:
     """Standard errors of the float parameters from a finite-difference Jacobian at the optimum.
 
     ``residual(params)`` is the model-minus-target vector of the fit; the covariance is
-    ``s^2 (J^T J)^-1`` with ``s^2 = SSE / (n - p)`` (Gauss-Newton). Parameters the data do not
-    determine (``J^T J`` numerically singular) get ``inf``.
+    ``s^2 (J^T J)^-1`` with ``s^2 = SSE / (n - p)`` (Gauss-Newton), ``p`` the free parameters.
+    Parameters the data do not determine (``J^T J`` numerically singular) get ``inf``; those
+    in ``fixed`` (see :func:`fixed_mask`) are not differentiated.
 
     Returns
     -------
     dict
         ``values`` and ``standard_errors`` (flat, the order of ``params.to_dict()``'s float
-        entries), ``relative`` (SE / |value|), ``condition_number`` of ``J^T J``.
+        entries; None where undetermined or fixed), ``relative`` (SE / |value|),
+        ``condition_number`` of ``J^T J`` over the free parameters, ``fixed`` (the names of
+        the parameters the fit holds fixed).
     """
     theta, rebuild = flatten_params(params)
+    free = _free(theta, fixed)
     r0 = residual(rebuild(theta))
     steps = error_steps(theta)
-    jac = np.empty((r0.size, theta.size))
-    for j, h in enumerate(steps):
+    jac = np.empty((r0.size, int(free.sum())))
+    for col, j in enumerate(np.flatnonzero(free)):
         shifted = theta.copy()
-        shifted[j] += h
-        jac[:, j] = (residual(rebuild(shifted)) - r0) / h
-    return errors_from_factor(theta, jac, float(r0 @ r0), n_data)
+        shifted[j] += steps[j]
+        jac[:, col] = (residual(rebuild(shifted)) - r0) / steps[j]
+    return errors_from_factor(theta, jac, float(r0 @ r0), n_data, free, parameter_names(params))
+
+
+def parameter_names(params: Any) -> list[str]:
+    """Names of the float entries of ``params.to_dict()`` in :func:`flatten_params` order
+    (depth first: ``w[1]``, ``v_b``; nested lists ``a[0][2]``)."""
+    names: list[str] = []
+
+    def walk(value: object, name: str) -> None:
+        if isinstance(value, dict):
+            for key, item in value.items():
+                walk(item, f"{name}.{key}" if name else str(key))
+        elif isinstance(value, list | tuple):
+            for i, item in enumerate(value):
+                walk(item, f"{name}[{i}]")
+        elif isinstance(value, float):
+            names.append(name)
+
+    walk(params.to_dict(), "")
+    return names
+
+
+def fixed_mask(family: Family, structure: Any, params: Any) -> np.ndarray:
+    """Which float entries of ``params`` (:func:`flatten_params` order) the family's fit holds
+    fixed (:meth:`hystkit.models.Family.fixed_params`), as a boolean array; the hook is
+    optional, so a family object without it (a duck-typed stand-in) holds none fixed."""
+    names = parameter_names(params)
+    declared = getattr(family, "fixed_params", None)
+    fixed = set() if declared is None else set(declared(structure, params))
+    if unknown := fixed.difference(names):
+        raise ValueError(f"{family.name}.fixed_params names {sorted(unknown)}, which are not "
+                         f"float entries of its parameters")
+    return np.array([name in fixed for name in names], dtype=bool)
+
+
+def _free(theta: np.ndarray, fixed: np.ndarray | None) -> np.ndarray:
+    return np.ones(theta.size, bool) if fixed is None else ~np.asarray(fixed, bool)
 
 
 def error_steps(theta: np.ndarray) -> np.ndarray:
@@ -58,14 +100,18 @@ def error_steps(theta: np.ndarray) -> np.ndarray:
     return 1e-6 * np.maximum(np.abs(theta), 1e-3)
 
 
-def errors_from_factor(theta: np.ndarray, factor: np.ndarray, sse: float, n_data: int) -> dict:
+def errors_from_factor(theta: np.ndarray, factor: np.ndarray, sse: float, n_data: int,
+                       free: np.ndarray | None = None, names: list[str] | None = None) -> dict:
     """:func:`standard_errors`' result from any ``factor`` with ``factor^T factor = J^T J``.
 
     ``factor`` is the Jacobian itself or its triangular factor ``R`` (``J = Q R``): both have
     the same singular values and right singular vectors, so the chunked route
-    (:mod:`._chunked_errors`) gives the dense one's numbers without holding ``J``.
+    (:mod:`._chunked_errors`) gives the dense one's numbers without holding ``J``. Its columns
+    are the ``free`` parameters (default: all); the others are held fixed by the fit and get
+    no standard error. ``names`` (:func:`parameter_names`; default ``theta[i]``) name them.
     """
-    dof = max(n_data - theta.size, 1)
+    free = np.ones(theta.size, bool) if free is None else np.asarray(free, bool)
+    dof = max(n_data - int(free.sum()), 1)
     sigma2 = sse / dof
     _u, sv, vt = np.linalg.svd(factor, full_matrices=False)
     determined = sv > sv[0] * 1e-8 if sv.size and sv[0] > 0 else np.zeros(sv.size, bool)
@@ -73,13 +119,17 @@ def errors_from_factor(theta: np.ndarray, factor: np.ndarray, sse: float, n_data
     variance = sigma2 * np.einsum("kj,k,kj->j", vt, inv_sv2, vt)
     # A parameter with weight in an undetermined direction has no finite standard error.
     blind = np.abs(vt[~determined]).max(axis=0) > 1e-6 if (~determined).any() \
-        else np.zeros(theta.size, bool)
-    se = np.where(blind, np.inf, np.sqrt(np.maximum(variance, 0.0)))
+        else np.zeros(vt.shape[1], bool)
+    se = np.full(theta.size, np.inf)
+    se[free] = np.where(blind, np.inf, np.sqrt(np.maximum(variance, 0.0)))
     with np.errstate(divide="ignore", invalid="ignore"):
         rel = np.where(theta != 0, se / np.abs(theta), np.inf)
     cond = float((sv[0] / sv[-1]) ** 2) if sv.size and sv[-1] > 0 else float("inf")
+    names = names or [f"theta[{i}]" for i in range(theta.size)]
+    fixed = [name for name, f in zip(names, free, strict=True) if not f]
     return {"values": theta.tolist(), "standard_errors": _finite_or_none(se),
-            "relative": _finite_or_none(rel), "condition_number": _finite_or_none(cond)}
+            "relative": _finite_or_none(rel), "condition_number": _finite_or_none(cond),
+            "fixed": fixed}
 
 
 def _finite_or_none(x):

@@ -27,7 +27,7 @@ from ._centring import (
 from ._chunked_errors import chunked_standard_errors
 from ._compensator import MODES, Compensator, check_training_data, inverse_is_bounded
 from ._conventions import LinearBaseline, prepare_training_data
-from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status
+from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status, fixed_mask
 from ._param_vector import flatten_params, simulate_segments
 from ._training_checks import MIN_SAMPLES, check_fitting_data
 
@@ -41,17 +41,25 @@ _OUTSIDE = 1e3
 
 
 def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.ndarray],
-                    targets: list[np.ndarray]) -> tuple[Any, str]:
-    """Refit the float parameters on per-recording simulations (generic, finite differences)."""
-    theta0, rebuild = flatten_params(params)
+                    targets: list[np.ndarray], fixed: np.ndarray) -> tuple[Any, str]:
+    """Refit the float parameters on per-recording simulations (generic, finite differences);
+    those in ``fixed`` (the family fit's gauge, :func:`~._diagnostics.fixed_mask`) stay."""
+    theta_all, rebuild = flatten_params(params)
+    free = ~fixed
+    theta0 = theta_all[free]
     if theta0.size > MAX_POLISH_PARAMS:
         return params, (f"{theta0.size} parameters: fitted on the concatenated recordings, "
                         f"joint polish skipped (more than {MAX_POLISH_PARAMS})")
     target = np.concatenate(targets)
 
+    def full(theta: np.ndarray) -> Any:
+        vector = theta_all.copy()
+        vector[free] = theta
+        return rebuild(vector)
+
     def residual(theta: np.ndarray) -> np.ndarray:
         try:
-            r = simulate_segments(run, structure, rebuild(theta), inputs) - target
+            r = simulate_segments(run, structure, full(theta), inputs) - target
         except (ValueError, HystkitError):
             return np.full(target.size, _OUTSIDE)
         return r if np.all(np.isfinite(r)) else np.full(target.size, _OUTSIDE)
@@ -61,13 +69,14 @@ def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.
     sol = least_squares(residual, theta0, method="trf", x_scale="jac", max_nfev=100)
     start_cost = 0.5 * float(np.sum(residual(theta0) ** 2))
     if sol.cost < start_cost:
-        return rebuild(sol.x), f"joint polish over {len(inputs)} recordings: {sol.message}"
+        return full(sol.x), f"joint polish over {len(inputs)} recordings: {sol.message}"
     return params, "joint polish found nothing better than the concatenated fit"
 
 
-def _count_params(params: Any) -> int:
-    """Fitted numbers: the float entries (integers in a params dict are structural)."""
-    return int(flatten_params(params)[0].size)
+def _count_params(params: Any, fixed: np.ndarray) -> int:
+    """Fitted numbers: the float entries (integers in a params dict are structural) that the
+    family's fit does not hold fixed."""
+    return int(flatten_params(params)[0].size - np.count_nonzero(fixed))
 
 
 def fit_compensator(recordings: Recording | Sequence[Recording], size: int | None = None, *,
@@ -127,9 +136,11 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
     inputs, targets = (s_list, p_list) if mode == "direct" else (p_list, s_list)
     result = _fit_family(family, structure, mode, s, p, recs[0].source)
     params, joint_note = result.params, ""
+    fixed = fixed_mask(family, structure, params)
     if len(recs) > 1:
-        params, joint_note = _polish_jointly(family.simulate, structure, params, inputs, targets)
-    n_params = _count_params(params)
+        params, joint_note = _polish_jointly(family.simulate, structure, params, inputs, targets,
+                                             fixed)
+    n_params = _count_params(params, fixed)
     if s.size < MIN_SAMPLES_PER_PARAM * n_params:
         raise InputError(f"{recs[0].source}: column 'position': {s.size} samples for "
                          f"{n_params} parameters of {model}; a fit needs at least "
@@ -203,7 +214,7 @@ def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording], s
     sse = float(residual @ residual)
     del estimate, residual
     n = p.size
-    k = _count_params(comp.params)
+    k = _count_params(comp.params, fixed_mask(family, structure, comp.params))
     log_term = n * np.log(max(sse, 1e-300) / n)
     info = {"cost": sse, "fit_seconds": result.seconds, "n_evaluations": result.n_evaluations,
             "converged": result.converged, "message": result.message,

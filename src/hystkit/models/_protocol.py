@@ -230,6 +230,16 @@ class Family(ABC):
         ``params.to_dict()``, nested lists included. Override when some are fixed."""
         return _count_numbers(params.to_dict())
 
+    def fixed_params(self, structure: Any, params: Any) -> tuple[str, ...]:
+        """Stored parameters the family's fit holds fixed (a gauge it does not fit), by name.
+
+        Names follow the float entries of ``params.to_dict()``, depth first: ``"v_b"``,
+        ``"w[0]"``, ``"a[0][2]"``. The fit's standard errors leave these out (they are
+        reported as fixed by the fit, not as undetermined by the data) and so does its count
+        of fitted numbers for AIC / BIC. Default: none.
+        """
+        return ()
+
     # -- running ----------------------------------------------------------------------------
 
     def rest_state(self, structure: Any, params: Any, value: float,

@@ -149,12 +149,15 @@ def _parameter_table(comp: Compensator) -> str:
         return (table(("parameter", "value", "standard error"), rows, spec=".6g")
                 + paragraph("Standard errors are not stored in this model file (written "
                             "before they were); refit to get them."))
-    rows = [(n, v, s, "undetermined" if r is None else f"{100 * r:.3g} %")
+    fixed = se.get("fixed", [])  # held fixed by the fit (a gauge): no SE, not undetermined
+    rows = [(n, v, s, "fixed by the fit" if n in fixed else "undetermined" if r is None
+             else f"{100 * r:.3g} %")
             for n, v, s, r in zip(names, se["values"], se["standard_errors"], se["relative"])]
-    blind = sum(s is None for s in se["standard_errors"])
+    blind = sum(s is None for s in se["standard_errors"]) - len(fixed)
     text = ("Standard errors: Gauss-Newton, s² (JᵀJ)⁻¹ from the finite-difference Jacobian at "
             f"the optimum (condition number of JᵀJ {_fixed(se.get('condition_number'), '.3g')})"
-            + (f"; {blind} parameter(s) not determined by the data (–)." if blind else "."))
+            + (f"; {blind} parameter(s) not determined by the data (–)" if blind else "")
+            + (f"; {', '.join(fixed)} fixed by the fit (its gauge)." if fixed else "."))
     return (table(("parameter", "value", "standard error", "relative"), rows, spec=".6g")
             + paragraph(text))
 

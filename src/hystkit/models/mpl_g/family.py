@@ -90,6 +90,11 @@ class MplGFamily(Family):
         fixed at 1 and 0 by the fit, so they count for no information criterion."""
         return 3 * structure.n_cells + 4
 
+    def fixed_params(self, structure, params) -> tuple[str, ...]:
+        """``w[0]`` and ``v_b``: the fit works in the gauge ``w_0 = 1``, ``V_b = 0``
+        (``fit.fit_mpl_g``), so the data determine neither."""
+        return ("w[0]", "v_b")
+
     def block(self, structure, params, inverse=False):
         from . import kernels
         from . import model as mpl_g
