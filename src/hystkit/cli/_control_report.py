@@ -70,7 +70,7 @@ def tune(args: argparse.Namespace, loop):
         print(f"  {name:<7}Kp = {p.kp:.4g}, Ti = {p.ti:.4g} s, Td = {p.td:.4g} s: e_p "
               f"{res.objective} {cost:.4g} m (in-sample); phase margin "
               f"{fmt(m.phase_margin_deg)} deg, gain margin "
-              f"{fmt(m.gain_margin_db, 'inf (no crossover)')} dB")
+              f"{fmt(m.gain_margin_db, 'inf')} dB")
     if not res.improved:
         print("  nothing better within the constraints: the start gains are kept")
     _print_held_out(res)
@@ -85,7 +85,8 @@ def _print_held_out(res) -> None:
         seed = "" if r["seed"] is None else f", noise seed {r['seed']}"
         print(f"    {r['experiment'] + seed + ': ' + r['case']:<34}"
               f"{fmt(r['before'], 'unbounded'):>10} -> {fmt(r['after'], 'unbounded'):<10}"
-              f"{_change(r['before'], r['after']):>9}")
+              f"{_change(r['before'], r['after']):>9}"
+              + ("  (the tuned run itself)" if r["repeats_tuned_run"] else ""))
 
 
 def noise_study(args: argparse.Namespace, loop) -> dict:

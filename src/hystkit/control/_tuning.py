@@ -73,8 +73,10 @@ class TuneResult:
         The optimiser's message.
     held_out : tuple of dict
         Out-of-sample check: per case of each held-out experiment, ``experiment``, ``case``,
-        ``seed`` (None without noise) and the plant error ``before`` / ``after`` [m] (None for
-        an unbounded run). Never used by the search.
+        ``seed`` (None without noise), the plant error ``before`` / ``after`` [m] (None for
+        an unbounded run) and ``repeats_tuned_run`` (the case is the tuned run itself, e.g.
+        the 0.5 Hz case of the frequency sweep after tuning on the sine). Never used by the
+        search.
     """
 
     pid_start: PID
@@ -214,7 +216,7 @@ def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: st
     if not _feasible(margins_start, limit, min_phase_margin, min_gain_margin_db):
         raise ValueError(f"the start gains break the constraints (phase margin "
                          f"{_fmt(margins_start.phase_margin_deg, 'none')} deg, gain margin "
-                         f"{_fmt(margins_start.gain_margin_db, 'inf (no crossover)')} dB; "
+                         f"{_fmt(margins_start.gain_margin_db, 'inf')} dB; "
                          f"need >= {min_phase_margin:.3g} deg, >= {min_gain_margin_db:.3g} dB): "
                          f"lower the minimums or start elsewhere")
     cost_start = cost(start)
@@ -251,7 +253,10 @@ def tune_nonlinear(loop: ControlLoop, experiment: str = "sine", *, objective: st
                             "xatol": 1e-3, "fatol": 1e-9 * cost_start})
     improved = best["pid"] is not start
     seconds = time.perf_counter() - t_start
-    rows = _held_out(loop, best["pid"], experiment, key, noise, tuple(held_out))
+    seed = None if noise is None else noise.seed
+    rows = tuple({**r, "repeats_tuned_run": (r["seed"] == seed and r["before"] == cost_start
+                                            and r["after"] == best["cost"])}
+                 for r in _held_out(loop, best["pid"], experiment, key, noise, tuple(held_out)))
     return TuneResult(start, best["pid"], objective, experiment, cost_start, best["cost"],
                       margins_start, best["margins"], min_phase_margin, min_gain_margin_db,
                       counts["runs"], counts["checks"], seconds, improved, str(res.message),
