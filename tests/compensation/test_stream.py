@@ -17,6 +17,7 @@ from hystkit.compensation import (
     advance,
     save_compensator,
 )
+from hystkit.compensation._stream import initial_state
 from hystkit.errors import FitDivergedError, InputError
 from hystkit.io import Recording
 from hystkit.models import FAMILIES
@@ -213,6 +214,11 @@ def test_the_oracle_centring_is_refused():
     comp = make_compensator("mpl", "direct", "recording")
     with pytest.raises(InputError, match="oracle"):
         Stream(comp)
+    # nor can a state made for a causal compensator run it through the pure function
+    causal = make_compensator("mpl", "direct", "track")
+    state = initial_state(causal)
+    with pytest.raises(InputError, match="oracle"):
+        advance(comp, state, sensor_for(causal)[:10])
 
 
 def test_a_runaway_estimate_names_the_stream_sample_and_keeps_the_state():

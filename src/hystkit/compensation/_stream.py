@@ -234,7 +234,10 @@ def advance(comp: Compensator, state: StreamState, sensor: np.ndarray, *,
         If an estimate is not finite or beyond ``MAX_NORMALISED`` times the training
         positions (as :meth:`Compensator.estimate`); the message names ``label`` and the
         stream's sample index. ``state`` is unchanged then.
+    InputError
+        If ``comp`` has the oracle centring ``recording``.
     """
+    check_streamable(comp)  # a state made for another compensator must not smuggle one in
     return _advance(_Path(comp, rest_position), state, sensor, label)
 
 
