@@ -6,8 +6,10 @@ over the input range and along a driven run. The mPL families add the document's
 analysis (eq. 5.18-5.28: knees, rest points, ``f' dt``).
 
 With ``--control`` the loop of ``hystkit control`` (same options) is examined beyond its
-linearisation: slope sectors of the hysteretic blocks and the discrete circle criterion
-(``hystkit.control.global_stability``), with a simulation that shows divergence when there is.
+linearisation: slope sectors of the hysteretic blocks (on the trained sine and in the
+simulated experiment, their hull tested) and the discrete circle criterion
+(``hystkit.control.global_stability``; a proof for a constant reference, within that sector),
+with a simulation that shows divergence when there is.
 """
 
 from __future__ import annotations
@@ -193,8 +195,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="examine the control loop set up by the options below (as 'hystkit "
                         "control'): slope sectors, circle criterion, a simulation")
     deferred(p.add_argument("--experiment", default="sine",
-                            help="with --control: the experiment simulated to show divergence "
-                                 "(default sine)"),
+                            help="with --control: the experiment simulated (default sine); its "
+                                 "closed-loop slopes join the trained sine's in the sector "
+                                 "tested, and a divergence shows instability"),
              choices=_experiments)
     add_setup_options(p, scheme_required=False)
     p.set_defaults(run=_stability)
