@@ -21,7 +21,6 @@ from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
 from threadpoolctl import ThreadpoolController
 
 from ..errors import FitDivergedError
@@ -224,6 +223,8 @@ class _StartSolver:
                 return SimpleNamespace(x=sol.x, cost=sol.cost, status=sol.status,
                                        message=sol.message, n_runs=sol.n_runs,
                                        column_norms=sol.column_norms)
+            from scipy.optimize import least_squares  # here: ~0.4 s to import, trf only
+
             sol = least_squares(self.residual, theta0, jac=self.jac,
                                 bounds=(self.lower, self.upper), method="trf", x_scale="jac",
                                 max_nfev=budget)

@@ -16,7 +16,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from hystkit.errors import NonFiniteError
 
@@ -132,6 +131,8 @@ def recording_variables(columns: Mapping[str, np.ndarray],
             raise ValueError(f"columns {name!r} and another both become MATLAB variable {key!r}")
         values = np.asarray(values)
         if values.dtype.kind not in "biuf":
+            import pandas as pd  # here: a model file written as .mat needs no pandas
+
             cell = np.empty((values.size, 1), dtype=object)
             cell[:, 0] = ["" if v is None or pd.isna(v) else str(v) for v in values]
             values = cell
