@@ -113,3 +113,19 @@ def test_reading_a_clean_csv_does_not_import_pandas(tmp_path):
             "print(r.n_samples, 'pandas' in sys.modules, 'scipy' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["10", "False", "False"]
+
+
+def test_a_fit_of_a_clean_csv_loads_neither_pandas_nor_scipy_optimize(tmp_path):
+    # issue 11.5: the start-up of 'hystkit fit' is what it imports; these two cost ~0.8 s
+    rng = np.random.default_rng(0)
+    t = np.arange(400) * 0.025
+    u = np.sin(2 * np.pi * 0.5 * t)
+    rec = Recording(time=t, position=3 * u, sensor=u + 0.01 * rng.standard_normal(t.size))
+    path = write_recording(rec, tmp_path / "rec.csv")
+    model = tmp_path / "m.json"
+    code = ("import sys; from hystkit.cli import main; "
+            f"code = main(['fit', {str(path)!r}, '--out', {str(model)!r}]); "
+            "print(code, 'pandas' in sys.modules, 'scipy.optimize' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split()[-3:] == ["0", "False", "False"], out.stdout + out.stderr
+    assert model.is_file()
