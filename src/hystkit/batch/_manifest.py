@@ -35,8 +35,27 @@ _ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
 class SensorJob:
     """One sensor: its recordings and model options.
 
-    ``split`` True: ``fit`` is one recording whose first half fits and second half validates
-    (``validate`` is empty).
+    Parameters
+    ----------
+    sensor : str
+        The sensor's id (letters, digits, ``.``, ``_``, ``-``); it names the model file.
+    fit : tuple of Path
+        Recordings fitted jointly.
+    validate : tuple of Path
+        Recordings the fit is scored on.
+    model : str
+        Model family name.
+    size : int or None
+        Model size; None: the family's default.
+    mode : str
+        ``"direct"`` or ``"inverse"`` compensation.
+    center : str or None
+        Centring of the compensator; None: the library's default.
+    split : bool
+        True: ``fit`` is one recording whose first half fits and second half validates
+        (``validate`` is empty).
+    where : str
+        Where the job was read (manifest row or folder entry), for messages.
     """
 
     sensor: str
@@ -58,8 +77,19 @@ class SensorJob:
 
 
 def read_manifest(path: Path, defaults: Mapping[str, object]) -> list[SensorJob]:
-    """Jobs of a ``.csv`` or ``.toml`` manifest; options missing there come from `defaults`
-    (keys of ``OPTION_KEYS``).
+    """Jobs of a ``.csv`` or ``.toml`` manifest; options missing there come from `defaults`.
+
+    Parameters
+    ----------
+    path : Path
+        The manifest (see the module docstring for its columns or tables).
+    defaults : mapping
+        The batch's options (keys of ``OPTION_KEYS``) for sensors that do not set them.
+
+    Returns
+    -------
+    list of SensorJob
+        One job per sensor, in the manifest's order; paths resolved against its folder.
 
     Raises
     ------
@@ -198,6 +228,18 @@ def _check_unique(jobs: Sequence[SensorJob]) -> None:
 
 def jobs_from_folder(folder: Path, defaults: Mapping[str, object]) -> list[SensorJob]:
     """Jobs of a folder of recordings (see the module docstring for the convention).
+
+    Parameters
+    ----------
+    folder : Path
+        Folder of sensor sub-folders and/or recordings; names starting with ``.`` are skipped.
+    defaults : mapping
+        The batch's options (keys of ``OPTION_KEYS``) for every sensor.
+
+    Returns
+    -------
+    list of SensorJob
+        One job per sensor, in the order of the sorted entry names.
 
     Raises
     ------

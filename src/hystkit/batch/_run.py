@@ -48,6 +48,13 @@ def fit_sensor(job: SensorJob, *, read_options: ReadOptions | None = None) -> di
     """Read, fit and score one sensor (one piece of a batch; never raises for the sensor's own
     failure: it is the row's ``error``).
 
+    Parameters
+    ----------
+    job : SensorJob
+        The sensor's recordings and model options.
+    read_options : ReadOptions, optional
+        How to read the recordings (column names, time unit); None: the defaults.
+
     Returns
     -------
     dict
@@ -119,6 +126,23 @@ def run_batch(jobs: Sequence[SensorJob], out: Path, *, executor: Executor | None
               source: str = "", progress: Callable[[str], None] = lambda _: None) -> list[dict]:
     """Fit every sensor not finished in `out` yet (all with `refit`); write the results table.
 
+    Parameters
+    ----------
+    jobs : sequence of SensorJob
+        The sensors, in the order of the results table.
+    out : Path
+        The batch folder (see the module docstring); created if missing.
+    executor : Executor, optional
+        Where the fits run; by default serially in this process.
+    read_options : ReadOptions, optional
+        How to read the recordings; None: the defaults.
+    refit : bool
+        Fit every sensor again, and accept a non-empty `out` that is not a batch folder.
+    source : str
+        What the jobs came from (manifest or folder), stored in ``batch.json``.
+    progress : callable
+        Called with one line of text at the start and as each sensor finishes.
+
     Returns
     -------
     list of dict
@@ -165,7 +189,22 @@ def _claim(out: Path, refit: bool, source: str) -> None:
 
 
 def pending(jobs: Sequence[SensorJob], out: Path, refit: bool = False) -> list[SensorJob]:
-    """The jobs `run_batch` will fit (those not finished in `out`), e.g. to size a cluster."""
+    """The jobs `run_batch` will fit (those not finished in `out`), e.g. to size a cluster.
+
+    Parameters
+    ----------
+    jobs : sequence of SensorJob
+        The batch's sensors.
+    out : Path
+        The batch folder.
+    refit : bool
+        True: every job (as `run_batch` with `refit`).
+
+    Returns
+    -------
+    list of SensorJob
+        The jobs still to fit, in the order of `jobs`.
+    """
     return [job for job in jobs if refit or _finished(Path(out), job) is None]
 
 

@@ -52,8 +52,15 @@ def check_fit_data(u: np.ndarray, y: np.ndarray,
 
     Parameters
     ----------
+    u, y : array_like
+        Input and measured output of the fit, one value per sample.
     min_size : int
         Fewest samples accepted (a shorter pair is reported like a length mismatch).
+
+    Returns
+    -------
+    u, y : ndarray
+        The same data as contiguous float64 arrays (copies only where a conversion needs one).
 
     Raises
     ------
@@ -107,6 +114,8 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
     bounds : (lower, upper)
     to_params : callable
         ``theta -> params`` of the model family.
+    structure : object
+        The family's structure, stored as ``FitResult.structure``.
     jac : callable or "2-point"
         Exact Jacobian if the family has one, else finite differences.
     normal_equations : callable, optional
@@ -118,6 +127,17 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
         equations formed only where a step is accepted.
     solver : {"tr", "lm", "trf"}
         See the module docstring.
+    max_nfev : int
+        Evaluation budget of each polishing solve (to convergence or this budget).
+    screen_nfev : int
+        Evaluation budget of each start's screening solve.
+    n_polish : int
+        How many accepted candidates, cheapest first after screening, are polished; the best
+        of them is returned.
+    accept : callable, optional
+        ``params -> bool``; False vetoes a candidate. By default every candidate is accepted.
+    accept_reason : str
+        Why `accept` vetoes, for the error raised when it vetoes every candidate.
     names : sequence of str, optional
         Names of the ``theta`` coordinates, so that reports name a parameter on a bound
         (``FitResult.bound_hits``) instead of giving its index.
@@ -126,6 +146,12 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
         coordinate a note (``"cell 2 runs at the Euler slope cap"``) or None. A fit that ends
         on such a bound has found a model at its own limit; reports show the note instead of
         calling the fit "on bounds".
+
+    Returns
+    -------
+    FitResult
+        The lowest-cost accepted candidate, with its ``cost`` (sum of squared residuals),
+        evaluation count, wall time and whether its solver converged.
 
     Raises
     ------

@@ -28,6 +28,20 @@ def fit_cost(model: str, size: int | None, n_samples: int) -> float:
     """Estimated seconds of one fit of `model` at `size` (None: its default) on `n_samples`.
 
     A rough a-priori figure for ordering work, never a promise of run time.
+
+    Parameters
+    ----------
+    model : str
+        Model family name (``"mpl"``, ``"boucwen"``, ...); one not measured gets the median.
+    size : int or None
+        Model size; None: the family's default (the size it was measured at).
+    n_samples : int
+        Samples of the recording to fit.
+
+    Returns
+    -------
+    float
+        Estimated seconds on one core: linear in `n_samples`, quadratic in `size`.
     """
     seconds, measured_size = MEASURED.get(model, (_MEDIAN, None))
     ratio = 1.0 if size is None or measured_size is None else size / measured_size

@@ -22,7 +22,14 @@ _CURRENT: ContextVar[Executor | None] = ContextVar("hystkit_executor", default=N
 
 
 class Executor(Protocol):
-    """Runs ``func(item, **shared)`` for every item; results in the order of `items`."""
+    """Runs ``func(item, **shared)`` for every item; results in the order of `items`.
+
+    Parameters
+    ----------
+    *args, **kwargs
+        None: this protocol describes executors (`SerialExecutor`, the Dask ones) and is not
+        instantiated itself.
+    """
 
     n_workers: int
 
@@ -44,7 +51,8 @@ class SerialExecutor:
     """Every piece in this process, one after the other (``--workers 1``), with BLAS on one
     thread like a Dask worker: the fits' tall, narrow Jacobians gain nothing from more, and
     idle OpenBLAS threads spin (``select`` on a busy 2-core machine: 47 s with two BLAS
-    threads, 19 s with one)."""
+    threads, 19 s with one).
+    """
 
     n_workers = 1
 
@@ -66,7 +74,13 @@ class SerialExecutor:
 
 
 def available_cores() -> int:
-    """Cores this process may run on (its affinity mask, not the machine's count)."""
+    """Cores this process may run on (its affinity mask, not the machine's count).
+
+    Returns
+    -------
+    int
+        The number of cores in the affinity mask; off Linux, ``os.cpu_count()`` (1 if unknown).
+    """
     try:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # not Linux
@@ -74,8 +88,16 @@ def available_cores() -> int:
 
 
 def current_executor() -> Executor | None:
-    """The parallel executor that `open_executor` holds open here, or None (serial, or inside
-    a Dask worker): work that can split itself, such as a fit's starts, asks this."""
+    """The parallel executor that `open_executor` holds open here, if any.
+
+    Work that can split itself, such as a fit's starts, asks this.
+
+    Returns
+    -------
+    Executor or None
+        The open parallel executor of this thread; None when the run is serial or this is
+        a Dask worker.
+    """
     return _CURRENT.get()
 
 
