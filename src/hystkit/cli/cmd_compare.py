@@ -171,8 +171,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         return f"comma-separated models (default: all: {', '.join(sorted(FAMILIES))})"
 
     p = sub.add_parser("compare", help="fit every model on one recording, score on another")
-    p.add_argument("data_fit", type=Path)
-    p.add_argument("data_val", type=Path)
+    p.add_argument("data_fit", type=Path, help="recording to fit every model on")
+    p.add_argument("data_val", type=Path, help="recording to score them on (not seen by the "
+                   "fits)")
     deferred(p.add_argument("--models"), help=models_help)
     p.add_argument("--size", action="append", default=[], metavar="MODEL=N",
                    help="model size, e.g. --size mpl=3 (repeatable)")
@@ -187,7 +188,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("data", type=Path, nargs="*",
                    help="your recordings (at least two, one rate); default: the virtual sensor")
     deferred(p.add_argument("--models"), help=models_help)
-    p.add_argument("--size", action="append", default=[], metavar="MODEL=N")
+    p.add_argument("--size", action="append", default=[], metavar="MODEL=N",
+                   help="model size, e.g. --size mpl=3 (repeatable; default: each family's own)")
     p.add_argument("--out", type=Path, help="output folder (default hystkit-generalize): "
                    "generalize.json, generalize.mat, generalize.png")
     add_read_options(p)

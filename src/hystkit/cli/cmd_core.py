@@ -401,7 +401,9 @@ _MODEL_HELP = "model file written by fit or select (.json or .mat)"
 def register(sub: argparse._SubParsersAction) -> None:
     """Add this module's subcommands to the ``hystkit`` parser."""
     p = sub.add_parser("simulate-sensor", help="record an experiment on the virtual sensor")
-    deferred(p.add_argument("--excitation", required=True), choices=_experiment_names)
+    deferred(p.add_argument("--excitation", required=True,
+                            help="the experiment of the document to record (ch. 4, table 5.5)"),
+             choices=_experiment_names)
     p.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
                    help="random seed, 0 to 2^32 - 1 (default 0)")
     p.add_argument("--out", type=Path, required=True, help="CSV or Parquet file to write")

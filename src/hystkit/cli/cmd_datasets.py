@@ -149,7 +149,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     q = actions.add_parser("export", help="write one run as a time, position, sensor "
                                           "recording (CSV, Parquet or .mat) plus a .json sidecar")
-    deferred(q.add_argument("name"), choices=_dataset_names)
+    deferred(q.add_argument("name", help="the data set to export (see 'hystkit datasets list')"),
+             choices=_dataset_names)
     q.add_argument("--variant", help="the run (default: the data set's default; see "
                                      "'hystkit datasets list NAME')")
     q.add_argument("--segment", help="only this named segment of the run")
