@@ -49,7 +49,7 @@ from .._validation import (
 )
 from ..mpl.model import I_S_RANGE, V_T_RANGE, knee_voltage, resistor_current
 from ..mpl_poly.kernels import solve_output
-from ..mpl_poly.model import G_MIN, POLY_MAX, output_current, output_slope
+from ..mpl_poly.model import G_MIN, POLY_MAX, branch_around, output_current, output_slope
 from . import kernels
 
 __all__ = [
@@ -185,16 +185,7 @@ def output_branch(params: MplGParams) -> tuple[float, float, float]:
     FitDivergedError
         If ``g'(z_rest) = 0`` (no monotone branch through the operating point).
     """
-    z_rest = -params.v_b
-    slope = float(output_slope(params, z_rest))
-    if slope == 0:
-        raise FitDivergedError(f"the output resistor has g'(z) = 0 at the rest point "
-                               f"z = {z_rest:.4g}, so it is not invertible there")
-    roots = np.roots([3 * params.g[3], 2 * params.g[2], params.g[1]])
-    roots = roots[np.abs(roots.imag) <= 1e-12 * np.abs(roots)].real
-    lo = max(roots[roots < z_rest], default=-np.inf)
-    hi = min(roots[roots > z_rest], default=np.inf)
-    return float(lo), float(hi), float(np.sign(slope))
+    return branch_around(params, -params.v_b)
 
 
 def inverse_branch(params: MplGParams) -> tuple[float, float, float, float]:

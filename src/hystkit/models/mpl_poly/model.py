@@ -492,6 +492,31 @@ def output_branch(structure: MplPolyStructure,
         If ``g'(z_rest) = 0`` (no monotone branch through the operating point).
     """
     z_rest = -params.w[1:] @ rest_voltages(structure, params) - params.v_b
+    return branch_around(params, z_rest)
+
+
+def branch_around(params: MplPolyParams, z_rest: float) -> tuple[float, float, float]:
+    """``(lo, hi, sign)``: the monotone branch of the cubic ``g`` through ``z_rest`` (between
+    the nearest real roots of ``g'``, ``+-inf`` where there is none) and the sign of ``g'`` on
+    it; shared with the ch. 7 compensator (``mpl_g``), whose ``g`` is the same cubic.
+
+    Parameters
+    ----------
+    params : MplPolyParams or MplGParams
+        Parameters with the output resistor's coefficients ``g``.
+    z_rest : float
+        The operating point.
+
+    Returns
+    -------
+    lo, hi, sign : float
+        As :func:`output_branch`.
+
+    Raises
+    ------
+    FitDivergedError
+        If ``g'(z_rest) = 0``.
+    """
     slope = float(output_slope(params, z_rest))
     if slope == 0:
         raise FitDivergedError(f"the output resistor has g'(z) = 0 at the rest point "
