@@ -8,7 +8,7 @@ per-recording simulations, so the joins between recordings carry no state.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -83,6 +83,7 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
                     model: str = "mpl", mode: str = "direct", center: str = DEFAULT_CENTER,
                     tare_seconds: float = DEFAULT_TARE_SECONDS,
                     track_seconds: float = DEFAULT_TRACK_SECONDS, diagnose: bool = True,
+                    fit_options: Mapping[str, Any] | None = None,
                     **structure_options: Any) -> Compensator:
     """Fit a compensator and its straight-line baseline on one or several recordings.
 
@@ -101,6 +102,8 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
         Tare window and drift-tracker time constant [s], stored in the model.
     diagnose : bool
         Compute parameter standard errors (one model run per parameter).
+    fit_options : mapping, optional
+        Keyword options of the family's fit (``Family.fit``), e.g. mPL's ``starts``.
     **structure_options
         Passed to the family's ``make_structure`` (mPL: ``slope_cap``).
 
@@ -134,7 +137,7 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
         recs, center, tare_seconds=tare_seconds, track_seconds=track_seconds)
     s, p = _joined(s_list), _joined(p_list)
     inputs, targets = (s_list, p_list) if mode == "direct" else (p_list, s_list)
-    result = _fit_family(family, structure, mode, s, p, recs[0].source)
+    result = _fit_family(family, structure, mode, s, p, recs[0].source, dict(fit_options or {}))
     params, joint_note = result.params, ""
     fixed = fixed_mask(family, structure, params)
     if len(recs) > 1:
@@ -160,11 +163,11 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
 
 
 def _fit_family(family: Family, structure: Any, mode: str, s: np.ndarray,
-                p: np.ndarray, source: str) -> FitResult:
+                p: np.ndarray, source: str, options: dict[str, Any]) -> FitResult:
     """The family's fit; whatever else it raises on data that passed the checks (a solver's
     LinAlgError, a family's ValueError) is that family's failure, said in one line."""
     try:
-        return _run_fit(family, structure, mode, s, p)
+        return _run_fit(family, structure, mode, s, p, options)
     except HystkitError:
         raise
     # A numerical failure of the family's fit is reported; a programming error is not hidden.
@@ -174,15 +177,16 @@ def _fit_family(family: Family, structure: Any, mode: str, s: np.ndarray,
 
 
 def _run_fit(family: Family, structure: Any, mode: str, s: np.ndarray,
-             p: np.ndarray) -> FitResult:
+             p: np.ndarray, options: dict[str, Any]) -> FitResult:
     if mode == "direct":
-        return family.fit(s, p, structure)
+        return family.fit(s, p, structure, **options)
     # The exact inverse of a discrete forward model can be unstable even when the model is
     # not (for the mPL its cells see a self-gain 1 + w_k / w_0); only keep fits whose inverse
     # stays bounded on the training data.
     return family.fit(p, s, structure, accept=lambda params: inverse_is_bounded(
         family, structure, params, s), accept_reason="their inverse diverges on the training "
-                                                     "data; use --mode direct or a smaller model")
+                                                     "data; use --mode direct or a smaller model",
+                      **options)
 
 
 def _joined(columns: list[np.ndarray]) -> np.ndarray:
