@@ -513,6 +513,28 @@ def test_fit_rejects_slope_cap_outside_0_2(cap: float, data: dict[str, Path], tm
                      tmp_path, "slope")
 
 
+@pytest.mark.parametrize("model", ["mpl-poly", "pl", "ladder", "chua"])
+def test_fit_slope_cap_reaches_every_capped_family(model: str, data: dict[str, Path],
+                                                   tmp_path: Path,
+                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "m.json"
+    code, _, err = _run(capsys, "fit", data["fit"], "--model", model, "--slope-cap", "0.5",
+                        "--out", out)
+    assert code in (0, 3), err  # 3: written, but a guard fired (not this test's concern)
+    assert json.loads(out.read_text(encoding="utf-8"))["structure"]["slope_cap"] == 0.5
+
+
+@pytest.mark.parametrize("model", ["bobbio", "preisach"])
+def test_fit_slope_cap_refused_for_a_family_without_one(model: str, data: dict[str, Path],
+                                                        tmp_path: Path,
+                                                        capsys: pytest.CaptureFixture[str]
+                                                        ) -> None:
+    out = tmp_path / "m.json"
+    line = _assert_rejected(capsys, ["fit", data["fit"], "--model", model, "--slope-cap", "0.5",
+                                     "--out", out], out, tmp_path, "--slope-cap", model)
+    assert "ladder" in line and "mpl-g" in line  # names the families that have one
+
+
 def test_model_with_mismatched_cell_count(data: dict[str, Path], tmp_path: Path,
                                           capsys: pytest.CaptureFixture[str]) -> None:
     model = json.loads(data["model"].read_text(encoding="utf-8"))

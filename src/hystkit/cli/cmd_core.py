@@ -83,8 +83,9 @@ def _fit(args: argparse.Namespace) -> int:
                       what="a model file")
     family = get_family(args.model)
     options = {} if args.slope_cap is None else {"slope_cap": args.slope_cap}
-    if options and args.model != "mpl":
-        raise UsageError(f"--slope-cap applies to the mpl model only, not {args.model!r}")
+    if options and not has_slope_cap(family):
+        raise UsageError(f"--slope-cap applies to the models with an Euler slope cap "
+                         f"({', '.join(_slope_cap_models())}), not {args.model!r}")
     options.update(_pl_options(args, family))
     check_size(args.model, args.cells, "--cells")
     recs = [read_recording(path, options=read_options(args, path)) for path in args.data]
@@ -120,6 +121,18 @@ def _fit(args: argparse.Namespace) -> int:
         return GUARD_EXIT
     print(f"  status: ok ({info['status_message']})")
     return 0
+
+
+def has_slope_cap(family) -> bool:
+    """Whether the family's structure takes an Euler slope cap (``make_structure(...,
+    slope_cap=...)``): the mPL families, PL, the ladder and Chua's model."""
+    import inspect
+
+    return "slope_cap" in inspect.signature(family.make_structure).parameters
+
+
+def _slope_cap_models() -> list[str]:
+    return [name for name, family in _families().items() if has_slope_cap(family)]
 
 
 def _units_label(rec) -> str:
@@ -434,8 +447,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     deferred(p._actions[-1], choices=lambda: _compensation("MODES"))
     _add_centring_options(p)
     p.add_argument("--slope-cap", type=slope_cap, default=None,
-                   help="mpl only: Euler stability cap f'·dt of the cell resistors, in [0.001, 2) "
-                        "(default 1)")
+                   help="models with an Euler slope cap (mpl, mpl-poly, mpl-g, pl, ladder, "
+                        "chua): cap on the step gain f'·dt of their non-linear elements, in [0.001, 2), "
+                        "default 1 (eq. 5.28-5.29; the ladder allows at most 1; each model's "
+                        "docs page says what it caps)")
     p.add_argument("--p", type=number(1, low_open=True), default=None, metavar="P",
                    help="pl only: power p of the cells, > 1 (default 21; 'hystkit pl-search' "
                         "searches it)")
