@@ -4,7 +4,7 @@ Each family's own fit is in its folder, ``hystkit.models.<family>``; the registr
 :mod:`hystkit.models`.
 """
 
-from ._least_squares import check_fit_data, fit_multistart
+from ._least_squares import LOSSES, check_fit_data, check_weights, fit_multistart
 from ._lm import solve_lm
 from ._normal_equations import (
                                 ChunkedDifferences,
@@ -14,5 +14,5 @@ from ._normal_equations import (
 )
 from ._result import BoundHit, FitResult
 
-__all__ = ["BoundHit", "ChunkedDifferences", "FitResult", "NormalEquations", "SolveResult",
-           "check_fit_data", "dense_normal_equations", "fit_multistart", "solve_lm"]
+__all__ = ["LOSSES", "BoundHit", "ChunkedDifferences", "FitResult", "NormalEquations", "SolveResult",
+           "check_fit_data", "check_weights", "dense_normal_equations", "fit_multistart", "solve_lm"]

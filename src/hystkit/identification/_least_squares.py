@@ -9,6 +9,11 @@ Jacobian (or '2-point'), the normal equations are formed from them:
 * ``solver="lm"``: a projected Levenberg-Marquardt (:mod:`._lm`);
 * ``solver="trf"``: scipy's ``least_squares(method="trf", x_scale="jac")`` on the residual and
   dense Jacobian, kept for comparison and as a fallback.
+
+Beside the SSE a fit can minimise a robust or weighted cost (`fit_multistart`'s ``loss``,
+``f_scale``, ``weights``): ``sum_i w_i f^2 rho(r_i^2 / f^2)`` with scipy's ``rho`` (soft_l1,
+huber, cauchy). Such fits run on scipy's trf with the residual and Jacobian scaled by
+``sqrt(w)``; the compiled normal equations have no weights.
 """
 
 from __future__ import annotations
@@ -30,9 +35,12 @@ from ._normal_equations import NormalEquations, dense_normal_equations
 from ._result import FitResult
 from ._trust_region import solve_trust_region
 
-__all__ = ["check_fit_data", "fit_multistart"]
+__all__ = ["LOSSES", "check_fit_data", "check_weights", "fit_multistart"]
 
 _SOLVERS = {"tr": solve_trust_region, "lm": solve_lm, "trf": None}
+LOSSES = ("linear", "soft_l1", "huber", "cauchy")
+"""Costs a fit can minimise: ``linear`` is the SSE (eq. 5.9), the others scipy's robust losses
+(``least_squares(loss=...)``)."""
 # When an executor is open, a fit's other starts are screened on its workers if the first
 # start's solve took SPLIT_MIN_START or more and all of them together take SPLIT_MIN_SECONDS
 # or more (CPU seconds of this thread, which the machine's load does not inflate). A map on a
@@ -90,8 +98,11 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
                    accept_reason: str = "rejected by the acceptance test",
                    names: Sequence[str] | None = None,
                    limits: tuple[Sequence[str | None], Sequence[str | None]] | None = None,
+                   loss: str = "linear", f_scale: float = 1.0,
+                   weights: np.ndarray | None = None,
                    ) -> FitResult:
-    """Minimise ``sum(residual(theta)**2)`` from several starts; return the best as a FitResult.
+    """Minimise ``sum(residual(theta)**2)`` (or a robust or weighted cost, see `loss` and
+    `weights`) from several starts; return the best as a FitResult.
 
     Every start first gets ``screen_nfev`` evaluations; the ``n_polish`` cheapest are then run
     to convergence (most starts fall into the same few basins, so polishing all of them would
@@ -146,23 +157,40 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
         coordinate a note (``"cell 2 runs at the Euler slope cap"``) or None. A fit that ends
         on such a bound has found a model at its own limit; reports show the note instead of
         calling the fit "on bounds".
+    loss : {"linear", "soft_l1", "huber", "cauchy"}
+        The cost: ``sum_i w_i f^2 rho(r_i^2 / f^2)`` with scipy's ``rho`` (``least_squares``);
+        "linear" (``rho(z) = z``) with no weights is the SSE (eq. 5.9) and the default path.
+    f_scale : float
+        Residual size ``f`` at which a robust loss leaves the quadratic (scipy's `f_scale`),
+        in the units of the residual.
+    weights : array, shape (m,), optional
+        One weight ``w_i >= 0`` per residual entry (finite, not all zero). A robust loss or
+        weights run on scipy's trf (whatever `solver` says) with the residual and Jacobian
+        scaled by ``sqrt(w)``; `normal_equations` and `cost` are then not used.
 
     Returns
     -------
     FitResult
-        The lowest-cost accepted candidate, with its ``cost`` (sum of squared residuals),
-        evaluation count, wall time and whether its solver converged.
+        The lowest-objective accepted candidate, with its ``cost`` (the plain sum of squared
+        residuals, unweighted, whatever the loss), its ``objective`` (the minimised cost, equal
+        to ``cost`` for the SSE), the loss, evaluation count, wall time and whether its solver
+        converged.
 
     Raises
     ------
     FitDivergedError
         If no start gives a finite cost, or every candidate is vetoed (the message says why).
     ValueError
-        If ``names`` or ``limits`` do not have one entry per coordinate, or ``solver`` is
-        unknown.
+        If ``names`` or ``limits`` do not have one entry per coordinate, ``solver`` or
+        ``loss`` is unknown, ``f_scale`` is not positive, or ``weights`` are negative, not
+        finite, all zero or not one per residual entry.
     """
     if solver not in _SOLVERS:
         raise ValueError(f"solver must be one of {sorted(_SOLVERS)}, got {solver!r}")
+    if loss not in LOSSES:
+        raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
+    if not (np.isfinite(f_scale) and f_scale > 0):
+        raise ValueError(f"f_scale must be a positive number, got {f_scale!r}")
     lower, upper = (np.asarray(b, dtype=float) for b in bounds)
     names = _per_coordinate(names, lower.size, "names")
     if limits is not None:
@@ -171,6 +199,16 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
         limits = (_per_coordinate(limits[0], lower.size, "limits[0]"),
                   _per_coordinate(limits[1], lower.size, "limits[1]"))
     margin = 1e-9 * np.maximum(1.0, upper - lower)
+    starts = [np.clip(np.asarray(theta0, dtype=float), lower + margin, upper - margin)
+              for theta0 in starts]
+    plain_residual = residual
+    if weights is not None:
+        if not starts:
+            raise ValueError("a weighted fit needs at least one start")
+        weights = check_weights(weights, plain_residual(starts[0]).size)
+        residual, jac = _weighted(residual, jac, np.sqrt(weights))
+    if loss != "linear" or weights is not None:
+        solver, normal_equations, cost = "trf", None, None
     if solver != "trf" and normal_equations is None:
         normal_equations = dense_normal_equations(residual, jac, lower, upper)
         if cost is None and not callable(jac):
@@ -180,11 +218,10 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
                 return 0.5 * float(r @ r)
 
     solve = _StartSolver(residual=residual, jac=jac, normal_equations=normal_equations,
-                         cost=cost, solver=solver, lower=lower, upper=upper, margin=margin)
+                         cost=cost, solver=solver, lower=lower, upper=upper, margin=margin,
+                         loss=loss, f_scale=float(f_scale))
     t_start = time.perf_counter()
-    screened, executor = _screen(solve, [np.clip(np.asarray(theta0, dtype=float),
-                                                 lower + margin, upper - margin)
-                                         for theta0 in starts], screen_nfev)
+    screened, executor = _screen(solve, starts, screen_nfev)
     n_eval = sum(sol.n_runs for sol in screened)
     screened = sorted((sol for sol in screened if np.isfinite(sol.cost)),
                       key=lambda sol: sol.cost)
@@ -213,7 +250,15 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
         why = (f"all {rejected} candidate fits were rejected ({accept_reason})" if rejected
                else "no start gave a finite cost")
         raise FitDivergedError(f"the fit failed: {why}")
-    return FitResult(structure=structure, params=to_params(best.x), cost=2.0 * float(best.cost),
+    objective = 2.0 * float(best.cost)
+    sse = objective
+    if solve.loss != "linear" or weights is not None:
+        # the plain SSE of the final residuals, for R^2 and information criteria
+        r = plain_residual(best.x)
+        sse = float(r @ r)
+    return FitResult(structure=structure, params=to_params(best.x), cost=sse,
+                     objective=objective, loss=loss, f_scale=float(f_scale),
+                     weighted=weights is not None,
                      n_evaluations=int(n_eval), seconds=time.perf_counter() - t_start,
                      converged=bool(best.status > 0), message=str(best.message),
                      n_starts=len(starts), theta=np.array(best.x),
@@ -235,6 +280,8 @@ class _StartSolver:
     lower: np.ndarray
     upper: np.ndarray
     margin: np.ndarray
+    loss: str = "linear"
+    f_scale: float = 1.0
 
     def __call__(self, theta0: np.ndarray, budget: int) -> SimpleNamespace:
         # BLAS threads do not pay on (n x n_params) problems, and under load they cost 10-30x
@@ -253,7 +300,7 @@ class _StartSolver:
 
             sol = least_squares(self.residual, theta0, jac=self.jac,
                                 bounds=(self.lower, self.upper), method="trf", x_scale="jac",
-                                max_nfev=budget)
+                                loss=self.loss, f_scale=self.f_scale, max_nfev=budget)
         # Keep only what ranking and reporting need: the (n x n_params) Jacobian and the
         # residuals of every screened start alive together cost GBs on long recordings.
         return SimpleNamespace(x=sol.x, cost=float(sol.cost), status=sol.status,
@@ -297,6 +344,56 @@ def _solve_on(executor: Executor | None, solve: _StartSolver, thetas: list[np.nd
 def _solve_start(start: tuple[np.ndarray, int], *, solve: _StartSolver) -> SimpleNamespace:
     """One piece of a parallel multi-start (module level: a worker finds it by name)."""
     return solve(*start)
+
+
+def check_weights(weights: Any, size: int) -> np.ndarray:
+    """Per-residual weights as a float array: 1-D, ``size`` entries, finite, >= 0, not all 0.
+
+    Parameters
+    ----------
+    weights : array_like
+        One weight per residual entry.
+    size : int
+        The residual's length.
+
+    Returns
+    -------
+    ndarray
+        The weights as a contiguous float64 array.
+
+    Raises
+    ------
+    ValueError
+        Naming the first offending entry (0-based) or the lengths.
+    """
+    weights = np.ascontiguousarray(weights, dtype=float)
+    if weights.ndim != 1 or weights.size != size:
+        raise ValueError(f"weights must have one entry per residual entry ({size}), got "
+                         f"shape {weights.shape}")
+    bad = np.flatnonzero(~(np.isfinite(weights) & (weights >= 0)))
+    if bad.size:
+        raise ValueError(f"weights must be finite and >= 0, entry {bad[0]} is "
+                         f"{weights[bad[0]]!r}")
+    if not np.any(weights > 0):
+        raise ValueError("weights must not all be zero")
+    return weights
+
+
+def _weighted(residual: Callable[[np.ndarray], np.ndarray],
+              jac: Callable[[np.ndarray], np.ndarray] | str,
+              root: np.ndarray) -> tuple[Callable, Callable | str]:
+    """Residual and Jacobian scaled by ``root = sqrt(w)`` row by row ("2-point" stays so:
+    differences of the scaled residual are the scaled Jacobian)."""
+    def scaled_residual(theta: np.ndarray) -> np.ndarray:
+        return root * residual(theta)
+
+    if not callable(jac):
+        return scaled_residual, jac
+
+    def scaled_jac(theta: np.ndarray) -> np.ndarray:
+        return root[:, None] * jac(theta)
+
+    return scaled_residual, scaled_jac
 
 
 def _column_norms(jac: Any) -> np.ndarray | None:

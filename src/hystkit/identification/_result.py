@@ -48,7 +48,8 @@ class FitResult:
     structure, params : object
         The fitted model (the family's frozen dataclasses).
     cost : float
-        Sum of squared errors (eq. 5.9) on the data as given (normalised by the caller).
+        Sum of squared errors (eq. 5.9) on the data as given (normalised by the caller),
+        unweighted whatever cost the fit minimised (R^2 and AIC/BIC use it).
     n_evaluations : int
         Model runs over all starts: with the normal-equation solvers ("tr", "lm") each run
         yields the cost and ``J^T J``, ``J^T r`` (or the cost alone); with "trf" a residual and
@@ -73,6 +74,16 @@ class FitResult:
     sensitivity : array or None
         Column norms of the residual's Jacobian at the optimum, ``sqrt(diag(J^T J))`` (how
         much each coordinate moves the model output there).
+    objective : float or None
+        The cost the fit minimised, ``sum_i w_i f^2 rho(r_i^2 / f^2)`` (``cost`` for the SSE);
+        None if the fit did not record it.
+    loss : str
+        Its loss (``"linear"``: squared residuals; see
+        :data:`hystkit.identification.LOSSES`).
+    f_scale : float
+        Its robust loss's residual scale (unused by "linear").
+    weighted : bool
+        Whether it weighted the residuals.
     """
 
     structure: Any
@@ -88,6 +99,19 @@ class FitResult:
     names: Any = None
     limits: Any = None
     sensitivity: Any = None
+    objective: float | None = None
+    loss: str = "linear"
+    f_scale: float = 1.0
+    weighted: bool = False
+
+    @property
+    def objective_label(self) -> str:
+        """What ``objective`` is, for reports: ``"SSE"``, ``"weighted SSE"`` or e.g.
+        ``"huber cost (f_scale 0.1)"``."""
+        if self.loss == "linear":
+            return "weighted SSE" if self.weighted else "SSE"
+        weighted = ", weighted" if self.weighted else ""
+        return f"{self.loss} cost (f_scale {self.f_scale:g}{weighted})"
 
     def bound_hits(self, tolerance: float) -> list[BoundHit] | None:
         """Coordinates of ``theta`` within ``tolerance`` x (bound interval) of a finite bound.

@@ -123,7 +123,8 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
                 max_nfev: int = 200, screen_nfev: int = 10, n_polish: int = 2,
                 accept: Callable[[boucwen.BoucWenParams], bool] | None = None,
                 accept_reason: str = "rejected by the acceptance test",
-                solver: str = "tr") -> FitResult:
+                solver: str = "tr", loss: str = "linear", f_scale: float = 1.0,
+                weights: np.ndarray | None = None) -> FitResult:
     """Fit a Bouc-Wen oscillator mapping the force ``u`` to the displacement ``y`` (SSE, eq. 5.9).
 
     Parameters
@@ -156,6 +157,10 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
         See :func:`~hystkit.identification.fit_multistart`. The difference Jacobian is formed
         densely (``n x 7``): the residual's stride, discard and divergence penalty do not split
         into chunks.
+    loss, f_scale, weights
+        The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
+        (one per sample of `y`); see :func:`hystkit.identification.fit_multistart`. Both
+        stages minimise it.
 
     Returns
     -------
@@ -227,7 +232,8 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
                               (lower[free], upper[free]),
                               lambda th: boucwen.BoucWenParams.from_vector(full(th)), structure,
                               max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
-                              solver=solver, **options)
+                              solver=solver, loss=loss, f_scale=f_scale, weights=weights,
+                              **options)
 
     t_start = time.perf_counter()
     nu_start = 1.0 if nu is None else float(nu)

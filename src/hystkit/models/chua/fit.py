@@ -72,7 +72,8 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
              screen_nfev: int = 10, n_polish: int = 2,
              accept: Callable[[chua.ChuaParams], bool] | None = None,
              accept_reason: str = "rejected by the acceptance test",
-             solver: str = "tr") -> FitResult:
+             solver: str = "tr", loss: str = "linear", f_scale: float = 1.0,
+             weights: np.ndarray | None = None) -> FitResult:
     """Fit a Chua-Stromsmoe model mapping ``u`` to ``y`` (SSE, eq. 5.9).
 
     Parameters
@@ -90,6 +91,9 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
         Candidates for which ``accept(params)`` is false are skipped.
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart` ("trf": dense difference Jacobian).
+    loss, f_scale, weights
+        The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
+        (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`.
 
     Returns
     -------
@@ -125,7 +129,8 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
                           structure, normal_equations=chunked.normal_equations,
                           cost=chunked.cost, solver=solver, max_nfev=max_nfev,
                           screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
-                          accept_reason=accept_reason)
+                          accept_reason=accept_reason, loss=loss, f_scale=f_scale,
+                          weights=weights)
 
 
 

@@ -52,7 +52,8 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
                screen_nfev: int = 10, n_polish: int = 2,
                accept: Callable[[ladder.LadderParams], bool] | None = None,
                accept_reason: str = "rejected by the acceptance test",
-               solver: str = "trf") -> FitResult:
+               solver: str = "trf", loss: str = "linear", f_scale: float = 1.0,
+               weights: np.ndarray | None = None) -> FitResult:
     """Fit a PWL ladder mapping source voltage ``u`` to output ``y`` (SSE, eq. 5.9).
 
     Parameters
@@ -74,6 +75,10 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
         ladder fitted on seed 1 then diverges on seed 2 -- as does trf's own optimum with its
         conductance moved by 1e-9 relative (a knife edge that tests/models/ladder relies on).
         Variable projection keeps the Jacobian at ``n x 2 N``, so trf's cost here is small.
+    loss, f_scale, weights
+        The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
+        (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`. They act on
+        the resistor parameters; the projected weights and bias stay a least-squares fit.
 
     Returns
     -------
@@ -119,7 +124,8 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
                           default_starts(structure) if starts is None else starts,
                           (lower, upper), lambda th: project(th)[0], structure,
                           max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
-                          accept=accept, accept_reason=accept_reason, solver=solver)
+                          accept=accept, accept_reason=accept_reason, solver=solver,
+                          loss=loss, f_scale=f_scale, weights=weights)
 
 
 

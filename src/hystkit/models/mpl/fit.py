@@ -116,7 +116,8 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
             max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
             accept: Callable[[mpl.MplParams], bool] | None = None,
             accept_reason: str = "rejected by the acceptance test",
-            solver: str = "tr") -> FitResult:
+            solver: str = "tr", loss: str = "linear", f_scale: float = 1.0,
+            weights: np.ndarray | None = None) -> FitResult:
     """Fit an mPL model mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9).
 
     Parameters
@@ -140,6 +141,9 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
         Says in the error message why candidates were rejected by `accept`.
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart`.
+    loss, f_scale, weights
+        The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
+        (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`.
 
     Returns
     -------
@@ -198,7 +202,8 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
                           jac=lambda th: run(th)[1], normal_equations=normal_equations,
                           solver=solver, max_nfev=max_nfev, screen_nfev=screen_nfev,
                           n_polish=n_polish, accept=accept, accept_reason=accept_reason,
-                          names=theta_names(n), limits=theta_limits(n))
+                          names=theta_names(n), limits=theta_limits(n), loss=loss,
+                          f_scale=f_scale, weights=weights)
 
 
 def random_params(structure: mpl.MplStructure, rng: np.random.Generator) -> mpl.MplParams:

@@ -204,7 +204,8 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
               max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
               accept: Callable[[mpl_g.MplGParams], bool] | None = None,
               accept_reason: str = "rejected by the acceptance test",
-              solver: str = "tr") -> FitResult:
+              solver: str = "tr", loss: str = "linear", f_scale: float = 1.0,
+              weights: np.ndarray | None = None) -> FitResult:
     """Fit the ch. 7 compensator mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9), in the
     gauge ``w_0 = 1``, ``V_b = 0`` with ``g`` monotone on ``|z| <= MONOTONE_RANGE``.
 
@@ -222,6 +223,10 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
         Why candidates were rejected, for the message.
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart`.
+    loss, f_scale, weights
+        The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
+        (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`; the mPL
+        start is fitted with the same cost.
 
     Returns
     -------
@@ -244,7 +249,8 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
     mpl_accept = None if accept is None else (lambda p: accept(_from_mpl(p)))
     linear = fit_mpl(u, y, mpl.MplStructure(n_cells=n, dt=structure.dt,
                                             slope_cap=structure.slope_cap),
-                     accept=mpl_accept, accept_reason=accept_reason)
+                     accept=mpl_accept, accept_reason=accept_reason, loss=loss,
+                     f_scale=f_scale, weights=weights)
     start = canonical(_from_mpl(linear.params))
     coords = _Coordinates(n, 1.0 if linear.params.w[0] >= 0 else -1.0)
     cache: dict = {}
@@ -264,7 +270,8 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
                               jac=lambda th: run(th)[1], solver=solver, max_nfev=max_nfev,
                               screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
                               accept_reason=accept_reason, names=theta_names(n),
-                              limits=_limits(n))
+                              limits=_limits(n), loss=loss, f_scale=f_scale,
+                              weights=weights)
     except FitDivergedError:
         if accept is None:
             raise

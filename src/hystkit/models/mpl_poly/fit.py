@@ -186,7 +186,8 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
                  max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
                  accept: Callable[[mpl_poly.MplPolyParams], bool] | None = None,
                  accept_reason: str = "rejected by the acceptance test",
-                 solver: str = "tr") -> FitResult:
+                 solver: str = "tr", loss: str = "linear", f_scale: float = 1.0,
+                 weights: np.ndarray | None = None) -> FitResult:
     """Fit a polynomial mPL mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9).
 
     Parameters
@@ -204,6 +205,9 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
         Why candidates were rejected, for the message.
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart` ("trf" works on the dense Jacobian).
+    loss, f_scale, weights
+        The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
+        (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`.
 
     Returns
     -------
@@ -259,7 +263,8 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
                             structure, jac=lambda th: run(th)[1], normal_equations=one_pass,
                             solver=solver, max_nfev=max_nfev, screen_nfev=screen_nfev,
                             n_polish=n_polish, accept=accept, accept_reason=accept_reason,
-                            names=theta_names(n))
+                            names=theta_names(n), loss=loss, f_scale=f_scale,
+                            weights=weights)
     # the (N + 2)-dimensional valley of equivalent parameters (see the module docstring)
     if result.params.w[0] == 0:
         return result

@@ -113,7 +113,8 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
            starts: list[np.ndarray] | None = None, max_nfev: int = 40, screen_nfev: int = 4,
            n_polish: int = 2, accept: Callable[[pl.PlParams], bool] | None = None,
            accept_reason: str = "rejected by the acceptance test",
-           solver: str = "tr") -> FitResult:
+           solver: str = "tr", loss: str = "linear", f_scale: float = 1.0,
+           weights: np.ndarray | None = None) -> FitResult:
     """Fit the weights, bias, output resistor and ``I_T``, ``V_T`` for a fixed structure.
 
     Parameters
@@ -131,6 +132,10 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart`. Variable projection leaves two
         coordinates, so their difference Jacobian (``n x 2``) is formed densely.
+    loss, f_scale, weights
+        The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
+        (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`. They act on
+        ``I_T``, ``V_T``; the projected ``a``, ``w``, ``V_b`` stay the voltage-side fit.
 
     Returns
     -------
@@ -165,7 +170,7 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
                           (lower, upper), lambda th: project(th)[0], structure,
                           max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
                           accept=accept, accept_reason=accept_reason, names=THETA_NAMES,
-                          solver=solver)
+                          solver=solver, loss=loss, f_scale=f_scale, weights=weights)
 
 
 def random_params(structure: pl.PlStructure, rng: np.random.Generator) -> pl.PlParams:
