@@ -4,8 +4,9 @@ Each family's own fit is in its folder, ``hystkit.models.<family>``; the registr
 :mod:`hystkit.models`.
 """
 
-from ._least_squares import LOSSES, check_fit_data, check_weights, fit_multistart
+from ._least_squares import check_fit_data, check_weights, fit_multistart
 from ._lm import solve_lm
+from ._losses import LOSSES, check_cost, objective, require_linear_loss
 from ._normal_equations import (
                                 ChunkedDifferences,
                                 NormalEquations,
@@ -14,5 +15,6 @@ from ._normal_equations import (
 )
 from ._result import BoundHit, FitResult
 
-__all__ = ["LOSSES", "BoundHit", "ChunkedDifferences", "FitResult", "NormalEquations", "SolveResult",
-           "check_fit_data", "check_weights", "dense_normal_equations", "fit_multistart", "solve_lm"]
+__all__ = ["LOSSES", "BoundHit", "ChunkedDifferences", "FitResult", "NormalEquations",
+           "SolveResult", "check_cost", "check_fit_data", "check_weights", "dense_normal_equations",
+           "fit_multistart", "objective", "require_linear_loss", "solve_lm"]

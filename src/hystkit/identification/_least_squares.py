@@ -11,8 +11,8 @@ Jacobian (or '2-point'), the normal equations are formed from them:
   dense Jacobian, kept for comparison and as a fallback.
 
 Beside the SSE a fit can minimise a robust or weighted cost (`fit_multistart`'s ``loss``,
-``f_scale``, ``weights``): ``sum_i w_i f^2 rho(r_i^2 / f^2)`` with scipy's ``rho`` (soft_l1,
-huber, cauchy). Such fits run on scipy's trf with the residual and Jacobian scaled by
+``f_scale``, ``weights``): ``sum_i f^2 rho(w_i r_i^2 / f^2)`` with scipy's ``rho`` (soft_l1,
+huber, cauchy; :mod:`._losses`). Such fits run on scipy's trf with the residual and Jacobian scaled by
 ``sqrt(w)``; the compiled normal equations have no weights.
 """
 
@@ -31,16 +31,14 @@ from threadpoolctl import ThreadpoolController
 from ..errors import FitDivergedError
 from ..parallel import Executor, current_executor
 from ._lm import solve_lm
+from ._losses import check_cost
 from ._normal_equations import NormalEquations, dense_normal_equations
 from ._result import FitResult
 from ._trust_region import solve_trust_region
 
-__all__ = ["LOSSES", "check_fit_data", "check_weights", "fit_multistart"]
+__all__ = ["check_fit_data", "check_weights", "fit_multistart"]
 
 _SOLVERS = {"tr": solve_trust_region, "lm": solve_lm, "trf": None}
-LOSSES = ("linear", "soft_l1", "huber", "cauchy")
-"""Costs a fit can minimise: ``linear`` is the SSE (eq. 5.9), the others scipy's robust losses
-(``least_squares(loss=...)``)."""
 # When an executor is open, a fit's other starts are screened on its workers if the first
 # start's solve took SPLIT_MIN_START or more and all of them together take SPLIT_MIN_SECONDS
 # or more (CPU seconds of this thread, which the machine's load does not inflate). A map on a
@@ -158,8 +156,9 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
         on such a bound has found a model at its own limit; reports show the note instead of
         calling the fit "on bounds".
     loss : {"linear", "soft_l1", "huber", "cauchy"}
-        The cost: ``sum_i w_i f^2 rho(r_i^2 / f^2)`` with scipy's ``rho`` (``least_squares``);
-        "linear" (``rho(z) = z``) with no weights is the SSE (eq. 5.9) and the default path.
+        The cost: ``sum_i f^2 rho(w_i r_i^2 / f^2)`` with scipy's ``rho`` (``least_squares``,
+        :func:`hystkit.identification.objective`); "linear" (``rho(z) = z``) with no weights
+        is the SSE (eq. 5.9) and the default path.
     f_scale : float
         Residual size ``f`` at which a robust loss leaves the quadratic (scipy's `f_scale`),
         in the units of the residual.
@@ -187,10 +186,7 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
     """
     if solver not in _SOLVERS:
         raise ValueError(f"solver must be one of {sorted(_SOLVERS)}, got {solver!r}")
-    if loss not in LOSSES:
-        raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
-    if not (np.isfinite(f_scale) and f_scale > 0):
-        raise ValueError(f"f_scale must be a positive number, got {f_scale!r}")
+    check_cost(loss, f_scale)
     lower, upper = (np.asarray(b, dtype=float) for b in bounds)
     names = _per_coordinate(names, lower.size, "names")
     if limits is not None:

@@ -75,7 +75,7 @@ class FitResult:
         Column norms of the residual's Jacobian at the optimum, ``sqrt(diag(J^T J))`` (how
         much each coordinate moves the model output there).
     objective : float or None
-        The cost the fit minimised, ``sum_i w_i f^2 rho(r_i^2 / f^2)`` (``cost`` for the SSE);
+        The cost the fit minimised, ``sum_i f^2 rho(w_i r_i^2 / f^2)`` (``cost`` for the SSE);
         None if the fit did not record it.
     loss : str
         Its loss (``"linear"``: squared residuals; see

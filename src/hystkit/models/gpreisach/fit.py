@@ -17,17 +17,21 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ...identification import FitResult
+from ...identification import FitResult, require_linear_loss
 from .. import preisach
 from ..preisach import check_data, fit_oriented, smoothness_rows
 from . import model as gpreisach
 
-__all__ = ["fit_gpreisach"]
+__all__ = ["SUPPORTED_LOSSES", "fit_gpreisach"]
+
+SUPPORTED_LOSSES = ("linear",)
+"""Costs :func:`fit_gpreisach` minimises: the (weighted) SSE only (one linear solve)."""
 
 
 def fit_gpreisach(u: np.ndarray, y: np.ndarray, structure: gpreisach.GPreisachStructure, *,
                   accept: Callable[[gpreisach.GPreisachParams], bool] | None = None,
-                  accept_reason: str = "rejected by the acceptance test") -> FitResult:
+                  accept_reason: str = "rejected by the acceptance test", loss: str = "linear",
+                  f_scale: float = 1.0, weights: np.ndarray | None = None) -> FitResult:
     """Fit eq. 2.2 mapping ``u`` to ``y`` by bounded linear least squares (eq. 5.9).
 
     Parameters
@@ -40,6 +44,12 @@ def fit_gpreisach(u: np.ndarray, y: np.ndarray, structure: gpreisach.GPreisachSt
         Checked on each solution (one per orientation tried), cheapest first.
     accept_reason : str, optional
         Why solutions were rejected, for the message.
+    loss, f_scale : str, float
+        Only ``"linear"`` (the SSE): a robust loss is refused with InputError.
+    weights : array, shape (n,), optional
+        Per-sample weights (finite, >= 0, not all 0): the rows of the least-squares problem
+        are scaled by ``sqrt(w)`` and the smoothness penalty by ``sqrt(mean(w))`` (so weights
+        all equal to any ``c`` give the unweighted fit).
 
     Returns
     -------
@@ -50,7 +60,10 @@ def fit_gpreisach(u: np.ndarray, y: np.ndarray, structure: gpreisach.GPreisachSt
     ------
     FitDivergedError
         If ``accept`` rejects every solution.
+    InputError
+        If `loss` is a robust loss.
     """
+    require_linear_loss(loss, f_scale, "gpreisach", "linear least squares")
     u, y = check_data(u, y)
     levels, degree = structure.levels, structure.degree
     rows, cols = np.tril_indices(levels - 1)
@@ -83,4 +96,4 @@ def fit_gpreisach(u: np.ndarray, y: np.ndarray, structure: gpreisach.GPreisachSt
                                          nu=coef[2 * n_off: -1], offset=coef[-1])
 
     return fit_oriented(a, y, penalty, hysteretic, nonneg, structure.orientation, to_params,
-                        structure, accept, accept_reason)
+                        structure, accept, accept_reason, weights)

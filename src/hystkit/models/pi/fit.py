@@ -42,11 +42,15 @@ from scipy.optimize import lsq_linear
 from threadpoolctl import threadpool_limits
 
 from ...errors import FitDivergedError
-from ...identification import FitResult
+from ...identification import FitResult, check_weights, require_linear_loss
 from . import kernels
 from . import model as pi
 
-__all__ = ["MIN_SLOPE", "fit_pi", "make_structure", "output_thresholds"]
+__all__ = ["MIN_SLOPE", "SUPPORTED_LOSSES", "fit_pi", "make_structure", "output_thresholds"]
+
+SUPPORTED_LOSSES = ("linear",)
+"""Costs :func:`fit_pi` minimises: the (weighted) squared generalised error only (one bounded
+linear solve)."""
 
 MIN_SLOPE = 0.01  # smallest loading-curve / S^-1 slope, in normalised units (slope 1 = linear)
 
@@ -99,7 +103,8 @@ def _ramps(y: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
            accept: Callable[[pi.PiParams], bool] | None = None,
            accept_reason: str = "rejected by the acceptance test",
-           d_inv: np.ndarray | None = None, ridge: float = 1e-9) -> FitResult:
+           d_inv: np.ndarray | None = None, ridge: float = 1e-9, loss: str = "linear",
+           f_scale: float = 1.0, weights: np.ndarray | None = None) -> FitResult:
     """Fit a modified PI model mapping ``u`` to ``y`` by Kuhnen's generalised error.
 
     Parameters
@@ -119,11 +124,18 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
         every unknown towards a neutral value (slopes 1, creep weights and offset 0) that is
         ``ridge`` times the energy of a unit-variance regressor. The default 1e-9 only decides
         what the data leave open.
+    loss, f_scale : str, float
+        Only ``"linear"``: a robust loss is refused with InputError.
+    weights : array, shape (n,), optional
+        Per-sample weights (finite, >= 0, not all 0): the generalised error of sample ``i``
+        counts ``w_i`` times (its row scaled by ``sqrt(w_i)``), the ridge ``mean(w)`` times.
 
     Returns
     -------
     FitResult
-        ``cost`` is the output SSE (eq. 5.9) of the fitted model, not the generalised error.
+        ``cost`` is the output SSE (eq. 5.9) of the fitted model, not the generalised error;
+        with weights, ``objective`` is the weighted output SSE (the solve minimised the
+        weighted generalised error).
 
     Raises
     ------
@@ -134,12 +146,14 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
         vetoed by ``accept``.
     """
     t_start = time.perf_counter()
+    require_linear_loss(loss, f_scale, "pi", "bounded linear least squares")
     u = np.ascontiguousarray(u, dtype=float)
     y = np.ascontiguousarray(y, dtype=float)
     if u.shape != y.shape or u.ndim != 1 or u.size < 2:
         raise ValueError(f"u and y must be 1-D, of equal length >= 2, got {u.shape}, {y.shape}")
     if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
         raise ValueError("u and y must be finite")
+    weights = None if weights is None else check_weights(weights, y.size)
     n, n_k, m = structure.n_play, structure.n_creep, structure.n_deadzone
     n_unknowns = n + 2 * n_k + 1 + 2 * m
     if u.size <= n_unknowns:
@@ -162,6 +176,10 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
     lower = np.r_[np.full(n, MIN_SLOPE), np.zeros(2 * n_k), -np.inf, np.full(2 * m, MIN_SLOPE)]
     neutral = np.r_[np.ones(n), np.zeros(2 * n_k + 1), np.ones(2 * m)]
     lam = np.sqrt(ridge * u.size)
+    if weights is not None:
+        root = np.sqrt(weights)
+        a, centre = a * root[:, None], centre * root
+        lam *= np.sqrt(np.mean(weights))
     a_aug = np.vstack([a, lam * np.eye(a.shape[1])])
     t_aug = np.concatenate([centre, lam * neutral])
     # BLAS threads do not pay on (n x ~30) problems and cost a lot under load.
@@ -177,9 +195,13 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
     y_fit, _ = pi.simulate(structure, params, u)
     if accept is not None and not accept(params):
         raise FitDivergedError(f"the fit failed: the fitted model was rejected ({accept_reason})")
-    return FitResult(structure=structure, params=params, cost=float(np.sum((y_fit - y) ** 2)),
+    r2 = (y_fit - y) ** 2
+    sse = float(np.sum(r2))
+    return FitResult(structure=structure, params=params, cost=sse,
                      n_evaluations=2, seconds=time.perf_counter() - t_start,
-                     converged=bool(sol.status > 0), message=str(sol.message), n_starts=1)
+                     converged=bool(sol.status > 0), message=str(sol.message), n_starts=1,
+                     objective=sse if weights is None else float(weights @ r2),
+                     weighted=weights is not None)
 
 
 def _to_params(structure: pi.PiStructure, theta: np.ndarray, d_inv: np.ndarray,

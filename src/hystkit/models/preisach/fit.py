@@ -35,10 +35,10 @@ from scipy.optimize import lsq_linear
 from threadpoolctl import threadpool_limits
 
 from ...errors import FitDivergedError
-from ...identification import FitResult, check_fit_data
+from ...identification import FitResult, check_fit_data, check_weights, require_linear_loss
 from . import model as preisach
 
-__all__ = ["ORIENTATIONS", "check_data", "everett_from_forcs", "fit_oriented", "fit_preisach",
+__all__ = ["ORIENTATIONS", "SUPPORTED_LOSSES", "check_data", "everett_from_forcs", "fit_oriented", "fit_preisach",
            "smoothness_rows", "solve_regularised"]
 
 
@@ -132,12 +132,14 @@ def solve_regularised(a: np.ndarray, y: np.ndarray, penalty: np.ndarray,
 
 
 ORIENTATIONS = {"counterclockwise": (1.0,), "clockwise": (-1.0,), "auto": (1.0, -1.0)}
+SUPPORTED_LOSSES = ("linear",)
+"""Costs :func:`fit_preisach` minimises: the (weighted) SSE only (one linear solve)."""
 
 
 def fit_oriented(a: np.ndarray, y: np.ndarray, penalty: np.ndarray, hysteretic: np.ndarray,
                  nonneg: np.ndarray, orientation: str, to_params: Callable[[np.ndarray], Any],
                  structure: Any, accept: Callable[[Any], bool] | None,
-                 accept_reason: str) -> FitResult:
+                 accept_reason: str, weights: np.ndarray | None = None) -> FitResult:
     """Solve the linear fit for each loop orientation; return the cheapest accepted one.
 
     The columns ``hysteretic`` (off-diagonal Preisach cells) get the orientation's sign
@@ -166,27 +168,42 @@ def fit_oriented(a: np.ndarray, y: np.ndarray, penalty: np.ndarray, hysteretic: 
         A solution counts only if ``accept(params)`` is true.
     accept_reason : str
         The message when every solution is rejected.
+    weights : numpy.ndarray, shape (n,), optional
+        Per-sample weights: rows of `a` and `y` scaled by ``sqrt(w)``, `penalty` by
+        ``sqrt(mean(w))``; the solutions are ranked by the weighted SSE.
 
     Returns
     -------
     FitResult
-        The cheapest accepted solution.
+        The cheapest accepted solution; its ``cost`` is the plain SSE, its ``objective`` the
+        weighted one.
 
     Raises
     ------
     FitDivergedError
         If every solution is rejected.
+    ValueError
+        If `weights` are not one finite value >= 0 per sample, not all 0.
     """
     t_start = time.perf_counter()
+    a_w, y_w, penalty_w = a, y, penalty
+    if weights is not None:
+        weights = check_weights(weights, y.size)
+        root = np.sqrt(weights)
+        a_w, y_w = a * root[:, None], y * root
+        penalty_w = penalty * np.sqrt(np.mean(weights))
     candidates = []
     for sign in ORIENTATIONS[orientation]:
         flip = np.where(hysteretic, sign, 1.0)
-        coef, message, success = solve_regularised(a * flip, y, penalty * flip, nonneg)
+        coef, message, success = solve_regularised(a_w * flip, y_w, penalty_w * flip, nonneg)
         coef *= flip
-        candidates.append((float(np.sum((a @ coef - y) ** 2)), sign, coef, message, success))
+        r = a @ coef - y
+        sse = float(r @ r)
+        candidates.append((sse if weights is None else float(weights @ (r * r)), sse, sign,
+                           coef, message, success))
     candidates.sort(key=lambda cand: cand[0])
     rejected = 0
-    for cost, sign, coef, message, success in candidates:
+    for objective, cost, sign, coef, message, success in candidates:
         params = to_params(coef)
         if accept is not None and not accept(params):
             rejected += 1
@@ -194,14 +211,16 @@ def fit_oriented(a: np.ndarray, y: np.ndarray, penalty: np.ndarray, hysteretic: 
         loops = "counter-clockwise" if sign > 0 else "clockwise"
         return FitResult(structure=structure, params=params, cost=cost, n_evaluations=1,
                          seconds=time.perf_counter() - t_start, converged=success,
-                         message=f"{loops} loops; {message}", n_starts=len(candidates))
+                         message=f"{loops} loops; {message}", n_starts=len(candidates),
+                         objective=objective, weighted=weights is not None)
     raise FitDivergedError(f"the fit failed: all {rejected} least-squares solutions were "
                            f"rejected ({accept_reason})")
 
 
 def fit_preisach(u: np.ndarray, y: np.ndarray, structure: preisach.PreisachStructure, *,
                  accept: Callable[[preisach.PreisachParams], bool] | None = None,
-                 accept_reason: str = "rejected by the acceptance test") -> FitResult:
+                 accept_reason: str = "rejected by the acceptance test", loss: str = "linear",
+                 f_scale: float = 1.0, weights: np.ndarray | None = None) -> FitResult:
     """Fit the classical Preisach model mapping ``u`` to ``y`` (linear least squares, eq. 5.9).
 
     Parameters
@@ -217,6 +236,12 @@ def fit_preisach(u: np.ndarray, y: np.ndarray, structure: preisach.PreisachStruc
         skipped.
     accept_reason : str, optional
         The message when every solution is rejected.
+    loss, f_scale : str, float
+        Only ``"linear"`` (the SSE): a robust loss is refused with InputError.
+    weights : array, shape (n,), optional
+        Per-sample weights (finite, >= 0, not all 0): the rows of the least-squares problem
+        are scaled by ``sqrt(w)`` and the smoothness penalty by ``sqrt(mean(w))`` (so weights
+        all equal to any ``c`` give the unweighted fit).
 
     Returns
     -------
@@ -227,7 +252,10 @@ def fit_preisach(u: np.ndarray, y: np.ndarray, structure: preisach.PreisachStruc
     ------
     FitDivergedError
         If ``accept`` rejects every solution (with ``accept_reason``).
+    InputError
+        If `loss` is a robust loss.
     """
+    require_linear_loss(loss, f_scale, "preisach", "linear least squares")
     u, y = check_data(u, y)
     levels = structure.levels
     phi = preisach.cell_regressors(levels, u, capacity=structure.capacity)
@@ -246,7 +274,7 @@ def fit_preisach(u: np.ndarray, y: np.ndarray, structure: preisach.PreisachStruc
         return preisach.PreisachParams.from_masses(masses, offset=coef[-1])
 
     return fit_oriented(a, y, penalty, hysteretic, nonneg, structure.orientation, to_params,
-                        structure, accept, accept_reason)
+                        structure, accept, accept_reason, weights)
 
 
 def everett_from_forcs(alphas: np.ndarray, betas: np.ndarray, y: np.ndarray,
