@@ -33,7 +33,7 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
-__all__ = ["Block", "Family", "Record", "numerical_linearisation"]
+__all__ = ["Block", "Family", "FitStart", "Record", "numerical_linearisation"]
 
 
 class Record:
@@ -118,6 +118,47 @@ class Block(NamedTuple):
     n_state: int
 
 
+class FitStart(NamedTuple):
+    """How a family's fit starts from one given parameter set (:meth:`Family.start_options`).
+
+    Parameters
+    ----------
+    options : dict
+        Keyword options of the family's fit that make it start from exactly these parameters,
+        and from them only (the reference document's single-start fmincon procedure).
+    clipped : tuple of str
+        One note per optimiser coordinate the fit's box moves, naming it, its given value and
+        the value it starts from; empty when the start lies inside the box.
+    """
+
+    options: dict
+    clipped: tuple[str, ...] = ()
+
+    @classmethod
+    def in_box(cls, options: dict, theta: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+               names: list[str]) -> FitStart:
+        """``options`` with a note for every coordinate of ``theta`` outside ``[lower, upper]``.
+
+        Parameters
+        ----------
+        options : dict
+            The fit options.
+        theta, lower, upper : array, shape (p,)
+            The start in the fit's coordinates and the fit's box.
+        names : list of str
+            Names of the coordinates.
+
+        Returns
+        -------
+        FitStart
+        """
+        start = np.clip(theta, lower, upper)
+        moved = np.flatnonzero(start != theta)
+        return cls(options, tuple(f"{names[i]} = {theta[i]:.6g} is outside the fit's box "
+                                  f"[{lower[i]:.6g}, {upper[i]:.6g}]; the fit starts from "
+                                  f"{start[i]:.6g}" for i in moved))
+
+
 class Family(ABC):
     """One hysteresis model family. Subclass it once per family; export an instance as FAMILY.
 
@@ -163,6 +204,11 @@ class Family(ABC):
     # taken from ``model`` unless the family defines them.
     invert: ClassVar[Callable[..., tuple[np.ndarray, np.ndarray]] | None] = None
     invert_step: ClassVar[Callable[..., tuple[float, np.ndarray]] | None] = None
+
+    fit_options: ClassVar[frozenset[str]] = frozenset()
+    """Optional keywords of the family's fit beyond the common ones (``init`` from
+    :meth:`start_options`, ``weight_sum_max`` for the document's constraint sum |w| <= B), so
+    that a caller can refuse an option the family lacks before any work."""
 
     fit_function: ClassVar[Callable[..., Any] | None] = None
     """The family's fit function, ``fit_x(u, y, structure, *, accept, accept_reason,
@@ -224,6 +270,30 @@ class Family(ABC):
         """Named published parameter sets: ``name -> (structure, params, info)``; ``info`` says
         where the values come from. Default: none."""
         return {}
+
+    def start_options(self, structure: Any, params: Any) -> FitStart:
+        """Fit options that start the family's fit from exactly ``params`` (``--init``).
+
+        Parameters
+        ----------
+        structure : Structure
+            The structure the fit will use (the cell count must match ``params``).
+        params : Params
+            The start, in normalised units (eq. 5.10).
+
+        Returns
+        -------
+        FitStart
+            ``options`` to pass to :meth:`fit` and the notes on coordinates moved into the
+            fit's box.
+
+        Raises
+        ------
+        NotImplementedError
+            For a family whose fit cannot start from given parameters (the default).
+        """
+        raise NotImplementedError(f"the {self.name} fit cannot start from given parameters "
+                                  f"(--init); it has its own starts")
 
     def n_params(self, structure: Any, params: Any) -> int:
         """Number of fitted numbers (for information criteria): every number in

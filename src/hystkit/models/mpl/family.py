@@ -8,7 +8,7 @@ import numpy as np
 
 from ..._lazy import lazy
 from .._cells import Cells, cell_report
-from .._protocol import Block, Family
+from .._protocol import Block, Family, FitStart
 
 if TYPE_CHECKING:
     from . import model as mpl
@@ -29,6 +29,7 @@ class MplFamily(Family):
     Structure = lazy(".model", "MplStructure")
     Params = lazy(".model", "MplParams")
     model = lazy(".model")  # step, simulate, invert, invert_step
+    fit_options = frozenset({"init", "weight_sum_max"})
 
     @staticmethod
     def fit_function(u, y, structure, **options):
@@ -43,8 +44,26 @@ class MplFamily(Family):
     def invert_step(self, structure, params, x, y):
         return self.model.invert_step(structure, params, x, y)
 
-    def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> mpl.MplStructure:
-        return self.Structure(n_cells=size, dt=dt, slope_cap=slope_cap)
+    def make_structure(self, dt: float, size: int, slope_cap: float = 1.0,
+                       limit: bool = True) -> mpl.MplStructure:
+        return self.Structure(n_cells=size, dt=dt, slope_cap=slope_cap, limit=limit)
+
+    def presets(self):
+        """The reference document's one-cell sets (:mod:`.presets`): ``table-5.2`` (initial
+        conditions), ``table-5.2-fitted`` (its fmincon result, unlimited sinh) and
+        ``paper-9.1`` (initial conditions), normalised units, at 40 Hz."""
+        from .presets import PRESETS, preset
+
+        return {name: preset(name, limit=name != "table-5.2-fitted") for name in PRESETS}
+
+    def start_options(self, structure, params):
+        """``init=params`` for :func:`.fit.fit_mpl` (a single start, no linear initialisation
+        of the weights), with a note for every coordinate outside the fit's box."""
+        from .fit import fit_box, theta_names
+
+        lower, upper = fit_box(structure)
+        return FitStart.in_box({"init": params}, params.to_vector(), lower, upper,
+                               theta_names(structure.n_cells))
 
     def random_params(self, structure, rng):
         """The fit's box (:func:`.fit.fit_mpl`), normalised data: ``G_k = 2 I_S / V_T`` log-uniform

@@ -8,6 +8,11 @@ never stored), from a few deterministic starts (``solver="trf"``: scipy's trust-
 reflective on the dense Jacobian).
 Each start sets the cell time constants and gets its linear parameters (``w``, ``V_b``, which
 enter the output linearly) by linear least squares, so no start begins far off.
+
+The document's own setups (sec. 5.3.3) are options: ``init`` starts from one given parameter
+set only (table 5.2's initial conditions), ``weight_sum_max`` adds fmincon's constraint
+``sum |w| <= B`` (:mod:`hystkit.identification._constrained`), and a structure with
+``limit=False`` fits the unbounded sinh, whose box then has no Euler bound on ``G``.
 """
 
 from __future__ import annotations
@@ -18,16 +23,22 @@ from types import SimpleNamespace
 import numpy as np
 
 from ...identification import FitResult, NormalEquations, check_fit_data, fit_multistart
+from ...identification._constrained import constrain_fit
 from . import kernels
 from . import model as mpl
 
-__all__ = ["default_starts", "fit_mpl", "random_params", "theta_limits", "theta_names"]
+__all__ = ["default_starts", "fit_box", "fit_mpl", "random_params", "theta_limits",
+           "theta_names"]
 
 # Bounds in optimiser coordinates (see MplParams.to_vector). |w| <= 100 mirrors the document's
 # weight-sum constraint of 10^2 (sec. 5.3.3).
 _LOG_VT_BOUNDS = (np.log(1e-3), np.log(1e3))
 _LOG_G_MIN = np.log(1e-4)
 _W_BOUND = 100.0
+# Without the limit (limit=False) G has no Euler bound: a box wide enough for the document's
+# fitted G = 2 I_S / V_T = 1.1e-5 (table 5.2) and inside the domain (I_S = G V_T / 2 within
+# 1e-12 .. 1e12 for every V_T of the box).
+_LOG_G_UNLIMITED = (np.log(1e-8), np.log(1e8))
 
 
 def _linear_init(structure: mpl.MplStructure, i_s: np.ndarray, v_t: np.ndarray,
@@ -54,7 +65,34 @@ def theta_names(n_cells: int) -> list[str]:
     return [*cells, *(f"w[{k}]" for k in range(n_cells + 1)), "v_b"]
 
 
-def theta_limits(n_cells: int) -> tuple[list[str | None], list[str | None]]:
+def fit_box(structure: mpl.MplStructure) -> tuple[np.ndarray, np.ndarray]:
+    """The fit's bounds in optimiser coordinates (:meth:`MplParams.to_vector`).
+
+    ``log G_k`` in ``[log 1e-4, log(slope_cap / dt)]`` (the Euler limit) or, without the
+    limit, ``[log 1e-8, log 1e8]``; ``log V_T,k`` in ``[log 1e-3, log 1e3]``; ``w_k`` and
+    ``V_b`` in ``[-100, 100]``.
+
+    Parameters
+    ----------
+    structure : MplStructure
+        The model's structure.
+
+    Returns
+    -------
+    lower, upper : numpy.ndarray, shape (3N + 2,)
+    """
+    n = structure.n_cells
+    if structure.limit:
+        log_g = (_LOG_G_MIN, np.log(structure.slope_cap / structure.dt))
+    else:
+        log_g = _LOG_G_UNLIMITED
+    lower = np.r_[np.tile([log_g[0], _LOG_VT_BOUNDS[0]], n), np.full(n + 2, -_W_BOUND)]
+    upper = np.r_[np.tile([log_g[1], _LOG_VT_BOUNDS[1]], n), np.full(n + 2, _W_BOUND)]
+    return lower, upper
+
+
+def theta_limits(n_cells: int,
+                 limit: bool = True) -> tuple[list[str | None], list[str | None]]:
     """Which bounds are the model's own limits, with a note for each (see ``fit_multistart``).
 
     The criterion: moving past the bound cannot change the model's output, so a fit there has
@@ -70,13 +108,15 @@ def theta_limits(n_cells: int) -> tuple[list[str | None], list[str | None]]:
       bound stands for a linear cell resistor.
 
     Every other bound (``G_k`` at its floor, ``V_T`` at 1e-3, ``|w| = 100``) is a search box:
-    past it the model changes, and a fit there is reported as on bounds.
+    past it the model changes, and a fit there is reported as on bounds. Without the limit
+    (``limit=False``) the upper bound of ``log G_k`` is a search box too.
     """
     lower: list[str | None] = [None] * (3 * n_cells + 2)
     upper = list(lower)
     for k in range(n_cells):
-        upper[2 * k] = (f"cell {k + 1} runs at the Euler slope cap (G dt = slope_cap, "
-                        f"eq. 5.28-5.29)")
+        if limit:
+            upper[2 * k] = (f"cell {k + 1} runs at the Euler slope cap (G dt = slope_cap, "
+                            f"eq. 5.28-5.29)")
         upper[2 * k + 1] = (f"cell {k + 1} has a linear resistor (V_T at its bound "
                             f"{np.exp(_LOG_VT_BOUNDS[1]):g} stands for V_T -> inf)")
     return lower, upper
@@ -117,7 +157,8 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
             accept: Callable[[mpl.MplParams], bool] | None = None,
             accept_reason: str = "rejected by the acceptance test",
             solver: str = "tr", loss: str = "linear", f_scale: float = 1.0,
-            weights: np.ndarray | None = None) -> FitResult:
+            weights: np.ndarray | None = None, init: mpl.MplParams | None = None,
+            weight_sum_max: float | None = None) -> FitResult:
     """Fit an mPL model mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9).
 
     Parameters
@@ -144,6 +185,14 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     loss, f_scale, weights
         The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
         (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`.
+    init : MplParams, optional
+        Start from exactly these parameters and from them only (the document's single fmincon
+        start, table 5.2); `starts` is then ignored. Coordinates outside :func:`fit_box` are
+        clipped into it.
+    weight_sum_max : float, optional
+        Constrain ``sum_k |w_k| <= weight_sum_max`` (fmincon's constraint, ``B = 100`` in
+        sec. 5.3.3): the multi-start's best is carried on to the constrained optimum
+        (:func:`hystkit.identification._constrained.constrain_fit`); SSE only.
 
     Returns
     -------
@@ -154,7 +203,9 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     Raises
     ------
     ValueError
-        If `u` and `y` are not 1-D, differ in length or are not finite, or `solver` is unknown.
+        If `u` and `y` are not 1-D, differ in length or are not finite, `solver` is unknown,
+        `init` has another number of cells, or `weight_sum_max` is given with a robust loss or
+        weights.
     FitDivergedError
         If no start gives a finite cost, or `accept` rejects every candidate.
     """
@@ -162,8 +213,7 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     n = structure.n_cells
     cap = structure.slope_cap / structure.dt
     x0 = np.full(n, u[0])
-    lower = np.r_[np.tile([_LOG_G_MIN, _LOG_VT_BOUNDS[0]], n), np.full(n + 2, -_W_BOUND)]
-    upper = np.r_[np.tile([np.log(cap), _LOG_VT_BOUNDS[1]], n), np.full(n + 2, _W_BOUND)]
+    lower, upper = fit_box(structure)
     starts = default_starts(structure) if starts is None else starts
     cache: dict = {}
 
@@ -191,19 +241,35 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
     # are rejected, so a cost-only trial (a simulation) plus a pass at every accepted point
     # would cost more.
     def normal_equations(theta: np.ndarray) -> NormalEquations:
-        sse, jtj, jtr = kernels.theta_normal_equations(u, y, x0, theta, structure.slope_cap,
-                                                       structure.dt)
+        if not structure.limit:  # the compiled theta version always applies the limit
+            sse, jtj, jtr = kernels.normal_equations(u, y, x0, *kernel_args(theta))
+        else:
+            sse, jtj, jtr = kernels.theta_normal_equations(u, y, x0, theta,
+                                                           structure.slope_cap, structure.dt)
         return NormalEquations(0.5 * sse, jtj, jtr)
 
-    thetas = [_linear_init(structure, np.asarray(i_s, float), np.asarray(v_t, float), u,
-                           y).to_vector() for i_s, v_t in starts]
-    return fit_multistart(lambda th: run(th)[0] - y, thetas, (lower, upper),
-                          lambda th: mpl.MplParams.from_vector(th, n), structure,
-                          jac=lambda th: run(th)[1], normal_equations=normal_equations,
-                          solver=solver, max_nfev=max_nfev, screen_nfev=screen_nfev,
-                          n_polish=n_polish, accept=accept, accept_reason=accept_reason,
-                          names=theta_names(n), limits=theta_limits(n), loss=loss,
-                          f_scale=f_scale, weights=weights)
+    if init is not None:
+        if init.n_cells != n:
+            raise ValueError(f"init has {init.n_cells} cell(s), the structure {n}")
+        thetas = [init.to_vector()]
+    else:
+        thetas = [_linear_init(structure, np.asarray(i_s, float), np.asarray(v_t, float), u,
+                               y).to_vector() for i_s, v_t in starts]
+
+    def to_params(theta: np.ndarray) -> mpl.MplParams:
+        return mpl.MplParams.from_vector(theta, n)
+
+    result = fit_multistart(lambda th: run(th)[0] - y, thetas, (lower, upper), to_params,
+                            structure, jac=lambda th: run(th)[1],
+                            normal_equations=normal_equations, solver=solver,
+                            max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
+                            accept=accept, accept_reason=accept_reason, names=theta_names(n),
+                            limits=theta_limits(n, structure.limit), loss=loss,
+                            f_scale=f_scale, weights=weights)
+    if weight_sum_max is None:
+        return result
+    return constrain_fit(result, normal_equations, np.arange(2 * n, 3 * n + 1),
+                         weight_sum_max, to_params, accept=accept, accept_reason=accept_reason)
 
 
 def random_params(structure: mpl.MplStructure, rng: np.random.Generator) -> mpl.MplParams:

@@ -83,7 +83,19 @@ class MplStructure(CellStructure):
     slope_cap : float, default 1.0
         Largest Euler slope ``f'(v) dt`` of a cell resistor (below 2, eq. 5.28; 1 gives
         overshoot-free cells).
+    limit : bool, default True
+        Apply the stability limit (eq. 5.29, corrected). ``False`` runs the document's
+        unbounded sinh resistor, whose forward Euler step diverges once ``f'(v) dt`` passes 2
+        (sec. 5.3.3); it exists to reproduce that, not for use. Model files written before
+        this field load as limited.
     """
+
+    limit: bool = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not isinstance(self.limit, bool):
+            raise TypeError(f"limit must be true or false, got {self.limit!r}")
 
     @property
     def n_params(self) -> int:
@@ -110,8 +122,8 @@ class MplParams(Record):
     -----
     Domain (checked here): ``I_S`` in ``I_S_RANGE`` (1e-12 .. 1e12), ``V_T`` in
     ``V_T_RANGE`` (1e-6 .. 1e12), ``|w_k|, |V_b| <= MAX_VALUE`` (1e6), at most ``MAX_CELLS``
-    cells. Every Euler step moves a cell towards its input (overshooting by at most
-    ``slope_cap - 1`` of the gap), so ``|y| <= sum |w| B + |V_b|`` with
+    cells. With the limit (``MplStructure.limit``, the default) every Euler step moves a
+    cell towards its input (overshooting by at most ``slope_cap - 1`` of the gap), so ``|y| <= sum |w| B + |V_b|`` with
     ``B = max(max|x0|, max|u| max(1, slope_cap / (2 - slope_cap)))`` (:func:`output_bound`).
 
     The optimiser sees the vector ``[log G_1, log V_T1, ..., log G_N, log V_TN, w_0..w_N, V_b]``
@@ -182,7 +194,9 @@ def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:
     """Voltage ``x+`` (= ``-x-``) beyond which each cell's resistor is a straight line.
 
     Solves ``f'(x) = slope_cap / dt`` for the sinh resistor, ``f'(v) = G cosh(v / V_T)``;
-    zero when even the small-signal slope ``G`` exceeds the cap (the cell is then linear).
+    zero when even the small-signal slope ``G`` exceeds the cap (the cell is then linear);
+    ``+inf`` without the limit (``structure.limit`` false: the sinh everywhere). A structure
+    without a ``limit`` field (the mpl-g family's) is limited.
 
     Parameters
     ----------
@@ -197,6 +211,8 @@ def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:
         ``x+`` of each cell (>= 0).
     """
     g = 2 * params.i_s / params.v_t
+    if not getattr(structure, "limit", True):
+        return np.full(np.shape(g), np.inf)
     ratio = structure.slope_cap / (structure.dt * g)
     return np.where(ratio > 1, params.v_t * np.arccosh(np.maximum(ratio, 1.0)), 0.0)
 
@@ -324,7 +340,23 @@ def simulate(structure: MplStructure, params: MplParams, u: np.ndarray,
     knee = knee_voltage(structure, params)
     y, x_end = kernels.simulate(u, x, params.i_s, params.v_t, params.w, params.v_b, knee,
                                 structure.slope_cap / structure.dt, structure.dt)
+    if not structure.limit:
+        _check_unlimited_run(structure, params, y, u, x)
     return check_finite_run(y, "mpl"), x_end  # finite in the domain; inputs near 1e308 are not
+
+
+def _check_unlimited_run(structure: MplStructure, params: MplParams, y: np.ndarray,
+                         u: np.ndarray, x0: np.ndarray) -> None:
+    """Raise FitDivergedError, naming the first bad sample, if the unlimited model's output
+    left the finite range or went past 1e6 times the bound a limited run keeps to."""
+    limited = output_bound(structure, params, float(np.max(np.abs(u))),
+                           float(np.max(np.abs(x0))))
+    bad = np.flatnonzero(~(np.abs(y) <= 1e6 * (1.0 + limited)))
+    if bad.size:
+        raise FitDivergedError(
+            f"the unlimited sinh mPL (--no-limit) diverged at sample {int(bad[0]) + 1} of "
+            f"{y.size}: without the stability limit (eq. 5.29) its Euler step grows once "
+            f"f'(v) dt passes 2 (sec. 5.3.3)")
 
 
 def simulate_reference(structure: MplStructure, params: MplParams, u: np.ndarray,
