@@ -4,17 +4,23 @@ Several recordings are fitted jointly: each is centred by its own tare / tracker
 from its own rest state. The family fits the concatenated data (its fit takes one sequence);
 then a generic least-squares polish over the family's float parameters (``to_dict``) fits the
 per-recording simulations, so the joins between recordings carry no state.
+
+The cost is the SSE (eq. 5.9) unless the caller asks for a robust loss (``loss``, ``f_scale``,
+:mod:`hystkit.identification._losses`) or per-sample weights (a column of the recordings):
+the family's fit and the joint polish then minimise that cost, while the stored ``cost``,
+R² and AIC/BIC stay on the plain SSE.
 """
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from ..errors import FitDivergedError, HystkitError, InputError
-from ..identification import FitResult
+from ..identification import LOSSES, FitResult, check_cost, objective
 from ..io import Recording
 from ..metrics import r2
 from ..models import Family, get_family
@@ -31,7 +37,7 @@ from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status, fixed_
 from ._param_vector import flatten_params, simulate_segments
 from ._training_checks import MIN_SAMPLES, check_fitting_data
 
-__all__ = ["MIN_SAMPLES", "fit_compensator"]
+__all__ = ["MIN_SAMPLES", "fit_compensator", "supported_losses", "weight_column"]
 
 # The joint polish differentiates numerically, one model run per parameter: above this many
 # parameters (Preisach grids) it is skipped and the concatenated fit is kept.
@@ -40,10 +46,116 @@ MAX_POLISH_PARAMS = 40
 _OUTSIDE = 1e3
 
 
+def supported_losses(model: str) -> tuple[str, ...]:
+    """The losses model family `model` can fit with (all of
+    :data:`hystkit.identification.LOSSES` unless its ``fit`` module says otherwise in
+    ``SUPPORTED_LOSSES``: the linear-least-squares families fit the SSE only).
+
+    Parameters
+    ----------
+    model : str
+        A registered family name.
+
+    Returns
+    -------
+    tuple of str
+    """
+    package = type(get_family(model)).__module__.rpartition(".")[0]
+    try:
+        fit_module = importlib.import_module(f"{package}.fit")
+    except ModuleNotFoundError:
+        return LOSSES
+    return tuple(getattr(fit_module, "SUPPORTED_LOSSES", LOSSES))
+
+
+def weight_column(recordings: Sequence[Recording], column: str,
+                  other_columns: Sequence[Mapping[str, np.ndarray]] | None = None
+                  ) -> np.ndarray:
+    """Per-sample weights: column `column` of each recording, end to end.
+
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        The training recordings, in fitting order.
+    column : str
+        The weights column's name in their files.
+    other_columns : sequence of mappings, optional
+        Each recording's columns other than time, position and sensor (as
+        :func:`hystkit.io.read_other_columns` returns them); default: read from each
+        recording's ``source`` file with the default read options.
+
+    Returns
+    -------
+    numpy.ndarray, shape (sum of samples,)
+        The weights, finite and ``>= 0``, not all zero.
+
+    Raises
+    ------
+    InputError
+        A recording without the column (naming the file and its other columns), a value that
+        is not a finite number ``>= 0`` (naming file, column and row), or all weights zero.
+    """
+    from ..io import read_other_columns
+
+    if other_columns is not None and len(other_columns) != len(recordings):
+        raise ValueError(f"other_columns must have one mapping per recording "
+                         f"({len(recordings)}), got {len(other_columns)}")
+    parts = []
+    for i, rec in enumerate(recordings):
+        if other_columns is not None:
+            columns = other_columns[i]
+        else:
+            try:
+                columns = read_other_columns(rec.source, rec.n_samples)
+            except (OSError, ValueError) as exc:
+                raise InputError(f"{rec.source}: cannot read the weights column {column!r} "
+                                 f"({exc})") from None
+        if column not in columns:
+            others = ", ".join(map(repr, columns)) or "none"
+            raise InputError(f"{rec.source}: no weights column {column!r} (its other columns: "
+                             f"{others})")
+        values = np.asarray(columns[column])
+        if values.shape != (rec.n_samples,):
+            raise InputError(f"{rec.source}: column {column!r} has {values.size} rows, the "
+                             f"recording {rec.n_samples}")
+        if values.dtype.kind not in "fiu":
+            numbers = _as_numbers(values)
+            bad = np.flatnonzero(np.isnan(numbers))
+            if bad.size:
+                raise InputError(f"{rec.source}: column {column!r}, row {bad[0] + 1}: weight "
+                                 f"{str(values[bad[0]])[:40]!r} is not a number")
+            values = numbers
+        values = values.astype(float)
+        bad = np.flatnonzero(~(np.isfinite(values) & (values >= 0)))
+        if bad.size:
+            raise InputError(f"{rec.source}: column {column!r}, row {bad[0] + 1}: weight "
+                             f"{values[bad[0]]:g} is not a finite number >= 0")
+        parts.append(values)
+    weights = np.concatenate(parts)
+    if not np.any(weights > 0):
+        raise InputError(f"{', '.join(r.source for r in recordings)}: every value of the "
+                         f"weights column {column!r} is 0")
+    return weights
+
+
+def _as_numbers(values: np.ndarray) -> np.ndarray:
+    """Text cells as floats, NaN where a cell is not a number (or empty)."""
+    out = np.full(values.size, np.nan)
+    for i, cell in enumerate(values):
+        try:
+            out[i] = float(cell)
+        except (TypeError, ValueError):
+            pass
+    return out
+
+
 def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.ndarray],
-                    targets: list[np.ndarray], fixed: np.ndarray) -> tuple[Any, str]:
+                    targets: list[np.ndarray], fixed: np.ndarray, loss: str = "linear",
+                    f_scale: float = 1.0, weights: np.ndarray | None = None
+                    ) -> tuple[Any, str]:
     """Refit the float parameters on per-recording simulations (generic, finite differences);
-    those in ``fixed`` (the family fit's gauge, :func:`~._diagnostics.fixed_mask`) stay."""
+    those in ``fixed`` (the family fit's gauge, :func:`~._diagnostics.fixed_mask`) stay. The
+    cost is the fit's: `loss` with `f_scale`, residuals scaled by ``sqrt(weights)``."""
     theta_all, rebuild = flatten_params(params)
     free = ~fixed
     theta0 = theta_all[free]
@@ -51,6 +163,7 @@ def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.
         return params, (f"{theta0.size} parameters: fitted on the concatenated recordings, "
                         f"joint polish skipped (more than {MAX_POLISH_PARAMS})")
     target = np.concatenate(targets)
+    root = None if weights is None else np.sqrt(weights)
 
     def full(theta: np.ndarray) -> Any:
         vector = theta_all.copy()
@@ -62,12 +175,14 @@ def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.
             r = simulate_segments(run, structure, full(theta), inputs) - target
         except (ValueError, HystkitError):
             return np.full(target.size, _OUTSIDE)
-        return r if np.all(np.isfinite(r)) else np.full(target.size, _OUTSIDE)
+        r = r if np.all(np.isfinite(r)) else np.full(target.size, _OUTSIDE)
+        return r if root is None else root * r
 
     from scipy.optimize import least_squares  # here: only multi-recording fits pay its import
 
-    sol = least_squares(residual, theta0, method="trf", x_scale="jac", max_nfev=100)
-    start_cost = 0.5 * float(np.sum(residual(theta0) ** 2))
+    sol = least_squares(residual, theta0, method="trf", x_scale="jac", loss=loss,
+                        f_scale=f_scale, max_nfev=100)
+    start_cost = 0.5 * objective(residual(theta0), loss, f_scale)
     if sol.cost < start_cost:
         return full(sol.x), f"joint polish over {len(inputs)} recordings: {sol.message}"
     return params, "joint polish found nothing better than the concatenated fit"
@@ -83,7 +198,9 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
                     model: str = "mpl", mode: str = "direct", center: str = DEFAULT_CENTER,
                     tare_seconds: float = DEFAULT_TARE_SECONDS,
                     track_seconds: float = DEFAULT_TRACK_SECONDS, diagnose: bool = True,
-                    fit_options: Mapping[str, Any] | None = None,
+                    fit_options: Mapping[str, Any] | None = None, loss: str = "linear",
+                    f_scale: float = 1.0, weights: str | None = None,
+                    other_columns: Sequence[Mapping[str, np.ndarray]] | None = None,
                     **structure_options: Any) -> Compensator:
     """Fit a compensator and its straight-line baseline on one or several recordings.
 
@@ -104,6 +221,19 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
         Compute parameter standard errors (one model run per parameter).
     fit_options : mapping, optional
         Keyword options of the family's fit (``Family.fit``), e.g. mPL's ``starts``.
+    loss : {"linear", "soft_l1", "huber", "cauchy"}
+        The cost the fit (and the joint polish) minimises: "linear" is the SSE (eq. 5.9);
+        the robust losses are scipy's (:mod:`hystkit.identification._losses`). Families that
+        fit by linear least squares take "linear" only (:func:`supported_losses`).
+    f_scale : float
+        Residual scale of a robust loss, in normalised units (the data are scaled to
+        max |.| = 1 before the fit, eq. 5.10).
+    weights : str, optional
+        Name of a column of the recordings' files holding one weight per sample (finite,
+        ``>= 0``; zero drops a sample from the cost), see :func:`weight_column`.
+    other_columns : sequence of mappings, optional
+        Each recording's other columns, where `weights` is looked up; default: read from
+        the recordings' files.
     **structure_options
         Passed to the family's ``make_structure`` (mPL: ``slope_cap``).
 
@@ -112,12 +242,15 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
     Compensator
         The fitted compensator. The fit's ``status`` in ``fit_info`` is ``ok`` only if the
         model is not constant, beats the straight line on the training data, has no parameter
-        on a bound and converged.
+        on a bound and converged. ``fit_info`` records ``loss``, ``f_scale``, ``weights``
+        (the column) and the minimised ``objective`` with its ``objective_label``; its
+        ``cost``, R² and AIC/BIC are on the plain SSE.
     """
     recs = [recordings] if isinstance(recordings, Recording) else list(recordings)
     if not recs:
         raise InputError("no fitting recording given")
     family = get_family(model)
+    cost_options = _cost_options(model, loss, f_scale, fit_options)
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
     if center not in CENTERS:
@@ -126,6 +259,7 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
         raise InputError(f"model {model!r} has no inverse ({family.no_inverse_reason}); "
                          f"use --mode direct")
     check_training_data(recs)
+    sample_weights = None if weights is None else weight_column(recs, weights, other_columns)
     try:
         structure = family.make_structure(recs[0].dt, family.default_size if size is None
                                           else size, **structure_options)
@@ -137,12 +271,15 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
         recs, center, tare_seconds=tare_seconds, track_seconds=track_seconds)
     s, p = _joined(s_list), _joined(p_list)
     inputs, targets = (s_list, p_list) if mode == "direct" else (p_list, s_list)
-    result = _fit_family(family, structure, mode, s, p, recs[0].source, dict(fit_options or {}))
+    if sample_weights is not None:
+        cost_options["weights"] = sample_weights
+    result = _fit_family(family, structure, mode, s, p, recs[0].source,
+                         {**(fit_options or {}), **cost_options})
     params, joint_note = result.params, ""
     fixed = fixed_mask(family, structure, params)
     if len(recs) > 1:
         params, joint_note = _polish_jointly(family.simulate, structure, params, inputs, targets,
-                                             fixed)
+                                             fixed, loss, f_scale, sample_weights)
     n_params = _count_params(params, fixed)
     if s.size < MIN_SAMPLES_PER_PARAM * n_params:
         raise InputError(f"{recs[0].source}: column 'position': {s.size} samples for "
@@ -156,10 +293,49 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
                        position_range=(float(min(r.position.min() for r in recs)),
                                        float(max(r.position.max() for r in recs))),
                        **conventions)
-    info = _fit_info(comp, result, recs, s, p, s_list, inputs, targets, diagnose)
+    info = _fit_info(comp, result, recs, s, p, s_list, inputs, targets, diagnose,
+                     (loss, f_scale, sample_weights))
     info["n_params"], info["joint_fit"] = n_params, joint_note or None
+    info.update(_cost_info(loss, f_scale, weights, sample_weights))
     object.__setattr__(comp, "fit_info", info)
     return comp
+
+
+def _cost_options(model: str, loss: str, f_scale: float,
+                  fit_options: Mapping[str, Any] | None) -> dict[str, Any]:
+    """The fit's cost options (empty for the plain SSE), checked before any work."""
+    try:
+        check_cost(loss, f_scale)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    clash = {"loss", "f_scale", "weights"} & set(fit_options or {})
+    if clash:
+        raise ValueError(f"give {', '.join(sorted(clash))} as fit_compensator's own "
+                         f"arguments, not in fit_options")
+    if loss not in supported_losses(model):
+        raise InputError(f"model {model!r} fits by linear least squares; the {loss} loss is not "
+                         f"available for it (it takes per-sample weights)")
+    return {} if loss == "linear" else {"loss": loss, "f_scale": float(f_scale)}
+
+
+def _cost_info(loss: str, f_scale: float, column: str | None,
+               weights: np.ndarray | None) -> dict[str, Any]:
+    """What the fit minimised, for ``fit_info``: the loss, its scale, the weights column and
+    the label of the ``objective`` (the plain SSE's ``cost`` is stored beside it)."""
+    plain = loss == "linear" and weights is None
+    if plain:
+        label = "SSE"
+    elif loss == "linear":
+        label = f"SSE weighted by column {column!r}"
+    else:
+        weighted = f", weighted by column {column!r}" if column is not None else ""
+        label = f"{loss} cost (f_scale {f_scale:g}{weighted})"
+    out = {"loss": loss, "f_scale": float(f_scale) if loss != "linear" else None,
+           "weights": column, "objective_label": label}
+    if not plain:
+        out["criteria_note"] = (f"R², AIC and BIC are on the plain SSE; the fit minimised the "
+                                f"{label}")
+    return out
 
 
 def _fit_family(family: Family, structure: Any, mode: str, s: np.ndarray,
@@ -196,8 +372,10 @@ def _joined(columns: list[np.ndarray]) -> np.ndarray:
 
 def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording], s: np.ndarray,
               p: np.ndarray, s_list: list[np.ndarray], inputs: list[np.ndarray],
-              targets: list[np.ndarray], diagnose: bool) -> dict:
-    """The solver's report plus the guards: status, training R², bounds, AIC/BIC, SEs.
+              targets: list[np.ndarray], diagnose: bool,
+              cost: tuple[str, float, np.ndarray | None] = ("linear", 1.0, None)) -> dict:
+    """The solver's report plus the guards: status, training R², bounds, AIC/BIC, SEs, and
+    the ``objective`` (`cost`: loss, f_scale, weights) beside the plain SSE.
 
     ``s``, ``p``: normalised sensor and position of all recordings end to end. Full-length
     arrays are made only where needed (estimate, straight line); the rest is in place.
@@ -216,11 +394,12 @@ def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording], s
         family.simulate, structure, comp.params, inputs)
     residual -= _joined(targets)
     sse = float(residual @ residual)
+    minimised = objective(residual, *cost)
     del estimate, residual
     n = p.size
     k = _count_params(comp.params, fixed_mask(family, structure, comp.params))
     log_term = n * np.log(max(sse, 1e-300) / n)
-    info = {"cost": sse, "fit_seconds": result.seconds, "n_evaluations": result.n_evaluations,
+    info = {"cost": sse, "objective": minimised, "fit_seconds": result.seconds, "n_evaluations": result.n_evaluations,
             "converged": result.converged, "message": result.message,
             "n_starts": result.n_starts, "training_source": recs[0].source,
             "training_sources": [r.source for r in recs],

@@ -1,0 +1,94 @@
+"""``hystkit fit``'s cost options: ``--loss``, ``--f-scale``, ``--weights`` (issue 14.4).
+
+By default a fit minimises the SSE (eq. 5.9). ``--loss`` picks one of scipy's robust losses
+instead, ``--f-scale`` its residual scale (normalised units: the data are scaled to max |.| = 1
+before the fit, eq. 5.10) and ``--weights`` a column of the recordings with one weight per
+sample. A model whose fit is a linear least-squares solve takes weights but no robust loss:
+it is refused here, before any data are read.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass
+from pathlib import Path
+
+from ._common import UsageError, deferred, number, read_options
+
+__all__ = ["CostOptions", "add_cost_options", "cost_options", "print_cost_summary"]
+
+
+def _losses() -> tuple[str, ...]:
+    from ..identification import LOSSES
+
+    return LOSSES
+
+
+def add_cost_options(parser: argparse.ArgumentParser) -> None:
+    """Add ``--loss``, ``--f-scale`` and ``--weights`` to `parser` (the ``fit`` subcommand)."""
+    deferred(parser.add_argument(
+        "--loss", default="linear",
+        help="cost the fit minimises: linear = the SSE (eq. 5.9, default); soft_l1, huber, "
+             "cauchy = scipy's robust losses, which count residuals beyond --f-scale less "
+             "(outliers, spikes); models fitted by linear least squares (preisach, gpreisach, "
+             "bobbio, pi) take linear only"), choices=_losses)
+    parser.add_argument(
+        "--f-scale", type=number(0, low_open=True), default=None, metavar="F",
+        help="residual scale of a robust --loss, > 0, in normalised units: the data are "
+             "scaled to max |.| = 1 before the fit (eq. 5.10), so 0.05 is 5 %% of the range "
+             "(default 1, scipy's)")
+    parser.add_argument(
+        "--weights", default=None, metavar="COLUMN",
+        help="column of the recording(s) with one weight per sample (finite, >= 0; 0 drops "
+             "a sample from the cost); the fit minimises the weighted cost, while R², AIC and "
+             "BIC stay on the plain SSE")
+
+
+@dataclass(frozen=True)
+class CostOptions:
+    """The cost a ``fit`` command asked for, checked against its model."""
+
+    loss: str = "linear"
+    f_scale: float = 1.0
+    weights: str | None = None
+
+    def fit_arguments(self, args: argparse.Namespace, recs: list) -> dict:
+        """Keyword arguments of `hystkit.compensation.fit_compensator` for the recordings
+        `recs` read from ``args.data`` (the weights column read with the same read options);
+        empty for the plain SSE."""
+        out: dict = {}
+        if self.loss != "linear":
+            out.update(loss=self.loss, f_scale=self.f_scale)
+        if self.weights is not None:
+            from ..io import read_other_columns
+
+            out["weights"] = self.weights
+            out["other_columns"] = [
+                read_other_columns(path, rec.n_samples, read_options(args, Path(path)))
+                for path, rec in zip(args.data, recs, strict=True)]
+        return out
+
+
+def cost_options(args: argparse.Namespace) -> CostOptions:
+    """The parsed cost options, refused in one line (before any work) where they do not apply:
+    a robust loss for a model fitted by linear least squares, ``--f-scale`` without one."""
+    from ..compensation._fitting import supported_losses
+
+    if args.f_scale is not None and args.loss == "linear":
+        raise UsageError("--f-scale applies to a robust --loss (soft_l1, huber, cauchy), not "
+                         "to linear (the SSE)")
+    if args.loss not in supported_losses(args.model):
+        raise UsageError(f"model {args.model!r} fits by linear least squares; --loss "
+                         f"{args.loss} is not available for it (--weights is)")
+    if args.weights is not None and not args.weights.strip():
+        raise UsageError("--weights needs a column name")
+    return CostOptions(loss=args.loss, f_scale=1.0 if args.f_scale is None else args.f_scale,
+                       weights=args.weights)
+
+
+def print_cost_summary(info: dict) -> None:
+    """Print what a fit minimised when that was not the plain SSE (``fit_info`` of
+    `hystkit.compensation.fit_compensator`); nothing for the SSE, which ``fit`` prints."""
+    if info.get("criteria_note") is not None:
+        print(f"  minimised the {info['objective_label']}: {info['objective']:.4g} "
+              f"(normalised); R², AIC and BIC are on the plain SSE")
