@@ -369,7 +369,7 @@ def check_weights(weights: Any, size: int) -> np.ndarray:
     bad = np.flatnonzero(~(np.isfinite(weights) & (weights >= 0)))
     if bad.size:
         raise ValueError(f"weights must be finite and >= 0, entry {bad[0]} is "
-                         f"{weights[bad[0]]!r}")
+                         f"{float(weights[bad[0]])!r}")
     if not np.any(weights > 0):
         raise ValueError("weights must not all be zero")
     return weights
