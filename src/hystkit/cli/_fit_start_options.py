@@ -127,7 +127,7 @@ def start_options(args: argparse.Namespace, family: Any, dt: float, size: int,
     InputError
         If ``--init`` cannot be read (one line naming what is wrong).
     """
-    options: dict = {}
+    fit_options: dict = {}
     if args.weight_sum_max is not None:
         _check_takes(family, "weight_sum_max", "--weight-sum-max")
         if n_recordings > 1:
@@ -135,18 +135,21 @@ def start_options(args: argparse.Namespace, family: Any, dt: float, size: int,
                              "polish of several is unconstrained)")
         if getattr(args, "loss", None) not in (None, "linear"):
             raise UsageError("--weight-sum-max is solved on the SSE (eq. 5.9), not with --loss")
-        options["weight_sum_max"] = args.weight_sum_max
+        fit_options["weight_sum_max"] = args.weight_sum_max
     if args.init is not None:
         _check_takes(family, "init", "--init")
         try:
             structure = family.make_structure(dt, size, **options)
         except (ValueError, TypeError) as exc:
             raise InputError(f"model {family.name!r}: {exc}") from None
-        start = family.start_options(structure, parse_init(args.init, family, structure))
-        options.update(start.options)
+        try:
+            start = family.start_options(structure, parse_init(args.init, family, structure))
+        except ValueError as exc:  # e.g. mpl-g's gauge needs w_0 != 0
+            raise InputError(f"--init: {exc}") from None
+        fit_options.update(start.options)
         for note in start.clipped:
             print(f"  --init: {note}")
-    return options
+    return fit_options
 
 
 def _check_takes(family: Any, keyword: str, option: str) -> None:

@@ -170,7 +170,8 @@ def constrain_fit(result: FitResult, normal_equations: Callable[[np.ndarray], No
                   weights: np.ndarray, weight_sum_max: float,
                   to_params: Callable[[np.ndarray], Any], *,
                   accept: Callable[[Any], bool] | None = None,
-                  accept_reason: str = "rejected by the acceptance test") -> FitResult:
+                  accept_reason: str = "rejected by the acceptance test",
+                  label: str = "sum |w|") -> FitResult:
     """A family's unconstrained fit carried on to the constrained optimum ``sum |w| <= B``.
 
     The constrained solve starts from the unconstrained optimum (its weights scaled onto the
@@ -193,6 +194,8 @@ def constrain_fit(result: FitResult, normal_equations: Callable[[np.ndarray], No
         As the family's fit: the constrained result must pass it.
     accept_reason : str
         Why `accept` vetoes, for the error.
+    label : str, default "sum |w|"
+        What the bound limits, for the message.
 
     Returns
     -------
@@ -215,12 +218,12 @@ def constrain_fit(result: FitResult, normal_equations: Callable[[np.ndarray], No
                                    weight_sum_max)
     params = to_params(sol.theta)
     if accept is not None and not accept(params):
-        raise FitDivergedError(f"the fit failed: the constrained optimum (sum |w| <= "
+        raise FitDivergedError(f"the fit failed: the constrained optimum ({label} <= "
                                f"{weight_sum_max:g}) was rejected ({accept_reason})")
     state = "active" if sol.active else "inactive"
     return replace(result, params=params, theta=sol.theta, cost=sol.cost, objective=sol.cost,
                    converged=sol.converged, n_evaluations=result.n_evaluations + sol.n_runs,
                    seconds=result.seconds + time.perf_counter() - t0,
                    sensitivity=sol.column_norms,
-                   message=f"SLSQP under sum |w| <= {weight_sum_max:g} ({state}: sum |w| = "
+                   message=f"SLSQP under {label} <= {weight_sum_max:g} ({state}: {label} = "
                            f"{sol.weight_sum:.6g}): {sol.message}")

@@ -139,7 +139,9 @@ def test_analytical_linearisation_matches_numerical(inverse):
 
 def test_presets_are_paper_9_2_table_ii_and_run():
     presets = FAMILY.presets()
-    assert sorted(presets) == sorted(f"table-ii-{c}" for c in mp.PAPER_9_2_TABLE_II)
+    assert sorted(presets) == sorted([*(f"table-ii-{c}" for c in mp.PAPER_9_2_TABLE_II),
+                                      "paper-9.2-table-i"])
+    assert presets.pop("paper-9.2-table-i")[1] == mp.paper_9_2_params(mp.PAPER_9_2_TABLE_I)
     for name, (structure, params, info) in presets.items():
         column = name.removeprefix("table-ii-")
         assert params == mp.paper_9_2_params(mp.PAPER_9_2_TABLE_II[column])

@@ -10,7 +10,7 @@ import numpy as np
 from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._cells import Cells, cell_report
-from .._protocol import Block, Family
+from .._protocol import Block, Family, FitStart
 
 if TYPE_CHECKING:
     from . import model as mpl_g
@@ -34,6 +34,7 @@ class MplGFamily(Family):
     Structure = lazy(".model", "MplGStructure")
     Params = lazy(".model", "MplGParams")
     model = lazy(".model")  # step, simulate, invert, rest_state
+    fit_options = frozenset({"init", "weight_sum_max"})
 
     @staticmethod
     def fit_function(u, y, structure, **options):
@@ -74,6 +75,15 @@ class MplGFamily(Family):
         from .fit import random_params
 
         return random_params(structure, rng)
+
+    def start_options(self, structure, params):
+        """``init=params`` for :func:`.fit.fit_mpl_g` (a single start, in its gauge ``w_0 = 1``,
+        ``V_b = 0``), with a note for every coordinate outside the fit's box."""
+        from .fit import fit_box, start_theta, theta_names
+
+        lower, upper = fit_box(structure)
+        return FitStart.in_box({"init": params}, start_theta(params), lower, upper,
+                               theta_names(structure.n_cells))
 
     def presets(self):
         """The sec. 7.2 compensators of paper 9.2's table II sensors, ``ch7-table-ii-COLUMN``,

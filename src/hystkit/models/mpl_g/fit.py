@@ -32,12 +32,14 @@ import numpy as np
 
 from ...errors import FitDivergedError
 from ...identification import FitResult, check_fit_data, fit_multistart
+from ...identification._constrained import constrain_fit
+from ...identification._normal_equations import dense_normal_equations
 from ..mpl import model as mpl
 from ..mpl.fit import fit_mpl, theta_limits
 from . import model as mpl_g
 
-__all__ = ["MONOTONE_RANGE", "bernstein_slopes", "canonical", "fit_mpl_g", "output_from_slopes",
-           "random_params", "theta_names"]
+__all__ = ["MONOTONE_RANGE", "bernstein_slopes", "canonical", "fit_box", "fit_mpl_g",
+           "output_from_slopes", "random_params", "start_theta", "theta_names"]
 
 MONOTONE_RANGE = 2.0
 """Half-width of the interval ``|z| <= R`` (normalised units, gauge ``w_0 = 1``, ``V_b = 0``) on
@@ -124,6 +126,50 @@ def theta_names(n_cells: int) -> list[str]:
             *(f"w[{k}]" for k in range(1, n_cells + 1))]
 
 
+def fit_box(structure: mpl_g.MplGStructure) -> tuple[np.ndarray, np.ndarray]:
+    """The fit's bounds on its coordinates (:func:`theta_names`): the mPL's cell box, ``g_0``
+    in ``[-1e3, 1e3]``, the logs of the Bernstein slopes in ``[log 1e-6, log 1e3]``,
+    ``w_1..w_N`` in ``[-100, 100]``.
+
+    Parameters
+    ----------
+    structure : MplGStructure
+        The model's structure.
+
+    Returns
+    -------
+    lower, upper : numpy.ndarray, shape (3N + 4,)
+    """
+    n = structure.n_cells
+    cap = structure.slope_cap / structure.dt
+    lower = np.r_[np.tile([_LOG_G_MIN, _LOG_VT_BOUNDS[0]], n), -_G0_BOUND,
+                  np.full(3, _LOG_SLOPE_BOUNDS[0]), np.full(n, -_W_BOUND)]
+    upper = np.r_[np.tile([np.log(cap), _LOG_VT_BOUNDS[1]], n), _G0_BOUND,
+                  np.full(3, _LOG_SLOPE_BOUNDS[1]), np.full(n, _W_BOUND)]
+    return lower, upper
+
+
+def start_theta(params: mpl_g.MplGParams) -> np.ndarray:
+    """The fit's coordinates of ``params`` brought to the gauge (:func:`canonical`), not yet
+    clipped into :func:`fit_box`; a Bernstein slope of the wrong sign (``g`` not monotone on
+    ``|z| <= MONOTONE_RANGE``) is ``-inf``.
+
+    Parameters
+    ----------
+    params : MplGParams
+        Parameters with ``w_0 != 0``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3N + 4,)
+    """
+    canon = canonical(params)
+    b = bernstein_slopes(canon.g)
+    b = b * (1.0 if b.sum() >= 0 else -1.0)
+    log_b = np.array([np.log(v) if v > 0 else -np.inf for v in b])
+    return np.r_[canon.to_vector()[:2 * params.n_cells], canon.g[0], log_b, canon.w[1:]]
+
+
 def _limits(n_cells: int) -> tuple[list[str | None], list[str | None]]:
     """The cells' model limits are the mPL's (``mpl.fit.theta_limits``); the floor of a
     Bernstein slope is the edge of the monotone set; every other bound is a search box."""
@@ -205,7 +251,8 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
               accept: Callable[[mpl_g.MplGParams], bool] | None = None,
               accept_reason: str = "rejected by the acceptance test",
               solver: str = "tr", loss: str = "linear", f_scale: float = 1.0,
-              weights: np.ndarray | None = None) -> FitResult:
+              weights: np.ndarray | None = None, init: mpl_g.MplGParams | None = None,
+              weight_sum_max: float | None = None) -> FitResult:
     """Fit the ch. 7 compensator mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9), in the
     gauge ``w_0 = 1``, ``V_b = 0`` with ``g`` monotone on ``|z| <= MONOTONE_RANGE``.
 
@@ -227,6 +274,13 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
         The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
         (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`; the mPL
         start is fitted with the same cost.
+    init : MplGParams, optional
+        Start from these parameters only, instead of the fitted mPL: brought to the gauge
+        (:func:`canonical`, the same model) and clipped into :func:`fit_box` (a ``g`` that is
+        not monotone on ``|z| <= MONOTONE_RANGE`` has its slopes raised to the floor).
+    weight_sum_max : float, optional
+        Constrain ``sum_k |w_k| <= weight_sum_max`` (the document's fmincon constraint; SSE
+        only). In the gauge ``w_0 = 1``, so ``sum_{k>=1} |w_k| <= weight_sum_max - 1``.
 
     Returns
     -------
@@ -236,23 +290,34 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
 
     Raises
     ------
+    ValueError
+        If `init` has another number of cells or ``w_0 = 0``, or `weight_sum_max` is at most
+        1 or comes with a robust loss or weights.
     FitDivergedError
         If no start gives a finite cost, or every candidate is vetoed.
     """
     u, y = check_fit_data(u, y)
     n = structure.n_cells
-    cap = structure.slope_cap / structure.dt
-    lower = np.r_[np.tile([_LOG_G_MIN, _LOG_VT_BOUNDS[0]], n), -_G0_BOUND,
-                  np.full(3, _LOG_SLOPE_BOUNDS[0]), np.full(n, -_W_BOUND)]
-    upper = np.r_[np.tile([np.log(cap), _LOG_VT_BOUNDS[1]], n), _G0_BOUND,
-                  np.full(3, _LOG_SLOPE_BOUNDS[1]), np.full(n, _W_BOUND)]
-    mpl_accept = None if accept is None else (lambda p: accept(_from_mpl(p)))
-    linear = fit_mpl(u, y, mpl.MplStructure(n_cells=n, dt=structure.dt,
-                                            slope_cap=structure.slope_cap),
-                     accept=mpl_accept, accept_reason=accept_reason, loss=loss,
-                     f_scale=f_scale, weights=weights)
-    start = canonical(_from_mpl(linear.params))
-    coords = _Coordinates(n, 1.0 if linear.params.w[0] >= 0 else -1.0)
+    lower, upper = fit_box(structure)
+    if weight_sum_max is not None and not weight_sum_max > 1:
+        raise ValueError(f"in the gauge w_0 = 1 the weight sum is at least 1; got the bound "
+                         f"{weight_sum_max!r}")
+    if init is not None:
+        if init.n_cells != n:
+            raise ValueError(f"init has {init.n_cells} cell(s), the structure {n}")
+        linear = None
+        theta0 = start_theta(init)
+        coords = _Coordinates(n, 1.0 if bernstein_slopes(canonical(init).g).sum() >= 0
+                              else -1.0)
+    else:
+        mpl_accept = None if accept is None else (lambda p: accept(_from_mpl(p)))
+        linear = fit_mpl(u, y, mpl.MplStructure(n_cells=n, dt=structure.dt,
+                                                slope_cap=structure.slope_cap),
+                         accept=mpl_accept, accept_reason=accept_reason, loss=loss,
+                         f_scale=f_scale, weights=weights)
+        start = canonical(_from_mpl(linear.params))
+        coords = _Coordinates(n, 1.0 if linear.params.w[0] >= 0 else -1.0)
+        theta0 = coords.from_params(start)
     cache: dict = {}
 
     def run(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -265,16 +330,24 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
         return cache[key]
 
     try:
-        return fit_multistart(lambda th: run(th)[0] - y, [coords.from_params(start)],
-                              (lower, upper), coords.to_params, structure,
-                              jac=lambda th: run(th)[1], solver=solver, max_nfev=max_nfev,
-                              screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
-                              accept_reason=accept_reason, names=theta_names(n),
-                              limits=_limits(n), loss=loss, f_scale=f_scale,
-                              weights=weights)
+        result = fit_multistart(lambda th: run(th)[0] - y, [np.clip(theta0, lower, upper)],
+                                (lower, upper), coords.to_params, structure,
+                                jac=lambda th: run(th)[1], solver=solver, max_nfev=max_nfev,
+                                screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
+                                accept_reason=accept_reason, names=theta_names(n),
+                                limits=_limits(n), loss=loss, f_scale=f_scale,
+                                weights=weights)
     except FitDivergedError:
-        if accept is None:
+        if accept is None or linear is None:
             raise
+    else:
+        if weight_sum_max is None:
+            return result
+        normal_equations = dense_normal_equations(lambda th: run(th)[0] - y,
+                                                  lambda th: run(th)[1], lower, upper)
+        return constrain_fit(result, normal_equations, np.arange(2 * n + 4, 3 * n + 4),
+                             weight_sum_max - 1.0, coords.to_params, accept=accept,
+                             accept_reason=accept_reason, label="sum |w_1..w_N| (w_0 = 1)")
     # Every fit with a curved g was vetoed (an inverse that diverges on the training data);
     # the accepted mPL start is this family's model with a linear g, and is returned as such.
     return replace(linear, params=start, message=f"{linear.message}; g kept linear: the fit "

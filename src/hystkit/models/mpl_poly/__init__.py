@@ -14,6 +14,6 @@ FAMILY = MplPolyFamily()
 # used, so that the registry (hystkit fit --help) lists the family without compiling anything.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*",), "fit": ("canonical", "default_starts", "fit_mpl_poly"),
+    {"model": ("*",), "fit": ("canonical", "default_starts", "fit_box", "fit_mpl_poly"),
      "presets": ("PAPER_9_2_TABLE_I", "PAPER_9_2_TABLE_II", "paper_9_2_params")},
     first=("FAMILY", "MplPolyFamily"))

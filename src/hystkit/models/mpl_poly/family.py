@@ -9,7 +9,7 @@ import numpy as np
 from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._cells import Cells, cell_report
-from .._protocol import Block, Family
+from .._protocol import Block, Family, FitStart
 
 if TYPE_CHECKING:
     from . import model as mpl_poly
@@ -30,6 +30,7 @@ class MplPolyFamily(Family):
     Structure = lazy(".model", "MplPolyStructure")
     Params = lazy(".model", "MplPolyParams")
     model = lazy(".model")
+    fit_options = frozenset({"init", "weight_sum_max"})
 
     @staticmethod
     def fit_function(u, y, structure, **options):
@@ -63,16 +64,31 @@ class MplPolyFamily(Family):
 
     def presets(self):
         """Paper 9.2's table II columns: direct compensators (sensor -> position) fitted on
-        normalised 40 Hz data, N = 1, as printed (``f2^2``, ``f3^3``)."""
+        normalised 40 Hz data, N = 1, as printed (``f2^2``, ``f3^3``); and table I, the
+        initial conditions of its fits (``paper-9.2-table-i``, for ``--init``)."""
         from . import model as mpl_poly
-        from .presets import PAPER_9_2_TABLE_II, paper_9_2_params
+        from .presets import PAPER_9_2_TABLE_I, PAPER_9_2_TABLE_II, paper_9_2_params
 
         structure = mpl_poly.MplPolyStructure(n_cells=1, dt=0.025)
-        return {f"table-ii-{name}": (structure, paper_9_2_params(printed),
-                                     {"source": f"paper 9.2 table II, {name} column (as "
-                                                "printed, f2^2, f3^3)",
-                                      "direction": "sensor -> position", "fit_dt": 0.025})
-                for name, printed in PAPER_9_2_TABLE_II.items()}
+        presets = {f"table-ii-{name}": (structure, paper_9_2_params(printed),
+                                        {"source": f"paper 9.2 table II, {name} column (as "
+                                                   "printed, f2^2, f3^3)",
+                                         "direction": "sensor -> position", "fit_dt": 0.025})
+                   for name, printed in PAPER_9_2_TABLE_II.items()}
+        presets["paper-9.2-table-i"] = (
+            structure, paper_9_2_params(PAPER_9_2_TABLE_I),
+            {"source": "paper 9.2 table I, initial conditions of its fits (as printed, f2^2, "
+                       "f3^3; w0, w1, V_b from the text below table II)"})
+        return presets
+
+    def start_options(self, structure, params):
+        """``init=params`` for :func:`.fit.fit_mpl_poly` (a single start), with a note for
+        every coordinate outside the fit's box."""
+        from .fit import fit_box, theta_names
+
+        lower, upper = fit_box(structure)
+        return FitStart.in_box({"init": params}, params.to_vector(), lower, upper,
+                               theta_names(structure.n_cells))
 
     def invert_step(self, structure, params, x, y):
         """As :func:`model.invert_step`; NaN input estimate and state when ``y`` is outside

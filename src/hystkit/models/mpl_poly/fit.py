@@ -26,11 +26,13 @@ import numpy as np
 
 from ...errors import FitDivergedError
 from ...identification import FitResult, NormalEquations, check_fit_data, fit_multistart
+from ...identification._constrained import constrain_fit
 from . import kernels
 from . import model as mpl_poly
 from .presets import PAPER_9_2_TABLE_I, paper_9_2_params
 
-__all__ = ["canonical", "default_starts", "fit_mpl_poly", "random_params", "theta_names"]
+__all__ = ["canonical", "default_starts", "fit_box", "fit_mpl_poly", "random_params",
+           "theta_names"]
 
 # Bounds in optimiser coordinates (MplPolyParams.to_vector). |w| <= 100 mirrors the document's
 # weight-sum constraint (sec. 5.3.3); the polynomial coefficients only need to stay finite.
@@ -48,6 +50,28 @@ def theta_names(n_cells: int) -> list[str]:
     cells = [f"f[{k}].{c}" for k in range(1, n_cells + 1) for c in ("c0", "c1", "c2", "log_c3")]
     return [*cells, *(f"g.c{j}" for j in range(4)), *(f"w[{k}]" for k in range(n_cells + 1)),
             "v_b"]
+
+
+def fit_box(structure: mpl_poly.MplPolyStructure) -> tuple[np.ndarray, np.ndarray]:
+    """The fit's bounds in optimiser coordinates (:meth:`MplPolyParams.to_vector`):
+    ``c_k0..c_k2`` and ``g`` in ``[-1e3, 1e3]``, ``log c_k3`` in ``[log 1e-6, log 1e4]``,
+    ``w`` and ``V_b`` in ``[-100, 100]``.
+
+    Parameters
+    ----------
+    structure : mpl_poly.MplPolyStructure
+        The model's structure.
+
+    Returns
+    -------
+    lower, upper : numpy.ndarray, shape (5N + 6,)
+    """
+    n = structure.n_cells
+    lower = np.r_[np.tile([-_COEF_BOUND] * 3 + [_LOG_C3_BOUNDS[0]], n),
+                  np.full(4, -_COEF_BOUND), np.full(n + 2, -_W_BOUND)]
+    upper = np.r_[np.tile([_COEF_BOUND] * 3 + [_LOG_C3_BOUNDS[1]], n),
+                  np.full(4, _COEF_BOUND), np.full(n + 2, _W_BOUND)]
+    return lower, upper
 
 
 def canonical(structure: mpl_poly.MplPolyStructure,
@@ -187,7 +211,8 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
                  accept: Callable[[mpl_poly.MplPolyParams], bool] | None = None,
                  accept_reason: str = "rejected by the acceptance test",
                  solver: str = "tr", loss: str = "linear", f_scale: float = 1.0,
-                 weights: np.ndarray | None = None) -> FitResult:
+                 weights: np.ndarray | None = None, init: mpl_poly.MplPolyParams | None = None,
+                 weight_sum_max: float | None = None) -> FitResult:
     """Fit a polynomial mPL mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9).
 
     Parameters
@@ -208,6 +233,16 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
     loss, f_scale, weights
         The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
         (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`.
+    init : MplPolyParams, optional
+        Start from exactly these parameters and from them only (paper 9.2 started its
+        patternsearch from table I: the preset ``paper-9.2-table-i``); clipped into
+        :func:`fit_box`.
+    weight_sum_max : float, optional
+        Constrain ``sum_k |w_k| <= weight_sum_max`` (the document's fmincon constraint; SSE
+        only). The result is then returned as found, not in canonical form, whose ``w_0 = 1``
+        rescaling would change ``sum |w|``. The output resistor's gauge (``z -> alpha z``) lets
+        an equivalent model meet any bound, so here the constraint bounds the parametrisation
+        more than the model.
 
     Returns
     -------
@@ -216,15 +251,15 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
 
     Raises
     ------
+    ValueError
+        If `init` has another number of cells, or `weight_sum_max` comes with a robust loss
+        or weights.
     FitDivergedError
         If no start runs without diverging, none gives a finite cost, or all are vetoed.
     """
     u, y = check_fit_data(u, y)
     n = structure.n_cells
-    lower = np.r_[np.tile([-_COEF_BOUND] * 3 + [_LOG_C3_BOUNDS[0]], n),
-                  np.full(4, -_COEF_BOUND), np.full(n + 2, -_W_BOUND)]
-    upper = np.r_[np.tile([_COEF_BOUND] * 3 + [_LOG_C3_BOUNDS[1]], n),
-                  np.full(4, _COEF_BOUND), np.full(n + 2, _W_BOUND)]
+    lower, upper = fit_box(structure)
     cache: dict = {}
 
     def to_params(theta: np.ndarray) -> mpl_poly.MplPolyParams:
@@ -251,20 +286,29 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
             return NormalEquations(np.inf, np.full((p, p), np.nan), np.full(p, np.nan))
         return normal_equations(structure, params, u, y)
 
-    candidates = [_table_i_start(n)] + [_linear_output_start(structure, f, u, y)
-                                        for f in default_starts(structure)]
+    if init is not None:
+        if init.n_cells != n:
+            raise ValueError(f"init has {init.n_cells} cell(s), the structure {n}")
+        candidates = [init]
+    else:
+        candidates = [_table_i_start(n)] + [_linear_output_start(structure, f, u, y)
+                                            for f in default_starts(structure)]
     # the solver needs a finite cost at each start
     thetas = [p.to_vector() for p in candidates
               if p is not None and np.isfinite(one_pass(p.to_vector()).cost)]
     if not thetas:
-        raise FitDivergedError("the fit failed: the model diverges on the training data from "
-                               "every start (use the stability limit)")
+        raise FitDivergedError(f"the fit failed: the model diverges on the training data from "
+                               f"{'the given start' if init is not None else 'every start'} "
+                               f"(use the stability limit)")
     result = fit_multistart(lambda th: run(th)[0] - y, thetas, (lower, upper), to_params,
                             structure, jac=lambda th: run(th)[1], normal_equations=one_pass,
                             solver=solver, max_nfev=max_nfev, screen_nfev=screen_nfev,
                             n_polish=n_polish, accept=accept, accept_reason=accept_reason,
                             names=theta_names(n), loss=loss, f_scale=f_scale,
                             weights=weights)
+    if weight_sum_max is not None:
+        return constrain_fit(result, one_pass, np.arange(4 * n + 4, 5 * n + 5), weight_sum_max,
+                             to_params, accept=accept, accept_reason=accept_reason)
     # the (N + 2)-dimensional valley of equivalent parameters (see the module docstring)
     if result.params.w[0] == 0:
         return result
