@@ -186,3 +186,36 @@ def test_states_nothing_reads_are_left_out_of_the_analysis():
     a = np.array([[0.5, 0.3, 0.0], [0.0, 0.9, 0.1], [0.0, 0.0, 0.7]])
     assert _read_states(a, np.array([1.0, 0.0, 0.0])).tolist() == [True, True, True]
     assert _read_states(np.zeros((0, 0)), np.zeros(0)).tolist() == []
+
+
+# --------------------------------------------------------------------------- slow sign flips
+
+
+def _slow_compensator(w1: float) -> hc.SensorBlock:
+    """A 1-cell mPL compensator with a slow cell (G = 1e-2 /s: time constant 100 s) whose
+    static gain at rest is ``(w0 + w1) / 40`` (each cell's static gain is 1) and whose
+    instantaneous gain is ``w0 / 40``, with ``w0 = 1``."""
+    from hystkit.models.mpl.model import MplParams, MplStructure
+
+    structure = MplStructure(n_cells=1, dt=TS)
+    params = MplParams(i_s=[0.5 * 1e-2 * 0.5], v_t=[0.5], w=[1.0, w1], v_b=0.0)
+    return hc.SensorBlock(structure, params, in_scale=40.0, name="slow compensator")
+
+
+@pytest.mark.parametrize("w1", [-1.1, -0.5])
+def test_an_overturned_static_gain_is_named_as_the_cause(w1: float):
+    loop = hc.ControlLoop("direct", IDEAL, hc.DOCUMENT_PID_DIRECT,
+                          compensator=_slow_compensator(w1),
+                          model=hc.linear_block(40.0, name="model"), sensor_gain=1 / 40.0)
+    notes = hc.static_sign_flips(loop)
+    margins = hc.loop_margins(loop)
+    if w1 == -0.5:  # static gain 0.5 / 40, same sign as 1 / 40: nothing to name
+        assert notes == [] and margins.closed_loop_stable and margins.cause is None
+        return
+    # static gain (1 - 1.1) / 40 against the instantaneous 1 / 40: the loop's integral action
+    # pulls a pole beyond z = 1, slowly (the cell's time constant is 100 s)
+    assert len(notes) == 1
+    assert f"({-0.1 / 40:.3g})" in notes[0] and f"({1 / 40:.3g})" in notes[0]
+    assert "time constant 100 s" in notes[0]
+    assert not margins.closed_loop_stable and margins.growth_time_s > 1.0
+    assert margins.cause == notes[0]

@@ -40,7 +40,16 @@ def closed_loop(margins) -> str:
                 "eigenvalue: a state the linearised loop neither corrects nor amplifies, e.g. a "
                 "sticking element at rest or a double integrator)")
     return (f"UNSTABLE (max |pole| {margins.max_pole_radius:.10f}: grows e-fold in "
-            f"{margins.growth_time_s:.3g} s)")
+            f"{duration(margins.growth_time_s)}"
+            + (f"; {margins.cause}" if margins.cause else "") + ")")
+
+
+def duration(seconds: float) -> str:
+    """``8.1e+05 s (9.4 days)``: seconds, and in hours or days when that long."""
+    for unit, size in (("days", 86400.0), ("hours", 3600.0)):
+        if seconds >= 2 * size:
+            return f"{seconds:.3g} s ({seconds / size:.3g} {unit})"
+    return f"{seconds:.3g} s"
 
 
 def _change(before: float | None, after: float | None) -> str:

@@ -10,7 +10,7 @@ __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
     {"_names": ("EXPERIMENTS", "MASS", "SCHEMES", "TRAININGS"),
      "_analysis": ("DOB_CANDIDATES_HZ", "LoopMargins", "bode_data", "classify_poles",
-                   "design_dob", "loop_margins", "open_loop", "tune_pid"),
+                   "design_dob", "loop_margins", "open_loop", "static_sign_flips", "tune_pid"),
      "_blocks": ("DOCUMENT_PID_DIRECT", "DOCUMENT_PID_WEIGHTING", "PID", "TS",
                  "DisturbanceObserver", "Plant", "plant_matrices"),
      "_experiments": ("AMPLITUDES_MM", "FREQUENCIES_HZ", "Case", "ExperimentResult", "build_loop",

@@ -28,7 +28,8 @@ from ._blocks import (
 )
 from ._loop import ControlLoop, LoopState, rest_state
 
-__all__ = ["LoopMargins", "bode_data", "classify_poles", "design_dob", "loop_margins", "open_loop", "tune_pid"]
+__all__ = ["LoopMargins", "bode_data", "classify_poles", "design_dob", "loop_margins", "open_loop",
+           "static_sign_flips", "tune_pid"]
 
 
 def _ss(a, b, c, d, ts, inputs, outputs, name) -> control.StateSpace:
@@ -83,6 +84,14 @@ def open_loop(loop: ControlLoop, state: LoopState | None = None) -> control.Stat
     control.StateSpace
         ``L(z)``, input ``u_p`` [N], output ``v`` [N], sample time ``loop.ts``.
     """
+    blocks = _blocks(loop, state)
+    sys = control.interconnect(blocks, inplist=["u_p"], outlist=["v"], name="open_loop")
+    return control.ss(sys.A, sys.B, -sys.C, -sys.D, loop.ts, inputs="u_p", outputs="v",
+                      name="L")
+
+
+def _blocks(loop: ControlLoop, state: LoopState | None) -> list:
+    """The loop's linearised blocks, named, for ``control.interconnect``."""
     state = rest_state(loop) if state is None else state
     ts = loop.ts
     a, b, c = plant_matrices(loop.plant.mass, ts)
@@ -109,9 +118,46 @@ def open_loop(loop: ControlLoop, state: LoopState | None = None) -> control.Stat
         blocks.append(_ss(a_e - np.outer(gain, c_e), np.column_stack([gain, b_e]),
                           [0.0, 0.0, 1.0], [[0.0, 0.0]], ts, ["y_hat", "v"], "d_hat", "dob"))
         blocks.append(control.summing_junction(["u_c", "-d_hat"], "v", name="force"))
-    sys = control.interconnect(blocks, inplist=["u_p"], outlist=["v"], name="open_loop")
-    return control.ss(sys.A, sys.B, -sys.C, -sys.D, ts, inputs="u_p", outputs="v",
-                      name="L")
+    return blocks
+
+
+def static_sign_flips(loop: ControlLoop, state: LoopState | None = None) -> list[str]:
+    """Why a loop can be unstable only at time scales far beyond its runs, in words.
+
+    A sensor model or compensator whose static gain has the opposite sign of its
+    instantaneous gain (``D``) has a real zero beyond ``z = 1``: its slowest cell undoes, and
+    overshoots, the direct path over a time much longer than the training data. The loop's
+    integral action (the plant's double integrator, the PID's integrator) pulls a closed-loop
+    pole towards that zero, so the linearised loop drifts away with an e-folding time of
+    hours to days while every run of seconds to minutes stays bounded.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+    state : LoopState, optional
+        Operating point; default :func:`rest_state` at ``r = 0``.
+
+    Returns
+    -------
+    list of str
+        One sentence per block (sensor, compensator) with such a sign flip; empty if none.
+    """
+    notes = []
+    for sys in _blocks(loop, state):
+        if sys.name not in ("sensor", "compensator") or sys.nstates == 0:
+            continue
+        direct = float(np.asarray(sys.D).reshape(-1)[0])
+        poles = np.abs(np.linalg.eigvals(sys.A))
+        if poles.max() >= 1.0 or direct == 0.0:
+            continue
+        static = float(np.real(control.dcgain(sys)))
+        if np.sign(static) != np.sign(direct):
+            slowest = -loop.ts / np.log(poles.max())
+            notes.append(f"the {sys.name} has a static gain ({static:.3g}) of the opposite "
+                         f"sign to its instantaneous gain ({direct:.3g}): its slowest cell (time "
+                         f"constant {slowest:.3g} s) overturns it, a zero beyond z = 1 that "
+                         f"the integral action of the loop pulls a pole onto")
+    return notes
 
 
 @dataclass(frozen=True)
@@ -136,6 +182,8 @@ class LoopMargins:
         For an unstable loop, the e-folding time ``Ts / ln max|pole|`` [s] of its fastest
         growing mode: a slow drift (hours) and a blow-up (milliseconds) both count as unstable.
         None when no pole lies outside the unit circle (beyond its rounding).
+    cause : str or None
+        For an unstable loop, a known cause in words (:func:`static_sign_flips`), else None.
     marginal : bool
         No pole outside the unit circle and at least one on it (within the rounding of its
         eigenvalue, see :func:`classify_poles`): a state the linearised loop neither corrects
@@ -151,6 +199,7 @@ class LoopMargins:
     max_pole_radius: float
     growth_time_s: float | None = None
     marginal: bool = False
+    cause: str | None = None
 
     def to_dict(self) -> dict:
         """The fields as a dict (JSON-safe: floats, bools and None)."""
@@ -264,7 +313,9 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
                        phase_crossover_hz=f_pc, closed_loop_stable=stable,
                        max_pole_radius=radius,
                        growth_time_s=float(loop.ts / np.log(growth)) if growth > 1 else None,
-                       marginal=marginal)
+                       marginal=marginal,
+                       cause=("; ".join(static_sign_flips(loop, state)) or None)
+                       if growth > 1 else None)
 
 
 def bode_data(loop: ControlLoop, state: LoopState | None = None,

@@ -38,7 +38,8 @@ def stability_verdict(linear: dict) -> tuple[str, str]:
     growth = linear.get("growth_time_s")
     return (f"closed loop UNSTABLE (linearised at rest): max |pole| "
             f"{linear.get('max_pole_radius', float('nan')):.10f}"
-            + (f", grows e-fold in {growth:.3g} s" if growth is not None else ""), "bad")
+            + (f", grows e-fold in {growth:.3g} s" if growth is not None else "")
+            + (f"; {linear['cause']}" if linear.get("cause") else ""), "bad")
 
 
 def _fmt(value: object, spec: str = ".3g") -> str:
