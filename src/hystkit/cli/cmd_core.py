@@ -22,6 +22,7 @@ from ._common import (
     size_limit,
     slope_cap,
 )
+from ._fit_start_options import add_start_options, start_options, structure_options
 from ._inputs import check_inputs_exist
 from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_from_args
 
@@ -87,9 +88,11 @@ def _fit(args: argparse.Namespace) -> int:
         raise UsageError(f"--slope-cap applies to the models with an Euler slope cap "
                          f"({', '.join(_slope_cap_models())}), not {args.model!r}")
     options.update(_pl_options(args, family))
+    options.update(structure_options(args, family))
     check_size(args.model, args.cells, "--cells")
     recs = [read_recording(path, options=read_options(args, path)) for path in args.data]
     size = family.default_size if args.cells is None else args.cells
+    fit_options = start_options(args, family, recs[0].dt, size, options, len(recs))
     shown = "".join(f", {name} {value:g}" for name, value in options.items())
     print(f"fitting {args.model} ({family.size_help}: {size}{shown}, {args.mode} mode, centring: "
           f"{center_label(args.center)}) on {', '.join(map(str, args.data))}: "
@@ -97,7 +100,7 @@ def _fit(args: argparse.Namespace) -> int:
           f"{_units_label(recs[0])} ...", flush=True)
     comp = fit_compensator(recs, size, model=args.model, mode=args.mode, center=args.center,
                            tare_seconds=args.tare_seconds, track_seconds=args.track_seconds,
-                           **options)
+                           fit_options=fit_options, **options)
     units = _training_units(recs, args.data)
     if units:
         comp.fit_info["units"] = units
@@ -461,6 +464,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, required=True,
                    help="model file to write: .json, or .mat (a MATLAB struct with every field "
                         "of the JSON file; evaluate and compensate read both)")
+    add_start_options(p)
     add_read_options(p)
     p.set_defaults(run=_fit)
 
