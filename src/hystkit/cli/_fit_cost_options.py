@@ -13,29 +13,28 @@ import argparse
 from dataclasses import dataclass
 from pathlib import Path
 
-from ._common import UsageError, deferred, number, read_options
+from ._common import UsageError, number, read_options
 
-__all__ = ["CostOptions", "add_cost_options", "cost_options", "print_cost_summary"]
+__all__ = ["LOSSES", "CostOptions", "add_cost_options", "cost_options", "print_cost_summary"]
 
 
-def _losses() -> tuple[str, ...]:
-    from ..identification import LOSSES
-
-    return LOSSES
+# hystkit.identification.LOSSES, spelt out: importing it loads scipy and numba, which building
+# the parser must not (tests/cli/test_fit_cost_options.py checks that the two agree)
+LOSSES = ("linear", "soft_l1", "huber", "cauchy")
 
 
 def add_cost_options(parser: argparse.ArgumentParser) -> None:
     """Add ``--loss``, ``--f-scale`` and ``--weights`` to `parser` (the ``fit`` subcommand)."""
-    deferred(parser.add_argument(
-        "--loss", default="linear",
+    parser.add_argument(
+        "--loss", default="linear", choices=LOSSES,
         help="cost the fit minimises: linear = the SSE (eq. 5.9, default); soft_l1, huber, "
              "cauchy = scipy's robust losses, which count residuals beyond --f-scale less "
              "(outliers, spikes); models fitted by linear least squares (preisach, gpreisach, "
-             "bobbio, pi) take linear only"), choices=_losses)
+             "bobbio, pi) take linear only")
     parser.add_argument(
         "--f-scale", type=number(0, low_open=True), default=None, metavar="F",
         help="residual scale of a robust --loss, > 0, in normalised units: the data are "
-             "scaled to max |.| = 1 before the fit (eq. 5.10), so 0.05 is 5 %% of the range "
+             "scaled to max |.| = 1 before the fit (eq. 5.10), so 0.05 is 5 %% of the largest |value| "
              "(default 1, scipy's)")
     parser.add_argument(
         "--weights", default=None, metavar="COLUMN",

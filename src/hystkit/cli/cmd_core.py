@@ -22,6 +22,7 @@ from ._common import (
     size_limit,
     slope_cap,
 )
+from ._fit_cost_options import add_cost_options, cost_options, print_cost_summary
 from ._fit_start_options import add_start_options, start_options, structure_options
 from ._inputs import check_inputs_exist
 from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_from_args
@@ -83,6 +84,7 @@ def _fit(args: argparse.Namespace) -> int:
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
                       what="a model file")
     family = get_family(args.model)
+    costs = cost_options(args)
     options = {} if args.slope_cap is None else {"slope_cap": args.slope_cap}
     if options and not has_slope_cap(family):
         raise UsageError(f"--slope-cap applies to the models with an Euler slope cap "
@@ -100,6 +102,7 @@ def _fit(args: argparse.Namespace) -> int:
           f"{_units_label(recs[0])} ...", flush=True)
     comp = fit_compensator(recs, size, model=args.model, mode=args.mode, center=args.center,
                            tare_seconds=args.tare_seconds, track_seconds=args.track_seconds,
+                           **costs.fit_arguments(args, recs),
                            fit_options=fit_options, **options)
     units = _training_units(recs, args.data)
     if units:
@@ -108,6 +111,7 @@ def _fit(args: argparse.Namespace) -> int:
     info = comp.fit_info
     print(f"done in {info['fit_seconds']:.2f} s: SSE {info['cost']:.4g} (normalised), solver: "
           f"{info['message']}")
+    print_cost_summary(info)
     print(f"  parameters: {comp.params.to_dict()}")
     _print_standard_errors(info.get("standard_errors"))
     print(f"  training R² {info['training_r2']:.4f}, straight line {info['training_linear_r2']:.4f}"
@@ -465,6 +469,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="model file to write: .json, or .mat (a MATLAB struct with every field "
                         "of the JSON file; evaluate and compensate read both)")
     add_start_options(p)
+    add_cost_options(p)
     add_read_options(p)
     p.set_defaults(run=_fit)
 

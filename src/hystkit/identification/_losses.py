@@ -54,9 +54,9 @@ def objective(residual: np.ndarray, loss: str = "linear", f_scale: float = 1.0,
     """
     check_cost(loss, f_scale)
     r = np.asarray(residual, dtype=float)
+    if loss == "linear":  # as the fits sum it: r @ r
+        return float(r @ r) if weights is None else float(np.asarray(weights, float) @ (r * r))
     z = r * r if weights is None else np.asarray(weights, dtype=float) * r * r
-    if loss == "linear":
-        return float(np.sum(z))
     z = z / f_scale ** 2
     if loss == "soft_l1":
         rho = 2.0 * (np.sqrt(1.0 + z) - 1.0)
