@@ -399,7 +399,8 @@ def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording], s
     n = p.size
     k = _count_params(comp.params, fixed_mask(family, structure, comp.params))
     log_term = n * np.log(max(sse, 1e-300) / n)
-    info = {"cost": sse, "objective": minimised, "fit_seconds": result.seconds, "n_evaluations": result.n_evaluations,
+    info = {"cost": sse, "objective": minimised, "fit_seconds": result.seconds,
+            "n_evaluations": result.n_evaluations,
             "converged": result.converged, "message": result.message,
             "n_starts": result.n_starts, "training_source": recs[0].source,
             "training_sources": [r.source for r in recs],

@@ -12,8 +12,8 @@ Jacobian (or '2-point'), the normal equations are formed from them:
 
 Beside the SSE a fit can minimise a robust or weighted cost (`fit_multistart`'s ``loss``,
 ``f_scale``, ``weights``): ``sum_i f^2 rho(w_i r_i^2 / f^2)`` with scipy's ``rho`` (soft_l1,
-huber, cauchy; :mod:`._losses`). Such fits run on scipy's trf with the residual and Jacobian scaled by
-``sqrt(w)``; the compiled normal equations have no weights.
+huber, cauchy; :mod:`._losses`). Such fits run on scipy's trf with the residual and Jacobian
+scaled by ``sqrt(w)``; the compiled normal equations have no weights.
 """
 
 from __future__ import annotations

@@ -38,8 +38,8 @@ from ...errors import FitDivergedError
 from ...identification import FitResult, check_fit_data, check_weights, require_linear_loss
 from . import model as preisach
 
-__all__ = ["ORIENTATIONS", "SUPPORTED_LOSSES", "check_data", "everett_from_forcs", "fit_oriented", "fit_preisach",
-           "smoothness_rows", "solve_regularised"]
+__all__ = ["ORIENTATIONS", "SUPPORTED_LOSSES", "check_data", "everett_from_forcs",
+           "fit_oriented", "fit_preisach", "smoothness_rows", "solve_regularised"]
 
 
 def check_data(u: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
