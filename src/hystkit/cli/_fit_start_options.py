@@ -26,9 +26,10 @@ from ._common import UsageError, number
 
 __all__ = ["add_start_options", "parse_init", "start_options", "structure_options"]
 
-_NO_LIMIT_WARNING = ("hystkit: warning: --no-limit: the sinh mPL without the stability limit "
-                     "(eq. 5.29) can diverge (sec. 5.3.3); this fit reproduces the document's "
-                     "for study, not for use as a compensator")
+_NO_LIMIT_WARNING = ("hystkit: warning: --no-limit: {model} without the stability limit "
+                     "(eq. 5.29) can diverge (sec. 5.3.3; paper 9.2: its chirp model without "
+                     "the limits is unstable); this fit reproduces the document's for study, "
+                     "not for use as a compensator")
 
 
 class _ListPresets(argparse.Action):
@@ -71,8 +72,9 @@ def add_start_options(parser: argparse.ArgumentParser) -> None:
              "of sec. 5.3.3), to reproduce the document's diverging fits; not for use")
     parser.add_argument(
         "--weight-sum-max", type=number(0, low_open=True), default=None, metavar="B",
-        help="mpl, mpl-poly, mpl-g: constrain sum |w_k| <= B as the document's fmincon fit "
-             "(B = 100; default: no constraint beyond the box |w_k| <= 100)")
+        help="mpl, mpl-g: constrain sum |w_k| <= B as the document's fmincon fit (B = 100; "
+             "default: no constraint beyond the box |w_k| <= 100); mpl-g counts w_0 = 1 of its "
+             "gauge")
 
 
 def structure_options(args: argparse.Namespace, family: Any) -> dict:
@@ -90,7 +92,7 @@ def structure_options(args: argparse.Namespace, family: Any) -> dict:
     if "limit" not in inspect.signature(family.make_structure).parameters:
         raise UsageError(f"--no-limit applies to models with the stability limit eq. 5.29 "
                          f"(mpl, mpl-poly), not {family.name!r}")
-    print(_NO_LIMIT_WARNING, file=sys.stderr)
+    print(_NO_LIMIT_WARNING.format(model=family.name), file=sys.stderr)
     return {"limit": False}
 
 

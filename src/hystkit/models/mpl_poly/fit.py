@@ -26,7 +26,6 @@ import numpy as np
 
 from ...errors import FitDivergedError
 from ...identification import FitResult, NormalEquations, check_fit_data, fit_multistart
-from ...identification._constrained import constrain_fit
 from . import kernels
 from . import model as mpl_poly
 from .presets import PAPER_9_2_TABLE_I, paper_9_2_params
@@ -211,8 +210,8 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
                  accept: Callable[[mpl_poly.MplPolyParams], bool] | None = None,
                  accept_reason: str = "rejected by the acceptance test",
                  solver: str = "tr", loss: str = "linear", f_scale: float = 1.0,
-                 weights: np.ndarray | None = None, init: mpl_poly.MplPolyParams | None = None,
-                 weight_sum_max: float | None = None) -> FitResult:
+                 weights: np.ndarray | None = None,
+                 init: mpl_poly.MplPolyParams | None = None) -> FitResult:
     """Fit a polynomial mPL mapping ``u`` to ``y`` by minimising the SSE (eq. 5.9).
 
     Parameters
@@ -237,12 +236,6 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
         Start from exactly these parameters and from them only (paper 9.2 started its
         patternsearch from table I: the preset ``paper-9.2-table-i``); clipped into
         :func:`fit_box`.
-    weight_sum_max : float, optional
-        Constrain ``sum_k |w_k| <= weight_sum_max`` (the document's fmincon constraint; SSE
-        only). The result is then returned as found, not in canonical form, whose ``w_0 = 1``
-        rescaling would change ``sum |w|``. The output resistor's gauge (``z -> alpha z``) lets
-        an equivalent model meet any bound, so here the constraint bounds the parametrisation
-        more than the model.
 
     Returns
     -------
@@ -252,8 +245,7 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
     Raises
     ------
     ValueError
-        If `init` has another number of cells, or `weight_sum_max` comes with a robust loss
-        or weights.
+        If `init` has another number of cells.
     FitDivergedError
         If no start runs without diverging, none gives a finite cost, or all are vetoed.
     """
@@ -306,9 +298,6 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
                             n_polish=n_polish, accept=accept, accept_reason=accept_reason,
                             names=theta_names(n), loss=loss, f_scale=f_scale,
                             weights=weights)
-    if weight_sum_max is not None:
-        return constrain_fit(result, one_pass, np.arange(4 * n + 4, 5 * n + 5), weight_sum_max,
-                             to_params, accept=accept, accept_reason=accept_reason)
     # the (N + 2)-dimensional valley of equivalent parameters (see the module docstring)
     if result.params.w[0] == 0:
         return result
