@@ -131,7 +131,43 @@ def test_weights_on_an_inverse_model_is_one_error_line(tmp_path, capsys):
 def test_the_parser_constants_are_the_library_s():
     # the parser keeps its own copies so that building it imports no numpy
     from hystkit.cli import cmd_stream
-    from hystkit.compensation import ADAPT_PARAMETERS
+    from hystkit.compensation import ADAPT_PARAMETERS, Refit
 
-    assert cmd_stream.ADAPT_CHOICES == ADAPT_PARAMETERS
+    assert cmd_stream.ADAPT_CHOICES == (*ADAPT_PARAMETERS, "full")
     assert cmd_stream.DEFAULT_FORGETTING == Adaptation().forgetting
+    assert cmd_stream.DEFAULT_WINDOW == Refit().window_seconds
+    assert cmd_stream.DEFAULT_REFIT_EVERY == Refit().every
+
+
+def test_adapt_full_gives_the_library_refitting_stream(model, tmp_path, capsys):
+    from hystkit.compensation import Refit, RefittingStream
+
+    comp, path = model
+    rec = with_gain_drift(simulate_experiment("sine", 2), -0.10)
+    n = 1200  # 30 s, one reference per 0.25 s: 120, and 40 in a 10 s window
+    sensor, reference = rec.sensor[:n], occasional_references(rec, 0.25, seed=3)[:n]
+    data = tmp_path / "in.csv"
+    data.write_text(csv_lines(sensor, reference))
+    assert main(["stream", str(path), "--in", str(data), "--adapt", "full", "--window", "10",
+                 "--refit-every", "5"]) == 0
+    captured = capsys.readouterr()
+    stream = RefittingStream(comp, Refit(window_seconds=10.0, every=5))
+    assert_array_equal(estimates(captured.out), stream.process(sensor, reference))
+    report = stream.report
+    assert report.kept > 0
+    assert np.any(estimates(captured.out) != Stream(comp).process(sensor))
+    assert ("adaptation (full, window 10 s, refit every 5 references): 120 references"
+            in captured.err)
+    assert f"{report.kept} refits kept, {report.refused} refused" in captured.err
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--adapt", "full", "--forgetting", "0.9"],
+     "--forgetting applies to --adapt gain or weights, not full"),
+    (["--adapt", "gain", "--window", "30"], "--window only applies with --adapt full"),
+    (["--refit-every", "3"], "--refit-every only applies with --adapt"),
+])
+def test_refit_options_in_the_wrong_place_are_refused(model, capsys, argv, message):
+    _, path = model
+    assert main(["stream", str(path), *argv]) == 2
+    assert capsys.readouterr().err.strip() == f"hystkit: error: {message}"

@@ -22,9 +22,11 @@ Online adaptation (``--adapt gain`` or ``--adapt weights``, see
 :mod:`hystkit.compensation._adaptive`): a third column ``reference`` (named in the header, or
 the third field without one) gives the true position [mm] now and then, empty (or ``nan``) when
 unknown; each known one re-fits the output's gain and offset (or cell weights) by recursive
-least squares with forgetting, after its own sample's estimate is made. A reference that is
-not a number is ignored and counted. At the end stderr gets the references used, the a-priori
-error at them and the adapted parameters.
+least squares with forgetting, after its own sample's estimate is made. ``--adapt full``
+(:mod:`hystkit.compensation._refit`) re-fits every parameter on the last ``--window`` seconds
+after every ``--refit-every`` references. A reference that is not a number is ignored and
+counted. At the end stderr gets the references used, the a-priori error at them and the
+adapted parameters.
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ from typing import TYPE_CHECKING, TextIO
 from ..errors import InputError
 
 if TYPE_CHECKING:
-    from ..compensation import AdaptiveStream, Stream, SyncExcitation
+    from ..compensation import AdaptiveStream, RefittingStream, Stream, SyncExcitation
 
 __all__ = ["register"]
 
@@ -54,9 +56,11 @@ DEFAULT_BAUD = 115200
 MAX_LINE = 4096
 TOO_LONG = "\0 line too long"
 SERIAL_HINT = 'pip install "hystkit[serial]"'
-# As hystkit.compensation._adaptive (not imported here: building the parser stays light).
-ADAPT_CHOICES = ("gain", "weights")
+# As hystkit.compensation._adaptive and ._refit (not imported here: the parser stays light).
+ADAPT_CHOICES = ("gain", "weights", "full")
 DEFAULT_FORGETTING = 0.9
+DEFAULT_WINDOW = 60.0
+DEFAULT_REFIT_EVERY = 10
 
 
 # Kinds of problem whose sample is still compensated, and what happened instead of skipping it.
@@ -196,10 +200,21 @@ class _Learning:
         self.n += 1
         self.sum_sq += (estimate - reference) ** 2
 
-    def summary(self, stream: AdaptiveStream, adapt: str, forgetting: float) -> str:
-        head = f"hystkit stream: adaptation ({adapt}, forgetting {forgetting:g}): "
+    def summary(self, stream: AdaptiveStream | RefittingStream, adapt: str,
+                forgetting: float | None) -> str:
+        if adapt == "full":
+            refit = stream.refit
+            head = (f"hystkit stream: adaptation (full, window {refit.window_seconds:g} s, "
+                    f"refit every {refit.every} references): ")
+        else:
+            head = f"hystkit stream: adaptation ({adapt}, forgetting {forgetting:g}): "
         if not self.n:
             return head + "no reference arrived; the estimates are the plain stream's"
+        if adapt == "full":
+            report = stream.report
+            return (head + f"{self.n} references, rms error at them before learning from each "
+                    f"{(self.sum_sq / self.n) ** 0.5:.4g} mm; {report.kept} refits kept, "
+                    f"{report.refused} refused; now {stream.compensator.params.to_dict()}")
         values = ", ".join(f"{k} {v:.6g}" for k, v in stream.parameters.items())
         return (head + f"{self.n} references, rms error at them before learning from each "
                 f"{(self.sum_sq / self.n) ** 0.5:.4g} mm; now {values}")
@@ -231,7 +246,7 @@ class _Latency:
                 f"{self.max * 1e6:.1f} µs{window}")
 
 
-def _run_stream(stream: Stream | AdaptiveStream, lines: Iterator[str], tally: _Tally,
+def _run_stream(stream: Stream | AdaptiveStream | RefittingStream, lines: Iterator[str], tally: _Tally,
                 latency: _Latency, learning: _Learning | None = None) -> None:
     """Compensate every line, writing each result at once; an adapting stream (``learning``
     given) also gets each line's reference."""
@@ -314,21 +329,40 @@ def _stream(args: argparse.Namespace) -> int:
 
 
 ADAPT_OPTIONS = ("prior_gain", "prior_offset")
+REFIT_OPTIONS = ("window", "refit_every")
 
 
 def _check_adapt_options(args: argparse.Namespace) -> None:
+    def given(names: tuple[str, ...]) -> list[str]:
+        return [f"--{k.replace('_', '-')}" for k in names if getattr(args, k) is not None]
+
     if args.adapt is None:
-        used = [f"--{k.replace('_', '-')}" for k in ("forgetting", *ADAPT_OPTIONS)
-                if getattr(args, k) is not None]
+        used = given(("forgetting", *ADAPT_OPTIONS, *REFIT_OPTIONS))
         if used:
-            raise InputError(f"{', '.join(used)} only apply with --adapt")
-    elif args.forgetting is None:
-        args.forgetting = DEFAULT_FORGETTING
+            raise InputError(f"{', '.join(used)} only {_verb(used)} with --adapt")
+    elif args.adapt == "full":
+        if used := given(("forgetting", *ADAPT_OPTIONS)):
+            raise InputError(f"{', '.join(used)} {_verb(used)} to --adapt gain or weights, "
+                             f"not full")
+    else:
+        if used := given(REFIT_OPTIONS):
+            raise InputError(f"{', '.join(used)} only {_verb(used)} with --adapt full")
+        if args.forgetting is None:
+            args.forgetting = DEFAULT_FORGETTING
 
 
-def _adaptive_stream(args: argparse.Namespace, comp, start) -> AdaptiveStream:
-    from ..compensation import Adaptation, AdaptiveStream
+def _verb(options: list[str]) -> str:
+    return "applies" if len(options) == 1 else "apply"
 
+
+def _adaptive_stream(args: argparse.Namespace, comp,
+                     start) -> AdaptiveStream | RefittingStream:
+    from ..compensation import Adaptation, AdaptiveStream, Refit, RefittingStream
+
+    if args.adapt == "full":
+        refit = Refit(DEFAULT_WINDOW if args.window is None else args.window,
+                      DEFAULT_REFIT_EVERY if args.refit_every is None else args.refit_every)
+        return RefittingStream(comp, refit, start, label=str(args.model))
     options = {k: getattr(args, k) for k in ADAPT_OPTIONS if getattr(args, k) is not None}
     adaptation = Adaptation(args.adapt, args.forgetting, **options)
     return AdaptiveStream(comp, adaptation, start, label=str(args.model))
@@ -368,9 +402,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     adapt = p.add_argument_group("online adaptation (a reference column: the true position "
                                  "[mm] now and then, empty when unknown)")
     adapt.add_argument("--adapt", choices=ADAPT_CHOICES,
-                       help="re-fit the output from the references by recursive least squares: "
-                            "gain (gain and offset of the estimate, any model) or weights (cell "
-                            "output weights and offset; direct mpl, pl, ladder)")
+                       help="re-fit from the references: gain (gain and offset of the "
+                            "estimate, any model) or weights (cell output weights and offset; "
+                            "direct mpl, pl, ladder) by recursive least squares; full (every "
+                            "parameter, re-fitted on a sliding window; direct compensators)")
     adapt.add_argument("--forgetting", type=number(0, 1, low_open=True), metavar="LAMBDA",
                        help=f"forgetting factor per reference, in (0, 1]: remembers about "
                             f"1/(1-LAMBDA) references (default {DEFAULT_FORGETTING:g})")
@@ -380,4 +415,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     adapt.add_argument("--prior-offset", type=number(0, 1e9, low_open=True), metavar="MM",
                        help="prior standard deviation of the offset [mm] (default 10 %% of "
                             "the training positions' span)")
+    adapt.add_argument("--window", type=number(0, 1e6, low_open=True), metavar="SECONDS",
+                       help=f"--adapt full: length of the sliding window re-fitted [s] (default "
+                            f"{DEFAULT_WINDOW:g}); it must hold 4 references per parameter")
+    adapt.add_argument("--refit-every", type=positive_int, metavar="N",
+                       help=f"--adapt full: re-fit after every N new references (default "
+                            f"{DEFAULT_REFIT_EVERY})")
     p.set_defaults(run=_stream)

@@ -20,7 +20,7 @@ error against the reference is an honest prediction error). Until the first refe
 output is the plain stream's, bit for bit; a chunk of any size gives the same bits as the same
 samples one by one.
 
-Not done here: re-fitting the full model (cell dynamics too) on a sliding window.
+Re-fitting the whole model (cell dynamics too) on a sliding window: :mod:`._refit`.
 """
 
 from __future__ import annotations

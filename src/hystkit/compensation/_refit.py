@@ -35,6 +35,7 @@ from ..errors import FitDivergedError, InputError
 from ._compensator import Compensator
 from ._stream import (
     StartUp,
+    StepOutput,
     StreamOutput,
     StreamState,
     _advance,
@@ -145,6 +146,26 @@ class RefittingStream:
         fit = family.fit_function or family.fit
         self._budget = ({"max_nfev": self.refit.max_nfev}
                         if "max_nfev" in inspect.signature(fit).parameters else {})
+        self._warm_up()
+        if compensator.center == "track":
+            import scipy.signal  # noqa: F401  # now, not ~1 s late on the first sample
+
+    def _warm_up(self) -> None:
+        """Load the fit's code and compiled kernels now, not inside the first refit of a
+        live stream (where they stalled one sample by ~0.7 s): a one-evaluation weighted fit
+        on a short probe, whose result is not used."""
+        comp = self._path.comp
+        probe = 0.5 * np.sin(np.linspace(0.0, 4.0 * np.pi, 64))
+        try:
+            options = comp.family.start_options(comp.structure, comp.params).options
+        except NotImplementedError:
+            options = {}
+        try:
+            comp.family.fit(probe, probe, comp.structure, weights=np.ones(probe.size),
+                            **self._budget, **options)
+        except (FitDivergedError, InputError, ValueError, ArithmeticError,
+                np.linalg.LinAlgError):
+            pass  # a probe the family cannot fit still loaded its code
 
     @property
     def compensator(self) -> Compensator:
@@ -158,6 +179,18 @@ class RefittingStream:
     @property
     def state(self) -> StreamState:
         return self._state
+
+    def step(self, sensor: float, reference: float = float("nan")) -> float:
+        """Estimate [mm] for one raw sensor sample; then learn from ``reference`` if known."""
+        return self.step_flagged(sensor, reference).estimate
+
+    def step_flagged(self, sensor: float, reference: float = float("nan")) -> StepOutput:
+        """Estimate and use-time flags for one raw sensor sample (the bits of
+        :meth:`process`); then learn from ``reference`` [mm] if known."""
+        out = self.process_flagged(np.array([sensor], dtype=np.float64),
+                                   np.array([reference], dtype=np.float64))
+        return StepOutput(float(out.estimate[0]),
+                          *(None if flag is None else bool(flag[0]) for flag in out[1:]))
 
     def process(self, sensor: np.ndarray, reference: np.ndarray | None = None) -> np.ndarray:
         """Estimates [mm] for a chunk; ``reference`` [mm] per sample, NaN where unknown."""
