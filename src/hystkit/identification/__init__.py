@@ -6,7 +6,14 @@ Each family's own fit is in its folder, ``hystkit.models.<family>``; the registr
 
 from ._least_squares import check_fit_data, check_weights, fit_multistart
 from ._lm import solve_lm
-from ._losses import LOSSES, check_cost, objective, require_linear_loss
+from ._losses import (
+    LOSSES,
+    check_cost,
+    loss_slope,
+    objective,
+    require_linear_loss,
+    robust_linear_fit,
+)
 from ._normal_equations import (
                                 ChunkedDifferences,
                                 NormalEquations,
@@ -17,4 +24,5 @@ from ._result import BoundHit, FitResult
 
 __all__ = ["LOSSES", "BoundHit", "ChunkedDifferences", "FitResult", "NormalEquations",
            "SolveResult", "check_cost", "check_fit_data", "check_weights", "dense_normal_equations",
-           "fit_multistart", "objective", "require_linear_loss", "solve_lm"]
+           "fit_multistart", "loss_slope", "objective", "require_linear_loss",
+           "robust_linear_fit", "solve_lm"]

@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LOSSES", "check_cost", "objective", "require_linear_loss"]
+__all__ = ["LOSSES", "check_cost", "loss_slope", "objective", "require_linear_loss",
+           "robust_linear_fit"]
 
 LOSSES = ("linear", "soft_l1", "huber", "cauchy")
 """Costs a fit can minimise: ``linear`` is the SSE (eq. 5.9), the others scipy's robust losses
@@ -92,3 +93,67 @@ def require_linear_loss(loss: str, f_scale: float, model: str, method: str) -> N
     if loss != "linear":
         raise InputError(f"model {model!r} fits by {method}; the {loss} loss is not available "
                          f"for it (its fit takes per-sample weights)")
+
+
+def loss_slope(z: np.ndarray, loss: str) -> np.ndarray:
+    """``rho'(z)`` of scipy's loss `loss` (the IRLS weight of a residual with ``z = w r^2 /
+    f^2``): 1, ``(1 + z)^-1/2``, ``min(1, z^-1/2)``, ``1 / (1 + z)``."""
+    z = np.asarray(z, dtype=float)
+    if loss == "linear":
+        return np.ones_like(z)
+    if loss == "soft_l1":
+        return 1.0 / np.sqrt(1.0 + z)
+    if loss == "huber":
+        return np.where(z <= 1.0, 1.0, 1.0 / np.sqrt(np.maximum(z, 1.0)))
+    if loss == "cauchy":
+        return 1.0 / (1.0 + z)
+    raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
+
+
+def robust_linear_fit(a: np.ndarray, b: np.ndarray, loss: str = "linear",
+                      f_scale: float = 1.0, weights: np.ndarray | None = None, *,
+                      max_iter: int = 100, rtol: float = 1e-10) -> np.ndarray:
+    """``argmin_x sum_i f^2 rho(w_i (a x - b)_i^2 / f^2)`` for a linear model, by iteratively
+    reweighted least squares from the (weighted) least-squares solution.
+
+    Each step solves ``min sum_i w_i rho'(z_i) (a x - b)_i^2`` with ``rho'`` at the previous
+    residuals; its fixed point is a stationary point of the objective (for the non-convex
+    cauchy loss, the one nearest the least-squares start).
+
+    Parameters
+    ----------
+    a : array, shape (m, p)
+        Design matrix.
+    b : array, shape (m,)
+        Target.
+    loss, f_scale, weights
+        The cost, as in :func:`objective`.
+    max_iter : int
+        Most reweighting steps.
+    rtol : float
+        Stop when no coefficient moves more than ``rtol`` times the largest one.
+
+    Returns
+    -------
+    numpy.ndarray, shape (p,)
+        The coefficients (``lstsq``'s minimum-norm solution where ``a`` is rank deficient).
+    """
+    check_cost(loss, f_scale)
+    if weights is None:
+        w = np.ones(b.size)
+        x = np.linalg.lstsq(a, b, rcond=None)[0]
+    else:
+        w = np.asarray(weights, dtype=float)
+        root = np.sqrt(w)
+        x = np.linalg.lstsq(a * root[:, None], b * root, rcond=None)[0]
+    if loss == "linear":
+        return x
+    for _ in range(max_iter):
+        r = a @ x - b
+        root = np.sqrt(w * loss_slope(w * r * r / f_scale ** 2, loss))
+        x_new = np.linalg.lstsq(a * root[:, None], b * root, rcond=None)[0]
+        done = np.max(np.abs(x_new - x)) <= rtol * max(float(np.max(np.abs(x_new))), 1e-300)
+        x = x_new
+        if done:
+            break
+    return x

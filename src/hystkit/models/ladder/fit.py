@@ -3,7 +3,10 @@
 The read-out weights and bias enter the output linearly, so the SSE (eq. 5.9) is minimised by
 variable projection: ``fit_multistart`` moves only the resistor parameters (per cell the dead
 band ``E_k`` and ``log G_k``), and every residual evaluation solves the weights and bias by
-linear least squares on the simulated capacitor voltages (finite-difference Jacobian).
+linear least squares on the simulated capacitor voltages (finite-difference Jacobian). A robust
+loss or per-sample weights (``loss``, ``weights``) apply to both: the outer solver minimises the
+robust cost of the projected residual, and the projection solves the weights and bias for the
+same cost (weighted rows; iteratively reweighted for a robust loss).
 """
 
 from __future__ import annotations
@@ -12,7 +15,14 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ...identification import FitResult, check_fit_data, fit_multistart
+from ...identification import (
+    FitResult,
+    check_cost,
+    check_fit_data,
+    check_weights,
+    fit_multistart,
+    robust_linear_fit,
+)
 from . import model as ladder
 
 __all__ = ["default_starts", "fit_ladder", "random_params"]
@@ -77,8 +87,9 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
         Variable projection keeps the Jacobian at ``n x 2 N``, so trf's cost here is small.
     loss, f_scale, weights
         The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
-        (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`. They act on
-        the resistor parameters; the projected weights and bias stay a least-squares fit.
+        (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`. The
+        projected weights and bias minimise the same cost
+        (:func:`hystkit.identification.robust_linear_fit`).
 
     Returns
     -------
@@ -97,6 +108,9 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
     if u.size <= structure.n_params:
         raise ValueError(f"a ladder fit with {n} sections needs more samples than its "
                          f"{structure.n_params} parameters, got {u.size}")
+    check_cost(loss, f_scale)
+    if weights is not None:
+        weights = check_weights(weights, y.size)
     lower = np.tile([_BAND[0], _LOG_G_MIN], n)
     upper = np.tile([_BAND[1], np.log(ladder.conductance_limit(structure))], n)
     cache: dict = {}
@@ -110,7 +124,7 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
                                         w=np.zeros(n + 1))
             states, _ = ladder.states(structure, probe, u)
             design = np.column_stack([u, states, -np.ones_like(u)])
-            coef = np.linalg.lstsq(design, y, rcond=None)[0]
+            coef = robust_linear_fit(design, y, loss, f_scale, weights)
             coef[:-1] = np.clip(coef[:-1], -_W_BOUND, _W_BOUND)
             # V_b is free, but within the domain where runs stay bounded
             coef[-1] = np.clip(coef[-1], -ladder.MAX_VALUE, ladder.MAX_VALUE)

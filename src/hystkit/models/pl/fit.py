@@ -26,7 +26,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from ...identification import FitResult, check_fit_data, fit_multistart
+from ...identification import FitResult, check_fit_data, check_weights, fit_multistart
 from . import model as pl
 
 __all__ = ["THETA_NAMES", "default_starts", "fit_pl", "random_params", "solve_weights"]
@@ -40,7 +40,8 @@ _LOG_IT = (np.log(1e-6), np.log(1e4))
 THETA_NAMES = ("log_i_t", "log_v_t")
 
 def solve_weights(structure: pl.PlStructure, x: np.ndarray, u: np.ndarray,
-                  y: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+                  y: np.ndarray, weights: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, float]:
     """Constrained quadratic fit of ``a``, ``w``, ``V_b`` on the voltage side (see module doc).
 
     Parameters
@@ -51,6 +52,9 @@ def solve_weights(structure: pl.PlStructure, x: np.ndarray, u: np.ndarray,
         Cell voltages at every sample.
     u, y : array, shape (n,)
         Source voltage and measured output current.
+    weights : array, shape (n,), optional
+        Per-sample weights: each sample's row scaled by ``sqrt(w)``, the smoothing rows by
+        ``sqrt(mean(w))`` (weights all equal to any ``c`` give the unweighted fit).
 
     Returns
     -------
@@ -64,16 +68,20 @@ def solve_weights(structure: pl.PlStructure, x: np.ndarray, u: np.ndarray,
     phi = np.clip(y[:, None], lo, hi) - np.clip(0.0, lo, hi)
     # unknowns [a_1..a_M, w_0..w_N, V_b]: phi a - e w_0 - X w + V_b = 0
     rows = [np.column_stack([phi, -u, -x, np.ones(n)])]
+    mean_weight = 1.0
+    if weights is not None:
+        rows[0] *= np.sqrt(weights)[:, None]
+        mean_weight = float(np.mean(weights))
     rhs = [np.zeros(n)]
     width = rows[0].shape[1]
     if m > 1 and structure.smoothing > 0:
         diff = np.zeros((m - 1, width))
         diff[np.arange(m - 1), np.arange(m - 1)] = -1.0
         diff[np.arange(m - 1), np.arange(1, m)] = 1.0
-        rows.append(np.sqrt(structure.smoothing * n) * diff)
+        rows.append(np.sqrt(structure.smoothing * n * mean_weight) * diff)
         rhs.append(np.zeros(m - 1))
     # the scale constraint as a heavily weighted row (exact to ~1e-8 relative)
-    heavy = 1e4 * np.sqrt(n)
+    heavy = 1e4 * np.sqrt(n * mean_weight)
     constraint = np.zeros((1, width))
     constraint[0, :m] = heavy
     rows.append(constraint)
@@ -134,8 +142,9 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
         coordinates, so their difference Jacobian (``n x 2``) is formed densely.
     loss, f_scale, weights
         The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
-        (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`. They act on
-        ``I_T``, ``V_T``; the projected ``a``, ``w``, ``V_b`` stay the voltage-side fit.
+        (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`. The
+        loss acts on ``I_T``, ``V_T`` only: the projected ``a``, ``w``, ``V_b`` stay the
+        voltage-side least-squares fit, with its rows weighted by `weights`.
 
     Returns
     -------
@@ -148,6 +157,8 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
         If no start gives a finite cost or every candidate is vetoed.
     """
     u, y = check_fit_data(u, y)
+    if weights is not None:
+        weights = check_weights(weights, y.size)
     cache: dict = {}
 
     def project(theta: np.ndarray) -> tuple[pl.PlParams, np.ndarray]:
@@ -157,7 +168,7 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
             probe = pl.PlParams(i_t=i_t, v_t=v_t, w=np.zeros(structure.n_cells + 1),
                                 a=np.ones(structure.n_basis))
             x, _ = pl.states(structure, probe, u)
-            a, w, v_b = solve_weights(structure, x, u, y)
+            a, w, v_b = solve_weights(structure, x, u, y, weights)
             params = pl.PlParams(i_t=i_t, v_t=v_t, w=w, v_b=v_b, a=a)
             cache.clear()
             cache[key] = params, pl.simulate(structure, params, u)[0] - y
