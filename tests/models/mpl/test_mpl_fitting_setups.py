@@ -177,3 +177,13 @@ def test_constraint_refuses_a_robust_loss(data):
     with pytest.raises(ValueError, match="SSE"):
         mpl_fit.fit_mpl(*data, mpl.MplStructure(dt=DT), weight_sum_max=1.5, loss="huber",
                         solver="trf")
+
+
+def test_unlimited_cells_report_the_would_be_knees_and_run_the_sinh():
+    params = mpl.MplParams(i_s=[0.1], v_t=[0.2], w=[1.0, 0.4], v_b=-0.6)
+    limited = FAMILY.cells(mpl.MplStructure(dt=DT), params)
+    free = FAMILY.cells(mpl.MplStructure(dt=DT, limit=False), params)
+    assert_allclose(free.knees, limited.knees, rtol=0)  # finite: where the cap would act
+    v = np.array([1.5 * limited.knees[0, 1]])  # beyond the knee
+    assert_allclose(free.current(v), 2 * 0.1 * np.sinh(v / 0.2), rtol=1e-14)
+    assert free.current(v)[0] > limited.current(v)[0]

@@ -112,10 +112,15 @@ class MplFamily(Family):
         return np.diag(1.0 - g), g, w.copy(), float(w0)
 
     def cells(self, structure, params) -> Cells:
-        """The model as the eq. 5.18-5.28 analysis sees it (linear output ``g(z) = z``)."""
+        """The model as the eq. 5.18-5.28 analysis sees it (linear output ``g(z) = z``). Without
+        the limit the resistor is the sinh everywhere; the knees reported are still where
+        ``f' dt`` reaches the slope cap (where the limit would act), as mpl-poly's."""
+        import dataclasses
+
         from . import model as mpl
 
         knee = mpl.knee_voltage(structure, params)
+        shown = mpl.knee_voltage(dataclasses.replace(structure, limit=True), params)
         cap = structure.slope_cap / structure.dt
         g = 2 * params.i_s / params.v_t
 
@@ -126,7 +131,7 @@ class MplFamily(Family):
 
         return Cells(current=lambda v: mpl.resistor_current(structure, params, v), slope=slope,
                      output=lambda z: z, output_slope=lambda z: 1.0, w=params.w,
-                     v_b=params.v_b, dt=structure.dt, knees=np.column_stack([-knee, knee]),
+                     v_b=params.v_b, dt=structure.dt, knees=np.column_stack([-shown, shown]),
                      rest_points=[np.zeros(1)] * structure.n_cells,  # sinh: odd, monotone
                      start=lambda e0: np.full(structure.n_cells, e0),
                      check=lambda u: mpl.simulate(structure, params, u))
