@@ -108,6 +108,7 @@ def test_all_zero_weights(recording, tmp_path, capsys):
      "model 'preisach' fits by linear least squares; --loss huber is not available"),
     (["--f-scale", "0.1"], "--f-scale applies to a robust --loss"),
     (["--loss", "cauchy", "--f-scale", "0"], "argument --f-scale"),
+    (["--weights", "w", "--weight-sum-max", "100"], "--weight-sum-max is solved on the SSE"),
 ])
 def test_refused_before_any_work(recording, tmp_path, capsys, argv, message):
     code, out, err = _run(capsys, "fit", recording, *argv, "--out", tmp_path / "m.json")

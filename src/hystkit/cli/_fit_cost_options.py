@@ -81,6 +81,8 @@ def cost_options(args: argparse.Namespace) -> CostOptions:
                          f"{args.loss} is not available for it (--weights is)")
     if args.weights is not None and not args.weights.strip():
         raise UsageError("--weights needs a column name")
+    if args.weights is not None and getattr(args, "weight_sum_max", None) is not None:
+        raise UsageError("--weight-sum-max is solved on the SSE (eq. 5.9), not with --weights")
     return CostOptions(loss=args.loss, f_scale=1.0 if args.f_scale is None else args.f_scale,
                        weights=args.weights)
 
