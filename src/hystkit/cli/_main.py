@@ -32,6 +32,12 @@ __all__ = ["main"]
 # default every 25 % of that growth costs a full pass over all of them (2-3 passes, ~0.06 s of a
 # 1-cell `fit`); young garbage is collected as before (benchmarks/README.md, start-up).
 _PROGRAM_GC_THRESHOLDS = (700, 10, 100)
+# Thread counts OpenBLAS reads when it loads (numpy's and scipy's copies each start their pool
+# then); the CLI process sets the first to 1 unless one of them is set. Every BLAS call of
+# hystkit's that matters already runs on one thread (fits, their workers: tall, narrow
+# problems where more threads lose), so the pools only cost start-up: ~0.04 s of CPU per
+# library, plus its threads' spinning on a busy machine (benchmarks/README.md, start-up).
+_BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")
 
 
 def _parser() -> Parser:
@@ -68,7 +74,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     Run as the program (`argv` None) it tunes the process's garbage collector for a short
     life (`_PROGRAM_GC_THRESHOLDS`, and a frozen heap at the end, which the interpreter's
-    shutdown does not walk again); stopped by a signal after forking workers, it ends the
+    shutdown does not walk again) and has OpenBLAS start one thread unless the environment
+    says otherwise (`_BLAS_THREAD_VARIABLES`); stopped by a signal after forking workers, it ends the
     process itself: multiprocessing's exit handlers would otherwise wait forever to flush queues
     to the workers it stopped.
 
@@ -88,6 +95,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """
     if argv is None:
         gc.set_threshold(*_PROGRAM_GC_THRESHOLDS)
+        if not any(os.environ.get(name) for name in _BLAS_THREAD_VARIABLES):
+            os.environ["OPENBLAS_NUM_THREADS"] = "1"  # before numpy is imported
     code = _main(argv)
     if argv is None:
         # Nothing but the interpreter's shutdown follows, whose garbage collections walk the
