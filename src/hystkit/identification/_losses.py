@@ -26,7 +26,20 @@ LOSSES = ("linear", "soft_l1", "huber", "cauchy")
 
 
 def check_cost(loss: str, f_scale: float) -> None:
-    """Raise ValueError unless `loss` is one of `LOSSES` and `f_scale` a positive number."""
+    """Raise ValueError unless `loss` is one of `LOSSES` and `f_scale` a positive number.
+
+    Parameters
+    ----------
+    loss : str
+        The loss's name.
+    f_scale : float
+        Its residual scale.
+
+    Raises
+    ------
+    ValueError
+        Naming the bad value.
+    """
     if loss not in LOSSES:
         raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
     if not (isinstance(f_scale, (int, float, np.floating)) and np.isfinite(f_scale)
@@ -96,8 +109,22 @@ def require_linear_loss(loss: str, f_scale: float, model: str, method: str) -> N
 
 
 def loss_slope(z: np.ndarray, loss: str) -> np.ndarray:
-    """``rho'(z)`` of scipy's loss `loss` (the IRLS weight of a residual with ``z = w r^2 /
-    f^2``): 1, ``(1 + z)^-1/2``, ``min(1, z^-1/2)``, ``1 / (1 + z)``."""
+    """``rho'(z)`` of scipy's loss `loss`: the IRLS weight of a residual with ``z = w r^2 /
+    f^2``.
+
+    Parameters
+    ----------
+    z : array_like
+        Scaled squared residuals, ``>= 0``.
+    loss : {"linear", "soft_l1", "huber", "cauchy"}
+        The loss.
+
+    Returns
+    -------
+    numpy.ndarray
+        1 (linear), ``(1 + z)^-1/2`` (soft_l1), ``min(1, z^-1/2)`` (huber) or
+        ``1 / (1 + z)`` (cauchy).
+    """
     z = np.asarray(z, dtype=float)
     if loss == "linear":
         return np.ones_like(z)
