@@ -144,6 +144,130 @@ print(json.dumps({**out, "cpu": cpu()}))
 """
 
 
+# One command run in this process, traced: wall-clock events (time.time(), comparable across
+# the forked workers) appended as JSON lines to a file, each with the pid that wrote it:
+# the interpreter's start (the launch time comes from the caller), the command's main(), the
+# executor's opening and closing, each map and each piece (start, end, CPU), and the parent's
+# own first start of a split multi-start. The workers are forked from this process after the
+# patches, so they log too.
+TRACE = r"""
+import json, os, sys, time
+from contextlib import contextmanager
+T_SCRIPT = time.time()
+launch, trace_file, args = float(sys.argv[1]), sys.argv[2], sys.argv[3:]
+MAIN = os.getpid()
+fd = os.open(trace_file, os.O_WRONLY | os.O_CREAT | os.O_APPEND)
+
+def log(kind, label, t0, t1=None, **extra):
+    os.write(fd, (json.dumps({"pid": os.getpid(), "kind": kind, "label": label, "t0": t0,
+                              "t1": t1, **extra}) + "\n").encode())
+
+log("phase", "interpreter", launch, T_SCRIPT)
+from hystkit.cli import _main
+import hystkit.identification._least_squares as least_squares
+import hystkit.parallel as parallel
+import hystkit.parallel._executor as executors
+opened = parallel.open_executor
+
+@contextmanager
+def traced_open(*a, **k):
+    t0 = time.time()
+    with opened(*a, **k) as executor:
+        if not hasattr(type(executor).map, "traced"):  # imported only now, as in a user's run
+            trace_map(type(executor))
+        log("phase", "open", t0, time.time())
+        try:
+            yield executor
+        finally:
+            t2 = time.time()
+    log("phase", "close", t2, time.time())
+parallel.open_executor = traced_open
+
+class Traced:
+    def __init__(self, func):
+        self.func, self.__name__ = func, getattr(func, "__name__", "piece")
+    def __call__(self, item, **shared):
+        t0, c0 = time.time(), time.thread_time()
+        try:
+            return self.func(item, **shared)
+        finally:
+            log("task", f"{self.__name__} {str(item)[:70]}", t0, time.time(),
+                cpu=time.thread_time() - c0)
+
+def trace_map(cls):
+    run = cls.map
+    def map(self, func, items, **kw):
+        t0 = time.time()
+        try:
+            return run(self, Traced(func), items, **kw)
+        finally:
+            log("map", f"{getattr(func, '__name__', '')} x{len(items)}", t0, time.time())
+    map.traced = True
+    cls.map = map
+trace_map(executors.SerialExecutor)
+screen = least_squares._screen
+def traced_screen(solve, thetas, budget):
+    t0, c0 = time.time(), time.thread_time()
+    try:
+        return screen(solve, thetas, budget)
+    finally:
+        if os.getpid() == MAIN and parallel.current_executor() is not None:
+            log("phase", f"multi-start of {len(thetas)} here", t0, time.time(),
+                cpu=time.thread_time() - c0)
+least_squares._screen = traced_screen
+import contextlib, io
+t_main = time.time()
+try:
+    with contextlib.redirect_stdout(io.StringIO()):
+        _main.main(args)
+finally:
+    log("phase", "main", t_main, time.time())
+"""
+
+
+def _trace(cwd: Path, argv: list[str]) -> list[dict]:
+    """The events of one traced run of ``hystkit ARGV`` (see `TRACE`)."""
+    trace_file = cwd / "trace.jsonl"
+    trace_file.unlink(missing_ok=True)
+    launch = time.time()
+    proc = subprocess.run([sys.executable, "-c", TRACE, str(launch), str(trace_file), *argv],
+                          cwd=cwd, capture_output=True, text=True, check=False)
+    end = time.time()
+    if proc.returncode not in (0, 3):
+        raise RuntimeError(f"traced {' '.join(argv)} failed ({proc.returncode}): {proc.stderr}")
+    events = [json.loads(line) for line in trace_file.read_text().splitlines()]
+    return [{"pid": None, "kind": "end", "label": "exit", "t0": end, "t1": end}, *events]
+
+
+def _timeline(events: list[dict]) -> dict:
+    """Where one run's wall time went, in seconds from its launch: before the main map
+    (start-up, imports, reading, opening the executor), the map's first piece's latency, the
+    map, each worker's busy time and idle tail, and what follows (refit, writing, exit)."""
+    launch = next(e["t0"] for e in events if e["label"] == "interpreter")
+    end = next(e["t0"] for e in events if e["kind"] == "end")
+    main = next(e for e in events if e["label"] == "main")
+    opened = next((e for e in events if e["label"] == "open"), None)
+    big = max((e for e in events if e["kind"] == "map"), key=lambda e: e["t1"] - e["t0"])
+    tasks = [e for e in events if e["kind"] == "task" and big["t0"] <= e["t0"] <= big["t1"]]
+    workers: dict = {}
+    for task in tasks:
+        workers.setdefault(task["pid"], []).append(task)
+    busy = {pid: sum(t["t1"] - t["t0"] for t in ts) for pid, ts in workers.items()}
+    ends = [max(t["t1"] for t in ts) for ts in workers.values()]
+    return {"total": end - launch, "start-up": main["t0"] - launch,
+            "before map": big["t0"] - main["t0"] - (opened["t1"] - opened["t0"]
+                                                   if opened else 0.0),
+            "open": opened["t1"] - opened["t0"] if opened else 0.0,
+            "first piece": min(t["t0"] for t in tasks) - big["t0"],
+            "map": big["t1"] - big["t0"], "busy": sorted(busy.values(), reverse=True),
+            "cpu": sum(t["cpu"] for t in tasks), "pieces": len(tasks),
+            "tail": big["t1"] - min(ends), "after map": end - big["t1"],
+            "parent multi-start": sum(e["t1"] - e["t0"] for e in events
+                                      if e["label"].startswith("multi-start")),
+            "tasks": sorted((t["t0"] - launch, t["t1"] - launch, t["pid"], t["label"])
+                             for t in events if t["kind"] == "task")}
+
+
 def _machine() -> str:
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     return (f"platform {platform.platform()}; cpus {os.cpu_count()}; load average {load}\n"
@@ -212,12 +336,20 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--small", action="store_true")
+    parser.add_argument("--searches-only", action="store_true",
+                        help="only compare, generalize and select (no shell loop, batch, "
+                             "in-process breakdown or multi-start)")
+    parser.add_argument("--tasks", action="store_true",
+                        help="list every piece of the traced runs (start, end, process)")
     parser.add_argument("--out", type=Path, default=Path(__file__).with_name(
         "last_run_scale.txt"), help="also write the report here (default: %(default)s)")
     args = parser.parse_args()
     n_samples, n_sensors = (4000, 8) if args.small else (8000, N_SENSORS)
     commands = _commands(args.small)
+    if args.searches_only:
+        del commands["batch"]
     times: dict[str, list[tuple[float, float]]] = {}
+    timelines: dict[str, dict] = {}
     load_before = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         cwd = Path(tmp)
@@ -227,24 +359,55 @@ def main() -> None:
         print("pieces timed", file=sys.stderr, flush=True)
         for repeat in range(args.repeats):
             order = ("1", "2") if repeat % 2 == 0 else ("2", "1")
-            times.setdefault("shell loop", []).append(_run(["bash", "loop.sh"], cwd))
-            for workers in order:
-                for part, seconds in _python(BREAKDOWN, cwd, workers).items():
-                    times.setdefault(f"in-process compare {part} @{workers}", []).append(
-                        (seconds, 0.0))
-                fits = _python(MULTISTART, cwd, workers)
-                cpu = fits.pop("cpu")
-                for key, seconds in fits.items():
-                    times.setdefault(f"multistart {key}", []).append((seconds, 0.0))
-                times.setdefault(f"multistart cpu @{workers}", []).append((cpu, 0.0))
+            if not args.searches_only:
+                times.setdefault("shell loop", []).append(_run(["bash", "loop.sh"], cwd))
+                for workers in order:
+                    for part, seconds in _python(BREAKDOWN, cwd, workers).items():
+                        times.setdefault(f"in-process compare {part} @{workers}", []).append(
+                            (seconds, 0.0))
+                    fits = _python(MULTISTART, cwd, workers)
+                    cpu = fits.pop("cpu")
+                    for key, seconds in fits.items():
+                        times.setdefault(f"multistart {key}", []).append((seconds, 0.0))
+                    times.setdefault(f"multistart cpu @{workers}", []).append((cpu, 0.0))
             for name, argv in commands.items():
                 for workers in order:
                     times.setdefault(f"{name} @{workers}", []).append(
                         _run([*argv, "--workers", workers], cwd))
             print(f"repeat {repeat + 1}/{args.repeats} done", file=sys.stderr, flush=True)
+        for name in ("compare", "generalize", "select"):
+            for workers in ("1", "2"):
+                timelines[f"{name} @{workers}"] = _timeline(_trace(
+                    cwd, [*commands[name][3:], "--workers", workers]))
+        print("traced", file=sys.stderr, flush=True)
     report = _report(times, commands, args, n_samples, n_sensors, load_before, pieces)
+    report += "\n\n" + _timeline_report(timelines, args.tasks)
     print(report)
     args.out.write_text(report + "\n")
+
+
+def _timeline_report(timelines: dict, tasks: bool) -> str:
+    """One traced run of each search at 1 and 2 workers: where its wall time went."""
+    lines = [("timeline, one traced run each (wall s; start-up: interpreter and CLI; before: "
+              "imports and reading; open: the executor (kernel warm-up); first: the map's first "
+              "piece starts; busy: each process's pieces; tail: the map's end after the first "
+              "process ran out of pieces; after: refit, writing, exit)"),
+             (f"{'run':<15}{'total':>7}{'start-up':>9}{'before':>7}{'open':>6}{'first':>6}"
+             f"{'map':>7}  {'busy':<12}{'tail':>5}{'after':>7}{'pieces':>7}{'CPU':>6}")]
+    for run, t in timelines.items():
+        busy = "/".join(f"{b:.2f}" for b in t["busy"])
+        lines.append(f"{run:<15}{t['total']:>7.2f}{t['start-up']:>9.2f}{t['before map']:>7.2f}"
+                     f"{t['open']:>6.2f}{t['first piece']:>6.2f}{t['map']:>7.2f}  {busy:<12}"
+                     f"{t['tail']:>5.2f}{t['after map']:>7.2f}{t['pieces']:>7d}"
+                     f"{t['cpu']:>6.2f}")
+        if t["parent multi-start"]:
+            lines.append(f"{'':<15}(of which the parent's own first multi-start solves "
+                         f"{t['parent multi-start']:.2f})")
+    if tasks:
+        for run, t in timelines.items():
+            lines += ["", f"pieces of {run} (start, end, process):"]
+            lines += [f"  {a:7.2f} {b:7.2f} {pid:>7} {label}" for a, b, pid, label in t["tasks"]]
+    return "\n".join(lines)
 
 
 def _report(times: dict, commands: dict, args: argparse.Namespace, n_samples: int,
@@ -265,11 +428,13 @@ def _report(times: dict, commands: dict, args: argparse.Namespace, n_samples: in
                      f"{med[f'{name} @1'] / med[f'{name} @2']:>9.2f}x{ratio:>20.2f}x"
                      f"{cpu[f'{name} @1']:>8.1f}{cpu[f'{name} @2']:>8.1f}"
                      f"{cpu[f'{name} @1'] / cpu[f'{name} @2']:>9.2f}")
+    full = "shell loop" in med  # not --searches-only
     lines += ["", "compare in one process [s]: " + "; ".join(
         f"{part} {med[f'in-process compare {part} @1']:.2f} / "
         f"{med[f'in-process compare {part} @2']:.2f}"
         for part in ("start-up", "open", "map", "close")) + " (1 / 2 workers); map efficiency "
-        f"{med['in-process compare map @1'] / (2 * med['in-process compare map @2']):.2f}"]
+        f"{med['in-process compare map @1'] / (2 * med['in-process compare map @2']):.2f}"] \
+        if full else []
     lines += ["", ("pieces, each timed alone in one process (CPU s): sum, longest, the bound "
               "on a 2-worker map max(longest, sum / 2), and work outside the map")]
     for name, entry in pieces.items():
@@ -279,6 +444,9 @@ def _report(times: dict, commands: dict, args: argparse.Namespace, n_samples: in
         lines.append(f"  {name:<11}{len(seconds):>3} pieces, sum {sum(seconds):6.2f}, longest "
                      f"{longest:5.2f} ({label}), bound {bound:5.2f} (at most "
                      f"{sum(seconds) / bound:.2f}x), outside {entry['outside']:5.2f}")
+    if not full:
+        return "\n".join(lines + ["", "all times: " + "; ".join(
+            f"{k} " + ", ".join(f"{w:.2f}" for w, _ in v) for k, v in times.items())])
     fits = [k.split()[1] for k in times if k.startswith("multistart") and k.endswith("@1")
             and "cpu" not in k]
     lines += ["", "one fit on 8000 samples, wall [s] serial / 2-worker executor open (starts "

@@ -36,6 +36,20 @@ def test_serial_map_runs_in_order_and_loads_no_dask():
     assert out == ["SerialExecutor", "False", "False"]
 
 
+def test_forked_map_runs_in_order_and_does_not_load_distributed():
+    """The default local executor never imports ``distributed`` (0.3 s at the idle machine,
+    which dask.compute spends looking for a client when the scheduler is given by name)."""
+    code = ("import sys\n"
+            "from hystkit.parallel import open_executor\n"
+            "with open_executor(2) as ex:\n"
+            "    out = ex.map(pow, [2, 3, 4, 5], shared={'exp': 2})\n"
+            "assert out == [4, 9, 16, 25], out\n"
+            "print(type(ex).__name__, 'distributed' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=300).stdout.split()
+    assert out == ["ForkedExecutor", "False"]
+
+
 def test_more_workers_than_pieces_is_serial():
     with open_executor(4, n_pieces=1) as executor:
         assert isinstance(executor, SerialExecutor)

@@ -23,6 +23,7 @@ from concurrent.futures import ProcessPoolExecutor
 from typing import Any
 
 import dask
+import dask.multiprocessing
 from dask.callbacks import Callback
 
 from ._cost import cost_order
@@ -84,7 +85,10 @@ class ForkedExecutor:
                  for i, item in enumerate(items)]
         callbacks = [_Reporter({key: i for i, key in enumerate(keys)}, on_done)._callback] \
             if on_done is not None else []
-        return list(dask.compute(*tasks, scheduler="processes", pool=self._pool,
+        # The scheduler as a function, not its name "processes": given a name, dask.compute
+        # imports ``distributed`` to look for a client (0.3 s on the idle machine, at the
+        # start of every command's first map).
+        return list(dask.compute(*tasks, scheduler=dask.multiprocessing.get, pool=self._pool,
                                  num_workers=self.n_workers, chunksize=1,
                                  optimize_graph=False, callbacks=callbacks))
 

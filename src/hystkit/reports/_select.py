@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from matplotlib.figure import Figure
+from threadpoolctl import threadpool_limits
 
 from ..compensation import DEFAULT_CENTER, check_fitting_data, evaluate, fit_compensator
 from ..errors import FitDivergedError
@@ -230,9 +231,14 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
         if "error" in row or row["guard_failed"]:
             continue
         try:
-            out["compensator"] = fit_compensator(list(recordings), row["size"],
-                                                 model=row["model"], mode=row["mode"],
-                                                 center=row["center"], **options)
+            # BLAS on one thread, as in every fold fit (on a worker or `SerialExecutor`): the
+            # refit's standard errors take QR factors of chunks of (~1000 x n_params) rows,
+            # too small for threads, and idle OpenBLAS threads spin (measured: the Preisach
+            # refit 0.4 s with one thread, 0.8-3.4 s with two on a busy 2-core machine).
+            with threadpool_limits(limits=1, user_api="blas"):
+                out["compensator"] = fit_compensator(list(recordings), row["size"],
+                                                     model=row["model"], mode=row["mode"],
+                                                     center=row["center"], **options)
         except FAMILY_FAILURES as exc:
             row["error_final"] = str(exc)
             continue
