@@ -76,7 +76,7 @@ def cost_options(args: argparse.Namespace) -> CostOptions:
     if args.f_scale is not None and args.loss == "linear":
         raise UsageError("--f-scale applies to a robust --loss (soft_l1, huber, cauchy), not "
                          "to linear (the SSE)")
-    if args.loss not in supported_losses(args.model):
+    if args.loss != "linear" and args.loss not in supported_losses(args.model):
         raise UsageError(f"model {args.model!r} fits by linear least squares; --loss "
                          f"{args.loss} is not available for it (--weights is)")
     if args.weights is not None and not args.weights.strip():
