@@ -35,7 +35,8 @@ def add_cost_options(parser: argparse.ArgumentParser) -> None:
         "--f-scale", type=number(0, low_open=True), default=None, metavar="F",
         help="residual scale of a robust --loss, > 0, in normalised units: the data are "
              "scaled to max |.| = 1 before the fit (eq. 5.10), so 0.05 is 5 %% of the largest "
-             "|value| (default 1, scipy's)")
+             "|value|; default 1 (scipy's), which on such data leaves a robust loss close to "
+             "the SSE: set it to 5-10 times the plain fit's RMS residual, below the outliers")
     parser.add_argument(
         "--weights", default=None, metavar="COLUMN",
         help="column of the recording(s) with one weight per sample (finite, >= 0; 0 drops "
