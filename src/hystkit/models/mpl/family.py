@@ -120,7 +120,10 @@ class MplFamily(Family):
         from . import model as mpl
 
         knee = mpl.knee_voltage(structure, params)
-        shown = mpl.knee_voltage(dataclasses.replace(structure, limit=True), params)
+        limited = structure  # mpl-g's structure, which reuses these cells, has no limit field
+        if not getattr(structure, "limit", True):
+            limited = dataclasses.replace(structure, limit=True)
+        shown = mpl.knee_voltage(limited, params)
         cap = structure.slope_cap / structure.dt
         g = 2 * params.i_s / params.v_t
 
