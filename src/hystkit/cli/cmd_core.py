@@ -95,7 +95,8 @@ def _fit(args: argparse.Namespace) -> int:
     recs = [read_recording(path, options=read_options(args, path)) for path in args.data]
     size = family.default_size if args.cells is None else args.cells
     fit_options = start_options(args, family, recs[0].dt, size, options, len(recs))
-    shown = "".join(f", {name} {value:g}" for name, value in options.items())
+    shown = "".join(f", {name} {str(value).lower() if isinstance(value, bool) else f'{value:g}'}"
+                    for name, value in options.items())
     print(f"fitting {args.model} ({family.size_help}: {size}{shown}, {args.mode} mode, centring: "
           f"{center_label(args.center)}) on {', '.join(map(str, args.data))}: "
           f"{sum(r.n_samples for r in recs)} samples at {recs[0].fs:g} Hz"
