@@ -156,9 +156,12 @@ def _stability(args: argparse.Namespace) -> int:
           f"{report['n_state']} state(s)")
     details = report["details"]
     if details is not None:
-        limit = getattr(structure, "limit", True)
-        print(f"  stability limit {'on' if limit else 'OFF'} (slope cap f'·dt <= "
-              f"{structure.slope_cap:g} beyond the knees)")
+        if getattr(structure, "limit", True):
+            print(f"  stability limit on (slope cap f'·dt <= {structure.slope_cap:g} beyond the "
+                  f"knees, eq. 5.29)")
+        else:
+            print(f"  stability limit OFF (eq. 5.29 not applied: beyond the knees below, where "
+                  f"f'·dt would reach {structure.slope_cap:g}, an Euler step can diverge)")
         _print_cells(details)
     print(f"operating points: {report['n_points']} (rest states at {len(report['rest']['inputs'])}"
           f" inputs, and {report['trajectory']['n_points']} of {report['trajectory']['n_samples']}"
