@@ -146,6 +146,7 @@ def test_weight_sum_max_bounds_the_saved_weights(recordings, tmp_path, capsys):
     (["--model", "pi", "--init", "table-5.2"], ("--init applies to mpl",)),
     (["--init", "i_s=0.1"], ("missing v_t, w, v_b",)),
     (["--weight-sum-max", "0"], ("--weight-sum-max",)),
+    (["--init", "i_s=nan,v_t=0.2,w=1:0.4,v_b=-0.6"], ("error: --init: i_s must be finite",)),
 ])
 def test_bad_options_exit_2_with_one_line(recordings, tmp_path, capsys, argv, fragments):
     code, _, err = _run(capsys, "fit", recordings["sine"], *argv, "--out", tmp_path / "m.json")

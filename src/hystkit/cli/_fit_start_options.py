@@ -146,6 +146,8 @@ def start_options(args: argparse.Namespace, family: Any, dt: float, size: int,
             raise InputError(f"model {family.name!r}: {exc}") from None
         try:
             start = family.start_options(structure, parse_init(args.init, family, structure))
+        except InputError:  # already one line naming --init
+            raise
         except ValueError as exc:  # e.g. mpl-g's gauge needs w_0 != 0
             raise InputError(f"--init: {exc}") from None
         fit_options.update(start.options)
