@@ -157,13 +157,15 @@ def bound_flags(result: FitResult) -> tuple[list[str] | None, list[str]]:
 
 
 def fit_status(estimate: np.ndarray, target: np.ndarray, line: np.ndarray,
-               on_bounds: list[str] | None, converged: bool) -> tuple[str, str]:
+               on_bounds: list[str] | None, converged: bool,
+               limited: bool = True) -> tuple[str, str]:
     """``(status, message)`` of a fit from its training estimate and the straight line's.
 
     Status is the first that applies: ``collapsed`` (estimate constant), ``worse_than_line``
     (training R² below the line's), ``on_bounds`` (search box hits, by name: see
-    :func:`bound_flags`; a model at its own limit is not on bounds), ``not_converged``, else
-    ``ok``.
+    :func:`bound_flags`; a model at its own limit is not on bounds), ``not_converged``,
+    ``no_limit`` (a model without the stability limit, ``limited`` False: fitted for study,
+    it may diverge on other data), else ``ok``.
     """
     r2_model, r2_line = r2(target, estimate), r2(target, line)
     if np.std(estimate) < COLLAPSE_RATIO * np.std(target):
@@ -177,4 +179,8 @@ def fit_status(estimate: np.ndarray, target: np.ndarray, line: np.ndarray,
                              f"{', '.join(map(str, on_bounds))}")
     if not converged:
         return "not_converged", "the solver stopped on its evaluation budget"
+    if not limited:
+        return "no_limit", (f"fitted without the stability limit (eq. 5.29, --no-limit; "
+                            f"training R² {r2_model:.4f}): its Euler step can diverge on other "
+                            f"data (sec. 5.3.3)")
     return "ok", f"training R² {r2_model:.4f} (straight line {r2_line:.4f})"

@@ -388,7 +388,8 @@ def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording], s
     line = comp.baseline(s)
     # after a joint polish (no bounds) the family fit's optimum is not the model's
     on_bounds, limit_notes = bound_flags(result) if len(recs) == 1 else (None, [])
-    status, message = fit_status(estimate, p, line, on_bounds, result.converged)
+    status, message = fit_status(estimate, p, line, on_bounds, result.converged,
+                                 limited=getattr(structure, "limit", True))
     r2_model, r2_line = r2(p, estimate), r2(p, line)
     del line
     # The forward model's misfit; in direct mode the estimate is that forward run.
