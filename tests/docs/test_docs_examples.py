@@ -62,9 +62,16 @@ def blocks_of(path: Path) -> list[Block]:
 def commands_of(code: str) -> list[list[str]]:
     """The ``hystkit`` command lines of a bash block as argument lists (continuations joined,
     comments dropped, the shell's redirections and what follows a pipe left out)."""
+    return [words for words, _ in expected_commands(code)]
+
+
+def expected_commands(code: str) -> list[tuple[list[str], int]]:
+    """:func:`commands_of` with each command's expected exit code: 0, or N for a line ending
+    in the comment ``# exit N`` (a fit written for inspection exits 3)."""
     joined = re.sub(r"\\\n", " ", code)
     commands = []
     for line in joined.splitlines():
+        expected = re.search(r"#\s*exit (\d+)\s*$", line)
         # Quotes kept while cutting, so a quoted ';' (--sep ';') is an argument, not an operator.
         lexer = shlex.shlex(line, posix=False, punctuation_chars="|<>&;")
         lexer.whitespace_split, lexer.commenters = True, "#"
@@ -72,7 +79,7 @@ def commands_of(code: str) -> list[list[str]]:
         cut = next((i for i, t in enumerate(tokens) if set(t) <= set("|<>&;")), len(tokens))
         words = shlex.split(" ".join(tokens[:cut]))
         if words and words[0] == "hystkit":
-            commands.append(words[1:])
+            commands.append((words[1:], int(expected.group(1)) if expected else 0))
     return commands
 
 
@@ -119,14 +126,14 @@ def test_page_examples_run(path, tmp_path, monkeypatch):
                 _skip_without_shared_data(block, str(exc))
                 raise
             continue
-        for argv in commands_of(block.code):
+        for argv, expected in expected_commands(block.code):
             out = io.StringIO()
             with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
                 code = main(argv)
-            if code != 0:
+            if code != expected:
                 _skip_without_shared_data(block, out.getvalue())
-            assert code == 0, f"{block.where}: hystkit {' '.join(argv)} -> {code}:\n" \
-                              f"{out.getvalue()[-2000:]}"
+            assert code == expected, f"{block.where}: hystkit {' '.join(argv)} -> {code}:\n" \
+                                     f"{out.getvalue()[-2000:]}"
 
 
 def _skip_without_shared_data(block, message: str) -> None:
