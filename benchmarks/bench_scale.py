@@ -171,11 +171,11 @@ opened = parallel.open_executor
 
 @contextmanager
 def traced_open(*a, **k):
-    t0 = time.time()
+    t0, c0 = time.time(), time.process_time()
     with opened(*a, **k) as executor:
         if not hasattr(type(executor).map, "traced"):  # imported only now, as in a user's run
             trace_map(type(executor))
-        log("phase", "open", t0, time.time())
+        log("phase", "open", t0, time.time(), cpu=time.process_time() - c0)
         try:
             yield executor
         finally:
@@ -197,11 +197,12 @@ class Traced:
 def trace_map(cls):
     run = cls.map
     def map(self, func, items, **kw):
-        t0 = time.time()
+        t0, c0 = time.time(), time.process_time()
         try:
             return run(self, Traced(func), items, **kw)
         finally:
-            log("map", f"{getattr(func, '__name__', '')} x{len(items)}", t0, time.time())
+            log("map", f"{getattr(func, '__name__', '')} x{len(items)}", t0, time.time(),
+                cpu_before=c0, cpu_after=time.process_time())
     map.traced = True
     cls.map = map
 trace_map(executors.SerialExecutor)
@@ -221,7 +222,7 @@ try:
     with contextlib.redirect_stdout(io.StringIO()):
         _main.main(args)
 finally:
-    log("phase", "main", t_main, time.time())
+    log("phase", "main", t_main, time.time(), cpu_after=time.process_time())
 """
 
 
@@ -262,6 +263,9 @@ def _timeline(events: list[dict]) -> dict:
             "map": big["t1"] - big["t0"], "busy": sorted(busy.values(), reverse=True),
             "cpu": sum(t["cpu"] for t in tasks), "pieces": len(tasks),
             "tail": big["t1"] - min(ends), "after map": end - big["t1"],
+            "cpu before map": big["cpu_before"], "cpu open": opened["cpu"] if opened else 0.0,
+            "cpu parent in map": big["cpu_after"] - big["cpu_before"],
+            "cpu after map": main["cpu_after"] - big["cpu_after"],
             "parent multi-start": sum(e["t1"] - e["t0"] for e in events
                                       if e["label"].startswith("multi-start")),
             "tasks": sorted((t["t0"] - launch, t["t1"] - launch, t["pid"], t["label"])
@@ -400,6 +404,9 @@ def _timeline_report(timelines: dict, tasks: bool) -> str:
                      f"{t['open']:>6.2f}{t['first piece']:>6.2f}{t['map']:>7.2f}  {busy:<12}"
                      f"{t['tail']:>5.2f}{t['after map']:>7.2f}{t['pieces']:>7d}"
                      f"{t['cpu']:>6.2f}")
+        lines.append(f"{'':<15}CPU of the main process: {t['cpu before map']:.2f} before the "
+                     f"map (of which {t['cpu open']:.2f} opening the executor), "
+                     f"{t['cpu parent in map']:.2f} during it, {t['cpu after map']:.2f} after")
         if t["parent multi-start"]:
             lines.append(f"{'':<15}(of which the parent's own first multi-start solves "
                          f"{t['parent multi-start']:.2f})")

@@ -5,9 +5,13 @@ Imported only when a parallel run starts on a platform that can fork (Linux). Me
 0.6-1.1 s of wall time and importing ``distributed`` 1.1 s more, where a pool of forked
 processes took 0.13-0.16 s and ``dask.multiprocessing`` 0.5 s to import: for a ``compare`` whose
 parallel map lasts 3-4 s that is the difference between gaining and not. The workers are forked
-from this process once the model kernels are loaded (`warm_kernels`), so they start with
-everything imported; they keep BLAS on one thread. A piece's arguments travel with it (pickled
-by cloudpickle); at 8000 samples a piece's recordings are ~0.2-0.4 MB, a millisecond to send.
+at the first map, so they start with every library the command has imported; they keep BLAS on
+one thread. Each loads the model kernels its pieces use from numba's on-disk cache when it first
+runs them, as a serial run does. Loading every family's kernels here before the fork
+(`warm_kernels`) cost ~1.05 s of CPU in this process alone, with the other core idle, against
+~0.55 s in each worker side by side (``compare`` at 2 workers, 2026-11-24: the same CPU in all,
+0.4-0.5 s less wall). A piece's arguments travel with it (pickled by cloudpickle); at 8000 samples
+the recordings of a piece are 0.2-1.4 MB, under a millisecond to pickle.
 
 Dask's local scheduler runs independent tasks in descending order of their keys
 (``dask.order``); the keys here are numbered so that the costliest piece sorts last and runs
@@ -28,7 +32,6 @@ from dask.callbacks import Callback
 
 from ._cost import cost_order
 from ._executor import _CURRENT, Cost, OnDone
-from ._warm import warm_kernels
 
 __all__ = ["ForkedExecutor"]
 
@@ -64,7 +67,6 @@ class ForkedExecutor:
     scheduler); close it with `close`."""
 
     def __init__(self, n_workers: int):
-        warm_kernels()
         self.n_workers = n_workers
         self._pool = ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context(
             "fork"), initializer=_worker_start)

@@ -1,4 +1,9 @@
-"""Loading the model kernels once, in the process that forks the workers."""
+"""Loading every model kernel at a ``distributed`` worker's start (`._dask.WorkerSetup`).
+
+The default forked workers do not use it: each loads the kernels its pieces use when it first
+runs them (`._forked`), which on 2 cores costs less wall time than loading all of them in the
+parent before the fork.
+"""
 
 from __future__ import annotations
 
@@ -13,11 +18,9 @@ _warmed = False
 def warm_kernels() -> None:
     """Import the model families, fit each one to a short hysteretic signal and invert it:
     this loads their simulation, fit and inverse kernels from numba's on-disk cache
-    (``cache=True``) once, here, instead of in every worker (measured: without the fits'
-    kernels, two forked workers each loaded them again and a 4 s ``compare`` map took as long
-    on 2 workers as on 1). The signal is a play operator's (every family fits it; a family's
-    own random parameters left Bouc-Wen unfitted, its fit kernels unloaded) and short:
-    loading is what counts here (~1.5 s of CPU, of which ~0.7 s runs the fits)."""
+    (``cache=True``). The signal is a play operator's (every family fits it; a family's own
+    random parameters left Bouc-Wen unfitted, its fit kernels unloaded) and short: ~1.05 s of
+    CPU on the 2-core machine, of which ~0.6 s runs the fits (2026-11-24)."""
     global _warmed
     from ..models import FAMILIES
 
