@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from hystkit.errors import FitDivergedError
 from hystkit.models import get_family
 from hystkit.models.mpl_g import fit as g_fit
 from hystkit.models.mpl_g import model as mpl_g
@@ -52,3 +53,21 @@ def test_weight_sum_bound_is_active_and_costs_fit(y):
     assert_allclose(large.cost, free.cost, rtol=1e-6, atol=1e-12)
     with pytest.raises(ValueError, match="at least 1"):
         g_fit.fit_mpl_g(U, y, STRUCTURE, weight_sum_max=0.5)
+
+
+def test_linear_g_fallback_keeps_the_weight_sum_bound_or_fails(y):
+    # accept vetoes every curved g, so the fit falls back on the mPL start with a linear g;
+    # that start's sum |w| (gauge w_0 = 1) decides whether the bound is kept
+    def linear_only(params):
+        return np.allclose(params.g[2:], 0)
+
+    fallback = g_fit.fit_mpl_g(U, y, STRUCTURE, accept=linear_only)
+    weight_sum = np.abs(fallback.params.w).sum()
+    assert weight_sum > 1.2  # the premise: a bound of 1.2 bites
+    with pytest.raises(FitDivergedError, match="could not be carried out"):
+        g_fit.fit_mpl_g(U, y, STRUCTURE, accept=linear_only, weight_sum_max=1.2)
+    kept = g_fit.fit_mpl_g(U, y, STRUCTURE, accept=linear_only,
+                           weight_sum_max=weight_sum + 0.1)
+    assert_allclose(kept.params.w, fallback.params.w, rtol=0, atol=0)
+    assert np.abs(kept.params.w).sum() <= weight_sum + 0.1
+    assert "not solved under sum |w|" in kept.message

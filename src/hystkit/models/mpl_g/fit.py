@@ -286,7 +286,8 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
     -------
     FitResult
         The best start's fit. If ``accept`` vetoes every fit with a cubic ``g``, the accepted
-        mPL start with a linear ``g`` (its message says so).
+        mPL start with a linear ``g`` (its message says so; with `weight_sum_max`, only if
+        it keeps the bound).
 
     Raises
     ------
@@ -294,7 +295,8 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
         If `init` has another number of cells or ``w_0 = 0``, or `weight_sum_max` is at most
         1 or comes with a robust loss or weights.
     FitDivergedError
-        If no start gives a finite cost, or every candidate is vetoed.
+        If no start gives a finite cost, or every candidate is vetoed, or every fit with a
+        cubic ``g`` is vetoed and the linear-g start breaks `weight_sum_max`.
     """
     u, y = check_fit_data(u, y)
     n = structure.n_cells
@@ -349,9 +351,20 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
                              weight_sum_max - 1.0, coords.to_params, accept=accept,
                              accept_reason=accept_reason, label="sum |w_1..w_N| (w_0 = 1)")
     # Every fit with a curved g was vetoed (an inverse that diverges on the training data);
-    # the accepted mPL start is this family's model with a linear g, and is returned as such.
-    return replace(linear, params=start, message=f"{linear.message}; g kept linear: the fit "
-                                                 f"with a cubic g was rejected ({accept_reason})")
+    # the accepted mPL start is this family's model with a linear g, and is returned as such,
+    # but only where it keeps the weight-sum bound: the constrained fit was not carried out.
+    message = (f"{linear.message}; g kept linear: the fit with a cubic g was rejected "
+               f"({accept_reason})")
+    if weight_sum_max is not None:
+        weight_sum = float(np.abs(start.w).sum())
+        if weight_sum > weight_sum_max:
+            raise FitDivergedError(
+                f"the fit failed: the constrained fit (sum |w| <= {weight_sum_max:g}, w_0 = 1) "
+                f"could not be carried out: every fit with a cubic g was rejected "
+                f"({accept_reason}) and the linear-g start has sum |w| = {weight_sum:.6g}")
+        message += (f"; not solved under sum |w| <= {weight_sum_max:g}, which this model keeps "
+                     f"(sum |w| = {weight_sum:.6g})")
+    return replace(linear, params=start, message=message)
 
 
 # The domain random_params draws from: the mPL's cells over the fit's box, and an output stage
