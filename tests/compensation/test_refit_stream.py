@@ -108,3 +108,27 @@ def test_inverse_compensators_and_bad_settings_are_refused():
                 {"min_references": 0}):
         with pytest.raises(InputError):
             Refit(**bad)
+
+
+def test_each_refit_keeps_to_its_budget(tracked, drifting):
+    rec, ref = drifting
+    # one start (the present parameters): its 12-evaluation screen, then at most max_nfev;
+    # a weighted fit runs on scipy's trf, whose count adds a Jacobian to each residual run
+    used = {}
+    for budget in (3, 30):
+        stream = RefittingStream(tracked, Refit(window_seconds=60, every=10, max_nfev=budget))
+        stream.process(rec.sensor, ref)
+        tried = stream.report.kept + stream.report.refused
+        assert tried > 0
+        assert stream.report.evaluations <= tried * 2 * (12 + budget)
+        used[budget] = stream.report.evaluations / tried
+    assert used[3] < used[30]
+
+
+def test_families_without_a_given_start_and_short_windows_are_refused():
+    pl = fit_compensator(simulate_experiment("sine", 3), 1, model="pl", diagnose=False)
+    with pytest.raises(InputError, match="cannot start from the present parameters"):
+        RefittingStream(pl)
+    comp = fit_compensator(simulate_experiment("sine", 3), 1, diagnose=False)
+    with pytest.raises(InputError, match="fewer than the 20 references a refit needs"):
+        RefittingStream(comp, Refit(window_seconds=0.25))

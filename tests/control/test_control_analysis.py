@@ -219,3 +219,15 @@ def test_an_overturned_static_gain_is_named_as_the_cause(w1: float):
     assert "time constant 100 s" in notes[0]
     assert not margins.closed_loop_stable and margins.growth_time_s > 1.0
     assert margins.cause == notes[0]
+
+
+def test_a_fast_blow_up_is_not_blamed_on_a_slow_sign_flip():
+    # gains that are unstable whatever the compensator: with the flipped slow compensator the
+    # loop blows up in well under a second, far faster than its 100 s cell could explain
+    loop = hc.ControlLoop("direct", IDEAL, replace(hc.DOCUMENT_PID_DIRECT, kp=545e3),
+                          compensator=_slow_compensator(-1.1),
+                          model=hc.linear_block(40.0, name="model"), sensor_gain=1 / 40.0)
+    margins = hc.loop_margins(loop)
+    assert not margins.closed_loop_stable and margins.growth_time_s < 1.0
+    assert margins.cause is None
+    assert hc.static_sign_flips(loop) != []  # the flip is there, but not the cause

@@ -45,7 +45,19 @@ def closed_loop(margins) -> str:
 
 
 def duration(seconds: float) -> str:
-    """``8.1e+05 s (9.4 days)``: seconds, and in hours or days when that long."""
+    """A duration as ``8.1e+05 s (9.38 days)``: seconds, and in hours or days when that long.
+
+    Parameters
+    ----------
+    seconds : float
+        The duration [s].
+
+    Returns
+    -------
+    str
+        Seconds to three significant digits; from two hours on also hours, from two days on
+        days.
+    """
     for unit, size in (("days", 86400.0), ("hours", 3600.0)):
         if seconds >= 2 * size:
             return f"{seconds:.3g} s ({seconds / size:.3g} {unit})"

@@ -213,8 +213,10 @@ class _Learning:
         if adapt == "full":
             report = stream.report
             return (head + f"{self.n} references, rms error at them before learning from each "
-                    f"{(self.sum_sq / self.n) ** 0.5:.4g} mm; {report.kept} refits kept, "
-                    f"{report.refused} refused; now {stream.compensator.params.to_dict()}")
+                    f"{(self.sum_sq / self.n) ** 0.5:.4g} mm; refits: {report.kept} kept, "
+                    f"{report.refused} refused, {report.skipped} skipped (the window held "
+                    f"too few references), {report.evaluations} model evaluations; now "
+                    f"{stream.compensator.params.to_dict()}")
         values = ", ".join(f"{k} {v:.6g}" for k, v in stream.parameters.items())
         return (head + f"{self.n} references, rms error at them before learning from each "
                 f"{(self.sum_sq / self.n) ** 0.5:.4g} mm; now {values}")
@@ -337,9 +339,10 @@ def _check_adapt_options(args: argparse.Namespace) -> None:
         return [f"--{k.replace('_', '-')}" for k in names if getattr(args, k) is not None]
 
     if args.adapt is None:
-        used = given(("forgetting", *ADAPT_OPTIONS, *REFIT_OPTIONS))
-        if used:
+        if used := given(("forgetting", *ADAPT_OPTIONS)):
             raise InputError(f"{', '.join(used)} only {_verb(used)} with --adapt")
+        if used := given(REFIT_OPTIONS):
+            raise InputError(f"{', '.join(used)} only {_verb(used)} with --adapt full")
     elif args.adapt == "full":
         if used := given(("forgetting", *ADAPT_OPTIONS)):
             raise InputError(f"{', '.join(used)} {_verb(used)} to --adapt gain or weights, "

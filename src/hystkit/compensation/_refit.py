@@ -7,7 +7,10 @@ parameters re-fitted too. Here the stream keeps its last ``window_seconds`` of m
 normalised sensor, computed exactly as the plain stream computes it) and the references that
 arrived in that time; after every ``every`` new references it fits the family on the window
 with per-sample weights 1 at the references and 0 elsewhere (so only the known positions count,
-while the model runs through every sample), starting from the present parameters.
+while the model runs through every sample), from one start, the present parameters, on a small
+evaluation budget. Only families whose fit can start from given parameters take part (mpl,
+mpl-poly, mpl-g: ``Family.start_options``); the others would re-run their whole multi-start at
+every refit, which no sample period allows.
 
 - The refit starts the model at rest at the window's first sample, as every fit does; the
   new parameters' state at the window's end (the same run) continues the stream. A window
@@ -20,18 +23,19 @@ while the model runs through every sample), starting from the present parameters
   indices (the n-th reference), so a chunked run gives the bits of the whole run.
 
 Direct compensators only: an inverse compensator's fitted model maps position to sensor, and
-the position is known only at the references.
+the position is known only at the references. A window too short to ever hold enough
+references is refused when the stream is made.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import inspect
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import FitDivergedError, InputError
+from ..models import FAMILIES
 from ._compensator import Compensator
 from ._stream import (
     StartUp,
@@ -60,7 +64,8 @@ class Refit:
     min_references : int or None
         References the window must hold before a refit; None: four per fitted parameter.
     max_nfev : int
-        Evaluation budget of each refit (one start: the present parameters).
+        Evaluation budget of each refit's polish (after the fit's short screening run of its
+        one start, the present parameters; ``screen_nfev`` of the family's fit, 12).
     """
 
     window_seconds: float = 60.0
@@ -91,6 +96,11 @@ class RefitReport:
     kept, refused : int
         Refits whose parameters the stream took, and those it did not (a failed fit, or no
         improvement on the window).
+    skipped : int
+        Refits that were due but not tried: the window held fewer references than a refit
+        needs (at the start of a stream, or after a gap in the references).
+    evaluations : int
+        Model evaluations of all refits together (their fits' ``n_evaluations``).
     last_cost_before, last_cost_after : float or None
         Weighted SSE (normalised units) on the window of the last kept refit, with the
         parameters before and after it.
@@ -99,6 +109,8 @@ class RefitReport:
     references: int = 0
     kept: int = 0
     refused: int = 0
+    skipped: int = 0
+    evaluations: int = 0
     last_cost_before: float | None = None
     last_cost_after: float | None = None
 
@@ -118,7 +130,8 @@ class RefittingStream:
     Raises
     ------
     InputError
-        For an inverse compensator or an oracle-centred one.
+        For an inverse compensator, an oracle-centred one, a family whose fit cannot start
+        from given parameters, or a window too short to hold the references a refit needs.
     """
 
     def __init__(self, compensator: Compensator, refit: Refit | None = None,
@@ -128,41 +141,45 @@ class RefittingStream:
             raise InputError(f"{compensator.source or 'compensator'}: adaptation 'full': an "
                              f"inverse compensator's model maps position to sensor, known "
                              f"only at the references; use a direct one, or 'gain'")
+        family = compensator.family
+        where = f"{compensator.source or 'compensator'}: adaptation 'full'"
+        if "init" not in family.fit_options:
+            starts = sorted(name for name, f in FAMILIES.items() if "init" in f.fit_options)
+            raise InputError(f"{where}: the {family.name} fit cannot start from the present "
+                             f"parameters (it would re-run its whole multi-start at every "
+                             f"refit); it applies to {', '.join(starts)}; use 'gain'")
         self.refit = refit or Refit()
         self.label = label
         self._rest_position = rest_position
         self._path = _Path(compensator, rest_position)
         self._state: StreamState = initial_state(compensator, start)
         n = max(1, round(self.refit.window_seconds / compensator.structure.dt))
+        n_params = family.n_params(compensator.structure, compensator.params)
+        self._min_refs = self.refit.min_references or 4 * n_params
+        if n < self._min_refs:
+            raise InputError(f"{where}: a {self.refit.window_seconds:g} s window holds {n} "
+                             f"samples, fewer than the {self._min_refs} references a refit "
+                             f"needs (4 per parameter); make --window longer")
         self._s = np.full(n, np.nan)  # ring buffers of the window, oldest first once full
         self._p = np.full(n, np.nan)
         self._filled = 0
         self._since = 0
         self._report = RefitReport()
-        family = compensator.family
-        n_params = family.n_params(compensator.structure, compensator.params)
-        self._min_refs = self.refit.min_references or 4 * n_params
-        # a budget for the fits that take one (the multi-start families)
-        fit = family.fit_function or family.fit
-        self._budget = ({"max_nfev": self.refit.max_nfev}
-                        if "max_nfev" in inspect.signature(fit).parameters else {})
+        self._options = {"max_nfev": self.refit.max_nfev}
         self._warm_up()
         if compensator.center == "track":
             import scipy.signal  # noqa: F401  # now, not ~1 s late on the first sample
 
     def _warm_up(self) -> None:
         """Load the fit's code and compiled kernels now, not inside the first refit of a
-        live stream (where they stalled one sample by ~0.7 s): a one-evaluation weighted fit
-        on a short probe, whose result is not used."""
+        live stream (where they stalled one sample by ~0.7 s): a weighted fit of one
+        evaluation on a short probe, whose result is not used."""
         comp = self._path.comp
         probe = 0.5 * np.sin(np.linspace(0.0, 4.0 * np.pi, 64))
-        try:
-            options = comp.family.start_options(comp.structure, comp.params).options
-        except NotImplementedError:
-            options = {}
+        options = comp.family.start_options(comp.structure, comp.params).options
         try:
             comp.family.fit(probe, probe, comp.structure, weights=np.ones(probe.size),
-                            **self._budget, **options)
+                            max_nfev=1, screen_nfev=1, **options)
         except (FitDivergedError, InputError, ValueError, ArithmeticError,
                 np.linalg.LinAlgError):
             pass  # a probe the family cannot fit still loaded its code
@@ -174,10 +191,12 @@ class RefittingStream:
 
     @property
     def report(self) -> RefitReport:
+        """What the refits did so far (:class:`RefitReport`)."""
         return self._report
 
     @property
     def state(self) -> StreamState:
+        """The plain stream's present state, with the present parameters' model state."""
         return self._state
 
     def step(self, sensor: float, reference: float = float("nan")) -> float:
@@ -256,22 +275,22 @@ class RefittingStream:
         p = self._p[self._p.size - self._filled:]
         weights = np.isfinite(p).astype(float)
         if weights.sum() < self._min_refs:
+            self._report = dataclasses.replace(self._report, skipped=self._report.skipped + 1)
             return
         comp = self._path.comp
         family, structure = comp.family, comp.structure
         target = np.where(np.isfinite(p), p, 0.0)
-        try:
-            options = family.start_options(structure, comp.params).options
-        except NotImplementedError:  # the family's own starts
-            options = {}
+        options = family.start_options(structure, comp.params).options
         before = _window_cost(family, structure, comp.params, s, target, weights)
         try:
-            result = family.fit(s, target, structure, weights=weights, **self._budget,
+            result = family.fit(s, target, structure, weights=weights, **self._options,
                                 **options)
             after = _window_cost(family, structure, result.params, s, target, weights)
         except (FitDivergedError, ValueError, ArithmeticError, np.linalg.LinAlgError):
             self._refused()
             return
+        self._report = dataclasses.replace(
+            self._report, evaluations=self._report.evaluations + result.n_evaluations)
         if not (np.isfinite(after) and after < before):
             self._refused()
             return

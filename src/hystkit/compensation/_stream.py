@@ -148,12 +148,19 @@ class _Path:
 
 
 def check_streamable(comp: Compensator) -> None:
-    """Refuse a compensator that cannot run causally (the oracle centring)."""
+    """Refuse a compensator that cannot run causally (the oracle centring), or that may not
+    be run live: a model without the stability limit (``--no-limit``), whose divergence a
+    sample-by-sample run could only see once its estimates were already wrong."""
     if comp.center == ORACLE_CENTER:
         raise InputError(
             f"{comp.source or 'compensator'}: key 'center': 'recording' (oracle) removes the "
             f"whole recording's sensor mean, which a stream does not know until it ends; refit "
             f"with --center fit, tare or track")
+    if getattr(comp.structure, "limit", True) is False:
+        raise InputError(
+            f"{comp.source or 'compensator'}: key 'structure.limit': false (fitted with "
+            f"--no-limit, for study): without the stability limit (eq. 5.29) the model can "
+            f"diverge (sec. 5.3.3), so it is not run live; refit without --no-limit")
 
 
 def initial_state(comp: Compensator, start: StartUp = "rest") -> StreamState:

@@ -121,7 +121,8 @@ def _blocks(loop: ControlLoop, state: LoopState | None) -> list:
     return blocks
 
 
-def static_sign_flips(loop: ControlLoop, state: LoopState | None = None) -> list[str]:
+def static_sign_flips(loop: ControlLoop, state: LoopState | None = None,
+                      growth_time_s: float | None = None) -> list[str]:
     """Why a loop can be unstable only at time scales far beyond its runs, in words.
 
     A sensor model or compensator whose static gain has the opposite sign of its
@@ -136,6 +137,11 @@ def static_sign_flips(loop: ControlLoop, state: LoopState | None = None) -> list
     loop : ControlLoop
     state : LoopState, optional
         Operating point; default :func:`rest_state` at ``r = 0``.
+    growth_time_s : float, optional
+        The loop's e-folding time [s]: only a flip that can explain it is named, a block
+        whose slowest cell is no slower than the growth (the pole such a flip pulls beyond
+        ``z = 1`` grows more slowly than that cell decays). A faster blow-up has another
+        cause (e.g. gains), and the flip is not named for it.
 
     Returns
     -------
@@ -151,8 +157,9 @@ def static_sign_flips(loop: ControlLoop, state: LoopState | None = None) -> list
         if poles.max() >= 1.0 or direct == 0.0:
             continue
         static = float(np.real(control.dcgain(sys)))
-        if np.sign(static) != np.sign(direct):
-            slowest = -loop.ts / np.log(poles.max())
+        slowest = -loop.ts / np.log(poles.max())
+        if np.sign(static) != np.sign(direct) and (growth_time_s is None
+                                                   or growth_time_s >= slowest):
             notes.append(f"the {sys.name} has a static gain ({static:.3g}) of the opposite "
                          f"sign to its instantaneous gain ({direct:.3g}): its slowest cell (time "
                          f"constant {slowest:.3g} s) overturns it, a zero beyond z = 1 that "
@@ -287,6 +294,7 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
     """
     lsys = open_loop(loop, state)
     growth, stable, marginal, radius = classify_poles(control.feedback(lsys, 1).A)
+    growth_time = float(loop.ts / np.log(growth)) if growth > 1 else None
 
     def h(f: float) -> complex:
         return complex(np.asarray(lsys(np.exp(2j * np.pi * f * loop.ts))).reshape(-1)[0])
@@ -312,10 +320,9 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
     return LoopMargins(crossover_hz=f_c, phase_margin_deg=pm, gain_margin_db=gm,
                        phase_crossover_hz=f_pc, closed_loop_stable=stable,
                        max_pole_radius=radius,
-                       growth_time_s=float(loop.ts / np.log(growth)) if growth > 1 else None,
-                       marginal=marginal,
-                       cause=("; ".join(static_sign_flips(loop, state)) or None)
-                       if growth > 1 else None)
+                       growth_time_s=growth_time, marginal=marginal,
+                       cause=("; ".join(static_sign_flips(loop, state, growth_time)) or None)
+                       if growth_time is not None else None)
 
 
 def bode_data(loop: ControlLoop, state: LoopState | None = None,
