@@ -80,6 +80,7 @@ def test_mpl_poly_matrix_rows_and_its_table_i_preset():
     ("i_s=0.1,v_t=0.2,w=1:0.4:3,v_b=0", ("w", "shape (2,)")),
     ("i_s=-1,v_t=0.2,w=1:0.4,v_b=0", ("i_s",)),
     ('{"i_s": 0.1', ("not valid JSON",)),
+    ("[1, 2]", ("the JSON must be an object", "got a list")),
     ("table-9.9", ("table-9.9", "presets: table-5.2")),
 ])
 def test_bad_init_is_one_clear_line(text, fragments):
@@ -94,13 +95,32 @@ def test_bad_init_is_one_clear_line(text, fragments):
 # --------------------------------------------------------------------------- the command
 
 
-def test_init_list_prints_the_presets(capsys):
-    with pytest.raises(SystemExit) as info:  # as --help: the listing ends the command
-        main(["fit", "--model", "mpl", "--init", "list"])
-    assert info.value.code == 0
-    out = capsys.readouterr().out
-    for name, (_, _, info) in MPL.presets().items():
-        assert f"{name}: {info['source']}" in out
+@pytest.mark.parametrize("model", ["mpl", "mpl-poly", "mpl-g"])
+def test_init_list_prints_the_presets_of_the_model_wherever_it_stands(capsys, model):
+    # the listing needs neither recordings nor --out, and --model may come after --init
+    for argv in (["--model", model, "--init", "list"], ["--init", "list", "--model", model]):
+        code, out, err = _run(capsys, "fit", *argv)
+        assert code == 0 and not err
+        presets = get_family(model).presets()
+        assert presets  # the premise: every family that takes --init has presets
+        listed = [line.split(":")[0] for line in out.splitlines() if not line.startswith(" ")]
+        assert listed == list(presets)
+        for name, (_, _, info) in presets.items():
+            assert f"{name}: {info['source']}" in out
+
+
+def test_mpl_g_weight_sum_floor_is_refused_before_the_data_are_read(recordings, tmp_path,
+                                                                    capsys, monkeypatch):
+    import hystkit.io
+
+    def unread(*args, **kwargs):
+        raise AssertionError("the data were read")
+
+    monkeypatch.setattr(hystkit.io, "read_recording", unread)
+    code, _, err = _run(capsys, "fit", recordings["sine"], "--model", "mpl-g",
+                        "--weight-sum-max", "1", "--out", tmp_path / "g.json")
+    assert code == 2
+    _one_error(err, "--weight-sum-max for mpl-g must be above 1", "w_0 = 1")
 
 
 def test_no_limit_fit_warns_saves_the_flag_and_its_divergence_is_reported(

@@ -4,7 +4,8 @@
   document's fmincon procedure, table 5.2). ``SPEC`` is JSON (``'{"i_s": 0.1, "v_t": 0.2,
   "w": [1, 0.4], "v_b": -0.6}'``), a ``key=value`` list (``i_s=0.1,v_t=0.2,w=1:0.4,v_b=-0.6``:
   pairs separated by ``,``, list entries by ``:``, rows of a matrix by ``;``), or the name of
-  one of the family's presets (``table-5.2``); ``--init list`` lists the presets. Keys are the
+  one of the family's presets (``table-5.2``); ``--init list`` lists the presets of
+  ``--model``. Keys are the
   family's parameter names, case-insensitive (``I_S`` = ``i_s``); a single value is repeated
   over the cells. Values are in normalised units (eq. 5.10).
 * ``--no-limit``: the model without the stability limit eq. 5.29 (the unbounded sinh of sec.
@@ -24,7 +25,8 @@ from typing import Any
 from ..errors import InputError
 from ._common import UsageError, number
 
-__all__ = ["add_start_options", "parse_init", "start_options", "structure_options"]
+__all__ = ["add_start_options", "list_presets", "parse_init", "start_options",
+           "structure_options", "weight_sum_options"]
 
 _NO_LIMIT_WARNING = ("hystkit: warning: --no-limit: {model} without the stability limit "
                      "(eq. 5.29) can diverge (sec. 5.3.3; paper 9.2: its chirp model without "
@@ -32,22 +34,40 @@ _NO_LIMIT_WARNING = ("hystkit: warning: --no-limit: {model} without the stabilit
                      "not for use as a compensator")
 
 
-class _ListPresets(argparse.Action):
-    """``--init list``: print the presets of ``--model`` (given before it) and exit."""
+class _InitSpec(argparse.Action):
+    """``--init SPEC``; ``--init list`` is resolved after parsing (:func:`list_presets`), when
+    ``--model`` is known wherever it stands, and needs neither recordings nor ``--out``."""
 
     def __call__(self, parser, namespace, values, option_string=None):
-        if values != "list":
-            setattr(namespace, self.dest, values)
-            return
-        from ..models import get_family
+        setattr(namespace, self.dest, values)
+        if values == "list":
+            # this parser is built for one command line: only the listing runs on it
+            for action in parser._actions:
+                action.required = False
 
-        family = get_family(namespace.model)
-        presets = family.presets()
-        if not presets:
-            print(f"{family.name} has no presets")
-        for name, (structure, params, info) in presets.items():
-            print(f"{name}: {info.get('source', '')}\n  {params.to_dict()}")
-        parser.exit(0)
+
+def list_presets(args: argparse.Namespace) -> int:
+    """Print the presets of ``args.model`` (``--init list``).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed ``fit`` arguments with ``init == "list"``.
+
+    Returns
+    -------
+    int
+        The exit code, 0.
+    """
+    from ..models import get_family
+
+    family = get_family(args.model)
+    presets = family.presets()
+    if not presets:
+        print(f"{family.name} has no presets")
+    for name, (structure, params, info) in presets.items():
+        print(f"{name}: {info.get('source', '')}\n  {params.to_dict()}")
+    return 0
 
 
 def add_start_options(parser: argparse.ArgumentParser) -> None:
@@ -59,13 +79,13 @@ def add_start_options(parser: argparse.ArgumentParser) -> None:
         The ``fit`` subcommand's parser.
     """
     parser.add_argument(
-        "--init", action=_ListPresets, default=None, metavar="SPEC",
+        "--init", action=_InitSpec, default=None, metavar="SPEC",
         help="start the fit from these parameters only (the document's single fmincon start, "
              "normalised units): JSON '{\"i_s\": 0.1, \"v_t\": 0.2, \"w\": [1, 0.4], \"v_b\": "
              "-0.6}', a list i_s=0.1,v_t=0.2,w=1:0.4,v_b=-0.6 (one value is repeated over the "
              "cells) or a preset name (mpl: table-5.2, table-5.2-fitted, paper-9.1; mpl-poly: "
-             "paper-9.2-table-i); '--init list' lists the presets of --model (put --model "
-             "first); mpl, mpl-poly, mpl-g")
+             "paper-9.2-table-i; mpl-g: ch7-table-ii-sine, -chirp, -decay, -noise); "
+             "'--init list' lists the presets of --model; mpl, mpl-poly, mpl-g")
     parser.add_argument(
         "--no-limit", action="store_true",
         help="mpl, mpl-poly: drop the stability limit eq. 5.29 (the unbounded sinh or cubic "
@@ -96,10 +116,49 @@ def structure_options(args: argparse.Namespace, family: Any) -> dict:
     return {"limit": False}
 
 
+def weight_sum_options(args: argparse.Namespace, family: Any) -> dict:
+    """The fit option of ``--weight-sum-max``, checked before any data are read.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed ``fit`` arguments (``data``, ``loss``, ``weight_sum_max``).
+    family : Family
+        The family to fit.
+
+    Returns
+    -------
+    dict
+        ``{"weight_sum_max": B}``, or ``{}`` without the option.
+
+    Raises
+    ------
+    UsageError
+        If the family's fit takes no such constraint, several recordings or a robust loss
+        come with it, or the bound is not above the family's floor (mpl-g: 1, its gauge's
+        ``w_0``).
+    """
+    if args.weight_sum_max is None:
+        return {}
+    from ..compensation._fitting import fit_module_constant
+
+    _check_takes(family, "weight_sum_max", "--weight-sum-max")
+    if len(args.data) > 1:
+        raise UsageError("--weight-sum-max applies to a fit on one recording (the joint "
+                         "polish of several is unconstrained)")
+    if getattr(args, "loss", None) not in (None, "linear"):
+        raise UsageError("--weight-sum-max is solved on the SSE (eq. 5.9), not with --loss")
+    floor = fit_module_constant(family.name, "WEIGHT_SUM_FLOOR", 0.0)
+    if not args.weight_sum_max > floor:
+        raise UsageError(f"--weight-sum-max for {family.name} must be above {floor:g} (its "
+                         f"fit's gauge fixes w_0 = 1), got {args.weight_sum_max:g}")
+    return {"weight_sum_max": args.weight_sum_max}
+
+
 def start_options(args: argparse.Namespace, family: Any, dt: float, size: int,
-                  options: dict, n_recordings: int = 1) -> dict:
-    """Fit options of ``--init`` and ``--weight-sum-max`` for ``family.fit``; prints a note for
-    every start value the fit's box moves.
+                  options: dict) -> dict:
+    """Fit options of ``--init`` for ``family.fit``; prints a note for every start value the
+    fit's box moves.
 
     Parameters
     ----------
@@ -114,8 +173,6 @@ def start_options(args: argparse.Namespace, family: Any, dt: float, size: int,
     options : dict
         Structure options (``slope_cap``, ``limit``): with `dt` and `size` they give the
         structure the fit will use, which sizes the ``--init`` values.
-    n_recordings : int, default 1
-        Number of recordings fitted (the constraint applies to a fit on one).
 
     Returns
     -------
@@ -125,35 +182,26 @@ def start_options(args: argparse.Namespace, family: Any, dt: float, size: int,
     Raises
     ------
     UsageError
-        If the family's fit takes no such option.
+        If the family's fit takes no start.
     InputError
         If ``--init`` cannot be read (one line naming what is wrong).
     """
-    fit_options: dict = {}
-    if args.weight_sum_max is not None:
-        _check_takes(family, "weight_sum_max", "--weight-sum-max")
-        if n_recordings > 1:
-            raise UsageError("--weight-sum-max applies to a fit on one recording (the joint "
-                             "polish of several is unconstrained)")
-        if getattr(args, "loss", None) not in (None, "linear"):
-            raise UsageError("--weight-sum-max is solved on the SSE (eq. 5.9), not with --loss")
-        fit_options["weight_sum_max"] = args.weight_sum_max
-    if args.init is not None:
-        _check_takes(family, "init", "--init")
-        try:
-            structure = family.make_structure(dt, size, **options)
-        except (ValueError, TypeError) as exc:
-            raise InputError(f"model {family.name!r}: {exc}") from None
-        try:
-            start = family.start_options(structure, parse_init(args.init, family, structure))
-        except InputError:  # already one line naming --init
-            raise
-        except ValueError as exc:  # e.g. mpl-g's gauge needs w_0 != 0
-            raise InputError(f"--init: {exc}") from None
-        fit_options.update(start.options)
-        for note in start.clipped:
-            print(f"  --init: {note}")
-    return fit_options
+    if args.init is None:
+        return {}
+    _check_takes(family, "init", "--init")
+    try:
+        structure = family.make_structure(dt, size, **options)
+    except (ValueError, TypeError) as exc:
+        raise InputError(f"model {family.name!r}: {exc}") from None
+    try:
+        start = family.start_options(structure, parse_init(args.init, family, structure))
+    except InputError:  # already one line naming --init
+        raise
+    except ValueError as exc:  # e.g. mpl-g's gauge needs w_0 != 0
+        raise InputError(f"--init: {exc}") from None
+    for note in start.clipped:
+        print(f"  --init: {note}")
+    return dict(start.options)
 
 
 def _check_takes(family: Any, keyword: str, option: str) -> None:
@@ -220,13 +268,14 @@ def parse_init(text: str, family: Any, structure: Any) -> Any:
 
 
 def _read_spec(text: str, family: Any) -> dict:
-    if text.startswith("{"):
+    if text.startswith(("{", "[", '"')):
         try:
             spec = json.loads(text)
         except json.JSONDecodeError as exc:
             raise InputError(f"--init: not valid JSON ({exc})") from None
         if not isinstance(spec, dict):
-            raise InputError("--init: the JSON must be an object of parameter values")
+            raise InputError(f"--init: the JSON must be an object of parameter values "
+                             f"({{\"name\": value, ...}}), got a {type(spec).__name__}")
         return spec
     if "=" in text:
         return dict(_read_pair(pair) for pair in text.split(",") if pair.strip())

@@ -23,7 +23,13 @@ from ._common import (
     slope_cap,
 )
 from ._fit_cost_options import add_cost_options, cost_options, print_cost_summary
-from ._fit_start_options import add_start_options, start_options, structure_options
+from ._fit_start_options import (
+    add_start_options,
+    list_presets,
+    start_options,
+    structure_options,
+    weight_sum_options,
+)
 from ._inputs import check_inputs_exist
 from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_from_args
 
@@ -76,6 +82,8 @@ def _simulate_sensor(args: argparse.Namespace) -> int:
 
 
 def _fit(args: argparse.Namespace) -> int:
+    if args.init == "list":
+        return list_presets(args)
     check_inputs_exist(args.data)  # a misspelt name is refused before the heavy imports
     from ..compensation import MODEL_SUFFIXES, center_label, fit_compensator, save_compensator
     from ..io import check_output_path, read_recording
@@ -85,6 +93,7 @@ def _fit(args: argparse.Namespace) -> int:
                       what="a model file")
     family = get_family(args.model)
     costs = cost_options(args)
+    constraint = weight_sum_options(args, family)
     options = {} if args.slope_cap is None else {"slope_cap": args.slope_cap}
     if options and not has_slope_cap(family):
         raise UsageError(f"--slope-cap applies to the models with an Euler slope cap "
@@ -94,7 +103,7 @@ def _fit(args: argparse.Namespace) -> int:
     check_size(args.model, args.cells, "--cells")
     recs = [read_recording(path, options=read_options(args, path)) for path in args.data]
     size = family.default_size if args.cells is None else args.cells
-    fit_options = start_options(args, family, recs[0].dt, size, options, len(recs))
+    fit_options = {**start_options(args, family, recs[0].dt, size, options), **constraint}
     shown = "".join(f", {name} {str(value).lower() if isinstance(value, bool) else f'{value:g}'}"
                     for name, value in options.items())
     print(f"fitting {args.model} ({family.size_help}: {size}{shown}, {args.mode} mode, centring: "

@@ -37,13 +37,41 @@ from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status, fixed_
 from ._param_vector import flatten_params, simulate_segments
 from ._training_checks import MIN_SAMPLES, check_fitting_data
 
-__all__ = ["MIN_SAMPLES", "fit_compensator", "supported_losses", "weight_column"]
+__all__ = ["MIN_SAMPLES", "fit_compensator", "fit_module_constant", "supported_losses",
+           "weight_column"]
 
 # The joint polish differentiates numerically, one model run per parameter: above this many
 # parameters (Preisach grids) it is skipped and the concatenated fit is kept.
 MAX_POLISH_PARAMS = 40
 # Residual of a parameter vector outside the family's domain (the polish has no bounds).
 _OUTSIDE = 1e3
+
+
+def fit_module_constant(model: str, name: str, default: Any) -> Any:
+    """A constant the fit module of family `model` declares (``hystkit.models.<family>.fit``),
+    or `default` where it declares none.
+
+    Parameters
+    ----------
+    model : str
+        A registered family name.
+    name : str
+        The constant's name, e.g. ``SUPPORTED_LOSSES`` or ``WEIGHT_SUM_FLOOR``.
+    default : object
+        The value for a family without it (or without a fit module of its own).
+
+    Returns
+    -------
+    object
+    """
+    package = type(get_family(model)).__module__.rpartition(".")[0]
+    if not package:  # a family object outside a package of its own (a test's stand-in)
+        return default
+    try:
+        fit_module = importlib.import_module(f"{package}.fit")
+    except ModuleNotFoundError:
+        return default
+    return getattr(fit_module, name, default)
 
 
 def supported_losses(model: str) -> tuple[str, ...]:
@@ -60,14 +88,7 @@ def supported_losses(model: str) -> tuple[str, ...]:
     -------
     tuple of str
     """
-    package = type(get_family(model)).__module__.rpartition(".")[0]
-    if not package:  # a family object outside a package of its own (a test's stand-in)
-        return LOSSES
-    try:
-        fit_module = importlib.import_module(f"{package}.fit")
-    except ModuleNotFoundError:
-        return LOSSES
-    return tuple(getattr(fit_module, "SUPPORTED_LOSSES", LOSSES))
+    return tuple(fit_module_constant(model, "SUPPORTED_LOSSES", LOSSES))
 
 
 def weight_column(recordings: Sequence[Recording], column: str,

@@ -38,12 +38,15 @@ from ..mpl import model as mpl
 from ..mpl.fit import fit_mpl, theta_limits
 from . import model as mpl_g
 
-__all__ = ["MONOTONE_RANGE", "bernstein_slopes", "canonical", "fit_box", "fit_mpl_g",
-           "output_from_slopes", "random_params", "start_theta", "theta_names"]
+__all__ = ["MONOTONE_RANGE", "WEIGHT_SUM_FLOOR", "bernstein_slopes", "canonical", "fit_box",
+           "fit_mpl_g", "output_from_slopes", "random_params", "start_theta", "theta_names"]
 
 MONOTONE_RANGE = 2.0
 """Half-width of the interval ``|z| <= R`` (normalised units, gauge ``w_0 = 1``, ``V_b = 0``) on
 which a fitted ``g`` is strictly monotone."""
+
+WEIGHT_SUM_FLOOR = 1.0
+"""A weight-sum bound must exceed this: the gauge fixes ``w_0 = 1``."""
 
 # Bounds in optimiser coordinates: the cells' are the mPL's; |w| <= 100 mirrors the document's
 # weight-sum constraint (sec. 5.3.3); g_0 only needs to stay finite; the Bernstein slopes of g
@@ -301,7 +304,7 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
     u, y = check_fit_data(u, y)
     n = structure.n_cells
     lower, upper = fit_box(structure)
-    if weight_sum_max is not None and not weight_sum_max > 1:
+    if weight_sum_max is not None and not weight_sum_max > WEIGHT_SUM_FLOOR:
         raise ValueError(f"in the gauge w_0 = 1 the weight sum is at least 1; got the bound "
                          f"{weight_sum_max!r}")
     if init is not None:
