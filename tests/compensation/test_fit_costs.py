@@ -37,7 +37,10 @@ def _block_reversed(rec: Recording, column: str, block: slice) -> Recording:
 
 @pytest.mark.parametrize(("value", "why"), [(-0.5, "weight -0.5 is not a finite number >= 0"),
                                             (np.nan, "weight nan is not a finite number >= 0"),
-                                            ("x1", "weight 'x1' is not a number")])
+                                            ("x1", "weight 'x1' is not a number"),
+                                            (1e308, ("weight 1e+308 is above 1e+100 (only the "
+                                                     "ratios of the weights matter: scale the "
+                                                     "column down)"))])
 def test_bad_weight_names_file_column_and_row(recordings, value, why):
     recs = [_renamed(r, f"rec{i}.csv") for i, r in enumerate(recordings)]
     w = np.ones(recs[1].n_samples, dtype=object if isinstance(value, str) else float)
@@ -55,6 +58,22 @@ def test_missing_and_zero_weights_are_refused(recordings):
         weight_column([rec], "w", [{"temp": np.ones(rec.n_samples)}])
     with pytest.raises(InputError, match="every value of the weights column 'w' is 0"):
         weight_column([rec], "w", [{"w": np.zeros(rec.n_samples)}])
+
+
+@pytest.mark.parametrize(("model", "size"), [("pi", None), ("mpl", 1)])
+def test_weights_up_to_the_bound_are_scale_free(recordings, model, size):
+    # the weighted SSE's minimiser depends only on the weights' ratios: the column times
+    # 1e99 (below MAX_WEIGHT) gives the same compensator, its objective 1e99 times as large
+    rec = recordings[0]
+    w = np.ones(rec.n_samples)
+    w[::7] = 3.0
+    fits = [fit_compensator(rec, size, model=model, diagnose=False, weights="w",
+                            other_columns=[{"w": w * scale}]) for scale in (1.0, 1e99)]
+    # rtol: the two solves differ only in rounding (measured 1e-11 for pi, 1e-15 for mpl)
+    np.testing.assert_allclose(flatten_params(fits[1].params)[0],
+                               flatten_params(fits[0].params)[0], rtol=1e-9, atol=1e-12)
+    assert fits[1].fit_info["objective"] == pytest.approx(1e99 * fits[0].fit_info["objective"],
+                                                          rel=1e-9)
 
 
 def test_text_weights_that_are_numbers_are_read(recordings):

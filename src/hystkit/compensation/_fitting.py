@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FitDivergedError, HystkitError, InputError
-from ..identification import LOSSES, FitResult, check_cost, objective
+from ..identification import LOSSES, MAX_WEIGHT, FitResult, check_cost, objective
 from ..io import Recording
 from ..metrics import r2
 from ..models import Family, get_family
@@ -110,13 +110,14 @@ def weight_column(recordings: Sequence[Recording], column: str,
     Returns
     -------
     numpy.ndarray, shape (sum of samples,)
-        The weights, finite and ``>= 0``, not all zero.
+        The weights, finite, in ``[0, MAX_WEIGHT]`` (1e100), not all zero.
 
     Raises
     ------
     InputError
         A recording without the column (naming the file and its other columns), a value that
-        is not a finite number ``>= 0`` (naming file, column and row), or all weights zero.
+        is not a finite number in ``[0, MAX_WEIGHT]`` (naming file, column and row), or all
+        weights zero.
     """
     from ..io import read_other_columns
 
@@ -153,6 +154,11 @@ def weight_column(recordings: Sequence[Recording], column: str,
         if bad.size:
             raise InputError(f"{rec.source}: column {column!r}, row {bad[0] + 1}: weight "
                              f"{values[bad[0]]:g} is not a finite number >= 0")
+        bad = np.flatnonzero(values > MAX_WEIGHT)
+        if bad.size:
+            raise InputError(f"{rec.source}: column {column!r}, row {bad[0] + 1}: weight "
+                             f"{values[bad[0]]:g} is above {MAX_WEIGHT:g} (only the ratios of "
+                             f"the weights matter: scale the column down)")
         parts.append(values)
     weights = np.concatenate(parts)
     if not np.any(weights > 0):

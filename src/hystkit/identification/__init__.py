@@ -4,7 +4,7 @@ Each family's own fit is in its folder, ``hystkit.models.<family>``; the registr
 :mod:`hystkit.models`.
 """
 
-from ._least_squares import check_fit_data, check_weights, fit_multistart
+from ._least_squares import MAX_WEIGHT, check_fit_data, check_weights, fit_multistart
 from ._lm import solve_lm
 from ._losses import (
     LOSSES,
@@ -22,7 +22,7 @@ from ._normal_equations import (
 )
 from ._result import BoundHit, FitResult
 
-__all__ = ["LOSSES", "BoundHit", "ChunkedDifferences", "FitResult", "NormalEquations",
+__all__ = ["LOSSES", "MAX_WEIGHT", "BoundHit", "ChunkedDifferences", "FitResult", "NormalEquations",
            "SolveResult", "check_cost", "check_fit_data", "check_weights", "dense_normal_equations",
            "fit_multistart", "loss_slope", "objective", "require_linear_loss",
            "robust_linear_fit", "solve_lm"]

@@ -342,8 +342,15 @@ def _solve_start(start: tuple[np.ndarray, int], *, solve: _StartSolver) -> Simpl
     return solve(*start)
 
 
+MAX_WEIGHT = 1e100
+"""Largest per-sample weight a fit takes: above it ``w r^2`` and the weights' sums overflow
+(1e308 gives inf in numpy and illegal values in LAPACK). Only ratios of weights matter to the
+SSE, so a column of larger numbers can be rescaled by the user."""
+
+
 def check_weights(weights: Any, size: int) -> np.ndarray:
-    """Per-residual weights as a float array: 1-D, ``size`` entries, finite, >= 0, not all 0.
+    """Per-residual weights as a float array: 1-D, ``size`` entries, finite, in
+    ``[0, MAX_WEIGHT]``, not all 0.
 
     Parameters
     ----------
@@ -366,10 +373,10 @@ def check_weights(weights: Any, size: int) -> np.ndarray:
     if weights.ndim != 1 or weights.size != size:
         raise ValueError(f"weights must have one entry per residual entry ({size}), got "
                          f"shape {weights.shape}")
-    bad = np.flatnonzero(~(np.isfinite(weights) & (weights >= 0)))
+    bad = np.flatnonzero(~(np.isfinite(weights) & (weights >= 0) & (weights <= MAX_WEIGHT)))
     if bad.size:
-        raise ValueError(f"weights must be finite and >= 0, entry {bad[0]} is "
-                         f"{float(weights[bad[0]])!r}")
+        raise ValueError(f"weights must be finite, >= 0 and <= {MAX_WEIGHT:g}, entry {bad[0]} "
+                         f"is {float(weights[bad[0]])!r}")
     if not np.any(weights > 0):
         raise ValueError("weights must not all be zero")
     return weights
