@@ -62,16 +62,45 @@ def test_robust_weighted_fit_is_recorded_and_summarised(recording, tmp_path, cap
     n, k = fit["training_samples"], fit["n_params"]
     assert fit["aic"] == pytest.approx(n * math.log(fit["cost"] / n) + 2 * k, rel=1e-12)
     assert fit["objective"] < fit["cost"]  # huber counts the large residuals less
+    # the standard errors are the plain SSE's: labelled as indicative in the output, the
+    # model file and the report alike
+    caveat = ("standard errors of the plain SSE at these parameters, indicative only: the fit "
+              "minimised the huber cost (f_scale 0.05, weighted by column 'w')")
+    assert fit["standard_errors"]["caveat"] == caveat
+    lines = out.splitlines()
+    at = next(i for i, line in enumerate(lines) if line.startswith("  standard errors"))
+    assert lines[at + 1] == f"    ({caveat})"
+    import html
+
+    from hystkit.compensation import load_compensator
+    from hystkit.reports._report_model import fit_section
+
+    assert f"Caveat: {caveat}." in html.unescape(fit_section(load_compensator(model)).to_html())
+
+
+def test_robust_loss_without_f_scale_warns_once(recording, tmp_path, capsys):
+    code, _, err = _run(capsys, "fit", recording, "--cells", 1, "--loss", "cauchy", "--out",
+                        tmp_path / "m.json")
+    assert code in (0, 3)
+    warnings = [line for line in err.splitlines() if "without --f-scale" in line]
+    expected = ("hystkit: warning: --loss cauchy without --f-scale: f_scale 1 leaves a robust "
+                "loss close to the SSE on the normalised data (max |.| = 1); set --f-scale to "
+                "5-10 times the plain fit's RMS residual")
+    assert warnings == [expected]
+    _, _, err = _run(capsys, "fit", recording, "--cells", 1, "--loss", "cauchy", "--f-scale",
+                     0.05, "--out", tmp_path / "m2.json")
+    assert "without --f-scale" not in err
 
 
 def test_plain_fit_records_the_sse(recording, tmp_path, capsys):
     model = tmp_path / "m.json"
     code, out, err = _run(capsys, "fit", recording, "--cells", 1, "--out", model)
     assert code == 0, err
-    assert "minimised" not in out
+    assert "minimised" not in out and "indicative only" not in out
     fit = json.loads(model.read_text())["fit"]
     assert (fit["loss"], fit["weights"], fit["objective_label"]) == ("linear", None, "SSE")
     assert fit["objective"] == fit["cost"]
+    assert "caveat" not in fit["standard_errors"]
 
 
 @pytest.mark.parametrize(("row", "value", "shown"), [(10, -1.0, "-1"), (20, "", "nan"),
@@ -105,7 +134,7 @@ def test_all_zero_weights(recording, tmp_path, capsys):
 @pytest.mark.parametrize(("argv", "message"), [
     (["--loss", "l1"], "argument --loss: invalid choice: 'l1'"),
     (["--loss", "huber", "--model", "preisach"],
-     "model 'preisach' fits by linear least squares; --loss huber is not available"),
+     "model 'preisach' fits by linear least squares; the huber loss is not available"),
     (["--f-scale", "0.1"], "--f-scale applies to a robust --loss"),
     (["--loss", "cauchy", "--f-scale", "0"], "argument --f-scale"),
     (["--weights", "w", "--weight-sum-max", "100"], "--weight-sum-max is solved on the SSE"),

@@ -158,6 +158,14 @@ def test_weight_sum_max_bounds_the_saved_weights(recordings, tmp_path, capsys):
     assert_allclose(np.abs(w).sum(), 1.2, rtol=1e-8)
     assert "SLSQP under sum |w| <= 1.2 (active" in out
     assert code in (0, 3)  # the guards judge the constrained fit like any other
+    # at an active constraint the SSE is not stationary: its standard errors are labelled
+    caveat = json.loads(model.read_text())["fit"]["standard_errors"]["caveat"]
+    assert caveat.endswith("the fit ended on its active constraint sum |w| <= 1.2, where the "
+                           "SSE is not stationary")
+    assert f"    ({caveat})" in out.splitlines()
+    _, out, _ = _run(capsys, "fit", recordings["sine"], "--weight-sum-max", "100", "--out",
+                     tmp_path / "free.json")
+    assert "(inactive" in out and "indicative only" not in out
 
 
 @pytest.mark.parametrize(("argv", "fragments"), [

@@ -53,7 +53,7 @@ def test_weighted_linear_fit_is_the_closed_form_solution():
     r = a @ res.theta - b
     assert res.cost == pytest.approx(float(r @ r), rel=1e-12)  # the plain SSE
     assert res.objective == pytest.approx(float(w @ r ** 2), rel=1e-9)
-    assert res.weighted and res.loss == "linear" and res.objective_label == "weighted SSE"
+    assert res.weighted and res.loss == "linear" and res.objective_label == "SSE weighted by per-sample weights"
 
 
 @pytest.mark.parametrize("loss", ["soft_l1", "huber", "cauchy"])

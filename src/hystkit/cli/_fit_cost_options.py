@@ -4,12 +4,13 @@ By default a fit minimises the SSE (eq. 5.9). ``--loss`` picks one of scipy's ro
 instead, ``--f-scale`` its residual scale (normalised units: the data are scaled to max |.| = 1
 before the fit, eq. 5.10) and ``--weights`` a column of the recordings with one weight per
 sample. A model whose fit is a linear least-squares solve takes weights but no robust loss:
-it is refused here, before any data are read.
+it is refused here, before any data are read, with the library's message.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,9 +23,20 @@ __all__ = ["LOSSES", "CostOptions", "add_cost_options", "cost_options", "print_c
 # the parser must not (tests/cli/test_fit_cost_options.py checks that the two agree)
 LOSSES = ("linear", "soft_l1", "huber", "cauchy")
 
+_DEFAULT_F_SCALE_WARNING = ("hystkit: warning: --loss {loss} without --f-scale: f_scale 1 "
+                            "leaves a robust loss close to the SSE on the normalised data "
+                            "(max |.| = 1); set --f-scale to 5-10 times the plain fit's RMS "
+                            "residual")
+
 
 def add_cost_options(parser: argparse.ArgumentParser) -> None:
-    """Add ``--loss``, ``--f-scale`` and ``--weights`` to `parser` (the ``fit`` subcommand)."""
+    """Add ``--loss``, ``--f-scale`` and ``--weights`` to the ``fit`` parser.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The ``fit`` subcommand's parser.
+    """
     parser.add_argument(
         "--loss", default="linear", choices=LOSSES,
         help="cost the fit minimises: linear = the SSE (eq. 5.9, default); soft_l1, huber, "
@@ -70,27 +82,56 @@ class CostOptions:
 
 
 def cost_options(args: argparse.Namespace) -> CostOptions:
-    """The parsed cost options, refused in one line (before any work) where they do not apply:
-    a robust loss for a model fitted by linear least squares, ``--f-scale`` without one."""
-    from ..compensation._fitting import supported_losses
+    """The parsed cost options, refused in one line (before any work) where they do not apply.
+
+    A robust ``--loss`` without ``--f-scale`` runs with scipy's f = 1 and a warning on stderr:
+    on data normalised to max |.| = 1 that leaves the loss close to the SSE.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed ``fit`` arguments (``model``, ``loss``, ``f_scale``, ``weights``,
+        ``weight_sum_max``).
+
+    Returns
+    -------
+    CostOptions
+        The cost to fit with.
+
+    Raises
+    ------
+    UsageError
+        ``--f-scale`` without a robust loss, an empty ``--weights``, or ``--weights`` with
+        ``--weight-sum-max``.
+    InputError
+        A robust loss for a model fitted by linear least squares
+        (:func:`hystkit.compensation._fitting.check_loss_available`).
+    """
+    from ..compensation._fitting import check_loss_available
 
     if args.f_scale is not None and args.loss == "linear":
         raise UsageError("--f-scale applies to a robust --loss (soft_l1, huber, cauchy), not "
                          "to linear (the SSE)")
-    if args.loss != "linear" and args.loss not in supported_losses(args.model):
-        raise UsageError(f"model {args.model!r} fits by linear least squares; --loss "
-                         f"{args.loss} is not available for it (--weights is)")
+    f_scale = 1.0 if args.f_scale is None else args.f_scale
+    check_loss_available(args.model, args.loss, f_scale)
     if args.weights is not None and not args.weights.strip():
         raise UsageError("--weights needs a column name")
     if args.weights is not None and getattr(args, "weight_sum_max", None) is not None:
         raise UsageError("--weight-sum-max is solved on the SSE (eq. 5.9), not with --weights")
-    return CostOptions(loss=args.loss, f_scale=1.0 if args.f_scale is None else args.f_scale,
-                       weights=args.weights)
+    if args.loss != "linear" and args.f_scale is None:
+        print(_DEFAULT_F_SCALE_WARNING.format(loss=args.loss), file=sys.stderr)
+    return CostOptions(loss=args.loss, f_scale=f_scale, weights=args.weights)
 
 
 def print_cost_summary(info: dict) -> None:
-    """Print what a fit minimised when that was not the plain SSE (``fit_info`` of
-    `hystkit.compensation.fit_compensator`); nothing for the SSE, which ``fit`` prints."""
+    """Print what a fit minimised when that was not the plain SSE.
+
+    Parameters
+    ----------
+    info : dict
+        ``fit_info`` of :func:`hystkit.compensation.fit_compensator`; nothing is printed for
+        the plain SSE, whose value ``fit`` prints itself.
+    """
     if info.get("criteria_note") is not None:
         print(f"  minimised the {info['objective_label']}: {info['objective']:.4g} "
               f"(normalised); R², AIC and BIC are on the plain SSE")

@@ -197,6 +197,8 @@ def _print_standard_errors(se: dict | None) -> None:
     print(f"  standard errors (Gauss-Newton, finite-difference Jacobian): {worst}"
           f"{f'; {n_blind} parameter(s) not determined by the data' if n_blind else ''}"
           f"{'; fixed by the fit: ' + ', '.join(fixed) if fixed else ''}")
+    if se.get("caveat"):  # a robust or weighted cost, an active constraint
+        print(f"    ({se['caveat']})")
 
 
 def _compensate(args: argparse.Namespace) -> int:

@@ -20,7 +20,15 @@ from typing import Any
 import numpy as np
 
 from ..errors import FitDivergedError, HystkitError, InputError
-from ..identification import LOSSES, MAX_WEIGHT, FitResult, check_cost, objective
+from ..identification import (
+    LOSSES,
+    MAX_WEIGHT,
+    FitResult,
+    check_cost,
+    cost_label,
+    objective,
+    require_linear_loss,
+)
 from ..io import Recording
 from ..metrics import r2
 from ..models import Family, get_family
@@ -37,8 +45,8 @@ from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status, fixed_
 from ._param_vector import flatten_params, simulate_segments
 from ._training_checks import MIN_SAMPLES, check_fitting_data
 
-__all__ = ["MIN_SAMPLES", "fit_compensator", "fit_module_constant", "supported_losses",
-           "weight_column"]
+__all__ = ["MIN_SAMPLES", "check_loss_available", "fit_compensator", "fit_module_constant",
+           "supported_losses", "weight_column"]
 
 # The joint polish differentiates numerically, one model run per parameter: above this many
 # parameters (Preisach grids) it is skipped and the concatenated fit is kept.
@@ -273,7 +281,9 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
         model is not constant, beats the straight line on the training data, has no parameter
         on a bound and converged. ``fit_info`` records ``loss``, ``f_scale``, ``weights``
         (the column) and the minimised ``objective`` with its ``objective_label``; its
-        ``cost``, R² and AIC/BIC are on the plain SSE.
+        ``cost``, R² and AIC/BIC are on the plain SSE. Its ``standard_errors`` (of the plain
+        SSE) carry a ``caveat`` where they are indicative only: a robust loss, weights, or an
+        active weight-sum constraint.
     """
     recs = [recordings] if isinstance(recordings, Recording) else list(recordings)
     if not recs:
@@ -326,24 +336,45 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
                      (loss, f_scale, sample_weights))
     info["n_params"], info["joint_fit"] = n_params, joint_note or None
     info.update(_cost_info(loss, f_scale, weights, sample_weights))
+    caveat = _standard_error_caveat(info, result)
+    if info.get("standard_errors") and caveat:
+        info["standard_errors"]["caveat"] = caveat
     object.__setattr__(comp, "fit_info", info)
     return comp
+
+
+def check_loss_available(model: str, loss: str, f_scale: float) -> None:
+    """Refuse, before any work, a cost the family cannot fit with.
+
+    Parameters
+    ----------
+    model : str
+        A registered family name.
+    loss, f_scale
+        The requested cost (:func:`hystkit.identification.check_cost`).
+
+    Raises
+    ------
+    InputError
+        If the cost is not valid, or the family fits by linear least squares and `loss` is
+        a robust loss (:func:`hystkit.identification.require_linear_loss`, one line).
+    """
+    try:
+        check_cost(loss, f_scale)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    if loss not in supported_losses(model):
+        require_linear_loss(loss, f_scale, model, "linear least squares")
 
 
 def _cost_options(model: str, loss: str, f_scale: float,
                   fit_options: Mapping[str, Any] | None) -> dict[str, Any]:
     """The fit's cost options (empty for the plain SSE), checked before any work."""
-    try:
-        check_cost(loss, f_scale)
-    except ValueError as exc:
-        raise InputError(str(exc)) from None
+    check_loss_available(model, loss, f_scale)
     clash = {"loss", "f_scale", "weights"} & set(fit_options or {})
     if clash:
         raise ValueError(f"give {', '.join(sorted(clash))} as fit_compensator's own "
                          f"arguments, not in fit_options")
-    if loss != "linear" and loss not in supported_losses(model):
-        raise InputError(f"model {model!r} fits by linear least squares; the {loss} loss is not "
-                         f"available for it (it takes per-sample weights)")
     return {} if loss == "linear" else {"loss": loss, "f_scale": float(f_scale)}
 
 
@@ -352,19 +383,27 @@ def _cost_info(loss: str, f_scale: float, column: str | None,
     """What the fit minimised, for ``fit_info``: the loss, its scale, the weights column and
     the label of the ``objective`` (the plain SSE's ``cost`` is stored beside it)."""
     plain = loss == "linear" and weights is None
-    if plain:
-        label = "SSE"
-    elif loss == "linear":
-        label = f"SSE weighted by column {column!r}"
-    else:
-        weighted = f", weighted by column {column!r}" if column is not None else ""
-        label = f"{loss} cost (f_scale {f_scale:g}{weighted})"
+    label = cost_label(loss, f_scale, None if weights is None else f"column {column!r}")
     out = {"loss": loss, "f_scale": float(f_scale) if loss != "linear" else None,
            "weights": column, "objective_label": label}
     if not plain:
         out["criteria_note"] = (f"R², AIC and BIC are on the plain SSE; the fit minimised the "
                                 f"{label}")
     return out
+
+
+def _standard_error_caveat(info: Mapping[str, Any], result: FitResult) -> str | None:
+    """Why the Gauss-Newton standard errors (of the plain SSE) are indicative only at this
+    optimum, or None where they apply: the fit minimised another cost, or it stopped on an
+    active constraint, where the SSE is not stationary."""
+    reason = None
+    if info.get("criteria_note") is not None:
+        reason = f"the fit minimised the {info['objective_label']}"
+    elif result.constraint is not None:
+        reason = (f"the fit ended on its active constraint {result.constraint}, where the SSE "
+                  f"is not stationary")
+    return None if reason is None else (f"standard errors of the plain SSE at these "
+                                        f"parameters, indicative only: {reason}")
 
 
 def _fit_family(family: Family, structure: Any, mode: str, s: np.ndarray,

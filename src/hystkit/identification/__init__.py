@@ -9,6 +9,7 @@ from ._lm import solve_lm
 from ._losses import (
     LOSSES,
     check_cost,
+    cost_label,
     loss_slope,
     objective,
     require_linear_loss,
@@ -22,7 +23,8 @@ from ._normal_equations import (
 )
 from ._result import BoundHit, FitResult
 
-__all__ = ["LOSSES", "MAX_WEIGHT", "BoundHit", "ChunkedDifferences", "FitResult", "NormalEquations",
-           "SolveResult", "check_cost", "check_fit_data", "check_weights", "dense_normal_equations",
+__all__ = ["LOSSES", "MAX_WEIGHT", "BoundHit", "ChunkedDifferences", "FitResult",
+           "NormalEquations", "SolveResult", "check_cost", "check_fit_data", "check_weights",
+           "cost_label", "dense_normal_equations",
            "fit_multistart", "loss_slope", "objective", "require_linear_loss",
            "robust_linear_fit", "solve_lm"]

@@ -200,8 +200,9 @@ def constrain_fit(result: FitResult, normal_equations: Callable[[np.ndarray], No
     Returns
     -------
     FitResult
-        The constrained optimum: its SSE, ``converged`` as SLSQP reports, and a message that
-        gives ``sum |w|`` and whether the constraint is active.
+        The constrained optimum: its SSE, ``converged`` as SLSQP reports, a message that
+        gives ``sum |w|`` and whether the constraint is active, and ``constraint`` set where
+        it is.
 
     Raises
     ------
@@ -225,5 +226,6 @@ def constrain_fit(result: FitResult, normal_equations: Callable[[np.ndarray], No
                    converged=sol.converged, n_evaluations=result.n_evaluations + sol.n_runs,
                    seconds=result.seconds + time.perf_counter() - t0,
                    sensitivity=sol.column_norms,
+                   constraint=f"{label} <= {weight_sum_max:g}" if sol.active else None,
                    message=f"SLSQP under {label} <= {weight_sum_max:g} ({state}: {label} = "
                            f"{sol.weight_sum:.6g}): {sol.message}")

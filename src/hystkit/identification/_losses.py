@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LOSSES", "check_cost", "loss_slope", "objective", "require_linear_loss",
-           "robust_linear_fit"]
+__all__ = ["LOSSES", "check_cost", "cost_label", "loss_slope", "objective",
+           "require_linear_loss", "robust_linear_fit"]
 
 LOSSES = ("linear", "soft_l1", "huber", "cauchy")
 """Costs a fit can minimise: ``linear`` is the SSE (eq. 5.9), the others scipy's robust losses
@@ -45,6 +45,30 @@ def check_cost(loss: str, f_scale: float) -> None:
     if not (isinstance(f_scale, (int, float, np.floating)) and np.isfinite(f_scale)
             and f_scale > 0):
         raise ValueError(f"f_scale must be a positive number, got {f_scale!r}")
+
+
+def cost_label(loss: str, f_scale: float, weights: str | None = None) -> str:
+    """What a fit minimised, in words, for messages, reports and ``fit_info``.
+
+    Parameters
+    ----------
+    loss : str
+        One of :data:`LOSSES`.
+    f_scale : float
+        The robust loss's residual scale (unused by ``"linear"``).
+    weights : str, optional
+        What weighted the residuals (``"column 'w'"``); None if unweighted.
+
+    Returns
+    -------
+    str
+        ``"SSE"``, ``"SSE weighted by column 'w'"``, ``"huber cost (f_scale 0.05)"`` or
+        ``"huber cost (f_scale 0.05, weighted by column 'w')"``.
+    """
+    if loss == "linear":
+        return "SSE" if weights is None else f"SSE weighted by {weights}"
+    weighted = "" if weights is None else f", weighted by {weights}"
+    return f"{loss} cost (f_scale {f_scale:g}{weighted})"
 
 
 def objective(residual: np.ndarray, loss: str = "linear", f_scale: float = 1.0,

@@ -7,6 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from ._losses import cost_label
+
 __all__ = ["INSENSITIVE", "BoundHit", "FitResult"]
 
 # A coordinate whose Jacobian column is below this share of the largest column does not affect
@@ -84,6 +86,10 @@ class FitResult:
         Its robust loss's residual scale (unused by "linear").
     weighted : bool
         Whether it weighted the residuals.
+    constraint : str or None
+        The constraint the optimum lies on (active), e.g. ``"sum |w| <= 100"``: there the
+        cost is not stationary, so its Gauss-Newton standard errors do not apply. None if
+        the fit was unconstrained or the constraint inactive.
     """
 
     structure: Any
@@ -103,15 +109,14 @@ class FitResult:
     loss: str = "linear"
     f_scale: float = 1.0
     weighted: bool = False
+    constraint: str | None = None
 
     @property
     def objective_label(self) -> str:
-        """What ``objective`` is, for reports: ``"SSE"``, ``"weighted SSE"`` or e.g.
-        ``"huber cost (f_scale 0.1)"``."""
-        if self.loss == "linear":
-            return "weighted SSE" if self.weighted else "SSE"
-        weighted = ", weighted" if self.weighted else ""
-        return f"{self.loss} cost (f_scale {self.f_scale:g}{weighted})"
+        """What ``objective`` is, for reports (:func:`~._losses.cost_label`): ``"SSE"``,
+        ``"SSE weighted by per-sample weights"`` or e.g. ``"huber cost (f_scale 0.1)"``."""
+        return cost_label(self.loss, self.f_scale,
+                          "per-sample weights" if self.weighted else None)
 
     def bound_hits(self, tolerance: float) -> list[BoundHit] | None:
         """Coordinates of ``theta`` within ``tolerance`` x (bound interval) of a finite bound.

@@ -157,7 +157,8 @@ def _parameter_table(comp: Compensator) -> str:
     text = ("Standard errors: Gauss-Newton, s² (JᵀJ)⁻¹ from the finite-difference Jacobian at "
             f"the optimum (condition number of JᵀJ {_fixed(se.get('condition_number'), '.3g')})"
             + (f"; {blind} parameter(s) not determined by the data (–)" if blind else "")
-            + (f"; {', '.join(fixed)} fixed by the fit (its gauge)." if fixed else "."))
+            + (f"; {', '.join(fixed)} fixed by the fit (its gauge)." if fixed else ".")
+            + (f" Caveat: {se['caveat']}." if se.get("caveat") else ""))
     return (table(("parameter", "value", "standard error", "relative"), rows, spec=".6g")
             + paragraph(text))
 
