@@ -59,15 +59,17 @@ class Parser(argparse.ArgumentParser):
     def error(self, message: str):  # argparse would print the usage and call sys.exit(2)
         raise UsageError(f"{message} (see '{self.prog} --help')")
 
-    def _resolve(self) -> None:
+    def _resolve(self, names: tuple[str, ...] = ("choices", "default", "help")) -> None:
         for action in self._actions:
-            for name in ("choices", "default", "help"):
+            for name in names:
                 value = getattr(action, name, None)
                 if isinstance(value, Deferred):
                     setattr(action, name, value.compute())
 
     def parse_known_args(self, args=None, namespace=None):
-        self._resolve()  # a subcommand's parser: only the chosen one pays for its values
+        # A subcommand's parser: only the chosen one pays for its values, and parsing needs
+        # no help text (fit's lists every model family; its --model check needs one).
+        self._resolve(("choices", "default"))
         return super().parse_known_args(args, namespace)
 
     def format_usage(self) -> str:

@@ -3,12 +3,15 @@
 A family is a sub-package ``hystkit/models/<folder>/`` exporting ``FAMILY``; a separately
 installed package can add one through the ``hystkit.families`` entry-point group (the value
 names a module exporting ``FAMILY``); code (a test, a notebook) can call :func:`register`.
-Discovery is lazy, so commands that never touch a model do not import any.
+Discovery is lazy, so commands that never touch a model do not import any, and looking up one
+name (``get_family``, ``name in FAMILIES``) imports only its own folder while nothing has been
+discovered or registered yet.
 """
 
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import pkgutil
 from collections.abc import Iterator, Mapping
 from importlib.metadata import entry_points
@@ -49,6 +52,28 @@ def _families() -> dict[str, Family]:
     if _found is None:
         _found = _discover()
     return _found
+
+
+def _own_folder(name: str) -> Family | None:
+    """The family `name` from its own folder (``mpl-g``: ``mpl_g``) before any discovery, or
+    None. Discovery gives a folder's family precedence over plugins, so this is the family it
+    would find; a command naming one model imports no other (~8 ms less, the entry points
+    unread)."""
+    folder = name.replace("-", "_")
+    if _found is not None or not folder.isidentifier() or folder.startswith("_"):
+        return None
+    spec = importlib.util.find_spec(f"{_PACKAGE}.{folder}")
+    if spec is None or spec.submodule_search_locations is None:  # not a sub-package
+        return None
+    module = importlib.import_module(spec.name)
+    family = getattr(module, "FAMILY", None)
+    if family is None or _check(family, module.__name__).name != name:
+        return None
+    return family
+
+
+def _lookup(name: str) -> Family | None:
+    return _own_folder(name) or _families().get(name)
 
 
 def register(family: Family) -> Family:
@@ -102,12 +127,11 @@ def get_family(name: str) -> Family:
     InputError
         An unknown name.
     """
-    families = _families()
-    try:
-        return families[name]
-    except KeyError:
+    family = _lookup(name)
+    if family is None:
         raise InputError(f"unknown model {name!r}; known models: "
-                         f"{', '.join(sorted(families))}") from None
+                         f"{', '.join(sorted(_families()))}")
+    return family
 
 
 def family_of(structure: object) -> Family:
@@ -139,7 +163,10 @@ class _Families(Mapping[str, Family]):
     """Read-only, lazily discovered view of the registry, sorted by name."""
 
     def __getitem__(self, name: str) -> Family:
-        return _families()[name]
+        family = _lookup(name) if isinstance(name, str) else None
+        if family is None:
+            raise KeyError(name)
+        return family
 
     def __iter__(self) -> Iterator[str]:
         return iter(sorted(_families()))
