@@ -98,7 +98,19 @@ def add_start_options(parser: argparse.ArgumentParser) -> None:
 
 
 def structure_options(args: argparse.Namespace, family: Any) -> dict:
-    """``{"limit": False}`` for ``--no-limit`` (printing its warning), else ``{}``.
+    """The structure options of ``--no-limit``, its warning printed on stderr.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed ``fit`` arguments (``no_limit``).
+    family : Family
+        The family to fit (its ``make_structure`` must take ``limit``).
+
+    Returns
+    -------
+    dict
+        ``{"limit": False}`` for ``--no-limit``, else ``{}``.
 
     Raises
     ------

@@ -124,8 +124,9 @@ def _fit(args: argparse.Namespace) -> int:
     print_cost_summary(info)
     print(f"  parameters: {comp.params.to_dict()}")
     _print_standard_errors(info.get("standard_errors"))
-    print(f"  training R² {info['training_r2']:.4f}, straight line {info['training_linear_r2']:.4f}"
-          f"; AIC {info['aic']:.1f}, BIC {info['bic']:.1f}; sensor polarity {comp.polarity:+g}")
+    print(f"  training R² {info['training_r2']:.4f}, straight line "
+          f"{info['training_linear_r2']:.4f}; AIC {info['aic']:.1f}, BIC {info['bic']:.1f}; "
+          f"sensor polarity {comp.polarity:+g}")
     if info.get("joint_fit"):
         print(f"  {info['joint_fit']}")
     for note in info.get("at_model_limits") or ():
@@ -467,9 +468,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     _add_centring_options(p)
     p.add_argument("--slope-cap", type=slope_cap, default=None,
                    help="models with an Euler slope cap (mpl, mpl-poly, mpl-g, pl, ladder, "
-                        "chua): cap on the step gain f'·dt of their non-linear elements, in [0.001, 2), "
-                        "default 1 (eq. 5.28-5.29; the ladder allows at most 1; each model's "
-                        "docs page says what it caps)")
+                        "chua): cap on the step gain f'·dt of their non-linear elements, in "
+                        "[0.001, 2), default 1 (eq. 5.28-5.29; the ladder allows at most 1; "
+                        "each model's docs page says what it caps)")
     p.add_argument("--p", type=number(1, low_open=True), default=None, metavar="P",
                    help="pl only: power p of the cells, > 1 (default 21; 'hystkit pl-search' "
                         "searches it)")

@@ -123,7 +123,8 @@ class MplParams(Record):
     Domain (checked here): ``I_S`` in ``I_S_RANGE`` (1e-12 .. 1e12), ``V_T`` in
     ``V_T_RANGE`` (1e-6 .. 1e12), ``|w_k|, |V_b| <= MAX_VALUE`` (1e6), at most ``MAX_CELLS``
     cells. With the limit (``MplStructure.limit``, the default) every Euler step moves a
-    cell towards its input (overshooting by at most ``slope_cap - 1`` of the gap), so ``|y| <= sum |w| B + |V_b|`` with
+    cell towards its input (overshooting by at most ``slope_cap - 1`` of the gap), so
+    ``|y| <= sum |w| B + |V_b|`` with
     ``B = max(max|x0|, max|u| max(1, slope_cap / (2 - slope_cap)))`` (:func:`output_bound`).
 
     The optimiser sees the vector ``[log G_1, log V_T1, ..., log G_N, log V_TN, w_0..w_N, V_b]``
