@@ -513,15 +513,45 @@ def test_fit_rejects_slope_cap_outside_0_2(cap: float, data: dict[str, Path], tm
                      tmp_path, "slope")
 
 
-@pytest.mark.parametrize("model", ["mpl-poly", "pl", "ladder", "chua"])
+CAPPED = ["mpl", "mpl-poly", "mpl-g", "pl", "ladder", "chua"]
+
+
+def test_capped_families_are_the_registry_s():
+    from hystkit.cli.cmd_core import has_slope_cap
+    from hystkit.models import FAMILIES, get_family
+
+    assert sorted(CAPPED) == sorted(n for n in FAMILIES if has_slope_cap(get_family(n)))
+
+
+@pytest.mark.parametrize("model", CAPPED)
 def test_fit_slope_cap_reaches_every_capped_family(model: str, data: dict[str, Path],
                                                    tmp_path: Path,
                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    import dataclasses
+
+    from hystkit.compensation import load_compensator
+    from hystkit.models import get_family
+
     out = tmp_path / "m.json"
-    code, _, err = _run(capsys, "fit", data["fit"], "--model", model, "--slope-cap", "0.5",
+    cap = 0.05  # far below the default 1: the cap binds for most parameter sets
+    code, _, err = _run(capsys, "fit", data["fit"], "--model", model, "--slope-cap", str(cap),
                         "--out", out)
     assert code in (0, 3), err  # 3: written, but a guard fired (not this test's concern)
-    assert json.loads(out.read_text(encoding="utf-8"))["structure"]["slope_cap"] == 0.5
+    assert json.loads(out.read_text(encoding="utf-8"))["structure"]["slope_cap"] == cap
+    # the model file loads with the structure the family builds with that cap ...
+    family, structure = get_family(model), load_compensator(out).structure
+    assert structure == family.make_structure(structure.dt, family.default_size, slope_cap=cap)
+    # ... and the cap acts in its runs: parameters drawn from the default cap's domain give
+    # another output under the loaded structure than under the default cap (the draws whose
+    # slopes stay below the cap run alike, so several are tried)
+    default = dataclasses.replace(structure, slope_cap=1.0)
+    u = np.sin(2 * np.pi * 0.2 * structure.dt * np.arange(2000))
+    changes = []
+    for seed in range(5):
+        params = family.random_params(default, np.random.default_rng(seed))
+        capped, free = (family.simulate(s, params, u)[0] for s in (structure, default))
+        changes.append(np.max(np.abs(capped - free)) / np.max(np.abs(free)))
+    assert max(changes) > 1e-2, changes
 
 
 @pytest.mark.parametrize("model", ["bobbio", "preisach"])
