@@ -454,7 +454,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("data", type=Path, nargs="+",
                    help="recording(s): time, position, sensor (CSV/Parquet/.mat); several are "
                         "fitted jointly, each with its own initial state and tare")
-    deferred(p.add_argument("--model", default="mpl"), choices=lambda: sorted(_families()),
+    # The registry's mapping as the choices: checking a name imports that family only.
+    deferred(p.add_argument("--model", default="mpl"), choices=_families,
              help=lambda: "; ".join(f"{f.name}: {f.title}" for f in _families().values()))
     deferred(p.add_argument("--cells", "--size", type=positive_int, default=None),
              help=lambda: "model size: " + "; ".join(f"{f.name}: {f.size_help} (default "
