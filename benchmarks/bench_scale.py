@@ -1,6 +1,7 @@
 """Scaling of the parallel searches and of ``hystkit batch`` (issue 13).
 
-Run:  python benchmarks/bench_scale.py [--repeats N] [--small] [--out FILE]
+Run:  python benchmarks/bench_scale.py [--repeats N] [--small] [--searches-only] [--tasks]
+                                      [--out FILE]
       (writes benchmarks/last_run_scale.txt unless --out names another file)
 
 Whole-process wall time, from starting ``python -m hystkit ...`` to its exit (what a user
@@ -18,6 +19,10 @@ waits for: start-up, reading, the work, writing), of
   (``max(longest, sum / 2)``, the critical path of a longest-first schedule's bound);
 - one long fit's multi-start (Bouc-Wen, Chua and PL on 8000 samples) serially and with a
   2-worker executor open, where its starts are screened on the workers;
+- one traced run of each search at 1 and 2 workers (`TRACE`): where its wall time goes, from
+  the launch to the exit: start-up, imports and reading, opening the executor, the first
+  piece's start, each piece on each process (``--tasks`` lists them), the idle tail, and what
+  follows the map (refit, writing, exit), with the main process's CPU before, during and after;
 - a fleet of 20 virtual sensors (different seeds; a fit and a validation recording each)
   through ``hystkit batch`` at 1 and 2 workers, against a shell loop that runs ``hystkit fit``
   and ``hystkit evaluate`` for each sensor (the same work: fit, model file, scores).
