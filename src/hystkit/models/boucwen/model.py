@@ -50,7 +50,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import resample_poly
 
 from ...errors import FitDivergedError
 from .._protocol import Record
@@ -572,6 +571,9 @@ def bandlimited_upsample(u: np.ndarray, factor: int, periodic: bool) -> np.ndarr
     if factor == 1:
         return u.copy()
     if not periodic:
+        # here: scipy.signal costs ~1 s to import, and only this input hold needs it
+        from scipy.signal import resample_poly
+
         return resample_poly(u, factor, 1, window=("kaiser", 10.0))
     n = u.size
     spectrum = np.zeros(n * factor // 2 + 1, dtype=complex)
