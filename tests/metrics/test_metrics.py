@@ -263,3 +263,25 @@ def test_sinad_rejects_bad_input() -> None:
         sinad_db(np.ones(1024))
     with pytest.raises(ValueError, match="sinad_db needs at least"):
         sinad_db(np.sin(np.arange(60.0)))
+
+
+@pytest.mark.parametrize("n", [4000, 4001, 64])
+def test_kaiser_periodogram_is_scipys(n: int) -> None:
+    from scipy.signal import periodogram
+
+    from hystkit.metrics._metrics import kaiser_periodogram
+
+    x = np.random.default_rng(n).standard_normal(n) + np.sin(np.arange(n) * 0.3)
+    _, want = periodogram(x, fs=40.0, window=("kaiser", 38.0), detrend=False)
+    assert_allclose(kaiser_periodogram(x, 40.0, 38.0), want, rtol=1e-10,
+                    atol=1e-12 * want.max())
+
+
+def test_loop_area_trapezoid_is_scipys() -> None:
+    from scipy.integrate import trapezoid
+
+    t = np.linspace(0, 6 * np.pi, 1000)
+    x, y = np.sin(t), np.sin(t - 0.4)
+    x_hat, y_hat = (x - x.min()) / np.ptp(x), (y - y.min()) / np.ptp(y)
+    # three cycles: sweeps of height 1 up and down
+    assert_allclose(loop_area(x, y), 100.0 / 3.0 * trapezoid(y_hat, x_hat), rtol=1e-12)
