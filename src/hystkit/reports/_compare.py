@@ -98,7 +98,7 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
                    executor: Executor | None = None) -> dict:
     """Fit every model on ``fit_rec`` and score it on ``val_rec``.
 
-    Each family is two pieces of work for `executor` (default: serial), its forward model and
+    Each family is one piece of work for `executor` (default: serial): its forward model and
     its direct compensator; the table is the same whichever executor ran them.
 
     Parameters
@@ -136,27 +136,31 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
     check_fitting_data([fit_rec])
     check_excursion([val_rec])
     models = sorted(FAMILIES) if models is None else list(models)
-    pieces = [(name, (sizes or {}).get(name), part) for name in models
-              for part in ("forward", "direct")]
-    waiting = {name: 2 for name in models}
+    # One piece per family, its two fits together: a worker then loads one family's compiled
+    # kernels once, where two pieces of the same family on two workers loaded them twice.
+    pieces = [(name, (sizes or {}).get(name)) for name in models]
+    n_done = 0
 
     def done(i: int, _: dict) -> None:
-        name = pieces[i][0]
-        waiting[name] -= 1
-        if not waiting[name]:
-            progress(f"  {name}: fitted and scored ({sum(not n for n in waiting.values())}/"
-                     f"{len(models)})")
+        nonlocal n_done
+        n_done += 1
+        progress(f"  {pieces[i][0]}: fitted and scored ({n_done}/{len(models)})")
 
     results = (executor or SerialExecutor()).map(
-        _compare_piece, pieces, shared={"fit_rec": fit_rec, "val_rec": val_rec}, on_done=done,
-        cost=lambda piece: fit_cost(piece[0], piece[1], fit_rec.sensor.size))
-    table = {}
-    for k, name in enumerate(models):
-        forward, direct = results[2 * k], results[2 * k + 1]
-        # the forward fit's error first, as when the two ran one after the other
-        table[name] = next((part for part in (forward, direct) if "error" in part),
-                           {**forward, **direct})
-    return table
+        _compare_family, pieces, shared={"fit_rec": fit_rec, "val_rec": val_rec},
+        on_done=done, cost=lambda piece: 2 * fit_cost(piece[0], piece[1], fit_rec.sensor.size))
+    return dict(zip(models, results, strict=True))
+
+
+def _compare_family(piece: tuple[str, int | None], *, fit_rec: Recording,
+                    val_rec: Recording) -> dict:
+    """One family's forward scores and its direct compensator's, or the first ``error``
+    (the forward fit's, as when the two ran one after the other)."""
+    name, size = piece
+    forward, direct = (_compare_piece((name, size, part), fit_rec=fit_rec, val_rec=val_rec)
+                       for part in ("forward", "direct"))
+    return next((part for part in (forward, direct) if "error" in part),
+                {**forward, **direct})
 
 
 def _compare_piece(piece: tuple[str, int | None, str], *, fit_rec: Recording,
