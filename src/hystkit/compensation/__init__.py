@@ -11,6 +11,7 @@ __getattr__, __dir__ = lazy_exports(
     {"_adaptive": ("ADAPT_PARAMETERS", "Adaptation", "AdaptiveState", "AdaptiveStream",
                    "advance_adaptive"),
      "_refit": ("Refit", "RefitReport", "RefittingStream"),
+     "_param_vector": ("named_floats",),
      "_centring": ("CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",
                    "DEPLOYABLE_CENTERS", "ORACLE_CENTER", "center_label"),
      "_modes": ("MODES",),

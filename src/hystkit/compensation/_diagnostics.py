@@ -15,7 +15,7 @@ import numpy as np
 from ..identification import FitResult
 from ..metrics import r2
 from ..models import Family
-from ._param_vector import flatten_params
+from ._param_vector import flatten_params, named_floats
 
 __all__ = ["BOUND_TOLERANCE", "COLLAPSE_RATIO", "MIN_SAMPLES_PER_PARAM", "bound_flags",
            "error_steps", "errors_from_factor", "fit_status", "fixed_mask", "parameter_names",
@@ -62,20 +62,7 @@ def standard_errors(residual: Callable[[np.ndarray], np.ndarray], params: Any,
 def parameter_names(params: Any) -> list[str]:
     """Names of the float entries of ``params.to_dict()`` in :func:`flatten_params` order
     (depth first: ``w[1]``, ``v_b``; nested lists ``a[0][2]``)."""
-    names: list[str] = []
-
-    def walk(value: object, name: str) -> None:
-        if isinstance(value, dict):
-            for key, item in value.items():
-                walk(item, f"{name}.{key}" if name else str(key))
-        elif isinstance(value, list | tuple):
-            for i, item in enumerate(value):
-                walk(item, f"{name}[{i}]")
-        elif isinstance(value, float):
-            names.append(name)
-
-    walk(params.to_dict(), "")
-    return names
+    return [name for name, _ in named_floats(params.to_dict())]
 
 
 def fixed_mask(family: Family, structure: Any, params: Any) -> np.ndarray:

@@ -12,16 +12,39 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["flatten_params", "simulate_segments"]
+__all__ = ["flatten_params", "named_floats", "simulate_segments"]
+
+
+def named_floats(tree: Any, name: str = "") -> list[tuple[str, float]]:
+    """``(name, value)`` of the float leaves of a nested dict / list tree, depth first.
+
+    The order of :func:`flatten_params` (lists may be ragged); names as ``w[1]``, ``v_b``,
+    ``a[0][2]``, a nested dict's keys joined by dots.
+
+    Parameters
+    ----------
+    tree : dict, list, tuple or scalar
+        E.g. ``params.to_dict()``.
+    name : str, default ""
+        Name of `tree` itself (a prefix of its leaves' names).
+
+    Returns
+    -------
+    list of (str, float)
+        One entry per float leaf; integers and booleans are structural and left out.
+    """
+    if isinstance(tree, dict):
+        return [leaf for key, value in tree.items()
+                for leaf in named_floats(value, f"{name}.{key}" if name else str(key))]
+    if isinstance(tree, list | tuple):
+        return [leaf for i, value in enumerate(tree)
+                for leaf in named_floats(value, f"{name}[{i}]")]
+    return [(name, float(tree))] if isinstance(tree, float) else []
 
 
 def _floats(tree: Any) -> list[float]:
     """Float leaves of a nested dict / list tree, depth first (lists may be ragged)."""
-    if isinstance(tree, dict):
-        return [x for v in tree.values() for x in _floats(v)]
-    if isinstance(tree, list | tuple):
-        return [x for v in tree for x in _floats(v)]
-    return [float(tree)] if isinstance(tree, float) else []
+    return [value for _, value in named_floats(tree)]
 
 
 def _replace_floats(tree: Any, values: Iterator[float]) -> Any:

@@ -17,6 +17,7 @@ from pathlib import Path
 from matplotlib.figure import Figure
 
 from ..compensation import Compensator, center_label, evaluate, load_compensator
+from ..compensation import named_floats as named_parameters  # the standard errors' order
 from ..io import Recording
 from ._figures import DEFAULT_SENSOR_LABEL, plot_loops, plot_time_series
 from ._html import Section, definition_list, figure_png, note, paragraph, png_block, table
@@ -67,25 +68,6 @@ class ReportContent:
             raise ValueError(f"two figures named {name!r}")
         self.pngs[name] = png
         section.add(png_block(png, caption))
-
-
-def named_parameters(params: dict) -> list[tuple[str, float]]:
-    """``(name, value)`` of the float entries of ``params.to_dict()``, in the order the fit's
-    standard errors use (depth first: ``w[1]``, ``v_b``; nested lists ``a[0][2]``)."""
-    found: list[tuple[str, float]] = []
-
-    def walk(value: object, name: str) -> None:
-        if isinstance(value, dict):
-            for key, item in value.items():
-                walk(item, f"{name}.{key}" if name else str(key))
-        elif isinstance(value, list | tuple):
-            for i, item in enumerate(value):
-                walk(item, f"{name}[{i}]")
-        elif isinstance(value, float):
-            found.append((name, value))
-
-    walk(params, "")
-    return found
 
 
 def _provenance(comp: Compensator, model_path: Path | None, version: str | None) -> Section:
