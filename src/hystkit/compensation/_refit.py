@@ -44,7 +44,7 @@ from ._stream import (
     StreamState,
     _advance,
     _Path,
-    _sensor_offset,
+    advance_scaled,
     initial_state,
 )
 
@@ -248,9 +248,7 @@ class RefittingStream:
         """The plain stream over one part, and the window's buffers updated."""
         path, state = self._path, self._state
         comp = path.comp
-        offset, _ = _sensor_offset(path, state, s_raw)  # as _advance, the same bits
-        s = comp.polarity * (s_raw - offset) / comp.scaling.sensor_scale
-        out, self._state = _advance(path, state, s_raw, self.label)
+        out, self._state, s = advance_scaled(path, state, s_raw, self.label)
         p = (r - path.position_offset) / comp.scaling.position_scale
         self._push(s, p)
         n_refs = int(np.isfinite(r).sum())

@@ -250,11 +250,19 @@ def advance(comp: Compensator, state: StreamState, sensor: np.ndarray, *,
 
 def _advance(path: _Path, state: StreamState, sensor: np.ndarray,
              label: str) -> tuple[StreamOutput, StreamState]:
+    out, nxt, _ = advance_scaled(path, state, sensor, label)
+    return out, nxt
+
+
+def advance_scaled(path: _Path, state: StreamState, sensor: np.ndarray,
+                   label: str) -> tuple[StreamOutput, StreamState, np.ndarray]:
+    """`_advance`, and the centred, scaled sensor the model ran on (what a window re-fit on
+    the stream's own input needs, without centring the part a second time)."""
     comp = path.comp
     s_raw = np.ascontiguousarray(sensor, dtype=np.float64).reshape(-1)
     if s_raw.size == 0:
         empty = np.empty(0)
-        return StreamOutput(empty, *_flags(path, empty, empty)), state
+        return StreamOutput(empty, *_flags(path, empty, empty)), state, empty
     offset, centring = _sensor_offset(path, state, s_raw)
     s = comp.polarity * (s_raw - offset) / comp.scaling.sensor_scale
     with np.errstate(over="ignore", invalid="ignore"):
@@ -268,7 +276,7 @@ def _advance(path: _Path, state: StreamState, sensor: np.ndarray,
         estimate = p * comp.scaling.position_scale + path.position_offset
     _check_runaway(comp, p, estimate, state.n_samples, label)
     nxt = StreamState(x_end, state.n_samples + s.size, **centring)
-    return StreamOutput(estimate, *_flags(path, s, estimate)), nxt
+    return StreamOutput(estimate, *_flags(path, s, estimate)), nxt, s
 
 
 def _run_model(comp: Compensator, s: np.ndarray,
