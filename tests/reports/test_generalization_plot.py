@@ -35,3 +35,43 @@ def test_every_cell_shows_its_r2_and_failures_say_so():
     texts = [t.get_text() for t in fig.axes[0].texts]
     assert texts == ["0.999", "0.876", "-2390.000", "fail"]
     assert np.ma.is_masked(fig.axes[0].images[0].get_array()[1, 1])
+
+
+def _long_named_matrix() -> dict:
+    """Four models on three recordings, one with a long file name (rows and columns)."""
+    names = ["sine", "lab_run_2024-11-03_slow_sweep", "noise"]
+    grid = {a: {b: 0.99 if a == b else 0.8 for b in names} for a in names}
+    return {model: {"r2": grid} for model in ("mpl", "pi", "ladder", "preisach")}
+
+
+def _drawn_boxes(fig):
+    """Each axes' extent with its labels, title and tick labels (pixels), and the figure's."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    return [ax.get_tightbbox(renderer) for ax in fig.axes], fig.bbox, renderer
+
+
+def test_labels_stay_in_the_figure_and_off_the_other_panels():
+    # the layout is computed without drawing: check it against the drawn figure
+    for matrix in (MATRIX, _long_named_matrix()):
+        fig = plot_generalization(matrix)
+        boxes, page, _ = _drawn_boxes(fig)
+        assert len(boxes) == len(matrix) + 1  # the panels and the colour bar
+        for box in boxes:
+            assert page.x0 <= box.x0 and box.x1 <= page.x1
+            assert page.y0 <= box.y0 and box.y1 <= page.y1
+        for i, a in enumerate(boxes):
+            assert not any(a.overlaps(b) for b in boxes[i + 1:])
+
+
+def test_long_column_names_stand_upright_without_overlapping():
+    fig = plot_generalization(_long_named_matrix())
+    _, _, renderer = _drawn_boxes(fig)
+    for ax in fig.axes[:-1]:
+        labels = [t.get_window_extent(renderer) for t in ax.get_xticklabels()]
+        assert all(t.get_rotation() == 90 for t in ax.get_xticklabels())
+        assert not any(a.overlaps(b) for i, a in enumerate(labels) for b in labels[i + 1:])
+    # short names stay level, as in the default four-excitation figure
+    assert all(t.get_rotation() == 0 for t in plot_generalization(MATRIX).axes[0]
+               .get_xticklabels())

@@ -7,10 +7,9 @@ the same data, with table 2.1's properties measured on the fitted model.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.colors import LogNorm
-from matplotlib.figure import Figure
 
 from ..compensation import (
     centre_and_scale,
@@ -25,6 +24,9 @@ from ..metrics import e_max_pct, e_rms_pct, r2
 from ..models import FAMILIES, get_family
 from ..parallel import Executor, SerialExecutor, fit_cost
 from ._properties import measure_properties
+
+if TYPE_CHECKING:  # matplotlib loads in plot_generalization: compare draws nothing (~0.3 s)
+    from matplotlib.figure import Figure
 
 __all__ = ["compare_models", "format_compare", "generalization_matrix", "plot_generalization"]
 
@@ -281,20 +283,23 @@ def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
     Returns
     -------
     matplotlib.figure.Figure
-        Up to three panels a row, one per model, with a shared colour bar.
+        Up to three panels a row, one per model, with a shared colour bar on the right.
     """
-    n_cols = min(3, len(matrix))
-    n_rows = -(-len(matrix) // n_cols)
-    fig = Figure(figsize=(3.6 * n_cols, 3.2 * n_rows), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(n_rows, n_cols)).ravel()
-    for ax in axes[len(matrix):]:
-        ax.set_axis_off()
+    from matplotlib.colors import LogNorm
+    from matplotlib.figure import Figure
+
     grids = {name: _r2_grid(entry["r2"]) for name, entry in matrix.items()}
+    layout = _PanelLayout.fit(
+        len(matrix), [label for rows, _, _ in grids.values() for label in rows],
+        [label for _, names, _ in grids.values() for label in names],
+        max((len(names) for _, names, _ in grids.values()), default=1))
+    fig = Figure(figsize=layout.figsize)
     worst = max([np.nanmax(1 - v) for _, _, v in grids.values() if np.isfinite(v).any()],
                 default=1.0)
     norm = LogNorm(vmin=_UNEXPLAINED_FLOOR, vmax=max(1.0, worst))
     image = None
-    for ax, (name, (rows, names, values)) in zip(axes, grids.items()):
+    for k, (name, (rows, names, values)) in enumerate(grids.items()):
+        ax = fig.add_axes(layout.panel(k))
         unexplained = np.clip(1 - values, _UNEXPLAINED_FLOOR, None)
         image = ax.imshow(unexplained, norm=norm, cmap="viridis_r")
         for i in range(len(rows)):
@@ -306,10 +311,78 @@ def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
         ax.set(xticks=range(len(names)), xticklabels=names, yticks=range(len(rows)),
                yticklabels=rows, xlabel="tested on", ylabel="trained on",
                title=f"{name} (deployable R²)")
+        ax.tick_params(axis="x", labelrotation=layout.column_rotation)
     if image is not None:
-        fig.colorbar(image, ax=list(axes[:len(matrix)]), shrink=0.8,
-                     label="1 - R² (log scale; 1: no better than the mean)")
+        fig.colorbar(image, cax=fig.add_axes(layout.colour_bar()),
+                     label="1 - R² (log scale)\n1: no better than the mean")
     return fig
+
+
+class _PanelLayout:
+    """Where the generalisation figure's panels and colour bar go, worked out once from the
+    fonts' sizes and the longest recording names (no drawing): up to three panels a row, each
+    a 2.7 x 2.2 in axes box (the image square inside it) with room for its labels, and the
+    colour bar on the right. Matplotlib's constrained layout found such places by drawing the
+    figure an extra time: ~0.5 s of the ~1 s that saving the 10-model figure took, serial work
+    after ``generalize``'s parallel map."""
+
+    AXES = (2.7, 2.2)  # inches of a panel's axes box; the labels go around it
+    BAR_SPACE = 1.4  # inches right of the panels: the colour bar, its ticks and its label
+    PAD = 0.1  # inches between a panel's labels and the next panel or the figure's edge
+
+    def __init__(self, n_panels: int, margins: tuple[float, float, float],
+                 column_rotation: float):
+        self.n_cols = min(3, max(n_panels, 1))
+        self.n_rows = max(-(-n_panels // self.n_cols), 1)
+        self.left, self.bottom, self.top = margins
+        self.column_rotation = column_rotation
+        self.cell = (self.left + self.AXES[0] + self.PAD, self.bottom + self.AXES[1] + self.top)
+        self.figsize = (self.cell[0] * self.n_cols + self.BAR_SPACE, self.cell[1] * self.n_rows)
+
+    @classmethod
+    def fit(cls, n_panels: int, row_labels: Sequence[str], column_labels: Sequence[str],
+            n_columns: int) -> _PanelLayout:
+        """Margins that hold the longest of `row_labels` (tick labels left of a panel) and of
+        `column_labels` (below it, turned upright when wider than a column of `n_columns`)."""
+        import matplotlib as mpl
+        from matplotlib.font_manager import FontProperties
+        from matplotlib.textpath import TextToPath
+
+        rc, measure = mpl.rcParams, TextToPath()
+
+        def extent(texts: Sequence[str], size: str | float) -> tuple[float, float]:
+            """Widest width and one line's height of `texts` at font `size` [points]."""
+            font = FontProperties(size=size)
+            widths = [measure.get_text_width_height_descent(t, font, ismath=False)[0]
+                      for t in texts]
+            line = measure.get_text_width_height_descent("Tg", font, ismath=False)[1] * 1.2
+            return max(widths, default=0.0), line
+
+        label = extent([], rc["axes.labelsize"])[1] + rc["axes.labelpad"]
+        ticks = max(rc["ytick.major.size"], rc["xtick.major.size"]) + max(
+            rc["ytick.major.pad"], rc["xtick.major.pad"])
+        row_width, _ = extent(row_labels, rc["ytick.labelsize"])
+        column_width, line = extent(column_labels, rc["xtick.labelsize"])
+        # A column's share of the image (square cells in the axes box's height) [points]
+        upright = column_width > 0.9 * 72 * cls.AXES[1] / max(n_columns, 1)
+        bottom = label + ticks + (column_width if upright else line)
+        top = extent([], rc["axes.titlesize"])[1] + rc["axes.titlepad"]
+        margins = (cls.PAD + (label + ticks + row_width) / 72, cls.PAD + bottom / 72,
+                   cls.PAD + top / 72)
+        return cls(n_panels, margins, 90.0 if upright else 0.0)
+
+    def panel(self, k: int) -> tuple[float, float, float, float]:
+        """Axes rectangle (left, bottom, width, height; figure fractions) of panel `k`, row by
+        row from the top left."""
+        (width, height), (cell_w, cell_h) = self.figsize, self.cell
+        x0 = (k % self.n_cols) * cell_w + self.left
+        y0 = (self.n_rows - 1 - k // self.n_cols) * cell_h + self.bottom
+        return x0 / width, y0 / height, self.AXES[0] / width, self.AXES[1] / height
+
+    def colour_bar(self) -> tuple[float, float, float, float]:
+        """The colour bar's rectangle: 0.2 in wide, 80 % of the figure's height, centred."""
+        width = self.figsize[0]
+        return (self.cell[0] * self.n_cols + 0.25) / width, 0.1, 0.2 / width, 0.8
 
 
 # 1 - R² below this (R² above 0.9999) shows as the best colour
