@@ -1,7 +1,7 @@
 """Scaling of the parallel searches and of ``hystkit batch`` (issue 13).
 
 Run:  python benchmarks/bench_scale.py [--repeats N] [--small] [--searches-only] [--tasks]
-                                      [--out FILE]
+                                      [--commands compare,generalize,...] [--out FILE]
       (writes benchmarks/last_run_scale.txt unless --out names another file)
 
 Whole-process wall time, from starting ``python -m hystkit ...`` to its exit (what a user
@@ -33,7 +33,9 @@ and the median of the per-repeat speed-ups. Wall and CPU time (user + system of 
 and its workers) are both given: on a shared machine the wall time carries the other jobs'
 load, and CPU 1 / CPU 2 (the work the serial run does over what the parallel one does, 1.00 =
 no parallel overhead) is the figure that load changes least. ``--small``: 4000-sample recordings, 8 sensors, ``generalize`` on the two recordings,
-fewer select candidates (a quick check, not the issue's numbers).
+fewer select candidates (a quick check, not the issue's numbers). ``--commands compare,generalize``:
+only those commands (their pieces, repeats and traces; the shell loop, the in-process breakdown
+and the multi-start run only with ``batch``).
 """
 
 from __future__ import annotations
@@ -108,6 +110,8 @@ runs = {"compare": lambda ex: compare_models(fit, val, executor=ex),
         "select": lambda ex: select_model([fit], candidates(select_models), executor=ex)}
 report = {}
 for name, run in runs.items():
+    if name not in ONLY:
+        continue
     ex = Timed(); ex.pieces = []
     c0 = time.process_time()
     run(ex)
@@ -350,6 +354,9 @@ def main() -> None:
                              "in-process breakdown or multi-start)")
     parser.add_argument("--tasks", action="store_true",
                         help="list every piece of the traced runs (start, end, process)")
+    parser.add_argument("--commands", type=lambda text: text.split(","), metavar="NAMES",
+                        help="only these of compare, generalize, select, batch (comma-separated; "
+                             "default: all that the other options leave)")
     parser.add_argument("--out", type=Path, default=Path(__file__).with_name(
         "last_run_scale.txt"), help="also write the report here (default: %(default)s)")
     args = parser.parse_args()
@@ -357,6 +364,11 @@ def main() -> None:
     commands = _commands(args.small)
     if args.searches_only:
         del commands["batch"]
+    if args.commands:
+        unknown = set(args.commands) - set(commands)
+        if unknown:
+            parser.error(f"--commands: unknown {', '.join(sorted(unknown))}")
+        commands = {name: argv for name, argv in commands.items() if name in args.commands}
     times: dict[str, list[tuple[float, float]]] = {}
     timelines: dict[str, dict] = {}
     load_before = os.getloadavg()
@@ -364,11 +376,12 @@ def main() -> None:
         cwd = Path(tmp)
         (cwd / "loop").mkdir()
         _recordings(cwd, n_samples, n_sensors)
-        pieces = _python(PIECES.replace("SMALL", str(args.small)), cwd)
+        pieces = _python(PIECES.replace("SMALL", str(args.small)).replace(
+            "ONLY", repr(list(commands))), cwd)
         print("pieces timed", file=sys.stderr, flush=True)
         for repeat in range(args.repeats):
             order = ("1", "2") if repeat % 2 == 0 else ("2", "1")
-            if not args.searches_only:
+            if "batch" in commands:  # the shell loop, in-process breakdown, multi-start
                 times.setdefault("shell loop", []).append(_run(["bash", "loop.sh"], cwd))
                 for workers in order:
                     for part, seconds in _python(BREAKDOWN, cwd, workers).items():
@@ -384,7 +397,7 @@ def main() -> None:
                     times.setdefault(f"{name} @{workers}", []).append(
                         _run([*argv, "--workers", workers], cwd))
             print(f"repeat {repeat + 1}/{args.repeats} done", file=sys.stderr, flush=True)
-        for name in ("compare", "generalize", "select"):
+        for name in [name for name in commands if name != "batch"]:
             for workers in ("1", "2"):
                 timelines[f"{name} @{workers}"] = _timeline(_trace(
                     cwd, [*commands[name][3:], "--workers", workers]))
