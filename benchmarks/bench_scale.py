@@ -173,6 +173,8 @@ def log(kind, label, t0, t1=None, **extra):
 
 log("phase", "interpreter", launch, T_SCRIPT)
 from hystkit.cli import _main
+if not any(os.environ.get(name) for name in _main._BLAS_THREAD_VARIABLES):
+    os.environ["OPENBLAS_NUM_THREADS"] = "1"  # as the program's main() does, before numpy loads
 import hystkit.identification._least_squares as least_squares
 import hystkit.parallel as parallel
 import hystkit.parallel._executor as executors
@@ -226,10 +228,11 @@ def traced_screen(solve, thetas, budget):
                 cpu=time.thread_time() - c0)
 least_squares._screen = traced_screen
 import contextlib, io
+sys.argv = ["hystkit", *args]  # main() reading sys.argv runs as the program does (its GC tuning)
 t_main = time.time()
 try:
     with contextlib.redirect_stdout(io.StringIO()):
-        _main.main(args)
+        _main.main()
 finally:
     log("phase", "main", t_main, time.time(), cpu_after=time.process_time())
 """
