@@ -75,3 +75,15 @@ def test_long_column_names_stand_upright_without_overlapping():
     # short names stay level, as in the default four-excitation figure
     assert all(t.get_rotation() == 0 for t in plot_generalization(MATRIX).axes[0]
                .get_xticklabels())
+
+
+def test_colour_bar_labels_each_decade_as_a_power_of_ten():
+    fig = plot_generalization(MATRIX)  # 1 - R² from 1e-4 to 2391
+    _drawn_boxes(fig)  # tick labels get their text when drawn
+    bar = fig.axes[-1]
+    shown = {round(np.log10(tick)): label.get_text()
+             for tick, label in zip(bar.get_yticks(), bar.get_yticklabels())
+             if bar.get_ylim()[0] <= tick <= bar.get_ylim()[1]}
+    assert shown == {-4: "10⁻⁴", -3: "10⁻³", -2: "10⁻²", -1: "10⁻¹", 0: "10⁰", 1: "10¹",
+                     2: "10²", 3: "10³"}
+    assert bar.yaxis.get_minorticklocs().size == 0

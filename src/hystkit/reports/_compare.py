@@ -287,6 +287,7 @@ def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
     """
     from matplotlib.colors import LogNorm
     from matplotlib.figure import Figure
+    from matplotlib.ticker import FuncFormatter
 
     grids = {name: _r2_grid(entry["r2"]) for name, entry in matrix.items()}
     layout = _PanelLayout.fit(
@@ -313,9 +314,25 @@ def plot_generalization(matrix: Mapping[str, dict]) -> Figure:
                title=f"{name} (deployable R²)")
         ax.tick_params(axis="x", labelrotation=layout.column_rotation)
     if image is not None:
-        fig.colorbar(image, cax=fig.add_axes(layout.colour_bar()),
-                     label="1 - R² (log scale)\n1: no better than the mean")
+        bar = fig.colorbar(image, cax=fig.add_axes(layout.colour_bar()),
+                           label="1 - R² (log scale)\n1: no better than the mean")
+        # Decades as plain text (10⁻⁴), without minor ticks: matplotlib's default 10^-4 labels
+        # set up its maths typesetter, ~0.14 s of the figure's first drawing, and its minor
+        # ticks ~0.08 s more
+        bar.ax.yaxis.set_major_formatter(FuncFormatter(_decade_label))
+        bar.minorticks_off()
     return fig
+
+
+_SUPERSCRIPTS = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def _decade_label(value: float, _position: int) -> str:
+    """``10⁻⁴`` for 1e-4 and the other powers of ten; nothing between them."""
+    exponent = round(np.log10(value)) if value > 0 else None
+    if exponent is None or not np.isclose(value, 10.0 ** exponent, rtol=1e-9):
+        return ""
+    return "10" + str(exponent).translate(_SUPERSCRIPTS)
 
 
 class _PanelLayout:
