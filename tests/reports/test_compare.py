@@ -7,6 +7,8 @@ import numpy as np
 import pytest
 
 from hystkit.cli import main
+from hystkit.io import Recording
+from hystkit.parallel import SerialExecutor
 from hystkit.reports._compare import compare_models, generalization_matrix
 from hystkit.reports._properties import measure_properties
 from hystkit.sensors import simulate_experiment
@@ -85,3 +87,38 @@ def test_compare_cli_writes_json(tmp_path, capsys):
             "e_max_pct"} <= set(table["mpl"])
     assert main(["compare", str(f), str(v), "--models", "nope"]) == 2
     assert "unknown model(s) nope" in capsys.readouterr().err
+
+
+class _Recorded(SerialExecutor):
+    """Runs the pieces here, as the serial executor, and keeps them; claims `n_workers`."""
+
+    def __init__(self, n_workers: int):
+        self.n_workers, self.pieces = n_workers, []
+
+    def map(self, func, items, **kwargs):
+        self.pieces.append(list(items))
+        return super().map(func, items, **kwargs)
+
+
+def test_generalize_pieces_whole_models_unless_one_outweighs_a_worker():
+    def head(rec: Recording) -> Recording:  # 50 s: the fits take a moment
+        return Recording(time=rec.time[:2000], sensor=rec.sensor[:2000],
+                         position=rec.position[:2000], source=rec.source)
+
+    train = {n: head(simulate_experiment(n, 1)) for n in ("sine", "noise")}
+    test = {n: head(simulate_experiment(n, 2)) for n in ("noise", "sine")}
+    models = ["mpl", "pi", "bobbio", "mpl-g"]
+    runs = {n: _Recorded(n) for n in (1, 2, 8)}
+    matrices = {n: generalization_matrix(train, test, models, {"mpl": 1}, executor=ex)
+                for n, ex in runs.items()}
+    # 1 or 2 workers: no model holds half the estimated work, so one piece per model (a
+    # worker loads its kernels once); 8 workers: each model's share is over 1/8, so one piece
+    # per model and training recording
+    for n in (1, 2):
+        assert runs[n].pieces == [[(m, 1 if m == "mpl" else None, ("sine", "noise"))
+                                   for m in models]]
+    assert runs[8].pieces == [[(m, 1 if m == "mpl" else None, (t,)) for m in models
+                               for t in ("sine", "noise")]]
+    # the same matrix, to the order of every key, whichever way the work was cut
+    assert json.dumps(matrices[1]) == json.dumps(matrices[2]) == json.dumps(matrices[8])
+    assert list(matrices[8]["pi"]["r2"]["noise"]) == ["noise", "sine"]

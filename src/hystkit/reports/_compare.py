@@ -193,8 +193,10 @@ def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Rec
                           executor: Executor | None = None) -> dict:
     """Train a direct compensator on each training recording, test it on every test recording.
 
-    One piece of work for `executor` (default: serial) per model and training recording: its
-    fit and its tests; the matrix is the same whichever executor ran them.
+    One piece of work for `executor` (default: serial) per model, its fits on every training
+    recording and their tests, so that a worker loads a family's kernels once; or per model
+    and training recording when one model's share of the estimated work (`fit_cost`) is more
+    than a worker's share of all of it. The matrix is the same whichever executor ran them.
 
     Parameters
     ----------
@@ -221,25 +223,43 @@ def generalization_matrix(train: Mapping[str, Recording], test: Mapping[str, Rec
         gives None and its reason in ``errors``, as does a collapsed fit or one worse than its
         line (its scores are kept); parameters on bounds or an exhausted budget are ``notes``.
     """
+    executor = executor or SerialExecutor()
     train, test = dict(train), dict(test)
-    pieces = [(name, (sizes or {}).get(name), train_name) for name in models
-              for train_name in train]
-    results = (executor or SerialExecutor()).map(
-        _generalize_piece, pieces, shared={"train": train, "test": test},
-        on_done=lambda i, _: progress(f"  {pieces[i][0]}: trained on {pieces[i][2]}"),
-        cost=lambda piece: fit_cost(piece[0], piece[1], train[piece[2]].sensor.size))
-    out = {}
-    for name in models:
-        grids = {key: {} for key in GRID_KEYS}
-        errors, notes = {}, {}
-        for (model, _, train_name), (rows, row_errors, row_notes) in zip(pieces, results):
-            if model == name:
-                for key in GRID_KEYS:
-                    grids[key][train_name] = rows[key]
-                errors.update(row_errors)
-                notes.update(row_notes)
-        out[name] = {**grids, "errors": errors, "notes": notes}
+
+    def cost(piece: tuple[str, int | None, tuple[str, ...]]) -> float:
+        return sum(fit_cost(piece[0], piece[1], train[t].sensor.size) for t in piece[2])
+
+    whole = [(name, (sizes or {}).get(name), tuple(train)) for name in models]
+    total = sum(cost(piece) for piece in whole)
+    if max(map(cost, whole), default=0.0) <= total / executor.n_workers:
+        pieces = whole
+    else:  # e.g. one model: its recordings on several workers
+        pieces = [(name, size, (t,)) for name, size, names in whole for t in names]
+
+    def done(i: int, _: list) -> None:
+        for train_name in pieces[i][2]:
+            progress(f"  {pieces[i][0]}: trained on {train_name}")
+
+    results = executor.map(_generalize_rows, pieces, shared={"train": train, "test": test},
+                           on_done=done, cost=cost)
+    out = {name: {**{key: {} for key in GRID_KEYS}, "errors": {}, "notes": {}}
+           for name in models}
+    for (name, _, train_names), piece_rows in zip(pieces, results, strict=True):
+        for train_name, (rows, errors, notes) in zip(train_names, piece_rows, strict=True):
+            for key in GRID_KEYS:
+                out[name][key][train_name] = rows[key]
+            out[name]["errors"].update(errors)
+            out[name]["notes"].update(notes)
     return out
+
+
+def _generalize_rows(piece: tuple[str, int | None, tuple[str, ...]], *,
+                     train: Mapping[str, Recording],
+                     test: Mapping[str, Recording]) -> list[tuple[dict, dict, dict]]:
+    """One model trained on each of the recordings ``piece[2]`` in turn, each tested on every
+    test recording: `_generalize_piece`'s result for each."""
+    name, size, train_names = piece
+    return [_generalize_piece((name, size, t), train=train, test=test) for t in train_names]
 
 
 def _generalize_piece(piece: tuple[str, int | None, str], *, train: Mapping[str, Recording],
