@@ -13,17 +13,17 @@ Whole-process wall time, from starting ``python -m hystkit ...`` to its exit, of
   within 2x of the fit itself. Two yardsticks for "the fit itself":
 
   * the fit inside the same process: ``fit 1 cell (timed)`` runs the very command (as the
-    program, ``main()`` with ``sys.argv``) with ``fit_compensator`` wrapped in a timer; that
-    first fit includes what a fresh process must do before its first fit can run (numba
-    loading the cached kernels). Its row compares the process's wall time with it;
+    program: ``hystkit.cli.program()`` on ``sys.argv``) with ``fit_compensator`` wrapped in a
+    timer; that first fit includes what a fresh process must do before its first fit can run
+    (numba loading the cached kernels). Its row compares the process's wall time with it;
   * the warm fit: ``fit_compensator`` on the same recording in this (benchmark) process,
     kernels loaded long ago (``/ in-proc`` columns of the ``fit`` rows).
 
 Below the table, what a fresh process pays before any hystkit code runs (its floor), with
-OpenBLAS on one thread and the garbage collector set as the ``hystkit`` program has them: ``import numpy, numba``, and that plus
-numba made ready to load cached kernels (its target context: every implementation registry
-and scipy.linalg, which numba needs for LAPACK), the step every first call of a cached kernel
-takes.
+OpenBLAS on one thread, the garbage collector and the process's end as the ``hystkit`` program
+has them: ``import numpy, numba``, and that plus numba made ready to load cached kernels (its
+target context: every implementation registry and scipy.linalg, which numba needs for LAPACK),
+the step every first call of a cached kernel takes.
 
 Children run with Python's bytecode cache (in a temporary ``PYTHONPYCACHEPREFIX``, filled by
 the warm-up round), as an installed package does, even if ``PYTHONDONTWRITEBYTECODE`` is set
@@ -64,8 +64,10 @@ COMMANDS = {
                     "--force"],
 }
 IN_PROCESS = {"fit 1 cell": 1, "fit 3 cells": 3}  # command -> cells of the in-process fit
-# Floors run as the hystkit program runs: OpenBLAS on one thread, its garbage collector settings.
-_AS_PROGRAM = f"import gc\ngc.set_threshold{_PROGRAM_GC_THRESHOLDS}\n{{}}\ngc.freeze()"
+# Floors run as the hystkit program runs: OpenBLAS on one thread, its garbage collector settings
+# and its end (exit handlers, then the process ends without the interpreter's teardown).
+_AS_PROGRAM = (f"import atexit, gc, os\ngc.set_threshold{_PROGRAM_GC_THRESHOLDS}\n{{}}\n"
+               "atexit._run_exitfuncs()\nos._exit(0)")
 NUMBA_FLOORS = {
     "import numpy, numba": _AS_PROGRAM.format("import numpy, numba"),
     "  + numba ready (refresh)": _AS_PROGRAM.format(
@@ -88,9 +90,9 @@ def timed_fit(*args, **kwargs):
             out.write(f"{time.perf_counter() - start!r} {time.process_time() - cpu!r}")
 
 compensation.fit_compensator = timed_fit
-from hystkit.cli import main
+from hystkit.cli import program
 sys.argv = ["hystkit", "fit", "fit.csv", "--size", "1", "--out", "m1t.json", "--force"]
-sys.exit(main())
+program()
 """
 
 

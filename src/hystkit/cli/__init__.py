@@ -1,5 +1,5 @@
 """Command-line interface (``hystkit``)."""
 
-from ._main import main
+from ._main import main, program
 
-__all__ = ["main"]
+__all__ = ["main", "program"]
