@@ -87,16 +87,17 @@ def _compare(args: argparse.Namespace) -> int:
     if out is not None:
         check_output_folder(out, COMPARE_FILES, args.force, inputs=inputs)
     sizes = _sizes(args.size)
-    fit_rec = read_recording(args.data_fit, options=read_options(args, args.data_fit))
-    val_rec = read_recording(args.data_val, options=read_options(args, args.data_val))
-    print(f"comparing {len(models)} models: fit on {args.data_fit}, validate on {args.data_val} "
-          f"(deployable centring: {DEFAULT_CENTER}; oracle: recording, the paper's protocol)")
     if out is not None:
         # compare.mat's writer (scipy.io), loaded before the workers fork: they inherit the
         # scipy core it shares with their fits' scipy.optimize, which each worker and then this
         # process imported on its own (traced at 2 workers, 7 pairs: median 0.11 s less)
         import scipy.io  # noqa: F401
-    with executor_for(args, 2 * len(models)) as executor:
+    with executor_for(args, 2 * len(models)) as executor:  # its workers start while we read
+        fit_rec = read_recording(args.data_fit, options=read_options(args, args.data_fit))
+        val_rec = read_recording(args.data_val, options=read_options(args, args.data_val))
+        print(f"comparing {len(models)} models: fit on {args.data_fit}, validate on "
+              f"{args.data_val} (deployable centring: {DEFAULT_CENTER}; oracle: recording, "
+              "the paper's protocol)")
         say_where(executor, 2 * len(models))
         table = compare_models(fit_rec, val_rec, models, sizes, progress=print,
                                executor=executor)

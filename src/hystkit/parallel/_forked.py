@@ -5,13 +5,20 @@ Imported only when a parallel run starts on a platform that can fork (Linux). Me
 0.6-1.1 s of wall time and importing ``distributed`` 1.1 s more, where a pool of forked
 processes took 0.13-0.16 s and ``dask.multiprocessing`` 0.5 s to import: for a ``compare`` whose
 parallel map lasts 3-4 s that is the difference between gaining and not. The workers are forked
-at the first map, so they start with every library the command has imported; they keep BLAS on
-one thread. Each loads the model kernels its pieces use from numba's on-disk cache when it first
-runs them, as a serial run does. Loading every family's kernels here before the fork
-(`warm_kernels`) cost ~1.05 s of CPU in this process alone, with the other core idle, against
-~0.55 s in each worker side by side (``compare`` at 2 workers, 2026-11-24: the same CPU in all,
-0.4-0.5 s less wall). A piece's arguments travel with it (pickled by cloudpickle); at 8000 samples
-the recordings of a piece are 0.2-1.4 MB, under a millisecond to pickle.
+when the executor opens, with every library the command has imported by then; they keep BLAS on
+one thread and make numba ready to load cached kernels at once. ``compare`` opens the
+executor before it reads its recordings, so that this start of each worker (~0.2 s) overlaps
+work this process does alone (2 workers, 2026-11-24, three runs of 6 alternating pairs: median
+0.09-0.12 s less wall time). ``generalize`` gained nothing from simulating its recordings after
+the fork (6 pairs, medians equal; the workers then load what the simulation imports
+themselves), nor ``select`` from reading after it (4 pairs, -0.04 s): both fork at their map.
+Each worker loads the model kernels its pieces use
+from numba's on-disk cache when it first runs them, as a serial run does. Loading every
+family's kernels here before the fork (`warm_kernels`) cost ~1.05 s of CPU in this process
+alone, with the other core idle, against ~0.55 s in each worker side by side (``compare`` at 2
+workers, 2026-11-24: the same CPU in all, 0.4-0.5 s less wall). A piece's arguments travel with
+it (pickled by cloudpickle); at 8000 samples the recordings of a piece are 0.2-1.4 MB, under a
+millisecond to pickle.
 
 Dask's local scheduler runs independent tasks in descending order of their keys
 (``dask.order``); the keys here are numbered so that the costliest piece sorts last and runs
@@ -37,13 +44,16 @@ __all__ = ["ForkedExecutor"]
 
 
 def _worker_start() -> None:
-    """In each worker before its first piece: BLAS on one thread (idle OpenBLAS threads spin
-    on the other worker's core), and no executor current (the parent's was copied by the
-    fork; a fit inside a piece stays serial)."""
+    """In each worker as it starts: BLAS on one thread (idle OpenBLAS threads spin on the
+    other worker's core), no executor current (the parent's was copied by the fork; a fit
+    inside a piece stays serial), and numba made ready to load cached kernels (its target
+    context, ~0.2 s), which every piece's first kernel call would otherwise do."""
+    from numba.core.registry import cpu_target
     from threadpoolctl import threadpool_limits
 
     threadpool_limits(1)  # kept for the worker's life
     _CURRENT.set(None)
+    cpu_target.target_context.refresh()
 
 
 def _run_piece(func: Callable[..., Any], item: Any, shared: Mapping[str, Any]) -> Any:
@@ -70,6 +80,7 @@ class ForkedExecutor:
         self.n_workers = n_workers
         self._pool = ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context(
             "fork"), initializer=_worker_start)
+        self._pool.submit(int)  # fork every worker now: each starts while this process reads
 
     def describe(self) -> str:
         return f"{self.n_workers} Dask workers (local, forked processes)"
