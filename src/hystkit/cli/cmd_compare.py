@@ -117,7 +117,8 @@ def _compare(args: argparse.Namespace) -> int:
 def _generalize(args: argparse.Namespace) -> int:
     from ..compensation import DEFAULT_CENTER
     from ..io import atomic_folder, check_output_folder, read_recording, write_json, write_mat
-    from ..reports import generalization_matrix, plot_generalization
+    from ..parallel import loading_meanwhile
+    from ..reports import FIGURE_MODULES, generalization_matrix, plot_generalization
     from ..sensors import simulate_experiment
     from ..signals import EXPERIMENTS
 
@@ -144,8 +145,10 @@ def _generalize(args: argparse.Namespace) -> int:
           f"compensators, deployable centring: {DEFAULT_CENTER}, oracle beside it)")
     with executor_for(args, len(models) * len(train)) as executor:
         say_where(executor, len(models) * len(train))
-        matrix = generalization_matrix(train, test, models, sizes, progress=print,
-                                       executor=executor)
+        # the figure's matplotlib (~0.3 s) loads while the workers run the map
+        with loading_meanwhile(executor, FIGURE_MODULES):
+            matrix = generalization_matrix(train, test, models, sizes, progress=print,
+                                           executor=executor)
     failed = []
     for name, entry in matrix.items():
         for key, label in (("r2", "deployable R²"), ("r2_oracle", "oracle R² (recording)")):

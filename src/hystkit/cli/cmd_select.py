@@ -45,7 +45,8 @@ def _select(args: argparse.Namespace) -> int:
         read_recording,
         write_json,
     )
-    from ..reports import candidates, folds, plot_selection, select_model
+    from ..parallel import loading_meanwhile
+    from ..reports import FIGURE_MODULES, candidates, folds, plot_selection, select_model
 
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
                       what="a model file")
@@ -58,7 +59,10 @@ def _select(args: argparse.Namespace) -> int:
           f"(deployable held-out R², "
           f"{'leave-one-recording-out' if len(recs) > 1 else 'blocked time folds'})")
     n_pieces = len(cands) * len(folds(recs))
-    with executor_for(args, n_pieces) as executor:
+    # while the workers run the map, this process loads the figure's matplotlib and numba for
+    # the winner's refit
+    with executor_for(args, n_pieces) as executor, \
+            loading_meanwhile(executor, FIGURE_MODULES, numba_ready=True):
         result = select_model(recs, cands, executor=executor, progress=print)
     rows = result["ranking"]
     print(f"{'candidate':<32}{'cv R²':>8}{'min':>8}{'oracle':>8}{'line':>8}{'params':>7}"

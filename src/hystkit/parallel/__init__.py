@@ -8,7 +8,8 @@ cluster); a scheduler address connects to an existing cluster. Results come back
 of the pieces, whatever order they finish in, so a parallel run gives the same table as the
 serial one; `fit_cost` estimates each piece so that the costliest start first. While a
 parallel executor is open, `current_executor` gives it to work that splits itself: a long fit
-screens its starts on the workers (:func:`hystkit.identification.fit_multistart`). Dask is
+screens its starts on the workers (:func:`hystkit.identification.fit_multistart`), and
+`loading_meanwhile` has this process load what it needs after the map while it waits. Dask is
 imported only when a parallel run starts.
 """
 
@@ -20,6 +21,7 @@ from ._executor import (
     current_executor,
     open_executor,
 )
+from ._meanwhile import loading_meanwhile
 
 __all__ = ["Executor", "SerialExecutor", "available_cores", "current_executor", "fit_cost",
-           "open_executor"]
+           "loading_meanwhile", "open_executor"]

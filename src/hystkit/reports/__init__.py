@@ -6,6 +6,10 @@ and ``select`` need no part of the demo, whose preprocessing imports scipy.signa
 
 from .._lazy import lazy_exports
 
+# What drawing a figure and saving it as PNG imports (~0.3 s): a parallel command loads them
+# while its workers run (`hystkit.parallel.loading_meanwhile`).
+FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
+
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
     {"_compare": ("compare_models", "format_compare", "generalization_matrix",
@@ -16,4 +20,4 @@ __getattr__, __dir__ = lazy_exports(
      "_report_page": ("FIGURE_FORMATS", "build_report", "write_report"),
      "_select": ("Candidate", "candidates", "folds", "plot_selection", "select_model"),
      },
-    first=())
+    first=("FIGURE_MODULES",))
