@@ -11,14 +11,13 @@ executor before it reads its recordings, so that this start of each worker (~0.2
 work this process does alone (2 workers, 2026-11-24, three runs of 6 alternating pairs: median
 0.09-0.12 s less wall time). ``generalize`` gained nothing from simulating its recordings after
 the fork (6 pairs, medians equal; the workers then load what the simulation imports
-themselves), nor ``select`` from reading after it (4 pairs, -0.04 s): both fork at their map.
-Each worker loads the model kernels its pieces use
-from numba's on-disk cache when it first runs them, as a serial run does. Loading every
-family's kernels here before the fork (`warm_kernels`) cost ~1.05 s of CPU in this process
-alone, with the other core idle, against ~0.55 s in each worker side by side (``compare`` at 2
-workers, 2026-11-24: the same CPU in all, 0.4-0.5 s less wall). A piece's arguments travel with
-it (pickled by cloudpickle); at 8000 samples the recordings of a piece are 0.2-1.4 MB, under a
-millisecond to pickle.
+themselves), nor ``select`` from reading after it (4 pairs, -0.04 s): both open it at their
+map. Each worker loads the model kernels its pieces use from numba's on-disk cache when it
+first runs them, as a serial run does. Loading every family's kernels here before the fork
+(`warm_kernels`) cost ~1.05 s of CPU in this process alone, with the other core idle, against
+~0.55 s in each worker side by side (``compare`` at 2 workers, 2026-11-24: the same CPU in all,
+0.4-0.5 s less wall). A piece's arguments travel with it (pickled by cloudpickle); at 8000
+samples the recordings of a piece are 0.2-1.4 MB, under a millisecond to pickle.
 
 Dask's local scheduler runs independent tasks in descending order of their keys
 (``dask.order``); the keys here are numbered so that the costliest piece sorts last and runs
@@ -80,7 +79,8 @@ class ForkedExecutor:
         self.n_workers = n_workers
         self._pool = ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context(
             "fork"), initializer=_worker_start)
-        self._pool.submit(int)  # fork every worker now: each starts while this process reads
+        self._pool.submit(int)  # fork the workers now, not at the first map: they start
+        # while this process does what comes before the map (compare: reading the recordings)
 
     def describe(self) -> str:
         return f"{self.n_workers} Dask workers (local, forked processes)"
