@@ -38,7 +38,6 @@ FAST_CHUNK_ROWS = 1 << 18  # rows parsed at once by the first pass, copied into 
 MAX_COLUMNS = 1000  # a wider file is not a recording; pandas would build a column per field
 PLAIN_BYTES = 1 << 24  # larger files go straight to pandas, whose import is then a small share
 _HEADER_BYTES = 1 << 16
-_PLAIN_NUMBER = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
 _SEP_NAMES = {",": "comma", ";": "semicolon", "\t": "tab"}
 _TEXT = {"header": None, "dtype": str, "keep_default_na": False, "skip_blank_lines": False,
          "encoding": "utf-8-sig"}
@@ -82,8 +81,9 @@ def _read_plain(path: Path, need_position: bool, where: Where, sep: str, skip: i
     """The pandas-free pass: every data cell a plain decimal, or None (the file goes on)."""
     if path.stat().st_size > PLAIN_BYTES:
         return None
+    data = path.read_bytes()
     try:
-        text = path.read_bytes().decode("utf-8-sig")
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError:
         return None
     lines = text.split("\n")
@@ -93,18 +93,34 @@ def _read_plain(path: Path, need_position: bool, where: Where, sep: str, skip: i
     body = lines[1 + skip:]
     if "\r" in text or '"' in lines[0] or not body or any(not h.strip() for h in header):
         return None
-    number = _PLAIN_NUMBER
-    row = re.compile(f"{number}(?:{re.escape(sep)}{number}){{{len(header) - 1}}}")
-    if not all(map(row.fullmatch, body)):
+    # The data lines hold only digits, . e E + -, separators and single line ends (a blank
+    # line, spaces, nan, inf, quotes or hex go on to pandas). Over that alphabet numpy's
+    # parser accepts exactly the plain decimals and refuses everything else (1e, 1.2.3, an
+    # empty cell, a short or long row): a one-pass byte check instead of a regular
+    # expression per line (~5 ms on 8000 lines).
+    start = len(codecs.BOM_UTF8) if data.startswith(codecs.BOM_UTF8) else 0  # as decoded
+    for _ in range(1 + skip):
+        start = data.index(b"\n", start) + 1
+    if b"\n\n" in data[start - 1:] or data[start:].translate(None, _plain_bytes(sep)):
         return None
     header = [name.strip() for name in header]
     names = pick(header, need_position, where, hint=hint)
-    table = np.loadtxt(body, delimiter=sep, dtype=np.float64, ndmin=2)
+    try:
+        table = np.loadtxt(body, delimiter=sep, dtype=np.float64, ndmin=2)
+    except ValueError:
+        return None
+    if table.shape[1] != len(header):
+        return None
     arrays = {name: np.ascontiguousarray(table[:, header.index(where.name(name))])
               for name in names}
     if not all(np.isfinite(values).all() for values in arrays.values()):
         return None  # e.g. 1e999: the checks downstream say which cell, as for every file
     return arrays
+
+
+def _plain_bytes(sep: str) -> bytes:
+    """The bytes a plain data line may hold: deleting them leaves nothing."""
+    return b"0123456789.eE+-\n" + sep.encode()
 
 
 def _units_row(path: Path, where: Where, sep: str, names: list[str]) -> tuple[tuple[str, str], ...]:
