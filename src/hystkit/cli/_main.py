@@ -26,6 +26,7 @@ from typing import NoReturn
 from .. import __version__
 from ..errors import HystkitError, Terminated
 from ._common import INTERNAL_EXIT, Parser
+from ._numba_config import hide_yaml_from_numba_config
 from ._signals import forked_workers, received_signal, signals_as_exceptions
 
 __all__ = ["main", "program"]
@@ -92,9 +93,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     Run as the program (`argv` None) it tunes the process's garbage collector for a short
     life (`_PROGRAM_GC_THRESHOLDS`, and a frozen heap at the end, which the interpreter's
     shutdown does not walk again) and has OpenBLAS start one thread unless the environment
-    says otherwise (`_BLAS_THREAD_VARIABLES`); stopped by a signal after forking workers, it ends the
-    process itself: multiprocessing's exit handlers would otherwise wait forever to flush queues
-    to the workers it stopped.
+    says otherwise (`_BLAS_THREAD_VARIABLES`), and numba loads without PyYAML unless the working
+    directory has a numba config file (`hide_yaml_from_numba_config`); stopped by a signal after
+    forking workers, it ends the process itself: multiprocessing's exit handlers would otherwise
+    wait forever to flush queues to the workers it stopped.
 
     Parameters
     ----------
@@ -114,6 +116,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         gc.set_threshold(*_PROGRAM_GC_THRESHOLDS)
         if not any(os.environ.get(name) for name in _BLAS_THREAD_VARIABLES):
             os.environ["OPENBLAS_NUM_THREADS"] = "1"  # before numpy is imported
+        hide_yaml_from_numba_config()
     code = _main(argv)
     if argv is None:
         # Nothing but the interpreter's shutdown follows, whose garbage collections walk the
