@@ -21,9 +21,10 @@ Whole-process wall time, from starting ``python -m hystkit ...`` to its exit, of
 
 Below the table, what a fresh process pays before any hystkit code runs (its floor), with
 OpenBLAS on one thread, the garbage collector and the process's end as the ``hystkit`` program
-has them: ``import numpy, numba``, and that plus numba made ready to load cached kernels (its
-target context: every implementation registry and scipy.linalg, which numba needs for LAPACK),
-the step every first call of a cached kernel takes.
+has them (numba imported without PyYAML): ``import numpy, numba``, and that plus numba made
+ready to load cached kernels (its target context: every implementation registry and
+scipy.linalg, which numba needs for LAPACK), the step every first call of a cached kernel
+takes.
 
 Children run with Python's bytecode cache (in a temporary ``PYTHONPYCACHEPREFIX``, filled by
 the warm-up round), as an installed package does, even if ``PYTHONDONTWRITEBYTECODE`` is set
@@ -68,10 +69,12 @@ IN_PROCESS = {"fit 1 cell": 1, "fit 3 cells": 3}  # command -> cells of the in-p
 # and its end (exit handlers, then the process ends without the interpreter's teardown).
 _AS_PROGRAM = (f"import atexit, gc, os\ngc.set_threshold{_PROGRAM_GC_THRESHOLDS}\n{{}}\n"
                "atexit._run_exitfuncs()\nos._exit(0)")
+# numba imported as the program imports it: without PyYAML (hystkit.cli._numba_config).
+_NUMBA = "import sys\nsys.modules['yaml'] = None\nimport numpy, numba\ndel sys.modules['yaml']"
 NUMBA_FLOORS = {
-    "import numpy, numba": _AS_PROGRAM.format("import numpy, numba"),
+    "import numpy, numba": _AS_PROGRAM.format(_NUMBA),
     "  + numba ready (refresh)": _AS_PROGRAM.format(
-        "import numpy, numba\nfrom numba.core.registry import cpu_target\n"
+        f"{_NUMBA}\nfrom numba.core.registry import cpu_target\n"
         "cpu_target.target_context.refresh()"),
 }
 TIMED = "fit 1 cell (timed)"
