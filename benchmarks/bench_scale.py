@@ -175,6 +175,7 @@ log("phase", "interpreter", launch, T_SCRIPT)
 from hystkit.cli import _main
 if not any(os.environ.get(name) for name in _main._BLAS_THREAD_VARIABLES):
     os.environ["OPENBLAS_NUM_THREADS"] = "1"  # as the program's main() does, before numpy loads
+_main.hide_yaml_from_numba_config()  # as main() does, here before numba loads
 import hystkit.identification._least_squares as least_squares
 import hystkit.parallel as parallel
 import hystkit.parallel._executor as executors
@@ -228,13 +229,17 @@ def traced_screen(solve, thetas, budget):
                 cpu=time.thread_time() - c0)
 least_squares._screen = traced_screen
 import contextlib, io
-sys.argv = ["hystkit", *args]  # main() reading sys.argv runs as the program does (its GC tuning)
-t_main = time.time()
-try:
-    with contextlib.redirect_stdout(io.StringIO()):
-        _main.main()
-finally:
-    log("phase", "main", t_main, time.time(), cpu_after=time.process_time())
+real_main = _main.main
+def traced_main(argv=None):
+    t_main = time.time()
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            return real_main(argv)
+    finally:
+        log("phase", "main", t_main, time.time(), cpu_after=time.process_time())
+_main.main = traced_main
+sys.argv = ["hystkit", *args]
+_main.program()  # main() on sys.argv (its GC tuning), then the program's end
 """
 
 
