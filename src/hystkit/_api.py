@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
 
@@ -23,7 +24,7 @@ from .compensation import (
 )
 from .compensation import evaluate as _evaluate
 from .compensation import use_flags as _use_flags
-from .io import ReadOptions, Recording, read_recording
+from .io import ReadOptions, Recording, options_for, read_recording
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -37,8 +38,12 @@ Data = Union[Recording, "pd.DataFrame", str, os.PathLike]
 
 
 def read(path: str | os.PathLike, *, columns: Mapping[str, str] | None = None,
-         time_unit: str = "s", **options: Any) -> Recording:
+         time_unit: str | None = None, **options: Any) -> Recording:
     """Read a recording from a CSV, Parquet or MATLAB file, with its own column names.
+
+    A settings file beside it (``my.toml`` for ``my.csv``: columns, time unit, ..., see
+    ``docs/own_data.md``) is read first, as the command line does; what is given here
+    overrides it (``columns`` name by name).
 
     Parameters
     ----------
@@ -47,8 +52,9 @@ def read(path: str | os.PathLike, *, columns: Mapping[str, str] | None = None,
     columns : mapping, optional
         hystkit name (``time``, ``position``, ``sensor``) -> the file's column (or MATLAB
         variable) name; names not given are read as hystkit's.
-    time_unit : {"s", "ms", "us", "ns", "min"}
-        Unit of the time column, converted to seconds.
+    time_unit : {"s", "ms", "us", "ns", "min"}, optional
+        Unit of the time column, converted to seconds; default: the settings file's, else
+        seconds.
     **options
         The other fields of `hystkit.io.ReadOptions` (``skip_rows``, ``sep``, ``units_row``,
         ...).
@@ -77,7 +83,15 @@ def read(path: str | os.PathLike, *, columns: Mapping[str, str] | None = None,
     >>> rec.to_frame().columns.tolist()
     ['time', 'position', 'sensor']
     """
-    reading = ReadOptions(columns=columns or (), time_unit=time_unit, **options)
+    given = dict(options)
+    if columns is not None:
+        given["columns"] = tuple(columns.items())
+    if time_unit is not None:
+        given["time_unit"] = time_unit
+    unknown = sorted(set(given) - {f.name for f in fields(ReadOptions)})
+    if unknown:
+        raise TypeError(f"read() got unexpected keyword argument(s) {', '.join(unknown)}")
+    reading, _ = options_for(path, given)
     return read_recording(path, need_position=False, options=reading)
 
 
@@ -312,7 +326,7 @@ def _as_recording(data: Data) -> Recording:
     if isinstance(data, Recording):
         return data
     if isinstance(data, str | os.PathLike):
-        return read_recording(data, need_position=False)
+        return read_recording(data, need_position=False, options=options_for(data)[0])
     if hasattr(data, "columns") and hasattr(data, "to_numpy"):  # a DataFrame, without pandas
         return Recording.from_frame(data)
     raise TypeError(f"expected a Recording, a DataFrame or a file path, got "

@@ -219,3 +219,34 @@ def test_compensate_with_resample_leaves_out_text_and_gappy_columns(files, tmp_p
     # up to rounding (its times are ms x 1e-3, the grid's t0 + k / 40: a few ulp apart)
     np.testing.assert_allclose(written["sensor"].to_numpy(),
                                files["own"]["resistance_ohm"].to_numpy(), rtol=0, atol=1e-13)
+
+
+def test_the_python_api_reads_the_settings_file_as_the_command_line_does(files, tmp_path):
+    import hystkit as hk
+
+    by_file = hk.read(files["with_toml"])  # my.toml beside it: names, ms, ';', units line
+    std = read_recording(files["std"])
+    assert_array_equal(by_file.sensor, std.sensor)
+    assert dict(by_file.units) == {"position": "mm", "sensor": "Ohm"}
+    with pytest.raises(InputError, match="time is read in s"):  # given overrides the file's
+        hk.read(files["with_toml"], time_unit="s")
+    with pytest.raises(InputError, match="missing required column"):  # no settings file
+        hk.read(files["plain"])
+    with pytest.raises(TypeError, match="time_units"):
+        hk.read(files["with_toml"], time_units="ms")
+    comp = hk.fit(files["with_toml"], "mpl", size=1)
+    assert comp.params == hk.fit(std, "mpl", size=1).params
+
+
+def test_report_reads_each_recording_with_its_settings_file(files, tmp_path, capsys):
+    model = tmp_path / "m.json"
+    assert main(["fit", str(files["std"]), "--cells", "1", "--out", str(model)]) == 0
+    figures = tmp_path / "f"
+    code, out, err = _run(capsys, "report", model, files["with_toml"], "--out",
+                          tmp_path / "r.html", "--figures", figures, "--format", "svg")
+    assert code == 0, err
+    assert "with the settings in" in out
+    # the user's sensor name and unit (from the units line the settings file asks for)
+    assert "resistance_ohm [Ohm]" in (figures / "loops.svg").read_text(encoding="utf-8")
+    code, _, err = _run(capsys, "report", model, files["plain"], "--out", tmp_path / "p.html")
+    assert code == 2 and "missing required column" in err

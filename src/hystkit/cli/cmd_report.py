@@ -25,7 +25,8 @@ def _report(args: argparse.Namespace) -> int:
         if args.figures.exists() and not args.figures.is_dir():
             raise UsageError(f"--figures {args.figures}: is a file, not a folder")
         check_folder_writable(args.figures)
-    content = build_report(args.inputs, options=read_options(args))
+    # each recording with its settings file, the command line's reading options on top
+    content = build_report(args.inputs, options=lambda path: read_options(args, path))
     paths = write_report(content, args.out, figures=args.figures, fmt=args.format,
                          force=args.force)
     size = paths[0].stat().st_size

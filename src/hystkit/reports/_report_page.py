@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import datetime
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from .. import __version__
 from ..errors import InputError
-from ..io import ReadOptions, Recording, atomic_outputs, read_recording
+from ..io import ReadOptions, Recording, atomic_outputs, options_for, read_recording
 from ._figures import DEFAULT_SENSOR_LABEL
 from ._html import render_page
 from ._report_control import control_report
@@ -38,15 +38,19 @@ def sensor_label(options: ReadOptions | None, recordings: Sequence[Recording] = 
 
 
 def build_report(inputs: Sequence[str | os.PathLike[str]], *,
-                 options: ReadOptions | None = None) -> ReportContent:
+                 options: ReadOptions | Callable[[Path], ReadOptions] | None = None,
+                 ) -> ReportContent:
     """The page's content for `inputs`: ``MODEL.json RECORDING...`` or ``FOLDER...``.
 
     Parameters
     ----------
     inputs : sequence of str or os.PathLike
         A model file and recordings, or result folders.
-    options : ReadOptions, optional
-        How to read the recordings (see :func:`~hystkit.io.read_recording`).
+    options : ReadOptions or callable, optional
+        How to read the recordings (see :func:`~hystkit.io.read_recording`): one
+        `ReadOptions` for all, or a function of a recording's path giving its own. Default:
+        each recording's settings file beside it when it has one (``my.toml`` for ``my.csv``,
+        :func:`~hystkit.io.options_for`), as the command line reads it.
 
     Returns
     -------
@@ -74,14 +78,20 @@ def build_report(inputs: Sequence[str | os.PathLike[str]], *,
                          f"'hystkit fit') or a result folder first")
     if len(paths) < 2:
         raise InputError(f"{first}: give one or more recordings to report the model on")
-    recordings = {}
+    recordings, reading = {}, []
     for path in paths[1:]:
         if path.name in recordings:
             raise InputError(f"{path}: two recordings named {path.name!r}; the page and its "
                              f"figures name them by file name")
-        recordings[path.name] = read_recording(path, options=options)
+        if options is None:
+            reading.append(options_for(path)[0])  # its settings file, if it has one
+        else:
+            reading.append(options(path) if callable(options) else options)
+        recordings[path.name] = read_recording(path, options=reading[-1])
     return model_report(first, recordings,
-                        sensor_label=sensor_label(options, list(recordings.values())))
+                        sensor_label=sensor_label(reading[0], list(recordings.values())))
+
+
 
 
 def _folders(folders: list[Path]) -> ReportContent:
