@@ -21,8 +21,9 @@ _CONFIG_MODULE = "numba.core.config"
 
 
 class _YamlHiddenFromNumbaConfig:
-    """A meta path finder (a plain class: importlib.abc costs ~0.01 s to import) that refuses
-    ``yaml`` to numba's config module and then has no more to say.
+    """A meta path finder (a plain class: importlib.abc is not loaded this early in the
+    program, ~0.01 s) that refuses ``yaml`` to numba's config module and then has no more to
+    say.
 
     It decides once, at the first import of ``yaml``: refused while numba's config module runs
     (its ``__spec__._initializing``, set by the import system during a module's first run;
