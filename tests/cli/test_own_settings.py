@@ -250,3 +250,23 @@ def test_report_reads_each_recording_with_its_settings_file(files, tmp_path, cap
     assert "resistance_ohm [Ohm]" in (figures / "loops.svg").read_text(encoding="utf-8")
     code, _, err = _run(capsys, "report", model, files["plain"], "--out", tmp_path / "p.html")
     assert code == 2 and "missing required column" in err
+
+
+def test_pl_search_and_stability_read_the_settings_file(files, tmp_path, capsys):
+    grid = ["--n", 1, "--p", 2, "--m", 2, "--s", 0, "--workers", 1]
+    found = []
+    for data in (files["with_toml"], files["std"]):
+        code, out, err = _run(capsys, "pl-search", data, *grid)
+        assert code == 0, err
+        found.append([line for line in out.splitlines() if line.startswith("best:")])
+    assert found[0] == found[1] and found[0]
+    model = tmp_path / "m.json"
+    assert main(["fit", str(files["std"]), "--cells", "1", "--out", str(model)]) == 0
+    steps = []
+    for data, options in ((files["with_toml"], []), (files["plain"], OWN), (files["std"], [])):
+        code, out, err = _run(capsys, "stability", model, "--data", data, *options)
+        assert code == 0, err
+        steps.append([line for line in out.splitlines() if "eigenvalues" in line])
+    assert steps[0] == steps[1] == steps[2] and steps[0]
+    code, _, err = _run(capsys, "pl-search", files["plain"], *grid)
+    assert code == 2 and "missing required column" in err

@@ -6,7 +6,7 @@ import argparse
 from collections.abc import Callable
 from pathlib import Path
 
-from ._common import deferred, integer, number
+from ._common import add_read_options, deferred, integer, number, read_recording_args
 from .cmd_compare import add_parallel_options, executor_for, say_where
 
 __all__ = ["register"]
@@ -39,12 +39,12 @@ _smoothing = _list(number(0), "smoothing weights >= 0")
 
 
 def _search(args: argparse.Namespace) -> int:
-    from ..io import check_output_path, read_recording, write_json
+    from ..io import check_output_path, write_json
     from ..models.pl import format_search_table, structural_search
 
     if args.json is not None:
         check_output_path(args.json, args.force, inputs=[args.data])
-    rec = read_recording(args.data)
+    rec = read_recording_args(args, args.data)
     u, y = ((rec.position, rec.sensor) if args.direction == "position-to-sensor"
             else (rec.sensor, rec.position))
     grid = {"n": args.n, "p": args.p, "m": args.m, "s": args.s}
@@ -90,4 +90,5 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "compensator")
     p.add_argument("--json", type=Path, help="also write the rows to this JSON file")
     add_parallel_options(p)
+    add_read_options(p)
     p.set_defaults(run=_search)

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import InputError
-from ._common import UsageError, deferred
+from ._common import UsageError, add_read_options, deferred, read_recording_args
 from .cmd_control import add_setup_options, setup_inputs, setup_loop
 
 if TYPE_CHECKING:  # the library loads when the command runs
@@ -40,12 +40,10 @@ def _probe_input(dt: float) -> np.ndarray:
     return exponential_chirp(np.arange(round(100.0 / dt)) * dt, amplitude=1.0)
 
 
-def _model_input(comp: Compensator, path: Path) -> np.ndarray:
+def _model_input(comp: Compensator, path: Path, args: argparse.Namespace) -> np.ndarray:
     """The fitted model's input on a recording, normalised as at fit time (eq. 5.10): the
     sensor signal for a direct compensator, the position for an inverse one's forward model."""
-    from ..io import read_recording
-
-    rec = read_recording(path, need_position=comp.mode == "inverse")
+    rec = read_recording_args(args, path, need_position=comp.mode == "inverse")
     comp.check_sampling(rec)
     if comp.mode == "direct":
         return comp.normalised_sensor(rec.sensor)
@@ -143,7 +141,7 @@ def _stability(args: argparse.Namespace) -> int:
                           inputs=[args.model_json] + ([args.data] if args.data else []))
     comp = load_compensator(args.model_json)
     family, structure = comp.family, comp.structure
-    u = (_probe_input(structure.dt) if args.data is None else _model_input(comp, args.data))
+    u = (_probe_input(structure.dt) if args.data is None else _model_input(comp, args.data, args))
     probe = ("a unit chirp 0.1 -> 3 Hz" if args.data is None else str(args.data))
     try:
         report = stability_report(family, structure, comp.params, u)
@@ -203,4 +201,5 @@ def register(sub: argparse._SubParsersAction) -> None:
                                  "tested, and a divergence shows instability"),
              choices=_experiments)
     add_setup_options(p, scheme_required=False)
+    add_read_options(p)
     p.set_defaults(run=_stability)
