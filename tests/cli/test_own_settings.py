@@ -270,3 +270,17 @@ def test_pl_search_and_stability_read_the_settings_file(files, tmp_path, capsys)
     assert steps[0] == steps[1] == steps[2] and steps[0]
     code, _, err = _run(capsys, "pl-search", files["plain"], *grid)
     assert code == 2 and "missing required column" in err
+
+
+def test_control_reads_its_training_recording_with_the_settings_file(files, tmp_path, capsys):
+    metrics = []
+    for name, data, options in (("own", files["with_toml"], []), ("cli", files["plain"], OWN),
+                                ("std", files["std"], [])):
+        out = tmp_path / name
+        code, _, err = _run(capsys, "control", "--scheme", "direct", "--experiment", "sine",
+                            "--training-data", data, *options, "--out", out)
+        assert code == 0, err
+        table = json.loads((out / "metrics.json").read_text())
+        metrics.append({k: v for k, v in table["cases"]["sine"].items()
+                        if not k.endswith("seconds")})
+    assert metrics[0] == metrics[1] == metrics[2]

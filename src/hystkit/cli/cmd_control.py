@@ -12,11 +12,20 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from . import _control_report as report
-from ._common import UsageError, check_size, deferred, number, positive_int
+from ._common import (
+    UsageError,
+    add_read_options,
+    check_size,
+    deferred,
+    number,
+    positive_int,
+    read_options,
+)
 from ._control_options import PID_TYPES, TUNE_TYPES, Checked
 
 if TYPE_CHECKING:  # the library loads when the command runs
     from ..control import SensorModels
+    from ..io import ReadOptions
 
 __all__ = ["add_setup_options", "register", "setup_inputs", "setup_loop"]
 
@@ -57,7 +66,8 @@ def _file_block(make, path: Path, name: str, option: str):
 def _models(training: str, excitation: str, sensor_size: int | None, model_size: int | None,
             sensor_data: Path | None = None, training_data: Path | None = None,
             sensor: str = "virtual", sensor_model: str = "mpl",
-            model: str = "mpl") -> SensorModels:
+            model: str = "mpl", sensor_options: ReadOptions | None = None,
+            training_options: ReadOptions | None = None) -> SensorModels:
     # In-memory only, per process (repeated main() calls in one session, e.g. tests); nothing
     # is cached on disk, so every command line fits its models afresh (about 2 s).
     from ..control import fit_sensor_models
@@ -67,8 +77,10 @@ def _models(training: str, excitation: str, sensor_size: int | None, model_size:
         sensor=_sensor(sensor), training=training, training_excitation=excitation,
         sensor_cells=sensor_size, model_cells=model_size, sensor_model=sensor_model,
         model=model,
-        sensor_recording=None if sensor_data is None else read_recording(sensor_data),
-        training_recording=None if training_data is None else read_recording(training_data))
+        sensor_recording=None if sensor_data is None else read_recording(
+            sensor_data, options=sensor_options),
+        training_recording=None if training_data is None else read_recording(
+            training_data, options=training_options))
 
 
 def _slug(label: str) -> str:
@@ -110,7 +122,9 @@ def setup_loop(args: argparse.Namespace):
     t_start = time.perf_counter()
     models = _models(training, args.training_excitation, args.sensor_size,
                      args.model_size, args.sensor_data, args.training_data, args.sensor,
-                     args.sensor_model, args.model)
+                     args.sensor_model, args.model, *(
+                         None if path is None else read_options(args, path)
+                         for path in (args.sensor_data, args.training_data)))
     if args.compensator is not None:
         models = replace(models, compensator=_file_block(
             _library("compensator_block"), args.compensator, "S_m^comp", "--compensator"),
@@ -348,6 +362,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("control", help="closed-loop position control with a hysteretic "
                        "sensor: the document's ch. 7 experiments")
     add_setup_options(p)
+    add_read_options(p)  # for --sensor-data and --training-data
     deferred(p.add_argument("--experiment",
                    help="sine (eq. 7.3), frequency / amplitude sweeps, cubic trajectory, "
                         "output disturbance steps"),
