@@ -55,11 +55,26 @@ def test_the_exit_code_of_a_failed_command_is_kept():
 
 
 def test_a_running_non_daemon_thread_gets_the_normal_exit_which_waits_for_it():
-    later = ("def late():\n"
-             "    time.sleep(0.5)\n"
+    # The thread starts its last stretch only when the command has returned, so it is still
+    # running when the program decides how to end, however slow the machine (a fixed sleep
+    # raced the command under load).
+    later = ("import hystkit.cli._main as _main\n"
+             "returned = threading.Event()\n"
+             "def command(*args, _main_=_main.main):\n"
+             "    try:\n"
+             "        return _main_(*args)\n"
+             "    finally:\n"
+             "        returned.set()\n"
+             "_main.main = command\n"
+             "def late():\n"
+             "    returned.wait()\n"
+             "    time.sleep(0.3)\n"
              "    print('thread finished', flush=True)\n"
              "threading.Thread(target=late).start()\n")
     done = _program(["datasets", "list"], before=later)
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
-    assert lines.index("thread finished") == lines.index("exit handler ran") - 1
+    assert "piezo_micromanipulator" in done.stdout
+    # the normal exit waited for the thread (os._exit would have ended it mid-sleep), then ran
+    # the exit handlers
+    assert lines[-2:] == ["thread finished", "exit handler ran"]
