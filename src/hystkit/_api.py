@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
 
@@ -24,7 +23,7 @@ from .compensation import (
 )
 from .compensation import evaluate as _evaluate
 from .compensation import use_flags as _use_flags
-from .io import ReadOptions, Recording, options_for, read_recording
+from .io import Recording, options_for, read_recording
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -88,10 +87,7 @@ def read(path: str | os.PathLike, *, columns: Mapping[str, str] | None = None,
         given["columns"] = tuple(columns.items())
     if time_unit is not None:
         given["time_unit"] = time_unit
-    unknown = sorted(set(given) - {f.name for f in fields(ReadOptions)})
-    if unknown:
-        raise TypeError(f"read() got unexpected keyword argument(s) {', '.join(unknown)}")
-    reading, _ = options_for(path, given)
+    reading, _ = options_for(path, given)  # an unknown option is a TypeError there
     return read_recording(path, need_position=False, options=reading)
 
 

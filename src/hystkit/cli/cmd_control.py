@@ -120,11 +120,13 @@ def setup_loop(args: argparse.Namespace):
     training = args.training or ("recording" if args.sensor in ("virtual", "virtual-physics")
                                  else "loop")
     t_start = time.perf_counter()
+    def reading(path: Path | None):
+        return None if path is None else read_options(args, path)
+
     models = _models(training, args.training_excitation, args.sensor_size,
                      args.model_size, args.sensor_data, args.training_data, args.sensor,
-                     args.sensor_model, args.model, *(
-                         None if path is None else read_options(args, path)
-                         for path in (args.sensor_data, args.training_data)))
+                     args.sensor_model, args.model, sensor_options=reading(args.sensor_data),
+                     training_options=reading(args.training_data))
     if args.compensator is not None:
         models = replace(models, compensator=_file_block(
             _library("compensator_block"), args.compensator, "S_m^comp", "--compensator"),

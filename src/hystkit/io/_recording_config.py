@@ -167,8 +167,17 @@ def options_for(data_path: str | os.PathLike[str], given: dict[str, Any] | None 
     settings : Path or None
         The settings file used, if any. A raw recording's settings file of the same stem
         (`is_raw_settings`) is not used.
+
+    Raises
+    ------
+    TypeError
+        A key of `given` that is not a `ReadOptions` field.
     """
-    given = {k: v for k, v in (given or {}).items() if k in _FIELD_NAMES}
+    given = dict(given or {})
+    unknown = sorted(set(given) - _FIELD_NAMES)
+    if unknown:
+        raise TypeError(f"unexpected reading option(s): {', '.join(unknown)} (ReadOptions "
+                        f"has {', '.join(sorted(_FIELD_NAMES))})")
     settings = find_recording_config(data_path)
     if settings is not None and is_raw_settings(_load(settings)):
         settings = None  # the raw recording's settings (for preprocess), not this file's

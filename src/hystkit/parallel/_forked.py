@@ -38,6 +38,7 @@ from dask.callbacks import Callback
 
 from ._cost import cost_order
 from ._executor import _CURRENT, Cost, OnDone
+from ._meanwhile import make_numba_ready
 
 __all__ = ["ForkedExecutor"]
 
@@ -47,12 +48,11 @@ def _worker_start() -> None:
     other worker's core), no executor current (the parent's was copied by the fork; a fit
     inside a piece stays serial), and numba made ready to load cached kernels (its target
     context, ~0.2 s), which every piece's first kernel call would otherwise do."""
-    from numba.core.registry import cpu_target
     from threadpoolctl import threadpool_limits
 
     threadpool_limits(1)  # kept for the worker's life
     _CURRENT.set(None)
-    cpu_target.target_context.refresh()
+    make_numba_ready()
 
 
 def _run_piece(func: Callable[..., Any], item: Any, shared: Mapping[str, Any]) -> Any:

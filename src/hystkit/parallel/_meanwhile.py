@@ -16,7 +16,7 @@ from contextlib import contextmanager
 
 from ._executor import Executor
 
-__all__ = ["loading_meanwhile"]
+__all__ = ["loading_meanwhile", "make_numba_ready"]
 
 
 @contextmanager
@@ -58,8 +58,16 @@ def _load(modules: tuple[str, ...], numba_ready: bool) -> None:
         except Exception:  # noqa: BLE001, S112  (a head start only: see loading_meanwhile)
             continue
     if numba_ready:
-        from numba.core.compiler_lock import global_compiler_lock
-        from numba.core.registry import cpu_target
+        make_numba_ready()
 
-        with global_compiler_lock:  # not beside a kernel load in the main thread
-            cpu_target.target_context.refresh()
+
+def make_numba_ready() -> None:
+    """Make numba ready to load cached kernels: its target context (every implementation
+    registry, scipy.linalg for LAPACK; ~0.2 s), which the first kernel call of a process would
+    otherwise set up. Under numba's compiler lock, so never beside a kernel load in another
+    thread."""
+    from numba.core.compiler_lock import global_compiler_lock
+    from numba.core.registry import cpu_target
+
+    with global_compiler_lock:
+        cpu_target.target_context.refresh()
