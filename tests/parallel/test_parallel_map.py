@@ -73,6 +73,21 @@ def test_a_failing_piece_raises_in_the_caller(parallel_executor):
     assert parallel_executor.map(pow, [2, 3], shared={"exp": 2}) == [4, 9]  # still usable
 
 
+def _describe_shared(x: int, *, options: dict, pairs: list) -> tuple:
+    return x, type(options).__name__, options, type(pairs).__name__, pairs
+
+
+def test_shared_containers_arrive_whole_even_empty(parallel_executor):
+    """A dict or list passed in `shared` reaches each piece as that dict or list, as it does
+    serially (the cluster's scatter would split it into one future per element, and refused
+    an empty one)."""
+    shared = {"options": {}, "pairs": [(1, 2), (3, 4)]}
+    expected = SerialExecutor().map(_describe_shared, [0, 1], shared=shared)
+    assert expected == [(0, "dict", {}, "list", [(1, 2), (3, 4)]),
+                        (1, "dict", {}, "list", [(1, 2), (3, 4)])]
+    assert parallel_executor.map(_describe_shared, [0, 1], shared=shared) == expected
+
+
 def test_an_unreachable_scheduler_is_one_error(monkeypatch):
     import hystkit.parallel._dask as dask_executor
 

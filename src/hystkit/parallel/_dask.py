@@ -80,9 +80,11 @@ class DaskExecutor:
     def map(self, func: Callable[..., Any], items: Sequence[Any], *,
             shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None,
             cost: Cost | None = None) -> list:
-        # Shared inputs (recordings) travel to each worker once, not with every piece.
-        sent = {key: value if value is None else self.client.scatter(value, broadcast=True,
-                                                                     hash=False)
+        # Shared inputs (recordings) travel to each worker once, not with every piece; each
+        # as one object (scatter splits a list or dict into one future per element, and
+        # refuses an empty one)
+        sent = {key: value if value is None else self.client.scatter([value], broadcast=True,
+                                                                     hash=False)[0]
                 for key, value in (shared or {}).items()}
         run = uuid.uuid4().hex[:8]
         name = getattr(func, "__name__", "piece")
