@@ -6,11 +6,13 @@ import numpy as np
 import pytest
 
 from hystkit.cli import main
-from hystkit.compensation import evaluate, fit_compensator, load_compensator
+from hystkit.compensation import DEFAULT_CENTER, evaluate, fit_compensator, load_compensator
 from hystkit.compensation._param_vector import flatten_params
+from hystkit.errors import FitDivergedError
 from hystkit.io import Recording
 from hystkit.models import FAMILIES
-from hystkit.reports._select import folds
+from hystkit.reports import _select
+from hystkit.reports._select import Candidate, folds, select_model
 from hystkit.sensors import simulate_experiment
 
 
@@ -77,3 +79,23 @@ def test_a_rest_block_trains_but_is_not_scored():
     assert len(pairs) == 2
     assert all(np.ptp(held.position) > 0 for _, held in pairs)
     assert all(len(train) == 2 for train, _ in pairs)
+
+
+def test_a_winner_whose_refit_fails_gives_way_to_the_next(monkeypatch):
+    rec = simulate_experiment("sine", 1)
+    cands = [Candidate("mpl", 1, "direct", DEFAULT_CENTER),
+             Candidate("bobbio", 10, "direct", DEFAULT_CENTER)]
+    first, second = select_model([rec], cands)["ranking"]
+    real_fit = _select.fit_compensator
+
+    def refit_of_the_first_fails(recordings, size, **kw):
+        # the fold fits pass diagnose=False; the refit on all recordings does not
+        if "diagnose" not in kw and kw["model"] == first["model"]:
+            raise FitDivergedError("diverged on purpose")
+        return real_fit(recordings, size, **kw)
+
+    monkeypatch.setattr(_select, "fit_compensator", refit_of_the_first_fails)
+    result = select_model([rec], cands)
+    assert result["ranking"][0]["error_final"] == "diverged on purpose"
+    assert result["winner"]["candidate"] == second["candidate"]
+    assert result["compensator"].model == second["model"]
