@@ -3,8 +3,9 @@
 During a parallel map this process only waits, and the cores are busy with the workers; what
 it loads there (a module's import, numba's target context) costs the map about half its CPU
 time (the cores are shared three ways), where after the map it would cost all of it, with the
-other core idle. ``generalize`` imports matplotlib for its figure this way (2 workers, ~0.3 s
-of imports), ``select`` also makes numba ready for the refit of its winner.
+other core idle. ``generalize`` imports matplotlib for its figure (2 workers, ~0.3 s of
+imports) and scipy.io for its ``.mat`` file this way, ``select`` matplotlib and makes numba
+ready for the refit of its winner.
 """
 
 from __future__ import annotations
