@@ -92,8 +92,6 @@ def build_report(inputs: Sequence[str | os.PathLike[str]], *,
                         sensor_label=sensor_label(reading[0], list(recordings.values())))
 
 
-
-
 def _folders(folders: list[Path]) -> ReportContent:
     kinds = [folder_kind(f) for f in folders]  # every folder recognised before any work
     content = ReportContent(title=f"hystkit report: {', '.join(f.name or str(f) for f in folders)}")
