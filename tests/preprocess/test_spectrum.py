@@ -4,6 +4,7 @@ floor, the cut-off rule on lines of known height, the Butterworth overlay, CLI."
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -78,10 +79,20 @@ def test_rule_finds_the_highest_line_above_the_margin():
     assert s["gain_at_f_signal_db"] == pytest.approx(-20 * np.log10(1 + q ** 4), rel=1e-9)
 
 
-def test_pure_noise_has_no_line():
+def test_pure_noise_has_no_line_but_its_spectrum():
+    """Issue 25.4: no line to pick a cut-off from is said, not refused; the PSD and the floor
+    are there, f_signal and the cut-off are NaN, no filter is summarised."""
     _, x = _noise(60.0, seed=2)
-    with pytest.raises(ValueError, match="no spectral line stands 10 dB above"):
-        spectrum({"differential": x}, FS, segment_s=SEGMENT)
+    result = spectrum({"differential": x}, FS, segment_s=SEGMENT, compare_cutoff=20.0)
+    assert result.summary["no_line"].startswith(
+        "no spectral line stands 10 dB above the noise floor between 0.2 and 400 Hz, so there "
+        "is no line to pick a cut-off from")
+    assert np.isnan(result.f_signal) and np.isnan(result.cutoff)
+    assert result.summary["f_signal_hz"] is None and result.summary["filters"] == {}
+    assert list(result.response) == ["20 Hz (compare)"]  # the overlay asked for stays
+    freq, psd, _ = welch_psd(x, FS, SEGMENT)
+    assert_allclose(result.psd["differential"], psd, rtol=1e-12)
+    assert result.plot().axes  # the figure draws without an f_signal
     with pytest.raises(ValueError, match="2 Welch segment"):  # 40 s segments in 60 s
         spectrum({"differential": x}, FS, segment_s=40.0)
     assert spectrum({"differential": x + _line(np.arange(x.size) / FS, 3.0, 1e4)},
@@ -92,12 +103,13 @@ def test_no_line_in_a_short_record_names_its_resolution_and_length():
     """Review 14, sec. 7: 5 s at 40 Hz gives 2.5 s segments, bins 0.4 Hz apart, so the 4 Hz
     running median spans 10 bins and the search starts at 0.8 Hz."""
     x = np.random.default_rng(3).normal(size=200)
-    with pytest.raises(ValueError, match=r"the record is short \(5 s, frequency resolution "
-                       r"0\.4 Hz\): a fundamental below 0\.8 Hz .* spans only 10 bins"):
-        spectrum({"differential": x}, 40.0)
+    assert re.search(r"the record is short \(5 s, frequency resolution 0\.4 Hz\): a "
+                     r"fundamental below 0\.8 Hz .* spans only 10 bins",
+                     spectrum({"differential": x}, 40.0).summary["no_line"])
     _, long = _noise(60.0, seed=2)  # 0.1 Hz bins: 40 in the median, no word on the length
-    with pytest.raises(ValueError, match=r"between 0\.2 and 400 Hz: nothing to keep"):
-        spectrum({"differential": long}, FS, segment_s=SEGMENT)
+    assert spectrum({"differential": long}, FS, segment_s=SEGMENT).summary["no_line"].endswith(
+        "between 0.2 and 400 Hz, so there is no line to pick a cut-off from: the signal is a "
+        "band, not lines (a broadband excitation), pure noise or flat")
 
 
 def test_a_comparison_at_nyquist_is_skipped_with_a_reason():
@@ -185,11 +197,11 @@ def test_cli_force_and_nothing_partial(raw_sine, tmp_path, capsys):
     assert (out / "spectrum.json").read_bytes() == first
     assert main(["spectrum", str(raw_sine), "--out", str(out), "--force"]) == 0
     assert (out / "spectrum.json").read_bytes() != first  # 20 s segments now
-    # a failing run (a margin no line reaches) leaves nothing behind
+    # a failing run (too few Welch segments) leaves nothing behind
     empty = tmp_path / "none"
-    assert main(["spectrum", str(raw_sine), "--out", str(empty), "--margin", "200"]) == 2
+    assert main(["spectrum", str(raw_sine), "--out", str(empty), "--segment", "30"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "no spectral line stands 200 dB" in err
+    assert err.count("\n") == 1 and "1 Welch segment(s) of 30 s" in err
     assert str(raw_sine) in err
     assert not empty.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["spec"]
 

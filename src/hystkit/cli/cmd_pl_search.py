@@ -39,12 +39,17 @@ _smoothing = _list(number(0), "smoothing weights >= 0")
 
 
 def _search(args: argparse.Namespace) -> int:
+    from ..compensation import check_fitting_data
     from ..io import check_output_path, write_json
-    from ..models.pl import format_search_table, structural_search
+    from ..models.pl import FAMILY, PlStructure, format_search_table, structural_search
 
     if args.json is not None:
         check_output_path(args.json, args.force, inputs=[args.data])
     rec = read_recording_args(args, args.data)
+    # What `fit` demands (samples per parameter, a position and sensor that move), for the
+    # largest structure of the grid: two samples "fit" every structure with e_rms 0.000 %.
+    check_fitting_data([rec], FAMILY, PlStructure(n_cells=max(args.n), n_basis=max(args.m),
+                                                  dt=rec.dt))
     u, y = ((rec.position, rec.sensor) if args.direction == "position-to-sensor"
             else (rec.sensor, rec.position))
     grid = {"n": args.n, "p": args.p, "m": args.m, "s": args.s}

@@ -127,8 +127,13 @@ def _preprocess(args: argparse.Namespace) -> int:
           f"{rep.encoder_kind} encoder, decimated by {round(rep.fs / rep.fs_mid)} to "
           f"{rep.fs_mid:.6g} Hz, zero-phase Butterworth (order {settings.order}, "
           f"{settings.cutoff:g} Hz), {settings.fs_out:g} Hz out")
-    levels = ", ".join(f"{v:.4g}" for v in rep.encoder_levels)
-    print(f"  encoder: levels {levels} V; {rep.n_edges} state changes, {rep.n_illegal} illegal "
+    if rep.encoder_thresholds_v is None:
+        levels = "levels " + ", ".join(f"{v:.4g}" for v in rep.encoder_levels) + " V"
+    else:  # A/B: the decoder's levels are the codes 2A + B, not voltages
+        levels = ("A/B logic channels, thresholds " + ", ".join(
+            f"{name} {v:.4g} V" for name, v in zip(("enc_a", "enc_b"),
+                                                    rep.encoder_thresholds_v, strict=True)))
+    print(f"  encoder: {levels}; {rep.n_edges} state changes, {rep.n_illegal} illegal "
           f"double transition(s), {rep.n_rejected} short excursion(s) rejected "
           f"(dwell {rep.encoder_dwell_samples} samples)")
     print(f"  gauges: R1 = {rep.r1_mean_ohm:.6g} Ohm, R2 = {rep.r2_mean_ohm:.6g} Ohm, "

@@ -131,7 +131,7 @@ def _print_fit(name: str, fit, rest) -> None:
                  + (" EXTRAPOLATED past the log's end" if rest.extrapolated else ""))
     print(f"  {name}: {fit.model}: R_final = {p['r_final']:.5g} ± {se['r_final']:.2g} Ohm, "
           f"drop {p['drop']:.4g} Ohm, {taus}; rms {fit.rms:.3g} Ohm; rest time "
-          f"(drift < {rest.threshold_pct_per_hour:g} %/h) {rest_text}")
+          f"(drift |dR/dt| / R_final < {rest.threshold_pct_per_hour:g} %/h) {rest_text}")
 
 
 def _simulate_settling(args: argparse.Namespace) -> int:

@@ -110,9 +110,14 @@ def _spectrum(args: argparse.Namespace) -> int:
     print(f"  Welch: {s['n_segments']} segments of {s['segment_s']:.4g} s, resolution "
           f"{s['resolution_hz']:.3g} Hz, {', '.join(result.psd)}")
     print(f"  rule: {rule.text()}")
-    print(f"  f_signal = {result.f_signal:.4g} Hz (noise floor there "
-          f"{s['noise_floor_at_f_signal_per_hz']:.3g} /Hz); suggested cut-off "
-          f"{result.cutoff:.4g} Hz; the document: f_c,min >~ 8 Hz, f_c = 20 Hz (sec. 4.3.1)")
+    if s["no_line"]:
+        print(f"  {s['no_line']}; no cut-off suggested (the document: f_c = 20 Hz, "
+              "sec. 4.3.1)")
+    else:
+        print(f"  f_signal = {result.f_signal:.4g} Hz (noise floor there "
+              f"{s['noise_floor_at_f_signal_per_hz']:.3g} /Hz); suggested cut-off "
+              f"{result.cutoff:.4g} Hz; the document: f_c,min >~ 8 Hz, f_c = 20 Hz "
+              "(sec. 4.3.1)")
     for key, f in s["filters"].items():
         print(f"  {key} {f['cutoff_hz']:.4g} Hz: gain at f_signal {f['gain_at_f_signal_db']:.3g} "
               f"dB, noise floor above f_signal passed {f['noise_rms_above_f_signal_passed']:.3g}"
@@ -125,8 +130,10 @@ def _spectrum(args: argparse.Namespace) -> int:
               "seconds": time.perf_counter() - t0}
     with atomic_folder(args.out, args.force, SPECTRUM_FILES) as tmp:
         write_json(report, tmp / "spectrum.json")
-        result.plot(f"{args.input.name}: Welch PSD, suggested cut-off "
-                    f"{result.cutoff:.3g} Hz").savefig(tmp / "spectrum.png", dpi=110)
+        title = (f"{args.input.name}: Welch PSD, no spectral line above the margin, no "
+                 "cut-off" if s["no_line"] else
+                 f"{args.input.name}: Welch PSD, suggested cut-off {result.cutoff:.3g} Hz")
+        result.plot(title).savefig(tmp / "spectrum.png", dpi=110)
     print(f"wrote {args.out / 'spectrum.json'} and spectrum.png "
           f"({time.perf_counter() - t0:.1f} s)")
     return 0

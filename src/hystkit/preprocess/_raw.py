@@ -173,7 +173,7 @@ class PreprocessReport:
         One merged 4-level channel, or separate A and B channels.
     encoder_levels, encoder_levels_end : list of float
         The four levels at the start and, tracked, at the end [V] (for A/B channels the
-        codes 0, 1, 2, 3).
+        codes 0, 1, 2, 3, not voltages).
     encoder_dwell_samples : int
         The encoder dwell [samples].
     n_edges : int
@@ -198,6 +198,9 @@ class PreprocessReport:
         The :class:`RawDataWarning` messages issued.
     seconds : float
         Wall time of the run [s].
+    encoder_thresholds_v : list of float or None
+        For A/B channels, the logic threshold of ``enc_a`` and of ``enc_b`` [V] (midway
+        between each channel's two levels); None for a merged channel.
     """
 
     source: str
@@ -226,6 +229,7 @@ class PreprocessReport:
     v0_max_v: float | None = None
     warnings: list[str] = field(default_factory=list)
     seconds: float = 0.0
+    encoder_thresholds_v: list[float] | None = None
 
     def to_dict(self) -> dict:
         """The report as a JSON-ready dict."""
@@ -402,7 +406,8 @@ def _finish(reader: RawReader, settings: PreprocessSettings, mid: np.ndarray, t0
         r1_mean_ohm=float(r1.mean()), r2_mean_ohm=float(r2.mean()),
         symmetry=gauge_symmetry(r1, r2), clipped={k: c for k, (c, _) in clipped.items()},
         **supply.fields(), warnings=notes,
-        seconds=_time.perf_counter() - t_start)
+        seconds=_time.perf_counter() - t_start,
+        encoder_thresholds_v=None if logic is None else [float(v) for v in logic])
     return PreprocessResult(recording, {"r1": r1, "r2": r2, "dr1": dr1, "dr2": dr2}, report)
 
 

@@ -100,9 +100,11 @@ class Spectrum:
     floor : numpy.ndarray, shape (m,)
         The differential's local noise floor [1/Hz].
     f_signal, cutoff : float
-        The rule's highest signal line and suggested cut-off [Hz].
+        The rule's highest signal line and suggested cut-off [Hz]; NaN when no line stands
+        above the margin (a broadband signal or noise: ``summary["no_line"]`` says why).
     response : dict of str to numpy.ndarray
-        Cut-off label -> zero-phase amplitude response ``|H|^2`` on `freq`.
+        Cut-off label -> zero-phase amplitude response ``|H|^2`` on `freq` (the suggested
+        cut-off's only when there is one).
     rule : CutoffRule
         The rule applied.
     fs : float
@@ -144,24 +146,29 @@ class Spectrum:
         ax.loglog(f, self.floor[keep], "k--", lw=0.8, label="noise floor (differential)")
         ax.loglog(f, self.floor[keep] * 10 ** (self.rule.margin_db / 10), "k:", lw=0.8,
                   label=f"floor + {self.rule.margin_db:g} dB")
-        ax.axvline(self.f_signal, color="tab:red", lw=0.8)
-        ax.text(self.f_signal, 0.02, f" f_signal {self.f_signal:.3g} Hz", color="tab:red",
-                transform=ax.get_xaxis_transform(), rotation=90, va="bottom")
+        if math.isfinite(self.f_signal):
+            ax.axvline(self.f_signal, color="tab:red", lw=0.8)
+            ax.text(self.f_signal, 0.02, f" f_signal {self.f_signal:.3g} Hz", color="tab:red",
+                    transform=ax.get_xaxis_transform(), rotation=90, va="bottom")
         # Far below the floor of the flat band only the decimation filter's edge remains.
         flat = keep & (self.freq <= 0.4 * self.fs)
         ax.set_ylim(bottom=max(ax.get_ylim()[0], 1e-3 * float(np.min(self.floor[flat]))))
         ax.set_xlabel("frequency [Hz]")
         ax.set_ylabel("PSD [1/Hz]")
-        twin = ax.twinx()
-        for (label, h), style in zip(self.response.items(), ("-", "-."), strict=False):
-            twin.semilogx(f, 20 * np.log10(np.maximum(h[keep], 1e-12)), style,
-                          color="tab:purple", lw=1.0, label=f"zero-phase Butterworth {label}")
-        twin.set_ylim(-120, 5)
-        twin.set_ylabel("filter |H|² [dB]")
-        lines = ax.get_legend_handles_labels()
-        more = twin.get_legend_handles_labels()
+        lines, more = ax.get_legend_handles_labels(), ([], [])
+        if self.response:  # no filter to draw when no line gave a cut-off and none is compared
+            twin = ax.twinx()
+            for (label, h), style in zip(self.response.items(), ("-", "-."), strict=False):
+                twin.semilogx(f, 20 * np.log10(np.maximum(h[keep], 1e-12)), style,
+                              color="tab:purple", lw=1.0,
+                              label=f"zero-phase Butterworth {label}")
+            twin.set_ylim(-120, 5)
+            twin.set_ylabel("filter |H|² [dB]")
+            more = twin.get_legend_handles_labels()
         ax.legend(lines[0] + more[0], lines[1] + more[1], fontsize=7, loc="lower left")
-        ax.set_title(title or f"Welch PSD; suggested cut-off {self.cutoff:.3g} Hz")
+        ax.set_title(title or (f"Welch PSD; suggested cut-off {self.cutoff:.3g} Hz"
+                               if math.isfinite(self.cutoff)
+                               else "Welch PSD; no spectral line above the margin, no cut-off"))
         return fig
 
 
@@ -278,14 +285,16 @@ def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float | None 
     Returns
     -------
     Spectrum
-        PSDs, noise floor, f_signal, the suggested cut-off and the filters' responses.
+        PSDs, noise floor, f_signal, the suggested cut-off and the filters' responses. When no
+        line stands `margin_db` above the floor (a broadband signal, pure noise or a flat
+        signal) f_signal and the cut-off are NaN and ``summary["no_line"]`` says why: the
+        spectrum is still shown, there is no line to pick a cut-off from.
 
     Raises
     ------
     ValueError
         Fewer than 3 segments (one or two leave single noise bins a few percent likely to pass
-        10 dB over the floor), no line stands `margin_db` above the floor (nothing to keep:
-        pure noise, or a flat signal), or the suggested cut-off is not below fs / 2.
+        10 dB over the floor), or the suggested cut-off is not below fs / 2.
     """
     rule = CutoffRule() if rule is None else rule
     names = [k for k in ("dr1", "dr2", "differential") if k in rows]
@@ -302,17 +311,20 @@ def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float | None 
     # Above the second bin: the first bins hold what is left of the mean and the drift.
     search = (freq >= 2 * df) & (freq <= f_max)
     above = search & (diff > floor * 10 ** (rule.margin_db / 10))
-    if not above.any():
-        raise ValueError(f"no spectral line stands {rule.margin_db:g} dB above the noise floor "
-                         f"between {2 * df:.3g} and {f_max:.3g} Hz: "
-                         + _why_no_line(duration, df, rule.floor_width_hz))
-    f_signal = float(freq[_last_line_peak(above, diff)])
+    no_line = None
+    if above.any():
+        f_signal = float(freq[_last_line_peak(above, diff)])
+    else:  # a broadband signal (or pure noise): the spectrum, but no cut-off to suggest
+        f_signal = math.nan
+        no_line = (f"no spectral line stands {rule.margin_db:g} dB above the noise floor "
+                   f"between {2 * df:.3g} and {f_max:.3g} Hz, so there is no line to pick a "
+                   f"cut-off from: " + _why_no_line(duration, df, rule.floor_width_hz))
     cutoff = rule.safety * f_signal
-    if not cutoff < fs / 2:
+    if not cutoff < fs / 2 and no_line is None:
         raise ValueError(f"suggested cut-off {cutoff:.3g} Hz is not below fs/2 = {fs / 2:.3g} Hz: "
                          "the signal reaches the top of the analysed band (analyse the raw file "
                          "at a higher rate)")
-    cutoffs, compare_skipped = {"suggested": cutoff}, None
+    cutoffs, compare_skipped = ({} if no_line else {"suggested": cutoff}), None
     # fs from time stamps can be 40.000000001 Hz: a 20 Hz comparison would sit at Nyquist.
     if compare_cutoff is not None and compare_cutoff != cutoff:
         if compare_cutoff < 0.5 * fs * (1 - 1e-6):
@@ -325,11 +337,14 @@ def spectrum(rows: dict[str, np.ndarray], fs: float, *, segment_s: float | None 
     summary = {
         "fs_hz": fs, "n_samples": int(np.shape(rows["differential"])[-1]),
         "segment_s": (2 * (freq.size - 1)) / fs, "n_segments": n_seg, "resolution_hz": df,
-        "f_signal_hz": f_signal, "suggested_cutoff_hz": cutoff,
-        "noise_floor_at_f_signal_per_hz": float(np.interp(f_signal, freq, floor)),
-        "filters": {key: _filter_summary(freq, fs, value, rule.order, f_signal, floor)
-                    for key, value in cutoffs.items()},
-        "compare_skipped": compare_skipped,
+        "f_signal_hz": None if no_line else f_signal,
+        "suggested_cutoff_hz": None if no_line else cutoff,
+        "noise_floor_at_f_signal_per_hz": (None if no_line
+                                           else float(np.interp(f_signal, freq, floor))),
+        "filters": {} if no_line else {
+            key: _filter_summary(freq, fs, value, rule.order, f_signal, floor)
+            for key, value in cutoffs.items()},
+        "compare_skipped": compare_skipped, "no_line": no_line,
     }
     return Spectrum(freq=freq, psd=dict(zip(names, psd, strict=True)), floor=floor,
                     f_signal=f_signal, cutoff=cutoff, response=response, rule=rule, fs=fs,
@@ -344,7 +359,7 @@ def _why_no_line(duration: float, df: float, floor_width_hz: float) -> str:
     """The likely cause of finding no line: a record too short to resolve it, or no signal."""
     bins = floor_width_hz / df
     if bins >= _FEW_FLOOR_BINS:
-        return "nothing to keep (pure noise or a flat signal?)"
+        return "the signal is a band, not lines (a broadband excitation), pure noise or flat"
     return (f"the record is short ({duration:.3g} s, frequency resolution {df:.2g} Hz): a "
             f"fundamental below {2 * df:.2g} Hz is outside the search, and the "
             f"{floor_width_hz:g} Hz running median spans only {bins:.0f} bins, which the "
