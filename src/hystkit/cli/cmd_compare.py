@@ -59,6 +59,9 @@ def _models(text: str | None) -> list[str]:
 
 def _sizes(pairs: list[str]) -> dict[str, int]:
     """``--size MODEL=N`` options; each size checked against its family's limits."""
+    if not names:
+        raise UsageError(f"--models {text!r} names no model; give one or more of "
+                         f"{', '.join(sorted(FAMILIES))}, separated by commas")
     from ..models import FAMILIES
 
     out = {}
