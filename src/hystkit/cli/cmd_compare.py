@@ -50,6 +50,9 @@ def _models(text: str | None) -> list[str]:
     if text is None:
         return sorted(FAMILIES)
     names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise UsageError(f"--models {text!r} names no model; give one or more of "
+                         f"{', '.join(sorted(FAMILIES))}, separated by commas")
     unknown = [n for n in names if n not in FAMILIES]
     if unknown:
         raise UsageError(f"unknown model(s) {', '.join(unknown)}; known: "
@@ -59,9 +62,6 @@ def _models(text: str | None) -> list[str]:
 
 def _sizes(pairs: list[str]) -> dict[str, int]:
     """``--size MODEL=N`` options; each size checked against its family's limits."""
-    if not names:
-        raise UsageError(f"--models {text!r} names no model; give one or more of "
-                         f"{', '.join(sorted(FAMILIES))}, separated by commas")
     from ..models import FAMILIES
 
     out = {}
