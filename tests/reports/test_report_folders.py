@@ -124,7 +124,7 @@ def test_select_names_the_winner_and_ranks(folders: dict[str, Path], page: Path)
     data = json.loads((folders["sel"] / "selection.json").read_text(encoding="utf-8"))
     text = page.read_text(encoding="utf-8")
     assert f"winner: {data['winner']['candidate']}" in text
-    ranking = next(t for t in tables(text) if t[0][:2] == ["candidate", "cv R²"])
+    ranking = next(t for t in tables(text) if t[0][:2] == ["candidate", "held-out R²"])
     assert [r[0] for r in ranking[1:]] == [r["candidate"] for r in data["ranking"]]
     assert [float(r[1]) for r in ranking[1:]] == pytest.approx(
         [r["cv_r2"] for r in data["ranking"]], abs=5e-5)

@@ -16,21 +16,29 @@ from hystkit.reports._select import Candidate, folds, select_model
 from hystkit.sensors import simulate_experiment
 
 
-def test_time_folds_partition_one_recording():
+def test_interleaved_folds_partition_one_recording_and_cover_its_range():
     rec = simulate_experiment("sine", 1)
-    pairs = folds([rec])
-    held = np.concatenate([h.sensor for _, h in pairs])
-    np.testing.assert_array_equal(held, rec.sensor)
-    for train, h in pairs:
-        assert len(train) == 2 and all(t.sensor.size + h.sensor.size < rec.n_samples + 1
-                                       for t in train)
+    fold_list = folds([rec])
+    assert len(fold_list) == 3
+    held = np.array([f.held for f in fold_list])
+    np.testing.assert_array_equal(held.sum(axis=0), np.ones(rec.n_samples))  # a partition
+    for f in fold_list:
+        assert f.scored is rec and f.train == [rec]
+        assert f.n_train == rec.n_samples - int(f.held.sum())
+        # held-out pieces are spread over the run: their positions lie inside the range the
+        # fold is fitted on (a block per fold would not: it would score extrapolation)
+        assert f.extrapolated() < _select.EXTRAPOLATION_NOTE
+        assert np.count_nonzero(np.diff(f.held.astype(int)) == 1) >= 3
 
 
 def test_leave_one_recording_out():
     recs = [simulate_experiment(n, 1) for n in ("sine", "noise", "chirp")]
-    pairs = folds(recs)
-    assert [h is r for (_, h), r in zip(pairs, recs, strict=True)] == [True] * 3
-    assert all(h not in train for train, h in pairs)
+    fold_list = folds(recs)
+    assert [f.scored is r for f, r in zip(fold_list, recs, strict=True)] == [True] * 3
+    assert all(f.held is None and f.scored not in f.train and len(f.train) == 2
+               for f in fold_list)
+    assert _select.protocol(recs) == "left-out recording"
+    assert _select.protocol(recs[:1]) == "interleaved cycles of the training recording"
 
 
 @pytest.mark.parametrize("name", sorted(FAMILIES))
@@ -71,20 +79,20 @@ def test_select_writes_the_winner_and_its_table(tmp_path, capsys):
     capsys.readouterr()
 
 
-def test_a_rest_block_trains_but_is_not_scored():
+def test_a_rest_piece_trains_but_is_not_scored():
     rec = simulate_experiment("sine", 1)
     still = rec.position.copy()
-    still[: rec.n_samples // 3 + 1] = 0.0  # the first block is at rest
-    pairs = folds([Recording(time=rec.time, sensor=rec.sensor, position=still)])
-    assert len(pairs) == 2
-    assert all(np.ptp(held.position) > 0 for _, held in pairs)
-    assert all(len(train) == 2 for train, _ in pairs)
+    held = folds([rec])[0].held
+    still[held] = 0.0  # every piece of the first fold is at rest
+    fold_list = folds([Recording(time=rec.time, sensor=rec.sensor, position=still)])
+    assert len(fold_list) == 2
+    assert all(np.ptp(still[f.held]) > 0 and not np.any(f.held & held) for f in fold_list)
 
 
 def test_a_winner_whose_refit_fails_gives_way_to_the_next(monkeypatch):
     rec = simulate_experiment("sine", 1)
     cands = [Candidate("mpl", 1, "direct", DEFAULT_CENTER),
-             Candidate("bobbio", 10, "direct", DEFAULT_CENTER)]
+             Candidate("pi", 10, "direct", DEFAULT_CENTER)]
     first, second = select_model([rec], cands)["ranking"]
     real_fit = _select.fit_compensator
 

@@ -294,6 +294,7 @@ def _warn_if_outside(flags: dict, data: Path) -> None:
 
 def _evaluate(args: argparse.Namespace) -> int:
     check_inputs_exist([args.model, args.data])
+    from ..compensation import verdict
     from ..io import check_output_path, read_recording, write_json, write_mat
 
     evaluate, load_compensator = _module.evaluate, _module.load_compensator
@@ -324,6 +325,9 @@ def _evaluate(args: argparse.Namespace) -> int:
     print(f"{'sensor loop area %':<20}{_fmt(scores['sensor_loop_area']):>12}")
     print(f"outside training: {_count(scores['n_sensor_outside'])} sensor samples, "
           f"{_count(scores['n_estimate_outside'])} estimates")
+    # the shared verdict, on the deployable scores: what a compensator in use would give
+    status, message = verdict(scores["r2"], scores["linear_r2"], f"{args.data}: deployable")
+    scores["verdict"], scores["verdict_message"] = status, message
     if args.json is not None:
         write_json(scores, args.json, force=args.force)
         print(f"wrote {args.json}")
@@ -333,6 +337,12 @@ def _evaluate(args: argparse.Namespace) -> int:
         else:
             write_json(scores, args.out, force=args.force)
         print(f"wrote {args.out}")
+    if status not in ("ok", "undetermined"):
+        print(f"hystkit: evaluate: {status.replace('_', ' ')}: {message}; on these data the "
+              f"{comp.model} compensator should not be used (the straight line, or another "
+              f"model from `hystkit select`, does better)", file=sys.stderr)
+        return GUARD_EXIT
+    print(f"verdict: {status} ({message})")
     return 0
 
 

@@ -1,4 +1,4 @@
-"""``hystkit select``: choose family x size x mode by cross-validation on training data."""
+"""``hystkit select``: choose family x size x mode x centring, validated the way it is used."""
 
 from __future__ import annotations
 
@@ -12,7 +12,6 @@ from ._common import (
     UsageError,
     add_read_options,
     deferred,
-    failures_exit,
     positive_int,
     read_options,
 )
@@ -47,34 +46,47 @@ def _select(args: argparse.Namespace) -> int:
     )
     from ..parallel import loading_meanwhile
     from ..reports import FIGURE_MODULES, candidates, folds, plot_selection, select_model
+    from ..reports._select import protocol
+    from ..reports._text_table import text_table
 
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
                       what="a model file")
     report = args.report or args.out.with_name(args.out.stem + "-selection")
     check_output_folder(report, SELECTION_FILES, args.force, inputs=args.data)
     recs = [read_recording(path, options=read_options(args, path)) for path in args.data]
-    cands = candidates(_models(args.models), _centers(args.centers))
+    fold_list = folds(recs)
+    fit_samples = min((f.n_train for f in fold_list), default=0)
+    cands = candidates(_models(args.models), _centers(args.centers), fit_samples=fit_samples,
+                       dt=recs[0].dt)
     t0 = time.perf_counter()
     print(f"selecting among {len(cands)} candidates on {', '.join(map(str, args.data))} "
-          f"(deployable held-out R², "
-          f"{'leave-one-recording-out' if len(recs) > 1 else 'blocked time folds'})")
-    n_pieces = len(cands) * len(folds(recs))
+          f"(deployable R² on held-out data: {protocol(recs)})")
     # while the workers run the map, this process loads the figure's matplotlib and numba for
     # the winner's refit
-    with executor_for(args, n_pieces) as executor, \
+    with executor_for(args, len(cands) * len(fold_list)) as executor, \
             loading_meanwhile(executor, FIGURE_MODULES, numba_ready=True):
         result = select_model(recs, cands, executor=executor, progress=print)
     rows = result["ranking"]
-    print(f"{'candidate':<32}{'cv R²':>8}{'min':>8}{'oracle':>8}{'line':>8}{'params':>7}"
-          f"{'AIC':>10}{'BIC':>10}  guards")
+    scored = [r for r in rows if "error" not in r]
+    print(text_table(
+        ("candidate", "held-out R²", "min", "line", "oracle", "params", "AIC", "BIC", "verdict"),
+        [(r["candidate"], r["cv_r2"], r["cv_r2_min"], r["cv_linear_r2"], r["cv_r2_oracle"],
+          r["n_params"], r["aic"], r["bic"],
+          (r["guard_failed"] or r["verdict"]).replace("_", " ")) for r in scored],
+        digits=(0, 4, 4, 4, 4, 0, 1, 1, 0)))
+    print(f"  held-out R²: {result['protocol']}, mean over {len(fold_list)} fold(s); line: the "
+          f"straight line fitted on the same training samples; oracle: the paper's protocol, "
+          f"n/a for tare/track (it replaces the offset being judged)")
     for r in rows:
         if "error" in r:
-            print(f"{r['candidate']:<32}  FAILED: {r['error']}")
-            continue
-        print(f"{r['candidate']:<32}{r['cv_r2']:>8.4f}{r['cv_r2_min']:>8.4f}"
-              f"{r['cv_r2_oracle']:>8.4f}{r['cv_linear_r2']:>8.4f}{r['n_params']:>7d}"
-              f"{r['aic']:>10.0f}{r['bic']:>10.0f}  {r['guard_failed'] or 'ok'}")
-    summary = {"winner": result["winner"], "folds": result["folds"], "ranking": rows,
+            print(f"  {r['candidate']}: FAILED: {r['error']}")
+        elif r.get("error_final"):
+            print(f"  {r['candidate']}: not taken: {r['error_final']}")
+    for caveat in result["caveats"]:
+        print(f"  note: {caveat}")
+    summary = {"winner": result["winner"], "protocol": result["protocol"],
+               "caveats": result["caveats"], "refusal": result["refusal"],
+               "folds": result["folds"], "ranking": rows,
                "seconds": time.perf_counter() - t0, "model_file": str(args.out)}
     # The report folder is published only after the winner's model file was: a failure on the
     # way leaves neither (the model file alone only if the folder's rename itself fails).
@@ -87,12 +99,15 @@ def _select(args: argparse.Namespace) -> int:
             save_compensator(result["compensator"], args.out, force=args.force)
     print(f"wrote {report / 'selection.json'}, .csv, .png ({summary['seconds']:.1f} s)")
     if result["winner"] is None:
-        print("hystkit: no candidate passed its guards; no model written", file=sys.stderr)
+        print(f"hystkit: select: no usable model, none written: {result['refusal']}",
+              file=sys.stderr)
         return GUARD_EXIT
     w = result["winner"]
-    print(f"winner: {w['candidate']} (held-out deployable R² {w['cv_r2']:.4f}, oracle "
-          f"{w['cv_r2_oracle']:.4f}, line {w['cv_linear_r2']:.4f}); wrote {args.out}")
-    return failures_exit([r["candidate"] for r in rows if "error" in r], "candidate(s)")
+    oracle = "" if w["cv_r2_oracle"] is None else f", oracle {w['cv_r2_oracle']:.4f}"
+    print(f"winner: {w['candidate']} (deployable R² {w['cv_r2']:.4f} on held-out data, "
+          f"{result['protocol']}; straight line {w['cv_linear_r2']:.4f}{oracle}); "
+          f"wrote {args.out}")
+    return 0
 
 
 def _default_center() -> str:
@@ -103,9 +118,11 @@ def _default_center() -> str:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``select``."""
-    p = sub.add_parser("select", help="choose model family, size and mode by cross-validation "
-                                      "on training recordings")
-    p.add_argument("data", type=Path, nargs="+", help="training recording(s), one rate")
+    p = sub.add_parser("select", help="choose model family, size, mode and centring, each "
+                                      "validated on held-out data as it will be used")
+    p.add_argument("data", type=Path, nargs="+", help="training recording(s), one rate; give one per run: each is then held out in "
+                        "turn (left-out recording), the only check of offsets that change "
+                        "between runs")
     p.add_argument("--out", type=Path, required=True, help="model JSON file of the winner")
     p.add_argument("--report", type=Path,
                    help="folder for selection.json/.csv/.png (default: OUT's name + -selection)")

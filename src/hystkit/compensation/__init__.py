@@ -24,5 +24,6 @@ __getattr__, __dir__ = lazy_exports(
                      "load_compensator", "save_compensator"),
      "_stream": ("StepOutput", "Stream", "StreamOutput", "StreamState", "advance"),
      "_sync": ("SyncExcitation", "sync_excitation"),
-     "_training_checks": ("check_excursion", "check_fitting_data")},
+     "_training_checks": ("check_excursion", "check_fitting_data"),
+     "_verdict": ("MIN_EXPLAINED", "verdict")},
     first=())

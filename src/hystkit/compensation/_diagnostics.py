@@ -16,6 +16,7 @@ from ..identification import FitResult
 from ..metrics import r2
 from ..models import Family
 from ._param_vector import flatten_params, named_floats
+from ._verdict import verdict
 
 __all__ = ["BOUND_TOLERANCE", "COLLAPSE_RATIO", "MIN_SAMPLES_PER_PARAM", "bound_flags",
            "error_steps", "errors_from_factor", "fit_status", "fixed_mask", "parameter_names",
@@ -148,19 +149,19 @@ def fit_status(estimate: np.ndarray, target: np.ndarray, line: np.ndarray,
                limited: bool = True) -> tuple[str, str]:
     """``(status, message)`` of a fit from its training estimate and the straight line's.
 
-    Status is the first that applies: ``collapsed`` (estimate constant), ``worse_than_line``
-    (training R² below the line's), ``on_bounds`` (search box hits, by name: see
-    :func:`bound_flags`; a model at its own limit is not on bounds), ``not_converged``,
-    ``no_limit`` (a model without the stability limit, ``limited`` False: fitted for study,
-    it may diverge on other data), else ``ok``.
+    Status is the first that applies: ``collapsed`` (estimate constant), ``no_signal`` or
+    ``worse_than_line`` (the shared verdict on the training data, :func:`~._verdict.verdict`),
+    ``on_bounds`` (search box hits, by name: see :func:`bound_flags`; a model at its own limit
+    is not on bounds), ``not_converged``, ``no_limit`` (a model without the stability limit,
+    ``limited`` False: fitted for study, it may diverge on other data), else ``ok``.
     """
-    r2_model, r2_line = r2(target, estimate), r2(target, line)
+    r2_model = r2(target, estimate)
     if np.std(estimate) < COLLAPSE_RATIO * np.std(target):
         return "collapsed", (f"the fitted model is constant (std of its estimate "
                              f"{np.std(estimate):.3g} against {np.std(target):.3g} of the target)")
-    if r2_model < r2_line:
-        return "worse_than_line", (f"training R² {r2_model:.4f} is below the straight line's "
-                                   f"{r2_line:.4f}")
+    status, message = verdict(r2_model, r2(target, line), "training")
+    if status != "ok":
+        return status, message
     if on_bounds:
         return "on_bounds", (f"{len(on_bounds)} parameter(s) on a bound of the search box: "
                              f"{', '.join(map(str, on_bounds))}")
@@ -170,4 +171,4 @@ def fit_status(estimate: np.ndarray, target: np.ndarray, line: np.ndarray,
         return "no_limit", (f"fitted without the stability limit (eq. 5.29, --no-limit; "
                             f"training R² {r2_model:.4f}): its Euler step can diverge on other "
                             f"data (sec. 5.3.3)")
-    return "ok", f"training R² {r2_model:.4f} (straight line {r2_line:.4f})"
+    return "ok", message

@@ -36,7 +36,7 @@ __all__ = ["compare_models", "format_compare", "generalization_matrix", "plot_ge
 # one family's code raises on odd data: one family never takes the others down.
 FAMILY_FAILURES = (Exception,)
 # Fit statuses (compensation guards) that make a model unusable, not merely suspicious.
-DISQUALIFYING = ("collapsed", "worse_than_line")
+DISQUALIFYING = ("collapsed", "no_signal", "worse_than_line")
 
 
 def _forward_scores(name: str, size: int | None, fit_rec: Recording,

@@ -156,19 +156,26 @@ def _select(folder: Path, content: ReportContent) -> None:
     if winner is None:
         section.add(note("No candidate passed its guards; no model was written.", "bad"))
     else:
+        oracle = winner.get("cv_r2_oracle")
         section.add(note(f"winner: {winner['candidate']} (held-out deployable R² "
-                         f"{winner['cv_r2']:.4f}, oracle {winner['cv_r2_oracle']:.4f}, straight "
-                         f"line {winner['cv_linear_r2']:.4f}); model file "
+                         f"{winner['cv_r2']:.4f}, straight line {winner['cv_linear_r2']:.4f}"
+                         f"{'' if oracle is None else f', oracle {oracle:.4f}'}); model file "
                          f"{data.get('model_file', 'not stored')}", "good"))
-    section.add(paragraph(f"{len(data['folds'])} fold(s): "
+    if data.get("refusal"):
+        section.add(note(data["refusal"], "bad"))
+    section.add(paragraph(f"Validation: {data.get('protocol', 'held-out folds')}; "
+                          f"{len(data['folds'])} fold(s): "
                           + "; ".join(f"train {', '.join(f['train'])} → test {f['test']}"
                                       for f in data["folds"])))
+    for caveat in data.get("caveats") or ():
+        section.add(note(caveat))
     ok = [r for r in rows if "error" not in r]
-    section.add(table(("candidate", "cv R²", "min", "oracle", "line", "params", "AIC", "BIC",
-                       "guards"),
-                      [(r["candidate"], r["cv_r2"], r["cv_r2_min"], r["cv_r2_oracle"],
-                        r["cv_linear_r2"], r["n_params"], _f(r["aic"], ".0f"),
-                        _f(r["bic"], ".0f"), r["guard_failed"] or "ok") for r in ok]))
+    section.add(table(("candidate", "held-out R²", "min", "line", "oracle", "params", "AIC",
+                       "BIC", "verdict"),
+                      [(r["candidate"], r["cv_r2"], r["cv_r2_min"], r["cv_linear_r2"],
+                        r["cv_r2_oracle"], r["n_params"], _f(r["aic"], ".0f"),
+                        _f(r["bic"], ".0f"),
+                        r["guard_failed"] or r.get("verdict", "ok")) for r in ok]))
     for r in rows:
         if "error" in r:
             section.add(note(f"{r['candidate']}: FAILED: {r['error']}", "bad"))

@@ -1,15 +1,28 @@
-"""``hystkit select``: family x size x mode (x centring) by cross-validation on training data.
+"""``hystkit select``: family x size x mode (x centring), validated the way it will be used.
 
-Only the training recordings are used: leave-one-recording-out when there are several, blocked
-time folds otherwise (each fold trains on the other blocks as separate recordings, so no state
-crosses a gap). The score is the *deployable* held-out R²; AIC / BIC of the fold fits are shown
-beside it, and a candidate whose fit fails its guards in any fold (collapsed, worse than the
-line) in most folds is ranked after every candidate that passes.
+Only the training recordings are used, and every candidate is scored the way a compensator is
+used on a *later* run: its estimate from the sensor alone, run from the start of a recording.
+
+- Several recordings: **left-out recording**. Each recording is held out in turn; the
+  candidate is fitted on the others and run on it. A ``tare`` candidate is tared at the held-out
+  recording's own rest position (its position during the tare window), as a user tares at the
+  pose they know. This is the only protocol that sees an offset that changes between runs.
+- One recording: **interleaved cycles of the training recording**. The recording is cut into
+  ``N_SEGMENTS`` pieces; fold k holds out every third piece from the k-th, so every fold's
+  training part covers the input range the held-out part meets (one block per fold would score
+  extrapolation instead). The candidate is fitted with zero weight on its held-out pieces,
+  run over the whole recording from its start (where ``tare`` tares) and scored on the
+  held-out samples only. An offset that changes between runs is invisible to it: the output
+  says so.
+
+The score is the held-out deployable R² (mean over the folds); the straight line beside it is
+fitted on the same training samples. A candidate wins only if it beats its straight line and
+explains the position (the shared verdict, :func:`hystkit.compensation.verdict`), and only if
+its refit on all the data passes the fit's guards.
 """
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -17,21 +30,38 @@ import numpy as np
 from matplotlib.figure import Figure
 from threadpoolctl import threadpool_limits
 
-from ..compensation import DEFAULT_CENTER, check_fitting_data, evaluate, fit_compensator
-from ..errors import FitDivergedError
+from ..compensation import DEFAULT_CENTER, check_fitting_data, fit_compensator, verdict
+from ..compensation._diagnostics import MIN_SAMPLES_PER_PARAM
+from ..compensation._training_checks import count_fitted
 from ..io import Recording
+from ..metrics import r2
 from ..models import FAMILIES, get_family
 from ..parallel import Executor, SerialExecutor, fit_cost
 from ._compare import DISQUALIFYING, FAMILY_FAILURES
 
-__all__ = ["Candidate", "candidates", "folds", "plot_selection", "select_model"]
+__all__ = ["PROTOCOLS", "Candidate", "Fold", "admissible_size", "candidates", "fold_scores",
+           "folds", "fits_in", "plot_selection", "protocol", "select_model"]
 
-N_TIME_FOLDS = 3
+N_FOLDS = 3
+# Pieces of one recording: N_FOLDS interleaved sets of N_SEGMENTS / N_FOLDS each.
+N_SEGMENTS = 12
+# Shortest piece worth holding out (fewer samples: fewer pieces).
+MIN_SEGMENT = 20
+PROTOCOLS = {"recordings": "left-out recording",
+             "cycles": "interleaved cycles of the training recording"}
+ONE_RUN_CAVEAT = ("one recording: an offset that changes between runs is invisible to this "
+                  "validation; give several recordings (one per run) to see it")
+# A fold whose held-out positions lie this much outside its training range measures
+# extrapolation, not use; the output says so.
+EXTRAPOLATION_NOTE = 0.05
+# Refits tried, best first, before select gives up on the candidates whose refit fails.
+MAX_REFITS = 5
+_WEIGHTS = "select: training samples of the fold"
 
 
 @dataclass(frozen=True)
 class Candidate:
-    """One model configuration that :func:`select_model` cross-validates.
+    """One model configuration that :func:`select_model` validates.
 
     Parameters
     ----------
@@ -55,8 +85,145 @@ class Candidate:
         return f"{self.model}:{self.size}:{self.mode}:{self.center}"
 
 
+@dataclass(frozen=True)
+class Fold:
+    """One validation fold: fit on ``train``, run on ``scored``, score ``held`` samples.
+
+    Parameters
+    ----------
+    train : list of Recording
+        The recordings the fold's fits see.
+    scored : Recording
+        The recording the fitted compensator is run on, from its start.
+    held : numpy.ndarray of bool or None
+        The samples of `scored` that are scored and that the fit does not see (weight zero);
+        None: all of `scored`, a recording the fit never saw.
+    label : str
+        What is held out, for the outputs.
+    """
+
+    train: list[Recording]
+    scored: Recording
+    held: np.ndarray | None
+    label: str
+
+    @property
+    def n_train(self) -> int:
+        """Samples the fold's fit is fitted on."""
+        if self.held is not None:
+            return int(np.count_nonzero(~self.held))
+        return sum(r.n_samples for r in self.train)
+
+    def extrapolated(self) -> float:
+        """Share of the held-out positions outside the range of the fold's training positions
+        (the measurand's range: a sensor's offset may differ between runs, its range not)."""
+        if self.held is None:
+            lo = min(float(r.position.min()) for r in self.train)
+            hi = max(float(r.position.max()) for r in self.train)
+            p = self.scored.position
+        else:
+            lo, hi = (float(f(self.scored.position[~self.held])) for f in (np.min, np.max))
+            p = self.scored.position[self.held]
+        return float(np.mean((p < lo) | (p > hi)))
+
+
+def protocol(recordings: Sequence[Recording]) -> str:
+    """The validation protocol's name for these training recordings (:data:`PROTOCOLS`).
+
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        The training recordings.
+
+    Returns
+    -------
+    str
+    """
+    return PROTOCOLS["recordings" if len(recordings) > 1 else "cycles"]
+
+
+def folds(recordings: Sequence[Recording]) -> list[Fold]:
+    """The validation folds of the training recordings; see the module docstring.
+
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        The training recordings (at least one).
+
+    Returns
+    -------
+    list of Fold
+        One per recording for several (leave-one-recording-out); for one, ``N_FOLDS``
+        interleaved sets of pieces. A fold whose held-out position does not move (a rest
+        period) cannot be scored by R² and is left out; its samples still train.
+    """
+    if len(recordings) > 1:
+        return [Fold([r for j, r in enumerate(recordings) if j != i], held, None,
+                     f"recording {held.source}")
+                for i, held in enumerate(recordings)]
+    rec = recordings[0]
+    n_pieces = max(N_FOLDS, min(N_SEGMENTS, rec.n_samples // MIN_SEGMENT))
+    piece = np.minimum(np.arange(rec.n_samples) * n_pieces // rec.n_samples, n_pieces - 1)
+    out = []
+    for k in range(N_FOLDS):
+        held = piece % N_FOLDS == k
+        if np.ptp(rec.position[held]) > 0:
+            pieces = ", ".join(str(i + 1) for i in range(k, n_pieces, N_FOLDS))
+            out.append(Fold([rec], rec, held, f"pieces {pieces} of {n_pieces} of {rec.source}"))
+    return out
+
+
+def fits_in(model: str, size: int, dt: float, n_samples: int) -> bool:
+    """Whether `n_samples` can fit the family at `size` (``MIN_SAMPLES_PER_PARAM`` samples per
+    fitted number; a size the family refuses cannot).
+
+    Parameters
+    ----------
+    model : str
+        A registered family name.
+    size : int
+        The family's size knob.
+    dt : float
+        Sample time [s] of the data.
+    n_samples : int
+        Samples the fit sees.
+
+    Returns
+    -------
+    bool
+    """
+    family = get_family(model)
+    try:
+        n_params = count_fitted(family, family.make_structure(dt, size))
+    except (ValueError, TypeError):
+        return False
+    return n_params is None or MIN_SAMPLES_PER_PARAM * n_params <= n_samples
+
+
+def admissible_size(model: str, dt: float, n_samples: int) -> int | None:
+    """Largest size up to the family's default that `n_samples` can fit (:func:`fits_in`),
+    or None if not even size 1 can.
+
+    Parameters
+    ----------
+    model : str
+        A registered family name.
+    dt : float
+        Sample time [s] of the data.
+    n_samples : int
+        Samples the smallest fit will see.
+
+    Returns
+    -------
+    int or None
+    """
+    return next((size for size in range(get_family(model).default_size, 0, -1)
+                 if fits_in(model, size, dt, n_samples)), None)
+
+
 def candidates(models: Sequence[str] | None = None, centers: Sequence[str] = (DEFAULT_CENTER,),
-               extra_sizes: dict[str, Sequence[int]] | None = None) -> list[Candidate]:
+               extra_sizes: dict[str, Sequence[int]] | None = None, *,
+               fit_samples: int | None = None, dt: float | None = None) -> list[Candidate]:
     """Every family at its default size (and ``extra_sizes``), direct and, where one exists,
     inverse mode, for each centring.
 
@@ -68,6 +235,12 @@ def candidates(models: Sequence[str] | None = None, centers: Sequence[str] = (DE
         Centrings to try (as :class:`Candidate`).
     extra_sizes : dict of str to sequence of int, optional
         Sizes to try beside the default, per family name; None: ``{"mpl": (1, 3)}``.
+    fit_samples : int, optional
+        Samples the smallest fold fit sees: sizes needing more are dropped, and a family none
+        of whose sizes fits is tried at its largest admissible size (:func:`admissible_size`)
+        instead of vanishing. None: no limit.
+    dt : float, optional
+        Sample time [s], needed with `fit_samples`.
 
     Returns
     -------
@@ -84,76 +257,110 @@ def candidates(models: Sequence[str] | None = None, centers: Sequence[str] = (DE
     for name in sorted(FAMILIES) if models is None else models:
         family = get_family(name)
         sizes = sorted({family.default_size, *extra.get(name, ())})
+        if fit_samples is not None:
+            sizes = [size for size in sizes if fits_in(name, size, dt, fit_samples)] or [
+                size for size in [admissible_size(name, dt, fit_samples)] if size is not None]
         modes = ("direct", "inverse") if family.invert is not None else ("direct",)
         out += [Candidate(name, size, mode, center) for center in centers for size in sizes
                 for mode in modes]
     return out
 
 
-def folds(recordings: Sequence[Recording]) -> list[tuple[list[Recording], Recording]]:
-    """(training recordings, held-out recording) pairs; see the module docstring.
+def _fit_fold(cand: Candidate, fold: Fold, options: dict):
+    if fold.held is None:
+        return fit_compensator(fold.train, cand.size, model=cand.model, mode=cand.mode,
+                               center=cand.center, diagnose=False, **options)
+    return fit_compensator(fold.train, cand.size, model=cand.model, mode=cand.mode,
+                           center=cand.center, diagnose=False, weights=_WEIGHTS,
+                           other_columns=[{_WEIGHTS: (~fold.held).astype(float)}], **options)
+
+
+def fold_scores(comp, fold: Fold) -> dict:
+    """The fold's held-out scores of a compensator fitted on its training part.
 
     Parameters
     ----------
-    recordings : sequence of Recording
-        The training recordings (at least one).
+    comp : Compensator
+        Fitted on ``fold.train`` (with zero weight on ``fold.held``).
+    fold : Fold
+        The fold.
 
     Returns
     -------
-    list of (list of Recording, Recording)
-        Leave-one-recording-out pairs for several recordings; for one, three blocked time
-        folds (a block without motion only trains, it is never held out).
+    dict
+        ``r2`` (deployable), ``linear_r2`` (the straight line fitted on the fold's training
+        samples, same centring), ``r2_oracle`` (the paper's protocol; None unless the
+        centring is ``fit``: for ``tare`` / ``track`` the oracle replaces the very offset
+        being judged), ``aic`` / ``bic`` of the fit on its training samples.
     """
-    if len(recordings) > 1:
-        return [([r for j, r in enumerate(recordings) if j != i], held)
-                for i, held in enumerate(recordings)]
-    rec = recordings[0]
-    edges = np.linspace(0, rec.n_samples, N_TIME_FOLDS + 1).astype(int)
-    blocks = [_block(rec, a, b, k) for k, (a, b) in enumerate(itertools.pairwise(edges))]
-    # A block without motion (a rest period) cannot be scored by R²; it still trains.
-    return [([b for j, b in enumerate(blocks) if j != i], held) for i, held in enumerate(blocks)
-            if np.ptp(held.position) > 0]
+    rec = fold.scored
+    rest = None
+    if comp.center == "tare" and fold.held is None:
+        n_tare = max(1, round(comp.tare_seconds / rec.dt))
+        rest = float(np.mean(rec.position[:n_tare]))
+    guess = comp.estimate(rec, rest_position=rest)
+    if fold.held is None:
+        scored, line = slice(None), comp.estimate_linear(rec, rest_position=rest)
+    else:
+        scored = fold.held
+        s = comp.normalised_sensor(rec.sensor)
+        slope, intercept = np.polyfit(s[~scored], rec.position[~scored], 1)
+        line = slope * s + intercept
+    p = rec.position[scored]
+    out = {"r2": r2(p, guess[scored]), "linear_r2": r2(p, line[scored]), "r2_oracle": None}
+    if comp.center == "fit":
+        oracle = comp.oracle().estimate(rec, float(np.mean(rec.position)))
+        out["r2_oracle"] = r2(p, oracle[scored])
+    info = comp.fit_info
+    if fold.held is None:
+        out["aic"], out["bic"] = info["aic"], info["bic"]
+    else:
+        fit_part = ~fold.held
+        resid = (guess[fit_part] - rec.position[fit_part]) / comp.scaling.position_scale
+        n, k = resid.size, info["n_params"]
+        log_term = n * np.log(max(float(resid @ resid), 1e-300) / n)
+        out["aic"], out["bic"] = float(log_term + 2 * k), float(log_term + k * np.log(n))
+    return out
 
 
-def _block(rec: Recording, start: int, stop: int, k: int) -> Recording:
-    return Recording(time=rec.time[start:stop] - rec.time[start], sensor=rec.sensor[start:stop],
-                     position=rec.position[start:stop], source=f"{rec.source}[block {k + 1}]")
-
-
-def _score_fold(piece: tuple[Candidate, int, dict], *, pairs: Sequence) -> dict:
+def _score_fold(piece: tuple[Candidate, int, dict], *, fold_list: Sequence[Fold]) -> dict:
     """One candidate fitted on one fold's training part and scored on its held-out part."""
     cand, k, options = piece
-    train, held = pairs[k]
+    fold = fold_list[k]
     try:
-        comp = fit_compensator(train, cand.size, model=cand.model, mode=cand.mode,
-                               center=cand.center, diagnose=False, **options)
-        s = evaluate(comp, held)
-        if s["r2"] is None:  # evaluate gives None where R² is undefined or overflowed
-            raise FitDivergedError(f"{held.source}: held-out R² undefined for this fit")
+        comp = _fit_fold(cand, fold, options)
+        scores = fold_scores(comp, fold)
+        if not np.isfinite(scores["r2"]):
+            raise ValueError(f"{fold.label}: held-out R² undefined for this fit")
     except FAMILY_FAILURES as exc:
         return {"error": f"{type(exc).__name__}: {exc}"}
-    info = comp.fit_info
-    return {"r2": s["r2"], "r2_oracle": s["r2_oracle"], "linear_r2": s["linear_r2"],
-            "aic": info["aic"], "bic": info["bic"], "status": info["status"],
-            "n_params": info["n_params"]}
+    return {**scores, "status": comp.fit_info["status"], "n_params": comp.fit_info["n_params"]}
 
 
-def _candidate_row(cand: Candidate, fold_rows: Sequence[dict]) -> dict:
-    """A candidate's cross-validation row from its folds (in fold order): the first failing
-    fold's error, or the means over the folds."""
+def _mean(values: Sequence[float | None]) -> float | None:
+    return None if any(v is None for v in values) else float(np.mean(values))
+
+
+def _candidate_row(cand: Candidate, fold_rows: Sequence[dict], where: str) -> dict:
+    """A candidate's validation row from its folds (in fold order): the first failing fold's
+    error, or the means over the folds and the shared verdict on them."""
     failed = next((f for f in fold_rows if "error" in f), None)
     if failed is not None:
         return {**_describe(cand), "error": failed["error"]}
     scores = [f["r2"] for f in fold_rows]
     statuses = [f["status"] for f in fold_rows]
-    # One bad fold (e.g. a block that is all rest) does not condemn a family; most folds do.
+    # One bad fold (e.g. a piece that is all rest) does not condemn a family; most folds do.
     failing = [st for st in statuses if st in DISQUALIFYING]
     bad = sorted(set(failing)) if 2 * len(failing) > len(statuses) else []
-    mean = lambda key: float(np.mean([f[key] for f in fold_rows]))
-    return {**_describe(cand), "cv_r2": float(np.mean(scores)), "cv_r2_min": float(min(scores)),
-            "cv_r2_oracle": mean("r2_oracle"), "cv_linear_r2": mean("linear_r2"),
-            "n_params": fold_rows[-1]["n_params"], "aic": mean("aic"), "bic": mean("bic"),
-            "fold_status": statuses, "guard_failed": ", ".join(bad) or None}
+    cv_r2, cv_line = float(np.mean(scores)), float(np.mean([f["linear_r2"] for f in fold_rows]))
+    status, message = verdict(cv_r2, cv_line, where)
+    return {**_describe(cand), "cv_r2": cv_r2, "cv_r2_min": float(min(scores)),
+            "cv_r2_oracle": _mean([f["r2_oracle"] for f in fold_rows]), "cv_linear_r2": cv_line,
+            "n_params": fold_rows[-1]["n_params"],
+            "aic": float(np.mean([f["aic"] for f in fold_rows])),
+            "bic": float(np.mean([f["bic"] for f in fold_rows])),
+            "fold_status": statuses, "guard_failed": ", ".join(bad) or None,
+            "verdict": status, "verdict_message": message}
 
 
 def _describe(cand: Candidate) -> dict:
@@ -163,17 +370,19 @@ def _describe(cand: Candidate) -> dict:
 
 def _rank_key(row: dict) -> tuple:
     if "error" in row:
-        return (2, 0.0)
-    return (1 if row["guard_failed"] else 0, -row["cv_r2"])
+        return (3, 0.0)
+    if row["guard_failed"]:
+        return (2, -row["cv_r2"])
+    return (0 if row["verdict"] == "ok" else 1, -row["cv_r2"])
 
 
 def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
                  executor: Executor | None = None,
                  progress: Callable[[str], None] = lambda _: None, **options) -> dict:
-    """Rank candidates by cross-validated deployable R²; refit the winner on all recordings.
+    """Rank candidates by validated deployable R²; refit the best usable one on all recordings.
 
     Every candidate x fold is one piece of work for `executor` (default: serial); the ranking
-    is the same whichever executor ran them. The winner's refit runs here.
+    is the same whichever executor ran them. The refit runs here.
 
     Parameters
     ----------
@@ -184,7 +393,7 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
     executor : Executor, optional
         Runs the pieces of work; None: serially, here.
     progress : callable, optional
-        Called with one line of text at the start and as each candidate is cross-validated
+        Called with one line of text at the start and as each candidate is validated
         (default: nothing).
     **options
         Passed to :func:`hystkit.compensation.fit_compensator` for every fit (e.g.
@@ -193,10 +402,13 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
     Returns
     -------
     dict
-        ``ranking`` (rows of candidate, cv_r2, cv_r2_min, cv_r2_oracle, cv_linear_r2, n_params,
-        aic, bic, fold_status, guard_failed, or error), ``folds`` (descriptions), ``winner``
-        (its row) and ``compensator`` (fitted on all recordings), or ``winner`` None when
-        every candidate failed.
+        ``protocol`` (its name, :data:`PROTOCOLS`), ``caveats`` (what this validation cannot
+        see), ``ranking`` (rows of candidate, cv_r2, cv_r2_min, cv_r2_oracle, cv_linear_r2,
+        n_params, aic, bic, fold_status, guard_failed, verdict, verdict_message; or error),
+        ``folds`` (descriptions), ``winner`` (its row) and ``compensator`` (fitted on all
+        recordings), or ``winner`` None with ``refusal`` (one line) when no candidate is
+        usable: none beats its straight line and a constant on the held-out data, or none's
+        refit passes the fit's guards.
 
     Raises
     ------
@@ -205,50 +417,84 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
         once before the folds. A candidate that fails in a fold is that candidate's error.
     """
     check_fitting_data(recordings)
-    pairs = folds(recordings)
+    fold_list = folds(recordings)
+    name = protocol(recordings)
     executor = executor or SerialExecutor()
-    progress(f"  {len(cands)} candidates x {len(pairs)} folds on {executor.describe()} ...")
-    pieces = [(c, k, options) for c in cands for k in range(len(pairs))]
-    folds_left = [len(pairs)] * len(cands)
+    progress(f"  {len(cands)} candidates x {len(fold_list)} folds ({name}) on "
+             f"{executor.describe()} ...")
+    pieces = [(c, k, options) for c in cands for k in range(len(fold_list))]
+    folds_left = [len(fold_list)] * len(cands)
 
     def fold_done(i: int, _: dict) -> None:
-        j = i // len(pairs)
+        j = i // len(fold_list)
         folds_left[j] -= 1
         if not folds_left[j]:
-            progress(f"  {cands[j].label}: cross-validated "
-                     f"({folds_left.count(0)}/{len(cands)})")
+            progress(f"  {cands[j].label}: validated ({folds_left.count(0)}/{len(cands)})")
 
-    fold_rows = executor.map(_score_fold, pieces, shared={"pairs": pairs}, on_done=fold_done,
-                             cost=lambda piece: fit_cost(piece[0].model, piece[0].size, sum(
-                                 rec.sensor.size for rec in pairs[piece[1]][0])))
-    rows = [_candidate_row(c, fold_rows[j * len(pairs):(j + 1) * len(pairs)])
-            for j, c in enumerate(cands)]
+    fold_rows = executor.map(_score_fold, pieces, shared={"fold_list": fold_list},
+                             on_done=fold_done, cost=lambda piece: fit_cost(
+                                 piece[0].model, piece[0].size, fold_list[piece[1]].n_train))
+    rows = [_candidate_row(c, fold_rows[j * len(fold_list):(j + 1) * len(fold_list)],
+                           f"held-out ({name})") for j, c in enumerate(cands)]
     rows.sort(key=_rank_key)
-    out = {"folds": [{"train": [r.source for r in train], "test": held.source}
-                     for train, held in pairs], "ranking": rows, "winner": None,
-           "compensator": None}
-    for row in rows:
-        if "error" in row or row["guard_failed"]:
-            continue
+    caveats = [] if len(recordings) > 1 else [ONE_RUN_CAVEAT]
+    worst = max((f.extrapolated() for f in fold_list), default=0.0)
+    if worst > EXTRAPOLATION_NOTE:
+        caveats.append(f"the folds cannot cover the range: up to {worst:.0%} of a fold's "
+                       f"held-out positions lie outside its training positions, so the scores "
+                       f"partly measure extrapolation")
+    out = {"protocol": name, "caveats": caveats,
+           "folds": [{"train": [r.source for r in f.train], "test": f.label,
+                      "extrapolated": f.extrapolated()} for f in fold_list],
+           "ranking": rows, "winner": None, "compensator": None, "refusal": None}
+    usable = [r for r in rows if "error" not in r and not r["guard_failed"]
+              and r["verdict"] == "ok"]
+    if not usable:
+        out["refusal"] = _refusal(rows, name)
+        return out
+    for row in usable[:MAX_REFITS]:
         try:
             # BLAS on one thread, as in every fold fit (on a worker or `SerialExecutor`): the
             # refit's standard errors take QR factors of chunks of (~1000 x n_params) rows,
             # too small for threads, and idle OpenBLAS threads spin (measured: the Preisach
             # refit 0.4 s with one thread, 0.8-3.4 s with two on a busy 2-core machine).
             with threadpool_limits(limits=1, user_api="blas"):
-                out["compensator"] = fit_compensator(list(recordings), row["size"],
-                                                     model=row["model"], mode=row["mode"],
-                                                     center=row["center"], **options)
+                comp = fit_compensator(list(recordings), row["size"], model=row["model"],
+                                       mode=row["mode"], center=row["center"], **options)
         except FAMILY_FAILURES as exc:
             row["error_final"] = str(exc)
             continue
-        out["winner"] = row
-        break
+        row["final_status"] = comp.fit_info["status"]
+        if comp.fit_info["status"] != "ok":
+            row["error_final"] = (f"its fit on all the data: {comp.fit_info['status']}: "
+                                  f"{comp.fit_info['status_message']}")
+            continue
+        out["winner"], out["compensator"] = row, comp
+        return out
+    out["refusal"] = (f"the best {min(len(usable), MAX_REFITS)} candidate(s) beat their "
+                      f"straight line held out, but none's fit on all the data passed its "
+                      f"guards (see error_final)")
     return out
 
 
+def _refusal(rows: Sequence[dict], name: str) -> str:
+    """Why no candidate can win, in one line."""
+    scored = [r for r in rows if "error" not in r]
+    if not scored:
+        return "every candidate failed in its folds (reasons in the table)"
+    best = max(scored, key=lambda r: r["cv_r2"])
+    if all(r["verdict"] == "no_signal" for r in scored):
+        return (f"no candidate explains the position on held-out data ({name}): the best, "
+                f"{best['candidate']}, has R² {best['cv_r2']:.4f}; check that the sensor "
+                f"column carries the measurand")
+    return (f"no candidate beats its straight line and a constant on held-out data ({name}): "
+            f"the best, {best['candidate']}, {best['verdict_message']}")
+
+
 def plot_selection(ranking: Sequence[dict]) -> Figure:
-    """Held-out deployable R² per candidate (oracle and straight line as markers).
+    """Held-out R² of every candidate as 1 - R² on a log scale (the deployable score, the
+    straight line and, where it means something, the oracle), so that close candidates are
+    told apart.
 
     Parameters
     ----------
@@ -258,20 +504,13 @@ def plot_selection(ranking: Sequence[dict]) -> Figure:
     Returns
     -------
     matplotlib.figure.Figure
-        One bar per candidate, grey where its fit failed its guards; R² below -0.5 is drawn
-        at -0.5.
+        One row per candidate, best at the top, its R² written beside each marker.
     """
+    from ._report_folders import plot_unexplained
+
     rows = [r for r in ranking if "error" not in r]
-    fig = Figure(figsize=(7, 0.3 * len(rows) + 1.5), layout="constrained")
-    ax = fig.subplots()
-    y = np.arange(len(rows))[::-1]
-    clip = lambda v: max(v, -0.5)
-    ax.barh(y, [clip(r["cv_r2"]) for r in rows],
-            color=["tab:gray" if r["guard_failed"] else "tab:blue" for r in rows],
-            label="deployable R² (mean over folds)")
-    ax.plot([clip(r["cv_r2_oracle"]) for r in rows], y, "k|", ms=10, label="oracle R²")
-    ax.plot([clip(r["cv_linear_r2"]) for r in rows], y, "rx", label="straight line")
-    ax.set(yticks=y, yticklabels=[r["candidate"] for r in rows], xlabel="held-out R²",
-           xlim=(min(0.0, *(clip(r["cv_r2"]) for r in rows)) if rows else 0.0, 1.0))
-    ax.legend(loc="lower left", fontsize="small")
-    return fig
+    return plot_unexplained(
+        [(r["candidate"] + ("" if r["verdict"] == "ok" and not r["guard_failed"] else " ✗"),
+          {"deployable (mean over folds)": r["cv_r2"], "straight line": r["cv_linear_r2"],
+           "oracle": r["cv_r2_oracle"]}) for r in rows],
+        "held-out 1 − R² (log scale, left is better; dashed: R² = 0; ✗: not usable)")
