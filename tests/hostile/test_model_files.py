@@ -63,7 +63,7 @@ CONTENT_CASES = [
     ("polarity-string", _set("polarity", "up"), ["polarity"]),
     ("polarity-two", _set("polarity", 2.0), ["key 'polarity'"]),
     ("tare-negative", _set("tare_seconds", -1.0), ["key 'tare_seconds'"]),
-    ("range-reversed", _set("training_range", [2.0, 1.0]), ["key 'training_range'"]),
+    ("range-reversed", _set("training_range", [0.5, -0.5]), ["key 'training_range'"]),
     ("unknown-family", _set("model", "nope"), ["model", "nope"]),
     ("model-not-string", _set("model", 3), ["model", "string"]),
     ("unknown-mode", _set("mode", "sideways"), ["mode"]),

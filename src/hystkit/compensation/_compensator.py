@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import FitDivergedError, InputError
 from ..io import Recording
+from ..io._recording import MAX_MAGNITUDE
 from ..models import Family, get_family
 from ._centring import (
     CENTERS,
@@ -36,7 +37,7 @@ from ._conventions import LinearBaseline, Scaling
 from ._modes import MODES
 
 __all__ = ["MAX_NORMALISED", "MODES", "POSITION_MARGIN", "SENSOR_MARGIN", "Compensator",
-           "LinearBaseline", "Scaling"]
+           "LinearBaseline", "Scaling", "runaway_kind", "runaway_samples"]
 
 # Use-time guards: a sensor sample is "outside" beyond this share of the training sensor range
 # on either side, an estimate beyond this share of the training position range.
@@ -215,20 +216,40 @@ class Compensator:
             except FitDivergedError as exc:  # the family's own guard: say which file and model
                 raise FitDivergedError(f"{recording.source}: the {self.model} compensator"
                                        f"{self._from()}: {exc}") from None
-            estimate = p * self.scaling.position_scale + self.position_offset(position_mean,
-                                                                               rest_position)
-        # Normalised data have |p| <= 1 in training; MAX_NORMALISED times that is no position
-        # estimate but a model that ran away (and would overflow every score).
-        bad = np.flatnonzero(~(np.abs(np.asarray(p, dtype=float)) <= MAX_NORMALISED)
-                             | ~np.isfinite(estimate))
+            offset = self.position_offset(position_mean, rest_position)
+            estimate = p * self.scaling.position_scale + offset
+        bad = runaway_samples(p, estimate, self.runaway_bounds(offset))
         if bad.size:
-            kind = "not finite" if not np.isfinite(estimate[bad[0]]) else (
-                f"{estimate[bad[0]]:.3g} mm, beyond {MAX_NORMALISED:g} times the training range")
             raise FitDivergedError(
                 f"{recording.source}: column 'sensor', sample {bad[0]}: the {self.model} "
-                f"compensator{self._from()} gives an estimate that is {kind} "
-                f"({bad.size} such samples)")
+                f"compensator{self._from()} gives an estimate that is "
+                f"{runaway_kind(estimate[bad[0]])} ({bad.size} such samples)")
         return estimate
+
+    def runaway_bounds(self, offset: float) -> tuple[float, float] | None:
+        """Estimates [mm] beyond these are refused as a runaway (:func:`runaway_samples`):
+        the training positions widened by ``MAX_NORMALISED`` times their extent, shifted
+        with the position offset in use; None if the model file does not know them.
+
+        Parameters
+        ----------
+        offset : float
+            The position offset [mm] added to the normalised estimate
+            (:meth:`position_offset`).
+
+        Returns
+        -------
+        tuple of float or None
+            ``(low, high)`` [mm].
+        """
+        if self.position_range is None:
+            return None
+        lo, hi = self.position_range
+        # a normalised estimate of MAX_NORMALISED at the stored scale, if the scale fits these
+        # positions (a fit writes their max |position - offset|, at most this extent)
+        pad = MAX_NORMALISED * max(hi - lo, abs(lo), abs(hi))
+        shift = offset - self.scaling.position_offset
+        return (lo + shift - pad, hi + shift + pad) if pad > 0 else None
 
     def _from(self) -> str:
         return "" if self.source is None else f" of {self.source}"
@@ -275,6 +296,57 @@ class Compensator:
         """Share of samples whose sensor value lies outside the range seen in training."""
         mask = self.sensor_outside(recording, margin)
         return None if mask is None else float(np.mean(mask))
+
+
+def runaway_samples(p: np.ndarray, estimate: np.ndarray,
+                    bounds: tuple[float, float] | None = None) -> np.ndarray:
+    """Indices of the samples the runaway guard refuses: the model's normalised output beyond
+    ``MAX_NORMALISED`` (normalised training data have |p| <= 1), or, after de-normalisation,
+    an estimate that is not finite, beyond ``MAX_MAGNITUDE`` mm (no recording could hold it)
+    or outside `bounds` (:meth:`Compensator.runaway_bounds`: a position scale that does not
+    fit the training positions).
+
+    Parameters
+    ----------
+    p : numpy.ndarray, shape (n,)
+        The model's output in normalised units.
+    estimate : numpy.ndarray, shape (n,)
+        The same de-normalised [mm].
+    bounds : tuple of float, optional
+        ``(low, high)`` [mm] the estimates must lie within; None: no such bound.
+
+    Returns
+    -------
+    numpy.ndarray of int
+        The refused samples' indices, in order (empty if none).
+    """
+    estimate = np.asarray(estimate, dtype=float)
+    # NaN fails every comparison: written so that it is refused too
+    ok = (np.abs(np.asarray(p, dtype=float)) <= MAX_NORMALISED) \
+        & (np.abs(estimate) <= MAX_MAGNITUDE)
+    if bounds is not None:
+        ok &= (estimate >= bounds[0]) & (estimate <= bounds[1])
+    return np.flatnonzero(~ok)
+
+
+def runaway_kind(value: float) -> str:
+    """What is wrong with a refused estimate [mm] (:func:`runaway_samples`), for messages.
+
+    Parameters
+    ----------
+    value : float
+        The first refused estimate [mm].
+
+    Returns
+    -------
+    str
+        ``"not finite"``, or its value and the bound it passes.
+    """
+    if not np.isfinite(value):
+        return "not finite"
+    if abs(value) > MAX_MAGNITUDE:
+        return f"{value:.3g} mm, beyond the largest magnitude {MAX_MAGNITUDE:g} of any recording"
+    return f"{value:.3g} mm, beyond {MAX_NORMALISED:g} times the training range"
 
 
 def check_training_data(recordings: Sequence[Recording]) -> None:

@@ -4,19 +4,34 @@ A model file is untrusted input: every value is checked for its JSON type, finit
 here, so that a bad file gives one error naming the file and the key path (``params.a``,
 ``structure.n_cells``), never a traceback from deep inside a family, and nothing is allocated
 for sizes nobody could have fitted.
+
+Then every number outside ``params`` is checked against the domain a fit writes it from
+(:func:`check_model_domain`): a recording holds magnitudes up to ``MAX_MAGNITUDE`` (1e100), so
+offsets lie within it and scales (max |.| of centred data) within ``[MIN_SCALE, MAX_SCALE]``;
+normalised quantities (training sensor range, straight line) within their normalised bounds;
+the sample time within the families' ``DT_RANGE``. A tampered
+``normalisation.position_scale = 1e308`` is refused here rather than turned into estimates of
+1e308 mm; a scale within the limits that does not fit the training positions is caught by the
+compensator's runaway guard, after de-normalisation. ``params`` are checked by each family
+against its own documented domain.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from collections.abc import Iterable, Iterator
 from typing import Any
 
 from ..errors import InputError
+from ..io._recording import MAX_MAGNITUDE
+from ..models._cells import DT_RANGE
+from ._compensator import MAX_NORMALISED
 
-__all__ = ["MAX_MODEL_BYTES", "MAX_PARAM_NUMBERS", "MAX_STRUCTURE_INT", "check_like",
-           "check_model_dict", "key_in_message"]
+__all__ = ["MAX_MODEL_BYTES", "MAX_PARAM_NUMBERS", "MAX_SCALE", "MAX_STRUCTURE_INT",
+           "MAX_WINDOW_SAMPLES", "MIN_SCALE", "check_keys", "check_like", "check_model_dict",
+           "check_model_domain", "key_in_message"]
 
 # A 10 000-cell mPL file is under 1 MB; anything far larger is not a model hystkit wrote.
 MAX_MODEL_BYTES = 16 * 2**20
@@ -26,6 +41,17 @@ MAX_PARAM_NUMBERS = 1_000_000
 # refused before the family allocates or loops over them (boucwen ``substeps: 1e12`` hangs).
 MAX_STRUCTURE_INT = 100_000
 
+# Scales are max |x - offset| of data with |x| <= MAX_MAGNITUDE: at most twice it. The lower
+# limit mirrors it: normalising a recording's sensor (|s| <= 1e100) by a scale of at least
+# 1e-100 stays finite (<= 2e200), where a subnormal scale gave inf and an internal error.
+MAX_SCALE = 2.0 * MAX_MAGNITUDE
+MIN_SCALE = 1.0 / MAX_MAGNITUDE
+# Tare window and tracker time constant, in samples of dt: beyond it the tracker's gain
+# 1 - exp(-dt / track_seconds) rounds to 0 (a 0/0 sensor level) and the window's sample count
+# stops being an integer a stream can hold.
+MAX_WINDOW_SAMPLES = 1e12
+# Relative slack of the normalised training range's bound 1 and of dt's two copies.
+_SLACK = 1e-9
 # Sections whose leaves are numbers only (strings are allowed in ``structure``).
 _NUMERIC_SECTIONS = ("params", "normalisation", "baseline")
 _OPTIONAL_NUMBERS = ("polarity", "tare_seconds", "track_seconds", "sensor_reference",
@@ -73,6 +99,103 @@ def check_model_dict(d: dict, source: str) -> None:
             _check_number(source, key, d[key])
 
 
+def check_model_domain(d: dict, source: str) -> None:
+    """Refuse numbers outside the domain a fit writes them from, naming the key path.
+
+    Runs after :func:`check_model_dict` (types and finiteness are known good). The limits are
+    in the module docstring; ``params`` are left to the family.
+
+    Parameters
+    ----------
+    d : dict
+        The model file's contents.
+    source : str
+        The file, for messages.
+
+    Raises
+    ------
+    InputError
+        ``"<source>: key 'normalisation.position_scale': ..."`` for the first value outside
+        its domain.
+    """
+    dt = d.get("structure", {}).get("dt")
+    for path, value in (("dt", d.get("dt")), ("structure.dt", dt)):
+        if value is not None:
+            _within(source, path, value, *DT_RANGE, "s: the sample times a model runs at")
+    if d.get("dt") is not None and dt is not None \
+            and abs(d["dt"] - dt) > _SLACK * abs(dt):
+        _fail(source, "dt", f"{d['dt']!r} s differs from structure.dt {dt!r} s (a fit writes "
+                            f"the same step to both)")
+    scaling = d.get("normalisation", {})
+    for name, value in scaling.items():
+        if name.endswith("_scale"):
+            _within(source, f"normalisation.{name}", value, MIN_SCALE, MAX_SCALE,
+                    "(a positive normal number: the max |.| of centred training data)")
+        else:
+            _within(source, f"normalisation.{name}", value, -MAX_MAGNITUDE, MAX_MAGNITUDE,
+                    "(the largest magnitude a recording may hold)")
+    for name, value in d.get("baseline", {}).items():
+        _within(source, f"baseline.{name}", value, -MAX_NORMALISED, MAX_NORMALISED,
+                "(normalised units)")
+    for i, value in enumerate(d.get("training_range") or []):
+        _within(source, f"training_range[{i}]", value, -1.0 - _SLACK, 1.0 + _SLACK,
+                "(the normalised training sensor, max |.| = 1 by eq. 5.10)")
+    for i, value in enumerate(d.get("position_range") or []):
+        _within(source, f"position_range[{i}]", value, -MAX_MAGNITUDE, MAX_MAGNITUDE,
+                "mm (the largest magnitude a recording may hold)")
+    for name in ("sensor_reference", "rest_position"):
+        if d.get(name) is not None:
+            _within(source, name, d[name], -MAX_MAGNITUDE, MAX_MAGNITUDE,
+                    "(the largest magnitude a recording may hold)")
+    step = dt if dt is not None else d.get("dt")
+    for name in ("tare_seconds", "track_seconds"):
+        if d.get(name) is not None:
+            high = MAX_WINDOW_SAMPLES * step if step is not None else math.inf
+            _within(source, name, d[name], _TINY, high,
+                    f"s (positive, at most {MAX_WINDOW_SAMPLES:g} samples of dt)")
+
+
+_TINY = float.fromhex("0x1p-1022")  # the smallest normal float
+
+
+def _within(source: str, path: str, value: float, low: float, high: float, why: str) -> None:
+    if not low <= value <= high:
+        _fail(source, path, f"{value!r} is outside [{low:g}, {high:g}] {why}")
+
+
+def check_keys(source: str, section: str, values: dict, record: type) -> None:
+    """The keys of `values` against the fields of the dataclass `record` it is built into:
+    a missing required field or an unknown key is named, never a constructor's TypeError.
+
+    Parameters
+    ----------
+    source : str
+        The file, for messages.
+    section : str
+        The key path of `values` (``"normalisation"``).
+    values : dict
+        The section's contents.
+    record : type
+        The dataclass built from them.
+
+    Raises
+    ------
+    InputError
+        ``"<source>: key 'normalisation.position_scale' is missing"`` or ``"... key
+        'normalisation.bogus': unknown key (expected ...)"``.
+    """
+    fields = [f for f in dataclasses.fields(record) if f.init]
+    names = [f.name for f in fields]
+    for f in fields:
+        required = (f.default is dataclasses.MISSING
+                    and f.default_factory is dataclasses.MISSING)
+        if required and f.name not in values:
+            raise InputError(f"{source}: key '{section}.{f.name}' is missing")
+    for key in values:
+        if key not in names:
+            _fail(source, f"{section}.{key}", f"unknown key (expected {', '.join(names)})")
+
+
 def check_like(source: str, section: str, values: dict, reference: dict) -> None:
     """Each value of `values` has the JSON kind (number, string, list) of the same key in
     `reference` (a family's default structure), so that ``n_cells: "abc"`` is named as such."""
@@ -95,11 +218,14 @@ def _kind(value: Any) -> str:
 
 
 def key_in_message(message: str, names: Iterable[str]) -> str | None:
-    """The first of `names` that `message` mentions as a word (the field an error is about)."""
+    """The one of `names` that `message` mentions first as a word (the field an error is
+    about: ``v_g must be positive (f and g ...)`` is about ``v_g``, not ``g``)."""
+    found = []
     for name in names:
-        if re.search(rf"(?<![\w.]){re.escape(name)}(?!\w)", message):
-            return name
-    return None
+        match = re.search(rf"(?<![\w.]){re.escape(name)}(?!\w)", message)
+        if match:
+            found.append((match.start(), -len(name), name))
+    return min(found)[2] if found else None
 
 
 def _leaves(value: Any, path: str) -> Iterator[tuple[str, Any]]:

@@ -29,7 +29,14 @@ from ..models import FAMILIES
 from ._centring import CENTERS
 from ._compensator import MODES, Compensator
 from ._conventions import LinearBaseline, Scaling
-from ._model_checks import MAX_MODEL_BYTES, check_like, check_model_dict, key_in_message
+from ._model_checks import (
+    MAX_MODEL_BYTES,
+    check_keys,
+    check_like,
+    check_model_dict,
+    check_model_domain,
+    key_in_message,
+)
 
 __all__ = [
     "MAT_JSON_KEY",
@@ -136,6 +143,10 @@ def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
     family = FAMILIES[d["model"]]
     check_like(source, "structure", d["structure"],
                family.make_structure(1.0, family.default_size).to_dict())
+    for section, record in (("structure", family.structure_type), ("normalisation", Scaling),
+                            ("baseline", LinearBaseline)):
+        check_keys(source, section, d[section], record)
+    check_model_domain(d, source)
     structure = _build(source, "structure", {name: "structure" for name in d["structure"]},
                        lambda: family.structure_type(**d["structure"]))
     params = _build(source, "params", {name: "params" for name in d["params"]},
@@ -146,7 +157,15 @@ def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
         scaling=Scaling(**d["normalisation"]), baseline=LinearBaseline(**d["baseline"]),
         fit_info=d.get("fit") or {}, training_range=_pair_or_none(d.get("training_range")),
         position_range=_pair_or_none(d.get("position_range")), model=d["model"],
-        source=source, **_optional(d)))
+        source=source, **_optional(d)), _defaulted(structure, d["structure"]))
+
+
+def _defaulted(structure: Any, given: dict) -> str:
+    """The structure fields a file left out (their defaults were used), to add to an error
+    about the model that they may explain (``params have 3 cells, structure has 1``)."""
+    missing = [f"structure.{k} (default {v!r})" for k, v in structure.to_dict().items()
+               if k not in given]
+    return f"; key {', '.join(missing)} missing from the file" if missing else ""
 
 
 def _sections(d: dict) -> dict[str, str]:
@@ -160,10 +179,10 @@ def _sections(d: dict) -> dict[str, str]:
 
 
 def _build(source: str, section: str, sections: dict[str, str],
-           make: Callable[[], Any]) -> Any:
+           make: Callable[[], Any], note: str = "") -> Any:
     """Run a family's (or the compensator's) constructor on checked values; whatever it
     raises becomes an InputError naming the key path: ``section.field`` when the message names
-    a field of `sections`, else `section` (none if that is "")."""
+    a field of `sections`, else `section` (none if that is ""); `note` is appended to it."""
     try:
         return make()
     except InputError:
@@ -178,7 +197,9 @@ def _build(source: str, section: str, sections: dict[str, str],
         name = key_in_message(message, sections)
         path = section if name is None else ".".join(filter(None, (sections[name], name)))
         where = f"key {path!r}: " if path else "invalid model contents: "
-        raise InputError(f"{source}: {where}{message}") from None
+        if not path and "params" in message and "structure" in message:
+            where = "keys 'structure' and 'params' do not fit together: "
+        raise InputError(f"{source}: {where}{message}{note}") from None
 
 
 def _pair_or_none(value: list | None) -> tuple | None:

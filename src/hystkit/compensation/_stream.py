@@ -22,7 +22,6 @@ Start-up (``start``):
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
@@ -31,7 +30,15 @@ import numpy as np
 
 from ..errors import FitDivergedError, InputError
 from ._centring import ORACLE_CENTER
-from ._compensator import MAX_NORMALISED, POSITION_MARGIN, SENSOR_MARGIN, Compensator
+from ..io._recording import MAX_MAGNITUDE
+from ._compensator import (
+    MAX_NORMALISED,
+    POSITION_MARGIN,
+    SENSOR_MARGIN,
+    Compensator,
+    runaway_kind,
+    runaway_samples,
+)
 from ._sync import sync_excitation
 
 __all__ = ["StartUp", "StepOutput", "Stream", "StreamOutput", "StreamState", "advance",
@@ -126,6 +133,7 @@ class _Path:
     position_offset: float = field(init=False)
     sensor_bounds: tuple[float, float] | None = field(init=False)
     estimate_bounds: tuple[float, float] | None = field(init=False)
+    runaway_bounds: tuple[float, float] | None = field(init=False)
 
     def __post_init__(self) -> None:
         comp, dt = self.comp, self.comp.structure.dt
@@ -133,6 +141,7 @@ class _Path:
                   "track_gain": float(1.0 - np.exp(-dt / comp.track_seconds)),
                   "position_offset": comp.position_offset(None, self.rest_position),
                   "sensor_bounds": None, "estimate_bounds": None}
+        values["runaway_bounds"] = comp.runaway_bounds(values["position_offset"])
         # Compensator.sensor_outside / estimate_outside: outside [lo - pad, hi + pad]
         if comp.training_range is not None:
             lo, hi = comp.training_range
@@ -274,7 +283,7 @@ def advance_scaled(path: _Path, state: StreamState, sensor: np.ndarray,
             raise FitDivergedError(f"{label}: {where}: the {comp.model} compensator"
                                    f"{_of(comp)}: {exc}") from None
         estimate = p * comp.scaling.position_scale + path.position_offset
-    _check_runaway(comp, p, estimate, state.n_samples, label)
+    _check_runaway(path, p, estimate, state.n_samples, label)
     nxt = StreamState(x_end, state.n_samples + s.size, **centring)
     return StreamOutput(estimate, *_flags(path, s, estimate)), nxt, s
 
@@ -339,17 +348,15 @@ def _tare_level(n_tare: int, state: StreamState, s: np.ndarray) -> tuple[np.ndar
     return level, total
 
 
-def _check_runaway(comp: Compensator, p: np.ndarray, estimate: np.ndarray, first: int,
+def _check_runaway(path: _Path, p: np.ndarray, estimate: np.ndarray, first: int,
                    label: str) -> None:
-    # The guard of Compensator.estimate: |p| beyond MAX_NORMALISED is a model that ran away.
-    bad = np.flatnonzero(~(np.abs(np.asarray(p, dtype=float)) <= MAX_NORMALISED)
-                         | ~np.isfinite(estimate))
+    # The guard of Compensator.estimate, after de-normalisation as there.
+    comp = path.comp
+    bad = runaway_samples(p, estimate, path.runaway_bounds)
     if bad.size:
-        value = estimate[bad[0]]
-        kind = "not finite" if not np.isfinite(value) else (
-            f"{value:.3g} mm, beyond {MAX_NORMALISED:g} times the training range")
         raise FitDivergedError(f"{label}: sample {first + bad[0]}: the {comp.model} "
-                               f"compensator{_of(comp)} gives an estimate that is {kind}")
+                               f"compensator{_of(comp)} gives an estimate that is "
+                               f"{runaway_kind(estimate[bad[0]])}")
 
 
 def _flags(path: _Path, s: np.ndarray | float,
@@ -415,8 +422,10 @@ def _advance_one(path: _Path, state: StreamState, v: float, label: str,
                                    f"compensator{_of(comp)}: {exc}") from None
     p = float(p_run[0])
     estimate = p * comp.scaling.position_scale + path.position_offset
-    if not (abs(p) <= MAX_NORMALISED and math.isfinite(estimate)):
-        _check_runaway(comp, np.array([p]), np.array([estimate]), state.n_samples, label)
+    bounds = path.runaway_bounds
+    if not (abs(p) <= MAX_NORMALISED and abs(estimate) <= MAX_MAGNITUDE
+            and (bounds is None or bounds[0] <= estimate <= bounds[1])):
+        _check_runaway(path, np.array([p]), np.array([estimate]), state.n_samples, label)
     nxt = StreamState(x_end, state.n_samples + 1, tare_sum, track_value, track_weight)
     return StepOutput(estimate, *_flags(path, s, estimate)), nxt, _Previous(nxt, state.x, s)
 
