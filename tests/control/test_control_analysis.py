@@ -42,7 +42,10 @@ def test_document_gains_give_the_documents_crossovers():
     assert_allclose(b.crossover_hz, 5.0, rtol=0.05)
     assert a.closed_loop_stable and b.closed_loop_stable
     assert 70 < a.phase_margin_deg < 85 and 80 < b.phase_margin_deg < 90
-    assert a.gain_margin_db is None  # the phase never returns to -180 deg above crossover
+    # the ZOH turns the phase through -180 deg near 495 Hz (issue 25: by hand and by root
+    # locus, Kp x 31.5 and x 128 put a pole on the unit circle; tests/control/test_gain_margin.py)
+    assert_allclose([a.gain_margin_db, b.gain_margin_db], [29.96, 42.14], atol=0.005)
+    assert_allclose([a.phase_crossover_hz, b.phase_crossover_hz], [494.6, 495.9], atol=0.05)
 
 
 def test_open_loop_of_the_linear_loop_is_c_times_p():

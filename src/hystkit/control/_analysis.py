@@ -178,7 +178,9 @@ class LoopMargins:
     phase_margin_deg : float or None
         Phase margin at the crossover [deg]; None without a crossover.
     gain_margin_db : float or None
-        Gain margin [dB]; None when the phase never crosses -180 deg (infinite gain margin).
+        Gain margin ``-20 log10 |L|`` [dB] at the phase crossing (``arg L = -180`` deg) that
+        limits the gain from above (see :func:`loop_margins`; negative for an unstable loop
+        whose gain is too high); None when no crossing limits it (infinite gain margin).
     phase_crossover_hz : float or None
         Phase-crossover frequency [Hz] at which the gain margin is read.
     closed_loop_stable : bool
@@ -269,13 +271,39 @@ def _grid(ts: float, f_min: float = 1e-3, n: int = 4000) -> np.ndarray:
     return np.geomspace(f_min, 0.999 * 0.5 / ts, n)
 
 
+def _gain_margin(h, f: np.ndarray, resp: np.ndarray,
+                 unstable: bool) -> tuple[float | None, float | None]:
+    """Gain margin [dB] and its phase-crossover frequency [Hz] (see :func:`loop_margins`)."""
+    im = resp.imag
+    margins = []  # (gain margin [dB], frequency [Hz]) at each crossing of arg L = -180 mod 360
+    for j in np.nonzero(np.sign(im[:-1]) != np.sign(im[1:]))[0]:
+        if resp[j].real >= 0 and resp[j + 1].real >= 0:
+            continue  # arg L = 0: the Nyquist curve crosses the positive real axis
+        f_pc = brentq(lambda x: h(x).imag, f[j], f[j + 1], xtol=1e-12 * f[j])
+        h_pc = h(f_pc)
+        if h_pc.real < 0 and h_pc != 0:
+            margins.append((float(-20 * np.log10(abs(h_pc))), float(f_pc)))
+    above = [m for m in margins if m[0] > 0]
+    if above:
+        return min(above)
+    if unstable and margins:  # the gain is too high: the reduction back to the last crossing
+        return max(margins)
+    return None, None
+
+
 def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargins:
     """Margins of :func:`open_loop` and closed-loop stability of the linearised loop.
 
     The crossover is the highest frequency with ``|L| = 1`` and the phase margin is
-    ``180 + arg L`` there; the gain margin is ``-|L|`` in dB at the first phase crossing
-    (``arg L = -180`` mod 360) above the crossover. Crossings are found on a 4000-point log grid
-    (1 mHz to Nyquist) and refined by root finding on the exact frequency response.
+    ``180 + arg L`` there. The gain margin is ``-20 log10 |L|`` at a phase crossing
+    (``arg L = -180`` mod 360, where a gain ``1 / |L|`` puts a closed-loop pole on the unit
+    circle): the crossing with the largest ``|L| < 1``, the factor by which the gain can grow
+    (a crossing with ``|L| > 1``, e.g. the low-frequency one of a double integrator with
+    integral action, bounds the gain from below and is not the margin). An unstable loop
+    without such a crossing has too much gain: its margin is negative, read at the crossing
+    with the smallest ``|L| > 1`` (the reduction back to it). Crossings are found on a
+    4000-point log grid (1 mHz to Nyquist) and refined by root finding on the exact frequency
+    response.
     python-control's ``stability_margins`` is not used: the loop's three poles at ``z = 1``
     (plant and integrator) make its polynomial method fall back to a grid that returns
     spurious low-frequency crossings.
@@ -304,19 +332,12 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
     # |L| = 0 exactly when the compensator is constant (a collapsed fit): no crossover
     log_mag = np.log(np.maximum(np.abs(resp), np.finfo(float).tiny))
     cross = np.nonzero(np.sign(log_mag[:-1]) != np.sign(log_mag[1:]))[0]
-    f_c = pm = gm = f_pc = None
+    f_c = pm = None
     if cross.size:
         i = cross[-1]
         f_c = brentq(lambda x: np.log(abs(h(x))), f[i], f[i + 1], xtol=1e-12 * f[i])
         pm = float(np.degrees(np.angle(-h(f_c))))
-        # phase crossings: Im(-L) changes sign while Re(-L) > 0, i.e. arg L = -180 mod 360
-        im = (-resp).imag
-        above = [j for j in np.nonzero(np.sign(im[:-1]) != np.sign(im[1:]))[0]
-                 if f[j] >= f_c and (-resp[j]).real < 0]
-        if above:
-            j = above[0]
-            f_pc = brentq(lambda x: (-h(x)).imag, f[j], f[j + 1], xtol=1e-12 * f[j])
-            gm = float(-20 * np.log10(abs(h(f_pc))))
+    gm, f_pc = _gain_margin(h, f, resp, unstable=growth_time is not None)
     return LoopMargins(crossover_hz=f_c, phase_margin_deg=pm, gain_margin_db=gm,
                        phase_crossover_hz=f_pc, closed_loop_stable=stable,
                        max_pole_radius=radius,
