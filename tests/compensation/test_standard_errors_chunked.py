@@ -7,7 +7,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from hystkit.compensation._chunked_errors import chunked_standard_errors
-from hystkit.compensation._diagnostics import standard_errors
+from hystkit.compensation._diagnostics import fixed_mask, standard_errors
 from hystkit.compensation._param_vector import simulate_segments
 from hystkit.models import get_family
 
@@ -30,7 +30,7 @@ def _dense(family, structure, params, inputs, targets) -> dict:
     target = np.concatenate(targets)
     return standard_errors(
         lambda q: simulate_segments(family.simulate, structure, q, inputs) - target,
-        params, target.size)
+        params, target.size, fixed_mask(family, structure, params))
 
 
 @pytest.mark.parametrize(("model", "size"), [("mpl", 2), ("bobbio", 3), ("ladder", 2), ("preisach", 4)])

@@ -41,6 +41,17 @@ class MplPolyFamily(Family):
 
         return fit_mpl_poly(u, y, structure, **options)
 
+    def n_params(self, structure, params) -> int:
+        """``4N + 4``: of the ``5N + 6`` stored numbers, ``c_k0``, ``w_0`` and ``V_b`` are the
+        gauge (:func:`.fit.canonical`), so they count for no information criterion."""
+        return 4 * structure.n_cells + 4
+
+    def fixed_params(self, structure, params) -> tuple[str, ...]:
+        """``f[k][0]`` of every cell, ``w[0]`` and ``v_b``: the fit maps its result to the
+        gauge ``v*_k = 0`` (so ``c_k0 = 0`` while the rest point is on the cubic), ``w_0 = 1``,
+        ``V_b = 0`` (:func:`.fit.canonical`); the data determine none of them."""
+        return (*(f"f[{k}][0]" for k in range(structure.n_cells)), "w[0]", "v_b")
+
     def invert(self, structure, params, y, x0=None):
         return self.model.invert(structure, params, y, x0)
 
