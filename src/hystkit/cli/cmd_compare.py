@@ -11,6 +11,7 @@ from ._common import (
     check_size,
     deferred,
     failures_exit,
+    number,
     positive_int,
     read_options,
 )
@@ -22,7 +23,8 @@ COMPARE_FILES = ["compare.json", "compare.mat"]
 
 
 def add_parallel_options(p: argparse.ArgumentParser) -> None:
-    """``--workers`` and ``--scheduler``: where the command's independent pieces run."""
+    """``--workers`` and ``--scheduler`` (with ``--scheduler-timeout``): where the command's
+    independent pieces run."""
     g = p.add_argument_group("parallel runs (results are the same as a serial run's)")
     x = g.add_mutually_exclusive_group()
     x.add_argument("--workers", type=positive_int, default=None, metavar="N",
@@ -31,13 +33,20 @@ def add_parallel_options(p: argparse.ArgumentParser) -> None:
     x.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on an existing Dask cluster, e.g. tcp://10.0.0.5:8786 (every "
                         "worker needs the same hystkit version)")
+    g.add_argument("--scheduler-timeout", type=number(0, 3600, low_open=True), default=None,
+                   metavar="SECONDS",
+                   help="seconds to reach --scheduler, connection and Dask's handshake "
+                        "together (default 20)")
 
 
 def executor_for(args: argparse.Namespace, n_pieces: int):
     """The executor (context manager) of ``--workers`` / ``--scheduler`` for `n_pieces`."""
     from ..parallel import open_executor
 
-    return open_executor(args.workers, args.scheduler, n_pieces=n_pieces)
+    if args.scheduler_timeout is not None and args.scheduler is None:
+        raise UsageError("--scheduler-timeout applies to --scheduler only")
+    return open_executor(args.workers, args.scheduler, n_pieces=n_pieces,
+                         connect_timeout=args.scheduler_timeout)
 
 
 def say_where(executor, n_pieces: int) -> None:

@@ -26,24 +26,21 @@ import dask
 from distributed import Client, LocalCluster, WorkerPlugin, as_completed
 
 from .. import __version__
-from ..errors import HystkitError
 from . import _warm
 from ._cost import cost_order
 from ._executor import Cost, OnDone, can_fork
+from ._reach import DEFAULT_CONNECT_TIMEOUT, SchedulerError, check_handshake
 
 __all__ = ["DaskExecutor", "SchedulerError", "WorkerSetup", "dask_executor"]
 
-# Seconds to reach a scheduler, and to close a client or cluster (a cluster whose workers a
-# signal has just ended must not hold the command's exit).
-CONNECT_TIMEOUT = 10
+# Seconds to reach a scheduler (connection and handshake), unless the caller gives its own, and
+# to close a client or cluster (a cluster whose workers a signal has just ended must not hold
+# the command's exit).
+CONNECT_TIMEOUT = DEFAULT_CONNECT_TIMEOUT
 CLOSE_TIMEOUT = 3
 # No dashboard; the scheduler's HTTP server (health checks) on a free port, not 8787, which
 # another cluster may hold (then Dask warns and moves).
 NO_DASHBOARD = {"dashboard_address": None, "scheduler_kwargs": {"dashboard_address": ":0"}}
-
-
-class SchedulerError(HystkitError):
-    """A Dask scheduler that cannot be reached or whose workers cannot run hystkit."""
 
 
 class WorkerSetup(WorkerPlugin):
@@ -115,9 +112,11 @@ def _fork_if_possible() -> str:
 
 
 @contextmanager
-def dask_executor(n_workers: int | None, scheduler: str | None) -> Iterator[DaskExecutor]:
-    """A local cluster of `n_workers` processes (one thread each), or a client of `scheduler`;
-    both closed on leaving, also on Ctrl-C and SIGTERM."""
+def dask_executor(n_workers: int | None, scheduler: str | None,
+                  connect_timeout: float | None = None) -> Iterator[DaskExecutor]:
+    """A local cluster of `n_workers` processes (one thread each), or a client of `scheduler`
+    reached within `connect_timeout` seconds (default `CONNECT_TIMEOUT`); both closed on
+    leaving, also on Ctrl-C and SIGTERM."""
     with ExitStack() as stack:
         if scheduler is None:
             method = _fork_if_possible()
@@ -133,16 +132,20 @@ def dask_executor(n_workers: int | None, scheduler: str | None) -> Iterator[Dask
             client = Client(cluster)
             where = f"local, {method}ed"
         else:
-            client, method = _connect(scheduler), "remote"
+            client = _connect(scheduler, CONNECT_TIMEOUT if connect_timeout is None
+                              else connect_timeout)
             where = scheduler
         stack.callback(client.close, timeout=CLOSE_TIMEOUT)
         _check_workers(client, where)
         yield DaskExecutor(client, where)
 
 
-def _connect(address: str) -> Client:
+def _connect(address: str, timeout: float) -> Client:
+    # Dask's Client bounds the connection but not the server's handshake: a port that accepts
+    # and never answers held it for ever. Its handshake is first completed here, bounded.
+    check_handshake(address, timeout)
     try:
-        return Client(address, timeout=CONNECT_TIMEOUT)
+        return Client(address, timeout=timeout)
     except (OSError, TimeoutError, ValueError) as exc:
         raise SchedulerError(f"--scheduler {address}: cannot connect to a Dask scheduler "
                              f"there ({type(exc).__name__}: {exc})") from None

@@ -103,7 +103,8 @@ def current_executor() -> Executor | None:
 
 @contextmanager
 def open_executor(workers: int | None = None, scheduler: str | None = None, *,
-                  n_pieces: int | None = None) -> Iterator[Executor]:
+                  n_pieces: int | None = None,
+                  connect_timeout: float | None = None) -> Iterator[Executor]:
     """The executor for one command; its cluster or connection is closed on leaving.
 
     While it is open, a parallel executor is also `current_executor`, so that a long fit run
@@ -121,6 +122,10 @@ def open_executor(workers: int | None = None, scheduler: str | None = None, *,
     n_pieces : int, optional
         How many pieces the command has at most: a local cluster gets no more workers than
         that, and a single piece runs serially.
+    connect_timeout : float, optional
+        Seconds to reach `scheduler`, its connection and Dask's handshake together (default
+        20): a port that accepts the connection but does not answer as a Dask scheduler is
+        then refused with a `~hystkit.errors.HystkitError` that says what answered.
     """
     if scheduler is None:
         n = available_cores() if workers is None else workers
@@ -129,7 +134,8 @@ def open_executor(workers: int | None = None, scheduler: str | None = None, *,
         if n <= 1:
             yield SerialExecutor()
             return
-    with _parallel_executor(n if scheduler is None else None, scheduler) as executor:
+    with _parallel_executor(n if scheduler is None else None, scheduler,
+                            connect_timeout) as executor:
         token = _CURRENT.set(executor)
         try:
             yield executor
@@ -138,7 +144,8 @@ def open_executor(workers: int | None = None, scheduler: str | None = None, *,
 
 
 @contextmanager
-def _parallel_executor(n_workers: int | None, scheduler: str | None) -> Iterator[Executor]:
+def _parallel_executor(n_workers: int | None, scheduler: str | None,
+                       connect_timeout: float | None = None) -> Iterator[Executor]:
     """Dask's multiprocessing scheduler on forked processes where the platform forks (the
     fastest to start, `._forked`); elsewhere a `distributed` LocalCluster of spawned workers,
     and for a scheduler address a client of it (`._dask`). Dask loads only here."""
@@ -153,7 +160,7 @@ def _parallel_executor(n_workers: int | None, scheduler: str | None) -> Iterator
         return
     from ._dask import dask_executor
 
-    with dask_executor(n_workers, scheduler) as executor:
+    with dask_executor(n_workers, scheduler, connect_timeout) as executor:
         yield executor
 
 
