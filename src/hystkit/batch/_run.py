@@ -72,6 +72,7 @@ def fit_sensor(job: SensorJob, *, read_options: ReadOptions | None = None) -> di
         comp = fit_compensator(fit_recs, job.size, model=job.model, mode=job.mode, **options)
         scores = [evaluate(comp, rec) for rec in val_recs]
     except Exception as exc:  # noqa: BLE001  (one sensor never stops the batch)
+        _raise_interrupt(exc)
         row.update(status="failed", error=f"{type(exc).__name__}: {exc}",
                    seconds=time.perf_counter() - t0)
         return {"row": row, "scores": [], "compensator": None}
@@ -84,6 +85,23 @@ def fit_sensor(job: SensorJob, *, read_options: ReadOptions | None = None) -> di
                guards=None if info["status"] == "ok" else info["status_message"],
                model_file=f"models/{job.sensor}.json")
     return {"row": row, "scores": scores, "compensator": comp}
+
+
+def _raise_interrupt(exc: BaseException) -> None:
+    """Raise the Ctrl-C or SIGTERM (KeyboardInterrupt, `Terminated`) behind `exc`, if any.
+
+    The signal handler's exception, raised while a numba kernel runs, comes out of the kernel
+    as ``SystemError: CPUDispatcher(...) returned a result with an exception set`` caused by
+    it: that stops the batch, it is not the sensor's failure (which was recorded, and the
+    batch went on to fit the others and exit 3).
+    """
+    seen: set[int] = set()
+    cause: BaseException | None = exc
+    while cause is not None and id(cause) not in seen:
+        if not isinstance(cause, Exception):
+            raise cause
+        seen.add(id(cause))
+        cause = cause.__cause__ or cause.__context__
 
 
 def _mean(scores: Sequence[dict], key: str) -> float | None:
