@@ -11,6 +11,7 @@ import argparse
 import math
 import sys
 from collections.abc import Callable
+from typing import TextIO
 
 from .._read_options import (
     MAX_RESAMPLE_HZ,
@@ -19,12 +20,12 @@ from .._read_options import (
     TIME_UNITS,
     parse_columns,
 )
-from ..errors import HystkitError
+from ..errors import HystkitError, OutputError
 
 __all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Deferred", "Parser", "UsageError", "add_read_options",
            "check_size", "deferred", "failures_exit", "given_read_options", "integer", "number",
            "positive_float", "positive_int", "read_options", "read_recording_args",
-           "size_limit", "slope_cap"]
+           "size_limit", "slope_cap", "stdout_for"]
 
 # Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
 # bounds, not converged; a family failed in compare/select); 2 is kept for errors that stop a
@@ -37,6 +38,16 @@ INTERNAL_EXIT = 70
 
 class UsageError(HystkitError):
     """A command line argparse rejected; reported on one line like every other error."""
+
+
+def stdout_for(what: str) -> TextIO:
+    """The standard output of a command whose product is written there (``stream``'s
+    estimates, ``datasets list``), refused when it is closed (``>&-``: Python makes it None);
+    other commands' progress lines then go nowhere, as ``print`` does."""
+    if sys.stdout is None:
+        raise OutputError(f"standard output is closed: nowhere to write {what} (redirect it "
+                          "to a file or a pipe)")
+    return sys.stdout
 
 
 class Deferred:

@@ -12,6 +12,7 @@ failed commands leave no partial output: every writer publishes atomically.
 from __future__ import annotations
 
 import atexit
+import errno
 import gc
 import importlib
 import os
@@ -125,9 +126,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         # are left for the operating system to reclaim.
         gc.freeze()
     if argv is None and code in (130, 143) and forked_workers():
-        sys.stdout.flush()
-        sys.stderr.flush()
+        code = _flush_streams(code)
         os._exit(code)
+    return code
+
+
+def _flush_streams(code: int) -> int:
+    """Flush stdout and stderr before an ``os._exit``; either may be closed (``>&-``: None)
+    or gone (a reader that left: exit 1 unless the code already says something)."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            if stream is not None:
+                stream.flush()
+        except BrokenPipeError:
+            if stream is sys.stdout:
+                code = code or 1
+        except OSError:  # nothing left to tell
+            pass
     return code
 
 
@@ -147,15 +162,7 @@ def program() -> NoReturn:
     code = main()
     if all(t.daemon for t in threading.enumerate() if t is not threading.main_thread()):
         atexit._run_exitfuncs()  # CPython's own exit step, here without the teardown after it
-        try:
-            sys.stdout.flush()
-        except BrokenPipeError:  # the reader left during the last write: not our error
-            code = code or 1
-        try:
-            sys.stderr.flush()
-        except OSError:
-            pass
-        os._exit(code)
+        os._exit(_flush_streams(code))
     sys.exit(code)
 
 
@@ -186,6 +193,10 @@ def _main(argv: Sequence[str] | None) -> int:
     except Exception as exc:  # noqa: BLE001  (the last resort is the point)
         if received_signal() is not None:  # cleanup that failed because of the signal
             return _stopped(received_signal())
+        if isinstance(exc, OSError) and exc.errno == errno.ENAMETOOLONG:
+            # A path no check caught (the writers check theirs before any work): the user's.
+            print(f"hystkit: error: {exc.filename}: file name too long", file=sys.stderr)
+            return 2
         # Last resort. Anything here is a bug (user errors are HystkitErrors): say so on one
         # line rather than with a traceback; the hostile tests treat this exit code as failure.
         if os.environ.get("HYSTKIT_DEBUG", "") not in ("", "0"):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import deferred
+from ._common import deferred, stdout_for
 
 __all__ = ["register"]
 
@@ -25,6 +25,7 @@ def _rates(rates: list[float | None]) -> str:
 def _list(args: argparse.Namespace) -> int:
     from ..datasets import DATASETS, list_excerpts, shared_data_status
 
+    stdout_for("the list")
     root, how = shared_data_status(args.root)
     print(f"shared data: {root} ({how})" if root is not None else how)
     if args.name is not None:

@@ -20,7 +20,8 @@ def _report(args: argparse.Namespace) -> int:
 
     if args.format != "png" and args.figures is None:
         raise UsageError("--format chooses the figure files' format; give --figures DIR too")
-    check_output_path(args.out, args.force, inputs=args.inputs)
+    check_output_path(args.out, args.force, inputs=args.inputs, formats=(".html", ".htm"),
+                      what="the report (one HTML page)")
     if args.figures is not None:
         if args.figures.exists() and not args.figures.is_dir():
             raise UsageError(f"--figures {args.figures}: is a file, not a folder")
@@ -54,7 +55,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="a model file (from 'hystkit fit') followed by one or more recordings "
                         "(CSV/Parquet/.mat with a position column), or one or more result "
                         "folders")
-    p.add_argument("--out", type=Path, required=True, help="HTML file to write")
+    p.add_argument("--out", type=Path, required=True, help="HTML file to write (.html)")
     p.add_argument("--figures", type=Path, metavar="DIR",
                    help="also write every figure as PNG (and --format) files into DIR")
     p.add_argument("--format", choices=FORMATS, default="png",

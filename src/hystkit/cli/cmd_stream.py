@@ -7,10 +7,12 @@ line naming the columns (``time,sensor``, any order, more columns allowed) is re
 Output, one line per accepted sample and flushed at once: ``time,position_estimate,flags``
 after a header line. ``time`` is echoed as received, the estimate [mm] is printed to full
 precision, ``flags`` is a bit mask: 1 = sensor outside the training range, 2 = estimate outside
-the training position range (the columns of ``hystkit compensate``).
+the training position range (the columns of ``hystkit compensate``). A closed stdout (``>&-``)
+is refused before any work; a full disk or a failing device ends the stream with one error line.
 
 Bad input never stops the stream: a line that is not numbers, lacks a field, is longer than
-4096 characters, or whose time does not advance is skipped; a sample whose step differs from the
+4096 characters, whose time does not advance, or a last line without its line end (cut off
+mid-write, so perhaps mid-number) is skipped; a sample whose step differs from the
 model's ``dt`` by more than 1 % (the tolerance ``compensate`` allows a recording's rate) is
 compensated but counted, since the model's Euler step assumes ``dt`` (a dropped sample,
 jitter); a sample whose estimate runs away is skipped and the model state kept. At the end (end
@@ -32,6 +34,7 @@ adapted parameters.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
 import time
@@ -40,7 +43,8 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
-from ..errors import InputError
+from ..errors import InputError, OutputError
+from ._common import stdout_for
 
 if TYPE_CHECKING:
     from ..compensation import AdaptiveStream, RefittingStream, Stream, SyncExcitation
@@ -89,7 +93,22 @@ class _Tally:
                   f"{self.first[kind]})", file=sys.stderr)
 
 
-def _lines(args: argparse.Namespace) -> tuple[str, Iterator[str]]:
+class _Input:
+    """The lines of an input and the handle they come from, closed together by `close` (also
+    when never read: the output's header failed)."""
+
+    def __init__(self, lines: Iterator[str], handle) -> None:
+        self.lines, self.handle = lines, handle
+
+    def __iter__(self) -> Iterator[str]:
+        return self.lines
+
+    def close(self) -> None:
+        self.lines.close()  # type: ignore[attr-defined]  (a generator)
+        self.handle.close()
+
+
+def _lines(args: argparse.Namespace) -> tuple[str, _Input]:
     """Name of the input and its lines (a serial port's until it closes)."""
     if args.serial is not None:
         return str(args.serial), _serial_lines(args.serial, args.baud or DEFAULT_BAUD)
@@ -114,9 +133,8 @@ def _bounded(readline: Callable[[int], str]) -> Iterator[str]:
         yield TOO_LONG
 
 
-def _file_lines(handle: TextIO) -> Iterator[str]:
-    with handle:
-        yield from _bounded(handle.readline)
+def _file_lines(handle: TextIO) -> _Input:
+    return _Input(_bounded(handle.readline), handle)
 
 
 def _open_serial(port: str, baud: int):
@@ -130,7 +148,7 @@ def _open_serial(port: str, baud: int):
         raise InputError(f"{port}: cannot open serial port ({exc})") from None
 
 
-def _serial_lines(port: str, baud: int) -> Iterator[str]:
+def _serial_lines(port: str, baud: int) -> _Input:
     """Lines of a serial port, opened now (before the output's header: a caller that waits
     for the header knows the port is listening)."""
     serial, handle = _open_serial(port, baud)
@@ -143,7 +161,7 @@ def _serial_lines(port: str, baud: int) -> Iterator[str]:
             except serial.SerialException:  # unplugged, or the other end closed
                 print(f"hystkit stream: {port} closed", file=sys.stderr)
 
-    return lines()
+    return _Input(lines(), handle)
 
 
 Columns = tuple[int, int, int | None]
@@ -255,7 +273,6 @@ def _run_stream(stream: Stream | AdaptiveStream | RefittingStream, lines: Iterat
     from ..errors import FitDivergedError
 
     dt = stream.compensator.structure.dt
-    out = sys.stdout
     columns, previous, first = DEFAULT_COLUMNS, None, True  # first: no non-empty line yet
     for line_no, line in enumerate(lines, start=1):
         arrived = time.perf_counter()
@@ -263,6 +280,9 @@ def _run_stream(stream: Stream | AdaptiveStream | RefittingStream, lines: Iterat
             tally.add("line too long", line_no)
             continue
         if not line.strip():
+            continue
+        if not line.endswith("\n"):  # only the last line can be: cut off mid-write?
+            tally.add("unterminated last line", line_no)
             continue
         if first and (named := _columns(line.split(","))) is not None:
             columns, first = named, False
@@ -295,8 +315,21 @@ def _run_stream(stream: Stream | AdaptiveStream | RefittingStream, lines: Iterat
         row = f"{text},{result.estimate!r},{flags}\n"
         # counted before the line leaves: a reader that got it finds it in the summary
         latency.add(time.perf_counter() - arrived)
-        out.write(row)
+        _write(row)
+
+
+def _write(text: str) -> None:
+    """Write and flush `text` to stdout at once; a full disk or a failing device is one error
+    line (a reader that left stays a BrokenPipeError: exit 1, as for every command)."""
+    out = stdout_for("the estimates")
+    try:
+        out.write(text)
         out.flush()
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        raise OutputError(f"standard output: cannot write the estimates "
+                          f"({exc.strerror or exc})") from None
 
 
 def _stream(args: argparse.Namespace) -> int:
@@ -305,6 +338,7 @@ def _stream(args: argparse.Namespace) -> int:
     if args.serial is None and args.baud is not None:
         raise InputError("--baud is for --serial")
     _check_adapt_options(args)
+    stdout_for("the estimates")
     comp = load_compensator(args.model)
     stream = Stream(comp, label=str(args.model))  # refuses the oracle centring
     start = "rest"
@@ -317,16 +351,16 @@ def _stream(args: argparse.Namespace) -> int:
     if args.adapt is not None:
         stream, learning = _adaptive_stream(args, comp, start), _Learning()
     source, lines = _lines(args)
-    sys.stdout.write("time,position_estimate,flags\n")
-    sys.stdout.flush()
-    tally, latency = _Tally(), _Latency()
-    try:
-        _run_stream(stream, lines, tally, latency, learning)
-    finally:  # also on Ctrl-C / SIGTERM: the summary, then main's exit 130 / 143
-        tally.report(source, comp.structure.dt)
-        print(latency.summary(), file=sys.stderr)
-        if learning is not None:
-            print(learning.summary(stream, args.adapt, args.forgetting), file=sys.stderr)
+    with contextlib.closing(lines):
+        _write("time,position_estimate,flags\n")
+        tally, latency = _Tally(), _Latency()
+        try:
+            _run_stream(stream, lines, tally, latency, learning)
+        finally:  # also on Ctrl-C / SIGTERM: the summary, then main's exit 130 / 143
+            tally.report(source, comp.structure.dt)
+            print(latency.summary(), file=sys.stderr)
+            if learning is not None:
+                print(learning.summary(stream, args.adapt, args.forgetting), file=sys.stderr)
     return 0
 
 

@@ -134,12 +134,27 @@ def _units_row(path: Path, where: Where, sep: str, names: list[str]) -> tuple[tu
         raise where.fail("--units-row: there is no line 2 to read units from")
     header = [str(name).strip() for name in lines.iloc[0]]
     row = lines.iloc[1].fillna("")
+    cells = [str(cell).strip() for cell in row if str(cell).strip()]
+    if cells and all(_is_number(cell) for cell in cells):
+        # A file without a units line: reading on would drop its first sample unsaid.
+        shown = ", ".join(cells[:3]) + (", ..." if len(cells) > 3 else "")
+        raise where.fail(f"line 2: --units-row reads units there but it holds numbers "
+                         f"({shown}), the first sample: this file has no units line (drop "
+                         "--units-row, or units_row from its settings file)")
     units = []
     for name in names:
         unit = str(row.iloc[header.index(where.name(name))]).strip()
         if unit:
             units.append((name, unit))
     return tuple(units)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _check_width(path: Path, where: Where, sep: str) -> str:

@@ -18,6 +18,7 @@ import numpy as np
 from hystkit.errors import InputError
 
 from ._raw import MAX_SKIP_ROWS
+from ._toml import load_toml
 from ._writing import atomic_output
 
 __all__ = ["CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_config"]
@@ -112,8 +113,7 @@ def read_raw_config(path: str | os.PathLike[str]) -> dict[str, Any]:
     try:
         if path.is_dir():
             raise InputError(f"{path}: is a folder, not a TOML settings file")
-        with path.open("rb") as handle:
-            values = tomllib.load(handle)
+        values = load_toml(path)
     except FileNotFoundError as exc:
         raise InputError(f"{path}: config file not found") from exc
     except (OSError, UnicodeDecodeError) as exc:

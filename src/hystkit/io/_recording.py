@@ -218,7 +218,8 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
     Raises
     ------
     InputError
-        Unknown suffix, missing or empty file, damaged file (MATLAB files are parsed in a
+        Unknown suffix, a ``mat_var`` for a file that is not ``.mat``, missing or empty file,
+        damaged file (MATLAB files are parsed in a
         child process, so even a crash of the parser ends here), missing column, non-numeric,
         empty or non-finite cell, magnitude above `MAX_MAGNITUDE`, unequal lengths, time not strictly increasing, non-uniform
         sampling, fewer than 2 samples. The message names file, column and row.
@@ -245,6 +246,11 @@ def read_unvalidated(path: Path, need_position: bool, options: ReadOptions,
             f"{source}: unsupported file type {suffix or '(no suffix)'!r}; "
             f"accepted: {', '.join(_READERS)}"
         )
+    if options.mat_var is not None and suffix != ".mat":
+        # Ignoring it would read the file as if the option were right.
+        raise InputError(f"{source}: --mat-var {options.mat_var} names a variable of a .mat "
+                         f"file, and this is a {suffix} file (drop --mat-var, or give it in "
+                         "the settings file of the .mat recording)")
     if not path.exists():
         raise InputError(f"{source}: file not found")
     if not path.is_file():

@@ -37,6 +37,7 @@ from typing import Any
 from hystkit.errors import InputError
 
 from .._read_options import FIELDS, ReadOptions
+from ._toml import load_toml
 
 __all__ = ["RECORDING_KEYS", "find_recording_config", "is_raw_settings", "options_for",
            "read_recording_config"]
@@ -123,8 +124,7 @@ def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
 
 def _load(path: Path) -> dict[str, Any]:
     try:
-        with path.open("rb") as handle:
-            return tomllib.load(handle)
+        return load_toml(path)
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: cannot read settings file ({exc})") from exc
     except (tomllib.TOMLDecodeError, RecursionError) as exc:

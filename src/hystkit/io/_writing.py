@@ -333,6 +333,7 @@ def check_output_path(path: str | os.PathLike[str], force: bool = False, *,
         Any other reason listed above.
     """
     path = Path(path)
+    _check_name_length(path)  # first: the system refuses even to look at a too-long name
     if path.is_dir():
         raise OutputError(f"{path} is a folder, not a file")
     for given in inputs:
@@ -343,7 +344,6 @@ def check_output_path(path: str | os.PathLike[str], force: bool = False, *,
     if path.exists() and not path.is_file():  # a device, pipe or socket: never replace it
         raise OutputError(f"{path} is not a regular file; write to a file")
     check_folder_writable(path.parent, what=path)
-    _check_name_length(path)
     if formats is not None:
         check_output_format(path, formats, what)
     return path
@@ -353,7 +353,7 @@ def _check_name_length(path: Path) -> None:
     """Refuse a name too long for the folder's file system once the temporary's marks are
     added (``.`` + ``.tmp-XXXXXXXX``: 14 bytes), rather than after the work."""
     existing = path.parent
-    while not existing.exists() and existing.parent != existing:
+    while not _exists(existing) and existing.parent != existing:
         existing = existing.parent
     try:
         limit = os.pathconf(existing, "PC_NAME_MAX")
@@ -363,6 +363,14 @@ def _check_name_length(path: Path) -> None:
         if len(part.encode()) + 14 + 4 > limit:  # + 4: the "old-" mark of a replaced file
             raise OutputError(f"{path}: file name too long ({len(part.encode())} bytes; "
                               f"at most {limit - 18} here)")
+
+
+def _exists(path: Path) -> bool:
+    """`Path.exists`, False for a name the system refuses to look up (too long)."""
+    try:
+        return path.exists()
+    except OSError:
+        return False
 
 
 def check_output_folder(folder: str | os.PathLike[str], names: Iterable[str],
@@ -392,6 +400,7 @@ def check_output_folder(folder: str | os.PathLike[str], names: Iterable[str],
         `folder` is a file, or a file in it is refused by :func:`check_output_path`.
     """
     folder = Path(folder)
+    _check_name_length(folder)
     if folder.exists() and not folder.is_dir():
         raise OutputError(f"{folder} is a file, not a folder")
     inputs = list(inputs)
