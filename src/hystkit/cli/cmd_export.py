@@ -2,8 +2,9 @@
 
 C99 without dependencies for microcontrollers (``float`` unless ``--double``), or MATLAB /
 Octave functions (chunk, init and a persistent-state variant for Simulink). The folder is
-written atomically; an existing one only with ``--force``. A family or mode without a
-translation is refused with the reason (exit 2).
+written atomically; an existing one only with ``--force`` (also one created by another export
+while this one built its files). A family or mode without a translation, and ``--double``
+with MATLAB, are refused with the reason (exit 2).
 """
 
 from __future__ import annotations
@@ -43,7 +44,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, required=True,
                    help="folder to write (refused if it exists, unless --force)")
     p.add_argument("--double", action="store_true",
-                   help="C only: double arithmetic (default float, for single-precision FPUs)")
+                   help="C only: double arithmetic (default float, for single-precision FPUs); "
+                        "refused with --lang matlab, whose code is always double")
     p.add_argument("--name", help="name of the generated functions (default: from the model "
                                   "file name)")
     p.set_defaults(run=_export)

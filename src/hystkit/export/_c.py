@@ -16,6 +16,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ._comments import c_comment_text, comment_text
 from ._families import translator
 from ._plan import ExportPlan
 
@@ -80,7 +81,7 @@ def _float_note(plan: ExportPlan) -> str:
 
 
 def _comment(plan: ExportPlan, what: str, double: bool) -> str:
-    p = plan.provenance
+    p = {key: c_comment_text(value) for key, value in plan.provenance.items()}
     warning = "" if double or plan.float_is_enough else f" *\n * WARNING: {float_warning(plan)}\n"
     return f"""/* {what}
  * Hysteresis compensator exported by hystkit {p['hystkit']} on {p['exported']}.
@@ -271,7 +272,7 @@ int main(void)
 
 
 def _readme(plan: ExportPlan, double: bool) -> str:
-    n, p = plan.name, plan.provenance
+    n, p = plan.name, {key: comment_text(value) for key, value in plan.provenance.items()}
     sync = (f"- `{n}_sync(&st)`: instead of `{n}_init`, start after the synchronisation "
             f"excitation e_sync;\n  {plan.sync_note}.\n" if plan.sync_state is not None else
             f"- {plan.sync_note}\n")

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._comments import comment_text
 from ._families import translator
 from ._plan import ExportPlan
 
@@ -38,7 +39,7 @@ def _column(values: np.ndarray) -> str:
 
 
 def _comment(plan: ExportPlan, what: str) -> str:
-    p = plan.provenance
+    p = {key: comment_text(value) for key, value in plan.provenance.items()}
     return f"""% {what}
 % Hysteresis compensator exported by hystkit {p['hystkit']} on {p['exported']}.
 % Do not edit: re-export from the model file instead.

@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import errno
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from ..compensation import Compensator
-from ..errors import InputError, OutputExistsError
-from ..io import atomic_folder
+from ..errors import InputError, OutputError, OutputExistsError
+from ..io import atomic_folder, check_output_folder
 from ._c import c_files
 from ._matlab import matlab_files
 from ._plan import ExportPlan, make_plan
@@ -48,11 +52,14 @@ def export_compensator(comp: Compensator, out: str | Path, lang: str = "c", *,
     lang : {"c", "matlab"}
         Target language.
     double : bool
-        C only: compute in double instead of float (the MATLAB code is always double).
+        C only: compute in double instead of float (the MATLAB code is always double, and
+        asking for it there is refused rather than ignored).
     name : str, optional
         Identifier of the generated functions (see :func:`make_plan`).
     force : bool
-        Write into an existing folder, replacing same-named files.
+        Write into an existing folder, replacing same-named files. Without it the folder is
+        created complete (built beside it, then renamed): of two exports to the same new
+        folder exactly one succeeds.
 
     Returns
     -------
@@ -64,19 +71,54 @@ def export_compensator(comp: Compensator, out: str | Path, lang: str = "c", *,
     Raises
     ------
     InputError
-        Unknown language, or a compensator that cannot be exported (the reason).
+        Unknown language, `double` with MATLAB, or a compensator that cannot be exported
+        (the reason).
     OutputExistsError
-        ``out`` exists and ``force`` is not given.
+        ``out`` exists (or was created while the files were built) and ``force`` is not
+        given.
     """
     if lang not in LANGUAGES:
         raise InputError(f"--lang {lang!r}: choose one of {', '.join(LANGUAGES)}")
+    if double and lang != "c":
+        raise InputError("--double applies to --lang c only (the MATLAB code always computes "
+                         "in double)")
     out = Path(out)
     if out.exists() and not force:
         raise OutputExistsError(f"{out} exists; use --force to write into it")
     sync_state, sync_note = sync_state_of(comp)
     plan = make_plan(comp, name, sync_state=sync_state, sync_note=sync_note)
     files = c_files(plan, double) if lang == "c" else matlab_files(plan)
-    with atomic_folder(out, force=force, names=files) as tmp:
-        for file_name, text in files.items():
-            (tmp / file_name).write_text(text, encoding="utf-8")
+    if force:  # into the folder, existing or not: same-named files replaced, others kept
+        with atomic_folder(out, force=True, names=files) as tmp:
+            _write_files(tmp, files)
+    else:
+        _create_folder(out, files)
     return plan, files
+
+
+def _write_files(folder: Path, files: dict[str, str]) -> None:
+    for file_name, text in files.items():
+        (folder / file_name).write_text(text, encoding="utf-8")
+
+
+def _create_folder(out: Path, files: dict[str, str]) -> None:
+    """Build `files` in a hidden sibling of `out` and rename it to `out`, which must not
+    exist: a folder that appeared meanwhile (another export, C beside MATLAB) is refused, not
+    merged into (`atomic_folder` merges into a folder that exists when it publishes)."""
+    check_output_folder(out, files)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name or 'export'}.tmp-",
+                                dir=Path(os.path.abspath(out)).parent))
+    try:
+        _write_files(tmp, files)
+        try:
+            # rename(2) refuses a non-empty target (and replaces an empty one, losing nothing)
+            os.rename(tmp, out)
+        except OSError as exc:
+            if exc.errno in (errno.ENOTEMPTY, errno.EEXIST, errno.ENOTDIR, errno.EISDIR):
+                raise OutputExistsError(f"{out} already exists (created while hystkit was "
+                                        f"writing it: another export?); nothing written, use "
+                                        f"another --out or --force") from None
+            raise OutputError(f"{out}: cannot create the folder ({exc.strerror})") from None
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
