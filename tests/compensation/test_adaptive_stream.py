@@ -1,6 +1,7 @@
 """The adapting stream: plain until a reference comes, chunk-independent, causal, and better than
 the fixed compensator on a sensor whose gain drifts."""
 
+import math
 from itertools import pairwise
 
 import numpy as np
@@ -38,6 +39,9 @@ CASES = [(name, mode) for name in sorted(FAMILIES) for mode in ("direct", "inver
 # output linear in the weights w and bias v_b (eq. 5.2); mpl-poly has them too, but behind its
 # cubic output resistor g (eq. 5.17), so it must be refused
 WEIGHTED = ["ladder", "mpl", "pl"]
+# The plausibility gates off, for tests of the arithmetic on drawn (unfitted) compensators whose
+# estimates stray far from their training positions; the gates: test_adaptive_references.py.
+UNGATED = {"reference_margin": math.inf, "max_innovation": math.inf}
 
 
 def drawn(name: str, mode: str = "direct", center: str = "track") -> Compensator:
@@ -81,9 +85,14 @@ def chunk_sizes(seed: int) -> list[int]:
 def test_gain_adaptation_chunked_equals_sample_by_sample(case):
     comp = drawn(*case)
     sensor, reference = signals(comp)
-    stream = AdaptiveStream(comp)
+    # references a gain and offset in their domain explain (some drawn models' estimates lie
+    # 1000 mm from the drawn references: an update towards those is refused)
+    reference = np.where(np.isfinite(reference), 0.95 * Stream(comp).process(sensor) + 0.1,
+                         np.nan)
+    adaptation = Adaptation(**UNGATED)
+    stream = AdaptiveStream(comp, adaptation)
     one_by_one = np.array([stream.step(s, r) for s, r in zip(sensor, reference, strict=True)])
-    chunked = in_chunks(AdaptiveStream(comp), sensor, reference, chunk_sizes(4))
+    chunked = in_chunks(AdaptiveStream(comp, adaptation), sensor, reference, chunk_sizes(4))
     assert_array_equal(chunked, one_by_one)
     assert stream.state.rls.n_updates == np.isfinite(reference).sum() > 0
 
@@ -137,8 +146,8 @@ def test_an_estimate_never_sees_its_own_reference():
     i = int(np.flatnonzero(np.isfinite(reference))[2])
     moved = reference.copy()
     moved[i] += 1.0
-    a = AdaptiveStream(comp).process(sensor, reference)
-    b = AdaptiveStream(comp).process(sensor, moved)
+    a = AdaptiveStream(comp, Adaptation(**UNGATED)).process(sensor, reference)
+    b = AdaptiveStream(comp, Adaptation(**UNGATED)).process(sensor, moved)
     assert_array_equal(a[:i + 1], b[:i + 1])
     assert np.all(a[i + 1:] != b[i + 1:])
 
@@ -162,7 +171,8 @@ def test_adapted_parameters_recover_a_known_gain_and_offset():
     sensor, _ = signals(comp)
     plain = Stream(comp).process(sensor)
     reference = np.where(np.arange(N) % 7 == 3, 0.9 * plain + 0.25, np.nan)
-    stream = AdaptiveStream(comp, Adaptation("gain", 1.0, prior_gain=1e3, prior_offset=1e3))
+    stream = AdaptiveStream(comp, Adaptation("gain", 1.0, prior_gain=1e3, prior_offset=1e3,
+                                             **UNGATED))
     stream.process(sensor, reference)
     theta = stream.parameters
     # a vague prior (std 1e3) and ~57 exact samples: the prior's pull is ~1e-8 of the data's

@@ -208,15 +208,30 @@ def _reference(line: str, columns: Columns) -> float | None:
 
 
 class _Learning:
-    """References used by an adapting stream and its a-priori errors at them [mm]."""
+    """References used by an adapting stream and its a-priori errors at them [mm]; those it
+    rejected as implausible or refused (out of the parameters' domain) are only counted."""
 
     def __init__(self) -> None:
         self.n = 0
         self.sum_sq = 0.0
+        self.ignored = 0
 
-    def add(self, estimate: float, reference: float) -> None:
+    def add(self, estimate: float, reference: float,
+            stream: AdaptiveStream | RefittingStream) -> None:
+        ignored = stream.n_rejected + getattr(stream, "n_refused", 0)
+        if ignored > self.ignored:  # this reference moved nothing
+            self.ignored = ignored
+            return
         self.n += 1
         self.sum_sq += (estimate - reference) ** 2
+
+    def _ignored_text(self, stream: AdaptiveStream | RefittingStream) -> str:
+        text = (f"; {stream.n_rejected} rejected as implausible (beyond the training "
+                f"positions or too far from the estimate)")
+        if hasattr(stream, "n_refused"):
+            text += (f", {stream.n_refused} refused (the update would have left the "
+                     f"parameters' domain)")
+        return text
 
     def summary(self, stream: AdaptiveStream | RefittingStream, adapt: str,
                 forgetting: float | None) -> str:
@@ -226,18 +241,19 @@ class _Learning:
                     f"refit every {refit.every} references): ")
         else:
             head = f"hystkit stream: adaptation ({adapt}, forgetting {forgetting:g}): "
-        if not self.n:
+        if not self.n and not self.ignored:
             return head + "no reference arrived; the estimates are the plain stream's"
+        used = (f"{self.n} references used, rms error at them before learning from each "
+                f"{(self.sum_sq / self.n) ** 0.5:.4g} mm" if self.n else "no reference used")
+        used += self._ignored_text(stream)
         if adapt == "full":
             report = stream.report
-            return (head + f"{self.n} references, rms error at them before learning from each "
-                    f"{(self.sum_sq / self.n) ** 0.5:.4g} mm; refits: {report.kept} kept, "
+            return (head + f"{used}; refits: {report.kept} kept, "
                     f"{report.refused} refused, {report.skipped} skipped (the window held "
                     f"too few references), {report.evaluations} model evaluations; now "
                     f"{stream.compensator.params.to_dict()}")
         values = ", ".join(f"{k} {v:.6g}" for k, v in stream.parameters.items())
-        return (head + f"{self.n} references, rms error at them before learning from each "
-                f"{(self.sum_sq / self.n) ** 0.5:.4g} mm; now {values}")
+        return head + f"{used}; now {values}"
 
 
 class _Latency:
@@ -309,7 +325,7 @@ def _run_stream(stream: Stream | AdaptiveStream | RefittingStream, lines: Iterat
             tally.add("estimate ran away", line_no)
             continue
         if learning is not None and not math.isnan(reference):
-            learning.add(result.estimate, reference)
+            learning.add(result.estimate, reference, stream)
         previous = t
         flags = (1 if result.sensor_outside else 0) + (2 if result.estimate_outside else 0)
         row = f"{text},{result.estimate!r},{flags}\n"

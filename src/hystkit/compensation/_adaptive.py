@@ -20,6 +20,16 @@ error against the reference is an honest prediction error). Until the first refe
 output is the plain stream's, bit for bit; a chunk of any size gives the same bits as the same
 samples one by one.
 
+Every reference is checked for plausibility before it moves anything (:class:`Plausible`): it
+must lie within the training positions widened by ``REFERENCE_MARGIN`` of their extent, and
+differ from the sample's estimate by at most ``MAX_INNOVATION`` extents; otherwise it is
+rejected and counted (``AdaptiveState.n_rejected``). An update that would take the output
+parameters out of their domain (a multiplier beyond ``MAX_MULTIPLIER`` or its reciprocal for
+``gain``, beyond ``MAX_MULTIPLIER`` in magnitude or out of the family's parameter domain for
+``weights``, an offset beyond one extent, or anything not finite) is refused and counted
+(``n_refused``): the parameters stay where they were. One reference of 1e20 mm used to set the
+gain to 2.7e17; one of 1e200 ended the stream with an OverflowError.
+
 Re-fitting the whole model (cell dynamics too) on a sliding window: :mod:`._refit`.
 """
 
@@ -49,13 +59,21 @@ from ._stream import (
     initial_state,
 )
 
-__all__ = ["ADAPT_PARAMETERS", "Adaptation", "AdaptiveState", "AdaptiveStream",
-           "advance_adaptive"]
+__all__ = ["ADAPT_PARAMETERS", "MAX_INNOVATION", "MAX_MULTIPLIER", "REFERENCE_MARGIN",
+           "Adaptation", "AdaptiveState", "AdaptiveStream", "Plausible", "advance_adaptive"]
 
 ADAPT_PARAMETERS = ("gain", "weights")
 # Relative error allowed between a model's output and its weighted cell outputs on the probe
 # run: rounding of a sum of a few hundred terms, far below any non-linearity in the weights.
 LINEARITY_TOLERANCE = 1e-9
+# Plausible references, in extents of the training positions (their span; module docstring):
+# a reference beyond the training positions widened by REFERENCE_MARGIN extents on each side, or
+# further than MAX_INNOVATION extents from the estimate, is no drift but a wrong reference.
+REFERENCE_MARGIN = 0.5
+MAX_INNOVATION = 1.0
+# The output parameters' domain: a gain moved by more than this factor (or a cell's weight
+# multiplier beyond it in magnitude) is no drift but another sensor; fit again.
+MAX_MULTIPLIER = 10.0
 
 
 @dataclass(frozen=True)
@@ -74,12 +92,20 @@ class Adaptation:
     prior_offset : float or None
         Prior standard deviation of the offset ``b`` [mm]; None: 10 % of the training
         positions' span (1 mm if the model file does not know it).
+    reference_margin : float, default REFERENCE_MARGIN
+        A reference [mm] beyond the training positions widened by this many extents of them
+        on each side is rejected (:class:`Plausible`; ``inf``: no such check).
+    max_innovation : float, default MAX_INNOVATION
+        A reference further than this many extents of the training positions from the
+        sample's estimate is rejected (``inf``: no such check).
     """
 
     parameters: str = "gain"
     forgetting: float = 0.9
     prior_gain: float = 0.1
     prior_offset: float | None = None
+    reference_margin: float = REFERENCE_MARGIN
+    max_innovation: float = MAX_INNOVATION
 
     def __post_init__(self) -> None:
         if self.parameters not in ADAPT_PARAMETERS:
@@ -91,6 +117,9 @@ class Adaptation:
             value = getattr(self, name)
             if value is not None and not (0.0 < value < float("inf")):
                 raise InputError(f"{name} {value!r}: must be a finite positive number")
+        for name in ("reference_margin", "max_innovation"):
+            if not getattr(self, name) > 0.0:  # inf allowed: no such check
+                raise InputError(f"{name} {getattr(self, name)!r}: must be a positive number")
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,10 +132,93 @@ class AdaptiveState:
         The plain (un-adapted) stream's state.
     rls : RlsState
         Estimate and covariance of the output parameters (multipliers, then the offset [mm]).
+    n_rejected : int, default 0
+        References rejected as implausible (:class:`Plausible`); they moved nothing.
+    n_refused : int, default 0
+        Plausible references whose update would have left the output parameters' domain;
+        refused, they moved nothing either.
     """
 
     stream: StreamState
     rls: RlsState
+    n_rejected: int = 0
+    n_refused: int = 0
+
+
+@dataclass(frozen=True)
+class Plausible:
+    """Where a reference [mm] is believed: the training positions ``(low, high)`` widened by
+    ``margin`` extents, and within ``innovation`` extents of the sample's estimate.
+
+    Parameters
+    ----------
+    low, high : float
+        The training positions [mm] (shifted by the centring's position offset in use).
+    extent : float
+        Their extent [mm] (> 0): the unit of the margins and of the offset's domain.
+    margin : float, default REFERENCE_MARGIN
+        Extents by which the range is widened on each side.
+    innovation : float, default MAX_INNOVATION
+        Largest distance from the estimate, in extents.
+    """
+
+    low: float
+    high: float
+    extent: float
+    margin: float = REFERENCE_MARGIN
+    innovation: float = MAX_INNOVATION
+
+    @classmethod
+    def of(cls, comp: Compensator, position_offset: float,
+           adaptation: Any = None) -> Plausible:
+        """The bounds of a compensator: its stored training positions, or (older files) the
+        positions its scaling maps [-1, 1] to.
+
+        Parameters
+        ----------
+        comp : Compensator
+            The compensator.
+        position_offset : float
+            The position offset [mm] in use (the stream's; shifts the stored range as
+            :meth:`Compensator.estimate_outside` does).
+        adaptation : Adaptation or Refit, optional
+            Its ``reference_margin`` and ``max_innovation`` (default: the module's).
+
+        Returns
+        -------
+        Plausible
+            Its bounds.
+        """
+        gates = (REFERENCE_MARGIN, MAX_INNOVATION) if adaptation is None else (
+            adaptation.reference_margin, adaptation.max_innovation)
+        scale = comp.scaling.position_scale
+        if comp.position_range is None:
+            return cls(position_offset - scale, position_offset + scale, 2.0 * scale, *gates)
+        lo, hi = comp.position_range
+        shift = position_offset - comp.scaling.position_offset
+        return cls(lo + shift, hi + shift, (hi - lo) if hi > lo else scale, *gates)
+
+    def why_not(self, reference: float, estimate: float) -> str | None:
+        """None if `reference` [mm] is plausible at a sample estimated at `estimate` [mm],
+        else why not.
+
+        Parameters
+        ----------
+        reference, estimate : float
+            The reference and the sample's estimate before learning from it [mm].
+
+        Returns
+        -------
+        str or None
+            ``"range"`` or ``"innovation"``, or None.
+        """
+        with np.errstate(invalid="ignore"):  # inf * 0 extents: no check
+            pad = self.margin * self.extent
+            if not self.low - pad <= reference <= self.high + pad:
+                return "range"
+            if not abs(reference - estimate) <= self.innovation * self.extent:
+                return "innovation"
+        return None
 
 
 class _Plan:
@@ -134,12 +246,44 @@ class _Plan:
         self.start = rls_start(np.r_[np.ones(n_mult), 0.0],
                                np.r_[np.full(n_mult, adaptation.prior_gain), offset_std])
         self.max_trace = float(np.trace(self.start.cov))
+        self.plausible = Plausible.of(comp, self.path.position_offset, adaptation)
 
     def update(self, rls: RlsState, phi: np.ndarray, r: float) -> RlsState:
         """Learn one reference [mm] (``P`` bounded by the prior's trace: no wind-up while the
         references repeat one position)."""
         return rls_bound(rls_update(rls, phi, r - self.constant, self.adaptation.forgetting),
                          self.max_trace)
+
+    def learn(self, state: AdaptiveState, phi: np.ndarray, r: float,
+              estimate: float) -> AdaptiveState:
+        """``state`` after the reference `r` [mm] of a sample estimated at `estimate` [mm]:
+        updated, or unchanged but for a count if `r` is implausible (rejected) or the update
+        would leave the parameters' domain (refused)."""
+        if self.plausible.why_not(r, estimate) is not None:
+            return dataclasses.replace(state, n_rejected=state.n_rejected + 1)
+        with np.errstate(all="ignore"):  # a non-finite result is refused just below
+            rls = self.update(state.rls, phi, r)
+        if not self.in_domain(rls.theta):
+            return dataclasses.replace(state, n_refused=state.n_refused + 1)
+        return dataclasses.replace(state, rls=rls)
+
+    def in_domain(self, theta: np.ndarray) -> bool:
+        """Whether output parameters ``theta`` lie in their domain (module docstring)."""
+        if not np.all(np.isfinite(theta)) or abs(theta[-1]) > self.plausible.extent:
+            return False
+        multipliers = theta[:-1]
+        if self.adaptation.parameters == "gain":
+            return bool(1.0 / MAX_MULTIPLIER <= multipliers[0] <= MAX_MULTIPLIER)
+        if not np.all(np.abs(multipliers) <= MAX_MULTIPLIER):
+            return False
+        comp = self.path.comp
+        try:  # the weights and bias the update stands for, in the family's domain
+            w = multipliers * np.asarray(comp.params.w, dtype=np.float64)
+            v_b = float(comp.params.v_b) - theta[-1] / comp.scaling.position_scale
+            dataclasses.replace(comp.params, w=w, v_b=v_b)
+        except ValueError:
+            return False
+        return True
 
     def regressors(self, state: StreamState, sensor: np.ndarray,
                    estimate: np.ndarray) -> np.ndarray:
@@ -222,16 +366,16 @@ def _advance_plan(plan: _Plan, state: AdaptiveState, sensor: np.ndarray,
         return plain, state
     phi = plan.regressors(state.stream, s_raw, plain.estimate)
     estimate = np.empty(s_raw.size)
-    rls, begin = state.rls, 0
+    learnt, begin = state, 0
     for i in [*np.flatnonzero(np.isfinite(r)).tolist(), s_raw.size]:
         part = slice(begin, min(i + 1, s_raw.size))
-        estimate[part] = plan.predict(rls, phi[part], plain.estimate[part])
+        estimate[part] = plan.predict(learnt.rls, phi[part], plain.estimate[part])
         if i < s_raw.size:
-            rls = plan.update(rls, phi[i], r[i])
+            learnt = plan.learn(learnt, phi[i], r[i], estimate[i])
         begin = i + 1
     out = StreamOutput(estimate, plain.sensor_outside,
                        _outside(estimate, plan.path.estimate_bounds))
-    return out, AdaptiveState(stream_next, rls)
+    return out, dataclasses.replace(learnt, stream=stream_next)
 
 
 def advance_adaptive(comp: Compensator, adaptation: Adaptation, state: AdaptiveState,
@@ -320,7 +464,7 @@ class AdaptiveStream:
             raise InputError(f"adaptive stream state: {state.rls.theta.size} output parameters, "
                              f"the {adaptation.parameters!r} adaptation of this compensator "
                              f"has {stream._plan.start.theta.size}")
-        stream._state = AdaptiveState(plain.state, state.rls)
+        stream._state = dataclasses.replace(state, stream=plain.state)
         return stream
 
     @property
@@ -331,6 +475,16 @@ class AdaptiveStream:
     def state(self) -> AdaptiveState:
         """The present state (immutable)."""
         return self._state
+
+    @property
+    def n_rejected(self) -> int:
+        """References rejected as implausible so far (:class:`Plausible`)."""
+        return self._state.n_rejected
+
+    @property
+    def n_refused(self) -> int:
+        """Updates refused so far: they would have left the output parameters' domain."""
+        return self._state.n_refused
 
     @property
     def parameters(self) -> dict[str, float]:
@@ -354,11 +508,11 @@ class AdaptiveStream:
         plain, stream_next, self._previous = _advance_one(
             self._plan.path, self._state.stream, sensor, self.label, self._previous)
         phi = np.array([[plain.estimate, 1.0]])
-        rls = self._state.rls
-        estimate = float(self._plan.predict(rls, phi, np.array([plain.estimate]))[0])
+        learnt = self._state
+        estimate = float(self._plan.predict(learnt.rls, phi, np.array([plain.estimate]))[0])
         if np.isfinite(r):
-            rls = self._plan.update(rls, phi[0], r)
-        self._state = AdaptiveState(stream_next, rls)
+            learnt = self._plan.learn(learnt, phi[0], r, estimate)
+        self._state = dataclasses.replace(learnt, stream=stream_next)
         return StepOutput(estimate, plain.sensor_outside,
                           _outside(estimate, self._plan.path.estimate_bounds))
 

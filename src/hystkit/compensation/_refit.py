@@ -18,6 +18,10 @@ every refit, which no sample period allows.
 - A refit is kept only if its fit succeeded and it lowers the weighted error on the window
   against the present parameters run the same way; otherwise the stream goes on with the
   present parameters and counts the refusal.
+- As in :mod:`._adaptive`, a reference is checked for plausibility (range and innovation,
+  :class:`~._adaptive.Plausible`) before it enters the window; a rejected one is counted
+  (``RefitReport.rejected``) and never fitted (one reference of 1e200 mm ended the stream with
+  an OverflowError). It still counts towards ``every``, so the refits stay at fixed references.
 - As in :mod:`._adaptive`, a sample's estimate is made before its reference is learnt: the
   error at each reference is an honest prediction error. Refits happen after fixed sample
   indices (the n-th reference), so a chunked run gives the bits of the whole run.
@@ -36,6 +40,7 @@ import numpy as np
 
 from ..errors import FitDivergedError, InputError
 from ..models import FAMILIES
+from ._adaptive import MAX_INNOVATION, REFERENCE_MARGIN, Plausible
 from ._compensator import Compensator
 from ._stream import (
     StartUp,
@@ -66,12 +71,16 @@ class Refit:
     max_nfev : int
         Evaluation budget of each refit's polish (after the fit's short screening run of its
         one start, the present parameters; ``screen_nfev`` of the family's fit, 12).
+    reference_margin, max_innovation : float
+        The plausibility gates of a reference, as :class:`~._adaptive.Adaptation`.
     """
 
     window_seconds: float = 60.0
     every: int = 10
     min_references: int | None = None
     max_nfev: int = 50
+    reference_margin: float = REFERENCE_MARGIN
+    max_innovation: float = MAX_INNOVATION
 
     def __post_init__(self) -> None:
         if not 0.0 < self.window_seconds < float("inf"):
@@ -83,6 +92,10 @@ class Refit:
                                  f"integer")
         if self.min_references is not None and self.min_references < 1:
             raise InputError(f"refit min_references {self.min_references!r}: must be >= 1")
+        for name in ("reference_margin", "max_innovation"):
+            if not getattr(self, name) > 0.0:  # inf allowed: no such check
+                raise InputError(f"refit {name} {getattr(self, name)!r}: must be a positive "
+                                 f"number")
 
 
 @dataclass(frozen=True)
@@ -93,6 +106,9 @@ class RefitReport:
     ----------
     references : int
         References received.
+    rejected : int
+        Of them, rejected as implausible (out of range, or too far from the estimate); they
+        never entered the window.
     kept, refused : int
         Refits whose parameters the stream took, and those it did not (a failed fit, or no
         improvement on the window).
@@ -107,6 +123,7 @@ class RefitReport:
     """
 
     references: int = 0
+    rejected: int = 0
     kept: int = 0
     refused: int = 0
     skipped: int = 0
@@ -195,6 +212,11 @@ class RefittingStream:
         return self._report
 
     @property
+    def n_rejected(self) -> int:
+        """References rejected as implausible so far (``report.rejected``)."""
+        return self._report.rejected
+
+    @property
     def state(self) -> StreamState:
         """The plain stream's present state, with the present parameters' model state."""
         return self._state
@@ -249,12 +271,17 @@ class RefittingStream:
         path, state = self._path, self._state
         comp = path.comp
         out, self._state, s = advance_scaled(path, state, s_raw, self.label)
+        known = np.flatnonzero(np.isfinite(r))
+        plausible = Plausible.of(comp, path.position_offset, self.refit)
+        rejected = [i for i in known if plausible.why_not(r[i], out.estimate[i]) is not None]
+        r = r.copy()
+        r[rejected] = np.nan  # before it moves anything: never in the window
         p = (r - path.position_offset) / comp.scaling.position_scale
         self._push(s, p)
-        n_refs = int(np.isfinite(r).sum())
-        self._since += n_refs
-        self._report = dataclasses.replace(self._report,
-                                           references=self._report.references + n_refs)
+        self._since += known.size
+        self._report = dataclasses.replace(
+            self._report, references=self._report.references + known.size,
+            rejected=self._report.rejected + len(rejected))
         return out
 
     def _push(self, s: np.ndarray, p: np.ndarray) -> None:
