@@ -322,6 +322,8 @@ def _evaluate(args: argparse.Namespace) -> int:
                   scores[f"linear_{key}_oracle"])
         print(f"{label:<20}" + "".join(f"{_fmt(v):>{w}}" for v, w in zip(values,
                                                                         (12, 10, 16, 13))))
+    for note in dict.fromkeys(scores["notes"].values()):  # why a score is n/a, once each
+        print(f"  {note}")
     print(f"{'sensor loop area %':<20}{_fmt(scores['sensor_loop_area']):>12}")
     print(f"outside training: {_count(scores['n_sensor_outside'])} sensor samples, "
           f"{_count(scores['n_estimate_outside'])} estimates")

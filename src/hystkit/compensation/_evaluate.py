@@ -50,11 +50,15 @@ def use_flags(compensator: Compensator, recording: Recording,
             "estimate_outside": compensator.estimate_outside(estimate)}
 
 
-def _scores(position: np.ndarray, guess: np.ndarray, scale: float, fs: float) -> dict:
-    return {"r2": _r2_or_none(position, guess), "e_rms_pct": e_rms_pct(position, guess, scale=scale),
-            "e_max_pct": e_max_pct(position, guess, scale=scale),
-            "sinad_db": _sinad_or_none(guess, fs), "loop_area": _loop_area_or_none(position,
-                                                                                  guess)}
+def _scores(position: np.ndarray, guess: np.ndarray, scale: float,
+            fs: float) -> tuple[dict, dict]:
+    """The scores of one estimate, and why any of them is undefined (by key)."""
+    sinad, sinad_note = _sinad_or_none(guess, fs)
+    scores = {"r2": _r2_or_none(position, guess),
+              "e_rms_pct": e_rms_pct(position, guess, scale=scale),
+              "e_max_pct": e_max_pct(position, guess, scale=scale),
+              "sinad_db": sinad, "loop_area": _loop_area_or_none(position, guess)}
+    return scores, ({} if sinad_note is None else {"sinad_db": sinad_note})
 
 
 def evaluate(compensator: Compensator, recording: Recording, *,
@@ -84,7 +88,9 @@ def evaluate(compensator: Compensator, recording: Recording, *,
         under the paper's protocol (``center_oracle``); ``sensor_loop_area``, ``n_samples``,
         ``extrapolated_fraction``, ``n_sensor_outside`` / ``n_estimate_outside`` (use-time
         guards, None if the model file predates them) with their margins. Every number is
-        finite; a score that is undefined or overflowed is None.
+        finite; a score that is undefined or overflowed is None. ``notes``: why a score is
+        None, by its key, where there is a reason to give (e.g. ``sinad_db``: the recording
+        is too short for its fundamental, and how many samples it needs); empty otherwise.
 
     Raises
     ------
@@ -100,7 +106,7 @@ def evaluate(compensator: Compensator, recording: Recording, *,
     scores = {"n_samples": recording.n_samples, "center": center_label(compensator.center),
               "center_oracle": center_label(ORACLE_CENTER)}
     runs = (("", compensator), ("_oracle", compensator.oracle()))
-    estimate = None
+    estimate, notes = None, {}
     for suffix, comp in runs:
         mean = float(np.mean(position)) if comp.center == ORACLE_CENTER else None
         guess = comp.estimate(recording, mean, rest_position=rest_position)
@@ -109,15 +115,17 @@ def evaluate(compensator: Compensator, recording: Recording, *,
         for prefix, values in (("", guess), ("linear_", line)):
             # a score that overflows (degenerate recording) becomes None below, not a warning
             with np.errstate(all="ignore"):
-                found = _scores(position, values, scale, recording.fs)
+                found, why = _scores(position, values, scale, recording.fs)
             for key, value in found.items():
                 scores[f"{prefix}{key}{suffix}"] = value
+            notes.update({f"{prefix}{key}{suffix}": note for key, note in why.items()})
     scores["sensor_loop_area"] = _loop_area_or_none(position, recording.sensor)
     flags = use_flags(compensator, recording, estimate)
     scores["extrapolated_fraction"] = compensator.extrapolated_fraction(recording)
     for name, mask in flags.items():
         scores[f"n_{name}"] = None if mask is None else int(np.sum(mask))
     scores["sensor_margin"], scores["position_margin"] = SENSOR_MARGIN, POSITION_MARGIN
+    scores["notes"] = notes
     return {key: _finite_or_none(value) for key, value in scores.items()}
 
 
@@ -139,10 +147,13 @@ def _loop_area_or_none(x: np.ndarray, y: np.ndarray) -> float | None:
     return None if np.ptp(y) == 0 or np.ptp(x) == 0 else loop_area(x, y)
 
 
-def _sinad_or_none(x: np.ndarray, fs: float) -> float | None:
-    """SINAD needs a periodogram long enough to separate the tone (and JSON has no inf)."""
+def _sinad_or_none(x: np.ndarray, fs: float) -> tuple[float | None, str | None]:
+    """SINAD and None, or None and why: it needs a periodogram long enough to separate the
+    tone from DC (:func:`~hystkit.metrics.sinad_db` says how long), and JSON has no inf."""
     try:
         value = sinad_db(x, fs)
-    except ValueError:
-        return None
-    return value if np.isfinite(value) else None
+    except ValueError as exc:
+        return None, f"SINAD n/a: {exc}"
+    if not np.isfinite(value):
+        return None, "SINAD n/a: nothing is left besides DC and the fundamental (infinite)"
+    return value, None

@@ -114,7 +114,8 @@ def measure_table_5_4(settings: Table54Settings = Table54Settings(),
         ``settings``; ``fit`` (status, message, training R², parameters); ``rows``: one dict per
         signal (``signal``, ``centring``, ``sinad_db``, ``loop_area_pct`` and the document's
         ``document_sinad_db``, ``document_loop_area_pct``; ``note`` where a row stands for
-        both centrings); ``centring_note`` (:data:`SAME_CENTRING_NOTE` or None);
+        both centrings; ``sinad_db`` None with ``sinad_note`` saying why where the recording is
+        too short for SINAD); ``centring_note`` (:data:`SAME_CENTRING_NOTE` or None);
         ``preprocess_warnings``.
 
     Raises
@@ -168,9 +169,14 @@ def _row(signal: str, centring: str, position: np.ndarray, y: np.ndarray, fs: fl
     from ..metrics import loop_area, sinad_db
 
     sinad, area = DOCUMENT_TABLE_5_4[signal]
-    return {"signal": signal, "centring": centring, "sinad_db": sinad_db(y, fs),
-            "document_sinad_db": sinad, "loop_area_pct": loop_area(position, y),
-            "document_loop_area_pct": area}
+    try:
+        measured, why = sinad_db(y, fs), None
+    except ValueError as exc:  # a recording too short for its fundamental: n/a, and why
+        measured, why = None, f"SINAD n/a: {exc}"
+    row = {"signal": signal, "centring": centring, "sinad_db": measured,
+           "document_sinad_db": sinad, "loop_area_pct": loop_area(position, y),
+           "document_loop_area_pct": area}
+    return row if why is None else {**row, "sinad_note": why}
 
 
 def signal_scores(comp: Compensator, recording: Recording, dr1: np.ndarray,
@@ -219,7 +225,9 @@ def _model_rows(comp: Compensator, centring: str, recording: Recording) -> list[
 
 
 def _same_scores(a: dict, b: dict) -> bool:
-    return (abs(a["sinad_db"] - b["sinad_db"]) <= _SAME_SCORE
+    if (a["sinad_db"] is None) != (b["sinad_db"] is None):
+        return False
+    return ((a["sinad_db"] is None or abs(a["sinad_db"] - b["sinad_db"]) <= _SAME_SCORE)
             and abs(a["loop_area_pct"] - b["loop_area_pct"]) <= _SAME_SCORE)
 
 

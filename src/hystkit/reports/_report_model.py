@@ -151,9 +151,9 @@ def score_section(comp: Compensator, scores: Mapping[str, dict]) -> Section:
     deployable, oracle = [], []
     for name, s in scores.items():
         for rows, suffix in ((deployable, ""), (oracle, "_oracle")):
-            rows.append((name, comp.model, *(_fixed_or_none(s[f"{k}{suffix}"], f)
+            rows.append((name, comp.model, *(_score_cell(s, f"{k}{suffix}", f)
                                              for k, _, f in _SCORES)))
-            rows.append((name, "straight line", *(_fixed_or_none(s[f"linear_{k}{suffix}"], f)
+            rows.append((name, "straight line", *(_score_cell(s, f"linear_{k}{suffix}", f)
                                                   for k, _, f in _SCORES)))
     first = next(iter(scores.values()))
     section = Section("Scores")
@@ -162,6 +162,10 @@ def score_section(comp: Compensator, scores: Mapping[str, dict]) -> Section:
                           f"|position| (eq. 5.10-5.11); loop area: eq. 5.15, 0 for a perfect "
                           f"compensator."),
                 table(head, deployable, text_columns=2))
+    # why a score is n/a (e.g. SINAD of a recording too short for its fundamental), once each
+    for text in dict.fromkeys(f"{name}: {why}" for name, s in scores.items()
+                              for why in s.get("notes", {}).values()):
+        section.add(note(text))
     trained = _training_names(comp) & set(scores)
     if trained:
         section.add(note(f"{', '.join(sorted(trained))}: the file name of a recording the model "
@@ -185,6 +189,13 @@ def _training_names(comp: Compensator) -> set[str]:
     info = comp.fit_info
     sources = info.get("training_sources") or [info.get("training_source") or ""]
     return {Path(s).name for s in sources if s}
+
+
+def _score_cell(scores: Mapping[str, object], key: str, spec: str) -> str | None:
+    """A score formatted; "n/a" where `evaluate` said why it has none (its ``notes``)."""
+    if scores[key] is None and key in scores.get("notes", {}):
+        return "n/a"
+    return _fixed_or_none(scores[key], spec)
 
 
 def _fixed_or_none(value: float | None, spec: str) -> str | None:
