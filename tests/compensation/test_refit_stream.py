@@ -112,7 +112,8 @@ def test_inverse_compensators_and_bad_settings_are_refused():
 
 def test_each_refit_keeps_to_its_budget(tracked, drifting):
     rec, ref = drifting
-    # one start (the present parameters): its 12-evaluation screen, then at most max_nfev;
+    # one start (the present parameters): its 12-evaluation screen, then at most max_nfev
+    # and, if the polish stops on that budget, once as much again (the flat-minimum check);
     # a weighted fit runs on scipy's trf, whose count adds a Jacobian to each residual run
     used = {}
     for budget in (3, 30):
@@ -120,7 +121,7 @@ def test_each_refit_keeps_to_its_budget(tracked, drifting):
         stream.process(rec.sensor, ref)
         tried = stream.report.kept + stream.report.refused
         assert tried > 0
-        assert stream.report.evaluations <= tried * 2 * (12 + budget)
+        assert stream.report.evaluations <= tried * 2 * (12 + 2 * budget)
         used[budget] = stream.report.evaluations / tried
     assert used[3] < used[30]
 

@@ -99,9 +99,12 @@ def test_fitted_models_evaluate_cleanly(cli, good, fitted, tmp_path, family):
     path.write_text(json.dumps(fitted[family]))
     run = cli("evaluate", path, good["val"], "--json", tmp_path / "scores.json")
     run.clean()
-    assert run.code == 0, run.err
     text = (tmp_path / "scores.json").read_text()
-    assert "NaN" not in text and "Infinity" not in text and json.loads(text)
+    assert "NaN" not in text and "Infinity" not in text
+    scores = json.loads(text)
+    # exit 3 only for the shared verdict (e.g. Chua's direct model is its straight line on
+    # this sensor), never for an error
+    assert run.code == (0 if scores["verdict"] in ("ok", "undetermined") else 3), run.err
 
 
 @pytest.mark.parametrize("family", FAMILIES)

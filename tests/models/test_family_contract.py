@@ -97,15 +97,22 @@ def test_split_run_equals_whole_run(name, factor):
 @pytest.mark.parametrize("name", NAMES)
 @pytest.mark.parametrize("factor", [1, 2])
 def test_compiled_run_equals_the_readable_steps_from_rest(name, factor):
+    """Each compiled step, from the readable run's state, equals the readable step. Step by
+    step, because over a whole run a model may amplify one rounding of its state: a Bouc-Wen
+    fitted with loops sharper than the record resolves turns 1e-16 into 4e-11 within 100
+    steps, in either implementation; the whole run then tests its conditioning, not the
+    kernel (the split-run test above checks that the compiled state carries the run)."""
     family = get_family(name)
     structure, params, _ = _example(name, factor)
     u = _probe(200, seed=1)
-    y, _ = family.simulate(structure, params, u)
+    y, _ = family.simulate(structure, params, u[:1])
     x = family.rest_state(structure, params, float(u[0]))
     for k, u_k in enumerate(u):
+        if k:
+            y, _ = family.simulate(structure, params, u[k:k + 1], x)
         y_k, x = family.step(structure, params, x, u_k)
         # the same arithmetic; library calls and sums may differ in the last bits (<= 4.4e-16)
-        assert y_k == pytest.approx(y[k], abs=1e-14), k
+        assert y_k == pytest.approx(y[0], abs=1e-14), k
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -282,19 +282,19 @@ def _warn_if_outside(flags: dict, data: Path) -> None:
     mask = flags["sensor_outside"]
     if mask is not None and mask.any():
         print(f"hystkit: warning: {data}: {int(mask.sum())} sample(s) "
-              f"({100 * mask.mean():.1f} %) lie outside the sensor range the compensator was "
+              f"({100 * mask.mean():.2g} %) lie outside the sensor range the compensator was "
               f"trained on (+{100 * SENSOR_MARGIN:g} % margin); its estimate there is an "
               f"extrapolation", file=sys.stderr)
     mask = flags["estimate_outside"]
     if mask is not None and mask.any():
         print(f"hystkit: warning: {data}: {int(mask.sum())} estimate(s) "
-              f"({100 * mask.mean():.1f} %) lie outside the training position range "
+              f"({100 * mask.mean():.2g} %) lie outside the training position range "
               f"(+{100 * POSITION_MARGIN:g} % margin)", file=sys.stderr)
 
 
 def _evaluate(args: argparse.Namespace) -> int:
     check_inputs_exist([args.model, args.data])
-    from ..compensation import verdict
+    from ..compensation import FAR_MARGIN, verdict
     from ..io import check_output_path, read_recording, write_json, write_mat
 
     evaluate, load_compensator = _module.evaluate, _module.load_compensator
@@ -328,7 +328,10 @@ def _evaluate(args: argparse.Namespace) -> int:
     print(f"outside training: {_count(scores['n_sensor_outside'])} sensor samples, "
           f"{_count(scores['n_estimate_outside'])} estimates")
     # the shared verdict, on the deployable scores: what a compensator in use would give
-    status, message = verdict(scores["r2"], scores["linear_r2"], f"{args.data}: deployable")
+    far = comp.sensor_outside(rec, margin=FAR_MARGIN)
+    outside = None if far is None else float(far.mean())
+    status, message = verdict(scores["r2"], scores["linear_r2"], f"{args.data}: deployable",
+                              outside)
     scores["verdict"], scores["verdict_message"] = status, message
     if args.json is not None:
         write_json(scores, args.json, force=args.force)
@@ -340,9 +343,9 @@ def _evaluate(args: argparse.Namespace) -> int:
             write_json(scores, args.out, force=args.force)
         print(f"wrote {args.out}")
     if status not in ("ok", "undetermined"):
-        print(f"hystkit: evaluate: {status.replace('_', ' ')}: {message}; on these data the "
-              f"{comp.model} compensator should not be used (the straight line, or another "
-              f"model from `hystkit select`, does better)", file=sys.stderr)
+        print(f"hystkit: evaluate: {status.replace('_', ' ')}: {message}; do not use the "
+              f"{comp.model} compensator on data like these (try `hystkit select` on "
+              f"recordings that cover them)", file=sys.stderr)
         return GUARD_EXIT
     print(f"verdict: {status} ({message})")
     return 0

@@ -45,9 +45,15 @@ def _select(args: argparse.Namespace) -> int:
         write_json,
     )
     from ..parallel import loading_meanwhile
-    from ..reports import FIGURE_MODULES, candidates, folds, plot_selection, select_model
-    from ..reports._select import protocol
-    from ..reports._text_table import text_table
+    from ..reports import (
+        FIGURE_MODULES,
+        candidates,
+        folds,
+        plot_selection,
+        protocol,
+        select_model,
+        text_table,
+    )
 
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
                       what="a model file")

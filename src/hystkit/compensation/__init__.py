@@ -24,6 +24,7 @@ __getattr__, __dir__ = lazy_exports(
                      "load_compensator", "save_compensator"),
      "_stream": ("StepOutput", "Stream", "StreamOutput", "StreamState", "advance"),
      "_sync": ("SyncExcitation", "sync_excitation"),
-     "_training_checks": ("check_excursion", "check_fitting_data"),
-     "_verdict": ("MIN_EXPLAINED", "verdict")},
+     "_training_checks": ("MIN_SAMPLES_PER_PARAM", "check_excursion", "check_fitting_data",
+                          "count_fitted"),
+     "_verdict": ("FAR_MARGIN", "MAX_OUTSIDE", "MIN_EXPLAINED", "verdict")},
     first=())

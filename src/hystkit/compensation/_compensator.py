@@ -23,8 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FitDivergedError, InputError
-from ..io import Recording
-from ..io._recording import MAX_MAGNITUDE
+from ..io import MAX_MAGNITUDE, Recording
 from ..models import Family, get_family
 from ._centring import (
     CENTERS,

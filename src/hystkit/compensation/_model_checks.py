@@ -25,8 +25,8 @@ from collections.abc import Iterable, Iterator
 from typing import Any
 
 from ..errors import InputError
-from ..io._recording import MAX_MAGNITUDE
-from ..models._cells import DT_RANGE
+from ..io import MAX_MAGNITUDE
+from ..models import DT_RANGE
 from ._compensator import MAX_NORMALISED
 
 __all__ = ["MAX_MODEL_BYTES", "MAX_PARAM_NUMBERS", "MAX_SCALE", "MAX_STRUCTURE_INT",

@@ -70,7 +70,9 @@ class Refit:
         References the window must hold before a refit; None: four per fitted parameter.
     max_nfev : int
         Evaluation budget of each refit's polish (after the fit's short screening run of its
-        one start, the present parameters; ``screen_nfev`` of the family's fit, 12).
+        one start, the present parameters; ``screen_nfev`` of the family's fit, 12); a polish
+        that stops on it is continued once with as much again, to tell a flat minimum from a
+        failure (:func:`hystkit.identification.fit_multistart`).
     reference_margin, max_innovation : float
         The plausibility gates of a reference, as :class:`~._adaptive.Adaptation`.
     """

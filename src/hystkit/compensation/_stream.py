@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import FitDivergedError, InputError
 from ._centring import ORACLE_CENTER
-from ..io._recording import MAX_MAGNITUDE
+from ..io import MAX_MAGNITUDE
 from ._compensator import (
     MAX_NORMALISED,
     POSITION_MARGIN,

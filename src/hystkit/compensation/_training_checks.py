@@ -95,7 +95,20 @@ def check_excursion(recordings: Sequence[Recording]) -> None:
 
 def count_fitted(family: Family, structure: Any) -> int | None:
     """Fitted numbers of `family` at `structure`, known before fitting (from a draw of its
-    documented domain); None for a family that documents none."""
+    documented domain).
+
+    Parameters
+    ----------
+    family : Family
+        The family to be fitted.
+    structure : object
+        Its structure.
+
+    Returns
+    -------
+    int or None
+        The count of float parameters; None for a family that documents no domain.
+    """
     draw = getattr(family, "random_params", None)  # duck-typed stand-ins may lack it
     if draw is None:
         return None

@@ -7,6 +7,11 @@ The same rules serve every command that judges a model (``fit``, ``select``, ``e
 - ``no_signal``: it does not, but its estimate explains less than ``MIN_EXPLAINED`` of the
   position's variance (its error is at least ~95 % of the position's own spread): the sensor,
   as modelled, carries nothing a compensator can use (e.g. a noise-only sensor column).
+- ``extrapolated``: it does neither, but more than ``MAX_OUTSIDE`` of the sensor samples lie
+  far outside the range the model was trained on (beyond it by more than ``FAR_MARGIN`` of
+  its width): whatever it scores there, it works by luck, not by what it learnt (judged only
+  where that share is given, e.g. by ``evaluate``). Samples just outside the range are
+  warned about per sample, not judged here.
 - ``undetermined``: R² is undefined there (a position that never moves): nothing to judge by.
 - ``ok``: none of these.
 
@@ -16,16 +21,21 @@ estimate, parameters on the search box, a solver that did not converge).
 
 from __future__ import annotations
 
-__all__ = ["MIN_EXPLAINED", "USE_STATUSES", "verdict"]
+__all__ = ["FAR_MARGIN", "MAX_OUTSIDE", "MIN_EXPLAINED", "USE_STATUSES", "verdict"]
 
 # Below this R² the estimate is no better than reporting a constant in any useful sense.
 MIN_EXPLAINED = 0.1
 # The statuses of this module: ``ok`` may be used, ``undetermined`` cannot be judged (no R²),
 # the others must not be used.
-USE_STATUSES = ("no_signal", "worse_than_line", "undetermined", "ok")
+USE_STATUSES = ("no_signal", "worse_than_line", "extrapolated", "undetermined", "ok")
+# More than this share of sensor samples far outside the training range (beyond it by more
+# than FAR_MARGIN of its width on either side) is use beyond the model.
+MAX_OUTSIDE = 0.1
+FAR_MARGIN = 0.5
 
 
-def verdict(r2_model: float | None, r2_line: float | None, where: str) -> tuple[str, str]:
+def verdict(r2_model: float | None, r2_line: float | None, where: str,
+            outside: float | None = None) -> tuple[str, str]:
     """``(status, message)`` of a model scored on some data against its straight line.
 
     Parameters
@@ -36,6 +46,9 @@ def verdict(r2_model: float | None, r2_line: float | None, where: str) -> tuple[
     where : str
         What the scores are of, for the message: ``"training"``, ``"held-out (left-out
         recording)"``, a file name.
+    outside : float, optional
+        Share of the scored sensor samples far outside the model's training range (beyond it
+        by more than ``FAR_MARGIN`` of its width); None: not judged.
 
     Returns
     -------
@@ -53,4 +66,9 @@ def verdict(r2_model: float | None, r2_line: float | None, where: str) -> tuple[
         return "no_signal", (f"{where} R² {r2_model:.4f} (straight line {line}): the estimate "
                              f"explains less than {MIN_EXPLAINED:.0%} of the position's "
                              f"variance, no better than a constant")
+    if outside is not None and outside > MAX_OUTSIDE:
+        return "extrapolated", (f"{outside:.0%} of the sensor samples lie far outside the "
+                                f"range the model was trained on (by more than "
+                                f"{FAR_MARGIN:.0%} of its width; {where} R² {r2_model:.4f}): "
+                                f"retrain on data that covers this range")
     return "ok", f"{where} R² {r2_model:.4f} (straight line {line})"

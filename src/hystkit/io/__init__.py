@@ -14,7 +14,7 @@ __getattr__, __dir__ = lazy_exports(
      "_other_columns": ("read_other_columns",),
      "_raw": ("RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter", "open_raw"),
      "_raw_config": ("CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_config"),
-     "_recording": ("Recording", "Sampled", "read_recording"),
+     "_recording": ("MAX_MAGNITUDE", "Recording", "Sampled", "read_recording"),
      "_recording_config": ("find_recording_config", "options_for", "read_recording_config"),
      "_writing": ("RECORDING_SUFFIXES", "atomic_folder", "atomic_output", "atomic_outputs",
                   "check_output_folder", "check_output_format", "check_output_path",

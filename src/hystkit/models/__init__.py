@@ -5,9 +5,10 @@ every registered name to its family. See :mod:`hystkit.models._protocol` for wha
 provides and how to add one.
 """
 
+from ._cells import DT_RANGE
 from ._protocol import Block, Family, FitStart, Record, numerical_linearisation
 from ._registry import FAMILIES, family_of, get_family, register, unregister
 from ._stability import stability_report
 
-__all__ = ["FAMILIES", "Block", "Family", "FitStart", "Record", "family_of", "get_family",
+__all__ = ["DT_RANGE", "FAMILIES", "Block", "Family", "FitStart", "Record", "family_of", "get_family",
            "numerical_linearisation", "register", "stability_report", "unregister"]

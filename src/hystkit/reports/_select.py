@@ -30,9 +30,14 @@ import numpy as np
 from matplotlib.figure import Figure
 from threadpoolctl import threadpool_limits
 
-from ..compensation import DEFAULT_CENTER, check_fitting_data, fit_compensator, verdict
-from ..compensation._diagnostics import MIN_SAMPLES_PER_PARAM
-from ..compensation._training_checks import count_fitted
+from ..compensation import (
+    DEFAULT_CENTER,
+    MIN_SAMPLES_PER_PARAM,
+    check_fitting_data,
+    count_fitted,
+    fit_compensator,
+    verdict,
+)
 from ..io import Recording
 from ..metrics import r2
 from ..models import FAMILIES, get_family

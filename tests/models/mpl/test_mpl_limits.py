@@ -72,7 +72,7 @@ def test_a_linear_cell_resistor_is_a_note():
 @pytest.mark.parametrize(("index", "side", "expected"), [
     (2, 1, "cell 2 runs at the Euler slope cap"),  # a model limit
     (3, 0, "log_v_t[2] (lower)"),
-    (0, 0, "log_G[1] (lower)"),
+    (0, 0, "cell 1 integrates over the record"),  # G at its floor on a 15 s record
     (5, 1, "cell 3 has a linear resistor"),  # a model limit
     (7, 1, "w[1] (upper)"),
     (10, 0, "v_b (lower)"),
@@ -88,8 +88,18 @@ def test_constructed_three_cell_optimum_on_each_kind_of_bound(index, side, expec
     theta[index] = result.bounds[side][index]
     moved = replace(result, theta=theta, sensitivity=None)
     on_bounds, notes = bound_flags(moved)
-    label = theta_limits(3)[side][index]
+    label = theta_limits(3, True, u.size * DT)[side][index]
     if label is None:
         assert on_bounds == [expected] and notes == []
     else:
         assert on_bounds == [] and notes == [label] and label.startswith(expected)
+
+
+def test_the_g_floor_is_a_search_box_on_a_record_long_enough_to_resolve_it():
+    """At G = 1e-4 /s a cell moves by G T of its drive over a record of T seconds: over 15 s it
+    integrates (only w G is identified); over 10^4 s it would move fully, so a fit at the
+    floor there is a search box too small, reported as on bounds."""
+    short, long = theta_limits(3, True, 15.0)[0][0], theta_limits(3, True, 1e4)[0][0]
+    assert short.startswith("cell 1 integrates over the record") and "15 s of data" in short
+    assert long is None
+    assert theta_limits(3)[0][0] is None  # no record length known: a search box

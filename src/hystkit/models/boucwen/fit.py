@@ -78,6 +78,34 @@ def parameter_bounds(structure: boucwen.BoucWenStructure, u: np.ndarray, y: np.n
     return lower, upper
 
 
+_NAMES = ("log_k0", "log_omega0", "log_zeta", "logit_r", "beta+gamma", "beta-gamma", "nu")
+
+
+def _theta_limits(bounded: bool) -> tuple[list[str | None], list[str | None]]:
+    """Which bounds of :func:`parameter_bounds` are limits of the model or of what a record can
+    tell, with a note for each; the others are a search box (a fit there is on bounds).
+
+    * ``logit r = +-9``: ``r = alpha / K0`` within 1.2e-4 of 0 or 1, an all but purely
+      hysteretic or purely elastic restoring force; past it the output changes by less.
+    * ``beta +- gamma`` at ``+-1e3 / y_ref``: the loop turns within 1e-3 of the output's
+      amplitude, sharper than the record resolves; ``bounded``: at 0, the edge of the class
+      whose ``z`` stays bounded.
+    * ``log omega0`` at ``log(1 / h)``: the resonance at the integrator's step.
+    * ``nu = 1``: the classic Bouc-Wen loop, the smallest exponent of the family.
+    """
+    sharp = "the loop turns sharper than the record resolves ({} at its bound +-1e3 / y_ref)"
+    edge = "the edge of the loops whose z stays bounded ({} = 0)"
+    lower: list[str | None] = [None, None, None,
+                               "r = alpha / K0 at 1.2e-4: an all but purely elastic spring",
+                               (edge if bounded else sharp).format("beta + gamma"),
+                               (edge if bounded else sharp).format("beta - gamma"),
+                               "nu = 1: the classic Bouc-Wen loop"]
+    upper: list[str | None] = [None, "the resonance sits at the integration step (omega0 h = 1)",
+                               None, "r = alpha / K0 at 1 - 1.2e-4: an all but linear spring",
+                               sharp.format("beta + gamma"), sharp.format("beta - gamma"), None]
+    return lower, upper
+
+
 def _linear_starts(lower: np.ndarray, upper: np.ndarray,
                    simulate_linear: Callable[[np.ndarray], np.ndarray | None],
                    y: np.ndarray) -> list[np.ndarray]:
@@ -199,6 +227,7 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
         raise ValueError(f"the record is too short to fit a Bouc-Wen model: its "
                          f"{u.size * structure.dt:.3g} s do not span one cycle at the fastest "
                          f"natural frequency 1 / h = {1 / structure.step_size:.3g} rad/s")
+    limits = _theta_limits(bounded)
     bound = _PENALTY * y_scale
     penalty = np.full(y.size, bound)
     linear = structure.input_hold == "linear"
@@ -233,6 +262,8 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
                               lambda th: boucwen.BoucWenParams.from_vector(full(th)), structure,
                               max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
                               solver=solver, loss=loss, f_scale=f_scale, weights=weights,
+                              names=[_NAMES[i] for i in free],
+                              limits=tuple([side[i] for i in free] for side in limits),
                               **options)
 
     t_start = time.perf_counter()

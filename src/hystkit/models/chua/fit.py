@@ -18,6 +18,8 @@ from . import model as chua
 
 __all__ = ["default_starts", "fit_chua", "random_params"]
 
+_ELEMENT_NAMES = ("log_k0", "log_k_inf", "log_y_s", "log_g", "log_v_g", "delta")
+
 # Bounds per element in optimiser coordinates, for data normalised to max |.| = 1 (eq. 5.10):
 # slopes and scales over four decades around 1, bands up to the whole half-range.
 _LOG_SLOPE = (np.log(1e-2), np.log(1e2))
@@ -32,6 +34,29 @@ def _bounds(structure: chua.ChuaStructure) -> tuple[np.ndarray, np.ndarray]:
     log_g = (np.log(1e-3), np.log(min(100.0 / structure.dt, chua.DOMAIN["g"][1])))
     per = [_LOG_SLOPE, _LOG_SLOPE, _LOG_SCALE, log_g, _LOG_VG, _DELTA]
     lower, upper = (np.tile([b[i] for b in per], structure.n_elements) for i in (0, 1))
+    return lower, upper
+
+
+def _theta_names(n_elements: int) -> list[str]:
+    """Names of the optimiser coordinates (:meth:`ChuaParams.to_vector`), elements from 1."""
+    return [f"{name}[{k}]" for k in range(1, n_elements + 1) for name in _ELEMENT_NAMES]
+
+
+def _theta_limits(n_elements: int) -> tuple[list[str | None], list[str | None]]:
+    """Which bounds are limits of the model itself, with a note for each.
+
+    * ``delta_k = 0``: the document's model (no dead band); a band cannot be narrower.
+    * ``log g_k`` at its upper bound: beyond the Euler cap ``g`` is a straight line of the
+      capped slope, so a larger ``G`` changes nothing (see ``_bounds``).
+
+    Every other bound is a search box: a fit there is reported as on bounds.
+    """
+    lower: list[str | None] = []
+    upper: list[str | None] = []
+    for k in range(1, n_elements + 1):
+        lower += [None] * 5 + [f"element {k} has no dead band (delta = 0, the document's model)"]
+        upper += [None] * 3 + [f"element {k} runs at the Euler slope cap (a larger G changes "
+                               f"nothing)", None, None]
     return lower, upper
 
 
@@ -129,7 +154,8 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
                           structure, normal_equations=chunked.normal_equations,
                           cost=chunked.cost, solver=solver, max_nfev=max_nfev,
                           screen_nfev=screen_nfev, n_polish=n_polish, accept=accept,
-                          accept_reason=accept_reason, loss=loss, f_scale=f_scale,
+                          accept_reason=accept_reason, names=_theta_names(n),
+                          limits=_theta_limits(n), loss=loss, f_scale=f_scale,
                           weights=weights)
 
 

@@ -32,6 +32,31 @@ _LOG_G_MIN = np.log(1e-3)
 _W_BOUND = 100.0  # as the mPL's |w| <= 100 (sec. 5.3.3)
 
 
+def _theta_names(n_cells: int) -> list[str]:
+    """Names of the optimiser coordinates ``[E_1, log G_1, .., E_N, log G_N]``, cells from 1."""
+    return [f"{name}[{k}]" for k in range(1, n_cells + 1) for name in ("E", "log_G")]
+
+
+def _theta_limits(n_cells: int) -> tuple[list[str | None], list[str | None]]:
+    """Which bounds are limits of the model itself, with a note for each.
+
+    * ``E_k = 0``: a dead band cannot be narrower than none; the cell is a linear resistor.
+    * ``E_k`` at its upper bound (1.5, beyond the normalised data's range, eq. 5.10): the cell
+      never conducts, and a wider band changes nothing.
+    * ``log G_k`` at its upper bound: the Euler limit of two conducting resistors at a node
+      (:func:`~.model.conductance_limit`), the edge of the family's domain.
+
+    The floor of ``log G_k`` is a search box: a fit there is reported as on bounds.
+    """
+    lower: list[str | None] = []
+    upper: list[str | None] = []
+    for k in range(1, n_cells + 1):
+        lower += [f"cell {k} has no dead band (E = 0: a linear resistor)", None]
+        upper += [f"cell {k}'s dead band covers the data's range (it never conducts)",
+                  f"cell {k} runs at the Euler limit (G dt = slope_cap / 2)"]
+    return lower, upper
+
+
 def default_starts(structure: ladder.LadderStructure) -> list[np.ndarray]:
     """Deterministic starts ``[E_1, log G_1, ..]``: bands growing along the ladder (0, 0.05 or
     0.2 of the range per cell) and conductances near the limit or 10 and 100 times slower.
@@ -139,6 +164,7 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
                           (lower, upper), lambda th: project(th)[0], structure,
                           max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
                           accept=accept, accept_reason=accept_reason, solver=solver,
+                          names=_theta_names(n), limits=_theta_limits(n),
                           loss=loss, f_scale=f_scale, weights=weights)
 
 

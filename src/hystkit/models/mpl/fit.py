@@ -91,8 +91,14 @@ def fit_box(structure: mpl.MplStructure) -> tuple[np.ndarray, np.ndarray]:
     return lower, upper
 
 
-def theta_limits(n_cells: int,
-                 limit: bool = True) -> tuple[list[str | None], list[str | None]]:
+# A cell whose rate G at the floor moves it by less than this share of its drive over the whole
+# record integrates: only w_k G_k is identified, and a smaller G with a larger w is the same
+# model over the record (the floor is then a limit of what the data can tell, not a box).
+_INTEGRATING = 0.1
+
+
+def theta_limits(n_cells: int, limit: bool = True,
+                 duration: float | None = None) -> tuple[list[str | None], list[str | None]]:
     """Which bounds are the model's own limits, with a note for each (see ``fit_multistart``).
 
     The criterion: moving past the bound cannot change the model's output, so a fit there has
@@ -107,13 +113,25 @@ def theta_limits(n_cells: int,
       ``(v / V_T)^2 / 6 < 1e-6`` relative for the normalised data (|v| <= 2, eq. 5.10), so the
       bound stands for a linear cell resistor.
 
-    Every other bound (``G_k`` at its floor, ``V_T`` at 1e-3, ``|w| = 100``) is a search box:
-    past it the model changes, and a fit there is reported as on bounds. Without the limit
-    (``limit=False``) the upper bound of ``log G_k`` is a search box too.
+    * Lower bound of ``log G_k`` (1e-4 /s), for a record of `duration` with ``G_min duration
+      <= 0.1``: over the record such a cell moves by at most a tenth of its drive, so it acts
+      as an integrator whose output depends on ``w_k G_k`` only; a slower cell with a larger
+      weight is the same model over the record (a redundant time constant, not a box too
+      small).
+
+    Every other bound (``G_k`` at its floor on a longer record, ``V_T`` at 1e-3, ``|w| =
+    100``) is a search box: past it the model changes, and a fit there is reported as on
+    bounds. Without the limit (``limit=False``) the upper bound of ``log G_k`` is a search
+    box too.
     """
     lower: list[str | None] = [None] * (3 * n_cells + 2)
     upper = list(lower)
+    g_floor = float(np.exp(_LOG_G_MIN if limit else _LOG_G_UNLIMITED[0]))
     for k in range(n_cells):
+        if duration is not None and g_floor * duration <= _INTEGRATING:
+            lower[2 * k] = (f"cell {k + 1} integrates over the record (time constant 1/G >= "
+                            f"{1 / g_floor:.3g} s against {duration:.3g} s of data): only "
+                            f"w[{k + 1}] G[{k + 1}] is identified")
         if limit:
             upper[2 * k] = (f"cell {k + 1} runs at the Euler slope cap (G dt = slope_cap, "
                             f"eq. 5.28-5.29)")
@@ -264,7 +282,8 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
                             normal_equations=normal_equations, solver=solver,
                             max_nfev=max_nfev, screen_nfev=screen_nfev, n_polish=n_polish,
                             accept=accept, accept_reason=accept_reason, names=theta_names(n),
-                            limits=theta_limits(n, structure.limit), loss=loss,
+                            limits=theta_limits(n, structure.limit, u.size * structure.dt),
+                            loss=loss,
                             f_scale=f_scale, weights=weights)
     if weight_sum_max is None:
         return result
