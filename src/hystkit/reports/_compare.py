@@ -12,11 +12,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..compensation import (
+    FAR_MARGIN,
     centre_and_scale,
     check_excursion,
     check_fitting_data,
     evaluate,
     fit_compensator,
+    verdict,
 )
 from ..errors import HystkitError
 from ..io import Recording
@@ -124,7 +126,8 @@ def compare_models(fit_rec: Recording, val_rec: Recording, models: Sequence[str]
         ``{model: {n_params, fit_seconds, r2_forward, r2_compensated (None if no inverse, with
         compensated_note), r2_direct (a compensator fitted sensor -> position), linear_r2,
         the same four with an ``_oracle`` suffix (paper's protocol), center, direct_status,
-        e_rms_pct, e_max_pct (forward, % of the normalised range), rate_dependent,
+        verdict and verdict_message (the shared verdict on the direct compensator's deployable
+        validation scores, :func:`hystkit.compensation.verdict`), e_rms_pct, e_max_pct (forward, % of the normalised range), rate_dependent,
         return_point_memory, minor_loops_close, ...}}``, in the order of `models`; a model
         whose fit fails has ``error`` (the others are still scored).
 
@@ -174,7 +177,11 @@ def _compare_piece(piece: tuple[str, int | None, str], *, fit_rec: Recording,
             return _forward_scores(name, size, fit_rec, val_rec)
         comp = fit_compensator(fit_rec, size, model=name, diagnose=False)
         direct = evaluate(comp, val_rec)
-        entry = {"center": direct["center"], "direct_status": comp.fit_info["status"]}
+        far = comp.sensor_outside(val_rec, margin=FAR_MARGIN)
+        use, why = verdict(direct["r2"], direct["linear_r2"], "validation (deployable)",
+                           None if far is None else float(far.mean()))
+        entry = {"center": direct["center"], "direct_status": comp.fit_info["status"],
+                 "verdict": use, "verdict_message": why}
         for suffix in ("", "_oracle"):
             entry[f"r2_direct{suffix}"] = direct[f"r2{suffix}"]
             entry[f"linear_r2{suffix}"] = direct[f"linear_r2{suffix}"]
@@ -460,7 +467,7 @@ def format_compare(table: Mapping[str, dict]) -> str:
     """
     head = (f"{'model':<10}{'params':>7}{'fit s':>7}{'R² fwd':>8}{'R² inv':>8}{'R² dir':>8}"
             f"{'line':>8} | oracle:{'R² inv':>8}{'R² dir':>8}{'line':>8}{'e_rms%':>8}"
-            f"  rate-dep  ret.point  minor  direct fit")
+            f"  rate-dep  ret.point  minor  direct fit  verdict on validation")
     lines = [head]
     for name, m in table.items():
         if "error" in m:
@@ -473,7 +480,8 @@ def format_compare(table: Mapping[str, dict]) -> str:
             f"{_fmt(m['r2_direct_oracle']):>8}{_fmt(m['linear_r2_oracle']):>8}"
             f"{_fmt(m['e_rms_pct'], '.2f'):>8}"
             f"  {_yes_no(m['rate_dependent']):>8}  {_yes_no(m['return_point_memory']):>9}"
-            f"  {_yes_no(m['minor_loops_close']):>5}  {m['direct_status']}")
+            f"  {_yes_no(m['minor_loops_close']):>5}  {m['direct_status']:<10}"
+            f"  {m.get('verdict', 'n/a')}")
     notes = [f"  {name}: no R² inv: {m['compensated_note']}" for name, m in table.items()
              if "error" not in m and m["r2_compensated"] is None]
     return "\n".join(lines + (["why some R² inv are missing:"] + notes if notes else []))
