@@ -62,9 +62,12 @@ def test_select_writes_the_winner_and_its_table(tmp_path, capsys):
     assert code == 0
     summary = json.loads((report / "selection.json").read_text())
     ranking = summary["ranking"]
-    assert {r["candidate"] for r in ranking} == {"mpl:1:direct:fit", "mpl:1:inverse:fit",
-                                                  "mpl:3:direct:fit", "mpl:3:inverse:fit"}
-    scores = [r["cv_r2"] for r in ranking if "error" not in r and not r["guard_failed"]]
+    # every deployable centring by default
+    assert {r["candidate"] for r in ranking} == {f"mpl:{n}:{mode}:{center}" for n in (1, 3)
+                                                 for mode in ("direct", "inverse")
+                                                 for center in ("fit", "tare", "track")}
+    scores = [r["cv_r2"] for r in ranking if "error" not in r and not r["guard_failed"]
+              and r["verdict"] == "ok"]
     assert scores == sorted(scores, reverse=True)
     winner = summary["winner"]
     assert winner["cv_r2"] == scores[0] and winner["cv_r2"] > winner["cv_linear_r2"]
