@@ -92,3 +92,17 @@ def test_settling_says_its_drift_rate_is_relative_to_r_final(cli: Callable[..., 
     run = cli("settling", log, "--traces", "r2", "--out", tmp_path / "s")
     assert run.code == 0, run.err
     assert "rest time (drift |dR/dt| / R_final < 0.1 %/h)" in run.out
+
+
+def test_a_few_samples_outside_the_training_range_are_not_rounded_to_zero(
+        cli: Callable[..., Run], good: dict[str, Path], tmp_path: Path) -> None:
+    """2 of 8000 samples beyond the training range were reported as '(0.0 %)'."""
+    table = pd.read_csv(good["val"])
+    top = table["sensor"].max()
+    span = top - table["sensor"].min()
+    table.loc[[100, 200], "sensor"] = top + 0.5 * span  # two samples well past the range
+    data = tmp_path / "two_outside.csv"
+    table.to_csv(data, index=False)
+    run = cli("compensate", good["model"], data, "--out", tmp_path / "c.csv")
+    warning = next(line for line in run.err.splitlines() if "lie outside the sensor range" in line)
+    assert f"2 sample(s) ({100 * 2 / len(table):.2g} %)" in warning, warning

@@ -116,8 +116,8 @@ def plot_settling(logs: Mapping[str, tuple[np.ndarray, np.ndarray, SettlingFit |
         if rest is not None and rest.hours > 0:
             extra = ", extrapolated" if rest.extrapolated else ""
             ax.axvline(rest.hours, color="k", ls="--", lw=1,
-                       label=f"rest {rest.hours / 24:.2f} d ({rest.threshold_pct_per_hour:g} "
-                             f"%/h{extra})")
+                       label=f"rest {rest.hours / 24:.2f} d (|dR/dt| / R_final < "
+                             f"{rest.threshold_pct_per_hour:g} %/h{extra})")
         ax.set_xscale("log")
         ax.set_ylabel("R [kOhm]")
         ax.grid(alpha=0.3, which="both")
