@@ -60,11 +60,15 @@ def test_direct_scheme_with_the_family_as_compensator(model_files, name, tmp_pat
     assert code == 0, err
     metrics = json.loads((tmp_path / "a" / "metrics.json").read_text())
     assert metrics["n_steps"] > 0 and "Traceback" not in err
-    if model_files[name][0] == 0:  # a fit that passed its guards keeps the loop bounded, with
-        # errors below the 3 mm stroke's double (bounded, not necessarily good: Preisach
-        # trained on noise reaches 3.1 mm)
+    if model_files[name][0] == 0 and metrics["linear"]["closed_loop_stable"]:
+        # a fit that passed its guards, in a loop whose linearisation is stable, keeps the loop
+        # bounded, with errors below the 3 mm stroke's double (bounded, not necessarily good:
+        # Preisach trained on noise reaches 3.1 mm)
         assert metrics["bounded"] and metrics["e_p_max"] < 6e-3, metrics
-    elif not metrics["bounded"]:  # a failed one may run away: stopped and said so
+    elif not metrics["bounded"]:
+        # a failed fit, or a good one whose dynamics the loop cannot take (Bouc-Wen trained on
+        # noise is a 4.5 Hz oscillator with 4 % damping inside the loop's 9 Hz crossover: the
+        # linearisation says UNSTABLE before the run): stopped and said so
         assert metrics["stop_reason"] and metrics["n_steps"] < metrics["n_requested"]
 
 
