@@ -34,6 +34,12 @@ def cases():
         yield f"virtual {name}", [simulate_experiment(name, 1)], simulate_experiment(name, 2)
     yield ("virtual noise -> sine", [simulate_experiment("noise", 1)],
            simulate_experiment("sine", 2))
+    yield from real_cases()
+
+
+def real_cases():
+    """(name, training recordings, a separate run) of every shared real data set that has
+    one; none (and a note on stderr) where the shared data are not found."""
     try:
         ident = load("piezo_micromanipulator", "identification").to_recording()
         test = load("piezo_micromanipulator", "test")
