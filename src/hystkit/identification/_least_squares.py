@@ -278,7 +278,8 @@ def _settle(solve: Callable, best: SimpleNamespace, max_nfev: int, to_params: Ca
     termination test, or if the cost moved by less than ``STALL_RTOL`` relative: the solver
     then crawls along a flat valley (parameters the data do not separate, e.g. two cells
     whose weights cancel), where more evaluations change the model's output by nothing; the
-    standard errors say which parameters are not determined."""
+    point where the budget ran out is kept, and the standard errors say which parameters
+    are not determined."""
     if best.status > 0:
         return best, True, str(best.message), 0
     more = solve(best.x, max_nfev)
@@ -289,10 +290,11 @@ def _settle(solve: Callable, best: SimpleNamespace, max_nfev: int, to_params: Ca
     if better and more.status > 0:
         return chosen, True, str(more.message), more.n_runs
     if change < STALL_RTOL:
-        return chosen, True, (f"the cost moved by {change:.1e} relative over "
-                              f"{more.n_runs} more evaluations: converged to a flat minimum "
-                              f"(the budget ran out while the parameters crawled along it)"
-                              ), more.n_runs
+        # keep the point where the cost stopped improving: further along the valley the
+        # parameters only grow more extreme (weights that cancel), the output does not change
+        return best, True, (f"the cost moved by {change:.1e} relative over {more.n_runs} more "
+                            f"evaluations: converged to a flat minimum (the budget ran out "
+                            f"while the parameters crawled along it)"), more.n_runs
     return chosen, False, str(more.message if better else best.message), more.n_runs
 
 
