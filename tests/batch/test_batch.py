@@ -181,3 +181,18 @@ def test_a_folder_that_is_not_a_batch_is_refused(tmp_path, fleet):
     with pytest.raises(OutputError, match="not a hystkit batch folder"):
         run_batch(read_manifest(fleet / "manifest.csv", {}), tmp_path)
     assert [p.name for p in tmp_path.iterdir()] == ["mine.txt"]
+
+
+def test_a_sensor_worse_than_its_line_on_validation_is_not_ok(tmp_path):
+    """A 3-cell mPL fitted on a sine passes its guards, but on the noise run it loses to its
+    straight line (R² 0.57 against 0.88): the row says so, as `evaluate` would (issue 24)."""
+    write_recording(simulate_experiment("sine", 1), tmp_path / "fit.csv")
+    write_recording(simulate_experiment("noise", 2), tmp_path / "val.csv")
+    write_recording(simulate_experiment("sine", 2), tmp_path / "val_sine.csv")
+    jobs = [SensorJob("a", (tmp_path / "fit.csv",), (tmp_path / "val.csv",), size=3),
+            SensorJob("b", (tmp_path / "fit.csv",), (tmp_path / "val_sine.csv",), size=3)]
+    table = run_batch(jobs, tmp_path / "out")
+    bad, good = table
+    assert bad["status"] == "worse_than_line" and "validation" in bad["guards"]
+    assert bad["r2_deployable"] < bad["linear_r2_deployable"]
+    assert good["status"] == "ok" and good["guards"] is None

@@ -19,7 +19,14 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from .. import __version__
-from ..compensation import DEFAULT_CENTER, evaluate, fit_compensator, save_compensator
+from ..compensation import (
+    DEFAULT_CENTER,
+    FAR_MARGIN,
+    evaluate,
+    fit_compensator,
+    save_compensator,
+    verdict,
+)
 from ..errors import InputError, OutputError
 from ..io import (
     ReadOptions,
@@ -77,12 +84,21 @@ def fit_sensor(job: SensorJob, *, read_options: ReadOptions | None = None) -> di
                    seconds=time.perf_counter() - t0)
         return {"row": row, "scores": [], "compensator": None}
     info = comp.fit_info
-    row.update(status=info["status"],
+    status, message = info["status"], info["status_message"]
+    if status == "ok" and scores:
+        # a fit that passed its guards is judged, as `evaluate` would, on the validation runs
+        far = [comp.sensor_outside(rec, margin=FAR_MARGIN) for rec in val_recs]
+        outside = None if any(m is None for m in far) else float(
+            sum(m.sum() for m in far) / sum(m.size for m in far))
+        status, message = verdict(_mean(scores, "r2"), _mean(scores, "linear_r2"),
+                                  "validation (deployable)", outside)
+        status = "ok" if status == "undetermined" else status
+    row.update(status=status,
                r2_deployable=_mean(scores, "r2"), e_rms_pct_deployable=_mean(scores, "e_rms_pct"),
                r2_oracle=_mean(scores, "r2_oracle"),
                linear_r2_deployable=_mean(scores, "linear_r2"),
                fit_seconds=info["fit_seconds"], seconds=time.perf_counter() - t0,
-               guards=None if info["status"] == "ok" else info["status_message"],
+               guards=None if status == "ok" else message,
                model_file=f"models/{job.sensor}.json")
     return {"row": row, "scores": scores, "compensator": comp}
 
