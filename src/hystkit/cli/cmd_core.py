@@ -294,7 +294,7 @@ def _warn_if_outside(flags: dict, data: Path) -> None:
 
 def _evaluate(args: argparse.Namespace) -> int:
     check_inputs_exist([args.model, args.data])
-    from ..compensation import FAR_MARGIN, verdict
+    from ..compensation import use_verdict
     from ..io import check_output_path, read_recording, write_json, write_mat
 
     evaluate, load_compensator = _module.evaluate, _module.load_compensator
@@ -328,10 +328,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     print(f"outside training: {_count(scores['n_sensor_outside'])} sensor samples, "
           f"{_count(scores['n_estimate_outside'])} estimates")
     # the shared verdict, on the deployable scores: what a compensator in use would give
-    far = comp.sensor_outside(rec, margin=FAR_MARGIN)
-    outside = None if far is None else float(far.mean())
-    status, message = verdict(scores["r2"], scores["linear_r2"], f"{args.data}: deployable",
-                              outside)
+    status, message = use_verdict(comp, rec, scores, f"{args.data}: deployable")
     scores["verdict"], scores["verdict_message"] = status, message
     if args.json is not None:
         write_json(scores, args.json, force=args.force)

@@ -26,5 +26,5 @@ __getattr__, __dir__ = lazy_exports(
      "_sync": ("SyncExcitation", "sync_excitation"),
      "_training_checks": ("MIN_SAMPLES_PER_PARAM", "check_excursion", "check_fitting_data",
                           "count_fitted"),
-     "_verdict": ("FAR_MARGIN", "MAX_OUTSIDE", "MIN_EXPLAINED", "verdict")},
+     "_verdict": ("FAR_MARGIN", "MAX_OUTSIDE", "MIN_EXPLAINED", "use_verdict", "verdict")},
     first=())

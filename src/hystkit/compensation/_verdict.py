@@ -21,7 +21,8 @@ estimate, parameters on the search box, a solver that did not converge).
 
 from __future__ import annotations
 
-__all__ = ["FAR_MARGIN", "MAX_OUTSIDE", "MIN_EXPLAINED", "USE_STATUSES", "verdict"]
+__all__ = ["FAR_MARGIN", "MAX_OUTSIDE", "MIN_EXPLAINED", "USE_STATUSES", "use_verdict",
+           "verdict"]
 
 # Below this R² the estimate is no better than reporting a constant in any useful sense.
 MIN_EXPLAINED = 0.1
@@ -72,3 +73,28 @@ def verdict(r2_model: float | None, r2_line: float | None, where: str,
                                 f"{FAR_MARGIN:.0%} of its width; {where} R² {r2_model:.4f}): "
                                 f"retrain on data that covers this range")
     return "ok", f"{where} R² {r2_model:.4f} (straight line {line})"
+
+
+def use_verdict(compensator, recording, scores: dict, where: str) -> tuple[str, str]:
+    """:func:`verdict` of a compensator on a recording from :func:`~._evaluate.evaluate`'s
+    deployable scores, with the share of its sensor samples far outside the training range.
+
+    Parameters
+    ----------
+    compensator : Compensator
+        The fitted compensator.
+    recording : Recording
+        The scored recording.
+    scores : dict
+        ``evaluate(compensator, recording)``.
+    where : str
+        What the scores are of, for the message.
+
+    Returns
+    -------
+    tuple of str
+        As :func:`verdict`.
+    """
+    far = compensator.sensor_outside(recording, margin=FAR_MARGIN)
+    return verdict(scores["r2"], scores["linear_r2"], where,
+                   None if far is None else float(far.mean()))

@@ -12,13 +12,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..compensation import (
-    FAR_MARGIN,
     centre_and_scale,
     check_excursion,
     check_fitting_data,
     evaluate,
     fit_compensator,
-    verdict,
+    use_verdict,
 )
 from ..errors import HystkitError
 from ..io import Recording
@@ -177,9 +176,7 @@ def _compare_piece(piece: tuple[str, int | None, str], *, fit_rec: Recording,
             return _forward_scores(name, size, fit_rec, val_rec)
         comp = fit_compensator(fit_rec, size, model=name, diagnose=False)
         direct = evaluate(comp, val_rec)
-        far = comp.sensor_outside(val_rec, margin=FAR_MARGIN)
-        use, why = verdict(direct["r2"], direct["linear_r2"], "validation (deployable)",
-                           None if far is None else float(far.mean()))
+        use, why = use_verdict(comp, val_rec, direct, "validation (deployable)")
         entry = {"center": direct["center"], "direct_status": comp.fit_info["status"],
                  "verdict": use, "verdict_message": why}
         for suffix in ("", "_oracle"):

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from ..compensation import Compensator, center_label, evaluate, load_compensator
+from ..compensation import Compensator, center_label, evaluate, load_compensator, use_verdict
 from ..compensation import named_floats as named_parameters  # the standard errors' order
 from ..io import Recording
 from ._figures import DEFAULT_SENSOR_LABEL, plot_loops, plot_time_series
@@ -176,6 +176,12 @@ def score_section(comp: Compensator, scores: Mapping[str, dict]) -> Section:
                           f"position, which no compensator in use can know: for comparison "
                           f"with the document only."),
                 table(head, oracle, text_columns=2, row_classes=["oracle"] * len(oracle)))
+    # the shared verdict of `evaluate`, per recording, on the deployable scores
+    for name, s in scores.items():
+        if s.get("verdict") not in (None, "ok", "undetermined"):
+            section.add(note(f"{name}: {s['verdict'].replace('_', ' ')}: {s['verdict_message']}"
+                             f"; do not use the {comp.model} compensator on data like these.",
+                             "bad"))
     guards = [(name, s["n_samples"], _count(s["n_sensor_outside"]),
                _count(s["n_estimate_outside"]), _fixed_or_none(s["sensor_loop_area"], ".3f"))
               for name, s in scores.items()]
@@ -222,6 +228,8 @@ def compensator_sections(comp: Compensator, recordings: Mapping[str, Recording],
     scores, shown = {}, {}
     for name, rec in recordings.items():
         scores[name] = evaluate(comp, rec)
+        scores[name]["verdict"], scores[name]["verdict_message"] = use_verdict(
+            comp, rec, scores[name], "deployable")
         shown[name] = (rec, comp.estimate(rec), comp.estimate_linear(rec))
     content.sections.append(score_section(comp, scores))
     figures = Section("Figures")

@@ -1,0 +1,19 @@
+"""The HTML report gives each scored recording the shared verdict of `evaluate` (issue 24)."""
+
+from __future__ import annotations
+
+from hystkit.compensation import fit_compensator
+from hystkit.reports._report_model import compensator_sections
+from hystkit.sensors import simulate_experiment
+
+
+def test_a_recording_the_model_loses_to_its_line_on_is_flagged():
+    """A 3-cell mPL fitted on a sine: fine on another sine, below its straight line on the
+    noise run (R² 0.57 against 0.88)."""
+    comp = fit_compensator(simulate_experiment("sine", 1), 3, diagnose=False)
+    content = compensator_sections(comp, {"sine": simulate_experiment("sine", 2),
+                                          "noise": simulate_experiment("noise", 2)})
+    scores = next(s for s in content.sections if s.title == "Scores").to_html()
+    assert "noise: worse than line: deployable R² 0.5" in scores
+    assert "do not use the mpl compensator on data like these" in scores
+    assert "sine: worse than line" not in scores and "sine: no signal" not in scores
