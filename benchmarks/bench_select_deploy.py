@@ -28,7 +28,7 @@ from hystkit.sensors import simulate_experiment
 
 # the shared real data's separate runs, as the centring example pairs them
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
-from centring_evidence import real_cases  # noqa: E402
+from centring_evidence import real_cases
 
 
 def _changed(rec: Recording, name: str, offset: float = 0.0, gain: float = 1.0) -> Recording:

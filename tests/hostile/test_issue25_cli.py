@@ -100,13 +100,13 @@ def test_stream_to_a_full_disk_is_one_error_line(scratch: Path, cli: Callable[..
                                                  room: int) -> None:
     out = _FullDisk(room)
     monkeypatch.setattr(sys, "stdout", out)
-    run = _refused(cli, scratch, ["stream", "model.json", "--in", "val.csv"],
-                   "standard output", "cannot write the estimates", "No space left on device")
+    _refused(cli, scratch, ["stream", "model.json", "--in", "val.csv"],
+             "standard output", "cannot write the estimates", "No space left on device")
     assert 0 < len(out.getvalue().splitlines()) < 10 or room == 0
 
 
 def test_stream_to_dev_full_is_one_error_line(scratch: Path) -> None:
-    with open("/dev/full", "w") as full:  # noqa: PTH123
+    with open("/dev/full", "w") as full:
         proc = subprocess.run([sys.executable, "-m", "hystkit", "stream", "model.json",
                                "--in", "val.csv"], stdout=full, stderr=subprocess.PIPE,
                               text=True, timeout=300, check=False, cwd=scratch)

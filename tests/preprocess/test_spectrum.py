@@ -90,7 +90,7 @@ def test_pure_noise_has_no_line_but_its_spectrum():
     assert np.isnan(result.f_signal) and np.isnan(result.cutoff)
     assert result.summary["f_signal_hz"] is None and result.summary["filters"] == {}
     assert list(result.response) == ["20 Hz (compare)"]  # the overlay asked for stays
-    freq, psd, _ = welch_psd(x, FS, SEGMENT)
+    _, psd, _ = welch_psd(x, FS, SEGMENT)
     assert_allclose(result.psd["differential"], psd, rtol=1e-12)
     assert result.plot().axes  # the figure draws without an f_signal
     with pytest.raises(ValueError, match="2 Welch segment"):  # 40 s segments in 60 s

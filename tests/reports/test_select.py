@@ -12,7 +12,8 @@ from hystkit.errors import FitDivergedError
 from hystkit.io import Recording
 from hystkit.models import FAMILIES
 from hystkit.reports import _select
-from hystkit.reports._select import Candidate, folds, select_model
+from hystkit.reports._select import Candidate, select_model
+from hystkit.reports._validation import EXTRAPOLATION_NOTE, folds, protocol
 from hystkit.sensors import simulate_experiment
 
 
@@ -27,7 +28,7 @@ def test_interleaved_folds_partition_one_recording_and_cover_its_range():
         assert f.n_train == rec.n_samples - int(f.held.sum())
         # held-out pieces are spread over the run: their positions lie inside the range the
         # fold is fitted on (a block per fold would not: it would score extrapolation)
-        assert f.extrapolated() < _select.EXTRAPOLATION_NOTE
+        assert f.extrapolated() < EXTRAPOLATION_NOTE
         assert np.count_nonzero(np.diff(f.held.astype(int)) == 1) >= 3
 
 
@@ -37,8 +38,8 @@ def test_leave_one_recording_out():
     assert [f.scored is r for f, r in zip(fold_list, recs, strict=True)] == [True] * 3
     assert all(f.held is None and f.scored not in f.train and len(f.train) == 2
                for f in fold_list)
-    assert _select.protocol(recs) == "left-out recording"
-    assert _select.protocol(recs[:1]) == "interleaved cycles of the training recording"
+    assert protocol(recs) == "left-out recording"
+    assert protocol(recs[:1]) == "interleaved cycles of the training recording"
 
 
 @pytest.mark.parametrize("name", sorted(FAMILIES))

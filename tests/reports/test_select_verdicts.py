@@ -11,9 +11,9 @@ from hystkit.cli import main
 from hystkit.compensation import MIN_EXPLAINED, fit_compensator, verdict
 from hystkit.io import Recording
 from hystkit.models import get_family
-from hystkit.reports import _select
-from hystkit.reports._select import Candidate, candidates, fits_in, folds, select_model
+from hystkit.reports._select import Candidate, candidates, select_model
 from hystkit.reports._text_table import text_table
+from hystkit.reports._validation import Fold, fits_in, fold_scores, folds
 from hystkit.sensors import simulate_experiment
 
 
@@ -67,8 +67,8 @@ def test_a_tare_candidate_is_tared_at_the_left_out_runs_rest_position():
     moved = Recording(time=runs[1].time, sensor=runs[1].sensor, position=runs[1].position + 1.0,
                       source="moved")
     comp = fit_compensator([runs[0]], model="bobbio", center="tare", diagnose=False)
-    same = _select.fold_scores(comp, _select.Fold([runs[0]], runs[1], None, "b"))
-    shifted = _select.fold_scores(comp, _select.Fold([runs[0]], moved, None, "b"))
+    same = fold_scores(comp, Fold([runs[0]], runs[1], None, "b"))
+    shifted = fold_scores(comp, Fold([runs[0]], moved, None, "b"))
     assert shifted["r2"] == pytest.approx(same["r2"], abs=1e-9)
     assert same["r2_oracle"] is None  # the oracle would replace the very offset judged
 

@@ -29,8 +29,8 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import FitDivergedError, InputError
-from ._centring import ORACLE_CENTER
 from ..io import MAX_MAGNITUDE
+from ._centring import ORACLE_CENTER
 from ._compensator import (
     MAX_NORMALISED,
     POSITION_MARGIN,

@@ -18,9 +18,9 @@ __getattr__, __dir__ = lazy_exports(
      "_figures": ("plot_loops", "plot_time_series"),
      "_report_model": ("ReportContent", "model_report"),
      "_report_page": ("FIGURE_FORMATS", "build_report", "write_report"),
-     "_select": ("PROTOCOLS", "Candidate", "Fold", "admissible_size", "candidates",
-                 "fits_in", "fold_scores", "folds", "plot_selection", "protocol",
-                 "select_model"),
+     "_select": ("Candidate", "candidates", "plot_selection", "select_model"),
+     "_validation": ("PROTOCOLS", "Fold", "admissible_size", "fits_in", "fold_scores", "folds",
+                     "protocol"),
      "_text_table": ("format_number", "text_table"),
      },
     first=("FIGURE_MODULES",))

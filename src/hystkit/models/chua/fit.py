@@ -55,8 +55,8 @@ def _theta_limits(n_elements: int) -> tuple[list[str | None], list[str | None]]:
     upper: list[str | None] = []
     for k in range(1, n_elements + 1):
         lower += [None] * 5 + [f"element {k} has no dead band (delta = 0, the document's model)"]
-        upper += [None] * 3 + [f"element {k} runs at the Euler slope cap (a larger G changes "
-                               f"nothing)", None, None]
+        cap = f"element {k} runs at the Euler slope cap (a larger G changes nothing)"
+        upper += [None] * 3 + [cap, None, None]
     return lower, upper
 
 
