@@ -275,7 +275,8 @@ def _refusal(rows: Sequence[dict], name: str) -> str:
                 f"{best['candidate']}, has R² {best['cv_r2']:.4f}; check that the sensor "
                 f"column carries the measurand")
     return (f"no candidate beats its straight line and a constant on held-out data ({name}): "
-            f"the best, {best['candidate']}, {best['verdict_message']}")
+            f"the best, {best['candidate']}, has R² {best['cv_r2']:.4f} against its line's "
+            f"{best['cv_linear_r2']:.4f}")
 
 
 def plot_selection(ranking: Sequence[dict]) -> Figure:
