@@ -158,3 +158,16 @@ def test_bad_select_on_a_noise_only_sensor(data, tmp_path, capsys):
     code = main(["select", str(data["noise_only"]), "--models", "mpl,pi", "--out", str(out)])
     assert code == GUARD_EXIT and not out.exists()
     assert "no usable model" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("cells", [1, 2, 3])
+@pytest.mark.parametrize("excitation", ["sine", "decay", "chirp", "noise"])
+def test_default_mpl_fits_end_ok(excitation, cells):
+    """The default mPL fit of the virtual sensor's recordings, 1 to 3 cells, is usable (a
+    3-cell fit on the sine used to stop 'on bounds' with its slowest cell at the rate floor:
+    over 200 s that cell integrates, and only w G is identified)."""
+    from hystkit.compensation import fit_compensator
+
+    info = fit_compensator(simulate_experiment(excitation, 1), cells, diagnose=False).fit_info
+    assert info["status"] == "ok", info["status_message"]
+    assert info["converged"] and info["training_r2"] > info["training_linear_r2"]
