@@ -590,3 +590,21 @@ def test_output_below_a_regular_file(data: dict[str, Path], tmp_path: Path,
     (tmp_path / "afile").write_bytes(b"")
     out = tmp_path / "afile" / "m.json"
     _assert_rejected(capsys, ["fit", data["fit"], "--out", out], out, tmp_path, out)
+
+
+def test_fit_prints_its_parameters_as_an_aligned_table(tmp_path, capsys):
+    """Names, values, standard errors and relative errors in columns (lmfit's fit report),
+    numbers to a few significant digits; a gauge the fit holds is 'fixed' (issue 27.4)."""
+    data = tmp_path / "sine.csv"
+    assert main(["simulate-sensor", "--excitation", "sine", "--seed", "1", "--out",
+                 str(data)]) == 0
+    assert main(["fit", str(data), "--model", "mpl-poly", "--out", str(tmp_path / "m.json")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    head = next(i for i, line in enumerate(lines) if line.split()[:2] == ["parameter", "value"])
+    rows = lines[head + 1:head + 12]
+    assert [r.split()[0] for r in rows] == ["f[0][0]", "f[0][1]", "f[0][2]", "f[0][3]", "g[0]",
+                                            "g[1]", "g[2]", "g[3]", "w[0]", "w[1]", "v_b"]
+    assert len({len(r.rstrip()) for r in rows if "fixed" not in r}) == 1  # right-aligned
+    assert rows[0].split()[1:] == ["0", "fixed"] and rows[8].split()[1:] == ["1", "fixed"]
+    value, error, relative = rows[1].split()[1:]
+    assert len(value.lstrip("-").replace(".", "")) <= 7 and float(error) > 0 < float(relative)

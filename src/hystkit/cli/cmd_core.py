@@ -122,7 +122,7 @@ def _fit(args: argparse.Namespace) -> int:
     print(f"done in {info['fit_seconds']:.2f} s: SSE {info['cost']:.4g} (normalised), solver: "
           f"{info['message']}")
     print_cost_summary(info)
-    print(f"  parameters: {comp.params.to_dict()}")
+    _print_parameters(comp, info.get("standard_errors"))
     _print_standard_errors(info.get("standard_errors"))
     print(f"  training R² {info['training_r2']:.4f}, straight line "
           f"{info['training_linear_r2']:.4f}; AIC {info['aic']:.1f}, BIC {info['bic']:.1f}; "
@@ -186,6 +186,36 @@ def _training_units(recs: list, paths: list[Path]) -> dict[str, str]:
                 raise UsageError(f"{path}: {name} is in {unit!r}, an earlier recording's in "
                                  f"{units[name]!r}; fit recordings in one unit")
     return units
+
+
+# Parameters printed by `fit`; a larger model's others are in its file.
+MAX_SHOWN = 24
+
+
+def _print_parameters(comp, se: dict | None) -> None:
+    """The fitted parameters as an aligned table (name, value, standard error, relative), as
+    lmfit's fit report: n/a where the data do not determine one, 'fixed' where the fit holds
+    it (a gauge)."""
+    from ..compensation import named_floats
+    from ..reports import text_table
+
+    names = [name for name, _ in named_floats(comp.params.to_dict())]
+    values = [value for _, value in named_floats(comp.params.to_dict())]
+    if se and len(se["standard_errors"]) == len(values):
+        fixed = set(se.get("fixed", []))
+        errors = ["fixed" if n in fixed else e for n, e in zip(names, se["standard_errors"],
+                                                               strict=True)]
+        relative = ["" if n in fixed else r for n, r in zip(names, se["relative"], strict=True)]
+    else:
+        errors = relative = [""] * len(values)
+    def g(x: object, digits: int) -> object:  # significant digits, for people
+        return f"{x:.{digits}g}" if isinstance(x, float) else ("n/a" if x is None else x)
+
+    rows = [(f"  {n}", g(v, 6), g(e, 2), g(r, 2))
+            for n, v, e, r in zip(names, values, errors, relative, strict=True)]
+    print(text_table(("  parameter", "value", "std error", "relative"), rows[:MAX_SHOWN]))
+    if len(rows) > MAX_SHOWN:  # a Preisach grid has 191: the rest is in the model file
+        print(f"  ... {len(rows) - MAX_SHOWN} more parameter(s): see the model file")
 
 
 def _print_standard_errors(se: dict | None) -> None:
