@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -19,9 +21,10 @@ def _truth() -> Recording:
     return Recording(time=t, position=np.sin(40 * t), sensor=0.01 * np.cos(40 * t) + 0.1)
 
 
-def _own_csv(path, rec: Recording, sep: str = ";", units_row: bool = False, scale=1e3):
+def _own_csv(path, rec: Recording, sep: str = ";", units_row: bool = False, scale=1e3,
+             names=OWN):
     """`rec` as a user would save it: own names, time in ms, `sep` between fields."""
-    lines = [sep.join(OWN.values())] + ([sep.join(["ms", "mm", "Ohm"])] if units_row else [])
+    lines = [sep.join(names.values())] + ([sep.join(["ms", "mm", "Ohm"])] if units_row else [])
     lines += [sep.join(repr(float(v)) for v in (t * scale, p, s))
               for t, p, s in zip(rec.time, rec.position, rec.sensor)]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
@@ -46,9 +49,27 @@ def test_own_names_ms_and_separators(tmp_path, sep, given):
 @pytest.mark.parametrize("unit, scale", [("us", 1e6), ("ns", 1e9), ("min", 1 / 60)])
 def test_time_units_become_seconds(tmp_path, unit, scale):
     rec = _truth()
-    path = _own_csv(tmp_path / "own.csv", rec, scale=scale)
-    back = read_recording(path, options=ReadOptions(columns=OWN, time_unit=unit, sep=";"))
+    names = {**OWN, "time": f"t_{unit}"}
+    path = _own_csv(tmp_path / "own.csv", rec, scale=scale, names=names)
+    back = read_recording(path, options=ReadOptions(columns=names, time_unit=unit, sep=";"))
     _assert_same(back, rec)
+
+
+@pytest.mark.parametrize("name, unit", [("t_ms", "ms"), ("time [us]", "us"), ("time_s", "s"),
+                                        ("Zeit (µs)", "us")])
+def test_a_time_column_named_for_another_unit_is_refused(tmp_path, name, unit):
+    """Forgetting --time-unit ms on a column named t_ms read 12000 samples at 0.05 Hz without
+    a word (issue 27): the name contradicts the unit read, so the file is refused with the fix."""
+    rec = _truth()
+    names = {**OWN, "time": name}
+    path = _own_csv(tmp_path / "own.csv", rec, names=names)
+    other = "ms" if unit != "ms" else "s"
+    with pytest.raises(InputError, match=rf"the time column '{re.escape(name)}' is named for "
+                                         rf"{unit} but time is read in {other}; pass "
+                                         rf"--time-unit {unit}"):
+        read_recording(path, options=ReadOptions(columns=names, time_unit=other, sep=";"))
+    back = read_recording(path, options=ReadOptions(columns=names, time_unit=unit, sep=";"))
+    assert back.n_samples == N
 
 
 def test_skip_rows_skips_a_units_line_and_keeps_line_numbers(tmp_path):

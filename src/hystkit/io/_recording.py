@@ -7,6 +7,7 @@ the column and the row, so the CLI can print it verbatim.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -265,6 +266,7 @@ def read_unvalidated(path: Path, need_position: bool, options: ReadOptions,
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
     units = {**dict(options.units), **dict(where.units)}  # the file's own units first
     _check_time_unit(units.get("time"), options, where)
+    _check_time_name(dict(options.columns).get("time", "time"), options, where)
     if options.time_scale != 1.0:  # to seconds before the checks, whose messages say "s"
         arrays["time"] = arrays["time"] * options.time_scale
     return arrays, where, units
@@ -279,6 +281,17 @@ def _check_time_unit(unit: str | None, options: ReadOptions, where: _Where) -> N
         raise where.fail(f"the file gives the time unit {unit!r} but time is read in "
                          f"{options.time_unit}; pass --time-unit {named} (or time_unit = "
                          f"\"{named}\" in the settings file)", "time")
+
+
+def _check_time_name(name: str, options: ReadOptions, where: _Where) -> None:
+    """A time column named for a unit (``t_ms``, ``time [us]``) other than the one read would
+    mean reading ms as s: 12000 samples at 0.05 Hz instead of 20 Hz, fitted without a word."""
+    words = {w.replace("µ", "u") for w in re.split(r"[^0-9A-Za-zµ]+", name) if w}
+    named = sorted(words & set(TIME_UNITS) - {options.time_unit})
+    if named and options.time_unit not in words:
+        raise where.fail(f"the time column {name!r} is named for {named[0]} but time is read "
+                         f"in {options.time_unit}; pass --time-unit {named[0]} (or time_unit = "
+                         f"\"{named[0]}\" in the settings file)", "time")
 
 
 def _adopt(arrays: dict[str, np.ndarray], source: str,
