@@ -192,20 +192,24 @@ class Compensator:
                 f"{recording.source}: column 'time': sampled every {recording.dt:.6g} s, but the "
                 f"model was fitted at {self.structure.dt:.6g} s; resample the recording first")
 
-    def estimate(self, recording: Recording, position_mean: float | None = None, *,
-                 rest_position: float | None = None) -> np.ndarray:
+    def estimate(self, recording: Recording | np.ndarray, position_mean: float | None = None,
+                 *, rest_position: float | None = None) -> np.ndarray:
         """Position estimate [mm] from the recording's sensor signal.
 
         With every centring but ``recording`` (oracle) the estimate at sample k uses sensor
-        samples <= k and the model file only; ``position_mean`` is ignored then.
+        samples <= k and the model file only; ``position_mean`` is ignored then. A plain array
+        is taken as the sensor samples, one every ``structure.dt``.
 
         Raises
         ------
+        TypeError
+            If `recording` is neither a Recording nor a 1-D array of numbers.
         FitDivergedError
             If the model's run diverges, or its output is not finite or beyond
             ``MAX_NORMALISED`` times the training positions (none of it is ever returned);
             the message names the recording, the first such sample and the model file.
         """
+        recording = self._as_recording(recording)
         self.check_sampling(recording)
         s = self.normalised_sensor(recording.sensor)
         run = self.family.simulate if self.mode == "direct" else self.family.invert
@@ -249,6 +253,21 @@ class Compensator:
         pad = MAX_NORMALISED * max(hi - lo, abs(lo), abs(hi))
         shift = offset - self.scaling.position_offset
         return (lo + shift - pad, hi + shift + pad) if pad > 0 else None
+
+    def _as_recording(self, data: Recording | np.ndarray) -> Recording:
+        """A Recording as it is; a 1-D array of sensor samples at the model's ``dt``."""
+        if isinstance(data, Recording):
+            return data
+        try:
+            sensor = np.asarray(data, dtype=float)
+        except (TypeError, ValueError):
+            sensor = None
+        if sensor is None or sensor.ndim != 1:
+            raise TypeError(f"estimate takes a Recording (hystkit.read(path)) or a 1-D array of "
+                            f"sensor samples taken every {self.structure.dt:g} s, not "
+                            f"{type(data).__name__}")
+        return Recording(time=np.arange(sensor.size) * self.structure.dt, sensor=sensor,
+                         source="<array>")
 
     def _from(self) -> str:
         return "" if self.source is None else f" of {self.source}"
