@@ -150,10 +150,11 @@ def test_cli_writes_a_folder_that_builds_with_the_readme_line(compensators, reco
     assert main(["export", str(model), "--lang", "c", "--out", str(out), "--double"]) == 0
     assert "cc -O2 -std=c99" in capsys.readouterr().out
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["README", "example_main.c", "tip_sensor_2.c", "tip_sensor_2.h"]
+    # the model file's name, its case kept (issue 27.4)
+    assert names == ["README", "Tip_Sensor_2.c", "Tip_Sensor_2.h", "example_main.c"]
     readme = (out / "README").read_text()
     assert COMPILE_LINE in readme
-    header = (out / "tip_sensor_2.h").read_text()
+    header = (out / "Tip_Sensor_2.h").read_text()
     for text in ("ladder", "inverse", "track", str(model), "hystkit 0."):
         assert text in header
     subprocess.run(COMPILE_LINE, shell=True, cwd=out, check=True, timeout=120)

@@ -4,6 +4,7 @@ calls), and one sample at a time through the persistent-state block variant."""
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 
 import numpy as np
@@ -112,3 +113,25 @@ def test_cli_writes_the_matlab_files(compensators, tmp_path, capsys):
     names = {p.name for p in out.iterdir()}
     assert {"tip.m", "tip_init.m", "tip_block.m"} <= names
     assert ("tip_sync.m" in names) == ("sync start-up: after e_sync" in capsys.readouterr().out)
+
+
+def test_a_model_files_name_keeps_its_case(compensators, tmp_path, capsys):
+    """bestA.json gives bestA.m: MATLAB finds a function on a case-sensitive file system only
+    by its file's exact name (it used to write besta.m; issue 27.4)."""
+    from hystkit.cli import main
+    from hystkit.compensation import save_compensator
+
+    model = tmp_path / "bestA.json"
+    save_compensator(compensators("mpl1", "direct", "fit"), model)
+    out = tmp_path / "m"
+    assert main(["export", str(model), "--lang", "matlab", "--out", str(out)]) == 0
+    names = {p.name for p in out.iterdir()}
+    assert {"bestA.m", "bestA_init.m", "bestA_block.m"} <= names
+    assert "function [estimate, state, flags] = bestA(sensor, state)" in (
+        out / "bestA.m").read_text()
+    capsys.readouterr()
+    if shutil.which("octave"):  # MATLAB's rule, checked by Octave: the name finds the function
+        script = f"addpath('{out}'); [e, st] = bestA([0.0; 0.01; 0.02]); disp(all(isfinite(e)))"
+        done = subprocess.run(["octave", "--no-gui", "--quiet", "--eval", script],
+                              capture_output=True, text=True, timeout=120, check=False)
+        assert done.returncode == 0 and done.stdout.strip() == "1", done.stderr

@@ -123,11 +123,12 @@ def identifier(text: str) -> str:
     Returns
     -------
     str
-        Lower-case letters, digits and ``_`` of `text` (at most 40 of them), starting with a
-        letter (``m_`` is put in front otherwise); C and Python keywords and names the
-        generated code calls get a ``_model`` suffix.
+        The letters (in their case: MATLAB finds ``bestA.m`` only as ``bestA`` on a
+        case-sensitive file system), digits and ``_`` of `text` (at most 40 of them),
+        starting with a letter (``m_`` is put in front otherwise); C and Python keywords and
+        names the generated code calls get a ``_model`` suffix.
     """
-    name = re.sub(r"[^0-9A-Za-z_]+", "_", text).strip("_").lower()[:40].strip("_")
+    name = re.sub(r"[^0-9A-Za-z_]+", "_", text).strip("_")[:40].strip("_")
     if not name or not name[0].isalpha():
         name = f"m_{name}".rstrip("_")
     if name in C_KEYWORDS or name in _MATLAB_TAKEN or keyword.iskeyword(name):
