@@ -17,3 +17,16 @@ def test_a_recording_the_model_loses_to_its_line_on_is_flagged():
     assert "noise: worse than line: deployable R² 0.5" in scores
     assert "do not use the mpl compensator on data like these" in scores
     assert "sine: worse than line" not in scores and "sine: no signal" not in scores
+
+
+def test_the_structure_is_written_for_people():
+    """A 50 Hz recording's sample time came out as dt = 0.019999999999999574 (issue 27.4)."""
+    from hystkit.io import Recording
+
+    rec = simulate_experiment("sine", 1)
+    t = (rec.time / 0.025 * 0.02)[:2000]  # 50 Hz: float rounding in the time column
+    fifty = Recording(time=t, sensor=rec.sensor[:2000], position=rec.position[:2000])
+    comp = fit_compensator(fifty, diagnose=False)
+    assert comp.structure.dt != 0.02  # what the time column gives, rounding included
+    text = compensator_sections(comp, {"run": fifty}).sections[0].to_html()
+    assert "dt = 0.02," in text and "0.0199999" not in text

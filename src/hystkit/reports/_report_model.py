@@ -74,7 +74,8 @@ def _provenance(comp: Compensator, model_path: Path | None, version: str | None)
     info = comp.fit_info
     items = [("model file", str(model_path) if model_path else "(in memory)"),
              ("model", f"{comp.model}: {comp.family.title}"),
-             ("structure", ", ".join(f"{k} = {v}" for k, v in comp.structure.to_dict().items())),
+             ("structure", ", ".join(f"{k} = {_for_people(v)}"
+                                     for k, v in comp.structure.to_dict().items())),
              ("mode", comp.mode), ("centring", center_label(comp.center)),
              ("fitted on", ", ".join(info.get("training_sources") or
                                      [info.get("training_source") or "not stored"])),
@@ -115,6 +116,12 @@ def fit_section(comp: Compensator, title: str = "Fit", sub: bool = False) -> Sec
         ("joint fit", info.get("joint_fit") or "no (one recording)")]))
     section.add(_parameter_table(comp))
     return section
+
+
+def _for_people(value: object) -> object:
+    """A float to 10 significant digits (dt = 0.02, not 0.019999999999999574: the sample time
+    a recording's time column gives, with its rounding); anything else as it is."""
+    return f"{value:.10g}" if isinstance(value, float) else value
 
 
 def _fixed(value: object, spec: str) -> str:
