@@ -1,5 +1,4 @@
-"""The polynomial mPL fit names its optimiser coordinates; its one model-limit bound is the
-cubic coefficient's floor (a resistor without a cubic term)."""
+"""The polynomial mPL fit names its optimiser coordinates; it has no model-limit bounds."""
 
 from dataclasses import replace
 
@@ -20,10 +19,7 @@ def test_a_coefficient_on_its_bound_is_named():
     result = fit_mpl_poly(u, 0.8 * u + 0.1 * np.sin(1.3 * t - 0.4), structure, n_polish=1)
     names = theta_names(2)
     assert list(result.names) == names and len(names) == result.theta.size == 5 * 2 + 6
-    # the Euler cap acts through the knees, not a bound; c3's floor is the one model limit
-    lower, upper = result.limits
-    assert [names[i] for i, note in enumerate(lower) if note] == ["f[1].log_c3", "f[2].log_c3"]
-    assert not any(upper)
+    assert result.limits is None  # the Euler cap acts through the knees, not a bound
     before = bound_flags(replace(result, sensitivity=None))[0]
     assert all(hit.split(" ")[0] in names for hit in before)
     theta = result.theta.copy()
@@ -31,16 +27,3 @@ def test_a_coefficient_on_its_bound_is_named():
     theta[j] = result.bounds[1][j]
     after = bound_flags(replace(result, theta=theta, sensitivity=None))[0]
     assert set(after) - set(before) == {"f[2].log_c3 (upper)"}
-
-
-def test_a_cubic_coefficient_on_its_floor_is_a_note():
-    structure = mp.MplPolyStructure(n_cells=2, dt=DT)
-    t = np.arange(800) * DT
-    u = np.sin(1.3 * t) * np.exp(-t / 30)
-    result = fit_mpl_poly(u, 0.8 * u + 0.1 * np.sin(1.3 * t - 0.4), structure, n_polish=1)
-    theta = result.theta.copy()
-    j = theta_names(2).index("f[2].log_c3")
-    theta[j] = result.bounds[0][j]
-    on_bounds, notes = bound_flags(replace(result, theta=theta, sensitivity=None))
-    assert "f[2].log_c3 (lower)" not in on_bounds
-    assert "cell 2's resistor has no cubic term (c3 at its floor 1e-6)" in notes
