@@ -47,3 +47,21 @@ def test_a_double_pole_clearly_outside_still_grows():
 
 def test_an_empty_system_is_stable():
     assert classify_poles(np.zeros((0, 0))) == (1.0, True, False, 0.0)
+
+
+def test_a_pole_that_grows_over_days_is_said_plainly():
+    """The default 3-cell mPL's slowest cell integrates over its 200 s record; in the ch. 7
+    loop it leaves a pole at 1.0000000006 (e-fold in 9.4 days), which control printed as
+    'closed loop UNSTABLE' beside runs that stay bounded (issue 27.8)."""
+    from types import SimpleNamespace
+
+    from hystkit.cli._control_report import closed_loop
+
+    slow = SimpleNamespace(closed_loop_stable=False, marginal=False,
+                           max_pole_radius=1.0000000006, growth_time_s=8.1e5,
+                           cause="its slowest cell overturns the static gain")
+    text = closed_loop(slow)
+    assert text.startswith("unstable only over days") and "UNSTABLE" not in text
+    assert "a factor 1.0004 over a 5-minute run" in text and "slowest cell" in text
+    fast = SimpleNamespace(**{**vars(slow), "growth_time_s": 0.04, "max_pole_radius": 1.0126})
+    assert closed_loop(fast).startswith("UNSTABLE (max |pole| 1.0126000000: grows e-fold in")

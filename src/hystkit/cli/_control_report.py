@@ -5,6 +5,7 @@ the command so each module stays small."""
 from __future__ import annotations
 
 import argparse
+import math
 
 from ._common import UsageError
 
@@ -13,6 +14,12 @@ __all__ = ["closed_loop", "fmt", "noise_study", "print_table", "resolve_tune_opt
 # defaults of the --tune-nonlinear options (None in the parser: given or not is seen)
 TUNE_DEFAULTS = {"tune_objective": "rms", "tune_budget": 300, "min_phase_margin": 30.0,
                  "min_gain_margin": 6.0}
+
+
+# A closed loop that grows e-fold in a day or more is unstable in principle and bounded in
+# any run of minutes: said so, with its growth over TYPICAL_RUN_S.
+SLOW_GROWTH_S = 86400.0
+TYPICAL_RUN_S = 300.0
 
 
 def fmt(x: float | None, none: str = "n/a") -> str:
@@ -39,9 +46,15 @@ def closed_loop(margins) -> str:
         return ("marginally stable (a pole on the unit circle, to within the rounding of its "
                 "eigenvalue: a state the linearised loop neither corrects nor amplifies, e.g. a "
                 "sticking element at rest or a double integrator)")
+    cause = f"; {margins.cause}" if margins.cause else ""
+    if margins.growth_time_s >= SLOW_GROWTH_S:
+        # a real but glacial instability (a slow cell's zero beyond z = 1): say what it means
+        factor = math.exp(TYPICAL_RUN_S / margins.growth_time_s)
+        return (f"unstable only over days (max |pole| {margins.max_pole_radius:.10f}: grows "
+                f"e-fold in {duration(margins.growth_time_s)}, a factor {factor:.4f} over a "
+                f"{TYPICAL_RUN_S / 60:g}-minute run{cause})")
     return (f"UNSTABLE (max |pole| {margins.max_pole_radius:.10f}: grows e-fold in "
-            f"{duration(margins.growth_time_s)}"
-            + (f"; {margins.cause}" if margins.cause else "") + ")")
+            f"{duration(margins.growth_time_s)}{cause})")
 
 
 def duration(seconds: float) -> str:
