@@ -196,3 +196,10 @@ def test_chromium_renders_the_folders_page(page: Path, tmp_path: Path) -> None:
     # viridis cells of the generalisation matrix and the Bode plot's blue trace
     for rgb in ((31, 119, 180),):
         assert np.all(np.abs(pixels.astype(int) - rgb) <= 12, axis=1).sum() > 2000
+
+
+def test_a_loop_unstable_only_over_days_is_a_note_not_a_failure() -> None:
+    text, kind = stability_verdict({"closed_loop_stable": False, "marginal": False,
+                                    "max_pole_radius": 1.0000000006, "growth_time_s": 8.1e5})
+    assert kind == "note" and text.startswith("closed loop unstable only over days")
+    assert "a factor 1.0004 over a 5-minute run" in text

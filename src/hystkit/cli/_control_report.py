@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import math
 
+from ..control import SLOW_GROWTH_S, TYPICAL_RUN_S
 from ._common import UsageError
 
 __all__ = ["closed_loop", "fmt", "noise_study", "print_table", "resolve_tune_options", "tune"]
@@ -14,12 +15,6 @@ __all__ = ["closed_loop", "fmt", "noise_study", "print_table", "resolve_tune_opt
 # defaults of the --tune-nonlinear options (None in the parser: given or not is seen)
 TUNE_DEFAULTS = {"tune_objective": "rms", "tune_budget": 300, "min_phase_margin": 30.0,
                  "min_gain_margin": 6.0}
-
-
-# A closed loop that grows e-fold in a day or more is unstable in principle and bounded in
-# any run of minutes: said so, with its growth over TYPICAL_RUN_S.
-SLOW_GROWTH_S = 86400.0
-TYPICAL_RUN_S = 300.0
 
 
 def fmt(x: float | None, none: str = "n/a") -> str:

@@ -8,7 +8,7 @@ from .._lazy import lazy_exports
 
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"_names": ("EXPERIMENTS", "MASS", "SCHEMES", "TRAININGS"),
+    {"_names": ("EXPERIMENTS", "MASS", "SCHEMES", "SLOW_GROWTH_S", "TRAININGS", "TYPICAL_RUN_S"),
      "_analysis": ("DOB_CANDIDATES_HZ", "LoopMargins", "bode_data", "classify_poles",
                    "design_dob", "loop_margins", "open_loop", "static_sign_flips", "tune_pid"),
      "_blocks": ("DOCUMENT_PID_DIRECT", "DOCUMENT_PID_WEIGHTING", "PID", "TS",

@@ -6,8 +6,10 @@ wrote, embedded as they are; they cannot be redrawn as SVG or PDF.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
+from ..control import SLOW_GROWTH_S, TYPICAL_RUN_S
 from ..errors import InputError
 from ._html import Section, definition_list, note, table
 from ._report_folders import read_json
@@ -36,6 +38,12 @@ def stability_verdict(linear: dict) -> tuple[str, str]:
     if linear.get("marginal"):
         return (_MARGINAL, "note")
     growth = linear.get("growth_time_s")
+    if growth is not None and growth >= SLOW_GROWTH_S:  # as `hystkit control` words it
+        return (f"closed loop unstable only over days (linearised at rest): max |pole| "
+                f"{linear.get('max_pole_radius', float('nan')):.10f}, grows e-fold in "
+                f"{growth:.3g} s, a factor {math.exp(TYPICAL_RUN_S / growth):.4f} over a "
+                f"{TYPICAL_RUN_S / 60:g}-minute run"
+                + (f"; {linear['cause']}" if linear.get("cause") else ""), "note")
     return (f"closed loop UNSTABLE (linearised at rest): max |pole| "
             f"{linear.get('max_pole_radius', float('nan')):.10f}"
             + (f", grows e-fold in {growth:.3g} s" if growth is not None else "")
