@@ -128,9 +128,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add ``select``."""
     p = sub.add_parser("select", help="choose model family, size, mode and centring, each "
                                       "validated on held-out data as it will be used")
-    p.add_argument("data", type=Path, nargs="+", help="training recording(s), one rate; give one per run: each is then held out in "
-                        "turn (left-out recording), the only check of offsets that change "
-                        "between runs")
+    p.add_argument("data", type=Path, nargs="+",
+                   help="training recording(s), one rate; give one per run: each is then held "
+                        "out in turn (left-out recording), the only check of offsets that "
+                        "change between runs")
     p.add_argument("--out", type=Path, required=True, help="model JSON file of the winner")
     p.add_argument("--report", type=Path,
                    help="folder for selection.json/.csv/.png (default: OUT's name + -selection)")

@@ -27,9 +27,7 @@ def format_number(value: object, digits: int = 4) -> str:
     """
     if value is None:
         return "n/a"
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        return str(value)
-    if isinstance(value, int):
+    if isinstance(value, bool | int) or not isinstance(value, float):
         return str(value)
     size = abs(value)
     if size != 0 and not _FIXED_RANGE[0] <= size < _FIXED_RANGE[1]:
