@@ -12,14 +12,17 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-__all__ = ["DEFAULT_OPTIONS", "FIELDS", "MAX_RESAMPLE_HZ", "MAX_SKIP_ROWS", "SEPARATORS",
-           "TIME_UNITS", "ReadOptions", "parse_columns"]
+__all__ = ["DECIMALS", "DEFAULT_OPTIONS", "FIELDS", "MAX_RESAMPLE_HZ", "MAX_SKIP_ROWS",
+           "SEPARATORS", "TIME_UNITS", "ReadOptions", "parse_columns"]
 
 FIELDS = ("time", "position", "sensor")  # hystkit's names, as io._cells.COLUMNS
 # Seconds per unit. s/ms/us/ns are the names raw files use (io._raw_config); min for slow logs.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "min": 60.0}
-# Accepted spellings -> the separator itself; "auto" looks at the header line.
+# Accepted spellings -> the separator itself; "auto" looks at the header and first data lines.
 SEPARATORS = {",": ",", ";": ";", "tab": "\t", "\t": "\t", "\\t": "\t", "auto": "auto"}
+# Decimal marks of CSV numbers; "auto" looks at the first data lines (a comma only where the
+# separator is not one: Excel in most of Europe writes 1,5 between semicolons).
+DECIMALS = (".", ",", "auto")
 # CSV lines skipped after the header (a units line or a few): pandas holds them as a set.
 MAX_SKIP_ROWS = 1_000_000
 MAX_RESAMPLE_HZ = 1e9  # as the raw files' fs_out
@@ -40,11 +43,18 @@ class ReadOptions:
         Unit of the time column; converted to seconds on reading.
     skip_rows : int
         CSV only: lines to skip *after* the header row, e.g. 1 for a units line such as
-        ``s,mm,Ohm`` (the same meaning as ``skip_rows`` of raw files). The header must be the
-        first line of the file.
-    sep : {",", ";", "tab", "auto"}
-        CSV only: field separator; ``auto`` takes the most frequent of the three in the
-        header line (a comma when none occurs). Stored as the character itself.
+        ``s,mm,Ohm`` (the same meaning as ``skip_rows`` of raw files). The header is the
+        first line of the file that is not a ``#`` comment (comment lines, and blank lines
+        among them, before it are skipped).
+    sep : {"auto", ",", ";", "tab"}
+        CSV only: field separator; ``auto`` (the default) takes the one of the three that
+        splits the header and the first data lines into the same number of fields (a file
+        where two do is refused, naming the line and ``--sep``). Stored as the character
+        itself.
+    decimal : {"auto", ".", ","}
+        CSV only: decimal mark of the numbers; ``auto`` (the default) reads ``1,5`` as 1.5 in
+        a file that is not comma-separated when the first data lines write their numbers so
+        (a file that mixes ``1,5`` and ``1.5`` there is refused, naming the lines).
     units_row : bool
         CSV only: the line after the header holds units (``s,mm,Ohm``); they are kept with
         the recording (`Recording.units`) and written to outputs. Lines skipped by
@@ -73,18 +83,21 @@ class ReadOptions:
 
     Notes
     -----
-    The defaults read files exactly as `read_recording` always did. Files hystkit writes keep
-    its standard column names (time [s], position, sensor) whatever was read.
+    The defaults read hystkit's own files and files as labs write them (``;`` or tab between
+    fields, a decimal comma, comment lines before the header: `hystkit.io.csv_layout` says
+    what it found). Files hystkit writes keep its standard column names (time [s],
+    position, sensor) whatever was read.
     """
 
     columns: tuple[tuple[str, str], ...] = ()
     time_unit: str = "s"
     skip_rows: int = 0
-    sep: str = ","
+    sep: str = "auto"
     units_row: bool = False
     resample_hz: float | None = None
     mat_var: str | None = None
     units: tuple[tuple[str, str], ...] = ()
+    decimal: str = "auto"
 
     def __post_init__(self) -> None:
         pairs = self.columns.items() if isinstance(self.columns, Mapping) else self.columns
@@ -119,6 +132,8 @@ class ReadOptions:
         if self.sep not in SEPARATORS:
             raise ValueError(f"sep must be one of ',', ';', 'tab', 'auto', got {self.sep!r}")
         object.__setattr__(self, "sep", SEPARATORS[self.sep])
+        if self.decimal not in DECIMALS:
+            raise ValueError(f"decimal must be one of '.', ',', 'auto', got {self.decimal!r}")
         if not isinstance(self.units_row, bool):
             # ValueError like every bad setting: callers catch one type
             raise ValueError(f"units_row must be true or false, got {self.units_row!r}")  # noqa: TRY004
@@ -180,4 +195,5 @@ def parse_columns(text: str) -> tuple[tuple[str, str], ...]:
 
 
 DEFAULT_OPTIONS = ReadOptions()
-"""Columns ``time``, ``position``, ``sensor``; seconds; commas; the header on line 1."""
+"""Columns ``time``, ``position``, ``sensor``; seconds; separator and decimal mark detected;
+the header on the first line that is not a comment."""

@@ -281,11 +281,14 @@ def test_csv_long_row(cli, good, tmp_path):
     _refused(cli, good, "fit", path, "row 7 (line 8): 4 fields but the header names 3 columns")
 
 
-def test_csv_semicolon_separator(cli, good, tmp_path):
+def test_csv_separator_that_cannot_be_told(cli, good, tmp_path):
+    # a ';'-separated file is read since issue 27.1; one that ';' and ',' split alike is not
     path = tmp_path / "rec.csv"
-    path.write_text(good["val"].read_text(encoding="utf-8").replace(",", ";"), encoding="utf-8")
-    _refused(cli, good, "evaluate", path, "missing required column 'time'",
-             "the first line must be a comma-separated header")
+    lines = good["val"].read_text(encoding="utf-8").splitlines()
+    path.write_text("\n".join(line.replace(",", ";", 1) for line in lines) + "\n",
+                    encoding="utf-8")
+    _refused(cli, good, "evaluate", path, "line 1: cannot tell the field separator: comma and "
+             "semicolon each split", "pass --sep ',' or --sep ';'")
 
 
 def test_csv_one_row(cli, good, tmp_path):

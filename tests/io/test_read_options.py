@@ -126,8 +126,10 @@ def test_defaults_read_as_before(tmp_path):
         np.testing.assert_array_equal(getattr(explicit, name), getattr(rec, name))
         np.testing.assert_array_equal(getattr(default, name), getattr(rec, name))
     (tmp_path / "semi.csv").write_text("time;position;sensor\n0;1;2\n1;2;3\n")
+    # the separator is detected by default (issue 27.1), and a given one still wins
+    np.testing.assert_array_equal(read_recording(tmp_path / "semi.csv").sensor, [2.0, 3.0])
     with pytest.raises(InputError, match="comma-separated header"):
-        read_recording(tmp_path / "semi.csv")  # the separator is not guessed by default
+        read_recording(tmp_path / "semi.csv", options=ReadOptions(sep=","))
 
 
 def test_mat_variables_mapped(tmp_path):

@@ -221,8 +221,12 @@ def add_read_options(p: argparse.ArgumentParser) -> None:
                    help="CSV: lines to skip after the header, e.g. 1 for a units line "
                         "(default 0)")
     g.add_argument("--sep", type=_separator, default=None, metavar="{',',;,tab,auto}",
-                   help="CSV field separator; auto: the most frequent of the three in the "
-                        "header line (default ',')")
+                   help="CSV field separator (default auto: the one that splits the header "
+                        "and the first data lines alike; '#' comment lines before the header "
+                        "are skipped)")
+    g.add_argument("--decimal", choices=[".", ",", "auto"], default=None,
+                   help="CSV decimal mark (default auto: a comma when the file is not "
+                        "comma-separated and its first data lines write 1,5)")
     g.add_argument("--units-row", action="store_true", default=False,
                    help="CSV: the line after the header holds units (s,mm,Ohm); they are "
                         "kept and written to the outputs (--skip-rows counts lines after it)")
@@ -252,7 +256,7 @@ def _mat_var(text: str) -> str:
 # Namespace attribute -> ReadOptions field, for the options add_read_options adds
 _READ_OPTIONS = {"columns": "columns", "time_unit": "time_unit", "skip_rows": "skip_rows",
                  "sep": "sep", "units_row": "units_row", "resample": "resample_hz",
-                 "mat_var": "mat_var"}
+                 "mat_var": "mat_var", "decimal": "decimal"}
 
 
 def given_read_options(args: argparse.Namespace) -> dict:
@@ -283,11 +287,33 @@ def read_options(args: argparse.Namespace, path=None):
         if settings is not None and str(settings) not in shown:
             shown.add(str(settings))
             print(f"reading {path} with the settings in {settings}", flush=True)
+        _say_layout(args, path, options)
         return options
     try:
         return ReadOptions(**given_read_options(args))
     except ValueError as exc:  # already checked one by one while parsing; kept as a guard
         raise UsageError(str(exc)) from None
+
+
+def _say_layout(args: argparse.Namespace, path, options) -> None:
+    """Print once per file what was detected in a CSV file that a plain comma-separated one
+    would not have (``reading my.csv: semicolon-separated, decimal comma``): a guess is said.
+    A file that cannot be opened is left to the reader, whose message names the problem."""
+    from pathlib import Path
+
+    from ..io import csv_layout
+
+    path = Path(path)
+    shown = args.__dict__.setdefault("_layout_shown", set())
+    if str(path) in shown or path.suffix.lower() != ".csv" or not path.is_file():
+        return
+    shown.add(str(path))
+    try:
+        notice = csv_layout(path, options).notice()
+    except OSError:
+        return
+    if notice:
+        print(f"reading {path}: {notice}", flush=True)
 
 
 def read_recording_args(args: argparse.Namespace, path, *, need_position: bool = True):

@@ -9,7 +9,8 @@ from .._read_options import ReadOptions as ReadOptions  # cheap: no numpy
 
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"_mat_reader": ("MatContents", "load_mat"),
+    {"_csv_layout": ("CsvLayout", "csv_layout"),
+     "_mat_reader": ("MatContents", "load_mat"),
      "_mat_writer": ("matlab_name", "write_mat"),
      "_other_columns": ("read_other_columns",),
      "_raw": ("RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter", "open_raw"),

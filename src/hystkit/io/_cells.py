@@ -65,8 +65,10 @@ def pick(found: list[str], need_position: bool, where: Where, hint: str = "") ->
     return [n for n in COLUMNS if where.name(n) in found]
 
 
-def text_problems(text: pd.Series) -> tuple[np.ndarray, np.ndarray, pd.Series]:
-    """Parse text cells to float64 without failing.
+def text_problems(text: pd.Series, decimal: str = ".") -> tuple[np.ndarray, np.ndarray,
+                                                                 pd.Series]:
+    """Parse text cells to float64 without failing; `decimal`: the numbers' decimal mark
+    (``,``: ``1,5`` is 1.5 and ``1.5`` is not a number).
 
     Returns
     -------
@@ -82,7 +84,11 @@ def text_problems(text: pd.Series) -> tuple[np.ndarray, np.ndarray, pd.Series]:
     missing = text.isna().to_numpy()
     stripped = text.where(~missing, "").astype(str).str.strip()
     empty = missing | (stripped == "").to_numpy()
-    numbers = pd.to_numeric(stripped.where(~empty), errors="coerce")
+    cells = stripped
+    if decimal == ",":  # a point is no number here; a comma is the point
+        cells = stripped.where(~stripped.str.contains(".", regex=False), "x")
+        cells = cells.str.replace(",", ".", regex=False)
+    numbers = pd.to_numeric(cells.where(~empty), errors="coerce")
     # to_numeric also yields NaN for a literal 'nan'; that one is numeric, the checks report it.
     literal_nan = stripped.str.lower().str.lstrip("+-").eq("nan").to_numpy()
     bad = empty | (numbers.isna().to_numpy() & ~literal_nan)

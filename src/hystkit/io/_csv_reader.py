@@ -15,6 +15,9 @@ Before both, a file of at most `PLAIN_BYTES` whose every data cell is a plain de
 without pandas: a command on a small clean file should not wait ~0.4 s for pandas to import.
 Plain decimals are parsed correctly rounded by any reader, so the values are the same bits
 pandas would give; anything else goes to the passes above, which decide and word the errors.
+
+First of all `csv_layout` (:mod:`._csv_layout`) settles what the options leave to it: the
+separator, a decimal comma, and comment lines before the header, which every pass skips.
 """
 
 from __future__ import annotations
@@ -32,13 +35,11 @@ from hystkit.errors import InputError
 
 from .._read_options import DEFAULT_OPTIONS, ReadOptions
 from ._cells import Where, cell_problem, pick, text_problems
+from ._csv_layout import COMMA_NUMBER, POINT_NUMBER, SEP_NAMES, CsvLayout, csv_layout
 
 CHUNK_ROWS = 100_000  # text cells held at once by the second pass
 FAST_CHUNK_ROWS = 1 << 18  # rows parsed at once by the first pass, copied into the result
-MAX_COLUMNS = 1000  # a wider file is not a recording; pandas would build a column per field
 PLAIN_BYTES = 1 << 24  # larger files go straight to pandas, whose import is then a small share
-_HEADER_BYTES = 1 << 16
-_SEP_NAMES = {",": "comma", ";": "semicolon", "\t": "tab"}
 _TEXT = {"header": None, "dtype": str, "keep_default_na": False, "skip_blank_lines": False,
          "encoding": "utf-8-sig"}
 
@@ -57,27 +58,36 @@ def read_csv(path: Path, source: str, need_position: bool,
              options: ReadOptions = DEFAULT_OPTIONS) -> tuple[dict[str, np.ndarray], Where]:
     """Read the recording columns of a CSV file as float64 arrays (not yet validated).
 
-    `options` gives the file's column names, the separator and the lines skipped after the
-    header; its time unit is applied by the caller.
+    `options` gives the file's column names, the separator, the decimal mark and the lines
+    skipped after the header (`csv_layout` settles those left at ``auto``); its time unit is
+    applied by the caller.
     """
-    # Data row r sits on file line r + 1 + units + skip_rows (header, units line, skipped lines).
+    # Data row r sits on file line r + preamble + 1 + units + skip_rows (comment lines,
+    # header, units line, skipped lines).
     skip = options.skip_rows + options.units_row
-    where = Where(source, header_lines=1 + skip, names=options.columns)
-    sep = _check_width(path, where, options.sep)
-    hint = f" (the first line must be a {_SEP_NAMES[sep]}-separated header naming the columns)"
-    arrays = _read_plain(path, need_position, where, sep, skip, hint)
+    where = Where(source, names=options.columns)
+    layout = csv_layout(path, options, where)
+    where = replace(where, header_lines=layout.preamble + 1 + skip)
+    sep, decimal, preamble = layout.sep, layout.decimal, layout.preamble
+    first = "the first line" if not preamble else f"line {preamble + 1}, below the comments,"
+    hint = f" ({first} must be a {SEP_NAMES[sep]}-separated header naming the columns)"
+    arrays = _read_plain(path, need_position, where, sep, skip, hint, decimal=decimal,
+                         preamble=preamble)
     if arrays is None:
-        arrays = _read_numbers(path, need_position, where, sep, skip, hint)
+        arrays = _read_numbers(path, need_position, where, sep, skip, hint, decimal=decimal,
+                               preamble=preamble)
     if arrays is None:
         arrays = _read_text(path, need_position, where, sep, skip, hint,
-                            units_hint=not options.units_row)
+                            units_hint=not options.units_row, decimal=decimal,
+                            preamble=preamble)
     if options.units_row:
-        where = replace(where, units=_units_row(path, where, sep, list(arrays)))
+        where = replace(where, units=_units_row(path, where, layout, list(arrays)))
     return arrays, where
 
 
 def _read_plain(path: Path, need_position: bool, where: Where, sep: str, skip: int,
-                hint: str) -> dict[str, np.ndarray] | None:
+                hint: str, *, decimal: str = ".", preamble: int = 0
+                ) -> dict[str, np.ndarray] | None:
     """The pandas-free pass: every data cell a plain decimal, or None (the file goes on)."""
     if path.stat().st_size > PLAIN_BYTES:
         return None
@@ -89,9 +99,11 @@ def _read_plain(path: Path, need_position: bool, where: Where, sep: str, skip: i
     lines = text.split("\n")
     if lines[-1] == "":
         lines.pop()  # the final line end
-    header = lines[0].split(sep)
-    body = lines[1 + skip:]
-    if "\r" in text or '"' in lines[0] or not body or any(not h.strip() for h in header):
+    if len(lines) <= preamble:
+        return None
+    header = lines[preamble].split(sep)
+    body = lines[preamble + 1 + skip:]
+    if "\r" in text or '"' in lines[preamble] or not body or any(not h.strip() for h in header):
         return None
     # The data lines hold only digits, . e E + -, separators and single line ends (a blank
     # line, spaces, nan, inf, quotes or hex go on to pandas). Over that alphabet numpy's
@@ -99,10 +111,12 @@ def _read_plain(path: Path, need_position: bool, where: Where, sep: str, skip: i
     # empty cell, a short or long row): a one-pass byte check instead of a regular
     # expression per line (~5 ms on 8000 lines).
     start = len(codecs.BOM_UTF8) if data.startswith(codecs.BOM_UTF8) else 0  # as decoded
-    for _ in range(1 + skip):
+    for _ in range(preamble + 1 + skip):
         start = data.index(b"\n", start) + 1
-    if b"\n\n" in data[start - 1:] or data[start:].translate(None, _plain_bytes(sep)):
+    if b"\n\n" in data[start - 1:] or data[start:].translate(None, _plain_bytes(sep, decimal)):
         return None
+    if decimal == ",":  # the separator is not a comma: every comma is a decimal mark
+        body = [line.replace(",", ".") for line in body]
     header = [name.strip() for name in header]
     names = pick(header, need_position, where, hint=hint)
     try:
@@ -118,27 +132,29 @@ def _read_plain(path: Path, need_position: bool, where: Where, sep: str, skip: i
     return arrays
 
 
-def _plain_bytes(sep: str) -> bytes:
+def _plain_bytes(sep: str, decimal: str = ".") -> bytes:
     """The bytes a plain data line may hold: deleting them leaves nothing."""
-    return b"0123456789.eE+-\n" + sep.encode()
+    return b"0123456789eE+-\n" + decimal.encode() + sep.encode()
 
 
-def _units_row(path: Path, where: Where, sep: str, names: list[str]) -> tuple[tuple[str, str], ...]:
+def _units_row(path: Path, where: Where, layout: CsvLayout,
+               names: list[str]) -> tuple[tuple[str, str], ...]:
     """(hystkit name, unit) from the line after the header; empty cells give no unit."""
     pd, _, parse_errors = _pandas()
+    line = layout.preamble + 2
     try:
-        lines = pd.read_csv(path, nrows=2, sep=sep, **_TEXT)
+        lines = pd.read_csv(path, nrows=2, sep=layout.sep, skiprows=layout.preamble, **_TEXT)
     except (*parse_errors, UnicodeDecodeError) as exc:
-        raise where.fail(f"cannot read the units line (line 2): {exc}") from exc
+        raise where.fail(f"cannot read the units line (line {line}): {exc}") from exc
     if len(lines) < 2:
-        raise where.fail("--units-row: there is no line 2 to read units from")
+        raise where.fail(f"--units-row: there is no line {line} to read units from")
     header = [str(name).strip() for name in lines.iloc[0]]
     row = lines.iloc[1].fillna("")
     cells = [str(cell).strip() for cell in row if str(cell).strip()]
-    if cells and all(_is_number(cell) for cell in cells):
+    if cells and all(_is_number(cell.replace(layout.decimal, ".")) for cell in cells):
         # A file without a units line: reading on would drop its first sample unsaid.
         shown = ", ".join(cells[:3]) + (", ..." if len(cells) > 3 else "")
-        raise where.fail(f"line 2: --units-row reads units there but it holds numbers "
+        raise where.fail(f"line {line}: --units-row reads units there but it holds numbers "
                          f"({shown}), the first sample: this file has no units line (drop "
                          "--units-row, or units_row from its settings file)")
     units = []
@@ -157,31 +173,13 @@ def _is_number(text: str) -> bool:
     return True
 
 
-def _check_width(path: Path, where: Where, sep: str) -> str:
-    """Refuse a header with more than `MAX_COLUMNS` fields before pandas builds that many;
-    returns the separator (`sep`, or for ``auto`` the most frequent one in the header)."""
-    with path.open("rb") as file:
-        start = file.read(_HEADER_BYTES)
-    ends = [i for i in (start.find(b"\n"), start.find(b"\r")) if i >= 0]
-    if not ends and len(start) == _HEADER_BYTES:
-        raise where.fail(f"the header line is longer than {_HEADER_BYTES} bytes; this is not "
-                         "a recording")
-    line = start[:min(ends, default=len(start))]
-    if sep == "auto":  # ties go to the earlier of comma, semicolon, tab
-        sep = max(_SEP_NAMES, key=lambda c: line.count(c.encode()))
-    fields = line.count(sep.encode()) + 1
-    if fields > MAX_COLUMNS:
-        raise where.fail(f"the header line has {fields} fields; a recording has at most "
-                         f"{MAX_COLUMNS} columns")
-    return sep
-
-
 def _read_numbers(path: Path, need_position: bool, where: Where, sep: str = ",", skip: int = 0,
-                  hint: str = "") -> dict[str, np.ndarray] | None:
+                  hint: str = "", *, decimal: str = ".", preamble: int = 0
+                  ) -> dict[str, np.ndarray] | None:
     """The fast pass: every column as float64, or None when anything needs a closer look."""
     pd, exact, parse_errors = _pandas()
     try:
-        first = pd.read_csv(path, nrows=1, sep=sep, **_TEXT)
+        first = pd.read_csv(path, nrows=1, sep=sep, skiprows=preamble, **_TEXT)
     except (*parse_errors, UnicodeDecodeError):
         return None
     if first.empty or first.iloc[0].isna().any():  # blank first line or empty file: pass 2
@@ -198,9 +196,10 @@ def _read_numbers(path: Path, need_position: bool, where: Where, sep: str = ",",
     try:
         # index_col=False: with names given, pandas would otherwise make a long row's extra
         # leading field an index; skip_blank_lines=False: a blank line becomes a NaN row.
-        with pd.read_csv(path, header=None, skiprows=1 + skip, names=list(range(len(header))),
-                         index_col=False, dtype=np.float64, skip_blank_lines=False, sep=sep,
-                         encoding="utf-8-sig", chunksize=FAST_CHUNK_ROWS, **exact) as reader:
+        with pd.read_csv(path, header=None, skiprows=preamble + 1 + skip,
+                         names=list(range(len(header))), index_col=False, dtype=np.float64,
+                         skip_blank_lines=False, sep=sep, decimal=decimal, encoding="utf-8-sig",
+                         chunksize=FAST_CHUNK_ROWS, **exact) as reader:
             for chunk in reader:
                 if n + len(chunk) > out[0].size:
                     return None  # cannot happen with the bound above; the text pass decides
@@ -227,7 +226,8 @@ def _line_bound(path: Path, block: int = 1 << 22) -> int:
 
 
 def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", skip: int = 0,
-               hint: str = "", units_hint: bool = False) -> dict[str, np.ndarray]:
+               hint: str = "", units_hint: bool = False, *, decimal: str = ".",
+               preamble: int = 0) -> dict[str, np.ndarray]:
     """The careful pass: text cells chunk by chunk, the first problem of each column kept;
     `units_hint`: when every column's first data cell is text, suggest ``--units-row``."""
     pd, _, parse_errors = _pandas()
@@ -240,8 +240,9 @@ def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", sk
     try:
         # header=None because with a header pandas silently turns the first column into an
         # index when every data row has one field too many.
-        with pd.read_csv(path, chunksize=CHUNK_ROWS, sep=sep,
-                         skiprows=range(1, 1 + skip) if skip else None, **_TEXT) as reader:
+        skipped = [*range(preamble), *range(preamble + 1, preamble + 1 + skip)]
+        with pd.read_csv(path, chunksize=CHUNK_ROWS, sep=sep, skiprows=skipped or None,
+                         **_TEXT) as reader:
             for chunk in reader:
                 if header is None:
                     header = [str(name).strip() for name in chunk.iloc[0]]
@@ -255,10 +256,12 @@ def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", sk
                     # Trailing blank lines are common at the end of logger files and carry no data.
                     n_rows = offset + int(np.flatnonzero(filled)[-1]) + 1
                 for name in names:
-                    numbers, bad, stripped = text_problems(chunk[header.index(where.name(name))])
+                    numbers, bad, stripped = text_problems(chunk[header.index(where.name(name))],
+                                                           decimal)
                     if name not in first_bad and bad.any():
                         i = int(np.argmax(bad))
-                        first_bad[name] = (offset + i, cell_problem(stripped, i))
+                        first_bad[name] = (offset + i, cell_problem(stripped, i)
+                                           + _decimal_hint(stripped.iloc[i], sep, decimal))
                     parts[name].append(numbers)
                 offset += len(chunk)
     except pd.errors.EmptyDataError as exc:
@@ -272,7 +275,8 @@ def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", sk
     if n_rows == 0:
         raise where.fail("no data rows below the header")
     units_like = units_hint and all(first_bad.get(name, (-1, ""))[0] == 0 for name in names) \
-        and all(first_bad[name][1].startswith("non-numeric") for name in names)
+        and all(first_bad[name][1].startswith("non-numeric") and "decimal" not in
+                first_bad[name][1] for name in names)
     for name in names:  # the first column in recording order with a bad cell in the data
         if name in first_bad and first_bad[name][0] < n_rows:
             row, problem = first_bad[name]
@@ -281,6 +285,16 @@ def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", sk
                             "true in the settings file)")
             raise where.fail(problem, name, row)
     return {name: np.concatenate(parts.pop(name))[:n_rows] for name in names}
+
+
+def _decimal_hint(cell: str, sep: str, decimal: str) -> str:
+    """What to do about a cell that is a number written with the other decimal mark."""
+    if decimal == "." and sep != "," and COMMA_NUMBER.fullmatch(cell):
+        return " (a decimal comma? pass --decimal ',', or decimal = \",\" in the settings file)"
+    if decimal == "," and POINT_NUMBER.fullmatch(cell):
+        return (" (a decimal point, where this file's numbers use a decimal comma: pass "
+                "--decimal '.' if they do not)")
+    return ""
 
 
 def _parse_error(exc: Exception, where: Where) -> InputError:

@@ -19,7 +19,7 @@ from hystkit.errors import InputError
 
 from .._read_options import DEFAULT_OPTIONS, FIELDS, ReadOptions
 from ._cells import COLUMNS, Where
-from ._csv_reader import _check_width
+from ._csv_layout import csv_layout
 
 __all__ = ["dropped_by_resampling", "read_other_columns"]
 
@@ -96,14 +96,17 @@ def _as_read(path: Path, n_samples: int | None, options: ReadOptions) -> dict[st
     else:
         from ._cells import Where
 
-        sep = _check_width(path, Where(str(path)), options.sep)
-        header = pd.read_csv(path, nrows=0, sep=sep, encoding="utf-8-sig").columns
+        layout = csv_layout(path, options, Where(str(path), names=options.columns))
+        header = pd.read_csv(path, nrows=0, sep=layout.sep, skiprows=layout.preamble,
+                             encoding="utf-8-sig").columns
         names = [n for n in header if str(n).strip() not in ours]
         if not names:
             return {}
         skip = options.skip_rows + options.units_row
-        frame = pd.read_csv(path, sep=sep, usecols=names, encoding="utf-8-sig",
-                            skiprows=range(1, 1 + skip) if skip else None)
+        skipped = [*range(layout.preamble), *range(layout.preamble + 1,
+                                                   layout.preamble + 1 + skip)]
+        frame = pd.read_csv(path, sep=layout.sep, decimal=layout.decimal, usecols=names,
+                            encoding="utf-8-sig", skiprows=skipped or None)
     if not names:
         return {}
     if n_samples is not None and len(frame) != n_samples:

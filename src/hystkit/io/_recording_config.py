@@ -6,7 +6,8 @@ keys and two tables::
 
     time_unit = "ms"          # s, ms, us, ns, min
     skip_rows = 0             # CSV lines skipped after the header (after the units line)
-    sep = ";"                 # ",", ";", "tab", "auto"
+    sep = ";"                 # ",", ";", "tab", "auto" (the default: detected)
+    decimal = ","             # ".", ",", "auto" (the default: detected)
     units_row = true          # CSV: the line after the header holds units
     resample_hz = 100.0       # bring jittered time onto a uniform grid
     mat_var = "run1"          # .mat: the struct or matrix holding the recording
@@ -46,6 +47,7 @@ RECORDING_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
     "time_unit": ((str,), "unit of the time column: s, ms, us, ns or min"),
     "skip_rows": ((int,), "CSV: lines to skip after the header (and its units line)"),
     "sep": ((str,), "CSV field separator: ',', ';', 'tab' or 'auto'"),
+    "decimal": ((str,), "CSV decimal mark: '.', ',' or 'auto'"),
     "units_row": ((bool,), "CSV: the line after the header holds units"),
     "resample_hz": ((int, float), "resample to a uniform grid at this rate [Hz]"),
     "mat_var": ((str,), ".mat: the variable holding the recording"),
