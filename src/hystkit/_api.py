@@ -10,6 +10,7 @@ tables back as DataFrames. ``hystkit/__init__`` exports these names lazily (PEP 
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
@@ -23,7 +24,7 @@ from .compensation import (
 )
 from .compensation import evaluate as _evaluate
 from .compensation import use_flags as _use_flags
-from .io import Recording, options_for, read_recording
+from .io import ReadOptions, Recording, options_for, read_recording, settings_for
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -41,8 +42,10 @@ def read(path: str | os.PathLike, *, columns: Mapping[str, str] | None = None,
     """Read a recording from a CSV, Parquet or MATLAB file, with its own column names.
 
     A settings file beside it (``my.toml`` for ``my.csv``: columns, time unit, ..., see
-    ``docs/own_data.md``) is read first, as the command line does; what is given here
-    overrides it (``columns`` name by name).
+    ``docs/own_data.md``) is read first, as the command line does, and one line on stderr
+    says so (``hystkit: reading my.csv with the settings in my.toml``; or that one beside it
+    is for another file and was not applied); what is given here overrides it (``columns``
+    name by name). So do the other functions here given a file path.
 
     Parameters
     ----------
@@ -87,8 +90,19 @@ def read(path: str | os.PathLike, *, columns: Mapping[str, str] | None = None,
         given["columns"] = tuple(columns.items())
     if time_unit is not None:
         given["time_unit"] = time_unit
-    reading, _ = options_for(path, given)  # an unknown option is a TypeError there
-    return read_recording(path, need_position=False, options=reading)
+    return read_recording(path, need_position=False, options=_reading(path, given))
+
+
+def _reading(path: str | os.PathLike, given: dict | None = None) -> ReadOptions:
+    """The options to read `path` with (its settings file, then `given`); says on stderr
+    which settings file was applied, or that one beside it is for another file."""
+    reading, settings = options_for(path, given)  # an unknown option is a TypeError there
+    note = settings_for(path)[1] if settings is None else ""
+    if settings is not None:
+        print(f"hystkit: reading {path} with the settings in {settings}", file=sys.stderr)
+    elif note:
+        print(f"hystkit: reading {path} without its settings: {note}", file=sys.stderr)
+    return reading
 
 
 def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None, *,
@@ -322,7 +336,7 @@ def _as_recording(data: Data) -> Recording:
     if isinstance(data, Recording):
         return data
     if isinstance(data, str | os.PathLike):
-        return read_recording(data, need_position=False, options=options_for(data)[0])
+        return read_recording(data, need_position=False, options=_reading(data))
     if hasattr(data, "columns") and hasattr(data, "to_numpy"):  # a DataFrame, without pandas
         return Recording.from_frame(data)
     raise TypeError(f"expected a Recording, a DataFrame or a file path, got "

@@ -280,13 +280,16 @@ def read_options(args: argparse.Namespace, path=None):
     from .._read_options import ReadOptions
 
     if path is not None:
-        from ..io import options_for
+        from ..io import options_for, settings_for
 
         options, settings = options_for(path, given_read_options(args))
         shown = args.__dict__.setdefault("_settings_shown", set())  # once per command
-        if settings is not None and str(settings) not in shown:
-            shown.add(str(settings))
-            print(f"reading {path} with the settings in {settings}", flush=True)
+        note = settings_for(path)[1] if settings is None else ""
+        said = (f"reading {path} with the settings in {settings}" if settings is not None
+                else f"reading {path} without its settings: {note}" if note else "")
+        if said and said not in shown:
+            shown.add(said)
+            print(said, flush=True)
         _say_layout(args, path, options)
         return options
     try:

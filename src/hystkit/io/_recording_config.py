@@ -1,9 +1,13 @@
 """How to read a recording, from a TOML settings file stored next to it.
 
 The rule (as for raw files, `hystkit.io.find_raw_config`): the settings of ``my.csv`` are in
-``my.toml`` in the same folder (same stem). The file holds the `ReadOptions` settings as flat
-keys and two tables::
+``my.toml`` in the same folder (same stem). They apply to that one file: when ``my.mat`` or
+``my.parquet`` sits beside ``my.csv``, the file must say which it is for (``file``), and a
+recording it is not for is read without it (`settings_for` says so), never with settings
+written for another format (a ``.mat`` in s beside a CSV in ms). The file holds the
+`ReadOptions` settings as flat keys and two tables::
 
+    file = "my.csv"           # the recording these are for, or one extension ("*.csv")
     time_unit = "ms"          # s, ms, us, ns, min
     skip_rows = 0             # CSV lines skipped after the header (after the units line)
     sep = ";"                 # ",", ";", "tab", "auto" (the default: detected)
@@ -41,9 +45,12 @@ from .._read_options import FIELDS, ReadOptions
 from ._toml import load_toml
 
 __all__ = ["RECORDING_KEYS", "find_recording_config", "is_raw_settings", "options_for",
-           "read_recording_config"]
+           "read_recording_config", "settings_for"]
+
+RECORDING_SUFFIXES = (".csv", ".parquet", ".mat")  # as _recording._READERS
 
 RECORDING_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
+    "file": ((str,), "the recording these settings are for (my.csv), or one extension (*.csv)"),
     "time_unit": ((str,), "unit of the time column: s, ms, us, ns or min"),
     "skip_rows": ((int,), "CSV: lines to skip after the header (and its units line)"),
     "sep": ((str,), "CSV field separator: ',', ';', 'tab' or 'auto'"),
@@ -113,6 +120,8 @@ def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
     for name, item in values.get("units", {}).items():
         if not isinstance(item, str):
             raise InputError(f"{path}: key 'units.{name}' = {item!r}: units are text")
+    if "file" in values:
+        _check_file(path, values.pop("file"))
     if "columns" in values:
         values["columns"] = tuple(values["columns"].items())
     if "units" in values:
@@ -122,6 +131,72 @@ def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
     except ValueError as exc:
         raise InputError(f"{path}: {exc}") from None
     return values
+
+
+def _check_file(path: Path, target: str) -> None:
+    """``file`` names a recording of this settings file's stem, or one recording extension:
+    found by its name, ``my.toml`` can be for nothing else."""
+    stem = Path(path).stem
+    names = [stem + suffix for suffix in RECORDING_SUFFIXES]
+    if target not in names and _extension(target) not in RECORDING_SUFFIXES:
+        raise InputError(f"{path}: key 'file' = {target!r}: settings found by their name are "
+                         f"for {', '.join(names)} (or one extension: \"*.csv\", ...)")
+
+
+def _extension(target: str) -> str | None:
+    """``.csv`` of ``*.csv`` or ``.csv``; None for a file name."""
+    if target.startswith("*."):
+        return target[1:].lower()
+    return target.lower() if target.startswith(".") else None
+
+
+def settings_for(data_path: str | os.PathLike[str]) -> tuple[Path | None, str]:
+    """The settings file that applies to a recording, and why one beside it does not.
+
+    ``my.toml`` applies to ``my.csv`` when it names it (``file = "my.csv"`` or ``"*.csv"``),
+    or names nothing and ``my.csv`` is the only recording of that stem there. A raw scope
+    recording's settings (`is_raw_settings`) are not a recording's.
+
+    Parameters
+    ----------
+    data_path : str or path-like
+        The recording.
+
+    Returns
+    -------
+    settings : Path or None
+        The settings file to read `data_path` with.
+    note : str
+        When a settings file beside it is for another file: ``"my.toml is for my.csv"``, to
+        say that it was not applied; else "".
+
+    Raises
+    ------
+    InputError
+        A settings file that names no file, beside two recordings of its stem (``my.csv``
+        and ``my.mat``): one line asking for ``file``. Unreadable or invalid TOML.
+    """
+    data = Path(data_path)
+    settings = find_recording_config(data)
+    if settings is None:
+        return None, ""
+    values = _load(settings)
+    if is_raw_settings(values):
+        return None, ""  # the raw recording's settings (for preprocess), not this file's
+    target = values.get("file")
+    if isinstance(target, str):
+        _check_file(settings, target)
+        if target == data.name or _extension(target) == data.suffix.lower():
+            return settings, ""
+        return None, f"{settings} is for {target}"
+    others = [data.with_suffix(s).name for s in RECORDING_SUFFIXES
+              if s != data.suffix.lower() and data.with_suffix(s).is_file()]
+    if others:
+        raise InputError(f"{settings}: settings beside {data.name} and {', '.join(others)}, "
+                         f"which may differ (a time unit, a separator): say which file they "
+                         f"are for with file = \"{data.name}\" in it (the other is then read "
+                         "with options given on the command line)")
+    return settings, ""
 
 
 def _load(path: Path) -> dict[str, Any]:
@@ -167,22 +242,23 @@ def options_for(data_path: str | os.PathLike[str], given: dict[str, Any] | None 
     -------
     options : ReadOptions
     settings : Path or None
-        The settings file used, if any. A raw recording's settings file of the same stem
-        (`is_raw_settings`) is not used.
+        The settings file used, if any (`settings_for`: not one written for another file of
+        the same stem, nor a raw recording's).
 
     Raises
     ------
     TypeError
         A key of `given` that is not a `ReadOptions` field.
+    InputError
+        A settings file that cannot be read or that `settings_for` refuses (one beside two
+        recordings of its stem that does not say which it is for).
     """
     given = dict(given or {})
     unknown = sorted(set(given) - _FIELD_NAMES)
     if unknown:
         raise TypeError(f"unexpected reading option(s): {', '.join(unknown)} (ReadOptions "
                         f"has {', '.join(sorted(_FIELD_NAMES))})")
-    settings = find_recording_config(data_path)
-    if settings is not None and is_raw_settings(_load(settings)):
-        settings = None  # the raw recording's settings (for preprocess), not this file's
+    settings, _ = settings_for(data_path)
     values = read_recording_config(settings) if settings is not None else {}
     if "columns" in given and "columns" in values:
         given["columns"] = tuple({**dict(values["columns"]), **dict(given["columns"])}.items())

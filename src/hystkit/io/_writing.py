@@ -126,7 +126,7 @@ def write_recording(
     if suffix == ".csv" and units_sidecar and all_units:
         with atomic_outputs([path, sidecar_path(path)], force) as (tmp, toml_tmp):
             frame.to_csv(tmp, index=False)
-            toml_tmp.write_text(units_settings_text(all_units), encoding="utf-8")
+            toml_tmp.write_text(units_settings_text(all_units, path.name), encoding="utf-8")
         return path
     with atomic_output(path, force) as tmp:
         if suffix == ".csv":  # pandas writes floats as repr(): the shortest exact round trip
@@ -152,21 +152,25 @@ def sidecar_path(path: str | os.PathLike[str]) -> Path:
     return Path(path).with_suffix(".toml")
 
 
-def units_settings_text(units: dict[str, str]) -> str:
+def units_settings_text(units: dict[str, str], file: str | None = None) -> str:
     """A recording's settings file (``out.toml``) that holds only the units of its columns.
 
     Parameters
     ----------
     units : dict of str to str
         Unit of each column, by column name.
+    file : str, optional
+        The name of the recording it is for (``out.csv``): then it applies to that file
+        only, even when an ``out.mat`` appears beside it.
 
     Returns
     -------
     str
         The TOML text, one ``[units]`` table.
     """
-    lines = ["# written by hystkit: units of the columns of the file beside this one", "",
-             "[units]"]
+    lines = ["# written by hystkit: units of the columns of the file beside this one", ""]
+    lines += [] if file is None else [f"file = {json.dumps(file)}", ""]
+    lines += ["[units]"]
     lines += [f"{json.dumps(name)} = {json.dumps(unit)}" for name, unit in units.items()]
     return "\n".join(lines) + "\n"
 
