@@ -3,6 +3,10 @@
 Input: CSV lines ``time,sensor`` (time in seconds) from stdin, a file (``--in``) or a serial
 port (``--serial PORT --baud B``, needs the ``serial`` extra). An optional first non-empty
 line naming the columns (``time,sensor``, any order, more columns allowed) is read as a header.
+A file laid out otherwise is read as ``fit`` reads it (:mod:`._stream_input`): its settings file,
+``--columns``, ``--time-unit``, ``--sep``, ``--decimal``, ``--units-row``, ``--skip-rows``, and
+the separator, decimal comma and comment lines detected. A stream that compensates no sample
+ends with an error naming the first line skipped and why.
 
 Output, one line per accepted sample and flushed at once: ``time,position_estimate,flags``
 after a header line. ``time`` is echoed as received, the estimate [mm] is printed to full
@@ -44,7 +48,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
 from ..errors import InputError, OutputError
-from ._common import stdout_for
+from ._common import add_read_options, stdout_for
+from ._stream_input import nothing_compensated, stream_format, stream_lines
 
 if TYPE_CHECKING:
     from ..compensation import AdaptiveStream, RefittingStream, Stream, SyncExcitation
@@ -354,6 +359,7 @@ def _stream(args: argparse.Namespace) -> int:
     if args.serial is None and args.baud is not None:
         raise InputError("--baud is for --serial")
     _check_adapt_options(args)
+    fmt = stream_format(args)  # --in FILE: its settings file and layout, as fit reads it
     stdout_for("the estimates")
     comp = load_compensator(args.model)
     stream = Stream(comp, label=str(args.model))  # refuses the oracle centring
@@ -367,11 +373,15 @@ def _stream(args: argparse.Namespace) -> int:
     if args.adapt is not None:
         stream, learning = _adaptive_stream(args, comp, start), _Learning()
     source, lines = _lines(args)
+    if not fmt.plain:
+        lines = _Input(stream_lines(iter(lines), fmt, source, TOO_LONG), lines)
     with contextlib.closing(lines):
         _write("time,position_estimate,flags\n")
         tally, latency = _Tally(), _Latency()
         try:
             _run_stream(stream, lines, tally, latency, learning)
+            if not latency.n:  # a stream that compensates nothing is no success
+                raise InputError(nothing_compensated(source, tally.count, tally.first))
         finally:  # also on Ctrl-C / SIGTERM: the summary, then main's exit 130 / 143
             tally.report(source, comp.structure.dt)
             print(latency.summary(), file=sys.stderr)
@@ -452,6 +462,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--start", choices=("rest", "sync"), default="rest",
                    help="rest: model at rest at the first sample (default); sync: after the "
                         "synchronisation excitation e_sync (eq. 2.21-2.22), printed to stderr")
+    add_read_options(p)  # --in FILE, stdin or a port laid out as the user's files
     adapt = p.add_argument_group("online adaptation (a reference column: the true position "
                                  "[mm] now and then, empty when unknown)")
     adapt.add_argument("--adapt", choices=ADAPT_CHOICES,
