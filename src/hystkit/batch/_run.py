@@ -15,7 +15,8 @@ from __future__ import annotations
 import json
 import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict
 from pathlib import Path
 
 from .. import __version__
@@ -33,6 +34,7 @@ from ..io import (
     Recording,
     atomic_outputs,
     check_output_path,
+    options_for,
     read_recording,
     write_json,
 )
@@ -49,9 +51,14 @@ RESULT_COLUMNS = ("sensor", "status", "model", "size", "mode", "center", "r2_dep
                   "e_rms_pct_deployable", "r2_oracle", "linear_r2_deployable", "fit_seconds",
                   "seconds", "guards", "error", "model_file")
 MARKER = "batch.json"
+#: How a batch reads its recordings: one `ReadOptions` for every file; a mapping from a file
+#: (as ``str(path)``) to its options; or None. A file not in the mapping, and every file with
+#: None, is read as ``hystkit fit`` and ``hk.read`` read it: with its settings file beside it
+#: (`hystkit.io.options_for`).
+Reading = ReadOptions | Mapping[str, ReadOptions] | None
 
 
-def fit_sensor(job: SensorJob, *, read_options: ReadOptions | None = None) -> dict:
+def fit_sensor(job: SensorJob, *, read_options: Reading = None) -> dict:
     """Read, fit and score one sensor (one piece of a batch; never raises for the sensor's own
     failure: it is the row's ``error``).
 
@@ -59,8 +66,9 @@ def fit_sensor(job: SensorJob, *, read_options: ReadOptions | None = None) -> di
     ----------
     job : SensorJob
         The sensor's recordings and model options.
-    read_options : ReadOptions, optional
-        How to read the recordings (column names, time unit); None: the defaults.
+    read_options : ReadOptions or mapping, optional
+        How to read the recordings (column names, time unit, ...; `Reading`); None: each
+        with its settings file, as ``hystkit fit`` reads it.
 
     Returns
     -------
@@ -125,11 +133,31 @@ def _mean(scores: Sequence[dict], key: str) -> float | None:
     return None if any(v is None for v in values) else float(sum(values) / len(values))
 
 
-def _recordings(job: SensorJob, options: ReadOptions | None) -> tuple[list, list]:
-    fit = [read_recording(p, options=options) for p in job.fit]
+def _recordings(job: SensorJob, reading: Reading) -> tuple[list, list]:
+    fit = [read_recording(p, options=_options(p, reading)) for p in job.fit]
     if not job.split:
-        return fit, [read_recording(p, options=options) for p in job.validate]
+        return fit, [read_recording(p, options=_options(p, reading)) for p in job.validate]
     return [_part(fit[0], 0, "first half")], [_part(fit[0], 1, "second half")]
+
+
+def _options(path: Path, reading: Reading) -> ReadOptions:
+    """The options to read `path` with (see `Reading`)."""
+    if isinstance(reading, ReadOptions):
+        return reading
+    if reading is not None and str(path) in reading:
+        return reading[str(path)]
+    return options_for(path)[0]
+
+
+def _reading_record(job: SensorJob, reading: Reading) -> list | None:
+    """The options each recording of `job` is read with, as stored with its result (a rerun
+    with other options, or an edited settings file, refits); None if they cannot be known
+    (a settings file refused: the sensor fails, and is tried again)."""
+    try:
+        pairs = [[str(p), asdict(_options(p, reading))] for p in (*job.fit, *job.validate)]
+    except InputError:
+        return None
+    return json.loads(json.dumps(pairs))  # as read back from the record
 
 
 def _part(rec: Recording, half: int, label: str) -> Recording:
@@ -156,7 +184,7 @@ def fingerprint(job: SensorJob) -> list:
 
 
 def run_batch(jobs: Sequence[SensorJob], out: Path, *, executor: Executor | None = None,
-              read_options: ReadOptions | None = None, refit: bool = False,
+              read_options: Reading = None, refit: bool = False,
               source: str = "", progress: Callable[[str], None] = lambda _: None) -> list[dict]:
     """Fit every sensor not finished in `out` yet (all with `refit`); write the results table.
 
@@ -168,8 +196,9 @@ def run_batch(jobs: Sequence[SensorJob], out: Path, *, executor: Executor | None
         The batch folder (see the module docstring); created if missing.
     executor : Executor, optional
         Where the fits run; by default serially in this process.
-    read_options : ReadOptions, optional
-        How to read the recordings; None: the defaults.
+    read_options : ReadOptions or mapping, optional
+        How to read the recordings (`Reading`); None: each with its settings file, as
+        ``hystkit fit`` reads it. A sensor finished with other options is fitted again.
     refit : bool
         Fit every sensor again, and accept a non-empty `out` that is not a batch folder.
     source : str
@@ -191,14 +220,14 @@ def run_batch(jobs: Sequence[SensorJob], out: Path, *, executor: Executor | None
     out = Path(out)
     _claim(out, refit, source)
     rows = {job.sensor: record["row"] for job in jobs
-            if (record := None if refit else _finished(out, job)) is not None}
+            if (record := None if refit else _finished(out, job, read_options)) is not None}
     todo = [job for job in jobs if job.sensor not in rows]
     progress(f"{len(jobs)} sensors: {len(rows)} finished before, {len(todo)} to fit on "
              f"{(executor or SerialExecutor()).describe()}")
 
     def finished(i: int, result: dict) -> None:
         job = todo[i]
-        _store(out, job, result)
+        _store(out, job, result, _reading_record(job, read_options))
         rows[job.sensor] = row = result["row"]
         progress(f"[{len(rows)}/{len(jobs)}] {_summary(row)}")
 
@@ -222,7 +251,8 @@ def _claim(out: Path, refit: bool, source: str) -> None:
         write_json({"hystkit": __version__, "source": source}, marker, force=True)
 
 
-def pending(jobs: Sequence[SensorJob], out: Path, refit: bool = False) -> list[SensorJob]:
+def pending(jobs: Sequence[SensorJob], out: Path, refit: bool = False,
+            read_options: Reading = None) -> list[SensorJob]:
     """The jobs `run_batch` will fit (those not finished in `out`), e.g. to size a cluster.
 
     Parameters
@@ -233,17 +263,20 @@ def pending(jobs: Sequence[SensorJob], out: Path, refit: bool = False) -> list[S
         The batch folder.
     refit : bool
         True: every job (as `run_batch` with `refit`).
+    read_options : ReadOptions or mapping, optional
+        As given to `run_batch`.
 
     Returns
     -------
     list of SensorJob
         The jobs still to fit, in the order of `jobs`.
     """
-    return [job for job in jobs if refit or _finished(Path(out), job) is None]
+    return [job for job in jobs if refit or _finished(Path(out), job, read_options) is None]
 
 
-def _finished(out: Path, job: SensorJob) -> dict | None:
-    """The sensor's record if it finished this very job (options and recordings unchanged)
+def _finished(out: Path, job: SensorJob, reading: Reading = None) -> dict | None:
+    """The sensor's record if it finished this very job (options, recordings and how they
+    are read unchanged; a record from before hystkit stored the latter is taken as it is)
     and its model file is there; failed sensors are tried again."""
     path = out / "sensors" / f"{job.sensor}.json"
     try:
@@ -252,6 +285,8 @@ def _finished(out: Path, job: SensorJob) -> dict | None:
         return None
     if record.get("job") != job.describe() or record.get("inputs") != fingerprint(job):
         return None
+    if "reading" in record and record["reading"] != _reading_record(job, reading):
+        return None
     row = record.get("row") or {}
     if row.get("status") in (None, "failed") or not (out / "models" /
                                                     f"{job.sensor}.json").is_file():
@@ -259,15 +294,16 @@ def _finished(out: Path, job: SensorJob) -> dict | None:
     return record
 
 
-def _store(out: Path, job: SensorJob, result: dict) -> None:
+def _store(out: Path, job: SensorJob, result: dict, reading: list | None = None) -> None:
     """The model file first, then the record that says the sensor is done."""
     model = out / "models" / f"{job.sensor}.json"
     if result["compensator"] is not None:
         save_compensator(result["compensator"], model, force=True)
     else:
         model.unlink(missing_ok=True)  # a model of an earlier run would contradict the row
-    write_json({"job": job.describe(), "inputs": fingerprint(job), "row": result["row"],
-                "scores": result["scores"]}, out / "sensors" / f"{job.sensor}.json", force=True)
+    write_json({"job": job.describe(), "inputs": fingerprint(job), "reading": reading,
+                "row": result["row"], "scores": result["scores"]},
+               out / "sensors" / f"{job.sensor}.json", force=True)
 
 
 def _summary(row: dict) -> str:

@@ -32,9 +32,13 @@ def _batch(args: argparse.Namespace) -> int:
     print(f"batch of {len(jobs)} sensors from {args.source} into {args.out} (scores on the "
           f"validation recordings: deployable; oracle: each recording's own means, the "
           f"paper's protocol)", flush=True)
+    # Every recording as fit reads it: its settings file, then the command line; settled (and
+    # said) here, so a settings file that is refused stops the batch before any fit.
+    reading = {str(path): read_options(args, path)
+               for job in jobs for path in (*job.fit, *job.validate)}
     # a rerun with everything finished starts no cluster
-    with executor_for(args, len(pending(jobs, args.out, args.force))) as executor:
-        table = run_batch(jobs, args.out, executor=executor, read_options=read_options(args),
+    with executor_for(args, len(pending(jobs, args.out, args.force, reading))) as executor:
+        table = run_batch(jobs, args.out, executor=executor, read_options=reading,
                           refit=args.force, source=str(args.source), progress=_say)
     print(f"wrote {args.out / 'results.parquet'}, {args.out / 'results.csv'} and "
           f"{sum(r['status'] != 'failed' for r in table)} model file(s) in "
