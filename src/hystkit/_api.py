@@ -17,14 +17,18 @@ from typing import TYPE_CHECKING, Any, Union
 
 from .compensation import (
     DEFAULT_CENTER,
+    DEFAULT_LEVEL,
     Compensator,
     fit_compensator,
     load_compensator,
     save_compensator,
+    interval,
+    with_band,
 )
 from .compensation import evaluate as _evaluate
 from .compensation import use_flags as _use_flags
 from .io import ReadOptions, Recording, options_for, read_recording, settings_for
+from .models import get_family
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -106,7 +110,8 @@ def _reading(path: str | os.PathLike, given: dict | None = None) -> ReadOptions:
 
 
 def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None, *,
-        mode: str = "direct", center: str = DEFAULT_CENTER, **options: Any) -> Compensator:
+        mode: str = "direct", center: str = DEFAULT_CENTER, band: bool = True,
+        level: float = DEFAULT_LEVEL, **options: Any) -> Compensator:
     """Fit a compensator (sensor -> position) on one or several recordings.
 
     Parameters
@@ -123,6 +128,12 @@ def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None
     center : {"fit", "tare", "track", "recording", "none"}
         How the sensor offset is removed in use (see ``docs/centring.md``); ``recording`` is the
         paper's oracle protocol, which a deployed compensator cannot have.
+    band : bool, default True
+        Calibrate a prediction band on the validation folds of the data (left-out recordings
+        when there are several, interleaved cycles of one; the same model refitted on each
+        fold, so the fit takes about four times as long); False: none.
+    level : float, default 0.90
+        The band's nominal coverage.
     **options
         Passed to `hystkit.compensation.fit_compensator` (``tare_seconds``, ``track_seconds``,
         ``diagnose``, the family's structure options such as ``slope_cap``).
@@ -131,7 +142,8 @@ def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None
     -------
     Compensator
         ``fit_info["status"]`` is ``"ok"`` only when the fit converged, beats a straight line
-        and has no parameter on a bound; ``estimate(recording)`` gives the position [mm].
+        and has no parameter on a bound; ``estimate(recording)`` gives the position [mm],
+        ``estimate_with_band(recording)`` the position with its band.
 
     Examples
     --------
@@ -144,11 +156,16 @@ def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None
     """
     items = list(data) if isinstance(data, list | tuple) else [data]
     recordings = [_as_recording(item) for item in items]
-    return fit_compensator(recordings, size, model=model, mode=mode, center=center, **options)
+    comp = fit_compensator(recordings, size, model=model, mode=mode, center=center, **options)
+    if not band:
+        return comp
+    options.pop("diagnose", None)
+    return with_band(comp, recordings, get_family(model).default_size if size is None else size,
+                     options, level=level)
 
 
 def evaluate(compensator: Compensator, data: Data, *,
-             rest_position: float | None = None) -> dict:
+             rest_position: float | None = None, level: float | None = None) -> dict:
     """Score a compensator on a recording: deployable scores first, the oracle's labelled.
 
     Parameters
@@ -160,6 +177,8 @@ def evaluate(compensator: Compensator, data: Data, *,
     rest_position : float, optional
         ``tare`` centring: the position [mm] during the tare window (default: the training
         rest position).
+    level : float, optional
+        Nominal coverage of the band scored; default the band's own.
 
     Returns
     -------
@@ -169,8 +188,9 @@ def evaluate(compensator: Compensator, data: Data, *,
         the same with a ``linear_`` prefix (the straight-line baseline); ``center_oracle`` and
         every score again with an ``_oracle`` suffix (the paper's protocol: the recording's
         own means, not available in use); then ``n_samples``, ``extrapolated_fraction``,
-        the use-time guard counts and their margins. See
-        `hystkit.compensation.evaluate`.
+        the use-time guard counts and their margins, and the band's ``band_coverage``,
+        ``band_width_mean``, ``band_width_median`` and ``interval_score`` (None without a
+        band). See `hystkit.compensation.evaluate`.
 
     Examples
     --------
@@ -182,8 +202,11 @@ def evaluate(compensator: Compensator, data: Data, *,
     ['center', 'r2', 'e_rms_pct']
     >>> scores["r2"] > scores["linear_r2"]
     True
+    >>> 0.8 < scores["band_coverage"] <= 1.0
+    True
     """
-    scores = _evaluate(compensator, _as_recording(data), rest_position=rest_position)
+    scores = _evaluate(compensator, _as_recording(data), rest_position=rest_position,
+                       level=level)
     return dict(sorted(scores.items(), key=lambda item: _score_rank(item[0])))
 
 
@@ -196,8 +219,9 @@ def _score_rank(key: str) -> int:
 
 
 def compensate(compensator: Compensator, data: Data, *,
-               rest_position: float | None = None) -> pd.DataFrame:
-    """The recording as a DataFrame with the compensator's ``position_estimate`` [mm] added.
+               rest_position: float | None = None, level: float | None = None) -> pd.DataFrame:
+    """The recording as a DataFrame with the compensator's ``position_estimate`` [mm] added,
+    and its band ``position_lower`` / ``position_upper`` [mm] when the compensator has one.
 
     Also adds the use-time guards ``sensor_outside`` and ``estimate_outside`` (True where the
     sensor or the estimate leaves the training range), as ``hystkit compensate`` writes them.
@@ -209,11 +233,13 @@ def compensate(compensator: Compensator, data: Data, *,
         The recording to compensate (``position`` is not needed).
     rest_position : float, optional
         ``tare`` centring: the position [mm] during the tare window.
+    level : float, optional
+        The band's nominal coverage; default the band's own (0.90 unless fitted otherwise).
 
     Returns
     -------
     pandas.DataFrame
-        The recording's columns, ``position_estimate`` [mm] and the guard flags.
+        The recording's columns, ``position_estimate`` [mm], the band and the guard flags.
 
     Examples
     --------
@@ -222,12 +248,16 @@ def compensate(compensator: Compensator, data: Data, *,
     >>> comp = hk.fit(simulate_experiment("noise", seed=1))
     >>> out = hk.compensate(comp, simulate_experiment("noise", seed=2))
     >>> out.columns.tolist()
-    ['time', 'position', 'sensor', 'position_estimate', 'sensor_outside', 'estimate_outside']
+    ['time', 'position', 'sensor', 'position_estimate', 'position_lower', 'position_upper', \
+'sensor_outside', 'estimate_outside']
     """
     recording = _as_recording(data)
     estimate = compensator.estimate(recording, rest_position=rest_position)
     frame = recording.to_frame()
     frame["position_estimate"] = estimate
+    if compensator.band is not None:
+        frame["position_lower"], frame["position_upper"] = interval(compensator, recording,
+                                                                    estimate, level)
     for name, mask in _use_flags(compensator, recording, estimate).items():
         if mask is not None:
             frame[name] = mask

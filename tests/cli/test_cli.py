@@ -239,6 +239,7 @@ def test_compensate_needs_no_position_column(data: dict[str, Path], tmp_path: Pa
     code, _, err = _run(capsys, "compensate", data["model"], rec, "--out", out)
     assert (code, err) == (0, "")
     assert list(pd.read_csv(out).columns) == ["time", "sensor", "position_estimate",
+                                              "position_lower", "position_upper",
                                               "sensor_outside", "estimate_outside"]
 
 

@@ -146,8 +146,8 @@ def test_compensate_keeps_other_columns_and_units(files, tmp_path, capsys):
     assert "position_estimate' [mm]" in stdout and "kept 2 other column(s)" in stdout
     written = pd.read_csv(out, keep_default_na=False, na_values=[""])
     assert list(written.columns) == ["time", "position", "sensor", "temp_C", "note",
-                                     "position_estimate", "sensor_outside",
-                                     "estimate_outside"]
+                                     "position_estimate", "position_lower",
+                                     "position_upper", "sensor_outside", "estimate_outside"]
     own = files["own"]
     assert_array_equal(written["temp_C"].to_numpy(), own["temp_C"].to_numpy())  # NaN kept
     assert written["note"].fillna("").tolist() == own["note"].tolist()
@@ -162,7 +162,7 @@ def test_compensate_keeps_other_columns_and_units(files, tmp_path, capsys):
     assert _run(capsys, "compensate", model, files["with_toml"], "--out", mat)[0] == 0
     m = loadmat(mat, simplify_cells=True)
     assert m["units"] == {"position": "mm", "sensor": "Ohm", "position_estimate": "mm",
-                          "temp_C": "degC"}
+                          "position_lower": "mm", "position_upper": "mm", "temp_C": "degC"}
     assert_array_equal(m["temp_C"], own["temp_C"].to_numpy())
     # a cell array of text; scipy reads an empty char as an empty array
     notes = [x if isinstance(x, str) else ("" if np.size(x) == 0 else x) for x in m["note"]]

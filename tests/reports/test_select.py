@@ -13,7 +13,7 @@ from hystkit.io import Recording
 from hystkit.models import FAMILIES
 from hystkit.reports import _select
 from hystkit.reports._select import Candidate, select_model
-from hystkit.reports._validation import EXTRAPOLATION_NOTE, folds, protocol
+from hystkit.compensation._folds import EXTRAPOLATION_NOTE, folds, protocol
 from hystkit.sensors import simulate_experiment
 
 

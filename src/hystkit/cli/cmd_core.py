@@ -37,7 +37,7 @@ __all__ = ["register"]
 
 # Library functions the commands call through this module, loaded on first use like every
 # library name here; tests replace them on it (monkeypatch cmd_core.evaluate) to build faults.
-_THROUGH_MODULE = ("evaluate", "load_compensator", "use_flags")
+_THROUGH_MODULE = ("evaluate", "interval", "load_compensator", "use_flags", "with_band")
 
 
 def __getattr__(name: str):
@@ -110,10 +110,13 @@ def _fit(args: argparse.Namespace) -> int:
           f"{center_label(args.center)}) on {', '.join(map(str, args.data))}: "
           f"{sum(r.n_samples for r in recs)} samples at {recs[0].fs:g} Hz"
           f"{_units_label(recs[0])} ...", flush=True)
+    fit_arguments = {"tare_seconds": args.tare_seconds, "track_seconds": args.track_seconds,
+                     **costs.fit_arguments(args, recs), "fit_options": fit_options, **options}
     comp = fit_compensator(recs, size, model=args.model, mode=args.mode, center=args.center,
-                           tare_seconds=args.tare_seconds, track_seconds=args.track_seconds,
-                           **costs.fit_arguments(args, recs),
-                           fit_options=fit_options, **options)
+                           **fit_arguments)
+    if not args.no_band:
+        # the band's folds refit the same model: after the fit, so a failed fit stops first
+        comp = _module.with_band(comp, recs, size, fit_arguments, level=args.level)
     units = _training_units(recs, args.data)
     if units:
         comp.fit_info["units"] = units
@@ -121,6 +124,7 @@ def _fit(args: argparse.Namespace) -> int:
     info = comp.fit_info
     print(f"done in {info['fit_seconds']:.2f} s: SSE {info['cost']:.4g} (normalised), solver: "
           f"{info['message']}")
+    _print_band(comp)
     print_cost_summary(info)
     _print_parameters(comp, info.get("standard_errors"))
     _print_standard_errors(info.get("standard_errors"))
@@ -139,6 +143,19 @@ def _fit(args: argparse.Namespace) -> int:
         return GUARD_EXIT
     print(f"  status: ok ({info['status_message']})")
     return 0
+
+
+def _print_band(comp) -> None:
+    """The band line of ``fit``: its half-width at the reference rate, or why there is none."""
+    note = comp.fit_info.get("band")
+    if comp.band is None:
+        if note:
+            print(f"  {note}")
+        return
+    unit = (comp.fit_info.get("units") or {}).get("position", "")
+    print(f"  prediction band {comp.band.level:.0%}: ±{comp.band.quantile():.4g}"
+          f"{' ' + unit if unit else ''} at the training rate, wider when faster or outside the "
+          f"training range ({note})")
 
 
 def has_slope_cap(family) -> bool:
@@ -259,14 +276,22 @@ def _compensate(args: argparse.Namespace) -> int:
     estimate = comp.estimate(rec, rest_position=args.rest_position)
     flags = use_flags(comp, rec, estimate)
     extra = {"position_estimate": estimate}
+    if comp.band is not None:
+        extra["position_lower"], extra["position_upper"] = _module.interval(comp, rec, estimate,
+                                                                            args.level)
+    elif args.level is not None:
+        raise UsageError(f"--level: {args.model} has no prediction band (fitted without one "
+                         f"or by a hystkit before bands); fit it again")
     extra.update({name: mask for name, mask in flags.items() if mask is not None})
     taken = {"time", "position", "sensor", *extra}  # an input column of such a name is renamed
     kept = {(f"{name}_input" if name in taken else name): values for name, values in kept.items()}
     write_recording(rec, args.out, extra=extra, kept=kept, units=units, force=args.force,
                     units_sidecar=True)
     unit = units.get("position_estimate", "unit of the training position")
-    print(f"wrote {args.out}: {rec.n_samples} samples with column 'position_estimate' [{unit}] "
-          f"(centring: {center_label(comp.center)}) and the flag columns "
+    band = ("" if comp.band is None else f", its {_level(comp, args.level):.0%} band "
+            f"'position_lower', 'position_upper'")
+    print(f"wrote {args.out}: {rec.n_samples} samples with column 'position_estimate' [{unit}]"
+          f"{band} (centring: {center_label(comp.center)}) and the flag columns "
           f"{', '.join(n for n, m in flags.items() if m is not None) or '(none: old model file)'}"
           + (f"; kept {len(kept)} other column(s): {', '.join(kept)}" if kept else "")
           + (f"; units in {sidecar_path(args.out)}" if units and args.out.suffix.lower()
@@ -286,7 +311,8 @@ def _output_units(comp, rec, options, kept: dict, data: Path) -> dict[str, str]:
     units = dict(rec.units)
     position = trained.get("position") or rec.unit("position")
     if position:
-        units["position_estimate"] = position
+        units.update(dict.fromkeys(("position_estimate", "position_lower", "position_upper"),
+                                   position))
     if trained.get("sensor") and rec.unit("sensor") and trained["sensor"] != rec.unit("sensor"):
         print(f"hystkit: warning: {data}: sensor unit {rec.unit('sensor')!r} but the model was "
               f"trained on {trained['sensor']!r}; the estimate is meaningless unless the "
@@ -339,7 +365,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     comp = load_compensator(args.model)
     _warn_if_oracle(comp.center, args.model)
     rec = read_recording(args.data, options=read_options(args, args.data))
-    scores = evaluate(comp, rec, rest_position=args.rest_position)
+    scores = evaluate(comp, rec, rest_position=args.rest_position, level=args.level)
     scores["units"] = dict(rec.units)  # of position and sensor, as the file gave them
     _warn_if_outside(use_flags(comp, rec, comp.estimate(rec, rest_position=args.rest_position)),
                      args.data)
@@ -355,6 +381,12 @@ def _evaluate(args: argparse.Namespace) -> int:
     for note in dict.fromkeys(scores["notes"].values()):  # why a score is n/a, once each
         print(f"  {note}")
     print(f"{'sensor loop area %':<20}{_fmt(scores['sensor_loop_area']):>12}")
+    if scores["band_coverage"] is not None:
+        print(f"band {scores['band_level']:.0%}: coverage {scores['band_coverage']:.3f}, width "
+              f"mean {scores['band_width_mean']:.4g}, median {scores['band_width_median']:.4g}, "
+              f"interval score {scores['interval_score']:.4g} (deployable)")
+    else:
+        print("band: n/a (the model was fitted without a prediction band)")
     print(f"outside training: {_count(scores['n_sensor_outside'])} sensor samples, "
           f"{_count(scores['n_estimate_outside'])} estimates")
     # the shared verdict, on the deployable scores: what a compensator in use would give
@@ -376,6 +408,10 @@ def _evaluate(args: argparse.Namespace) -> int:
         return GUARD_EXIT
     print(f"verdict: {status} ({message})")
     return 0
+
+
+def _level(comp, level: float | None) -> float:
+    return comp.band.level if level is None else level
 
 
 def _count(n: int | None) -> str:
@@ -464,6 +500,12 @@ def _add_centring_options(p: argparse.ArgumentParser) -> None:
                           f"than ~1/(2 pi T) is taken for drift")
 
 
+def _add_level(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--level", type=number(0, 1, low_open=True, high_open=True), default=None,
+                   help="nominal coverage of the prediction band, in (0, 1) (default: the "
+                        "model's own, 0.90 unless fitted otherwise)")
+
+
 def _add_rest_position(p: argparse.ArgumentParser) -> None:
     p.add_argument("--rest-position", type=number(), default=None,
                    help="tare centring: position [mm] during the tare window (default: where "
@@ -524,6 +566,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, required=True,
                    help="model file to write: .json, or .mat (a MATLAB struct with every field "
                         "of the JSON file; evaluate and compensate read both)")
+    p.add_argument("--level", type=number(0, 1, low_open=True, high_open=True), default=0.90,
+                   help="nominal coverage of the prediction band stored in the model (default "
+                        "0.90); the band is calibrated on held-out runs: left-out recordings, or "
+                        "interleaved cycles of one recording (docs/band.md)")
+    p.add_argument("--no-band", action="store_true",
+                   help="fit without a prediction band (the band refits the model on each "
+                        "validation fold: about four times the fit's time)")
     add_start_options(p)
     add_cost_options(p)
     add_read_options(p)
@@ -538,8 +587,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, required=True,
                    help="file to write, by its extension: .csv, .parquet or .mat (MATLAB: one "
                         "variable per column, with column_names and units); the input's "
-                        "columns, then position_estimate and the flags sensor_outside, "
+                        "columns, then position_estimate, its band position_lower and "
+                        "position_upper (if the model has one) and the flags sensor_outside, "
                         f"estimate_outside; {OUTPUT_NAMES_NOTE.replace(', ...', '')}")
+    _add_level(p)
     add_read_options(p)
     p.set_defaults(run=_compensate)
 
@@ -551,6 +602,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="also write the scores to this file, by its extension: .json or .mat "
                         "(MATLAB: one variable per score; missing scores are [])")
     _add_rest_position(p)
+    _add_level(p)
     add_read_options(p)
     p.set_defaults(run=_evaluate)
 

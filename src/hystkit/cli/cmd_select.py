@@ -45,15 +45,8 @@ def _select(args: argparse.Namespace) -> int:
         write_json,
     )
     from ..parallel import loading_meanwhile
-    from ..reports import (
-        FIGURE_MODULES,
-        candidates,
-        folds,
-        plot_selection,
-        protocol,
-        select_model,
-        text_table,
-    )
+    from ..compensation import folds, protocol
+    from ..reports import FIGURE_MODULES, candidates, plot_selection, select_model, text_table
 
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
                       what="a model file")

@@ -18,13 +18,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from ..errors import FitDivergedError, InputError
 from ..io import MAX_MAGNITUDE, Recording
 from ..models import Family, get_family
+from ._band import Band, interval
 from ._centring import (
     CENTERS,
     DEFAULT_TARE_SECONDS,
@@ -35,7 +36,7 @@ from ._centring import (
 from ._conventions import LinearBaseline, Scaling
 from ._modes import MODES
 
-__all__ = ["MAX_NORMALISED", "MODES", "POSITION_MARGIN", "SENSOR_MARGIN", "Compensator",
+__all__ = ["MAX_NORMALISED", "BandedEstimate", "MODES", "POSITION_MARGIN", "SENSOR_MARGIN", "Compensator",
            "LinearBaseline", "Scaling", "runaway_kind", "runaway_samples"]
 
 # Use-time guards: a sensor sample is "outside" beyond this share of the training sensor range
@@ -44,6 +45,19 @@ SENSOR_MARGIN = 0.05
 POSITION_MARGIN = 0.10
 # An estimate beyond this many times the (normalised, max |.| = 1) training positions is refused.
 MAX_NORMALISED = 1e6
+
+
+class BandedEstimate(NamedTuple):
+    """An estimate with its prediction band, all [mm] (:meth:`Compensator.estimate_with_band`).
+
+    Parameters
+    ----------
+    estimate, lower, upper : numpy.ndarray
+    """
+
+    estimate: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,6 +104,8 @@ class Compensator:
         Training position range [mm].
     source : str, optional
         Model file it was loaded from.
+    band : Band, optional
+        The calibrated prediction band (:mod:`._band`); None: fitted without one.
 
     Raises
     ------
@@ -115,6 +131,7 @@ class Compensator:
     rest_position: float | None = None
     position_range: tuple[float, float] | None = None
     source: str | None = field(default=None, compare=False)
+    band: Band | None = None
 
     @property
     def family(self) -> Family:
@@ -228,6 +245,38 @@ class Compensator:
                 f"compensator{self._from()} gives an estimate that is "
                 f"{runaway_kind(estimate[bad[0]])} ({bad.size} such samples)")
         return estimate
+
+    def estimate_with_band(self, recording: Recording | np.ndarray,
+                           level: float | None = None, *,
+                           rest_position: float | None = None) -> BandedEstimate:
+        """Position estimate [mm] with its prediction band (:mod:`hystkit.compensation._band`).
+
+        Causal like :meth:`estimate`: sample k's band uses sensor samples <= k and the model
+        file only.
+
+        Parameters
+        ----------
+        recording : Recording or numpy.ndarray
+            As for :meth:`estimate`.
+        level : float, optional
+            Nominal coverage in (0, 1); default the band's own (0.90 unless fitted otherwise).
+        rest_position : float, optional
+            As for :meth:`estimate` (``tare``).
+
+        Returns
+        -------
+        BandedEstimate
+            ``estimate``, ``lower`` and ``upper`` [mm].
+
+        Raises
+        ------
+        InputError
+            If the compensator has no band.
+        """
+        recording = self._as_recording(recording)
+        estimate = self.estimate(recording, rest_position=rest_position)
+        lower, upper = interval(self, recording, estimate, level)
+        return BandedEstimate(estimate, lower, upper)
 
     def runaway_bounds(self, offset: float) -> tuple[float, float] | None:
         """Estimates [mm] beyond these are refused as a runaway (:func:`runaway_samples`):

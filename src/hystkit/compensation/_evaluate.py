@@ -13,6 +13,7 @@ import numpy as np
 from ..errors import InputError
 from ..io import Recording
 from ..metrics import e_max_pct, e_rms_pct, loop_area, r2, sinad_db
+from ._band import BAND_SCORE_KEYS, interval, interval_scores
 from ._centring import ORACLE_CENTER, center_label
 from ._compensator import POSITION_MARGIN, SENSOR_MARGIN, Compensator
 from ._training_checks import MIN_SAMPLES
@@ -62,7 +63,7 @@ def _scores(position: np.ndarray, guess: np.ndarray, scale: float,
 
 
 def evaluate(compensator: Compensator, recording: Recording, *,
-             rest_position: float | None = None) -> dict:
+             rest_position: float | None = None, level: float | None = None) -> dict:
     """Compare the compensated and the straight-line position with the measured one.
 
     Errors in per cent are relative to the fitting data's max |position| (eq. 5.10-5.11).
@@ -78,6 +79,8 @@ def evaluate(compensator: Compensator, recording: Recording, *,
     rest_position : float, optional
         Where the device rests during the tare window [mm], if not where it rested in
         training; used only by the ``tare`` centring.
+    level : float, optional
+        Nominal level of the prediction band scored; default the band's own.
 
     Returns
     -------
@@ -91,6 +94,9 @@ def evaluate(compensator: Compensator, recording: Recording, *,
         finite; a score that is undefined or overflowed is None. ``notes``: why a score is
         None, by its key, where there is a reason to give (e.g. ``sinad_db``: the recording
         is too short for its fundamental, and how many samples it needs); empty otherwise.
+        With a band (:mod:`._band`): ``band_level``, ``band_coverage``, ``band_width_mean``,
+        ``band_width_median`` and ``interval_score`` (deployable: the band uses the sensor up
+        to each sample and the model file); without one these are None.
 
     Raises
     ------
@@ -125,8 +131,19 @@ def evaluate(compensator: Compensator, recording: Recording, *,
     for name, mask in flags.items():
         scores[f"n_{name}"] = None if mask is None else int(np.sum(mask))
     scores["sensor_margin"], scores["position_margin"] = SENSOR_MARGIN, POSITION_MARGIN
+    scores.update(_band_scores(compensator, recording, estimate, level))
     scores["notes"] = notes
     return {key: _finite_or_none(value) for key, value in scores.items()}
+
+
+def _band_scores(comp: Compensator, recording: Recording, estimate: np.ndarray,
+                 level: float | None) -> dict:
+    """Coverage, widths and interval score of the compensator's band (None without one)."""
+    if comp.band is None:
+        return dict.fromkeys(BAND_SCORE_KEYS)
+    level = comp.band.level if level is None else level
+    lower, upper = interval(comp, recording, estimate, level)
+    return interval_scores(recording.position, lower, upper, level)
 
 
 def _finite_or_none(value: object) -> object:

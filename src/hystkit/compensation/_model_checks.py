@@ -97,6 +97,16 @@ def check_model_dict(d: dict, source: str) -> None:
     for key in _OPTIONAL_NUMBERS:
         if d.get(key) is not None:
             _check_number(source, key, d[key])
+    band = d.get("band")
+    if band is not None:
+        if not isinstance(band, dict):
+            _fail(source, "band", f"must be null or a JSON object, got {_show(band)}")
+        for path, value in _leaves(band, "band"):
+            if path == "band.protocol":
+                if not isinstance(value, str):
+                    _fail(source, path, f"must be a string, got {_show(value)}")
+            else:
+                _check_number(source, path, value)
 
 
 def check_model_domain(d: dict, source: str) -> None:
@@ -153,6 +163,31 @@ def check_model_domain(d: dict, source: str) -> None:
             high = MAX_WINDOW_SAMPLES * step if step is not None else math.inf
             _within(source, name, d[name], _TINY, high,
                     f"s (positive, at most {MAX_WINDOW_SAMPLES:g} samples of dt)")
+    _check_band_domain(d.get("band"), step, source)
+
+
+def _check_band_domain(band: dict | None, step: float | None, source: str) -> None:
+    """The band's numbers within what a calibration writes: score quantiles are position
+    errors (at most twice the largest magnitude), rates of a normalised sensor at most
+    2 / dt, the memory a window of dt."""
+    if band is None:
+        return
+    for i, value in enumerate(band.get("quantiles") or []):
+        _within(source, f"band.quantiles[{i}]", value, 0.0, 2.0 * MAX_MAGNITUDE,
+                "(a position error: at most twice the largest magnitude of a recording)")
+    high = math.inf if step is None else MAX_WINDOW_SAMPLES * step
+    for name in ("tau",):
+        if name in band:
+            _within(source, f"band.{name}", band[name], _TINY, high,
+                    f"s (positive, at most {MAX_WINDOW_SAMPLES:g} samples of dt)")
+    fastest = math.inf if step is None else 2.0 * (1.0 + _SLACK) / step
+    for name in ("rate_reference", "rate_high"):
+        if name in band:
+            _within(source, f"band.{name}", band[name], _TINY, fastest,
+                    "/s (a rate of the normalised training sensor: at most 2 / dt)")
+    if "n_calibration" in band:
+        _within(source, "band.n_calibration", band["n_calibration"], 1.0, MAX_MAGNITUDE,
+                "(held-out samples)")
 
 
 _TINY = float.fromhex("0x1p-1022")  # the smallest normal float

@@ -8,8 +8,8 @@ the ``params`` variables still equal the text's, so a model edited in MATLAB is 
 than silently ignored.
 
 Keys added since the first files (``polarity``, ``tare_seconds``, ``track_seconds``,
-``sensor_reference``, ``rest_position``, ``position_range``) are optional when reading, with the
-behaviour of the files that lacked them: polarity +1, no position-range guard. A file with
+``sensor_reference``, ``rest_position``, ``position_range``, ``band``) are optional when reading, with the
+behaviour of the files that lacked them: polarity +1, no position-range guard, no band. A file with
 ``center: recording`` (the old default) still loads and runs the paper's protocol, which removes
 each recording's own sensor mean: it is an oracle (not causal) and is labelled so.
 """
@@ -26,6 +26,7 @@ from .. import __version__
 from ..errors import InputError
 from ..io import check_output_format, write_json, write_mat
 from ..models import FAMILIES
+from ._band import Band
 from ._centring import CENTERS
 from ._compensator import MODES, Compensator
 from ._conventions import LinearBaseline, Scaling
@@ -89,6 +90,7 @@ def compensator_to_dict(comp: Compensator) -> dict:
         "track_seconds": comp.track_seconds,
         "sensor_reference": comp.sensor_reference,
         "rest_position": comp.rest_position,
+        "band": None if comp.band is None else comp.band.to_dict(),
     }
 
 
@@ -151,13 +153,15 @@ def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
                        lambda: family.structure_type(**d["structure"]))
     params = _build(source, "params", {name: "params" for name in d["params"]},
                     lambda: family.params_type.from_dict(d["params"]))
+    band = None if d.get("band") is None else _build(
+        source, "band", {name: "band" for name in d["band"]}, lambda: Band.from_dict(d["band"]))
     # The compensator runs the model on two samples: structure and params must fit together.
     return _build(source, "", _sections(d), lambda: Compensator(
         structure=structure, params=params, mode=d["mode"], center=d["center"],
         scaling=Scaling(**d["normalisation"]), baseline=LinearBaseline(**d["baseline"]),
         fit_info=d.get("fit") or {}, training_range=_pair_or_none(d.get("training_range")),
         position_range=_pair_or_none(d.get("position_range")), model=d["model"],
-        source=source, **_optional(d)), _defaulted(structure, d["structure"]))
+        source=source, band=band, **_optional(d)), _defaulted(structure, d["structure"]))
 
 
 def _defaulted(structure: Any, given: dict) -> str:

@@ -19,8 +19,6 @@ __getattr__, __dir__ = lazy_exports(
      "_report_model": ("ReportContent", "model_report"),
      "_report_page": ("FIGURE_FORMATS", "build_report", "write_report"),
      "_select": ("Candidate", "candidates", "plot_selection", "select_model"),
-     "_validation": ("PROTOCOLS", "Fold", "admissible_size", "fits_in", "fold_scores", "folds",
-                     "protocol"),
      "_text_table": ("format_number", "text_table"),
      },
     first=("FIGURE_MODULES",))

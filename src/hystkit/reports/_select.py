@@ -1,6 +1,6 @@
 """``hystkit select``: family x size x mode x centring, validated the way it will be used.
 
-Every candidate is fitted and scored on the folds of :mod:`._validation` (left-out recording,
+Every candidate is fitted and scored on the folds of :mod:`hystkit.compensation._folds` (left-out recording,
 or interleaved cycles of one recording), from the training recordings only. The score is the
 held-out deployable R² (mean over the folds); the straight line beside it is fitted on the same
 training samples. A candidate wins only if it beats its straight line and explains the
@@ -17,22 +17,25 @@ import numpy as np
 from matplotlib.figure import Figure
 from threadpoolctl import threadpool_limits
 
-from ..compensation import DEFAULT_CENTER, check_fitting_data, fit_compensator, verdict
-from ..io import Recording
-from ..models import FAMILIES, get_family
-from ..parallel import Executor, SerialExecutor, fit_cost
-from ._compare import DISQUALIFYING, FAMILY_FAILURES
-from ._validation import (
+from ..compensation import (
+    DEFAULT_CENTER,
     EXTRAPOLATION_NOTE,
     ONE_RUN_CAVEAT,
     Fold,
     admissible_size,
+    check_fitting_data,
+    fit_compensator,
     fit_fold,
     fits_in,
     fold_scores,
     folds,
     protocol,
+    verdict,
 )
+from ..io import Recording
+from ..models import FAMILIES, get_family
+from ..parallel import Executor, SerialExecutor, fit_cost
+from ._compare import DISQUALIFYING, FAMILY_FAILURES
 
 __all__ = ["Candidate", "candidates", "plot_selection", "select_model"]
 

@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..compensation import MIN_SAMPLES_PER_PARAM, count_fitted, fit_compensator
+from ._fitting import fit_compensator
+from ._training_checks import MIN_SAMPLES_PER_PARAM, count_fitted
 from ..io import Recording
 from ..metrics import r2
 from ..models import get_family
@@ -177,8 +178,9 @@ def admissible_size(model: str, dt: float, n_samples: int) -> int | None:
 
 
 def fit_fold(cand, fold: Fold, options: dict):
-    """A candidate (:class:`~._select.Candidate`) fitted on a fold's training part (no
-    standard errors); `options` go to :func:`~hystkit.compensation.fit_compensator`."""
+    """A candidate (anything with ``model``, ``size``, ``mode`` and ``center``, such as
+    select's candidates) fitted on a fold's training part (no standard errors); `options` go
+    to :func:`~hystkit.compensation.fit_compensator`."""
     if fold.held is None:
         return fit_compensator(fold.train, cand.size, model=cand.model, mode=cand.mode,
                                center=cand.center, diagnose=False, **options)

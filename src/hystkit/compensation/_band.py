@@ -1,0 +1,436 @@
+"""A prediction band on every estimate: conformal, from held-out runs, with a local scale.
+
+Calibration (:func:`calibrate_band`) uses the validation folds of ``select``
+(:mod:`._folds`): left-out recordings when there are several, interleaved cycles of one
+recording otherwise. Each fold's compensator runs on its held-out samples the way it will be
+used, and every held-out sample gives a score
+
+    score = max(|position - estimate| - w * o, 0) / sigma
+
+where ``sigma`` is the local scale and ``w * o`` the extrapolation term below. The band at
+level ``L`` is ``estimate +- (q_L * sigma + w * o)``, ``q_L`` the ``ceil((n + 1) L) / n``
+empirical quantile of the n scores (split conformal prediction normalised by a local scale;
+Lei et al. 2018, "Distribution-free predictive inference for regression", sec. 5.2).
+
+The local scale and the extrapolation term use only sensor samples up to now and numbers in
+the model file (the band is causal, and a stream reproduces it bit for bit):
+
+- ``rate``: an exponentially weighted mean (time constant ``tau``) of |ds/dt| of the
+  normalised sensor. ``sigma = 1 - share + share * rate / rate_reference``: ``share`` is
+  fitted on the held-out errors (how much of them grows with the rate; at most
+  ``MAX_RATE_SHARE`` so that the band never vanishes at rest), and beyond the fastest rate seen
+  in training (``rate_high``, its 99th percentile) ``sigma`` grows in proportion: driven twice
+  as fast as ever in training, the band is at least twice as wide.
+- ``o``: how far the normalised sensor lies outside the training range, in units of that
+  range's width, remembered with the same time constant (a hysteretic model's state stays
+  disturbed for a while after an excursion). ``w`` is the training position range [mm]: beyond
+  the range, the band grows by the extrapolated distance itself, because nothing in the
+  training data says how the model behaves there.
+
+What the validation cannot see the band cannot either: with one recording an offset that
+changes between runs is invisible (give several recordings), and behaviour never met in
+training (another excitation, a new kind of drift) is covered only through the rate and range
+terms. ``hystkit evaluate`` reports the coverage a band achieved on a recording with truth.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, replace
+
+import numpy as np
+from numba import njit
+
+from ..errors import FitDivergedError, InputError
+from ..io import Recording
+
+__all__ = ["BAND_SCORE_KEYS", "DEFAULT_LEVEL", "Band", "BandState", "band_features",
+           "calibrate_band", "interval", "interval_scores", "with_band"]
+
+DEFAULT_LEVEL = 0.90
+# Probabilities at which the model file keeps the calibration scores' quantiles.
+QUANTILE_GRID = np.linspace(0.0, 1.0, 201)
+# The share of the scale that may grow with the rate: sigma >= 1 - MAX_RATE_SHARE at rest.
+MAX_RATE_SHARE = 0.9
+# Time constant of the rate and range memory: this many samples, and at least MIN_TAU_S.
+TAU_SAMPLES = 10
+MIN_TAU_S = 1.0
+# Fewer held-out samples than this cannot calibrate a band at the default level.
+MIN_CALIBRATION = 20
+BAND_SCORE_KEYS = ("band_level", "band_coverage", "band_width_mean", "band_width_median",
+                   "interval_score")
+
+
+@dataclass(frozen=True)
+class Band:
+    """A compensator's calibrated prediction band (see the module docstring).
+
+    Parameters
+    ----------
+    level : float
+        The nominal level the band was calibrated for and is used at by default.
+    quantiles : tuple of float
+        The calibration scores' quantiles [position units] at ``QUANTILE_GRID``.
+    n_calibration : int
+        Held-out samples the scores come from.
+    tau : float
+        Time constant [s] of the rate and range memory.
+    rate_reference : float
+        Mean rate of the normalised sensor in training [1/s].
+    rate_high : float
+        99th percentile of that rate in training [1/s].
+    rate_share : float
+        Share of the scale that grows with the rate, in ``[0, MAX_RATE_SHARE]``.
+    protocol : str
+        The validation protocol the scores come from.
+    """
+
+    level: float
+    quantiles: tuple[float, ...]
+    n_calibration: int
+    tau: float
+    rate_reference: float
+    rate_high: float
+    rate_share: float
+    protocol: str
+
+    def __post_init__(self) -> None:
+        q = np.asarray(self.quantiles, dtype=float)
+        if q.shape != QUANTILE_GRID.shape or not np.all(np.isfinite(q)) or np.any(q < 0) \
+                or np.any(np.diff(q) < 0):
+            raise ValueError(f"band quantiles must be {QUANTILE_GRID.size} finite, non-negative, "
+                             f"non-decreasing numbers")
+        check_level(self.level)
+        if not (isinstance(self.n_calibration, int | np.integer) and self.n_calibration >= 1):
+            raise ValueError(f"band n_calibration must be a positive integer, got "
+                             f"{self.n_calibration!r}")
+        for name in ("tau", "rate_reference", "rate_high"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value > 0):
+                raise ValueError(f"band {name} must be finite and positive, got {value!r}")
+        if not 0.0 <= self.rate_share <= MAX_RATE_SHARE:
+            raise ValueError(f"band rate_share must lie in [0, {MAX_RATE_SHARE}], got "
+                             f"{self.rate_share!r}")
+        object.__setattr__(self, "quantiles", tuple(float(v) for v in q))
+        object.__setattr__(self, "n_calibration", int(self.n_calibration))
+
+    def quantile(self, level: float | None = None) -> float:
+        """The score quantile ``q`` [position units] of the band at `level` (default: the
+        band's own), with the finite-sample correction of split conformal prediction."""
+        level = self.level if level is None else check_level(level)
+        n = self.n_calibration
+        p = min(1.0, math.ceil((n + 1) * level) / n)
+        return float(np.interp(p, QUANTILE_GRID, self.quantiles))
+
+    def to_dict(self) -> dict:
+        return {**asdict(self), "quantiles": list(self.quantiles)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Band:
+        names = set(cls.__dataclass_fields__)
+        if set(d) != names:
+            missing, extra = sorted(names - set(d)), sorted(set(d) - names)
+            raise ValueError(f"band needs the keys {', '.join(sorted(names))}"
+                             + (f"; missing {', '.join(missing)}" if missing else "")
+                             + (f"; unknown {', '.join(extra)}" if extra else ""))
+        return cls(**{**d, "quantiles": tuple(d["quantiles"])})
+
+
+def check_level(level: float) -> float:
+    """`level` if it is a probability strictly between 0 and 1, else ValueError."""
+    if not (isinstance(level, int | float | np.floating) and 0.0 < level < 1.0):
+        raise ValueError(f"band level must lie strictly between 0 and 1, got {level!r}")
+    return float(level)
+
+
+@dataclass(frozen=True)
+class BandState:
+    """What the band's features remember between samples (a stream carries it).
+
+    Parameters
+    ----------
+    started : bool
+        A sample has been seen (the first sample has no rate).
+    previous : float
+        The last normalised sensor sample.
+    rate : float
+        The rate's running mean [1/s].
+    outside : float
+        The remembered distance outside the training range [range widths].
+    """
+
+    started: bool = False
+    previous: float = 0.0
+    rate: float = 0.0
+    outside: float = 0.0
+
+
+@njit(cache=True)
+def _features_kernel(s, dt, decay, low, high, state):  # pragma: no cover - compiled
+    n = s.size
+    rate = np.empty(n)
+    outside = np.empty(n)
+    started, previous, r, o = state[0], state[1], state[2], state[3]
+    width = high - low
+    for k in range(n):
+        v = s[k]
+        d = abs(v - previous) / dt if started > 0.0 else 0.0
+        r = decay * r + (1.0 - decay) * d
+        beyond = max(low - v, v - high, 0.0) / width
+        o = max(beyond, decay * o)
+        rate[k] = r
+        outside[k] = o
+        previous = v
+        started = 1.0
+    return rate, outside, np.array([started, previous, r, o])
+
+
+def band_features(s: np.ndarray, dt: float, tau: float, training_range: tuple[float, float],
+                  state: BandState | None = None) -> tuple[np.ndarray, np.ndarray, BandState]:
+    """Rate and remembered range excursion of the normalised sensor, sample by sample.
+
+    Parameters
+    ----------
+    s : numpy.ndarray, shape (n,)
+        Normalised sensor samples (:meth:`Compensator.normalised_sensor`).
+    dt : float
+        Sample time [s].
+    tau : float
+        Time constant [s] of the memory.
+    training_range : tuple of float
+        The normalised sensor range seen in training.
+    state : BandState, optional
+        Where an earlier chunk left off; None: the start of a recording.
+
+    Returns
+    -------
+    rate : numpy.ndarray
+        Running mean of |ds/dt| [1/s].
+    outside : numpy.ndarray
+        Remembered distance outside the training range [range widths].
+    state : BandState
+        Where this chunk leaves off: the next chunk continues from it exactly.
+    """
+    state = state or BandState()
+    low, high = training_range
+    high = high if high > low else low + 1.0  # a range of one value: distances in its units
+    start = np.array([float(state.started), state.previous, state.rate, state.outside])
+    rate, outside, end = _features_kernel(np.ascontiguousarray(s, dtype=np.float64), float(dt),
+                                          math.exp(-dt / tau), float(low), float(high), start)
+    return rate, outside, BandState(bool(end[0]), float(end[1]), float(end[2]), float(end[3]))
+
+
+def local_scale(band: Band, rate: np.ndarray) -> np.ndarray:
+    """The scale ``sigma`` of the module docstring, per sample (1 at the reference rate)."""
+    share = band.rate_share
+    return (1.0 - share + share * rate / band.rate_reference
+            + np.maximum(rate / band.rate_high - 1.0, 0.0))
+
+
+def half_width(band: Band, rate: np.ndarray, outside: np.ndarray, position_width: float,
+               level: float | None = None) -> np.ndarray:
+    """The band's half-width [position units] per sample."""
+    return band.quantile(level) * local_scale(band, rate) + position_width * outside
+
+
+def position_width(comp) -> float:
+    """The training position range's width [mm] (the extrapolation term's unit)."""
+    lo, hi = comp.position_range
+    return float(hi - lo)
+
+
+def interval(comp, recording: Recording, estimate: np.ndarray,
+             level: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper band [mm] around `estimate`, the compensator's estimate on
+    `recording` (:meth:`Compensator.estimate`).
+
+    Parameters
+    ----------
+    comp : Compensator
+        A compensator with a band.
+    recording : Recording
+        The recording the estimate was made on.
+    estimate : numpy.ndarray
+        The estimate [mm].
+    level : float, optional
+        Nominal coverage; default the band's.
+
+    Returns
+    -------
+    lower, upper : numpy.ndarray
+    """
+    band = comp.band
+    if band is None:
+        raise InputError(f"the {comp.model} compensator{comp._from()} has no band (fitted "
+                         f"without one, or by a hystkit before bands); fit it again")
+    s = comp.normalised_sensor(recording.sensor)
+    rate, outside, _ = band_features(s, comp.structure.dt, band.tau, comp.training_range)
+    h = half_width(band, rate, outside, position_width(comp), level)
+    return estimate - h, estimate + h
+
+
+def interval_scores(position: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                    level: float) -> dict:
+    """How a band did against the truth: coverage, widths and the interval score.
+
+    Parameters
+    ----------
+    position : numpy.ndarray
+        The true position [mm].
+    lower, upper : numpy.ndarray
+        The band [mm].
+    level : float
+        Its nominal level.
+
+    Returns
+    -------
+    dict
+        ``band_level``, ``band_coverage`` (share of samples inside), ``band_width_mean`` and
+        ``band_width_median`` [mm], ``interval_score`` [mm] (Gneiting & Raftery 2007, eq. 43:
+        width plus 2 / (1 - level) times the miss; lower is better).
+    """
+    alpha = 1.0 - level
+    width = upper - lower
+    below, above = np.maximum(lower - position, 0.0), np.maximum(position - upper, 0.0)
+    return {"band_level": float(level),
+            "band_coverage": float(np.mean((position >= lower) & (position <= upper))),
+            "band_width_mean": float(np.mean(width)),
+            "band_width_median": float(np.median(width)),
+            "interval_score": float(np.mean(width + 2.0 / alpha * (below + above)))}
+
+
+# -- calibration -------------------------------------------------------------------------------
+
+
+def with_band(comp, recordings: Sequence[Recording], size: int, options: dict | None = None,
+              *, level: float = DEFAULT_LEVEL):
+    """`comp` with its band calibrated (:func:`calibrate_band`); ``fit_info["band"]`` says
+    from which protocol and how many held-out samples, or why there is none.
+
+    Parameters
+    ----------
+    comp : Compensator
+        Fitted on `recordings` by :func:`~hystkit.compensation.fit_compensator`.
+    recordings : sequence of Recording
+        Its training recordings.
+    size : int
+        The family's size knob it was fitted with.
+    options : dict, optional
+        The other options of its fit.
+    level : float, default 0.90
+        The band's nominal level.
+
+    Returns
+    -------
+    Compensator
+        A copy with ``band`` set (None if it could not be calibrated).
+    """
+    band, note = calibrate_band(comp, recordings, size, options, level=level)
+    return replace(comp, band=band, fit_info={**comp.fit_info, "band": note})
+
+
+def calibrate_band(comp, recordings: Sequence[Recording], size: int,
+                   options: dict | None = None, *, level: float = DEFAULT_LEVEL) -> tuple[Band | None, str]:
+    """The band of `comp`, calibrated on the validation folds of its training recordings.
+
+    Each fold refits the same model (family, size, mode, centring, `options`) on the fold's
+    training part, runs it on the held-out part from its start and keeps the held-out errors.
+
+    Parameters
+    ----------
+    comp : Compensator
+        The compensator fitted on all of `recordings`.
+    recordings : sequence of Recording
+        Its training recordings.
+    size : int
+        The family's size knob it was fitted with.
+    options : dict, optional
+        The fit's other options (:func:`~hystkit.compensation.fit_compensator`).
+    level : float, default 0.90
+        The nominal level stored as the band's default.
+
+    Returns
+    -------
+    band : Band or None
+        None when it cannot be calibrated (then `note` says why).
+    note : str
+        The protocol and number of held-out samples, or why there is no band.
+    """
+    from ._folds import fit_fold, folds, protocol  # the folds fit compensators: no cycle
+
+    check_level(level)
+    options = dict(options or {})
+    if comp.training_range is None or comp.position_range is None:
+        return None, "no band: the model does not know its training ranges"
+    if options.get("weights") and len(recordings) == 1:
+        return None, ("no band: --weights and the held-out pieces of one recording both weight "
+                      "the samples; give several recordings (one per run) for a band")
+    tau = max(TAU_SAMPLES * comp.structure.dt, MIN_TAU_S)
+    train_rate = np.concatenate([
+        band_features(comp.normalised_sensor(r.sensor), comp.structure.dt, tau,
+                      comp.training_range)[0] for r in recordings])
+    rate_reference = float(np.mean(train_rate))
+    if not rate_reference > 0:
+        return None, "no band: the training sensor does not move"
+    rate_high = max(float(np.quantile(train_rate, 0.99)), rate_reference)
+    errors, rates, excess = [], [], []
+    failed = []
+    for fold in folds(recordings):
+        try:
+            fold_comp = fit_fold(_Same(comp.model, size, comp.mode, comp.center), fold, options)
+            estimate = fold_comp.estimate(fold.scored, rest_position=_rest(fold_comp, fold))
+        except (FitDivergedError, InputError, ValueError, np.linalg.LinAlgError) as exc:
+            failed.append(f"{fold.label}: {exc}")
+            continue
+        held = slice(None) if fold.held is None else fold.held
+        s = fold_comp.normalised_sensor(fold.scored.sensor)
+        rate, outside, _ = band_features(s, comp.structure.dt, tau, fold_comp.training_range)
+        errors.append(np.abs(fold.scored.position - estimate)[held])
+        rates.append(rate[held])
+        excess.append((position_width(fold_comp) * outside)[held])
+    if failed and not errors:
+        return None, f"no band: every fold's fit failed ({failed[0]})"
+    error, rate, extra = (np.concatenate(v) for v in (errors, rates, excess))
+    if error.size < MIN_CALIBRATION:
+        return None, (f"no band: {error.size} held-out samples, fewer than "
+                      f"{MIN_CALIBRATION}")
+    share = _rate_share(np.maximum(error - extra, 0.0), rate / rate_reference)
+    trial = Band(level, tuple(np.zeros(QUANTILE_GRID.size)), error.size, tau, rate_reference,
+                 rate_high, share, protocol(recordings))
+    scores = np.maximum(error - extra, 0.0) / local_scale(trial, rate)
+    band = Band(level, tuple(np.quantile(scores, QUANTILE_GRID)), error.size, tau,
+                rate_reference, rate_high, share, trial.protocol)
+    note = f"band: {trial.protocol}, {error.size} held-out samples"
+    if failed:
+        note += f" ({len(failed)} fold(s) failed and are left out: {failed[0]})"
+    return band, note
+
+
+def _rate_share(error: np.ndarray, rate: np.ndarray) -> float:
+    """How much of the held-out error grows with the rate: ``c1 / (c0 + c1)`` of the
+    non-negative least-squares fit ``|e| ~ c0 + c1 rate``, at most ``MAX_RATE_SHARE``."""
+    from scipy.optimize import nnls
+
+    design = np.column_stack([np.ones_like(rate), rate])
+    (c0, c1), _ = nnls(design, error)
+    total = c0 + c1
+    return 0.0 if total <= 0 else float(min(c1 / total, MAX_RATE_SHARE))
+
+
+def _rest(comp, fold) -> float | None:
+    """A left-out recording's rest position for ``tare`` (the user tares there)."""
+    if comp.center != "tare" or fold.held is not None:
+        return None
+    n_tare = max(1, round(comp.tare_seconds / fold.scored.dt))
+    return float(np.mean(fold.scored.position[:n_tare]))
+
+
+@dataclass(frozen=True)
+class _Same:
+    """The model configuration a fold refits (what :func:`._folds.fit_fold` needs)."""
+
+    model: str
+    size: int
+    mode: str
+    center: str
