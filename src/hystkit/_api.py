@@ -20,9 +20,9 @@ from .compensation import (
     DEFAULT_LEVEL,
     Compensator,
     fit_compensator,
+    interval,
     load_compensator,
     save_compensator,
-    interval,
     with_band,
 )
 from .compensation import evaluate as _evaluate

@@ -41,7 +41,7 @@ def test_coverage_on_new_runs_of_the_same_excitation_is_nominal(banded):
     comp, _ = banded
     for seed in (2, 3, 4):
         test = simulate_experiment("sine", seed)
-        est, lower, upper = comp.estimate_with_band(test)
+        _, lower, upper = comp.estimate_with_band(test)
         coverage = interval_scores(test.position, lower, upper, 0.9)["band_coverage"]
         n_independent = test.n_samples * test.dt / comp.band.tau
         assert coverage >= 0.9 - 3 * math.sqrt(0.9 * 0.1 / n_independent), seed

@@ -7,13 +7,13 @@ import pytest
 
 from hystkit.cli import main
 from hystkit.compensation import DEFAULT_CENTER, evaluate, fit_compensator, load_compensator
+from hystkit.compensation._folds import EXTRAPOLATION_NOTE, folds, protocol
 from hystkit.compensation._param_vector import flatten_params
 from hystkit.errors import FitDivergedError
 from hystkit.io import Recording
 from hystkit.models import FAMILIES
 from hystkit.reports import _select
 from hystkit.reports._select import Candidate, select_model
-from hystkit.compensation._folds import EXTRAPOLATION_NOTE, folds, protocol
 from hystkit.sensors import simulate_experiment
 
 

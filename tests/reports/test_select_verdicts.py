@@ -9,11 +9,11 @@ import pytest
 
 from hystkit.cli import main
 from hystkit.compensation import MIN_EXPLAINED, fit_compensator, verdict
+from hystkit.compensation._folds import Fold, fits_in, fold_scores, folds
 from hystkit.io import Recording
 from hystkit.models import get_family
 from hystkit.reports._select import Candidate, candidates, select_model
 from hystkit.reports._text_table import text_table
-from hystkit.compensation._folds import Fold, fits_in, fold_scores, folds
 from hystkit.sensors import simulate_experiment
 
 

@@ -36,7 +36,7 @@ def _centers(text: str) -> list[str]:
 def _select(args: argparse.Namespace) -> int:
     import pandas as pd  # only this command needs it and matplotlib
 
-    from ..compensation import MODEL_SUFFIXES, save_compensator
+    from ..compensation import MODEL_SUFFIXES, folds, protocol, save_compensator
     from ..io import (
         atomic_folder,
         check_output_folder,
@@ -45,7 +45,6 @@ def _select(args: argparse.Namespace) -> int:
         write_json,
     )
     from ..parallel import loading_meanwhile
-    from ..compensation import folds, protocol
     from ..reports import FIGURE_MODULES, candidates, plot_selection, select_model, text_table
 
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,

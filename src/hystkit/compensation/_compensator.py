@@ -36,8 +36,18 @@ from ._centring import (
 from ._conventions import LinearBaseline, Scaling
 from ._modes import MODES
 
-__all__ = ["MAX_NORMALISED", "BandedEstimate", "MODES", "POSITION_MARGIN", "SENSOR_MARGIN", "Compensator",
-           "LinearBaseline", "Scaling", "runaway_kind", "runaway_samples"]
+__all__ = [
+    "MAX_NORMALISED",
+    "MODES",
+    "POSITION_MARGIN",
+    "SENSOR_MARGIN",
+    "BandedEstimate",
+    "Compensator",
+    "LinearBaseline",
+    "Scaling",
+    "runaway_kind",
+    "runaway_samples",
+]
 
 # Use-time guards: a sensor sample is "outside" beyond this share of the training sensor range
 # on either side, an estimate beyond this share of the training position range.

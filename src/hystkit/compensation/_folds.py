@@ -16,11 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._fitting import fit_compensator
-from ._training_checks import MIN_SAMPLES_PER_PARAM, count_fitted
 from ..io import Recording
 from ..metrics import r2
 from ..models import get_family
+from ._fitting import fit_compensator
+from ._training_checks import MIN_SAMPLES_PER_PARAM, count_fitted
 
 __all__ = ["EXTRAPOLATION_NOTE", "N_FOLDS", "ONE_RUN_CAVEAT", "PROTOCOLS", "Fold",
            "admissible_size", "fit_fold", "fits_in", "fold_scores", "folds", "protocol"]
