@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from hystkit.compensation import (
+    Stream,
     fit_compensator,
     interval_scores,
     load_compensator,
@@ -185,3 +186,19 @@ def test_several_recordings_calibrate_on_left_out_recordings():
     assert comp.band.protocol == "left-out recording"
     assert comp.band.n_calibration == sum(r.n_samples for r in runs)
     assert "left-out recording" in comp.fit_info["band"]
+
+
+@pytest.mark.parametrize("center", ["fit", "tare", "track"])
+def test_stream_gives_the_offline_band_bit_for_bit(center):
+    """Sample by sample and in chunks, the stream's band is the offline band exactly."""
+    train = simulate_experiment("noise", 1)
+    comp = with_band(fit_compensator(train, 1, center=center, diagnose=False), [train], 1)
+    test = simulate_experiment("sine", 2)
+    offline = comp.estimate_with_band(test, 0.8)
+    stream = Stream(comp, level=0.8)
+    steps = [stream.step_flagged(v) for v in test.sensor[:300]]
+    chunks = [stream.process_flagged(c) for c in np.array_split(test.sensor[300:], 7)]
+    for name in ("lower", "upper"):
+        got = np.concatenate([[getattr(s, name) for s in steps],
+                              *[getattr(c, name) for c in chunks]])
+        np.testing.assert_array_equal(got, getattr(offline, name))

@@ -9,9 +9,11 @@ the separator, decimal comma and comment lines detected. A stream that compensat
 ends with an error naming the first line skipped and why.
 
 Output, one line per accepted sample and flushed at once: ``time,position_estimate,flags``
-after a header line. ``time`` is echoed as received, the estimate [mm] is printed to full
-precision, ``flags`` is a bit mask: 1 = sensor outside the training range, 2 = estimate outside
-the training position range (the columns of ``hystkit compensate``). A closed stdout (``>&-``)
+after a header line, and ``position_lower,position_upper`` (the prediction band, bit for bit
+``hystkit compensate``'s) when the model has a band and the stream does not adapt. ``time`` is
+echoed as received, the estimate [mm] is printed to full precision, ``flags`` is a bit mask:
+1 = sensor outside the training range, 2 = estimate outside the training position range (the
+columns of ``hystkit compensate``). A closed stdout (``>&-``)
 is refused before any work; a full disk or a failing device ends the stream with one error line.
 
 Bad input never stops the stream: a line that is not numbers, lacks a field, is longer than
@@ -333,7 +335,8 @@ def _run_stream(stream: Stream | AdaptiveStream | RefittingStream, lines: Iterat
             learning.add(result.estimate, reference, stream)
         previous = t
         flags = (1 if result.sensor_outside else 0) + (2 if result.estimate_outside else 0)
-        row = f"{text},{result.estimate!r},{flags}\n"
+        band = "" if result.lower is None else f",{result.lower!r},{result.upper!r}"
+        row = f"{text},{result.estimate!r},{flags}{band}\n"
         # counted before the line leaves: a reader that got it finds it in the summary
         latency.add(time.perf_counter() - arrived)
         _write(row)
@@ -362,13 +365,16 @@ def _stream(args: argparse.Namespace) -> int:
     fmt = stream_format(args)  # --in FILE: its settings file and layout, as fit reads it
     stdout_for("the estimates")
     comp = load_compensator(args.model)
-    stream = Stream(comp, label=str(args.model))  # refuses the oracle centring
+    if args.level is not None and comp.band is None:
+        raise InputError(f"--level: {args.model} has no prediction band (fitted without one or "
+                         f"by a hystkit before bands); fit it again")
+    stream = Stream(comp, label=str(args.model), level=args.level)  # refuses the oracle
     start = "rest"
     if args.start == "sync":
         sync = sync_excitation(comp)
         _print_sync(sync)
         start = sync.state_after
-        stream = Stream(comp, start, label=str(args.model))
+        stream = Stream(comp, start, label=str(args.model), level=args.level)
     learning = None
     if args.adapt is not None:
         stream, learning = _adaptive_stream(args, comp, start), _Learning()
@@ -376,7 +382,9 @@ def _stream(args: argparse.Namespace) -> int:
     if not fmt.plain:
         lines = _Input(stream_lines(iter(lines), fmt, source, TOO_LONG), lines)
     with contextlib.closing(lines):
-        _write("time,position_estimate,flags\n")
+        banded = comp.band is not None and learning is None
+        _write("time,position_estimate,flags" + (",position_lower,position_upper" * banded)
+               + "\n")
         tally, latency = _Tally(), _Latency()
         try:
             _run_stream(stream, lines, tally, latency, learning)
@@ -463,6 +471,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="rest: model at rest at the first sample (default); sync: after the "
                         "synchronisation excitation e_sync (eq. 2.21-2.22), printed to stderr")
     add_read_options(p)  # --in FILE, stdin or a port laid out as the user's files
+    p.add_argument("--level", type=number(0, 1, low_open=True, high_open=True), default=None,
+                   help="nominal coverage of the prediction band columns, in (0, 1) (default: "
+                        "the model's own, 0.90 unless fitted otherwise)")
     adapt = p.add_argument_group("online adaptation (a reference column: the true position "
                                  "[mm] now and then, empty when unknown)")
     adapt.add_argument("--adapt", choices=ADAPT_CHOICES,

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..errors import FitDivergedError, InputError
 from ..io import MAX_MAGNITUDE
+from ._band import BandState, band_features, local_scale, position_width
 from ._centring import ORACLE_CENTER
 from ._compensator import (
     MAX_NORMALISED,
@@ -65,6 +66,8 @@ class StreamState:
         Last output of the tracker's un-normalised low-pass [sensor units] (``track``).
     track_weight : float, default 0.0
         Last output of the same low-pass run on ones: its weight sum (``track``).
+    band : BandState, default BandState()
+        What the prediction band's local scale remembers (:mod:`._band`).
     """
 
     x: np.ndarray | None
@@ -72,6 +75,7 @@ class StreamState:
     tare_sum: float = 0.0
     track_value: float = 0.0
     track_weight: float = 0.0
+    band: BandState = field(default_factory=BandState)
 
     def __post_init__(self) -> None:
         if self.x is not None:
@@ -96,11 +100,15 @@ class StreamOutput(NamedTuple):
     estimate_outside : numpy.ndarray of bool, shape (n,), or None
         Estimates outside the training positions plus their margin
         (:meth:`Compensator.estimate_outside`).
+    lower, upper : numpy.ndarray, shape (n,), or None
+        The prediction band [mm] (:meth:`Compensator.estimate_with_band`); None without one.
     """
 
     estimate: np.ndarray
     sensor_outside: np.ndarray | None
     estimate_outside: np.ndarray | None
+    lower: np.ndarray | None = None
+    upper: np.ndarray | None = None
 
 
 class StepOutput(NamedTuple):
@@ -114,11 +122,15 @@ class StepOutput(NamedTuple):
         The sensor sample is outside the training range plus its margin.
     estimate_outside : bool or None
         The estimate is outside the training positions plus their margin.
+    lower, upper : float or None
+        The prediction band [mm]; None without one.
     """
 
     estimate: float
     sensor_outside: bool | None
     estimate_outside: bool | None
+    lower: float | None = None
+    upper: float | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -128,19 +140,22 @@ class _Path:
 
     comp: Compensator
     rest_position: float | None
+    level: float | None = None
     n_tare: int = field(init=False)
     track_gain: float = field(init=False)
     position_offset: float = field(init=False)
     sensor_bounds: tuple[float, float] | None = field(init=False)
     estimate_bounds: tuple[float, float] | None = field(init=False)
     runaway_bounds: tuple[float, float] | None = field(init=False)
+    band_quantile: float | None = field(init=False)
 
     def __post_init__(self) -> None:
         comp, dt = self.comp, self.comp.structure.dt
         values = {"n_tare": max(1, round(comp.tare_seconds / dt)),
                   "track_gain": float(1.0 - np.exp(-dt / comp.track_seconds)),
                   "position_offset": comp.position_offset(None, self.rest_position),
-                  "sensor_bounds": None, "estimate_bounds": None}
+                  "sensor_bounds": None, "estimate_bounds": None,
+                  "band_quantile": None if comp.band is None else comp.band.quantile(self.level)}
         values["runaway_bounds"] = comp.runaway_bounds(values["position_offset"])
         # Compensator.sensor_outside / estimate_outside: outside [lo - pad, hi + pad]
         if comp.training_range is not None:
@@ -215,8 +230,8 @@ def _state_size(comp: Compensator) -> int:
 
 
 def advance(comp: Compensator, state: StreamState, sensor: np.ndarray, *,
-            rest_position: float | None = None,
-            label: str = "stream") -> tuple[StreamOutput, StreamState]:
+            rest_position: float | None = None, label: str = "stream",
+            level: float | None = None) -> tuple[StreamOutput, StreamState]:
     """Run one chunk of raw sensor samples [sensor units] from ``state``.
 
     Pure: nothing is kept anywhere; the returned state continues the stream.
@@ -236,11 +251,13 @@ def advance(comp: Compensator, state: StreamState, sensor: np.ndarray, *,
         training (``tare`` only; as :meth:`Compensator.estimate`).
     label : str, default "stream"
         Names the stream in error messages.
+    level : float, optional
+        Nominal coverage of the band in the output; default the band's own.
 
     Returns
     -------
     output : StreamOutput
-        The chunk's estimates [mm] and use-time flags.
+        The chunk's estimates [mm], their band and the use-time flags.
     state : StreamState
         The state after the chunk's last sample.
 
@@ -254,7 +271,7 @@ def advance(comp: Compensator, state: StreamState, sensor: np.ndarray, *,
         If ``comp`` has the oracle centring ``recording``.
     """
     check_streamable(comp)  # a state made for another compensator must not smuggle one in
-    return _advance(_Path(comp, rest_position), state, sensor, label)
+    return _advance(_Path(comp, rest_position, level), state, sensor, label)
 
 
 def _advance(path: _Path, state: StreamState, sensor: np.ndarray,
@@ -271,9 +288,11 @@ def advance_scaled(path: _Path, state: StreamState, sensor: np.ndarray,
     s_raw = np.ascontiguousarray(sensor, dtype=np.float64).reshape(-1)
     if s_raw.size == 0:
         empty = np.empty(0)
-        return StreamOutput(empty, *_flags(path, empty, empty)), state, empty
+        band = (None, None) if comp.band is None else (empty, empty)
+        return StreamOutput(empty, *_flags(path, empty, empty), *band), state, empty
     offset, centring = _sensor_offset(path, state, s_raw)
     s = comp.polarity * (s_raw - offset) / comp.scaling.sensor_scale
+    half, centring["band"] = _half_width(path, s, state.band)
     with np.errstate(over="ignore", invalid="ignore"):
         try:
             p, x_end = _run_model(comp, s, state.x)
@@ -285,7 +304,22 @@ def advance_scaled(path: _Path, state: StreamState, sensor: np.ndarray,
         estimate = p * comp.scaling.position_scale + path.position_offset
     _check_runaway(path, p, estimate, state.n_samples, label)
     nxt = StreamState(x_end, state.n_samples + s.size, **centring)
-    return StreamOutput(estimate, *_flags(path, s, estimate)), nxt, s
+    band = (None, None) if half is None else (estimate - half, estimate + half)
+    return StreamOutput(estimate, *_flags(path, s, estimate), *band), nxt, s
+
+
+def _half_width(path: _Path, s: np.ndarray,
+                state: BandState) -> tuple[np.ndarray | None, BandState]:
+    """The band's half-width [mm] over a chunk of scaled sensor samples, continuing the
+    features from `state` (:func:`._band.band_features`; the same operations as
+    :func:`._band.interval`, so chunked == whole); None without a band."""
+    comp = path.comp
+    if comp.band is None:
+        return None, state
+    rate, outside, nxt = band_features(s, comp.structure.dt, comp.band.tau, comp.training_range,
+                                       state)
+    return (path.band_quantile * local_scale(comp.band, rate)
+            + position_width(comp) * outside), nxt
 
 
 def _run_model(comp: Compensator, s: np.ndarray,
@@ -426,8 +460,13 @@ def _advance_one(path: _Path, state: StreamState, v: float, label: str,
     if not (abs(p) <= MAX_NORMALISED and abs(estimate) <= MAX_MAGNITUDE
             and (bounds is None or bounds[0] <= estimate <= bounds[1])):
         _check_runaway(path, np.array([p]), np.array([estimate]), state.n_samples, label)
-    nxt = StreamState(x_end, state.n_samples + 1, tare_sum, track_value, track_weight)
-    return StepOutput(estimate, *_flags(path, s, estimate)), nxt, _Previous(nxt, state.x, s)
+    half, band_state = _half_width(path, np.array([s]), state.band)
+    band = (None, None) if half is None else (estimate - float(half[0]),
+                                              estimate + float(half[0]))
+    nxt = StreamState(x_end, state.n_samples + 1, tare_sum, track_value, track_weight,
+                      band_state)
+    return (StepOutput(estimate, *_flags(path, s, estimate), *band), nxt,
+            _Previous(nxt, state.x, s))
 
 
 def _of(comp: Compensator) -> str:
@@ -449,6 +488,9 @@ class Stream:
         (``tare`` only; as :meth:`Compensator.estimate`).
     label : str
         Names the stream in error messages.
+    level : float, optional
+        Nominal coverage of the prediction band in the outputs (``lower``, ``upper``; a
+        compensator without a band gives None); default the band's own.
 
     Notes
     -----
@@ -458,17 +500,19 @@ class Stream:
     """
 
     def __init__(self, compensator: Compensator, start: StartUp = "rest", *,
-                 rest_position: float | None = None, label: str = "stream") -> None:
-        self._path = _Path(compensator, rest_position)
+                 rest_position: float | None = None, label: str = "stream",
+                 level: float | None = None) -> None:
+        self._path = _Path(compensator, rest_position, level)
         self._state = initial_state(compensator, start)
         self._previous: _Previous | None = None  # speeds up step; never changes a result
         self.label = label
 
     @classmethod
     def from_state(cls, compensator: Compensator, state: StreamState, *,
-                   rest_position: float | None = None, label: str = "stream") -> Stream:
+                   rest_position: float | None = None, label: str = "stream",
+                   level: float | None = None) -> Stream:
         """Resume a stream from a saved :class:`StreamState`."""
-        stream = cls(compensator, rest_position=rest_position, label=label)
+        stream = cls(compensator, rest_position=rest_position, label=label, level=level)
         if state.x is not None:
             initial_state(compensator, state.x)  # checks its size
         elif state.n_samples:

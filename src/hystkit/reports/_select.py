@@ -31,6 +31,7 @@ from ..compensation import (
     folds,
     protocol,
     verdict,
+    with_band,
 )
 from ..io import Recording
 from ..models import FAMILIES, get_family
@@ -196,7 +197,7 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
         see), ``ranking`` (rows of candidate, cv_r2, cv_r2_min, cv_r2_oracle, cv_linear_r2,
         n_params, aic, bic, fold_status, guard_failed, verdict, verdict_message; or error),
         ``folds`` (descriptions), ``winner`` (its row) and ``compensator`` (fitted on all
-        recordings), or ``winner`` None with ``refusal`` (one line) when no candidate is
+        recordings, with its prediction band calibrated on the same folds), or ``winner`` None with ``refusal`` (one line) when no candidate is
         usable: none beats its straight line and a constant on the held-out data, or none's
         refit passes the fit's guards.
 
@@ -259,6 +260,9 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
             row["error_final"] = (f"its fit on all the data: {comp.fit_info['status']}: "
                                   f"{comp.fit_info['status_message']}")
             continue
+        # the winner's band, from the same folds it was validated on
+        with threadpool_limits(limits=1, user_api="blas"):
+            comp = with_band(comp, list(recordings), row["size"], options)
         out["winner"], out["compensator"] = row, comp
         return out
     out["refusal"] = (f"the best {min(len(usable), MAX_REFITS)} candidate(s) beat their "
