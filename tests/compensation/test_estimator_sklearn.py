@@ -79,7 +79,8 @@ def _xy(rec: Recording) -> tuple[np.ndarray, np.ndarray]:
 def test_init_stores_only_and_clone_copies_params():
     est = CompensatorEstimator("pi", size=4, center="tare", dt=DT, options={"diagnose": False})
     assert est.get_params() == {"model": "pi", "size": 4, "mode": "direct", "center": "tare",
-                                "dt": DT, "options": {"diagnose": False}}
+                                "dt": DT, "options": {"diagnose": False}, "band": True,
+                                "level": 0.9}
     copy = clone(est)
     assert copy is not est and copy.get_params() == est.get_params()
     assert copy.set_params(size=7) is copy and copy.size == 7 and est.size == 4
