@@ -4,6 +4,7 @@ Each family's own fit is in its folder, ``hystkit.models.<family>``; the registr
 :mod:`hystkit.models`.
 """
 
+from ._clock import FitTimer
 from ._least_squares import MAX_WEIGHT, check_fit_data, check_weights, fit_multistart
 from ._lm import solve_lm
 from ._losses import (
@@ -23,7 +24,7 @@ from ._normal_equations import (
 )
 from ._result import BoundHit, FitResult
 
-__all__ = ["LOSSES", "MAX_WEIGHT", "BoundHit", "ChunkedDifferences", "FitResult",
+__all__ = ["LOSSES", "MAX_WEIGHT", "BoundHit", "ChunkedDifferences", "FitResult", "FitTimer",
            "NormalEquations", "SolveResult", "check_cost", "check_fit_data", "check_weights",
            "cost_label", "dense_normal_equations",
            "fit_multistart", "loss_slope", "objective", "require_linear_loss",

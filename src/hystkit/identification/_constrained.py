@@ -18,7 +18,6 @@ so the coordinates are scaled by the Gauss-Newton diagonal ``sqrt(diag J^T J)`` 
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
@@ -26,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FitDivergedError
+from ._clock import FitTimer
 from ._normal_equations import NormalEquations
 from ._result import FitResult
 
@@ -214,7 +214,7 @@ def constrain_fit(result: FitResult, normal_equations: Callable[[np.ndarray], No
     if result.loss != "linear" or result.weighted:
         raise ValueError(f"the weight-sum constraint is solved on the SSE (eq. 5.9), not on "
                          f"the {result.objective_label}")
-    t0 = time.perf_counter()
+    timer = FitTimer()
     sol = minimise_with_weight_sum(normal_equations, result.theta, result.bounds, weights,
                                    weight_sum_max)
     params = to_params(sol.theta)
@@ -224,7 +224,7 @@ def constrain_fit(result: FitResult, normal_equations: Callable[[np.ndarray], No
     state = "active" if sol.active else "inactive"
     return replace(result, params=params, theta=sol.theta, cost=sol.cost, objective=sol.cost,
                    converged=sol.converged, n_evaluations=result.n_evaluations + sol.n_runs,
-                   seconds=result.seconds + time.perf_counter() - t0,
+                   seconds=result.seconds + timer.seconds(),
                    sensitivity=sol.column_norms,
                    constraint=f"{label} <= {weight_sum_max:g}" if sol.active else None,
                    message=f"SLSQP under {label} <= {weight_sum_max:g} ({state}: {label} = "

@@ -30,6 +30,7 @@ from threadpoolctl import ThreadpoolController
 
 from ..errors import FitDivergedError
 from ..parallel import Executor, current_executor
+from ._clock import FitTimer
 from ._lm import solve_lm
 from ._losses import check_cost
 from ._normal_equations import NormalEquations, dense_normal_equations
@@ -223,7 +224,7 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
     solve = _StartSolver(residual=residual, jac=jac, normal_equations=normal_equations,
                          cost=cost, solver=solver, lower=lower, upper=upper, margin=margin,
                          loss=loss, f_scale=float(f_scale))
-    t_start = time.perf_counter()
+    timer = FitTimer()
     screened, executor = _screen(solve, starts, screen_nfev)
     n_eval = sum(sol.n_runs for sol in screened)
     screened = sorted((sol for sol in screened if np.isfinite(sol.cost)),
@@ -264,7 +265,7 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
     return FitResult(structure=structure, params=to_params(best.x), cost=sse,
                      objective=objective, loss=loss, f_scale=float(f_scale),
                      weighted=weights is not None,
-                     n_evaluations=int(n_eval), seconds=time.perf_counter() - t_start,
+                     n_evaluations=int(n_eval), seconds=timer.seconds(),
                      converged=converged, message=message,
                      n_starts=len(starts), theta=np.array(best.x),
                      bounds=(lower, upper), names=names, limits=limits,

@@ -9,14 +9,19 @@ sets place the play radii ``A_k = a_1 + .. + a_k-1`` of the springs on a grid up
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import nnls
 
 from ...errors import FitDivergedError
-from ...identification import FitResult, check_fit_data, check_weights, require_linear_loss
+from ...identification import (
+    FitResult,
+    FitTimer,
+    check_fit_data,
+    check_weights,
+    require_linear_loss,
+)
 from . import model as bobbio
 
 __all__ = ["SUPPORTED_LOSSES", "candidate_thresholds", "fit_bobbio"]
@@ -117,7 +122,7 @@ def fit_bobbio(u: np.ndarray, y: np.ndarray, structure: bobbio.BobbioStructure, 
     InputError
         If `loss` is a robust loss.
     """
-    t_start = time.perf_counter()
+    timer = FitTimer()
     require_linear_loss(loss, f_scale, "bobbio", "non-negative least squares")
     u, y = check_fit_data(u, y)
     weights = None if weights is None else check_weights(weights, y.size)
@@ -132,7 +137,7 @@ def fit_bobbio(u: np.ndarray, y: np.ndarray, structure: bobbio.BobbioStructure, 
             break
         if accept is None or accept(params):
             return FitResult(structure=structure, params=params, cost=cost,
-                             n_evaluations=len(sets), seconds=time.perf_counter() - t_start,
+                             n_evaluations=len(sets), seconds=timer.seconds(),
                              converged=True, message=f"best of {len(sets)} threshold sets "
                              f"({n_rejected} better ones rejected), non-negative least "
                              f"squares per set", n_starts=len(sets), objective=objective,

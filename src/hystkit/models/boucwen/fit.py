@@ -17,14 +17,13 @@ residual instead of NaN, so the solver backs off.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
 
 from ...errors import FitDivergedError
-from ...identification import FitResult, fit_multistart
+from ...identification import FitResult, FitTimer, fit_multistart
 from . import kernels
 from . import model as boucwen
 
@@ -266,7 +265,7 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
                               limits=tuple([side[i] for i in free] for side in limits),
                               **options)
 
-    t_start = time.perf_counter()
+    timer = FitTimer()
     nu_start = 1.0 if nu is None else float(nu)
     # Stage 1: r = 1/2 and beta = gamma = 0 make z = alpha y, a linear oscillator.
     template = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, nu_start])
@@ -284,7 +283,7 @@ def fit_boucwen(u: np.ndarray, y: np.ndarray, structure: boucwen.BoucWenStructur
     if not stage2.cost < float(penalty @ penalty):
         raise FitDivergedError(f"the fit failed: the integration diverged from every start "
                                f"(the last: {''.join(last_divergence) or 'no finite cost'})")
-    return replace(stage2, seconds=time.perf_counter() - t_start,
+    return replace(stage2, seconds=timer.seconds(),
                    n_evaluations=stage1.n_evaluations + stage2.n_evaluations,
                    n_starts=stage1.n_starts + stage2.n_starts)
 

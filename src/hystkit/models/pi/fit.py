@@ -34,7 +34,6 @@ travel are not excited at all, so a tiny ridge pulls every unknown towards a neu
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 
 import numpy as np
@@ -42,7 +41,7 @@ from scipy.optimize import lsq_linear
 from threadpoolctl import threadpool_limits
 
 from ...errors import FitDivergedError
-from ...identification import FitResult, check_weights, require_linear_loss
+from ...identification import FitResult, FitTimer, check_weights, require_linear_loss
 from . import kernels
 from . import model as pi
 
@@ -145,7 +144,7 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
         If the solution is not finite, leaves the parameter domain (``MAX_VALUE``) or is
         vetoed by ``accept``.
     """
-    t_start = time.perf_counter()
+    timer = FitTimer()
     require_linear_loss(loss, f_scale, "pi", "bounded linear least squares")
     u = np.ascontiguousarray(u, dtype=float)
     y = np.ascontiguousarray(y, dtype=float)
@@ -198,7 +197,7 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
     r2 = (y_fit - y) ** 2
     sse = float(np.sum(r2))
     return FitResult(structure=structure, params=params, cost=sse,
-                     n_evaluations=2, seconds=time.perf_counter() - t_start,
+                     n_evaluations=2, seconds=timer.seconds(),
                      converged=bool(sol.status > 0), message=str(sol.message), n_starts=1,
                      objective=sse if weights is None else float(weights @ r2),
                      weighted=weights is not None)

@@ -25,7 +25,6 @@ sample. ``smoothing = 0`` gives plain bounded least squares.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from typing import Any
 
@@ -35,7 +34,13 @@ from scipy.optimize import lsq_linear
 from threadpoolctl import threadpool_limits
 
 from ...errors import FitDivergedError
-from ...identification import FitResult, check_fit_data, check_weights, require_linear_loss
+from ...identification import (
+    FitResult,
+    FitTimer,
+    check_fit_data,
+    check_weights,
+    require_linear_loss,
+)
 from . import model as preisach
 
 __all__ = ["ORIENTATIONS", "SUPPORTED_LOSSES", "check_data", "everett_from_forcs",
@@ -185,7 +190,7 @@ def fit_oriented(a: np.ndarray, y: np.ndarray, penalty: np.ndarray, hysteretic: 
     ValueError
         If `weights` are not one finite value >= 0 per sample, not all 0.
     """
-    t_start = time.perf_counter()
+    timer = FitTimer()
     a_w, y_w, penalty_w = a, y, penalty
     if weights is not None:
         weights = check_weights(weights, y.size)
@@ -210,7 +215,7 @@ def fit_oriented(a: np.ndarray, y: np.ndarray, penalty: np.ndarray, hysteretic: 
             continue
         loops = "counter-clockwise" if sign > 0 else "clockwise"
         return FitResult(structure=structure, params=params, cost=cost, n_evaluations=1,
-                         seconds=time.perf_counter() - t_start, converged=success,
+                         seconds=timer.seconds(), converged=success,
                          message=f"{loops} loops; {message}", n_starts=len(candidates),
                          objective=objective, weighted=weights is not None)
     raise FitDivergedError(f"the fit failed: all {rejected} least-squares solutions were "
