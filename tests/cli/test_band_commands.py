@@ -12,7 +12,8 @@ import pandas as pd
 import pytest
 
 from hystkit.cli import main
-from hystkit.compensation import load_compensator
+from hystkit.compensation import evaluate, load_compensator
+from hystkit.io import read_recording
 from hystkit.sensors import simulate_experiment
 
 
@@ -72,3 +73,13 @@ def test_level_without_a_band_is_refused(files, capsys):
                  str(files["folder"] / "x.csv")])
     assert code == 2 and "has no prediction band" in capsys.readouterr().err
     assert not (files["folder"] / "x.csv").exists()
+
+
+def test_report_shades_the_band_and_tables_its_coverage(files, capsys):
+    page = files["folder"] / "report.html"
+    assert main(["report", str(files["model"]), str(files["test"]), "--out", str(page)]) == 0
+    html = page.read_text()
+    assert "Shaded: the 90% prediction band" in html
+    assert "Prediction band (deployable)" in html
+    scores = evaluate(load_compensator(files["model"]), read_recording(files["test"]))
+    assert f"<td>{scores['band_coverage']:.3f}</td>" in html  # evaluate's, to the table's digits

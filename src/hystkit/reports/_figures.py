@@ -130,7 +130,9 @@ def plot_loops(results: Results, *, sensor_label: str = DEFAULT_SENSOR_LABEL,
     return fig
 
 
-def plot_time_series(results: Results, *, model_label: str = "mPL") -> Figure:
+def plot_time_series(results: Results, *, model_label: str = "mPL",
+                     bands: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
+                     band_label: str = "band") -> Figure:
     """Measured and estimated position and the error over the whole of each recording, with a
     zoom on the stretch around the compensator's largest error.
 
@@ -143,6 +145,11 @@ def plot_time_series(results: Results, *, model_label: str = "mPL") -> Figure:
         Per recording name: the recording, the estimate [mm] and the linear estimate [mm].
     model_label : str, default "mPL"
         The compensator's name in the legend.
+    bands : mapping of str to (numpy.ndarray, numpy.ndarray), optional
+        Per recording name: the estimate's prediction band (lower, upper) [mm], shaded around
+        the estimate and, in the error panel, around the error (covered where it holds 0).
+    band_label : str, default "band"
+        The band's name in the legend.
 
     Returns
     -------
@@ -160,7 +167,14 @@ def plot_time_series(results: Results, *, model_label: str = "mPL") -> Figure:
             top, low = axes[2 * k, col], axes[2 * k + 1, col]
             tt = t[span]
             series = (p[span], linear[span], estimate[span], line_error[span], error[span])
-            keep = envelope_indices(series)
+            band = None if bands is None or name not in bands else tuple(
+                b[span] for b in bands[name])
+            keep = envelope_indices(series + (band or ()))
+            if band is not None:
+                top.fill_between(tt[keep], band[0][keep], band[1][keep], color=_COLORS["model"],
+                                 alpha=0.2, lw=0, label=band_label)
+                low.fill_between(tt[keep], (band[0] - p[span])[keep], (band[1] - p[span])[keep],
+                                 color=_COLORS["model"], alpha=0.2, lw=0)
             top.plot(tt[keep], series[0][keep], color=_COLORS["position"], lw=1.0,
                      label="position")
             top.plot(tt[keep], series[1][keep], color=_COLORS["line"], lw=0.8, alpha=0.6,

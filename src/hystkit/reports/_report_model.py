@@ -16,7 +16,14 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from ..compensation import Compensator, center_label, evaluate, load_compensator, use_verdict
+from ..compensation import (
+    Compensator,
+    center_label,
+    evaluate,
+    interval,
+    load_compensator,
+    use_verdict,
+)
 from ..compensation import named_floats as named_parameters  # the standard errors' order
 from ..io import Recording
 from ._figures import DEFAULT_SENSOR_LABEL, plot_loops, plot_time_series
@@ -189,6 +196,16 @@ def score_section(comp: Compensator, scores: Mapping[str, dict]) -> Section:
             section.add(note(f"{name}: {s['verdict'].replace('_', ' ')}: {s['verdict_message']}"
                              f"; do not use the {comp.model} compensator on data like these.",
                              "bad"))
+    banded = [(name, f"{s['band_level']:.0%}", _fixed_or_none(s["band_coverage"], ".3f"),
+               _fixed_or_none(s["band_width_median"], ".4g"),
+               _fixed_or_none(s["interval_score"], ".4g"))
+              for name, s in scores.items() if s.get("band_coverage") is not None]
+    if banded:
+        section.add(paragraph("Prediction band (deployable): the share of samples whose "
+                              "position it covers, its median width and the interval score "
+                              "(width plus 2 / (1 - level) times the miss; lower is better)."),
+                    table(("recording", "level", "coverage", "median width", "interval score"),
+                          banded, text_columns=2))
     guards = [(name, s["n_samples"], _count(s["n_sensor_outside"]),
                _count(s["n_estimate_outside"]), _fixed_or_none(s["sensor_loop_area"], ".3f"))
               for name, s in scores.items()]
@@ -232,12 +249,14 @@ def compensator_sections(comp: Compensator, recordings: Mapping[str, Recording],
     """
     content = ReportContent(title="")
     content.sections += [_provenance(comp, model_path, version), fit_section(comp)]
-    scores, shown = {}, {}
+    scores, shown, bands = {}, {}, {}
     for name, rec in recordings.items():
         scores[name] = evaluate(comp, rec)
         scores[name]["verdict"], scores[name]["verdict_message"] = use_verdict(
             comp, rec, scores[name], "deployable")
         shown[name] = (rec, comp.estimate(rec), comp.estimate_linear(rec))
+        if comp.band is not None:
+            bands[name] = interval(comp, rec, shown[name][1])
     content.sections.append(score_section(comp, scores))
     figures = Section("Figures")
     content.sections.append(figures)
@@ -249,10 +268,15 @@ def compensator_sections(comp: Compensator, recordings: Mapping[str, Recording],
         f"estimates against it (middle, dashed: ideal) and their error (bottom); deployable "
         f"centring {centring}.")
     content.add_figure(
-        figures, f"{prefix}time_series", plot_time_series(shown, model_label=comp.model),
+        figures, f"{prefix}time_series",
+        plot_time_series(shown, model_label=comp.model, bands=bands or None,
+                         band_label=f"{comp.band.level:.0%} band" if comp.band else "band"),
         "Each recording's whole run: measured and estimated position, and the error "
         "(estimate − position); right: a zoom on the stretch around the largest "
-        f"{comp.model} error.")
+        f"{comp.model} error."
+        + (f" Shaded: the {comp.band.level:.0%} prediction band (deployable: the sensor up to "
+           f"each sample and the model file), around the error in the lower panels: the "
+           f"band covers the position where the shading holds 0." if comp.band else ""))
     return content
 
 
