@@ -25,6 +25,7 @@ from collections.abc import Sequence
 from typing import NoReturn
 
 from .. import __version__
+from .._compilation import announce
 from ..errors import HystkitError, Terminated
 from ._common import INTERNAL_EXIT, Parser
 from ._numba_config import hide_yaml_from_numba_config
@@ -43,6 +44,13 @@ _PROGRAM_GC_THRESHOLDS = (700, 10, 100)
 # problems where more threads lose), so the pools only cost start-up: ~0.04 s of CPU per
 # library, plus its threads' spinning on a busy machine (benchmarks/README.md, start-up).
 _BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")
+# The program's line at its first numba compilation (`hystkit._compilation.announce`): the first
+# run after installing compiles the kernels it needs (2026-11-28, 2 cores: `fit` 10-12 s,
+# `control` 13-15 s, `compare` 40-60 s, against about 1, 1.6 and 6 s with the kernels in
+# numba's cache; benchmarks/bench_first_run.py).
+COMPILING_NOTICE = ("hystkit: compiling numba kernels, once per installation: this run takes "
+                    "10-60 s longer, later runs load them from numba's cache ('hystkit warm' "
+                    "compiles them ahead)")
 
 
 def _parser(command: str | None = None) -> Parser:
@@ -95,7 +103,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     life (`_PROGRAM_GC_THRESHOLDS`, and a frozen heap at the end, which the interpreter's
     shutdown does not walk again) and has OpenBLAS start one thread unless the environment
     says otherwise (`_BLAS_THREAD_VARIABLES`), and numba loads without PyYAML unless the working
-    directory has a numba config file (`hide_yaml_from_numba_config`); stopped by a signal after
+    directory has a numba config file (`hide_yaml_from_numba_config`), and a run that has to
+    compile numba kernels says so on stderr (`COMPILING_NOTICE`); stopped by a signal after
     forking workers, it ends the process itself: multiprocessing's exit handlers would otherwise
     wait forever to flush queues to the workers it stopped.
 
@@ -118,6 +127,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not any(os.environ.get(name) for name in _BLAS_THREAD_VARIABLES):
             os.environ["OPENBLAS_NUM_THREADS"] = "1"  # before numpy is imported
         hide_yaml_from_numba_config()
+        announce(COMPILING_NOTICE)
     code = _main(argv)
     if argv is None:
         # Nothing but the interpreter's shutdown follows, whose garbage collections walk the
