@@ -10,7 +10,8 @@ ends with an error naming the first line skipped and why.
 
 Output, one line per accepted sample and flushed at once: ``time,position_estimate,flags``
 after a header line, and ``position_lower,position_upper`` (the prediction band, bit for bit
-``hystkit compensate``'s) when the model has a band and the stream does not adapt. ``time`` is
+``hystkit compensate``'s) when the model has a band; ``--adapt gain|weights`` re-scales it
+from the references (:mod:`hystkit.compensation._adaptive`), ``--adapt full`` has none. ``time`` is
 echoed as received, the estimate [mm] is printed to full precision, ``flags`` is a bit mask:
 1 = sensor outside the training range, 2 = estimate outside the training position range (the
 columns of ``hystkit compensate``). A closed stdout (``>&-``)
@@ -260,7 +261,11 @@ class _Learning:
                     f"too few references), {report.evaluations} model evaluations; now "
                     f"{stream.compensator.params.to_dict()}")
         values = ", ".join(f"{k} {v:.6g}" for k, v in stream.parameters.items())
-        return head + f"{used}; now {values}"
+        state = stream.state
+        band = ("" if not state.n_band_checks else
+                f"; band: {state.n_band_misses} of {state.n_band_checks} references outside it, "
+                f"now x{math.exp(state.band_log_factor):.3g} its calibrated width")
+        return head + f"{used}; now {values}{band}"
 
 
 class _Latency:
@@ -382,7 +387,7 @@ def _stream(args: argparse.Namespace) -> int:
     if not fmt.plain:
         lines = _Input(stream_lines(iter(lines), fmt, source, TOO_LONG), lines)
     with contextlib.closing(lines):
-        banded = comp.band is not None and learning is None
+        banded = comp.band is not None and args.adapt != "full"
         _write("time,position_estimate,flags" + (",position_lower,position_upper" * banded)
                + "\n")
         tally, latency = _Tally(), _Latency()
@@ -436,7 +441,7 @@ def _adaptive_stream(args: argparse.Namespace, comp,
         return RefittingStream(comp, refit, start, label=str(args.model))
     options = {k: getattr(args, k) for k in ADAPT_OPTIONS if getattr(args, k) is not None}
     adaptation = Adaptation(args.adapt, args.forgetting, **options)
-    return AdaptiveStream(comp, adaptation, start, label=str(args.model))
+    return AdaptiveStream(comp, adaptation, start, label=str(args.model), level=args.level)
 
 
 def _print_sync(sync: SyncExcitation) -> None:

@@ -30,6 +30,14 @@ parameters out of their domain (a multiplier beyond ``MAX_MULTIPLIER`` or its re
 (``n_refused``): the parameters stay where they were. One reference of 1e20 mm used to set the
 gain to 2.7e17; one of 1e200 ended the stream with an OverflowError.
 
+The prediction band (:mod:`._band`) follows the references too, by online quantile tracking
+on a log scale (Angelopoulos, Candès & Tibshirani 2023, "Conformal PID control", the P part):
+the band is the plain stream's half-width times the adapted gain's magnitude (``gain``) times a
+multiplier ``m``; each plausible reference moves ``log m`` by ``BAND_STEP * (miss - alpha)``,
+``miss`` being 1 if the reference fell outside the sample's band and ``alpha = 1 - level``. Over
+the references the share of misses approaches ``alpha`` whatever the drift, as long as the
+multiplier can follow it (within ``[1 / MAX_BAND_FACTOR, MAX_BAND_FACTOR]``).
+
 Re-fitting the whole model (cell dynamics too) on a sliding window: :mod:`._refit`.
 """
 
@@ -59,7 +67,7 @@ from ._stream import (
     initial_state,
 )
 
-__all__ = ["ADAPT_PARAMETERS", "MAX_INNOVATION", "MAX_MULTIPLIER", "REFERENCE_MARGIN",
+__all__ = ["ADAPT_PARAMETERS", "BAND_STEP", "MAX_INNOVATION", "MAX_MULTIPLIER", "REFERENCE_MARGIN",
            "Adaptation", "AdaptiveState", "AdaptiveStream", "Plausible", "advance_adaptive"]
 
 ADAPT_PARAMETERS = ("gain", "weights")
@@ -74,6 +82,10 @@ MAX_INNOVATION = 1.0
 # The output parameters' domain: a gain moved by more than this factor (or a cell's weight
 # multiplier beyond it in magnitude) is no drift but another sensor; fit again.
 MAX_MULTIPLIER = 10.0
+# Quantile tracking of the band: log m moves by BAND_STEP (1 - alpha) at a miss, by
+# -BAND_STEP alpha at a hit (a miss widens the 90 % band by 20 %, nine hits narrow it back).
+BAND_STEP = 0.2
+MAX_BAND_FACTOR = 100.0
 
 
 @dataclass(frozen=True)
@@ -137,12 +149,21 @@ class AdaptiveState:
     n_refused : int, default 0
         Plausible references whose update would have left the output parameters' domain;
         refused, they moved nothing either.
+    band_log_factor : float, default 0.0
+        ``log m`` of the band's multiplier (module docstring).
+    n_band_misses : int, default 0
+        Plausible references that fell outside their sample's band.
+    n_band_checks : int, default 0
+        Plausible references checked against their sample's band.
     """
 
     stream: StreamState
     rls: RlsState
     n_rejected: int = 0
     n_refused: int = 0
+    band_log_factor: float = 0.0
+    n_band_misses: int = 0
+    n_band_checks: int = 0
 
 
 @dataclass(frozen=True)
@@ -225,8 +246,10 @@ class _Plan:
     """Per-stream constants: the plain stream's path, the regressors' recipe, the prior."""
 
     def __init__(self, comp: Compensator, adaptation: Adaptation,
-                 rest_position: float | None) -> None:
-        self.path = _Path(comp, rest_position)
+                 rest_position: float | None, level: float | None = None) -> None:
+        self.path = _Path(comp, rest_position, level)
+        self.alpha = None if comp.band is None else 1.0 - (
+            comp.band.level if level is None else level)
         self.adaptation = adaptation
         if adaptation.parameters == "weights":
             self.unit_params = _unit_weight_params(comp)
@@ -255,17 +278,38 @@ class _Plan:
                          self.max_trace)
 
     def learn(self, state: AdaptiveState, phi: np.ndarray, r: float,
-              estimate: float) -> AdaptiveState:
-        """``state`` after the reference `r` [mm] of a sample estimated at `estimate` [mm]:
-        updated, or unchanged but for a count if `r` is implausible (rejected) or the update
-        would leave the parameters' domain (refused)."""
+              estimate: float, half: float | None = None) -> AdaptiveState:
+        """``state`` after the reference `r` [mm] of a sample estimated at `estimate` [mm]
+        with band half-width `half` [mm] (None: no band): updated, or unchanged but for a
+        count if `r` is implausible (rejected) or the update would leave the parameters'
+        domain (refused). A plausible reference also moves the band's multiplier."""
         if self.plausible.why_not(r, estimate) is not None:
             return dataclasses.replace(state, n_rejected=state.n_rejected + 1)
+        if half is not None:
+            state = self.track_band(state, abs(r - estimate) > half)
         with np.errstate(all="ignore"):  # a non-finite result is refused just below
             rls = self.update(state.rls, phi, r)
         if not self.in_domain(rls.theta):
             return dataclasses.replace(state, n_refused=state.n_refused + 1)
         return dataclasses.replace(state, rls=rls)
+
+    def track_band(self, state: AdaptiveState, miss: bool) -> AdaptiveState:
+        """One step of the band's quantile tracking (module docstring)."""
+        limit = float(np.log(MAX_BAND_FACTOR))
+        log_factor = state.band_log_factor + BAND_STEP * (float(miss) - self.alpha)
+        return dataclasses.replace(state, band_log_factor=min(max(log_factor, -limit), limit),
+                                   n_band_misses=state.n_band_misses + int(miss),
+                                   n_band_checks=state.n_band_checks + 1)
+
+    @staticmethod
+    def untouched(state: AdaptiveState) -> bool:
+        """No reference has moved the output parameters or the band yet."""
+        return state.rls.n_updates == 0 and state.n_band_checks == 0
+
+    def half_width(self, state: AdaptiveState, plain_half: np.ndarray) -> np.ndarray:
+        """The adapted band's half-width [mm] from the plain stream's."""
+        gain = abs(float(state.rls.theta[0])) if self.adaptation.parameters == "gain" else 1.0
+        return plain_half * (gain * float(np.exp(state.band_log_factor)))
 
     def in_domain(self, theta: np.ndarray) -> bool:
         """Whether output parameters ``theta`` lie in their domain (module docstring)."""
@@ -366,22 +410,33 @@ def _advance_plan(plan: _Plan, state: AdaptiveState, sensor: np.ndarray,
         return plain, state
     phi = plan.regressors(state.stream, s_raw, plain.estimate)
     estimate = np.empty(s_raw.size)
+    banded = plain.lower is not None
+    plain_half = plain.upper - plain.estimate if banded else None
+    lower, upper = (np.empty(s_raw.size), np.empty(s_raw.size)) if banded else (None, None)
     learnt, begin = state, 0
     for i in [*np.flatnonzero(np.isfinite(r)).tolist(), s_raw.size]:
         part = slice(begin, min(i + 1, s_raw.size))
         estimate[part] = plan.predict(learnt.rls, phi[part], plain.estimate[part])
+        half = None
+        if banded:
+            if plan.untouched(learnt):  # the plain band, bit for bit, until a reference
+                lower[part], upper[part] = plain.lower[part], plain.upper[part]
+            else:
+                half = plan.half_width(learnt, plain_half[part])
+                lower[part], upper[part] = estimate[part] - half, estimate[part] + half
         if i < s_raw.size:
-            learnt = plan.learn(learnt, phi[i], r[i], estimate[i])
+            learnt = plan.learn(learnt, phi[i], r[i], estimate[i],
+                                None if not banded else float(upper[i] - estimate[i]))
         begin = i + 1
     out = StreamOutput(estimate, plain.sensor_outside,
-                       _outside(estimate, plan.path.estimate_bounds))
+                       _outside(estimate, plan.path.estimate_bounds), lower, upper)
     return out, dataclasses.replace(learnt, stream=stream_next)
 
 
 def advance_adaptive(comp: Compensator, adaptation: Adaptation, state: AdaptiveState,
                      sensor: np.ndarray, reference: np.ndarray | None = None, *,
-                     rest_position: float | None = None,
-                     label: str = "stream") -> tuple[StreamOutput, AdaptiveState]:
+                     rest_position: float | None = None, label: str = "stream",
+                     level: float | None = None) -> tuple[StreamOutput, AdaptiveState]:
     """Run one chunk of raw sensor samples with references [mm] (NaN: unknown).
 
     Pure, as :func:`~._stream.advance`; ``state`` comes from :attr:`AdaptiveStream.state`
@@ -404,12 +459,14 @@ def advance_adaptive(comp: Compensator, adaptation: Adaptation, state: AdaptiveS
         :class:`~._stream.Stream`).
     label : str, default "stream"
         Names the stream in error messages.
+    level : float, optional
+        Nominal coverage of the band; default the band's own.
 
     Returns
     -------
     output : StreamOutput
-        The chunk's adapted estimates [mm] and use-time flags (``estimate_outside`` of the
-        adapted estimate).
+        The chunk's adapted estimates [mm], their adapted band and the use-time flags
+        (``estimate_outside`` of the adapted estimate).
     state : AdaptiveState
         The state after the chunk's last sample and its references.
 
@@ -421,8 +478,8 @@ def advance_adaptive(comp: Compensator, adaptation: Adaptation, state: AdaptiveS
     FitDivergedError
         As :func:`~._stream.advance`.
     """
-    return _advance_plan(_Plan(comp, adaptation, rest_position), state, sensor, reference,
-                         label)
+    return _advance_plan(_Plan(comp, adaptation, rest_position, level), state, sensor,
+                         reference, label)
 
 
 class AdaptiveStream:
@@ -434,8 +491,9 @@ class AdaptiveStream:
         Any deployable compensator; ``"weights"`` needs a direct one with weights ``w``, ``v_b``.
     adaptation : Adaptation, optional
         What to re-fit and how fast to forget (default: gain and offset, lambda = 0.9).
-    start, rest_position, label
-        As :class:`~._stream.Stream`.
+    start, rest_position, label, level
+        As :class:`~._stream.Stream`; the band (if the compensator has one) follows the
+        references (module docstring).
 
     Notes
     -----
@@ -445,8 +503,8 @@ class AdaptiveStream:
 
     def __init__(self, compensator: Compensator, adaptation: Adaptation | None = None,
                  start: StartUp = "rest", *, rest_position: float | None = None,
-                 label: str = "stream") -> None:
-        self._plan = _Plan(compensator, adaptation or Adaptation(), rest_position)
+                 label: str = "stream", level: float | None = None) -> None:
+        self._plan = _Plan(compensator, adaptation or Adaptation(), rest_position, level)
         self._state = AdaptiveState(initial_state(compensator, start), self._plan.start)
         self._previous: _Previous | None = None  # speeds up step; never changes a result
         self.label = label
@@ -501,7 +559,8 @@ class AdaptiveStream:
         if self._plan.adaptation.parameters != "gain":
             out = self.process_flagged(np.array([sensor]), np.array([reference]))
             return StepOutput(float(out.estimate[0]),
-                              *(None if f is None else bool(f[0]) for f in out[1:]))
+                              *(None if f is None else bool(f[0]) for f in out[1:3]),
+                              *(None if b is None else float(b[0]) for b in out[3:]))
         # gain: the plain stream's fast one-sample path (the same bits as its chunks), then
         # the same prediction and update as a chunk's
         r = _references(np.array([reference]), 1, self._state.stream.n_samples, self.label)[0]
@@ -510,11 +569,20 @@ class AdaptiveStream:
         phi = np.array([[plain.estimate, 1.0]])
         learnt = self._state
         estimate = float(self._plan.predict(learnt.rls, phi, np.array([plain.estimate]))[0])
+        band = (None, None)
+        if plain.lower is not None and self._plan.untouched(learnt):
+            band = (plain.lower, plain.upper)
+        elif plain.lower is not None:  # the chunk path's operations on one-element arrays
+            half = self._plan.half_width(
+                learnt, np.array([plain.upper]) - np.array([plain.estimate]))
+            band = (float((np.array([estimate]) - half)[0]),
+                    float((np.array([estimate]) + half)[0]))
         if np.isfinite(r):
-            learnt = self._plan.learn(learnt, phi[0], r, estimate)
+            learnt = self._plan.learn(learnt, phi[0], r, estimate,
+                                      None if band[1] is None else band[1] - estimate)
         self._state = dataclasses.replace(learnt, stream=stream_next)
         return StepOutput(estimate, plain.sensor_outside,
-                          _outside(estimate, self._plan.path.estimate_bounds))
+                          _outside(estimate, self._plan.path.estimate_bounds), *band)
 
     def process(self, sensor: np.ndarray, reference: np.ndarray | None = None) -> np.ndarray:
         """Estimates [mm] for a chunk; ``reference`` [mm] per sample, NaN where unknown."""

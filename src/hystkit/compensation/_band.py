@@ -402,6 +402,9 @@ def calibrate_band(comp, recordings: Sequence[Recording], size: int,
     band = Band(level, tuple(np.quantile(scores, QUANTILE_GRID)), error.size, tau,
                 rate_reference, rate_high, share, trial.protocol)
     note = f"band: {trial.protocol}, {error.size} held-out samples"
+    if len(recordings) == 1:
+        note += ("; one recording: it holds for runs like this one, not for an offset, gain or "
+                 "excitation that changes between runs (give several recordings)")
     if failed:
         note += f" ({len(failed)} fold(s) failed and are left out: {failed[0]})"
     return band, note
