@@ -105,6 +105,10 @@ def test_batch_writes_models_and_a_table_of_their_scores(tmp_path, fleet):
         assert row["status"] == "ok" and row["error"] is None
         assert (row["r2_deployable"], row["r2_oracle"], row["e_rms_pct_deployable"]) == \
             (scores["r2"], scores["r2_oracle"], scores["e_rms_pct"])
+        # the written model carries its band, scored like evaluate's
+        assert (row["band_coverage"], row["band_width_median"]) == \
+            (scores["band_coverage"], scores["band_width_median"])
+        assert 0.5 < row["band_coverage"] <= 1.0
     for name in ("results.parquet", "results.csv"):
         read = getattr(pd, f"read_{name.split('.')[1]}")(tmp_path / "out" / name)
         assert list(read.columns) == list(RESULT_COLUMNS)

@@ -27,6 +27,7 @@ from ..compensation import (
     fit_compensator,
     save_compensator,
     verdict,
+    with_band,
 )
 from ..errors import InputError, OutputError
 from ..io import (
@@ -46,10 +47,12 @@ __all__ = ["RESULT_COLUMNS", "fit_sensor", "pending", "run_batch"]
 
 #: Columns of ``results.parquet`` / ``results.csv``. Scores are on the validation recordings
 #: (the mean over several): deployable (the model's own centring) and oracle (the paper's
-#: protocol, each recording's own means: not available in use).
+#: protocol, each recording's own means: not available in use); the prediction band's coverage
+#: and median width [mm] are deployable (its nominal level is the model file's, 0.90).
 RESULT_COLUMNS = ("sensor", "status", "model", "size", "mode", "center", "r2_deployable",
-                  "e_rms_pct_deployable", "r2_oracle", "linear_r2_deployable", "fit_seconds",
-                  "seconds", "guards", "error", "model_file")
+                  "e_rms_pct_deployable", "r2_oracle", "linear_r2_deployable", "band_coverage",
+                  "band_width_median", "fit_seconds", "seconds", "guards", "error",
+                  "model_file")
 MARKER = "batch.json"
 #: How a batch reads its recordings: one `ReadOptions` for every file; a mapping from a file
 #: (as ``str(path)``) to its options; or None. A file not in the mapping, and every file with
@@ -85,6 +88,9 @@ def fit_sensor(job: SensorJob, *, read_options: Reading = None) -> dict:
         fit_recs, val_recs = _recordings(job, read_options)
         options = {} if job.center is None else {"center": job.center}
         comp = fit_compensator(fit_recs, job.size, model=job.model, mode=job.mode, **options)
+        if comp.fit_info["status"] == "ok":  # a band for a model that may be used
+            options.pop("center", None)
+            comp = with_band(comp, fit_recs, row["size"], options)
         scores = [evaluate(comp, rec) for rec in val_recs]
     except Exception as exc:  # noqa: BLE001  (one sensor never stops the batch)
         _raise_interrupt(exc)
@@ -105,6 +111,8 @@ def fit_sensor(job: SensorJob, *, read_options: Reading = None) -> dict:
                r2_deployable=_mean(scores, "r2"), e_rms_pct_deployable=_mean(scores, "e_rms_pct"),
                r2_oracle=_mean(scores, "r2_oracle"),
                linear_r2_deployable=_mean(scores, "linear_r2"),
+               band_coverage=_mean(scores, "band_coverage"),
+               band_width_median=_mean(scores, "band_width_median"),
                fit_seconds=info["fit_seconds"], seconds=time.perf_counter() - t0,
                guards=None if status == "ok" else message,
                model_file=f"models/{job.sensor}.json")
