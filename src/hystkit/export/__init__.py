@@ -3,7 +3,9 @@
 
 The generated code repeats :meth:`hystkit.compensation.Compensator.estimate` sample by sample:
 the causal centring (fit / tare / track), polarity and scaling, and the family's compiled
-block (``Family.block``), translated per family in :mod:`._families`. A family, mode or
+block (``Family.block``), translated per family in :mod:`._families`; and, when the
+compensator carries one, its prediction band (:meth:`Compensator.estimate_with_band`: lower
+and upper [mm] per sample, the same code for every family). A family, mode or
 centring without a translation is refused with the reason (``InputError``), never stubbed.
 """
 

@@ -5,9 +5,12 @@ Files:
 - ``NAME_init.m``: ``state = NAME_init(first_sensor)``, at rest at the first sensor sample;
 - ``NAME.m``: ``[estimate, state, flags] = NAME(sensor, state)`` over a chunk (a vector) of
   sensor samples; ``state`` omitted or ``[]`` starts with ``NAME_init(sensor(1))``; calling it
-  chunk after chunk gives the same as one call on the whole signal;
-- ``NAME_block.m``: one sample in, one estimate out, the state ``persistent`` (for a Simulink
-  MATLAB Function block; ``clear NAME_block`` restarts it);
+  chunk after chunk gives the same as one call on the whole signal. With a prediction band,
+  ``[estimate, state, flags, lower, upper] = NAME(...)``: the band [mm] of each estimate, its
+  features carried in ``state`` (``Compensator.estimate_with_band``);
+- ``NAME_block.m``: one sample in, one estimate out (with a band: ``[estimate, lower,
+  upper]``), the state ``persistent`` (for a Simulink MATLAB Function block; ``clear
+  NAME_block`` restarts it);
 - ``NAME_sync.m`` when the state after the synchronisation excitation is known.
 
 The arithmetic repeats :meth:`Compensator.estimate` in the same order as the C export.
@@ -50,6 +53,7 @@ def _comment(plan: ExportPlan, what: str) -> str:
 % centring     : {p['center']} (causal)
 % source file  : {p['source']}
 % fit date     : {p['fit_date']}
+% band         : {p['band']}
 """
 
 
@@ -107,7 +111,7 @@ def _init(plan: ExportPlan) -> str:
 % {n} too). state = {n}_init([], x_model): from a saved model state (the family block's state
 % vector, as hystkit's Stream and {n}_sync give it); the centring starts afresh.
 state = struct('x', zeros({plan.n_state}, 1), 'level', 0.0, 'sum_z', 0.0, 'weight_z', 0.0, ...
-               'n_seen', 0);
+               'n_seen', 0{_BAND_FIELDS if plan.band else ''});
 if nargin > 1
     state.x = model_load(body(), x_model);
     return;
@@ -122,23 +126,61 @@ end
 {translator(plan.model).m_model(plan, lit)}"""
 
 
+_BAND_FIELDS = (", ...\n               'band_started', 0, 'band_previous', 0.0, 'band_rate', 0.0, "
+                "'band_outside', 0.0")
+
+
+def _band(plan: ExportPlan) -> str:
+    """``band_half``: the band's feature state (``_band.BandState``) and its half-width per
+    sample, ``_band._features_kernel`` then ``_band.half_width`` in their order of
+    operations."""
+    b = {k: lit(v) for k, v in plan.band.items()}
+    return f"""function [h, st] = band_half(st, s)
+% the prediction band's half-width [mm] at normalised sensor sample s (hystkit's
+% compensation._band): the rate's running mean and the remembered excursion beyond the training
+% range (causal), then q * sigma + w * o
+if st.band_started
+    d = abs(s - st.band_previous) / {b['DT']};
+else
+    d = 0.0;
+end
+st.band_rate = {b['DECAY']} * st.band_rate + {b['GAIN']} * d;
+beyond = max(max({b['LOW']} - s, s - {b['HIGH']}), 0.0) / {b['WIDTH']};
+st.band_outside = max(beyond, {b['DECAY']} * st.band_outside);
+st.band_previous = s;
+st.band_started = 1;
+h = {b['Q']} * (({b['BASE']} + {b['SHARE']} * st.band_rate / {b['RATE_REFERENCE']}) ...
+    + max(st.band_rate / {b['RATE_HIGH']} - 1.0, 0.0)) + {b['POSITION_WIDTH']} * st.band_outside;
+end
+"""
+
+
 def _chunk(plan: ExportPlan) -> str:
     n, c = plan.name, _constants(plan)
-    return _comment(plan, f"{n}.m") + f"""function [estimate, state, flags] = {n}(sensor, state)
+    if plan.band is None:
+        outputs, doc, start, step, sub = "[estimate, state, flags]", "", "", "", ""
+    else:
+        outputs = "[estimate, state, flags, lower, upper]"
+        doc = (f"% lower, upper: the prediction band [mm] of each estimate at nominal level "
+               f"{plan.band['LEVEL']:g}; its\n% features are carried in state.\n")
+        start = "lower = zeros(size(sensor));\nupper = zeros(size(sensor));\n"
+        step = "    [h, state] = band_half(state, s);\n"
+        sub = "\n" + _band(plan)
+    return _comment(plan, f"{n}.m") + f"""function {outputs} = {n}(sensor, state)
 % [estimate, state, flags] = {n}(sensor, state): position estimates [mm] for a chunk of sensor
 % samples. state omitted or [] starts at rest at sensor(1) ({n}_init); pass the returned state
 % to the next call. flags per sample: 1 sensor outside the training range, 2 estimate outside
 % the training positions, 4 model output not finite or beyond 1e6 x the training range.
-if nargin < 2 || isempty(state)
+{doc}if nargin < 2 || isempty(state)
     state = {n}_init(sensor(1));
 end
 B = body();
 estimate = zeros(size(sensor));
 flags = zeros(size(sensor));
-x = state.x;
+{start}x = state.x;
 for i = 1:numel(sensor)
     [s, state] = normalised(state, sensor(i));
-    [p, x] = model_step(B, x, s);
+{step}    [p, x] = model_step(B, x, s);
     e = p * {c['POSITION_SCALE']} + {c['POSITION_OFFSET']};
     f = 0;
     if s < {c['SENSOR_LOW']} || s > {c['SENSOR_HIGH']}, f = f + 1; end
@@ -146,10 +188,10 @@ for i = 1:numel(sensor)
     if ~(abs(p) <= {c['MAX_NORMALISED']}) || ~isfinite(e), f = f + 4; end
     estimate(i) = e;
     flags(i) = f;
-end
+{"    lower(i) = e - h;" + chr(10) + "    upper(i) = e + h;" + chr(10) if plan.band else ""}end
 state.x = x;
 end
-
+{sub}
 {_centring(plan)}
 {_body(plan)}
 {translator(plan.model).m_model(plan, lit)}"""
@@ -157,15 +199,20 @@ end
 
 def _block(plan: ExportPlan) -> str:
     n = plan.name
-    return _comment(plan, f"{n}_block.m") + f"""function estimate = {n}_block(sensor)
+    if plan.band is None:
+        outputs, call, doc = "estimate", "[estimate, state]", ""
+    else:
+        outputs, call = "[estimate, lower, upper]", "[estimate, state, ~, lower, upper]"
+        doc = "% lower, upper: the estimate's prediction band [mm].\n"
+    return _comment(plan, f"{n}_block.m") + f"""function {outputs} = {n}_block(sensor)
 % estimate = {n}_block(sensor): one sample in, one estimate [mm] out, the state kept in a
 % persistent variable (for a Simulink MATLAB Function block). Starts at rest at the first
 % sample; 'clear {n}_block' starts again.
-persistent state
+{doc}persistent state
 if isempty(state)
     state = {n}_init(sensor);
 end
-[estimate, state] = {n}(sensor, state);
+{call} = {n}(sensor, state);
 end
 """
 

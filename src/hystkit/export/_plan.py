@@ -3,15 +3,17 @@
 A :class:`ExportPlan` holds the model's compiled-block ``body`` (the flat float64 parameters
 ``Family.block`` gives the closed loop, so a translation reads the same numbers at the same
 indices as the family's numba kernel), the centring, polarity and scaling constants of
-:meth:`Compensator.estimate`, the use-time guard ranges, the optional synchronised start state
-and the provenance written into the generated files' comments. The C and MATLAB writers only
-format it.
+:meth:`Compensator.estimate`, the use-time guard ranges, the prediction band's constants (the
+same for every family: :mod:`hystkit.compensation._band`), the optional synchronised start
+state and the provenance written into the generated files' comments. The C and MATLAB writers
+only format it.
 """
 
 from __future__ import annotations
 
 import json
 import keyword
+import math
 import re
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -26,8 +28,8 @@ from ..compensation._compensator import MAX_NORMALISED, POSITION_MARGIN, SENSOR_
 from ..errors import InputError
 from ._families import translator
 
-__all__ = ["C_KEYWORDS", "FLOAT_SENSITIVITY_LIMIT", "ExportPlan", "float_sensitivity",
-           "identifier", "make_plan"]
+__all__ = ["C_KEYWORDS", "FLOAT_SENSITIVITY_LIMIT", "ExportPlan", "band_constants",
+           "float_sensitivity", "identifier", "make_plan"]
 
 # Largest change of the model's output, relative to its range, when its input is rounded to
 # float (1e-7 relative) for which a float export is offered without a warning: a tenth of the
@@ -45,7 +47,7 @@ _MATLAB_TAKEN = frozenset([
     "move", "current", "mpl_current", "dead_zone", "cubic", "cells", "solve_output", "everett",
     "term", "load_sums", "make_room", "update", "combine", "last_index", "running_sum",
     "branch_output", "rhs", "project", "restoring", "restoring_inverse", "dissipation",
-    "dissipation_inverse", "rest_input", "f_of", "f_inverse", "a", "p",
+    "dissipation_inverse", "rest_input", "f_of", "f_inverse", "a", "p", "band_half",
     # NAME_step of the C side would clash with its static model_step
     "model"])
 # Fit-date keys a model file's ``fit`` section may carry (none is written by hystkit yet).
@@ -80,6 +82,9 @@ class ExportPlan:
         :func:`float_sensitivity`).
     sync_note : str
         What the sync start-up is, or why there is none.
+    band : dict or None
+        The prediction band's constants at the exported level (see :func:`band_constants`);
+        None: the compensator has no band, and the export has no band outputs.
     """
 
     name: str
@@ -94,6 +99,7 @@ class ExportPlan:
     provenance: dict = field(default_factory=dict)
     float_sensitivity: float = 0.0
     sync_note: str = ""
+    band: dict | None = None
 
     @property
     def float_is_enough(self) -> bool:
@@ -137,7 +143,8 @@ def identifier(text: str) -> str:
 
 
 def make_plan(comp: Compensator, name: str | None = None, *,
-              sync_state: np.ndarray | None = None, sync_note: str = "") -> ExportPlan:
+              sync_state: np.ndarray | None = None, sync_note: str = "",
+              level: float | None = None) -> ExportPlan:
     """Gather what an exported ``comp`` needs; refuse (InputError) what cannot be exported.
 
     Parameters
@@ -151,6 +158,8 @@ def make_plan(comp: Compensator, name: str | None = None, *,
         Model state after the synchronisation excitation.
     sync_note : str
         What the sync start-up is, or why there is none.
+    level : float, optional
+        Nominal coverage of the exported band; default the band's own (``Band.level``).
 
     Returns
     -------
@@ -160,8 +169,9 @@ def make_plan(comp: Compensator, name: str | None = None, *,
     Raises
     ------
     InputError
-        When the family or mode has no translation, the centring is the oracle, or ``name``
-        is not an identifier; the message gives the reason on one line.
+        When the family or mode has no translation, the centring is the oracle, ``name``
+        is not an identifier, or `level` is given for a compensator without a band (or is
+        not a probability); the message gives the reason on one line.
     """
     source = comp.source or "<memory>"
     if comp.center == "recording":
@@ -179,6 +189,7 @@ def make_plan(comp: Compensator, name: str | None = None, *,
         raise InputError(f"--name {name!r}: not usable as a C/MATLAB identifier (letters, "
                          f"digits and _, starting with a letter, not a keyword); e.g. "
                          f"{identifier(name)!r}")
+    band = band_constants(comp, level)
     block = comp.family.block(comp.structure, comp.params, comp.mode == "inverse")
     return ExportPlan(
         name=name, model=comp.model, mode=comp.mode, center=comp.center,
@@ -186,8 +197,62 @@ def make_plan(comp: Compensator, name: str | None = None, *,
         constants=_constants(comp),
         extra=trans.extra(comp),
         sync_state=None if sync_state is None else np.asarray(sync_state, dtype=float),
-        provenance=_provenance(comp), float_sensitivity=float_sensitivity(comp),
-        sync_note=sync_note)
+        provenance=_provenance(comp, band), float_sensitivity=float_sensitivity(comp),
+        sync_note=sync_note, band=band)
+
+
+def band_constants(comp: Compensator, level: float | None = None) -> dict[str, float] | None:
+    """The prediction band of ``comp`` as numbers (names as in the C code), or None.
+
+    The generated per-sample recursion is ``_band._features_kernel`` and the half-width
+    ``_band.half_width``, in the same order of operations; the constants the Python side
+    derives from the model file (``exp(-dt / tau)``, ``1 - decay``, ``1 - share``, the range
+    widths) are computed here on the same doubles.
+
+    Parameters
+    ----------
+    comp : Compensator
+        The compensator.
+    level : float, optional
+        Nominal coverage; default the band's own.
+
+    Returns
+    -------
+    dict or None
+        ``LEVEL``, ``Q`` (the score quantile at the level [mm]), ``DT``, ``DECAY``, ``GAIN``,
+        ``LOW``, ``HIGH``, ``WIDTH`` (the normalised training range), ``BASE``, ``SHARE``,
+        ``RATE_REFERENCE``, ``RATE_HIGH`` and ``POSITION_WIDTH`` [mm]; None without a band.
+
+    Raises
+    ------
+    InputError
+        `level` given for a compensator without a band, `level` not strictly between 0 and
+        1, or a band without the training ranges it is measured against.
+    """
+    source = comp.source or "<memory>"
+    band = comp.band
+    if band is None:
+        if level is not None:
+            raise InputError(f"--level: {source} has no prediction band (fitted without one "
+                             f"or by a hystkit before bands); fit it again for a band")
+        return None
+    if comp.training_range is None or comp.position_range is None:
+        raise InputError(f"{source}: the prediction band needs the training ranges, which the "
+                         f"model file does not give; fit it again")
+    try:
+        q = band.quantile(level)
+    except ValueError as exc:
+        raise InputError(f"--level: {exc}") from None
+    dt = float(comp.structure.dt)
+    decay = math.exp(-dt / band.tau)
+    low, high = comp.training_range
+    high = high if high > low else low + 1.0  # as band_features: a range of one value
+    p_lo, p_hi = comp.position_range
+    return {"LEVEL": float(band.level if level is None else level), "Q": float(q), "DT": dt,
+            "DECAY": decay, "GAIN": 1.0 - decay, "LOW": float(low), "HIGH": float(high),
+            "WIDTH": float(high - low), "BASE": 1.0 - band.rate_share,
+            "SHARE": float(band.rate_share), "RATE_REFERENCE": float(band.rate_reference),
+            "RATE_HIGH": float(band.rate_high), "POSITION_WIDTH": float(p_hi - p_lo)}
 
 
 def float_sensitivity(comp: Compensator) -> float:
@@ -262,7 +327,16 @@ def _constants(comp: Compensator) -> dict[str, float]:
     }
 
 
-def _provenance(comp: Compensator) -> dict[str, str]:
+def _band_text(comp: Compensator, band: dict | None) -> str:
+    if band is None:
+        return ("none: the model file has no prediction band (fitted with --no-band, or by a "
+                "hystkit before bands); no lower/upper outputs")
+    return (f"prediction band at level {band['LEVEL']:g}, outputs lower/upper [mm] per sample "
+            f"(calibrated at {comp.band.level:g} on {comp.band.protocol}, "
+            f"{comp.band.n_calibration} held-out samples)")
+
+
+def _provenance(comp: Compensator, band: dict | None = None) -> dict[str, str]:
     info = comp.fit_info or {}
     date = next((str(info[k]) for k in _DATE_KEYS if info.get(k)), None)
     if date is None:
@@ -279,6 +353,7 @@ def _provenance(comp: Compensator) -> dict[str, str]:
         "fit_date": date,
         "hystkit": __version__,
         "exported": f"{datetime.now(UTC):%Y-%m-%d %H:%M} UTC",
+        "band": _band_text(comp, band),
     }
 
 

@@ -40,7 +40,8 @@ def sync_state_of(comp: Compensator) -> tuple[np.ndarray | None, str]:
 
 def export_compensator(comp: Compensator, out: str | Path, lang: str = "c", *,
                        double: bool = False, name: str | None = None,
-                       force: bool = False) -> tuple[ExportPlan, dict[str, str]]:
+                       force: bool = False,
+                       level: float | None = None) -> tuple[ExportPlan, dict[str, str]]:
     """Write ``comp`` as code into the folder ``out``; returns the plan and file name -> text.
 
     Parameters
@@ -60,6 +61,10 @@ def export_compensator(comp: Compensator, out: str | Path, lang: str = "c", *,
         Write into an existing folder, replacing same-named files. Without it the folder is
         created complete (built beside it, then renamed): of two exports to the same new
         folder exactly one succeeds.
+    level : float, optional
+        Nominal coverage of the exported prediction band (its lower/upper outputs); default
+        the band's own. A compensator without a band exports without band outputs, and
+        refuses a `level`.
 
     Returns
     -------
@@ -71,8 +76,8 @@ def export_compensator(comp: Compensator, out: str | Path, lang: str = "c", *,
     Raises
     ------
     InputError
-        Unknown language, `double` with MATLAB, or a compensator that cannot be exported
-        (the reason).
+        Unknown language, `double` with MATLAB, a `level` without a band, or a compensator
+        that cannot be exported (the reason).
     OutputExistsError
         ``out`` exists (or was created while the files were built) and ``force`` is not
         given.
@@ -86,7 +91,7 @@ def export_compensator(comp: Compensator, out: str | Path, lang: str = "c", *,
     if out.exists() and not force:
         raise OutputExistsError(f"{out} exists; use --force to write into it")
     sync_state, sync_note = sync_state_of(comp)
-    plan = make_plan(comp, name, sync_state=sync_state, sync_note=sync_note)
+    plan = make_plan(comp, name, sync_state=sync_state, sync_note=sync_note, level=level)
     files = c_files(plan, double) if lang == "c" else matlab_files(plan)
     if force:  # into the folder, existing or not: same-named files replaced, others kept
         with atomic_folder(out, force=True, names=files) as tmp:
