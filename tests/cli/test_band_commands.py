@@ -83,3 +83,16 @@ def test_report_shades_the_band_and_tables_its_coverage(files, capsys):
     assert "Prediction band (deployable)" in html
     scores = evaluate(load_compensator(files["model"]), read_recording(files["test"]))
     assert f"<td>{scores['band_coverage']:.3f}</td>" in html  # evaluate's, to the table's digits
+
+
+def test_export_bakes_the_level_in_and_refuses_it_without_a_band(files, capsys):
+    out = files["folder"] / "c_code"
+    assert main(["export", str(files["model"]), "--out", str(out), "--level", "0.8"]) == 0
+    assert "80% prediction band" in capsys.readouterr().out
+    assert "#define M_BAND_LEVEL 0.8\n" in (out / "m.h").read_text()
+    bare = files["folder"] / "bare_export.json"
+    assert main(["fit", str(files["train"]), "--no-band", "--out", str(bare)]) == 0
+    assert main(["export", str(bare), "--out", str(files["folder"] / "c2"), "--level",
+                 "0.8"]) == 2
+    assert "no prediction band" in capsys.readouterr().err
+    assert not (files["folder"] / "c2").exists()

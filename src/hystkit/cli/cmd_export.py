@@ -22,8 +22,11 @@ def _export(args: argparse.Namespace) -> int:
 
     comp = load_compensator(args.model)
     plan, files = export_compensator(comp, args.out, args.lang, double=args.double, name=args.name,
-                               force=args.force)
-    print(f"wrote {args.out}: {', '.join(sorted(files))}")
+                                     force=args.force, level=args.level)
+    band = ("" if comp.band is None else
+            f" (with the {comp.band.level if args.level is None else args.level:.0%} "
+            f"prediction band: lower, upper)")
+    print(f"wrote {args.out}: {', '.join(sorted(files))}{band}")
     if args.lang == "c":
         precision = "double" if args.double else "float"
         print(f"{precision} arithmetic; build the example with: cd {args.out} && {COMPILE_LINE}")
@@ -36,6 +39,8 @@ def _export(args: argparse.Namespace) -> int:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``export`` subcommand to the ``hystkit`` parser."""
+    from ._common import number
+
     p = sub.add_parser("export", help="write a fitted compensator as dependency-free C99 or "
                                       "as MATLAB/Octave code")
     p.add_argument("model", type=Path, help="model JSON file written by 'hystkit fit'")
@@ -48,4 +53,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "refused with --lang matlab, whose code is always double")
     p.add_argument("--name", help="name of the generated functions (default: from the model "
                                   "file name)")
+    p.add_argument("--level", type=number(0, 1, low_open=True, high_open=True), default=None,
+                   help="nominal coverage of the exported prediction band, in (0, 1) (default: "
+                        "the model's own, 0.90 unless fitted otherwise); refused for a model "
+                        "without a band")
     p.set_defaults(run=_export)

@@ -178,9 +178,24 @@ def admissible_size(model: str, dt: float, n_samples: int) -> int | None:
 
 
 def fit_fold(cand, fold: Fold, options: dict):
-    """A candidate (anything with ``model``, ``size``, ``mode`` and ``center``, such as
-    select's candidates) fitted on a fold's training part (no standard errors); `options` go
-    to :func:`~hystkit.compensation.fit_compensator`."""
+    """A model configuration fitted on a fold's training part (no standard errors).
+
+    Parameters
+    ----------
+    cand : object
+        Anything with ``model``, ``size``, ``mode`` and ``center`` (select's candidates, the
+        band's refits).
+    fold : Fold
+        The fold; its held-out samples get weight zero (one recording) or are another
+        recording.
+    options : dict
+        Further options of :func:`~hystkit.compensation.fit_compensator`.
+
+    Returns
+    -------
+    Compensator
+        Fitted on the fold's training part.
+    """
     if fold.held is None:
         return fit_compensator(fold.train, cand.size, model=cand.model, mode=cand.mode,
                                center=cand.center, diagnose=False, **options)
