@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..compensation import evaluate, fit_compensator
+from ..compensation import evaluate, fit_compensator, interval, with_band
 from ..io import atomic_folder, check_output_folder, write_json
 from ..preprocess import PreprocessSettings, preprocess_raw
 from ..sensors import ScopeSettings, simulate_experiment, simulate_raw
@@ -36,8 +36,9 @@ FIGURE_DPI = 110
 _LOOPS_CAPTION = ("Validation loops: the sensor against the position (top), the mPL and "
                   "straight-line estimates against it (middle, dashed: ideal), their error "
                   "against the position (bottom).")
-_SERIES_CAPTION = ("Each validation recording's whole run with the error trace; right: a zoom "
-                   "on the stretch around the largest mPL error.")
+_SERIES_CAPTION = ("Each validation recording's whole run with the error trace and the 90 % "
+                   "prediction band shaded (calibrated on interleaved cycles of the fitting "
+                   "recording); right: a zoom on the stretch around the largest mPL error.")
 FIT_SEED, VALIDATION_SEED = 1, 2
 # The raw path's scope rate: low enough to keep the demo fast (10 M samples per channel and
 # recording), high enough for every encoder state to last 25 samples. The lab used 2 and
@@ -68,17 +69,23 @@ def format_table(metrics: dict, title: str, reference: dict | None = None) -> st
     str
         The table, one line per excitation.
     """
+    banded = any(m.get("band_coverage") is not None for m in metrics.values())
     head = (f"{'excitation':<11}{'mPL R²':>9}{'line R²':>9}{'e_rms %':>9}{'loop area %':>13}"
-            f"{'oracle: mPL R²':>16}{'line R²':>9}")
+            + (f"{'band cover':>12}" if banded else "")
+            + f"{'oracle: mPL R²':>16}{'line R²':>9}")
     if reference:
         head += f"{'document mPL / line':>22}"
     centring = next(iter(metrics.values()))["center"] if metrics else ""
-    lines = [(f"{title}\ndeployable centring: {centring}; oracle: recording (the paper's "
-             f"protocol)"), head]
+    level = next((m["band_level"] for m in metrics.values() if m.get("band_level")), None)
+    band = ("" if level is None else f"; band cover: share of positions inside the "
+            f"{level:.0%} prediction band")
+    lines = [(f"{title}\ndeployable centring: {centring}{band}; oracle: recording (the "
+             f"paper's protocol)"), head]
     for name, m in metrics.items():
         row = (f"{name:<11}{_cell(m['r2']):>9}{_cell(m['linear_r2']):>9}"
                f"{_cell(m['e_rms_pct'], '.2f'):>9}{_cell(m['loop_area'], '.2f'):>13}"
-               f"{_cell(m['r2_oracle']):>16}{_cell(m['linear_r2_oracle']):>9}")
+               + (f"{_cell(m.get('band_coverage'), '.3f'):>12}" if banded else "")
+               + f"{_cell(m['r2_oracle']):>16}{_cell(m['linear_r2_oracle']):>9}")
         if reference and name in reference:
             row += f"{_cell(reference[name][0], '.3f'):>15} / {reference[name][1]:.3f}"
         lines.append(row)
@@ -130,14 +137,16 @@ def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
     names = DEMO_FILES + (RAW_DEMO_FILES if raw else ()) + (REPORT_DEMO_FILES if report else ())
     check_output_folder(out, names, force)
     t_start = time.perf_counter()
-    recordings, compensators, metrics, shown = {}, {}, {}, {}
+    recordings, compensators, metrics, shown, bands = {}, {}, {}, {}, {}
     for name in EXPERIMENTS:
         fit_rec = simulate_experiment(name, FIT_SEED)
         val_rec = simulate_experiment(name, VALIDATION_SEED)
-        comp = fit_compensator(fit_rec, n_cells)
+        comp = with_band(fit_compensator(fit_rec, n_cells), [fit_rec], n_cells)
         recordings[name], compensators[name] = val_rec, comp
         metrics[name] = evaluate(comp, val_rec)
         shown[name] = (val_rec, comp.estimate(val_rec), comp.estimate_linear(val_rec))
+        if comp.band is not None:
+            bands[name] = interval(comp, val_rec, shown[name][1])
         progress(f"  {name:<6} fitted in {comp.fit_info['fit_seconds']:.2f} s "
                  f"({fit_rec.n_samples} samples, {n_cells} cells, "
                  f"{comp.structure.n_params} parameters)")
@@ -148,7 +157,8 @@ def run_demo(out_dir: str | Path, *, n_cells: int = 3, force: bool = False,
               "center": comp.center, "fit_seed": FIT_SEED, "validation_seed": VALIDATION_SEED,
               "sensor": "VirtualSensor() defaults", "seconds": time.perf_counter() - t_start}
     loops = figure_png(plot_loops(shown, sensor_label=VIRTUAL_SENSOR_LABEL), FIGURE_DPI)
-    series = figure_png(plot_time_series(shown), FIGURE_DPI)
+    series = figure_png(plot_time_series(shown, bands=bands or None, band_label="90% band"),
+                        FIGURE_DPI)
     figures = {"loops": (loops, _LOOPS_CAPTION), "time_series": (series, _SERIES_CAPTION)}
     with atomic_folder(out, force, names) as tmp:
         write_json(metrics, tmp / "metrics.json")
