@@ -50,6 +50,9 @@ class StreamFormat:
     check_header : bool
         Refuse a first line that is neither numbers nor a header naming the columns (a file:
         its header is there from the start; a live input may begin mid-line).
+    comment_header : int
+        The line (from 1) of a header written as a comment (``# time,position,sensor``, as
+        ``numpy.savetxt`` writes it, `hystkit.io.CsvLayout`); 0: none.
     """
 
     sep: str = ","
@@ -59,6 +62,7 @@ class StreamFormat:
     time_scale: float = 1.0
     after_header: int = 0
     check_header: bool = False
+    comment_header: int = 0
 
     @property
     def plain(self) -> bool:
@@ -110,12 +114,15 @@ def stream_format(args: argparse.Namespace) -> StreamFormat:
     layout = csv_layout(path, options)
     if notice := layout.notice():
         _say(f"reading {path}: {notice}")
-    return _format(options, layout.sep, layout.decimal, check_header=True)
+    return _format(options, layout.sep, layout.decimal, check_header=True,
+                   comment_header=layout.preamble + 1 if layout.comment_header else 0)
 
 
-def _format(options, sep: str, decimal: str, check_header: bool = False) -> StreamFormat:
+def _format(options, sep: str, decimal: str, check_header: bool = False,
+            comment_header: int = 0) -> StreamFormat:
     return StreamFormat(sep, decimal, options.name("time"), options.name("sensor"),
-                        options.time_scale, options.units_row + options.skip_rows, check_header)
+                        options.time_scale, options.units_row + options.skip_rows, check_header,
+                        comment_header)
 
 
 def _say(line: str) -> None:
@@ -136,7 +143,9 @@ def stream_lines(lines: Iterator[str], fmt: StreamFormat, source: str,
         text = line.rstrip("\r\n")
         if columns is None:
             text = text.lstrip("\ufeff")  # a UTF-8 BOM first
-            if not text.strip() or text.lstrip().startswith("#"):
+            if line_no == fmt.comment_header:
+                text = text.lstrip().lstrip("#")  # the header, written as a comment
+            elif not text.strip() or text.lstrip().startswith("#"):
                 yield end  # blank and comment lines before the header
                 continue
             fields = _split(text, fmt.sep)

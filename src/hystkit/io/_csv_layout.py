@@ -6,7 +6,9 @@ separate with tabs. `csv_layout` looks at the first `SAMPLE_BYTES` of the file a
 for what `ReadOptions` leaves at ``auto``:
 
 - comment lines: the leading lines that start with ``#`` (and blank lines among them) come
-  before the header and are skipped;
+  before the header and are skipped. When the line after them is already data (numbers
+  only), the last comment line is the header (``numpy.savetxt(..., header="time,position,
+  sensor")`` writes ``# time,position,sensor``), provided it has as many fields;
 - separator: the one of ``,`` ``;`` tab that splits the header and the first `SAMPLE_LINES`
   data lines into the same number (at least 2) of fields. When none does (a damaged line),
   the header's most frequent one, and the readers name the line that disagrees; when two do,
@@ -38,6 +40,9 @@ SEP_NAMES = {",": "comma", ";": "semicolon", "\t": "tab"}
 _SEP_OPTION = {",": "','", ";": "';'", "\t": "tab"}
 COMMA_NUMBER = re.compile(r"[+-]?(\d+,\d*|,\d+)([eE][+-]?\d+)?")
 POINT_NUMBER = re.compile(r"[+-]?(\d+\.\d*|\.\d+)([eE][+-]?\d+)?")
+# A cell of a data line (either decimal mark, nan, inf, or empty), not a column name
+_DATA_CELL = re.compile(r"[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?|[+-]?(nan|inf)|",
+                        re.IGNORECASE)
 
 
 @dataclass(frozen=True)
@@ -54,12 +59,24 @@ class CsvLayout:
         Lines before the header (``#`` comments and blank lines among them).
     detected : tuple of str
         What was found rather than given (``"sep"``, ``"decimal"``, ``"preamble"``).
+    comment_header : bool
+        The header is a comment line (``# time,position,sensor``, as ``numpy.savetxt``
+        writes it): line ``preamble + 1``, whose ``#`` `names` drops.
     """
 
     sep: str = ","
     decimal: str = "."
     preamble: int = 0
     detected: tuple[str, ...] = ()
+    comment_header: bool = False
+
+    def names(self, fields: list[object]) -> list[str]:
+        """The column names of the header's `fields` as split: stripped, and without the
+        ``#`` of a header written as a comment."""
+        names = [str(field).strip() for field in fields]
+        if self.comment_header and names:
+            names[0] = names[0].lstrip("#").strip()
+        return names
 
     def notice(self) -> str:
         """What was found that a plain comma-separated file would not have, in a few words
@@ -72,6 +89,8 @@ class CsvLayout:
         if self.preamble:
             parts.append(f"{self.preamble} comment line{'s' * (self.preamble > 1)} before "
                          "the header skipped")
+        if self.comment_header:
+            parts.append(f"the header read from the comment on line {self.preamble + 1}")
         return ", ".join(parts)
 
 
@@ -115,12 +134,16 @@ def csv_layout(path: str | Path, options: ReadOptions | None = None,
     preamble = _preamble(lines)
     if preamble == len(lines):
         raise where.fail(f"line {preamble}: only comment lines, no header naming the columns")
-    header = lines[preamble]
+    comment_header = _comment_header(lines, preamble, options.units_row + options.skip_rows)
+    if comment_header:
+        preamble -= 1  # the header is the last comment line, the data follow it
+    header = lines[preamble].lstrip().lstrip("#") if comment_header else lines[preamble]
     first_data = preamble + 1 + options.units_row + options.skip_rows  # 0-based line index
     body = [(i, line) for i, line in enumerate(lines[first_data:], start=first_data)
             if line.strip()]
     sample = body[:SAMPLE_LINES]
     detected = ["preamble"] if preamble else []
+    detected += ["comment_header"] if comment_header else []
     sep = options.sep
     if sep == "auto":
         sep = _separator(header, sample, preamble, where)
@@ -133,7 +156,7 @@ def csv_layout(path: str | Path, options: ReadOptions | None = None,
     if decimal == "auto":
         decimal = "." if sep == "," else _decimal(fields, body, sep, where)
         detected.append("decimal")
-    return CsvLayout(sep, decimal, preamble, tuple(detected))
+    return CsvLayout(sep, decimal, preamble, tuple(detected), comment_header)
 
 
 def _head_lines(path: Path, where: Where) -> list[str]:
@@ -158,6 +181,22 @@ def _preamble(lines: list[str]) -> int:
     while n < len(lines) and (not lines[n].strip() or lines[n].lstrip().startswith("#")):
         n += 1
     return n if any(line.lstrip().startswith("#") for line in lines[:n]) else 0
+
+
+def _comment_header(lines: list[str], preamble: int, after: int = 0) -> bool:
+    """Whether the last of the `preamble` comment lines is the header: the first line of
+    data below it (past `after` lines: a units line, skipped lines) holds only numbers (no
+    header of its own follows) and, split by some separator, as many fields as the comment."""
+    first = preamble + after
+    if not preamble or first >= len(lines) or not lines[preamble - 1].lstrip().startswith("#"):
+        return False
+    comment = lines[preamble - 1].lstrip().lstrip("#")
+    for sep in SEP_NAMES:
+        fields = [field.strip() for field in _split(lines[first], sep)]
+        if (len(fields) >= 2 and all(_DATA_CELL.fullmatch(field) for field in fields)
+                and any(fields) and len(_split(comment, sep)) == len(fields)):
+            return True
+    return False
 
 
 def _split(line: str, sep: str) -> list[str]:

@@ -71,23 +71,21 @@ def read_csv(path: Path, source: str, need_position: bool,
     sep, decimal, preamble = layout.sep, layout.decimal, layout.preamble
     first = "the first line" if not preamble else f"line {preamble + 1}, below the comments,"
     hint = f" ({first} must be a {SEP_NAMES[sep]}-separated header naming the columns)"
-    arrays = _read_plain(path, need_position, where, sep, skip, hint, decimal=decimal,
-                         preamble=preamble)
+    header = {"decimal": decimal, "preamble": preamble, "comment_header": layout.comment_header}
+    arrays = _read_plain(path, need_position, where, sep, skip, hint, **header)
     if arrays is None:
-        arrays = _read_numbers(path, need_position, where, sep, skip, hint, decimal=decimal,
-                               preamble=preamble)
+        arrays = _read_numbers(path, need_position, where, sep, skip, hint, **header)
     if arrays is None:
         arrays = _read_text(path, need_position, where, sep, skip, hint,
-                            units_hint=not options.units_row, decimal=decimal,
-                            preamble=preamble)
+                            units_hint=not options.units_row, **header)
     if options.units_row:
         where = replace(where, units=_units_row(path, where, layout, list(arrays)))
     return arrays, where
 
 
 def _read_plain(path: Path, need_position: bool, where: Where, sep: str, skip: int,
-                hint: str, *, decimal: str = ".", preamble: int = 0
-                ) -> dict[str, np.ndarray] | None:
+                hint: str, *, decimal: str = ".", preamble: int = 0,
+                comment_header: bool = False) -> dict[str, np.ndarray] | None:
     """The pandas-free pass: every data cell a plain decimal, or None (the file goes on)."""
     if path.stat().st_size > PLAIN_BYTES:
         return None
@@ -117,7 +115,7 @@ def _read_plain(path: Path, need_position: bool, where: Where, sep: str, skip: i
         return None
     if decimal == ",":  # the separator is not a comma: every comma is a decimal mark
         body = [line.replace(",", ".") for line in body]
-    header = [name.strip() for name in header]
+    header = CsvLayout(comment_header=comment_header).names(header)
     names = pick(header, need_position, where, hint=hint)
     try:
         table = np.loadtxt(body, delimiter=sep, dtype=np.float64, ndmin=2)
@@ -148,7 +146,7 @@ def _units_row(path: Path, where: Where, layout: CsvLayout,
         raise where.fail(f"cannot read the units line (line {line}): {exc}") from exc
     if len(lines) < 2:
         raise where.fail(f"--units-row: there is no line {line} to read units from")
-    header = [str(name).strip() for name in lines.iloc[0]]
+    header = layout.names(list(lines.iloc[0]))
     row = lines.iloc[1].fillna("")
     cells = [str(cell).strip() for cell in row if str(cell).strip()]
     if cells and all(_is_number(cell.replace(layout.decimal, ".")) for cell in cells):
@@ -174,8 +172,8 @@ def _is_number(text: str) -> bool:
 
 
 def _read_numbers(path: Path, need_position: bool, where: Where, sep: str = ",", skip: int = 0,
-                  hint: str = "", *, decimal: str = ".", preamble: int = 0
-                  ) -> dict[str, np.ndarray] | None:
+                  hint: str = "", *, decimal: str = ".", preamble: int = 0,
+                  comment_header: bool = False) -> dict[str, np.ndarray] | None:
     """The fast pass: every column as float64, or None when anything needs a closer look."""
     pd, exact, parse_errors = _pandas()
     try:
@@ -184,7 +182,7 @@ def _read_numbers(path: Path, need_position: bool, where: Where, sep: str = ",",
         return None
     if first.empty or first.iloc[0].isna().any():  # blank first line or empty file: pass 2
         return None
-    header = [str(name).strip() for name in first.iloc[0]]
+    header = CsvLayout(comment_header=comment_header).names(list(first.iloc[0]))
     if any("\n" in name or "\r" in name for name in header):  # a quoted header spans lines
         return None
     names = pick(header, need_position, where, hint=hint)
@@ -227,7 +225,7 @@ def _line_bound(path: Path, block: int = 1 << 22) -> int:
 
 def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", skip: int = 0,
                hint: str = "", units_hint: bool = False, *, decimal: str = ".",
-               preamble: int = 0) -> dict[str, np.ndarray]:
+               preamble: int = 0, comment_header: bool = False) -> dict[str, np.ndarray]:
     """The careful pass: text cells chunk by chunk, the first problem of each column kept;
     `units_hint`: when every column's first data cell is text, suggest ``--units-row``."""
     pd, _, parse_errors = _pandas()
@@ -245,7 +243,8 @@ def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", sk
                          **_TEXT) as reader:
             for chunk in reader:
                 if header is None:
-                    header = [str(name).strip() for name in chunk.iloc[0]]
+                    header = CsvLayout(comment_header=comment_header).names(
+                        list(chunk.iloc[0]))
                     names = pick(header, need_position, where, hint=hint)
                     parts = {name: [] for name in names}
                     chunk = chunk.iloc[1:]

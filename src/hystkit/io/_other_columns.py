@@ -88,6 +88,8 @@ def _as_read(path: Path, n_samples: int | None, options: ReadOptions) -> dict[st
     import pandas as pd
 
     ours = {options.name(field) for field in FIELDS}
+    clean: dict[object, str] = {}  # the file's name -> the column's name (a comment header's
+    # first without its '#')
     if suffix == ".parquet":
         import pyarrow.parquet as pq
 
@@ -99,7 +101,8 @@ def _as_read(path: Path, n_samples: int | None, options: ReadOptions) -> dict[st
         layout = csv_layout(path, options, Where(str(path), names=options.columns))
         header = pd.read_csv(path, nrows=0, sep=layout.sep, skiprows=layout.preamble,
                              encoding="utf-8-sig").columns
-        names = [n for n in header if str(n).strip() not in ours]
+        clean = dict(zip(header, layout.names(list(header))))
+        names = [n for n in header if clean[n] not in ours]
         if not names:
             return {}
         skip = options.skip_rows + options.units_row
@@ -116,9 +119,10 @@ def _as_read(path: Path, n_samples: int | None, options: ReadOptions) -> dict[st
     for name in names:
         column = frame[name]
         if pd.api.types.is_numeric_dtype(column) and not pd.api.types.is_bool_dtype(column):
-            out[str(name).strip()] = column.to_numpy(dtype=np.float64)
+            out[clean.get(name, str(name).strip())] = column.to_numpy(dtype=np.float64)
         else:
-            out[str(name).strip()] = column.fillna("").astype(str).to_numpy(dtype=object)
+            out[clean.get(name, str(name).strip())] = column.fillna("").astype(
+                str).to_numpy(dtype=object)
     return out
 
 
