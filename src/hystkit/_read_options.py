@@ -78,8 +78,9 @@ class ReadOptions:
     ------
     ValueError
         One line naming the setting: unknown hystkit name, empty column name, two hystkit
-        names read from the same file column, unknown unit or separator, skip_rows outside
-        [0, `MAX_SKIP_ROWS`].
+        names read from the same file column, position and sensor read from each other's
+        columns (``position=sensor,sensor=position``), unknown unit or separator, skip_rows
+        outside [0, `MAX_SKIP_ROWS`].
 
     Notes
     -----
@@ -120,6 +121,7 @@ class ReadOptions:
                 if resolved[field] == resolved[other]:
                     raise ValueError(f"columns: {field} and {other} would both be read from "
                                      f"column {resolved[field]!r}")
+        _refuse_crossed(resolved)
         object.__setattr__(self, "columns",
                            tuple((f, given[f]) for f in FIELDS if f in given and given[f] != f))
         if self.time_unit not in TIME_UNITS:
@@ -167,6 +169,25 @@ class ReadOptions:
     def time_scale(self) -> float:
         """Seconds per unit of the time column."""
         return TIME_UNITS[self.time_unit]
+
+
+def _refuse_crossed(resolved: dict[str, str]) -> None:
+    """A file that names its columns ``position`` and ``sensor``, read the other way round
+    (``--columns position=sensor,sensor=position``), is refused: a monotone sensor makes the
+    swapped fit as good as the right one, so nothing downstream would notice (issue 24).
+
+    Only the full cross is refused: a lab may call its reference instrument "sensor", but a
+    file holding both names means hystkit's. Modelling the sensor from the position has its
+    own route (``--mode inverse``), and a forward model (position = the system's output) is
+    a file laid out that way (``hystkit datasets export --role forward``).
+    """
+    position, sensor = (resolved[f].strip().casefold() for f in ("position", "sensor"))
+    if (position, sensor) == ("sensor", "position"):
+        raise ValueError(f"columns: position would be read from column {resolved['position']!r} "
+                         f"and sensor from column {resolved['sensor']!r}, the file's columns "
+                         f"crossed (a compensator estimates the position from the sensor; "
+                         f"--mode inverse models the sensor from the position; to fit the "
+                         f"other way on purpose, rename the file's columns)")
 
 
 def parse_columns(text: str) -> tuple[tuple[str, str], ...]:

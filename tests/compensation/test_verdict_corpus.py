@@ -51,12 +51,17 @@ def data(tmp_path_factory) -> dict[str, Path]:
         "unrelated": _replace(sine1, "unrelated", position=np.convolve(
             rng.normal(size=sine1.n_samples), np.ones(40) / 40, "same")),
         "swapped": _replace(sine2, "swapped", sensor=sine2.position, position=sine2.sensor),
+        "sine1_swapped": _replace(sine1, "sine1 swapped", sensor=sine1.position,
+                                  position=sine1.sensor),
         "flipped": _replace(sine2, "flipped", sensor=-sine2.sensor),
         "short": _replace(sine1, "short", time=sine1.time[:150], sensor=sine1.sensor[:150],
                           position=sine1.position[:150]),
         "decay_tail": _replace(decay, "decay tail", time=decay.time[tail] - decay.time[tail][0],
                                sensor=decay.sensor[tail], position=decay.position[tail]),
     }
+    recs["ident_swapped"] = _replace(recs["ident"], "ident swapped",
+                                     sensor=recs["ident"].position,
+                                     position=recs["ident"].sensor)
     return {name: _write(rec, folder / f"{name}.csv") for name, rec in recs.items()}
 
 
@@ -140,6 +145,37 @@ def test_bad_use_is_never_ok(data, tmp_path, capsys, test, cells, status):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == GUARD_EXIT and scores["verdict"] == status
     assert err[-1].startswith(f"hystkit: evaluate: {status.replace('_', ' ')}")
+
+
+@pytest.mark.parametrize("train", ["sine1", "ident"])
+def test_bad_columns_read_crossed(data, tmp_path, capsys, train):
+    """--columns position=sensor,sensor=position on a file that names them: refused in one
+    line naming both columns, before any fit (the swapped fit alone would look fine)."""
+    code, model = _fit(data, tmp_path, train, "--columns", "position=sensor,sensor=position")
+    err = capsys.readouterr().err
+    assert code == 2 and not model.exists()
+    assert len(err.splitlines()) == 1
+    assert "position would be read from column 'sensor' and sensor from column 'position'" in err
+
+
+@pytest.mark.parametrize(("train", "test", "model"), [
+    ("sine1_swapped", "sine2", "mpl"), ("ident_swapped", "test", "mpl"),
+    ("ident_swapped", "test", "pi"),
+])
+def test_bad_fit_on_swapped_data_used_as_laid_out(data, tmp_path, capsys, train, test, model):
+    """A file whose header is right and whose data are swapped fits as well as the right
+    layout (it is the forward model, a layout hystkit supports: datasets export --role
+    forward), so the fit cannot tell; used on the next run as laid out, it is not ok: its
+    estimate is in the sensor's units (R² near 0 on the sine, where no signal and worse than
+    line differ by 1e-3; about -1e6 on the piezo)."""
+    code, path = _fit(data, tmp_path, train, "--model", model)
+    assert code == 0, capsys.readouterr().err
+    capsys.readouterr()
+    code, scores = _evaluate(data, tmp_path, path, test)
+    assert code == GUARD_EXIT and scores["verdict"] in ("no_signal", "worse_than_line")
+    assert scores["r2"] < 0.1
+    assert capsys.readouterr().err.strip().splitlines()[-1].startswith(
+        f"hystkit: evaluate: {scores['verdict'].replace('_', ' ')}")
 
 
 def test_bad_extrapolation_far_beyond_the_training_range(data, tmp_path, capsys):

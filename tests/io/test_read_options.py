@@ -175,6 +175,9 @@ def test_partial_mapping_keeps_the_other_names(tmp_path):
     ({"columns": {"time": ""}}, "time needs a column name"),
     ({"columns": {"time": "a", "sensor": "a"}}, "time and sensor would both be read from column 'a'"),
     ({"columns": {"position": "time"}}, "time and position would both"),
+    ({"columns": {"position": "sensor", "sensor": "position"}},
+     "position would be read from column 'sensor' and sensor from column 'position'"),
+    ({"columns": {"position": "Sensor", "sensor": "POSITION"}}, "columns crossed"),
     ({"time_unit": "h"}, "time_unit must be one of s, ms, us, ns, min"),
     ({"skip_rows": -1}, "skip_rows must be a whole number"),
     ({"skip_rows": True}, "skip_rows must be a whole number"),
@@ -184,6 +187,13 @@ def test_bad_settings_are_one_line(kwargs, message):
     with pytest.raises(ValueError, match=message) as err:
         ReadOptions(**kwargs)
     assert "\n" not in str(err.value)
+
+
+def test_a_lab_column_named_sensor_may_be_the_position():
+    """Only the full cross of hystkit's two names is refused (issue 24): a lab may call its
+    reference instrument 'sensor' and the device it calibrates something else."""
+    options = ReadOptions(columns={"position": "sensor", "sensor": "gauge"})
+    assert options.columns == (("position", "sensor"), ("sensor", "gauge"))
 
 
 def test_options_are_frozen_and_normalised():
