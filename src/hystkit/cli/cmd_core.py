@@ -133,7 +133,7 @@ def _fit(args: argparse.Namespace) -> int:
           f"sensor polarity {comp.polarity:+g}")
     if info.get("joint_fit"):
         print(f"  {info['joint_fit']}")
-    for note in info.get("at_model_limits") or ():
+    for note in [*(info.get("at_model_limits") or ()), *(info.get("redundant") or ())]:
         print(f"  note: {note}")
     print(f"wrote {args.out}")
     if info["status"] != "ok":

@@ -10,6 +10,7 @@ __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
     {"_adaptive": ("ADAPT_PARAMETERS", "Adaptation", "AdaptiveState", "AdaptiveStream",
                    "advance_adaptive"),
+     "_redundancy": ("redundancy_notes",),
      "_refit": ("Refit", "RefitReport", "RefittingStream"),
      "_param_vector": ("named_floats",),
      "_centring": ("CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",

@@ -43,6 +43,7 @@ from ._compensator import MODES, Compensator, check_training_data, inverse_is_bo
 from ._conventions import LinearBaseline, prepare_training_data
 from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status, fixed_mask
 from ._param_vector import flatten_params, simulate_segments
+from ._redundancy import redundancy_notes
 from ._training_checks import MIN_SAMPLES, check_fitting_data
 
 __all__ = ["MIN_SAMPLES", "check_loss_available", "fit_compensator", "fit_module_constant",
@@ -481,4 +482,6 @@ def _fit_info(comp: Compensator, result: FitResult, recs: Sequence[Recording], s
     if diagnose:
         info["standard_errors"] = chunked_standard_errors(family, structure, comp.params,
                                                           inputs, targets)
+        info["redundant"] = redundancy_notes(family, structure, comp.params, inputs, targets,
+                                             sse)
     return info

@@ -6,9 +6,10 @@ provides and how to add one.
 """
 
 from ._cells import DT_RANGE
-from ._protocol import Block, Family, FitStart, Record, numerical_linearisation
+from ._protocol import Block, Family, FitStart, Record, Reduction, numerical_linearisation
 from ._registry import FAMILIES, family_of, get_family, register, unregister
 from ._stability import stability_report
 
-__all__ = ["DT_RANGE", "FAMILIES", "Block", "Family", "FitStart", "Record", "family_of", "get_family",
-           "numerical_linearisation", "register", "stability_report", "unregister"]
+__all__ = ["DT_RANGE", "FAMILIES", "Block", "Family", "FitStart", "Record", "Reduction",
+           "family_of", "get_family", "numerical_linearisation", "register", "stability_report",
+           "unregister"]

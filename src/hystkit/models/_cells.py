@@ -27,16 +27,19 @@ on that description and imports no family.
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from ._protocol import Record
+from ._protocol import Record, Reduction
 from ._validation import check_cells, check_range, check_structure_size
 
-__all__ = ["DT_RANGE", "MAX_CELLS", "SLOPE_CAP_MIN", "CellStructure", "Cells", "LinearModel",
-           "cell_report", "discrete_eigenvalues", "linearise", "linearise_cells", "state_bound"]
+__all__ = ["DT_RANGE", "MAX_CELLS", "MAX_MERGED_CELLS", "SLOPE_CAP_MIN", "CellStructure", "Cells",
+           "LinearModel", "cell_reductions", "cell_report", "discrete_eigenvalues", "linearise",
+           "linearise_cells", "state_bound"]
 
 # Limits shared by the cell models (mpl, mpl-poly, pl, ladder). Runs cost O(N) a sample and
 # fits hold an (n_samples x ~3N) Jacobian, so 1000 cells (24 kB of parameters, 24 MB of
@@ -48,6 +51,11 @@ DT_RANGE = (1e-9, 1e6)
 # A slope cap below 1e-6 moves a capped cell by less than a millionth of its gap per sample,
 # and the straight continuations' rest points (f(knee) / cap) run off to 1e300.
 SLOPE_CAP_MIN = 1e-6
+# Merging every ordered pair of cells costs N (N - 1) model runs: beyond this many cells
+# only dropping each one is tried (N runs).
+MAX_MERGED_CELLS = 10
+
+
 def state_bound(x0_max: float, u_max: float, slope_cap: float) -> float:
     """Largest ``|u_k|`` a cell ``x+ = x + f(e - x) dt`` can reach from ``|x0| <= x0_max``
     under inputs ``|e| <= u_max``, when ``f`` is increasing through ``f(0) = 0`` with secant
@@ -258,3 +266,53 @@ def cell_report(cells: Cells, u: np.ndarray) -> dict:
         "n_points": int(everything.size), "n_violations": int(bad.sum()),
         "stable_everywhere": bool(not bad.any()),
     }
+
+
+def cell_reductions(structure: CellStructure, params: Record) -> tuple[Reduction, ...]:
+    """The models of ``N - 1`` cells made from a fitted cell model without refitting.
+
+    For parameters with per-cell ``i_s``, ``v_t`` (N,) and weights ``w`` (N + 1,; ``w[0]`` the
+    feed-through, ``w[k]`` cell k's), other fields kept: each cell dropped with its weight,
+    and (up to ``MAX_MERGED_CELLS`` cells) each cell merged into each other one (dropped, its
+    weight added to the other's). The merge is exact when the two cells have the same resistor
+    (equal voltages for all time): a fit can then split one weight into two large ones of
+    opposite sign of which only the sum is determined (-14.6 and +12.8 for -1.8).
+
+    Parameters
+    ----------
+    structure : CellStructure
+        The fitted model's structure (``n_cells`` N).
+    params : Record
+        Its parameters.
+
+    Returns
+    -------
+    tuple of Reduction
+        The drops first, then the merges; empty for one cell. Cells are numbered from 1, as
+        ``w[k]``.
+    """
+    n = structure.n_cells
+    if n < 2:
+        return ()
+    smaller = dataclasses.replace(structure, n_cells=n - 1)
+    label = f"{n - 1} cell{'s' if n > 2 else ''}"
+    w = np.asarray(params.w, dtype=float)
+
+    def without(k: int, weights: np.ndarray) -> Record:
+        keep = [i for i in range(1, n + 1) if i != k]
+        cells = np.asarray(keep) - 1
+        return dataclasses.replace(params, i_s=np.asarray(params.i_s)[cells],
+                                   v_t=np.asarray(params.v_t)[cells],
+                                   w=np.r_[weights[0], weights[keep]])
+
+    drops = [Reduction(f"cell {k} adds nothing the data resolve (w[{k}] = {w[k]:.3g})",
+                       n - 1, label, smaller, without(k, w)) for k in range(1, n + 1)]
+    merges = []
+    for k, j in itertools.permutations(range(1, n + 1) if n <= MAX_MERGED_CELLS else (), 2):
+        merged = w.copy()
+        merged[j] += w[k]
+        a, b = sorted((j, k))
+        kind = "cancel" if w[j] * w[k] < 0 else "duplicate each other"
+        merges.append(Reduction(f"cells {a} and {b} {kind} (weights {w[a]:+.3g}, {w[b]:+.3g})",
+                                n - 1, label, smaller, without(k, merged)))
+    return (*drops, *merges)

@@ -33,7 +33,7 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
-__all__ = ["Block", "Family", "FitStart", "Record", "numerical_linearisation"]
+__all__ = ["Block", "Family", "FitStart", "Record", "Reduction", "numerical_linearisation"]
 
 
 class Record:
@@ -157,6 +157,30 @@ class FitStart(NamedTuple):
         return cls(options, tuple(f"{names[i]} = {theta[i]:.6g} is outside the fit's box "
                                   f"[{lower[i]:.6g}, {upper[i]:.6g}]; the fit starts from "
                                   f"{start[i]:.6g}" for i in moved))
+
+
+class Reduction(NamedTuple):
+    """A model one size smaller, made from a fitted one without refitting
+    (:meth:`Family.reductions`): a cell dropped, or two cells merged into one.
+
+    Parameters
+    ----------
+    what : str
+        What was taken out, in the fitted model's numbering: ``"cells 2 and 3 cancel (weights
+        -14.6, +12.8)"``.
+    size : int
+        The family's size knob of the smaller model (``fit --cells``).
+    label : str
+        The smaller model's size for people: ``"2 cells"``.
+    structure, params
+        The smaller model.
+    """
+
+    what: str
+    size: int
+    label: str
+    structure: Any
+    params: Any
 
 
 class Family(ABC):
@@ -308,6 +332,13 @@ class Family(ABC):
         reported as fixed by the fit, not as undetermined by the data) and so does its count
         of fitted numbers for AIC / BIC. Default: none.
         """
+        return ()
+
+    def reductions(self, structure: Any, params: Any) -> tuple[Reduction, ...]:
+        """Models one size smaller made from ``params`` without refitting (a cell dropped, two
+        cells merged), for the fit's check of redundant cells
+        (:func:`hystkit.compensation.redundancy_notes`): when one of them describes the
+        training data as well, the data do not identify the larger model. Default: none."""
         return ()
 
     # -- running ----------------------------------------------------------------------------

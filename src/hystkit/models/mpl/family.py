@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..._lazy import lazy
-from .._cells import Cells, cell_report
+from .._cells import Cells, cell_reductions, cell_report
 from .._protocol import Block, Family, FitStart
 
 if TYPE_CHECKING:
@@ -72,6 +72,10 @@ class MplFamily(Family):
         from .fit import random_params
 
         return random_params(structure, rng)
+
+    def reductions(self, structure, params):
+        """Each cell dropped, and merged into each other one (:func:`.._cells.cell_reductions`)."""
+        return cell_reductions(structure, params)
 
     def rest_state(self, structure, params, value, inverse=False):
         # Forward: each cell equals its drive. Inverse: the drive is the input estimate, at rest

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..._lazy import lazy
 from ...errors import FitDivergedError
-from .._cells import Cells, cell_report
+from .._cells import Cells, cell_reductions, cell_report
 from .._protocol import Block, Family, FitStart
 
 if TYPE_CHECKING:
@@ -104,6 +104,11 @@ class MplGFamily(Family):
         """``w[0]`` and ``v_b``: the fit works in the gauge ``w_0 = 1``, ``V_b = 0``
         (``fit.fit_mpl_g``), so the data determine neither."""
         return ("w[0]", "v_b")
+
+    def reductions(self, structure, params):
+        """Each cell dropped, and merged into each other one (:func:`.._cells.cell_reductions`);
+        ``g`` and the gauge ``w_0``, ``V_b`` are kept."""
+        return cell_reductions(structure, params)
 
     def block(self, structure, params, inverse=False):
         from . import kernels
