@@ -62,10 +62,12 @@ def test_stream_gives_the_offline_estimate(files, capsys):
     lines.write_text("".join(f"{float(t)!r},{float(s)!r}\n" for t, s in pairs))
     assert main(["stream", str(model), "--in", str(lines)]) == 0
     rows = capsys.readouterr().out.splitlines()
-    assert rows[0] == "time,position_estimate,flags"
-    printed = np.array([float(row.split(",")[1]) for row in rows[1:]])
-    ref = load_compensator(model).estimate(rec)[:400]
-    assert_allclose(printed, ref, rtol=0, atol=1e-9 * np.max(np.abs(ref)))
+    assert rows[0] == "time,position_estimate,flags,position_lower,position_upper"
+    printed = np.array([[float(v) for v in row.split(",")[1:]] for row in rows[1:]])
+    ref = load_compensator(model).estimate_with_band(rec)
+    for column, expected in ((0, ref.estimate), (2, ref.lower), (3, ref.upper)):
+        assert_allclose(printed[:, column], expected[:400], rtol=0,
+                        atol=1e-9 * np.max(np.abs(ref.estimate)))
 
 
 def test_export_writes_c_and_matlab(files, capsys):
