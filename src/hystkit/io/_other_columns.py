@@ -62,7 +62,7 @@ def read_other_columns(path: str | os.PathLike[str], n_samples: int,
                dropped_by_resampling(as_read)}
     if not numeric:
         return {}
-    arrays, where, _ = read_unvalidated(path, False, options)
+    arrays, where, _ = read_unvalidated(path, False, options, notices=False)
     _validate(arrays, where, uniform=False)  # as read_recording does before resampling
     out = resample_arrays({"time": arrays["time"], **numeric}, options.resample_hz, where)
     out.pop("time")

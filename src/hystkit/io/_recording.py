@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import re
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -236,10 +237,13 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
                                            if k in ("position", "sensor")))
 
 
-def read_unvalidated(path: Path, need_position: bool, options: ReadOptions,
+def read_unvalidated(path: Path, need_position: bool, options: ReadOptions, *,
+                     notices: bool = True,
                      ) -> tuple[dict[str, np.ndarray], _Where, dict[str, str]]:
     """The recording's arrays as the file holds them, time in seconds, not resampled nor
-    checked; the error locator; the units (the file's own first)."""
+    checked; the error locator; the units (the file's own first). `notices`: say on stderr
+    what the reading suggests (a time step that looks like another unit); False for a
+    second read of the same file."""
     source = str(path)
     suffix = path.suffix.lower()
     if suffix not in _READERS:
@@ -269,7 +273,55 @@ def read_unvalidated(path: Path, need_position: bool, options: ReadOptions,
     _check_time_name(dict(options.columns).get("time", "time"), options, where)
     if options.time_scale != 1.0:  # to seconds before the checks, whose messages say "s"
         arrays["time"] = arrays["time"] * options.time_scale
+    if notices and (warning := time_step_warning(arrays["time"], options, where)):
+        say(f"warning: {warning}")
     return arrays, where, units
+
+
+def say(line: str) -> None:
+    """Tell the user what reading a file did or suggests, on stderr (a command's stdout may
+    carry its product: ``stream``'s estimates, ``datasets list``)."""
+    print(f"hystkit: {line}", file=sys.stderr, flush=True)
+
+
+# Words that name a time unit in a column name (``time_sec``, ``t [ms]``); a name with none
+# says nothing, and then the step is all there is to go by
+_UNIT_WORDS = {"s", "sec", "secs", "second", "seconds", "ms", "msec", "millis", "us", "usec",
+               "micros", "ns", "nsec", "min", "mins", "minute", "minutes"}
+MIN_PLAUSIBLE_HZ = 1.0
+"""A rate at or below which a time column whose name states no unit is probably not in the
+unit read: a logger in ms writes integer steps of 1 to 1000 (1 kHz to 1 Hz), read as seconds
+a rate of 1 Hz down to 1 mHz."""
+
+
+def time_step_warning(time: np.ndarray, options: ReadOptions, where: _Where) -> str:
+    """The one-line warning for a time column (in seconds) whose median step makes the
+    rate `MIN_PLAUSIBLE_HZ` or lower when its name states no unit, with the unit that would
+    make it plausible; "" otherwise. Never a guess that changes the numbers: the time stays
+    as read, in the unit the options say (``min`` is taken as meant).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> print(time_step_warning(np.arange(5) * 20.0, ReadOptions(), _Where("my.csv")))
+    my.csv: column 'time': one sample every 20 s (0.05 Hz) read in s; if the time is in ms, ...
+    """
+    name = where.name("time")
+    words = {w.lower().replace("µ", "u") for w in re.split(r"[^0-9A-Za-zµ]+", name) if w}
+    finite = time[np.isfinite(time)]
+    if options.time_unit == "min" or words & _UNIT_WORDS or finite.size < 2:
+        return ""
+    step = float(np.median(np.diff(finite)))
+    if not step >= 1 / MIN_PLAUSIBLE_HZ:  # also NaN: the checks report a bad time column
+        return ""
+    raw = step / options.time_scale  # as written in the file
+    smaller = [u for u, scale in TIME_UNITS.items() if scale < options.time_scale]
+    fits = [u for u in sorted(smaller, key=TIME_UNITS.__getitem__, reverse=True)
+            if raw * TIME_UNITS[u] < 1 / MIN_PLAUSIBLE_HZ]
+    hint = (f"; if the time is in {fits[0]}, pass --time-unit {fits[0]} (or time_unit = "
+            f"\"{fits[0]}\" in the settings file)" if fits else "")
+    return where.fail(f"one sample every {step:.6g} s ({1 / step:.6g} Hz) read in "
+                      f"{options.time_unit}{hint}", "time").args[0]
 
 
 def _check_time_unit(unit: str | None, options: ReadOptions, where: _Where) -> None:
