@@ -120,6 +120,8 @@ def fit_section(comp: Compensator, title: str = "Fit", sub: bool = False) -> Sec
          ", ".join(info["on_bounds"]) if info.get("on_bounds") else
          ("none" if "on_bounds" in info else "not stored")),
         ("at the model's own limits", "; ".join(info.get("at_model_limits") or ()) or "none"),
+        ("redundant cells", "; ".join(info.get("redundant") or ()) or "none found"),
+        ("prediction band", info.get("band") or "none (fitted without one)"),
         ("joint fit", info.get("joint_fit") or "no (one recording)")]))
     section.add(_parameter_table(comp))
     return section
