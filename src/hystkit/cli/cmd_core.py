@@ -114,9 +114,11 @@ def _fit(args: argparse.Namespace) -> int:
                      **costs.fit_arguments(args, recs), "fit_options": fit_options, **options}
     comp = fit_compensator(recs, size, model=args.model, mode=args.mode, center=args.center,
                            **fit_arguments)
-    if not args.no_band:
-        # the band's folds refit the same model: after the fit, so a failed fit stops first
+    if not args.no_band and comp.fit_info["status"] == "ok":
+        # the band's folds refit the same model: only for a model that may be used
         comp = _module.with_band(comp, recs, size, fit_arguments, level=args.level)
+    elif not args.no_band:
+        comp.fit_info["band"] = "no band: the fit did not pass its guards"
     units = _training_units(recs, args.data)
     if units:
         comp.fit_info["units"] = units
