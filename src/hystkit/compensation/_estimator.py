@@ -16,7 +16,8 @@ import numpy as np
 
 from ..io import Recording
 from ..metrics import r2
-from ._band import DEFAULT_LEVEL, interval, with_band
+from ._band import DEFAULT_LEVEL, interval
+from ._calibration import with_band
 from ._centring import DEFAULT_CENTER, ORACLE_CENTER
 from ._compensator import Compensator
 from ._fitting import fit_compensator

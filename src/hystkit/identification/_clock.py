@@ -27,7 +27,15 @@ def _compiler_seconds() -> float:
 class FitTimer:
     """Started when made; :meth:`seconds` is the wall time since then, less this thread's
     time in numba's compiler (`hystkit._compilation.compiler_seconds`): a fit's ``seconds``,
-    whether or not its kernels had to be compiled or loaded."""
+    whether or not its kernels had to be compiled or loaded.
+
+    Parameters
+    ----------
+    wall : float, optional
+        ``time.perf_counter()`` at the start (default: now).
+    compiling : float, optional
+        The compiler's seconds in this thread at the start (default: now).
+    """
 
     wall: float = field(default_factory=time.perf_counter)
     compiling: float = field(default_factory=_compiler_seconds)
