@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 __all__ = ["DECIMALS", "DEFAULT_OPTIONS", "FIELDS", "MAX_RESAMPLE_HZ", "MAX_SKIP_ROWS",
-           "SEPARATORS", "TIME_UNITS", "ReadOptions", "parse_columns"]
+           "MISSING", "SEPARATORS", "TIME_UNITS", "ReadOptions", "parse_columns"]
 
 FIELDS = ("time", "position", "sensor")  # hystkit's names, as io._cells.COLUMNS
 # Seconds per unit. s/ms/us/ns are the names raw files use (io._raw_config); min for slow logs.
@@ -23,6 +23,9 @@ SEPARATORS = {",": ",", ";": ";", "tab": "\t", "\t": "\t", "\\t": "\t", "auto": 
 # Decimal marks of CSV numbers; "auto" looks at the first data lines (a comma only where the
 # separator is not one: Excel in most of Europe writes 1,5 between semicolons).
 DECIMALS = (".", ",", "auto")
+# What to do with a row whose time, position or sensor cell is empty (or NaN): refuse the file,
+# drop the row, or interpolate it linearly in time (hystkit.io._missing)
+MISSING = ("error", "drop", "interpolate")
 # CSV lines skipped after the header (a units line or a few): pandas holds them as a set.
 MAX_SKIP_ROWS = 1_000_000
 MAX_RESAMPLE_HZ = 1e9  # as the raw files' fs_out
@@ -73,6 +76,12 @@ class ReadOptions:
         its three, the file's names for other columns) for a file without a units row; a
         units row's entries take precedence. Only labels: values are not converted (the time
         unit is `time_unit`).
+    missing : {"error", "drop", "interpolate"}
+        A row whose time, position or sensor is empty (or NaN): ``error`` (the default)
+        refuses the file naming the row; ``drop`` leaves the row out (its time steps become
+        gaps); ``interpolate`` fills the cell linearly in time (a missing time by the row's
+        place), dropping rows with nothing on one side (at the start or the end) and blank
+        rows. Either says in one line how many rows it touched (`hystkit.io._missing`).
 
     Raises
     ------
@@ -99,6 +108,7 @@ class ReadOptions:
     mat_var: str | None = None
     units: tuple[tuple[str, str], ...] = ()
     decimal: str = "auto"
+    missing: str = "error"
 
     def __post_init__(self) -> None:
         pairs = self.columns.items() if isinstance(self.columns, Mapping) else self.columns
@@ -136,6 +146,9 @@ class ReadOptions:
         object.__setattr__(self, "sep", SEPARATORS[self.sep])
         if self.decimal not in DECIMALS:
             raise ValueError(f"decimal must be one of '.', ',', 'auto', got {self.decimal!r}")
+        if self.missing not in MISSING:
+            raise ValueError(f"missing must be one of {', '.join(MISSING)}, got "
+                             f"{self.missing!r}")
         if not isinstance(self.units_row, bool):
             # ValueError like every bad setting: callers catch one type
             raise ValueError(f"units_row must be true or false, got {self.units_row!r}")  # noqa: TRY004

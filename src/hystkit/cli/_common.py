@@ -16,6 +16,7 @@ from typing import TextIO
 from .._read_options import (
     MAX_RESAMPLE_HZ,
     MAX_SKIP_ROWS,
+    MISSING,
     SEPARATORS,
     TIME_UNITS,
     parse_columns,
@@ -230,6 +231,10 @@ def add_read_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--units-row", action="store_true", default=False,
                    help="CSV: the line after the header holds units (s,mm,Ohm); they are "
                         "kept and written to the outputs (--skip-rows counts lines after it)")
+    g.add_argument("--missing", choices=list(MISSING), default=None,
+                   help="a row whose time, position or sensor is empty or NaN: error (the "
+                        "default) refuses the file, drop leaves the row out, interpolate fills "
+                        "it linearly in time; the rows touched are counted in one line")
     g.add_argument("--resample", type=number(0, MAX_RESAMPLE_HZ, low_open=True), default=None,
                    metavar="HZ",
                    help="bring jittered or non-uniform time onto a uniform grid at HZ: linear "
@@ -256,7 +261,7 @@ def _mat_var(text: str) -> str:
 # Namespace attribute -> ReadOptions field, for the options add_read_options adds
 _READ_OPTIONS = {"columns": "columns", "time_unit": "time_unit", "skip_rows": "skip_rows",
                  "sep": "sep", "units_row": "units_row", "resample": "resample_hz",
-                 "mat_var": "mat_var", "decimal": "decimal"}
+                 "mat_var": "mat_var", "decimal": "decimal", "missing": "missing"}
 
 
 def given_read_options(args: argparse.Namespace) -> dict:

@@ -87,10 +87,13 @@ def stream_format(args: argparse.Namespace) -> StreamFormat:
 
     given = given_read_options(args)
     refused = [f"--{k}" for k in ("resample", "mat_var") if getattr(args, k, None) is not None]
+    missing = given.get("missing") == "interpolate"
+    refused += ["--missing interpolate"] if missing else []
     if refused:
         raise InputError(f"{', '.join(refused).replace('_', '-')}: stream compensates the "
                          "samples of a text input as they come (resample the file, or read "
-                         "it with compensate)")
+                         "it with compensate)" + ("; a line missing a value is skipped and "
+                                                  "counted" if missing else ""))
     if args.input is None:
         try:
             options = ReadOptions(**given)
@@ -109,6 +112,9 @@ def stream_format(args: argparse.Namespace) -> StreamFormat:
     if options.resample_hz is not None:
         _say(f"{settings}: resample_hz is not applied: stream compensates the samples as they "
              "come and counts irregular steps")
+    if options.missing == "interpolate":
+        _say(f"{settings}: missing = \"interpolate\" is not applied: stream skips a line "
+             "missing a value and counts it")
     if not path.is_file():
         return _format(options, ",", ".")  # stream's own reading names the problem
     layout = csv_layout(path, options)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -28,6 +28,8 @@ class Where:
     names: tuple[tuple[str, str], ...] = ()
     # (hystkit name, unit) the file itself states (a CSV units row, Parquet metadata, .mat units)
     units: tuple[tuple[str, str], ...] = ()
+    # The file's row of each sample once rows were dropped (ReadOptions.missing); None: the same
+    rows: np.ndarray | None = field(default=None, compare=False, repr=False)
 
     def name(self, column: str) -> str:
         """The file's name for hystkit column `column`."""
@@ -39,13 +41,20 @@ class Where:
         name = self.name(column)
         return repr(name) if name == column else f"{name!r} ({column})"
 
+    def at(self, index: int) -> str:
+        """``'row 5 (line 6)'`` for sample `index` (0-based; the file's row when rows were
+        dropped), ``'sample 5'`` where there are no lines."""
+        if self.rows is not None and 0 <= index < self.rows.size:
+            index = int(self.rows[index])
+        text = f"{self.item} {index + 1}"
+        if self.header_lines is not None:
+            text += f" (line {index + 1 + self.header_lines})"
+        return text
+
     def fail(self, message: str, column: str | None = None, index: int | None = None) -> InputError:
         parts = [] if column is None else [f"{self.noun} {self.label(column)}"]
         if index is not None:
-            text = f"{self.item} {index + 1}"
-            if self.header_lines is not None:
-                text += f" (line {index + 1 + self.header_lines})"
-            parts.append(text)
+            parts.append(self.at(index))
         location = f"{', '.join(parts)}: " if parts else ""
         return InputError(f"{self.source}: {location}{message}")
 

@@ -36,6 +36,7 @@ from hystkit.errors import InputError
 from .._read_options import DEFAULT_OPTIONS, ReadOptions
 from ._cells import Where, cell_problem, pick, text_problems
 from ._csv_layout import COMMA_NUMBER, POINT_NUMBER, SEP_NAMES, CsvLayout, csv_layout
+from ._missing import missing_hint
 
 CHUNK_ROWS = 100_000  # text cells held at once by the second pass
 FAST_CHUNK_ROWS = 1 << 18  # rows parsed at once by the first pass, copied into the result
@@ -77,7 +78,7 @@ def read_csv(path: Path, source: str, need_position: bool,
         arrays = _read_numbers(path, need_position, where, sep, skip, hint, **header)
     if arrays is None:
         arrays = _read_text(path, need_position, where, sep, skip, hint,
-                            units_hint=not options.units_row, **header)
+                            units_hint=not options.units_row, missing=options.missing, **header)
     if options.units_row:
         where = replace(where, units=_units_row(path, where, layout, list(arrays)))
     return arrays, where
@@ -225,15 +226,18 @@ def _line_bound(path: Path, block: int = 1 << 22) -> int:
 
 def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", skip: int = 0,
                hint: str = "", units_hint: bool = False, *, decimal: str = ".",
-               preamble: int = 0, comment_header: bool = False) -> dict[str, np.ndarray]:
+               preamble: int = 0, comment_header: bool = False,
+               missing: str = "error") -> dict[str, np.ndarray]:
     """The careful pass: text cells chunk by chunk, the first problem of each column kept;
-    `units_hint`: when every column's first data cell is text, suggest ``--units-row``."""
+    `units_hint`: when every column's first data cell is text, suggest ``--units-row``;
+    `missing` other than ``error``: an empty cell is NaN (`hystkit.io._missing` decides)."""
     pd, _, parse_errors = _pandas()
     header: list[str] | None = None
     names: list[str] = []
     parts: dict[str, list[np.ndarray]] = {}
     first_bad: dict[str, tuple[int, str]] = {}
     n_rows = 0  # data rows up to the last one with any cell filled
+    empty_rows: list[np.ndarray] = []  # data rows with an empty recording cell
     offset = 0  # data rows before this chunk
     try:
         # header=None because with a header pandas silently turns the first column into an
@@ -254,14 +258,19 @@ def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", sk
                 if filled.any():
                     # Trailing blank lines are common at the end of logger files and carry no data.
                     n_rows = offset + int(np.flatnonzero(filled)[-1]) + 1
+                empty = np.zeros(len(chunk), dtype=bool)
                 for name in names:
                     numbers, bad, stripped = text_problems(chunk[header.index(where.name(name))],
                                                            decimal)
+                    empty |= (stripped == "").to_numpy()
+                    if missing != "error":
+                        bad &= (stripped != "").to_numpy()  # NaN: read_recording decides
                     if name not in first_bad and bad.any():
                         i = int(np.argmax(bad))
                         first_bad[name] = (offset + i, cell_problem(stripped, i)
                                            + _decimal_hint(stripped.iloc[i], sep, decimal))
                     parts[name].append(numbers)
+                empty_rows.append(offset + np.flatnonzero(empty))
                 offset += len(chunk)
     except pd.errors.EmptyDataError as exc:
         raise where.fail("file is empty (no header row)") from exc
@@ -282,6 +291,9 @@ def _read_text(path: Path, need_position: bool, where: Where, sep: str = ",", sk
             if units_like:
                 problem += ("; if this line holds units, pass --units-row (or units_row = "
                             "true in the settings file)")
+            elif problem == "empty cell":
+                empty = np.concatenate(empty_rows)
+                problem += missing_hint(int(np.count_nonzero(empty < n_rows)))
             raise where.fail(problem, name, row)
     return {name: np.concatenate(parts.pop(name))[:n_rows] for name in names}
 

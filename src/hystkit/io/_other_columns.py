@@ -45,6 +45,8 @@ def read_other_columns(path: str | os.PathLike[str], n_samples: int,
         In the file's order: numbers as float64 (an empty cell is NaN), anything else as
         text (an empty cell is ""). With ``options.resample_hz`` only the numeric columns
         without empty cells, resampled like the recording (see `dropped_by_resampling`).
+        With ``options.missing`` ``drop`` or ``interpolate``, the rows the recording kept
+        (other columns are not interpolated: an empty cell stays empty).
 
     Raises
     ------
@@ -52,12 +54,18 @@ def read_other_columns(path: str | os.PathLike[str], n_samples: int,
         The columns have a different number of rows than the recording.
     """
     path = Path(path)
-    if options.resample_hz is None:
+    if options.missing != "error":
+        as_read = _kept_rows(path, options)
+        if options.resample_hz is None:
+            _check_rows(path, as_read, n_samples)
+            return as_read
+    elif options.resample_hz is None:
         return _as_read(path, n_samples, options)
+    else:
+        as_read = _as_read(path, None, options)
     from ._recording import _validate, read_unvalidated
     from ._resample import resample_arrays
 
-    as_read = _as_read(path, None, options)
     numeric = {name: values for name, values in as_read.items() if name not in
                dropped_by_resampling(as_read)}
     if not numeric:
@@ -70,6 +78,28 @@ def read_other_columns(path: str | os.PathLike[str], n_samples: int,
         raise InputError(f"{path}: the resampled other columns have "
                          f"{next(iter(out.values())).size} rows, the recording {n_samples}")
     return out
+
+
+def _kept_rows(path: Path, options: ReadOptions) -> dict[str, np.ndarray]:
+    """The other columns at the rows `read_recording` keeps under ``options.missing``."""
+    from ._recording import read_unvalidated
+
+    _, where, _ = read_unvalidated(path, False, options, notices=False)
+    as_read = _as_read(path, None, options)
+    rows = where.rows
+    if rows is None or not rows.size or not as_read:
+        return as_read
+    short = [name for name, values in as_read.items() if values.size <= rows[-1]]
+    if short:
+        raise InputError(f"{path}: the other columns ({', '.join(short)}) end before the "
+                         f"recording's row {rows[-1] + 1}")
+    return {name: values[rows] for name, values in as_read.items()}
+
+
+def _check_rows(path: Path, columns: dict[str, np.ndarray], n_samples: int) -> None:
+    if any(values.size != n_samples for values in columns.values()):
+        raise InputError(f"{path}: the other columns ({', '.join(columns)}) have "
+                         f"{next(iter(columns.values())).size} rows, the recording {n_samples}")
 
 
 def dropped_by_resampling(columns: dict[str, np.ndarray]) -> list[str]:
@@ -108,8 +138,10 @@ def _as_read(path: Path, n_samples: int | None, options: ReadOptions) -> dict[st
         skip = options.skip_rows + options.units_row
         skipped = [*range(layout.preamble), *range(layout.preamble + 1,
                                                    layout.preamble + 1 + skip)]
+        # missing cells read past: a blank line is a row, as the recording's reader counts
         frame = pd.read_csv(path, sep=layout.sep, decimal=layout.decimal, usecols=names,
-                            encoding="utf-8-sig", skiprows=skipped or None)
+                            encoding="utf-8-sig", skiprows=skipped or None,
+                            skip_blank_lines=options.missing == "error")
     if not names:
         return {}
     if n_samples is not None and len(frame) != n_samples:

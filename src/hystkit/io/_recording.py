@@ -24,6 +24,7 @@ from ._cells import Where as _Where  # also imported by _raw
 from ._cells import as_vector
 from ._csv_reader import read_csv
 from ._mat_reader import read_mat
+from ._missing import fill_missing
 from ._resample import resample_arrays
 
 if TYPE_CHECKING:
@@ -273,6 +274,9 @@ def read_unvalidated(path: Path, need_position: bool, options: ReadOptions, *,
     _check_time_name(dict(options.columns).get("time", "time"), options, where)
     if options.time_scale != 1.0:  # to seconds before the checks, whose messages say "s"
         arrays["time"] = arrays["time"] * options.time_scale
+    arrays, where, notice = fill_missing(arrays, where, options.missing)
+    if notices and notice:
+        say(notice)
     if notices and (warning := time_step_warning(arrays["time"], options, where)):
         say(f"warning: {warning}")
     return arrays, where, units

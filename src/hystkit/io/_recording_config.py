@@ -15,6 +15,7 @@ written for another format (a ``.mat`` in s beside a CSV in ms). The file holds 
     units_row = true          # CSV: the line after the header holds units
     resample_hz = 100.0       # bring jittered time onto a uniform grid
     mat_var = "run1"          # .mat: the struct or matrix holding the recording
+    missing = "interpolate"   # a row missing a value: error (the default), drop, interpolate
 
     [columns]                 # hystkit name = the file's column (or .mat field/number)
     time = "t_ms"
@@ -58,6 +59,7 @@ RECORDING_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
     "units_row": ((bool,), "CSV: the line after the header holds units"),
     "resample_hz": ((int, float), "resample to a uniform grid at this rate [Hz]"),
     "mat_var": ((str,), ".mat: the variable holding the recording"),
+    "missing": ((str,), "a row missing a value: 'error', 'drop' or 'interpolate'"),
     "columns": ((dict,), "hystkit name = the file's column, e.g. {time = 't_ms'}"),
     "units": ((dict,), "units of the columns, e.g. {position = 'mm', sensor = 'Ohm'}"),
 }
