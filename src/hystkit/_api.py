@@ -27,7 +27,7 @@ from .compensation import (
 )
 from .compensation import evaluate as _evaluate
 from .compensation import use_flags as _use_flags
-from .io import ReadOptions, Recording, options_for, read_recording, settings_for
+from .io import ReadOptions, Recording, options_for, read_pieces, read_recording, settings_for
 from .models import get_family
 
 if TYPE_CHECKING:
@@ -118,7 +118,8 @@ def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None
     ----------
     data : Recording, DataFrame or path, or a sequence of them
         Fitting recording(s) with ``time`` [s], ``position`` [mm] and ``sensor``; several are
-        fitted jointly, each with its own initial state and centring.
+        fitted jointly, each with its own initial state and centring. A file whose settings
+        file says ``gaps = "split"`` is fitted as its pieces between time gaps.
     model : str
         A model family of ``hystkit.models.FAMILIES`` (``mpl``, ``pi``, ``preisach``, ...).
     size : int, optional
@@ -155,7 +156,7 @@ def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None
     ('ok', True)
     """
     items = list(data) if isinstance(data, list | tuple) else [data]
-    recordings = [_as_recording(item) for item in items]
+    recordings = [rec for item in items for rec in _as_recordings(item)]
     comp = fit_compensator(recordings, size, model=model, mode=mode, center=center, **options)
     if not band:
         return comp
@@ -353,6 +354,17 @@ def save(compensator: Compensator, path: str | os.PathLike, *, force: bool = Fal
     pathlib.Path
     """
     return save_compensator(compensator, path, force=force)
+
+
+def _as_recordings(data: Data) -> list[Recording]:
+    """`data` as recordings to fit jointly: a file whose settings say ``gaps = "split"`` as
+    its pieces between time gaps (`hystkit.io.read_pieces`), anything else as one."""
+    if isinstance(data, str | os.PathLike):
+        options = _reading(data)
+        if options.gaps == "split":
+            return read_pieces(data, need_position=False, options=options)
+        return [read_recording(data, need_position=False, options=options)]
+    return [_as_recording(data)]
 
 
 def _as_recording(data: Data) -> Recording:

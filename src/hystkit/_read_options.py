@@ -12,7 +12,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-__all__ = ["DECIMALS", "DEFAULT_OPTIONS", "FIELDS", "MAX_RESAMPLE_HZ", "MAX_SKIP_ROWS",
+__all__ = ["DECIMALS", "DEFAULT_OPTIONS", "FIELDS", "GAPS", "MAX_RESAMPLE_HZ", "MAX_SKIP_ROWS",
            "MISSING", "SEPARATORS", "TIME_UNITS", "ReadOptions", "parse_columns"]
 
 FIELDS = ("time", "position", "sensor")  # hystkit's names, as io._cells.COLUMNS
@@ -26,6 +26,9 @@ DECIMALS = (".", ",", "auto")
 # What to do with a row whose time, position or sensor cell is empty (or NaN): refuse the file,
 # drop the row, or interpolate it linearly in time (hystkit.io._missing)
 MISSING = ("error", "drop", "interpolate")
+# What to do with a recording whose time has gaps (steps far above the median step): refuse it
+# naming the gap's row, or split it into pieces at the gaps (hystkit.io._pieces)
+GAPS = ("error", "split")
 # CSV lines skipped after the header (a units line or a few): pandas holds them as a set.
 MAX_SKIP_ROWS = 1_000_000
 MAX_RESAMPLE_HZ = 1e9  # as the raw files' fs_out
@@ -82,6 +85,11 @@ class ReadOptions:
         gaps); ``interpolate`` fills the cell linearly in time (a missing time by the row's
         place), dropping rows with nothing on one side (at the start or the end) and blank
         rows. Either says in one line how many rows it touched (`hystkit.io._missing`).
+    gaps : {"error", "split"}
+        A time step longer than 3 median steps: ``error`` (the default) refuses the file
+        naming the gap's row; ``split`` makes the recording one piece per stretch between
+        gaps, which commands that fit several recordings fit jointly
+        (`hystkit.io.read_pieces`); a command that reads one recording refuses it.
 
     Raises
     ------
@@ -109,6 +117,7 @@ class ReadOptions:
     units: tuple[tuple[str, str], ...] = ()
     decimal: str = "auto"
     missing: str = "error"
+    gaps: str = "error"
 
     def __post_init__(self) -> None:
         pairs = self.columns.items() if isinstance(self.columns, Mapping) else self.columns
@@ -149,6 +158,8 @@ class ReadOptions:
         if self.missing not in MISSING:
             raise ValueError(f"missing must be one of {', '.join(MISSING)}, got "
                              f"{self.missing!r}")
+        if self.gaps not in GAPS:
+            raise ValueError(f"gaps must be one of {', '.join(GAPS)}, got {self.gaps!r}")
         if not isinstance(self.units_row, bool):
             # ValueError like every bad setting: callers catch one type
             raise ValueError(f"units_row must be true or false, got {self.units_row!r}")  # noqa: TRY004

@@ -14,6 +14,7 @@ from collections.abc import Callable
 from typing import TextIO
 
 from .._read_options import (
+    GAPS,
     MAX_RESAMPLE_HZ,
     MAX_SKIP_ROWS,
     MISSING,
@@ -26,7 +27,7 @@ from ..errors import HystkitError, OutputError
 __all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Deferred", "Parser", "UsageError", "add_read_options",
            "check_size", "deferred", "failures_exit", "given_read_options", "integer", "number",
            "positive_float", "positive_int", "read_options", "read_recording_args",
-           "size_limit", "slope_cap", "stdout_for"]
+           "read_recordings_args", "size_limit", "slope_cap", "stdout_for"]
 
 # Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
 # bounds, not converged; a family failed in compare/select); 2 is kept for errors that stop a
@@ -235,6 +236,11 @@ def add_read_options(p: argparse.ArgumentParser) -> None:
                    help="a row whose time, position or sensor is empty or NaN: error (the "
                         "default) refuses the file, drop leaves the row out, interpolate fills "
                         "it linearly in time; the rows touched are counted in one line")
+    g.add_argument("--gaps", choices=list(GAPS), default=None,
+                   help="a time step longer than 3 median steps: error (the default) refuses "
+                        "the file naming the row; split reads the pieces between gaps as "
+                        "separate recordings for a joint fit, said in one line (a command "
+                        "that reads one recording refuses them)")
     g.add_argument("--resample", type=number(0, MAX_RESAMPLE_HZ, low_open=True), default=None,
                    metavar="HZ",
                    help="bring jittered or non-uniform time onto a uniform grid at HZ: linear "
@@ -261,7 +267,8 @@ def _mat_var(text: str) -> str:
 # Namespace attribute -> ReadOptions field, for the options add_read_options adds
 _READ_OPTIONS = {"columns": "columns", "time_unit": "time_unit", "skip_rows": "skip_rows",
                  "sep": "sep", "units_row": "units_row", "resample": "resample_hz",
-                 "mat_var": "mat_var", "decimal": "decimal", "missing": "missing"}
+                 "mat_var": "mat_var", "decimal": "decimal", "missing": "missing",
+                 "gaps": "gaps"}
 
 
 def given_read_options(args: argparse.Namespace) -> dict:
@@ -322,6 +329,25 @@ def _say_layout(args: argparse.Namespace, path, options) -> None:
         return
     if notice:
         print(f"reading {path}: {notice}", flush=True)
+
+
+def read_recordings_args(args: argparse.Namespace, paths, *, need_position: bool = True
+                         ) -> list:
+    """The recordings of `paths` for a command that fits several jointly (``fit``): each
+    read as `read_recording_args` does, and a file read with ``gaps = "split"`` (``--gaps
+    split`` or its settings file) as its pieces between time gaps (`hystkit.io.read_pieces`,
+    which says how many and where)."""
+    from ..io import read_pieces, read_recording
+
+    recordings = []
+    for path in paths:
+        options = read_options(args, path)
+        if options.gaps == "split":
+            recordings += read_pieces(path, need_position=need_position, options=options)
+        else:
+            recordings.append(read_recording(path, need_position=need_position,
+                                             options=options))
+    return recordings
 
 
 def read_recording_args(args: argparse.Namespace, path, *, need_position: bool = True):

@@ -13,6 +13,7 @@ __getattr__, __dir__ = lazy_exports(
      "_mat_reader": ("MatContents", "load_mat"),
      "_mat_writer": ("matlab_name", "write_mat"),
      "_other_columns": ("read_other_columns",),
+     "_pieces": ("read_pieces", "time_gaps"),
      "_raw": ("RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter", "open_raw"),
      "_raw_config": ("CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_config"),
      "_recording": ("MAX_MAGNITUDE", "Recording", "Sampled", "read_recording"),

@@ -229,13 +229,29 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
     """
     options = ReadOptions() if options is None else options
     arrays, where, units = read_unvalidated(Path(path), need_position, options)
-    if options.resample_hz is not None:
+    if options.resample_hz is not None or options.gaps == "split":
         _validate(arrays, where, uniform=False)
+    if options.gaps == "split":
+        _refuse_pieces(arrays["time"], where)
+    if options.resample_hz is not None:
         arrays = resample_arrays(arrays, options.resample_hz, where)
     _validate(arrays, where)
     # time is in seconds once read, whatever the file's unit
     return _adopt(arrays, str(path), tuple((k, v) for k, v in units.items()
                                            if k in ("position", "sensor")))
+
+
+def _refuse_pieces(time: np.ndarray, where: _Where) -> None:
+    """``gaps = "split"`` where one recording is read: a file with gaps is refused (its
+    pieces are for commands that fit several recordings jointly, `read_pieces`)."""
+    from ._pieces import time_gaps
+
+    gaps = time_gaps(time)
+    if gaps.size:
+        raise where.fail(f"--gaps split cuts this recording at {gaps.size} time gap"
+                         f"{'s' * (gaps.size > 1)} into {gaps.size + 1} pieces, and this "
+                         "command reads it as one recording (split the file there)", "time",
+                         int(gaps[0]) + 1)
 
 
 def read_unvalidated(path: Path, need_position: bool, options: ReadOptions, *,
@@ -413,6 +429,11 @@ def _validate(arrays: dict[str, np.ndarray], where: _Where, *, uniform: bool = T
     bad = np.flatnonzero(np.abs(step - median) > _MAX_STEP_DEVIATION * median)
     if bad.size:
         i = int(bad[0]) + 1
+        from ._pieces import GAP_STEPS
+
+        fix = ("a time gap: split the recording there, or read the pieces between gaps "
+               "with --gaps split to fit them jointly" if step[i - 1] > GAP_STEPS * median else
+               "resample it to a uniform time grid (--resample HZ)")
         raise where.fail(f"non-uniform sampling: step {step[i - 1]:.6g} s deviates more than "
                          f"{_MAX_STEP_DEVIATION:.0%} from the median step {median:.6g} s; "
-                         "resample it to a uniform time grid (--resample HZ)", "time", i)
+                         f"{fix}", "time", i)

@@ -16,6 +16,7 @@ written for another format (a ``.mat`` in s beside a CSV in ms). The file holds 
     resample_hz = 100.0       # bring jittered time onto a uniform grid
     mat_var = "run1"          # .mat: the struct or matrix holding the recording
     missing = "interpolate"   # a row missing a value: error (the default), drop, interpolate
+    gaps = "split"            # time gaps: error (the default), split into pieces
 
     [columns]                 # hystkit name = the file's column (or .mat field/number)
     time = "t_ms"
@@ -60,6 +61,7 @@ RECORDING_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
     "resample_hz": ((int, float), "resample to a uniform grid at this rate [Hz]"),
     "mat_var": ((str,), ".mat: the variable holding the recording"),
     "missing": ((str,), "a row missing a value: 'error', 'drop' or 'interpolate'"),
+    "gaps": ((str,), "time gaps: 'error' or 'split' (into pieces fitted jointly)"),
     "columns": ((dict,), "hystkit name = the file's column, e.g. {time = 't_ms'}"),
     "units": ((dict,), "units of the columns, e.g. {position = 'mm', sensor = 'Ohm'}"),
 }

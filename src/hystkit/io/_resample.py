@@ -68,7 +68,7 @@ def resample_arrays(arrays: dict[str, np.ndarray], rate_hz: float,
         raise where.fail(f"gap of {step[i]:.6g} s after {time[i]:.12g} s: longer than "
                          f"{MAX_GAP_STEPS:g} median steps ({median:.6g} s) and than one step of "
                          f"the {rate_hz:g} Hz grid; --resample does not invent data across a "
-                         f"gap: split the recording there", "time", i + 1)
+                         f"gap: split the recording there (--gaps split)", "time", i + 1)
     n_out = int(np.floor((time[-1] - time[0]) * rate_hz * (1 + _SAME_RATE))) + 1
     if n_out < 2:
         raise where.fail(f"the recording lasts {time[-1] - time[0]:.6g} s: less than 2 samples "
