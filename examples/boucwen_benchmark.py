@@ -1,7 +1,8 @@
 """The Bouc-Wen hysteretic benchmark (Noel & Schoukens 2016) end to end with hystkit's boucwen.
 
 Data: ``boucwen_benchmark`` in the shared data folder (read-only; origin and licence in its
-README.txt). Training: a 5-period random-phase multisine (8192 samples per period, 750 Hz,
+README.txt; ``hystkit datasets show boucwen`` names the five files of github.com/forgi86/dynonet
+and where they go; without them this script ends in one line saying so). Training: a 5-period random-phase multisine (8192 samples per period, 750 Hz,
 50 N rms, 5-150 Hz) with the generator's band-limited output noise. Validation: the official
 noiseless multisine (one steady-state period) and sine sweep (18 -> 52 Hz at 10 Hz/min from rest).
 
@@ -21,14 +22,14 @@ the generator (15 kHz, MATLAB ``decimate(y, r, 'fir')`` = a 31-tap Hamming FIR p
 zero-phase): the multisine was decimated in stages 2, 2, 5 as in the benchmark's example
 script, the sweep in one stage of 20 (found by trying both; see the doc).
 
-Run: ``python examples/boucwen_benchmark.py [DATA_FOLDER]`` (needs h5py for train.h5). 20-35 s
-on the shared 2-core machine, most of it the fit.
+Run: ``python examples/boucwen_benchmark.py [DATA_FOLDER]`` (needs h5py for train.h5; the
+folder defaults to ``boucwen_benchmark`` below the shared data root, found as
+``hystkit.datasets.find_root`` does). 20-35 s on the shared 2-core machine, most of it the fit.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from collections.abc import Sequence
@@ -38,6 +39,7 @@ import numpy as np
 from scipy.io import loadmat
 from scipy.signal import firwin
 
+from hystkit.datasets import DATASETS, DataNotFoundError, find_root
 from hystkit.models import boucwen
 from hystkit.models.boucwen import fit_boucwen
 
@@ -53,15 +55,29 @@ PUBLISHED = (("PNLSS, degrees 3-5-7 (Noel et al. 2017)", 10 ** (-98.32 / 20)),
              ("best known (figure given to us; source not checked)", 7.5e-6))
 
 
+INFO = DATASETS["boucwen"]
+FILES = ("train.h5", "uval_multisine.mat", "yval_multisine.mat", "uval_sinesweep.mat",
+         "yval_sinesweep.mat")
+
+
 def data_folder(argument: str | None) -> Path:
-    """The benchmark folder: the argument, else shared/data beside the repository, else
-    ``$HYSTKIT_SHARED_DATA``."""
-    if argument:
-        return Path(argument)
-    beside = Path(__file__).resolve().parents[2] / "shared" / "data" / "boucwen_benchmark"
-    if beside.is_dir() or "HYSTKIT_SHARED_DATA" not in os.environ:
-        return beside
-    return Path(os.environ["HYSTKIT_SHARED_DATA"]) / "boucwen_benchmark"
+    """The benchmark folder: the argument, else ``boucwen_benchmark`` below the shared data
+    root (``$HYSTKIT_SHARED_DATA``, else a ``shared/data`` found above), with its five files.
+
+    Raises
+    ------
+    DataNotFoundError
+        No shared data root, or a file missing: one line saying where the files come from.
+    """
+    folder = Path(argument) if argument else find_root()[0] / INFO.folder
+    missing = [name for name in FILES if not (folder / name).is_file()]
+    if missing:
+        more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
+        raise DataNotFoundError(
+            f"{folder / missing[0]}: file not found{more}; the benchmark's files come from "
+            f"{INFO.provenance().repository} ({INFO.licence}): 'hystkit datasets show boucwen' "
+            "lists them and where they go")
+    return folder
 
 
 def load(folder: Path) -> dict[str, np.ndarray]:
@@ -142,9 +158,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("folder", nargs="?", help="boucwen_benchmark data folder")
     args = parser.parse_args(argv)
     folder = data_folder(args.folder)
-    if not (folder / "train.h5").is_file():
-        print(f"benchmark data not found in {folder}", file=sys.stderr)
-        return 1
     t_start = time.perf_counter()
     data = load(folder)
     periods = data["y_train"].reshape(-1, PERIOD)
@@ -174,4 +187,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except DataNotFoundError as exc:  # one line: where the data come from and where they go
+        sys.exit(f"boucwen_benchmark.py: {exc}")
+    except ImportError as exc:  # h5py, for train.h5
+        sys.exit(f"boucwen_benchmark.py: {exc} (pip install 'h5py>=3.10')")

@@ -3,8 +3,9 @@
 For each case a compensator (mPL, 3 cells, direct mode) is fitted on training data only and
 scored on held-out data with each centring: ``fit``, ``tare``, ``track`` (deployable) and
 ``recording`` (the paper's protocol, an oracle). Run: ``python examples/centring_evidence.py``
-(needs the shared data for the real cases; virtual-sensor cases always run). Output is the
-table in docs/centring.md.
+(needs the shared data for the real cases, ``hystkit datasets show NAME`` says where each comes
+from and where it goes; virtual-sensor cases always run, and without the data one line on
+stderr says which were skipped and why). Output is the table in docs/centring.md.
 """
 
 from __future__ import annotations

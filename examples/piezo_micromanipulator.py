@@ -32,8 +32,11 @@ post-inverse (compensating the output) are the same identity, so the calibrated 
 the inverse model's error; what the offline number cannot show is how the hardware would
 respond to a voltage it never saw.
 
-Run: ``python examples/piezo_micromanipulator.py`` (needs the shared data) or with
-``--excerpt`` (shipped 4-6 s excerpts; only shows that the pipeline runs).
+Run: ``python examples/piezo_micromanipulator.py`` (needs the shared data: the two files of
+github.com/yan9a/DiscreteBacklashOperator that ``hystkit datasets show piezo_micromanipulator``
+names, in ``piezo_micromanipulator_capsensor/`` of the shared data root) or with ``--excerpt``
+(shipped 4-6 s excerpts; only shows that the pipeline runs). Without the data it ends in one
+line saying where they come from and where they go.
 """
 
 from __future__ import annotations
@@ -46,7 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hystkit.compensation import Compensator, center_label, evaluate, fit_compensator
-from hystkit.datasets import Dataset, load, load_excerpt
+from hystkit.datasets import DataNotFoundError, Dataset, load, load_excerpt
 
 NAME = "piezo_micromanipulator"
 # Full-amplitude steady windows [s] inside the two segments: no start transient, no ramps.
@@ -252,4 +255,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except DataNotFoundError as exc:  # one line: where the data come from and where they go
+        sys.exit(f"piezo_micromanipulator.py: {exc}")

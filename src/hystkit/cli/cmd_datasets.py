@@ -1,4 +1,5 @@
-"""``hystkit datasets list|export``: the public hysteresis data sets (issue 4)."""
+"""``hystkit datasets list|show|export``: the public hysteresis data sets (issue 4); ``show``
+says where a data set's files come from and where they go (issue 27.8)."""
 
 from __future__ import annotations
 
@@ -46,6 +47,11 @@ def _list(args: argparse.Namespace) -> int:
     for name, variants in shipped.items():
         print(f"shipped excerpts (--excerpt, always available): {name}: {', '.join(variants)}")
     print("details of one data set: hystkit datasets list NAME")
+    absent = [info.name for info in DATASETS.values()
+              if root is None or not (root / info.folder).is_dir()]
+    if absent:
+        print(f"not here: {', '.join(absent)}; where each comes from and where to put it: "
+              "hystkit datasets show NAME")
     return 0
 
 
@@ -56,6 +62,8 @@ def _list_variants(name: str, root: Path | None) -> int:
     print(f"{info.name}: {info.what}")
     print(f"  input {info.input_name} [{info.input_unit}] -> output {info.output_name} "
           f"[{info.output_unit}]; folder {info.folder}; licence {info.licence}")
+    print(f"  source {info.provenance().repository}; the files and where they go: hystkit "
+          f"datasets show {info.name}")
     print(f"{'variant':<24}{'split':<16}{'samples':>8}  {'rate':<14}description")
     for v in info.variants:
         mark = " (default)" if v.name == info.default_variant else ""
@@ -63,6 +71,47 @@ def _list_variants(name: str, root: Path | None) -> int:
         print(f"{v.name:<24}{v.split or '-':<16}{v.n_samples:>8}  {rate:<14}{v.description}"
               f"{mark}")
     return 0
+
+
+def _show(args: argparse.Namespace) -> int:
+    from ..datasets import dataset_info, shared_data_status
+
+    stdout_for("the description")
+    info = dataset_info(args.name)
+    root, how = shared_data_status(args.root)
+    sources = [info.provenance(v.name) for v in info.variants]
+    first = sources[0]
+    print(f"{info.name}: {info.what}")
+    print(f"  source:  {first.repository}")
+    print(f"  licence: {first.licence}; keep {first.licence_file} (the licence text) beside "
+          "the files")
+    print(f"  credit:  {first.credit}")
+    print("  files: in the repository (commit) -> where hystkit reads them:")
+    here, listed = 0, set()
+    base = "SHARED_DATA" if root is None else str(root)
+    for source in sources:
+        for repo_path, local in zip(source.paths, source.files, strict=True):
+            if local in listed:
+                continue
+            listed.add(local)
+            found = root is not None and (root / local).is_file()
+            here += found
+            print(f"    {repo_path} ({source.commit[:7]})")
+            print(f"      -> {base}/{local}{'' if found else '  (missing)'}")
+    print(f"  here: {here} of {len(listed)} file(s)")
+    if root is None:
+        print(f"  shared data root: {how}")
+    else:
+        print(f"  shared data root: {root} ({how}); another: --root or ${_env_var()}")
+    if info.requires:
+        print(f"  needs {info.requires}")
+    return 0
+
+
+def _env_var() -> str:
+    from ..datasets import ENV_VAR
+
+    return ENV_VAR
 
 
 def _export(args: argparse.Namespace) -> int:
@@ -132,7 +181,8 @@ def _roles() -> tuple[str, ...]:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``datasets list`` and ``datasets export`` to the ``hystkit`` parser."""
+    """Add ``datasets list``, ``datasets show`` and ``datasets export`` to the ``hystkit``
+    parser."""
     p = sub.add_parser("datasets", help="public hysteresis data sets: list, export as a "
                                         "recording")
     # The parent gets a --force too (the CLI adds one to every top-level command); the child's
@@ -147,6 +197,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
                                              "or a shared/data folder found above)")
     q.set_defaults(run=_list)
+
+    q = actions.add_parser("show", help="where a data set's files come from (repository, "
+                                        "commit, licence, credit) and where to put them")
+    deferred(q.add_argument("name", help="the data set (see 'hystkit datasets list')"),
+             choices=_dataset_names)
+    q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
+                                             "or a shared/data folder found above)")
+    q.set_defaults(run=_show)
 
     q = actions.add_parser("export", help="write one run as a time, position, sensor "
                                           "recording (CSV, Parquet or .mat) plus a .json sidecar")

@@ -17,11 +17,12 @@ import numpy as np
 
 from ..errors import InputError
 from ._dataset import Dataset, DatasetInfo, Provenance, VariantInfo
-from ._files import data_folder, read_mat_matrix
+from ._files import read_mat_matrix
 
 __all__ = ["INFO", "load_bh_loops"]
 
 NAME = "bh_loops"
+FOLDER = "magnetic_bh_loops_ja"
 NOMINAL_DT = 1.0  # s per point; quasi-static data have no time axis
 _COMMIT = "4bbe905d420ce27c66ee93d8b25ef44b553f9175"
 # material -> (original path stem and suffix in the repository, description, field
@@ -42,9 +43,21 @@ _VARIANTS = {f"{m}_H{amp:g}": (m, j) for m, (_, _, amps, _) in _MATERIALS.items(
              for j, amp in enumerate(amps)}
 
 
+def _source(variant: str) -> Provenance:
+    material = _VARIANTS[variant][0]
+    repo_path = _MATERIALS[material][0]
+    return Provenance(
+        repository="github.com/romanszewczyk/JAmodel", commit=_COMMIT,
+        paths=(repo_path.format("H"), repo_path.format("B")), licence="MIT",
+        licence_file="LICENSE_MIT_JAmodel.txt",
+        credit="R. Szewczyk, JAmodel (Jiles-Atherton model identification, "
+               "github.com/romanszewczyk/JAmodel); data (c) 2016 Roman Szewczyk, MIT licence",
+        files=(f"{FOLDER}/{material}_H.mat", f"{FOLDER}/{material}_B.mat"))
+
+
 def _read(folder: Path, variant: str) -> Dataset:
     material, column = _VARIANTS[variant]
-    repo_path, what, amplitudes, _ = _MATERIALS[material]
+    _, what, amplitudes, _ = _MATERIALS[material]
     h_file, b_file = f"{material}_H.mat", f"{material}_B.mat"
     h = read_mat_matrix(folder / h_file, "HmeasT")
     b = read_mat_matrix(folder / b_file, "BmeasT")
@@ -57,13 +70,7 @@ def _read(folder: Path, variant: str) -> Dataset:
         input_unit="A/m", output_name="flux density B", output_unit="T",
         description=f"Quasi-static B(H) loop of {what}, field amplitude "
                     f"{amplitudes[column]:g} A/m (one averaged loop).",
-        provenance=Provenance(
-            repository="github.com/romanszewczyk/JAmodel", commit=_COMMIT,
-            paths=(repo_path.format("H"), repo_path.format("B")), licence="MIT",
-            licence_file="LICENSE_MIT_JAmodel.txt",
-            credit="R. Szewczyk, JAmodel (Jiles-Atherton model identification, "
-                   "github.com/romanszewczyk/JAmodel); data (c) 2016 Roman Szewczyk, MIT licence",
-            files=(f"{folder.name}/{h_file}", f"{folder.name}/{b_file}")),
+        provenance=_source(variant),
         time_note=f"no time axis (quasi-static): nominal point index x {NOMINAL_DT:g} s, "
                   "no rate information",
         conditions={"H_amplitude_A_per_m": float(amplitudes[column])},
@@ -71,7 +78,7 @@ def _read(folder: Path, variant: str) -> Dataset:
 
 
 INFO = DatasetInfo(
-    name=NAME, folder="magnetic_bh_loops_ja",
+    name=NAME, folder=FOLDER,
     what="quasi-static B(H) loops, 4 soft magnetic materials at several field amplitudes",
     input_name="magnetic field H", input_unit="A/m", output_name="flux density B",
     output_unit="T", licence="MIT",
@@ -79,7 +86,7 @@ INFO = DatasetInfo(
                                f"{_MATERIALS[m][1].split(';')[0]}, "
                                f"H amplitude {_MATERIALS[m][2][j]:g} A/m")
                    for v, (m, j) in _VARIANTS.items()),
-    default_variant="MnZn_ferrite_H80", reader=_read)
+    default_variant="MnZn_ferrite_H80", reader=_read, source=_source)
 
 
 def load_bh_loops(variant: str = "MnZn_ferrite_H80", *,
@@ -100,4 +107,4 @@ def load_bh_loops(variant: str = "MnZn_ferrite_H80", *,
     Dataset
         input = H [A/m], output = B [T]; time is nominal (1 s per point, no rate).
     """
-    return _read(data_folder(INFO.folder, root), INFO.variant(variant).name)
+    return INFO.read(variant, root)

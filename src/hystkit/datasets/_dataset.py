@@ -8,6 +8,7 @@ run came from; :meth:`Dataset.to_recording` turns it into the hystkit `Recording
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -18,6 +19,7 @@ import numpy as np
 
 from ..errors import HystkitError, InputError
 from ..io import Recording, Sampled
+from ._files import DataNotFoundError, data_folder
 
 __all__ = ["ROLES", "Dataset", "DatasetInfo", "MissingDependencyError", "Provenance",
            "VariantInfo"]
@@ -270,6 +272,9 @@ class DatasetInfo:
         Reads one run from the data set's folder.
     requires : str
         Optional packages some variants need, in words ("" when none).
+    source : callable (variant) -> Provenance
+        Where a run's files come from and where they go, known without reading them
+        (`Provenance.files` relative to the shared data root); the reader gives the same.
     """
 
     name: str
@@ -284,6 +289,7 @@ class DatasetInfo:
     default_variant: str
     reader: Callable[[Path, str], Dataset] = field(repr=False, compare=False)
     requires: str = ""  # optional packages some variants need
+    source: Callable[[str], Provenance] | None = field(default=None, repr=False, compare=False)
 
     def variant(self, name: str | None = None) -> VariantInfo:
         """The named run (default: `default_variant`); unknown names list the choices."""
@@ -293,6 +299,45 @@ class DatasetInfo:
                 return info
         raise InputError(f"dataset {self.name!r}: no variant {name!r}; variants: "
                          f"{', '.join(v.name for v in self.variants)}")
+
+    def provenance(self, variant: str | None = None) -> Provenance:
+        """Where the files of run `variant` (default: the default run) come from: repository,
+        commit, paths there, licence and the local files, without reading any."""
+        if self.source is None:
+            raise InputError(f"dataset {self.name!r}: no source registered")
+        return self.source(self.variant(variant).name)
+
+    def files(self) -> tuple[str, ...]:
+        """Every local file of every run (relative to the shared data root), in order."""
+        found = dict.fromkeys(f for v in self.variants for f in self.provenance(v.name).files)
+        return tuple(found)
+
+    def where_from(self, variant: str | None = None) -> str:
+        """One phrase: what to get from where, and where to put it."""
+        source = self.provenance(variant)
+        local = [f.removeprefix(f"{self.folder}/") for f in source.files]
+        return (f"{self.name} comes from {source.repository} (commit {source.commit[:7]}, "
+                f"{' and '.join(source.paths)}; licence {source.licence}): put "
+                f"{' and '.join(local)} in {self.folder}/ of the shared data root ('hystkit "
+                f"datasets show {self.name}' lists the files)")
+
+    def read(self, variant: str | None = None,
+             root: str | os.PathLike[str] | None = None) -> Dataset:
+        """Read run `variant` from the shared data (`root`, see `find_root`).
+
+        Raises
+        ------
+        DataNotFoundError
+            The shared data, the folder or a file is absent: one line naming the path looked
+            at, where the files come from and where they go (`where_from`).
+        InputError
+            An unknown variant, an unreadable file.
+        """
+        name = self.variant(variant).name
+        try:
+            return self.reader(data_folder(self.folder, root), name)
+        except DataNotFoundError as exc:
+            raise DataNotFoundError(f"{exc}; {self.where_from(name)}") from None
 
 
 def _vector(values: Any, what: str, where: str) -> np.ndarray:

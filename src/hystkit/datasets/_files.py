@@ -18,9 +18,16 @@ from scipy.io.matlab import MatReadError
 
 from ..errors import InputError
 
-__all__ = ["ENV_VAR", "data_folder", "find_root", "read_mat_matrix", "read_table"]
+__all__ = ["ENV_VAR", "DataNotFoundError", "data_folder", "find_root", "read_mat_matrix",
+           "read_table"]
 
 ENV_VAR = "HYSTKIT_SHARED_DATA"
+
+
+class DataNotFoundError(InputError):
+    """The shared data, a data set's folder or one of its files is not where it is looked
+    for; the registry adds where the files come from and where to put them.
+    """
 
 
 def find_root(root: str | os.PathLike[str] | None = None) -> tuple[Path, str]:
@@ -52,9 +59,9 @@ def find_root(root: str | os.PathLike[str] | None = None) -> tuple[Path, str]:
             candidate = folder / "shared" / "data"
             if candidate.is_dir():
                 return candidate, f"found above {start}"
-    raise InputError(f"shared data not found: no folder shared/data in {starts[0]}, in the "
-                     f"hystkit source tree or above them; set {ENV_VAR}=/path/to/shared/data "
-                     "or pass root=")
+    raise DataNotFoundError(f"shared data not found: no folder shared/data in {starts[0]}, in "
+                            f"the hystkit source tree or above them; set {ENV_VAR}=/path/to/"
+                            "shared/data or pass root=")
 
 
 def data_folder(folder: str, root: str | os.PathLike[str] | None = None) -> Path:
@@ -62,14 +69,14 @@ def data_folder(folder: str, root: str | os.PathLike[str] | None = None) -> Path
     base, how = find_root(root)
     path = base / folder
     if not path.is_dir():
-        raise InputError(f"{path}: data folder not found (shared data root {base}, from {how}); "
-                         f"get the shared data or point {ENV_VAR} at it")
+        raise DataNotFoundError(f"{path}: data folder not found (shared data root {base}, from "
+                                f"{how})")
     return path
 
 
 def _existing(path: Path) -> Path:
     if not path.is_file():
-        raise InputError(f"{path}: file not found")
+        raise DataNotFoundError(f"{path}: file not found")
     return path
 
 

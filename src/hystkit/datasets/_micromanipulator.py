@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ._dataset import Dataset, DatasetInfo, Provenance, VariantInfo
-from ._files import data_folder, read_table
+from ._files import read_table
 
 __all__ = ["INFO", "load_piezo_micromanipulator"]
 
@@ -57,9 +57,21 @@ INFO_VARIANTS = (
 )
 
 
+FOLDER = "piezo_micromanipulator_capsensor"
+_FILES = {"identification": "Model_Vi_Do.dat", "test": "Test_Vi_Do_Di.dat"}
+
+
+def _source(variant: str) -> Provenance:
+    return Provenance(
+        repository="github.com/yan9a/DiscreteBacklashOperator", commit=_COMMIT,
+        paths=(f"{_REPO_DIR}/{_FILES[variant]}",), licence="MIT",
+        licence_file="LICENSE_MIT_yan9a.txt", credit=_CREDIT,
+        files=(f"{FOLDER}/{_FILES[variant]}",))
+
+
 def _read(folder: Path, variant: str) -> Dataset:
     if variant == "identification":
-        path = folder / "Model_Vi_Do.dat"
+        path = folder / _FILES[variant]
         table = read_table(path, 7, usecols=[0, 4])
         u, y, channels, lag = table[:, 0], table[:, 1], {}, 0
         segments, units = ID_SEGMENTS, {}
@@ -67,7 +79,7 @@ def _read(folder: Path, variant: str) -> Dataset:
                        "capacitive sensor output; the author fits one cycle (segment "
                        "author_cycle).")
     else:
-        path = folder / "Test_Vi_Do_Di.dat"
+        path = folder / _FILES[variant]
         table = read_table(path, 11, usecols=[0, 4, 8])
         lag = 1
         u, y = table[:-lag, 0], table[lag:, 1]
@@ -86,22 +98,18 @@ def _read(folder: Path, variant: str) -> Dataset:
         input_name="actuator command", input_unit="V",
         output_name="capacitive sensor displacement", output_unit="um",
         description=description,
-        provenance=Provenance(
-            repository="github.com/yan9a/DiscreteBacklashOperator", commit=_COMMIT,
-            paths=(f"{_REPO_DIR}/{path.name}",), licence="MIT",
-            licence_file="LICENSE_MIT_yan9a.txt", credit=_CREDIT,
-            files=(f"{folder.name}/{path.name}",)),
+        provenance=_source(variant),
         time_note=f"no time column: row index / {FS:g} Hz (the author's Fs)",
         segments=segments, channels=channels, channel_units=units, notes=tuple(notes))
 
 
 INFO = DatasetInfo(
-    name=NAME, folder="piezo_micromanipulator_capsensor",
+    name=NAME, folder=FOLDER,
     what="piezo flexure micromanipulator, capacitive sensor, 1 Hz sine; identification run "
          "+ test run with the author's hardware feedforward",
     input_name="actuator command", input_unit="V",
     output_name="capacitive sensor displacement", output_unit="um", licence="MIT",
-    variants=INFO_VARIANTS, default_variant="identification", reader=_read)
+    variants=INFO_VARIANTS, default_variant="identification", reader=_read, source=_source)
 
 
 def load_piezo_micromanipulator(variant: str = "identification", *,
@@ -123,4 +131,4 @@ def load_piezo_micromanipulator(variant: str = "identification", *,
         input = actuator command [V], output = sensor displacement [um, arbitrary offset],
         200 Hz.
     """
-    return _read(data_folder(INFO.folder, root), INFO.variant(variant).name)
+    return INFO.read(variant, root)

@@ -17,11 +17,12 @@ import numpy as np
 
 from ..errors import InputError
 from ._dataset import Dataset, DatasetInfo, Provenance, VariantInfo
-from ._files import data_folder, read_mat_matrix, read_table
+from ._files import read_mat_matrix, read_table
 
 __all__ = ["INFO", "load_mr_damper"]
 
 NAME = "mr_damper"
+FOLDER = "mr_damper_utfsm"
 _COMMIT = "08753ffd7abd5b19053f7e79149c3a68f49bf73c"
 _TRAIN_DIR = "Cap7_ModeloMR/BoucWen Ajuste 2/Preprocesamiento-sinusoidales/Preprocesados"
 _EQ_FILE = "validacion_earthquake.mat"
@@ -59,11 +60,16 @@ _TRAIN = _train_variants()
 _EQ = {f"earthquake_{cur:g}A": (j + 1, cur) for j, cur in enumerate(_EQ_CURRENTS)}
 
 
-def _provenance(folder: Path, repo_path: str, local: str) -> Provenance:
+def _source(variant: str) -> Provenance:
+    if variant in _TRAIN:
+        stem = _TRAIN[variant][0]
+        repo_path, local = f"{_TRAIN_DIR}/{stem}.txt", f"train_sinusoids/{stem}.txt"
+    else:
+        repo_path, local = "Cap7_ModeloMR/BoucWen Ajuste 2/Validacion/validacion.mat", _EQ_FILE
     return Provenance(repository="github.com/DanielMaurelE/vRTHS_AMBC_MRdamper", commit=_COMMIT,
                       paths=(repo_path,), licence="MIT",
                       licence_file="LICENSE_MIT_mequiroz.txt", credit=_CREDIT,
-                      files=(f"{folder.name}/{local}",))
+                      files=(f"{FOLDER}/{local}",))
 
 
 def _read(folder: Path, variant: str) -> Dataset:
@@ -77,7 +83,7 @@ def _read(folder: Path, variant: str) -> Dataset:
             **common, time=table[:, 0], input=table[:, 1], output=table[:, 3],
             description=f"Training run: {amp} mm, {freq:g} Hz sine displacement, coil current "
                         f"{cur:g} A (several cycles incl. a short start-up transient).",
-            provenance=_provenance(folder, f"{_TRAIN_DIR}/{stem}.txt", local),
+            provenance=_source(variant),
             time_note="time column of the file",
             channels={"velocity": table[:, 2]}, channel_units={"velocity": "mm/s"},
             conditions={"amplitude_mm": float(amp), "frequency_Hz": freq, "current_A": cur},
@@ -93,8 +99,7 @@ def _read(folder: Path, variant: str) -> Dataset:
         output=data[:, column],
         description=f"Validation run: earthquake-type commanded displacement (about -8 ... "
                     f"+7 mm, 65 s), force at coil current {cur:g} A.",
-        provenance=_provenance(folder, "Cap7_ModeloMR/BoucWen Ajuste 2/Validacion/"
-                                       "validacion.mat", _EQ_FILE),
+        provenance=_source(variant),
         time_note=f"no time column: row index / {_EQ_FS:g} Hz (documented rate)",
         conditions={"current_A": cur},
         notes=(("authors' pre-processing: 300-sample (0.3 s) moving average; the five currents "
@@ -109,11 +114,12 @@ _VARIANTS = tuple(
           for v, (_, c) in _EQ.items())
 
 INFO = DatasetInfo(
-    name=NAME, folder="mr_damper_utfsm",
+    name=NAME, folder=FOLDER,
     what="MR damper force vs displacement: 30 sine runs (train) + earthquake record "
          "(validation) at several coil currents",
     input_name="displacement", input_unit="mm", output_name="damper force", output_unit="N",
-    licence="MIT", variants=_VARIANTS, default_variant="10mm_1Hz_0.5A", reader=_read)
+    licence="MIT", variants=_VARIANTS, default_variant="10mm_1Hz_0.5A", reader=_read,
+    source=_source)
 
 
 def load_mr_damper(variant: str = "10mm_1Hz_0.5A", *,
@@ -135,4 +141,4 @@ def load_mr_damper(variant: str = "10mm_1Hz_0.5A", *,
         input = displacement [mm], output = force [N]; training runs also carry the channel
         ``velocity`` [mm/s]; ``conditions`` hold amplitude, frequency and current.
     """
-    return _read(data_folder(INFO.folder, root), INFO.variant(variant).name)
+    return INFO.read(variant, root)

@@ -9,7 +9,7 @@ from types import MappingProxyType
 from ..errors import InputError
 from . import _bh_loops, _boucwen, _micromanipulator, _mr_damper, _piezo_actuator
 from ._dataset import Dataset, DatasetInfo
-from ._files import data_folder, find_root
+from ._files import find_root
 
 __all__ = ["DATASETS", "dataset_info", "list_datasets", "load", "shared_data_status"]
 
@@ -79,9 +79,7 @@ def load(name: str, variant: str | None = None, *,
     MissingDependencyError
         The variant's file format needs an optional package that is not installed.
     """
-    info = dataset_info(name)
-    chosen = info.variant(variant).name
-    return info.reader(data_folder(info.folder, root), chosen)
+    return dataset_info(name).read(variant, root)
 
 
 def shared_data_status(root: str | os.PathLike[str] | None = None) -> tuple[Path | None, str]:
