@@ -202,3 +202,19 @@ def test_stream_gives_the_offline_band_bit_for_bit(center):
         got = np.concatenate([[getattr(s, name) for s in steps],
                               *[getattr(c, name) for c in chunks]])
         np.testing.assert_array_equal(got, getattr(offline, name))
+
+
+def test_rate_share_is_scipys_nnls():
+    """The two-coefficient NNLS written out equals scipy.optimize.nnls (random cases, both
+    constraints active in some)."""
+    from scipy.optimize import nnls
+
+    from hystkit.compensation._calibration import MAX_RATE_SHARE, _rate_share
+
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        rate = rng.random(300) * rng.random() * 5
+        error = np.abs(rng.normal(rng.normal(), 1, 300) + rng.normal() * rate)
+        (c0, c1), _ = nnls(np.column_stack([np.ones_like(rate), rate]), error)
+        expected = 0.0 if c0 + c1 <= 0 else min(c1 / (c0 + c1), MAX_RATE_SHARE)
+        assert _rate_share(error, rate) == pytest.approx(expected, abs=1e-9)

@@ -204,7 +204,7 @@ def test_stream_skips_an_unterminated_last_line(scratch: Path, cli: Callable[...
     run.clean()
     assert run.code == 0, run.err
     rows = run.out.splitlines()
-    assert rows[0] == "time,position_estimate,flags"
+    assert rows[0] == "time,position_estimate,flags,position_lower,position_upper"  # band
     assert [r.split(",")[0] for r in rows[1:]] == [x.split(",")[0] for x in lines[1:]]
     assert ("hystkit: warning: cut.csv: 1 line(s) unterminated last line (skipped; first at "
             "line 13)") in run.err

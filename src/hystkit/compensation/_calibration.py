@@ -139,11 +139,20 @@ def calibrate_band(comp, recordings: Sequence[Recording], size: int,
 
 def _rate_share(error: np.ndarray, rate: np.ndarray) -> float:
     """How much of the held-out error grows with the rate: ``c1 / (c0 + c1)`` of the
-    non-negative least-squares fit ``|e| ~ c0 + c1 rate``, at most ``MAX_RATE_SHARE``."""
-    from scipy.optimize import nnls
+    non-negative least-squares fit ``|e| ~ c0 + c1 rate``, at most ``MAX_RATE_SHARE``.
 
-    design = np.column_stack([np.ones_like(rate), rate])
-    (c0, c1), _ = nnls(design, error)
+    Two coefficients: the unconstrained line if both are >= 0, else the better of the two
+    one-coefficient fits (the Karush-Kuhn-Tucker cases of NNLS, without scipy.optimize).
+    """
+    candidates = [(float(np.mean(error)), 0.0)]
+    rr = float(rate @ rate)
+    if rr > 0:
+        candidates.append((0.0, float(rate @ error) / rr))
+    if np.ptp(rate) > 0:
+        c1, c0 = np.polyfit(rate, error, 1)
+        candidates.append((float(c0), float(c1)))
+    feasible = [(c0, c1) for c0, c1 in candidates if c0 >= 0 and c1 >= 0]
+    c0, c1 = min(feasible, key=lambda c: float(np.sum((error - c[0] - c[1] * rate) ** 2)))
     total = c0 + c1
     return 0.0 if total <= 0 else float(min(c1 / total, MAX_RATE_SHARE))
 

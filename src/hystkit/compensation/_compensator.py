@@ -22,6 +22,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .._read_options import ReadOptions
 from ..errors import FitDivergedError, InputError
 from ..io import MAX_MAGNITUDE, Recording
 from ..models import Family, get_family
@@ -116,6 +117,11 @@ class Compensator:
         Model file it was loaded from.
     band : Band, optional
         The calibrated prediction band (:mod:`._band`); None: fitted without one.
+    reading : ReadOptions, optional
+        How the training recordings were read: their column names, time unit, units line and
+        units (only these fields; the others are left at their defaults). Later commands read
+        a file of the same column names this way by default. None: not known (fitted on
+        arrays, on files read differently, or by a hystkit before it was kept).
 
     Raises
     ------
@@ -142,6 +148,7 @@ class Compensator:
     position_range: tuple[float, float] | None = None
     source: str | None = field(default=None, compare=False)
     band: Band | None = None
+    reading: ReadOptions | None = None
 
     @property
     def family(self) -> Family:
@@ -175,6 +182,10 @@ class Compensator:
                     raise ValueError(f"{name} must be two finite numbers, low <= high, got "
                                      f"{value!r}")
                 object.__setattr__(self, name, (lo, hi))
+        if self.band is not None and (self.training_range is None
+                                      or self.position_range is None):
+            raise ValueError("a band needs the training_range and position_range it was "
+                             "calibrated with")
 
     # -- the data path ---------------------------------------------------------------------
 
