@@ -49,16 +49,17 @@ def test_fit_and_evaluate_own_csv_match_the_standard_file(files, tmp_path, capsy
         assert scores["own"][key] == pytest.approx(scores["std"][key], rel=1e-6), key
 
 
-def test_compensate_writes_standard_names(files, tmp_path, capsys):
+def test_compensate_keeps_the_inputs_names_and_time_unit(files, tmp_path, capsys):
     model = tmp_path / "m.json"
     assert _run(capsys, "fit", files["own"], "--cells", 1, "--out", model, *OWN)[0] == 0
     out = tmp_path / "out.csv"
     code, _, err = _run(capsys, "compensate", model, files["own"], "--out", out, *OWN)
     assert code == 0, err
     written = pd.read_csv(out)
-    assert list(written.columns[:4]) == ["time", "position", "sensor", "position_estimate"]
+    assert list(written.columns[:4]) == ["t_ms", "displacement_mm", "resistance_ohm",
+                                         "displacement_mm_estimate"]
     own = pd.read_csv(files["own"], sep=";")
-    np.testing.assert_allclose(written["time"], own["t_ms"] * 1e-3, rtol=1e-12)
+    np.testing.assert_allclose(written["t_ms"], own["t_ms"], rtol=1e-12)
 
 
 @pytest.mark.parametrize("option, fragments", [
@@ -101,4 +102,7 @@ def test_every_reading_command_has_the_options(command, capsys):
     text = " ".join(capsys.readouterr().out.split())
     for option in ("--columns", "--time-unit", "--skip-rows", "--sep"):
         assert option in text, (command, option)
-    assert "hystkit's column names (time [s], position, sensor" in text
+    if command == "compensate":  # its output keeps the input's names (issue 27.4)
+        assert "the output keeps the input's column names and time unit" in text
+    else:
+        assert "hystkit's column names (time [s], position, sensor" in text

@@ -143,31 +143,35 @@ def test_compensate_keeps_other_columns_and_units(files, tmp_path, capsys):
     out = tmp_path / "c.csv"
     code, stdout, err = _run(capsys, "compensate", model, files["with_toml"], "--out", out)
     assert code == 0, err
-    assert "position_estimate' [mm]" in stdout and "kept 2 other column(s)" in stdout
+    assert "displacement_mm_estimate' [mm]" in stdout and "kept 2 other column(s)" in stdout
     written = pd.read_csv(out, keep_default_na=False, na_values=[""])
-    assert list(written.columns) == ["time", "position", "sensor", "temp_C", "note",
-                                     "position_estimate", "position_lower",
-                                     "position_upper", "sensor_outside", "estimate_outside"]
+    # the input's names, the estimate and its band named after its position column
+    assert list(written.columns) == ["t_ms", "displacement_mm", "resistance_ohm", "temp_C",
+                                     "note", "displacement_mm_estimate",
+                                     "displacement_mm_lower", "displacement_mm_upper",
+                                     "sensor_outside", "estimate_outside"]
     own = files["own"]
     assert_array_equal(written["temp_C"].to_numpy(), own["temp_C"].to_numpy())  # NaN kept
     assert written["note"].fillna("").tolist() == own["note"].tolist()
-    # the units went into c.toml, which reading c.csv picks up again
+    # the units (and names, time unit) went into c.toml, which reading c.csv picks up again
     back, settings = options_for(out)
     assert settings == tmp_path / "c.toml"
     assert dict(read_recording(out, options=back).units) == {"position": "mm",
                                                               "sensor": "Ohm"}
-    assert dict(back.units)["position_estimate"] == "mm"
+    assert dict(back.units)["displacement_mm_estimate"] == "mm"
     assert dict(back.units)["temp_C"] == "degC"
     mat = tmp_path / "c.mat"
     assert _run(capsys, "compensate", model, files["with_toml"], "--out", mat)[0] == 0
     m = loadmat(mat, simplify_cells=True)
-    assert m["units"] == {"position": "mm", "sensor": "Ohm", "position_estimate": "mm",
-                          "position_lower": "mm", "position_upper": "mm", "temp_C": "degC"}
+    assert m["units"] == {"t_ms": "ms", "displacement_mm": "mm", "resistance_ohm": "Ohm",
+                          "displacement_mm_estimate": "mm", "displacement_mm_lower": "mm",
+                          "displacement_mm_upper": "mm", "temp_C": "degC"}
     assert_array_equal(m["temp_C"], own["temp_C"].to_numpy())
     # a cell array of text; scipy reads an empty char as an empty array
     notes = [x if isinstance(x, str) else ("" if np.size(x) == 0 else x) for x in m["note"]]
     assert notes == own["note"].tolist()
-    assert_array_equal(m["position_estimate"], written["position_estimate"].to_numpy())
+    assert_array_equal(m["displacement_mm_estimate"],
+                       written["displacement_mm_estimate"].to_numpy())
 
 
 def test_compensate_refuses_an_existing_units_file_before_work(files, tmp_path, capsys):
@@ -217,7 +221,7 @@ def test_compensate_with_resample_leaves_out_text_and_gappy_columns(files, tmp_p
     assert "temp_C" not in written.columns and "note" not in written.columns  # empty cell; text
     # the file is uniform at 40 Hz already: resampled at its own rate it is the same recording
     # up to rounding (its times are ms x 1e-3, the grid's t0 + k / 40: a few ulp apart)
-    np.testing.assert_allclose(written["sensor"].to_numpy(),
+    np.testing.assert_allclose(written["resistance_ohm"].to_numpy(),
                                files["own"]["resistance_ohm"].to_numpy(), rtol=0, atol=1e-13)
 
 

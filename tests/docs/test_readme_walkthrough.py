@@ -56,16 +56,27 @@ def test_readme_walkthrough_runs(tmp_path):
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     assert "hystkit: error" not in proc.stderr
 
-    # the user's file: ms and their names; the answers: seconds and hystkit's names
+    # the user's file: ms and their names; the answers: the same names and ms (issue 27.4)
     own = pd.read_csv(tmp_path / "my.csv", skiprows=[1])
     c = loadmat(tmp_path / "compensated.mat", simplify_cells=True)
-    assert_allclose(c["time"], own["t_ms"].to_numpy() * 1e-3, rtol=1e-15, atol=0)
-    assert_array_equal(c["position"], own["displacement_mm"].to_numpy())
-    assert_array_equal(c["sensor"], own["resistance_ohm"].to_numpy())
-    assert c["units"] == {"position": "mm", "sensor": "Ohm", "position_estimate": "mm"}
+    assert_allclose(c["t_ms"], own["t_ms"].to_numpy(), rtol=1e-15, atol=0)
+    assert_array_equal(c["displacement_mm"], own["displacement_mm"].to_numpy())
+    assert_array_equal(c["resistance_ohm"], own["resistance_ohm"].to_numpy())
+    band = [f"displacement_mm_{side}" for side in ("lower", "upper") if
+            f"displacement_mm_{side}" in c]  # the band's columns, when the model has one
+    assert c["units"] == {"t_ms": "ms", "displacement_mm": "mm", "resistance_ohm": "Ohm",
+                          "displacement_mm_estimate": "mm", **dict.fromkeys(band, "mm")}
+    # evaluate and compensate ran without options: as the model's training data were read
+    assert proc.stdout.count("reading my.csv as the model's training data were read: "
+                             "columns t_ms,displacement_mm,resistance_ohm, time in ms, a "
+                             "units line") == 2
+    # the same answer from the settings file, in CSV
+    written = pd.read_csv(tmp_path / "compensated.csv")
+    assert_array_equal(written["displacement_mm_estimate"].to_numpy(),
+                       c["displacement_mm_estimate"])
 
     # scores.mat's R² is that of compensated.mat's estimate (1 - SS_res / SS_tot)
-    x, estimate = c["position"], c["position_estimate"]
+    x, estimate = c["displacement_mm"], c["displacement_mm_estimate"]
     r2 = 1 - np.sum((x - estimate) ** 2) / np.sum((x - x.mean()) ** 2)
     s = loadmat(tmp_path / "scores.mat", simplify_cells=True)
     assert s["r2"] == pytest.approx(r2, rel=1e-9)

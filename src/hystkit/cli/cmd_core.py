@@ -5,11 +5,11 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from ._common import (
     GUARD_EXIT,
-    OUTPUT_NAMES_NOTE,
     UsageError,
     add_read_options,
     check_size,
@@ -31,6 +31,13 @@ from ._fit_start_options import (
     weight_sum_options,
 )
 from ._inputs import check_inputs_exist
+from ._own_layout import (
+    add_trained_note,
+    estimate_names,
+    options_as_trained,
+    output_names,
+    training_reading,
+)
 from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_from_args
 
 __all__ = ["register"]
@@ -101,7 +108,10 @@ def _fit(args: argparse.Namespace) -> int:
     options.update(_pl_options(args, family))
     options.update(structure_options(args, family))
     check_size(args.model, args.cells, "--cells")
-    recs = [read_recording(path, options=read_options(args, path)) for path in args.data]
+    reading, recs = [], []
+    for path in args.data:
+        reading.append(read_options(args, path))
+        recs.append(read_recording(path, options=reading[-1]))
     size = family.default_size if args.cells is None else args.cells
     fit_options = {**start_options(args, family, recs[0].dt, size, options), **constraint}
     shown = "".join(f", {name} {str(value).lower() if isinstance(value, bool) else f'{value:g}'}"
@@ -122,6 +132,8 @@ def _fit(args: argparse.Namespace) -> int:
     units = _training_units(recs, args.data)
     if units:
         comp.fit_info["units"] = units
+    remembered, not_remembered = training_reading(reading, args.data, units)
+    comp = replace(comp, reading=remembered)  # later commands read files of this layout so
     save_compensator(comp, args.out, force=args.force)
     info = comp.fit_info
     print(f"done in {info['fit_seconds']:.2f} s: SSE {info['cost']:.4g} (normalised), solver: "
@@ -135,7 +147,8 @@ def _fit(args: argparse.Namespace) -> int:
           f"sensor polarity {comp.polarity:+g}")
     if info.get("joint_fit"):
         print(f"  {info['joint_fit']}")
-    for note in [*(info.get("at_model_limits") or ()), *(info.get("redundant") or ())]:
+    for note in [*(info.get("at_model_limits") or ()), *(info.get("redundant") or ()),
+                 *filter(None, [not_remembered])]:
         print(f"  note: {note}")
     print(f"wrote {args.out}")
     if info["status"] != "ok":
@@ -269,35 +282,40 @@ def _compensate(args: argparse.Namespace) -> int:
                       formats=RECORDING_SUFFIXES, what="a recording")
     comp = load_compensator(args.model)
     _warn_if_oracle(comp.center, args.model)
-    options = read_options(args, args.data)
+    options = options_as_trained(args, args.data, comp.reading)
     rec = read_recording(args.data, need_position=False, options=options)
     kept = read_other_columns(args.data, rec.n_samples, options)
-    units = _output_units(comp, rec, options, kept, args.data)
-    if units and args.out.suffix.lower() == ".csv":  # the units go beside it: check it too
+    names = output_names(options)  # the input's names and time unit, kept in the output
+    new = estimate_names(names)
+    units = _output_units(comp, rec, options, kept, args.data, new)
+    sidecar = args.out.suffix.lower() == ".csv" and bool(units or rec.units or names
+                                                          or options.time_unit != "s")
+    if sidecar:  # the units and names go beside it: check it too
         check_output_path(sidecar_path(args.out), args.force, inputs=[args.data])
     estimate = comp.estimate(rec, rest_position=args.rest_position)
     flags = use_flags(comp, rec, estimate)
-    extra = {"position_estimate": estimate}
+    extra = {new["position_estimate"]: estimate}
     if comp.band is not None:
-        extra["position_lower"], extra["position_upper"] = _module.interval(comp, rec, estimate,
-                                                                            args.level)
+        extra[new["position_lower"]], extra[new["position_upper"]] = _module.interval(
+            comp, rec, estimate, args.level)
     elif args.level is not None:
         raise UsageError(f"--level: {args.model} has no prediction band (fitted without one "
                          f"or by a hystkit before bands); fit it again")
     extra.update({name: mask for name, mask in flags.items() if mask is not None})
-    taken = {"time", "position", "sensor", *extra}  # an input column of such a name is renamed
+    # an input column of such a name is renamed
+    taken = {*(names.get(name, name) for name in ("time", "position", "sensor")), *extra}
     kept = {(f"{name}_input" if name in taken else name): values for name, values in kept.items()}
     write_recording(rec, args.out, extra=extra, kept=kept, units=units, force=args.force,
-                    units_sidecar=True)
-    unit = units.get("position_estimate", "unit of the training position")
+                    units_sidecar=True, names=names, time_unit=options.time_unit)
+    unit = units.get(new["position_estimate"], "unit of the training position")
     band = ("" if comp.band is None else f", its {_level(comp, args.level):.0%} band "
-            f"'position_lower', 'position_upper'")
-    print(f"wrote {args.out}: {rec.n_samples} samples with column 'position_estimate' [{unit}]"
-          f"{band} (centring: {center_label(comp.center)}) and the flag columns "
+            f"'{new['position_lower']}', '{new['position_upper']}'")
+    print(f"wrote {args.out}: {rec.n_samples} samples with column '{new['position_estimate']}' "
+          f"[{unit}]{band} (centring: {center_label(comp.center)}) and the flag columns "
           f"{', '.join(n for n, m in flags.items() if m is not None) or '(none: old model file)'}"
           + (f"; kept {len(kept)} other column(s): {', '.join(kept)}" if kept else "")
-          + (f"; units in {sidecar_path(args.out)}" if units and args.out.suffix.lower()
-             == ".csv" else ""))
+          + (f"; {'units' if not names and options.time_unit == 's' else 'how to read it'} "
+             f"in {sidecar_path(args.out)}" if sidecar else ""))
     if options.resample_hz is not None:
         print("  (resampled: the input's other numeric columns were resampled like the "
               "recording; columns with text or empty cells cannot be and are left out)")
@@ -305,16 +323,17 @@ def _compensate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _output_units(comp, rec, options, kept: dict, data: Path) -> dict[str, str]:
-    """Units of compensate's output columns: the recording's, the estimate in the training
-    position's unit (from the model file, else the input's position unit), the kept
-    columns' from the settings file. Warns when the sensor unit differs from training."""
+def _output_units(comp, rec, options, kept: dict, data: Path,
+                  new: dict[str, str]) -> dict[str, str]:
+    """Units of compensate's output columns beyond the recording's (written with it): the
+    estimate and its band (`new`'s names) in the training position's unit (from the model
+    file, else the input's position unit), the kept columns' from the settings file. Warns
+    when the sensor unit differs from training."""
     trained = comp.fit_info.get("units") or {}
-    units = dict(rec.units)
+    units = {}
     position = trained.get("position") or rec.unit("position")
     if position:
-        units.update(dict.fromkeys(("position_estimate", "position_lower", "position_upper"),
-                                   position))
+        units.update(dict.fromkeys(new.values(), position))
     if trained.get("sensor") and rec.unit("sensor") and trained["sensor"] != rec.unit("sensor"):
         print(f"hystkit: warning: {data}: sensor unit {rec.unit('sensor')!r} but the model was "
               f"trained on {trained['sensor']!r}; the estimate is meaningless unless the "
@@ -366,7 +385,7 @@ def _evaluate(args: argparse.Namespace) -> int:
                           formats=(".json", ".mat"), what="the scores")
     comp = load_compensator(args.model)
     _warn_if_oracle(comp.center, args.model)
-    rec = read_recording(args.data, options=read_options(args, args.data))
+    rec = read_recording(args.data, options=options_as_trained(args, args.data, comp.reading))
     scores = evaluate(comp, rec, rest_position=args.rest_position, level=args.level)
     scores["units"] = dict(rec.units)  # of position and sensor, as the file gave them
     _warn_if_outside(use_flags(comp, rec, comp.estimate(rec, rest_position=args.rest_position)),
@@ -515,6 +534,9 @@ def _add_rest_position(p: argparse.ArgumentParser) -> None:
 
 
 _MODEL_HELP = "model file written by fit or select (.json or .mat)"
+# The reading options' note of compensate, whose output keeps the input's names
+COMPENSATE_NAMES_NOTE = ("the output keeps the input's column names and time unit, the "
+                         "estimate named after the position column")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -589,11 +611,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, required=True,
                    help="file to write, by its extension: .csv, .parquet or .mat (MATLAB: one "
                         "variable per column, with column_names and units); the input's "
-                        "columns, then position_estimate, its band position_lower and "
-                        "position_upper (if the model has one) and the flags sensor_outside, "
-                        f"estimate_outside; {OUTPUT_NAMES_NOTE.replace(', ...', '')}")
+                        "columns under its own names, time in its own unit, then the estimate "
+                        "named after the position column (position_estimate, or x_mm_estimate "
+                        "for a column x_mm), its band position_lower and position_upper (if "
+                        "the model has one; x_mm_lower, x_mm_upper) and the flags "
+                        "sensor_outside, estimate_outside")
     _add_level(p)
     add_read_options(p)
+    # compensate writes the input's names: not the group's note that outputs use hystkit's
+    add_trained_note(p, COMPENSATE_NAMES_NOTE)
     p.set_defaults(run=_compensate)
 
     p = sub.add_parser("evaluate", help="score a compensator on a recording")
@@ -606,6 +632,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     _add_rest_position(p)
     _add_level(p)
     add_read_options(p)
+    add_trained_note(p)
     p.set_defaults(run=_evaluate)
 
     p = sub.add_parser("demo", help="the main job on the built-in virtual sensor")

@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import UsageError, add_read_options, read_options
+from ._common import UsageError, add_read_options
+from ._own_layout import add_trained_note, options_as_trained
 
 __all__ = ["register"]
 
@@ -26,8 +27,11 @@ def _report(args: argparse.Namespace) -> int:
         if args.figures.exists() and not args.figures.is_dir():
             raise UsageError(f"--figures {args.figures}: is a file, not a folder")
         check_folder_writable(args.figures)
-    # each recording with its settings file, the command line's reading options on top
-    content = build_report(args.inputs, options=lambda path: read_options(args, path))
+    # each recording with its settings file, the command line's reading options on top, or
+    # as the model's training data were read
+    reading = _model_reading(args.inputs)
+    content = build_report(args.inputs,
+                           options=lambda path: options_as_trained(args, path, reading))
     paths = write_report(content, args.out, figures=args.figures, fmt=args.format,
                          force=args.force)
     size = paths[0].stat().st_size
@@ -38,6 +42,17 @@ def _report(args: argparse.Namespace) -> int:
     if args.figures is not None and args.format != "png" and png_only:
         print(f"  as PNG only (a control run's own figures): {', '.join(png_only)}")
     return 0
+
+
+def _model_reading(inputs: list[Path]):
+    """How the training data of the model file among `inputs` (the first, before
+    recordings) were read; None for result folders (the page's builder names a wrong mix)."""
+    from ..compensation import MODEL_SUFFIXES, load_compensator
+
+    first = inputs[0]
+    if len(inputs) < 2 or first.suffix.lower() not in MODEL_SUFFIXES or not first.is_file():
+        return None
+    return load_compensator(first).reading
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -62,4 +77,5 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="format of the figure files beside PNG: svg or pdf (default png only; "
                         "needs --figures)")
     add_read_options(p)
+    add_trained_note(p)
     p.set_defaults(run=_report)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from ._common import (
@@ -15,6 +16,7 @@ from ._common import (
     positive_int,
     read_options,
 )
+from ._own_layout import training_reading
 from .cmd_compare import _models, add_parallel_options, executor_for
 
 __all__ = ["register"]
@@ -51,7 +53,12 @@ def _select(args: argparse.Namespace) -> int:
                       what="a model file")
     report = args.report or args.out.with_name(args.out.stem + "-selection")
     check_output_folder(report, SELECTION_FILES, args.force, inputs=args.data)
-    recs = [read_recording(path, options=read_options(args, path)) for path in args.data]
+    reading, recs = [], []
+    for path in args.data:
+        reading.append(read_options(args, path))
+        recs.append(read_recording(path, options=reading[-1]))
+    units = {name: unit for name, unit in recs[0].units if all(r.unit(name) == unit for r in recs)}
+    remembered, not_remembered = training_reading(reading, args.data, units)
     fold_list = folds(recs)
     fit_samples = min((f.n_train for f in fold_list), default=0)
     cands = candidates(_models(args.models), _centers(args.centers), fit_samples=fit_samples,
@@ -94,12 +101,16 @@ def _select(args: argparse.Namespace) -> int:
                       for r in rows]).to_csv(tmp / "selection.csv", index=False)
         plot_selection(rows).savefig(tmp / "selection.png", dpi=110)
         if result["winner"] is not None:
-            save_compensator(result["compensator"], args.out, force=args.force)
+            # later commands read files of the training files' layout as these were read
+            save_compensator(replace(result["compensator"], reading=remembered), args.out,
+                             force=args.force)
     print(f"wrote {report / 'selection.json'}, .csv, .png ({summary['seconds']:.1f} s)")
     if result["winner"] is None:
         print(f"hystkit: select: no usable model, none written: {result['refusal']}",
               file=sys.stderr)
         return GUARD_EXIT
+    if not_remembered:
+        print(f"  note: {not_remembered}")
     w = result["winner"]
     oracle = "" if w["cv_r2_oracle"] is None else f", oracle {w['cv_r2_oracle']:.4f}"
     print(f"winner: {w['candidate']} (deployable R² {w['cv_r2']:.4f} on held-out data, "

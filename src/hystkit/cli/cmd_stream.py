@@ -52,6 +52,7 @@ from typing import TYPE_CHECKING, TextIO
 
 from ..errors import InputError, OutputError
 from ._common import add_read_options, stdout_for
+from ._own_layout import add_trained_note, stream_args
 from ._stream_input import nothing_compensated, stream_format, stream_lines
 
 if TYPE_CHECKING:
@@ -367,9 +368,10 @@ def _stream(args: argparse.Namespace) -> int:
     if args.serial is None and args.baud is not None:
         raise InputError("--baud is for --serial")
     _check_adapt_options(args)
+    comp = load_compensator(args.model)
+    stream_args(args, comp.reading)  # --in FILE of the training files' names: read as they were
     fmt = stream_format(args)  # --in FILE: its settings file and layout, as fit reads it
     stdout_for("the estimates")
-    comp = load_compensator(args.model)
     if args.level is not None and comp.band is None:
         raise InputError(f"--level: {args.model} has no prediction band (fitted without one or "
                          f"by a hystkit before bands); fit it again")
@@ -476,6 +478,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="rest: model at rest at the first sample (default); sync: after the "
                         "synchronisation excitation e_sync (eq. 2.21-2.22), printed to stderr")
     add_read_options(p)  # --in FILE, stdin or a port laid out as the user's files
+    add_trained_note(p)
     p.add_argument("--level", type=number(0, 1, low_open=True, high_open=True), default=None,
                    help="nominal coverage of the prediction band columns, in (0, 1) (default: "
                         "the model's own, 0.90 unless fitted otherwise)")

@@ -24,14 +24,15 @@ import re
 from collections.abc import Iterable, Iterator
 from typing import Any
 
+from .._read_options import FIELDS, TIME_UNITS, ReadOptions
 from ..errors import InputError
 from ..io import MAX_MAGNITUDE
 from ..models import DT_RANGE
 from ._compensator import MAX_NORMALISED
 
 __all__ = ["MAX_MODEL_BYTES", "MAX_PARAM_NUMBERS", "MAX_SCALE", "MAX_STRUCTURE_INT",
-           "MAX_WINDOW_SAMPLES", "MIN_SCALE", "check_keys", "check_like", "check_model_dict",
-           "check_model_domain", "key_in_message"]
+           "MAX_WINDOW_SAMPLES", "MIN_SCALE", "READING_KEYS", "check_keys", "check_like",
+           "check_model_dict", "check_model_domain", "check_reading", "key_in_message"]
 
 # A 10 000-cell mPL file is under 1 MB; anything far larger is not a model hystkit wrote.
 MAX_MODEL_BYTES = 16 * 2**20
@@ -56,6 +57,9 @@ _SLACK = 1e-9
 _NUMERIC_SECTIONS = ("params", "normalisation", "baseline")
 _OPTIONAL_NUMBERS = ("polarity", "tare_seconds", "track_seconds", "sensor_reference",
                      "rest_position", "dt")
+# The ``reading`` section: how the training recordings were read (`ReadOptions` fields)
+READING_KEYS = ("columns", "time_unit", "units_row", "units")
+MAX_READING_NAME = 1000  # characters of a column name or unit: far beyond any file's
 
 
 def check_model_dict(d: dict, source: str) -> None:
@@ -107,6 +111,70 @@ def check_model_dict(d: dict, source: str) -> None:
                     _fail(source, path, f"must be a string, got {_show(value)}")
             else:
                 _check_number(source, path, value)
+    check_reading(d.get("reading"), source)
+
+
+def check_reading(reading: Any, source: str) -> ReadOptions | None:
+    """The ``reading`` section (how the training data were read), checked and built.
+
+    Parameters
+    ----------
+    reading : object
+        The section's contents: null, or an object with ``columns`` (hystkit name -> the
+        file's column name), ``time_unit``, ``units_row`` and ``units`` (name -> unit), each
+        optional.
+    source : str
+        The file, for messages.
+
+    Returns
+    -------
+    ReadOptions or None
+        Those fields as reading options (the others at their defaults); None for null or a
+        file without the key (written before it was kept).
+
+    Raises
+    ------
+    InputError
+        ``"<source>: key 'reading.time_unit': ..."``: not an object, an unknown key, a value
+        of the wrong type, or one `ReadOptions` refuses (an unknown unit, two names read
+        from one column).
+    """
+    if reading is None:
+        return None
+    if not isinstance(reading, dict):
+        _fail(source, "reading", f"must be null or a JSON object, got {_show(reading)}")
+    for key, value in reading.items():
+        if key not in READING_KEYS:
+            _fail(source, f"reading.{key}", f"unknown key (expected {', '.join(READING_KEYS)})")
+        if key in ("columns", "units"):
+            _check_names(source, f"reading.{key}", value, FIELDS if key == "columns" else None)
+    if not isinstance(reading.get("time_unit", "s"), str) \
+            or reading.get("time_unit", "s") not in TIME_UNITS:
+        _fail(source, "reading.time_unit", f"must be one of {', '.join(TIME_UNITS)}, got "
+                                           f"{_show(reading['time_unit'])}")
+    if not isinstance(reading.get("units_row", False), bool):
+        _fail(source, "reading.units_row", f"must be true or false, got "
+                                           f"{_show(reading['units_row'])}")
+    try:
+        return ReadOptions(columns=tuple(reading.get("columns", {}).items()),
+                           time_unit=reading.get("time_unit", "s"),
+                           units_row=reading.get("units_row", False),
+                           units=tuple(reading.get("units", {}).items()))
+    except ValueError as exc:  # two names from one column, crossed columns
+        path = "reading.units" if str(exc).startswith("units") else "reading.columns"
+        raise InputError(f"{source}: key {path!r}: {exc}") from None
+
+
+def _check_names(source: str, path: str, value: Any, keys: tuple[str, ...] | None) -> None:
+    """An object of text values (column names or units), keyed by `keys` when given."""
+    if not isinstance(value, dict):
+        _fail(source, path, f"must be a JSON object, got {_show(value)}")
+    for key, item in value.items():
+        if keys is not None and key not in keys:
+            _fail(source, f"{path}.{key}", f"unknown key (expected {', '.join(keys)})")
+        if not isinstance(item, str) or not item.strip() or len(item) > MAX_READING_NAME:
+            _fail(source, f"{path}.{key}", f"must be a non-empty text of at most "
+                                           f"{MAX_READING_NAME} characters, got {_show(item)}")
 
 
 def check_model_domain(d: dict, source: str) -> None:

@@ -8,8 +8,11 @@ the ``params`` variables still equal the text's, so a model edited in MATLAB is 
 than silently ignored.
 
 Keys added since the first files (``polarity``, ``tare_seconds``, ``track_seconds``,
-``sensor_reference``, ``rest_position``, ``position_range``, ``band``) are optional when reading, with the
-behaviour of the files that lacked them: polarity +1, no position-range guard, no band. A file with
+``sensor_reference``, ``rest_position``, ``position_range``, ``band``, ``reading``) are optional
+when reading, with the behaviour of the files that lacked them: polarity +1, no position-range
+guard, no band, recordings read as the command line and settings files say. ``reading`` is how
+the training recordings were read (``columns``, ``time_unit``, ``units_row``, ``units``;
+`check_reading`), which later commands apply to a file of the same column names. A file with
 ``center: recording`` (the old default) still loads and runs the paper's protocol, which removes
 each recording's own sensor mean: it is an oracle (not causal) and is labelled so.
 """
@@ -23,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import __version__
+from .._read_options import ReadOptions
 from ..errors import InputError
 from ..io import check_output_format, write_json, write_mat
 from ..models import FAMILIES
@@ -36,6 +40,7 @@ from ._model_checks import (
     check_like,
     check_model_dict,
     check_model_domain,
+    check_reading,
     key_in_message,
 )
 
@@ -91,7 +96,21 @@ def compensator_to_dict(comp: Compensator) -> dict:
         "sensor_reference": comp.sensor_reference,
         "rest_position": comp.rest_position,
         "band": None if comp.band is None else comp.band.to_dict(),
+        "reading": _reading_dict(comp.reading),
     }
+
+
+def _reading_dict(reading: ReadOptions | None) -> dict | None:
+    """The ``reading`` section: the fields of `reading` a model file keeps (`READING_KEYS`);
+    empty ``columns`` and ``units`` are left out (in MATLAB an empty struct does not survive
+    a load and save)."""
+    if reading is None:
+        return None
+    section = {"time_unit": reading.time_unit, "units_row": reading.units_row}
+    for key in ("columns", "units"):
+        if getattr(reading, key):
+            section[key] = dict(getattr(reading, key))
+    return section
 
 
 def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
@@ -161,7 +180,8 @@ def compensator_from_dict(d: dict, source: str = "<dict>") -> Compensator:
         scaling=Scaling(**d["normalisation"]), baseline=LinearBaseline(**d["baseline"]),
         fit_info=d.get("fit") or {}, training_range=_pair_or_none(d.get("training_range")),
         position_range=_pair_or_none(d.get("position_range")), model=d["model"],
-        source=source, band=band, **_optional(d)), _defaulted(structure, d["structure"]))
+        source=source, band=band, reading=check_reading(d.get("reading"), source),
+        **_optional(d)), _defaulted(structure, d["structure"]))
 
 
 def _defaulted(structure: Any, given: dict) -> str:

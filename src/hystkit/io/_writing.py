@@ -14,7 +14,7 @@ import math
 import os
 import secrets
 import shutil
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -23,6 +23,7 @@ import numpy as np
 
 from hystkit.errors import NonFiniteError, OutputError, OutputExistsError
 
+from .._read_options import TIME_UNITS
 from ._recording import _COLUMNS, Recording
 
 if TYPE_CHECKING:  # pandas loads when a recording is written, not for a model file
@@ -43,13 +44,16 @@ def write_recording(
     kept: dict[str, np.ndarray] | None = None,
     units: dict[str, str] | None = None,
     units_sidecar: bool = False,
+    names: Mapping[str, str] | None = None,
+    time_unit: str = "s",
 ) -> Path:
     """Write a recording as CSV, Parquet or MATLAB (chosen by the suffix of `path`), atomically.
 
     Parameters
     ----------
     recording : Recording
-        Written as columns ``time``, ``position`` (if present), ``sensor``.
+        Written as columns ``time``, ``position`` (if present), ``sensor`` (or as `names`
+        says).
     path : str or path-like
         ``.csv``, ``.parquet`` or ``.mat``; parent directories are created.
     extra : dict of str to ndarray, shape (n,), optional
@@ -66,9 +70,18 @@ def write_recording(
         ``.mat`` file; CSV keeps its header plain (a units line would need ``--units-row`` to
         read back).
     units_sidecar : bool
-        CSV with units: also write them to the settings file beside it (``out.toml``, a
-        ``[units]`` table, `sidecar_path`), which reading ``out.csv`` picks up; both files
-        appear together or not at all.
+        CSV with units, or with `names` or a `time_unit` of its own: also write the settings
+        file beside it (``out.toml``, `sidecar_path`: the units in a ``[units]`` table, the
+        names in ``[columns]``, the ``time_unit``), which reading ``out.csv`` picks up; both
+        files appear together or not at all.
+    names : mapping of str to str, optional
+        The names to write the recording's ``time``, ``position``, ``sensor`` under (those of
+        the file it was read from, e.g. ``{"time": "t_ms"}``); `units` and `kept` use the
+        written names.
+    time_unit : {"s", "ms", "us", "ns", "min"}
+        Unit of the written time column (the input's, `hystkit.io.ReadOptions.time_unit`);
+        written in it and labelled so in the units (``ms``). A value is written in its
+        shortest form when that reads back (times the unit's seconds) to the same time.
 
     Returns
     -------
@@ -97,8 +110,10 @@ def write_recording(
     """
     path = Path(path)
     suffix = check_output_format(path, RECORDING_SUFFIXES, "a recording")
-    columns = {name: getattr(recording, name) for name in _COLUMNS
+    written = {name: (names or {}).get(name, name) for name in _COLUMNS}
+    columns = {written[name]: getattr(recording, name) for name in _COLUMNS
                if getattr(recording, name) is not None}
+    columns[written["time"]] = time_in_unit(recording.time, time_unit)
     for group in (kept or {}), (extra or {}):
         for name, values in group.items():
             values = np.asarray(values)
@@ -111,28 +126,36 @@ def write_recording(
     for name, values in columns.items():
         if name not in (kept or {}):
             _refuse_non_finite(path, name, np.asarray(values))
-    all_units = {**dict(recording.units), **(units or {})}
+    all_units = {**{written.get(name, name): unit for name, unit in recording.units},
+                 **(units or {})}
     all_units = {name: unit for name, unit in all_units.items() if name in columns}
+    # the time's unit labels it in .mat and Parquet; a settings file says time_unit instead
+    labels = {written["time"]: time_unit, **all_units} if time_unit != "s" else all_units
     if suffix == ".mat":
         from ._mat_writer import recording_variables, write_mat
 
         return write_mat(path, {}, force=force,
-                         verbatim=recording_variables(columns, all_units))
+                         verbatim=recording_variables(columns, labels))
     import pandas as pd
 
     # flags (bool) as 0/1 in text and Parquet files, as the files hystkit always wrote
     frame = pd.DataFrame({name: values.astype(int) if np.asarray(values).dtype.kind == "b"
                           else values for name, values in columns.items()})
-    if suffix == ".csv" and units_sidecar and all_units:
+    renamed = {name: other for name, other in written.items() if other != name}
+    if suffix == ".csv" and units_sidecar and (all_units or renamed or time_unit != "s"):
+        ours = {other: name for name, other in renamed.items()}  # [units] keys its three so
+        text = units_settings_text({ours.get(name, name): unit for name, unit in
+                                    all_units.items()}, path.name, columns=renamed,
+                                   time_unit=time_unit)
         with atomic_outputs([path, sidecar_path(path)], force) as (tmp, toml_tmp):
             frame.to_csv(tmp, index=False)
-            toml_tmp.write_text(units_settings_text(all_units, path.name), encoding="utf-8")
+            toml_tmp.write_text(text, encoding="utf-8")
         return path
     with atomic_output(path, force) as tmp:
         if suffix == ".csv":  # pandas writes floats as repr(): the shortest exact round trip
             frame.to_csv(tmp, index=False)
         else:
-            _write_parquet(frame, tmp, all_units)
+            _write_parquet(frame, tmp, labels)
     return path
 
 
@@ -152,27 +175,67 @@ def sidecar_path(path: str | os.PathLike[str]) -> Path:
     return Path(path).with_suffix(".toml")
 
 
-def units_settings_text(units: dict[str, str], file: str | None = None) -> str:
-    """A recording's settings file (``out.toml``) that holds only the units of its columns.
+def units_settings_text(units: dict[str, str], file: str | None = None, *,
+                        columns: Mapping[str, str] | None = None, time_unit: str = "s") -> str:
+    """A recording's settings file (``out.toml``) that holds the units of its columns (and
+    how to read a file written in its input's names and time unit).
 
     Parameters
     ----------
     units : dict of str to str
-        Unit of each column, by column name.
+        Unit of each column, by column name (hystkit's ``time``, ``position``, ``sensor``
+        for the columns `columns` renames).
     file : str, optional
         The name of the recording it is for (``out.csv``): then it applies to that file
         only, even when an ``out.mat`` appears beside it.
+    columns : mapping of str to str, optional
+        hystkit name -> the file's column name, written as a ``[columns]`` table.
+    time_unit : str
+        Unit of the time column; written when not ``s``.
 
     Returns
     -------
     str
-        The TOML text, one ``[units]`` table.
+        The TOML text: ``file``, ``time_unit``, a ``[columns]`` and a ``[units]`` table.
     """
-    lines = ["# written by hystkit: units of the columns of the file beside this one", ""]
-    lines += [] if file is None else [f"file = {json.dumps(file)}", ""]
-    lines += ["[units]"]
-    lines += [f"{json.dumps(name)} = {json.dumps(unit)}" for name, unit in units.items()]
-    return "\n".join(lines) + "\n"
+    lines = ["# written by hystkit: how to read the file beside this one", ""]
+    lines += [] if file is None else [f"file = {json.dumps(file)}"]
+    lines += [] if time_unit == "s" else [f"time_unit = {json.dumps(time_unit)}"]
+    lines += [""] if len(lines) > 2 else []
+    for table, values in (("columns", columns or {}), ("units", units)):
+        if values:
+            lines += [f"[{table}]"]
+            lines += [f"{json.dumps(name)} = {json.dumps(text)}" for name, text in values.items()]
+            lines += [""]
+    return "\n".join(lines).rstrip("\n") + "\n"
+
+
+def time_in_unit(seconds: np.ndarray, unit: str) -> np.ndarray:
+    """Times [s] in `unit` (``ms``, ...), each in its shortest form (15 significant digits)
+    where that gives back exactly `seconds` when read in `unit`: 20 ms read as 0.02 s is
+    written 20, not 20.000000000000004.
+
+    Parameters
+    ----------
+    seconds : numpy.ndarray
+        Times [s].
+    unit : str
+        A key of `hystkit.io.ReadOptions`' time units.
+
+    Returns
+    -------
+    numpy.ndarray
+        The times in `unit` (`seconds` itself for ``s``).
+    """
+    scale = TIME_UNITS[unit]
+    if scale == 1.0:
+        return seconds
+    values = np.asarray(seconds, dtype=np.float64) / scale
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # checked below
+        digits = 14 - np.floor(np.log10(np.abs(values)))
+        factor = 10.0 ** np.where(np.isfinite(digits), digits, 0.0)
+        short = np.round(values * factor) / factor
+        return np.where(short * scale == seconds, short, values)
 
 
 def _write_parquet(frame: pd.DataFrame, path: Path, units: dict[str, str]) -> None:
