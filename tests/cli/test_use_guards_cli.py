@@ -50,7 +50,7 @@ def _patched(monkeypatch, **overrides):
     real = get_family("mpl")
     fake = SimpleNamespace(**{k: getattr(real, k) for k in (
         "name", "title", "default_size", "size_help", "make_structure", "simulate", "invert",
-        "no_inverse_reason", "fit")})
+        "no_inverse_reason", "fit", "reductions")})
     for key, value in overrides.items():
         setattr(fake, key, value)
     for module in (compensator, fitting):
