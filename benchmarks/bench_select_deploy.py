@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from hystkit.compensation import evaluate
+from hystkit.compensation import evaluate, folds, protocol
 from hystkit.io import Recording
 from hystkit.parallel import open_executor
-from hystkit.reports import candidates, compare_models, folds, protocol, select_model
+from hystkit.reports import candidates, compare_models, select_model
 from hystkit.sensors import simulate_experiment
 
 # the shared real data's separate runs, as the centring example pairs them
