@@ -193,7 +193,7 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
     Returns
     -------
     dict
-        ``protocol`` (its name, :data:`PROTOCOLS`), ``caveats`` (what this validation cannot
+        ``protocol`` (its name, ``PROTOCOLS``), ``caveats`` (what this validation cannot
         see), ``ranking`` (rows of candidate, cv_r2, cv_r2_min, cv_r2_oracle, cv_linear_r2,
         n_params, aic, bic, fold_status, guard_failed, verdict, verdict_message; or error),
         ``folds`` (descriptions), ``winner`` (its row) and ``compensator`` (fitted on all
