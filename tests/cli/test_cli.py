@@ -21,6 +21,8 @@ from scipy.io import savemat
 
 from hystkit.cli import main
 
+from ..cli_support import run_cli
+
 matplotlib.use("Agg")  # the demo draws figures; never open a window
 
 MODEL_KEYS = {"schema", "schema_version", "hystkit_version", "model", "mode", "center", "dt",
@@ -35,14 +37,6 @@ BAD_ROW = 10  # 0-based data row the bad-file helpers break: "row 11", file line
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def _run(capsys: pytest.CaptureFixture[str], *argv: object) -> tuple[int, str, str]:
-    """Call ``main`` with the stringified arguments; return (code, stdout, stderr)."""
-    capsys.readouterr()  # drop anything printed before (e.g. by fixtures)
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def _error_line(err: str, *fragments: object) -> str:
@@ -189,7 +183,7 @@ def test_simulate_sensor_writes_a_recording(data: dict[str, Path]) -> None:
 def test_simulate_sensor_reports_what_it_wrote(tmp_path: Path,
                                                capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "sub" / "rec.parquet"
-    code, stdout, err = _run(capsys, "simulate-sensor", "--excitation", "sine", "--seed", 1,
+    code, stdout, err = run_cli(capsys, "simulate-sensor", "--excitation", "sine", "--seed", 1,
                              "--out", out)
     assert (code, err) == (0, "")
     assert f"wrote {out}" in stdout and "seed 1" in stdout and "8000 samples" in stdout
@@ -211,7 +205,7 @@ def test_fit_writes_model_json(data: dict[str, Path]) -> None:
 def test_fit_prints_progress_and_result(data: dict[str, Path], tmp_path: Path,
                                         capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "m.json"
-    code, stdout, err = _run(capsys, "fit", data["fit"], "--cells", 1, "--out", out)
+    code, stdout, err = run_cli(capsys, "fit", data["fit"], "--cells", 1, "--out", out)
     assert (code, err) == (0, "")
     assert "fitting mpl (cells N (3N + 2 params): 1, direct mode, centring: fit)" in stdout
     assert "status: ok" in stdout
@@ -222,7 +216,7 @@ def test_fit_prints_progress_and_result(data: dict[str, Path], tmp_path: Path,
 def test_compensate_adds_position_estimate(data: dict[str, Path], tmp_path: Path,
                                            capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "out.csv"
-    code, stdout, err = _run(capsys, "compensate", data["model"], data["val"], "--out", out)
+    code, stdout, err = run_cli(capsys, "compensate", data["model"], data["val"], "--out", out)
     assert (code, err) == (0, "")
     assert f"wrote {out}" in stdout and "position_estimate" in stdout
     val, result = pd.read_csv(data["val"]), pd.read_csv(out)
@@ -236,7 +230,7 @@ def test_compensate_needs_no_position_column(data: dict[str, Path], tmp_path: Pa
                                              capsys: pytest.CaptureFixture[str]) -> None:
     rec = _drop_column("position")(data["val"], tmp_path)
     out = tmp_path / "out.csv"
-    code, _, err = _run(capsys, "compensate", data["model"], rec, "--out", out)
+    code, _, err = run_cli(capsys, "compensate", data["model"], rec, "--out", out)
     assert (code, err) == (0, "")
     assert list(pd.read_csv(out).columns) == ["time", "sensor", "position_estimate",
                                               "position_lower", "position_upper",
@@ -245,7 +239,7 @@ def test_compensate_needs_no_position_column(data: dict[str, Path], tmp_path: Pa
 
 def _evaluate_json(capsys: pytest.CaptureFixture[str], model: Path, rec: Path,
                    out: Path) -> tuple[dict, str]:
-    code, stdout, err = _run(capsys, "evaluate", model, rec, "--json", out)
+    code, stdout, err = run_cli(capsys, "evaluate", model, rec, "--json", out)
     assert (code, err) == (0, "")
     return json.loads(out.read_text(encoding="utf-8")), stdout
 
@@ -265,7 +259,7 @@ def test_evaluate_without_json_writes_nothing(data: dict[str, Path], tmp_path: P
                                               capsys: pytest.CaptureFixture[str]) -> None:
     model = shutil.copy(data["model"], tmp_path / "m.json")
     rec = shutil.copy(data["val"], tmp_path / "val.csv")
-    code, stdout, err = _run(capsys, "evaluate", model, rec)
+    code, stdout, err = run_cli(capsys, "evaluate", model, rec)
     assert (code, err) == (0, "")
     assert "R²" in stdout and "wrote" not in stdout
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.json", "val.csv"]
@@ -274,7 +268,7 @@ def test_evaluate_without_json_writes_nothing(data: dict[str, Path], tmp_path: P
 def test_inverse_mode_beats_the_line(data: dict[str, Path], tmp_path: Path,
                                      capsys: pytest.CaptureFixture[str]) -> None:
     model = tmp_path / "mi.json"
-    code, stdout, err = _run(capsys, "fit", data["fit"], "--cells", 1, "--mode", "inverse",
+    code, stdout, err = run_cli(capsys, "fit", data["fit"], "--cells", 1, "--mode", "inverse",
                              "--out", model)
     assert (code, err) == (0, "")
     assert "inverse mode" in stdout
@@ -287,13 +281,13 @@ def test_inverse_mode_beats_the_line(data: dict[str, Path], tmp_path: Path,
 def test_center_option_is_used_and_named(center: str, data: dict[str, Path], tmp_path: Path,
                                          capsys: pytest.CaptureFixture[str]) -> None:
     model = tmp_path / "m.json"
-    code, stdout, err = _run(capsys, "fit", data["fit"], "--cells", 1, "--center", center,
+    code, stdout, err = run_cli(capsys, "fit", data["fit"], "--cells", 1, "--center", center,
                              "--out", model)
     assert (code, err) == (0, "")
     assert f"centring: {center}" in stdout
     assert json.loads(model.read_text(encoding="utf-8"))["center"] == center
 
-    code, stdout, err = _run(capsys, "compensate", model, data["val"], "--out",
+    code, stdout, err = run_cli(capsys, "compensate", model, data["val"], "--out",
                              tmp_path / "out.csv")
     assert (code, err) == (0, "")
     assert f"centring: {center}" in stdout
@@ -326,13 +320,13 @@ def test_demo_refuses_to_overwrite_and_force_overwrites(
     out = tmp_path / "D"
     shutil.copytree(demo_dir, out)  # keep the shared demo output pristine
     before = _snapshot(out)
-    code, _, err = _run(capsys, "demo", "--out", out)
+    code, _, err = run_cli(capsys, "demo", "--out", out)
     assert code != 0
     line = _error_line(err, "--force")
     assert any(str(out / name) in line for name in DEMO_FILES), line
     assert _snapshot(out) == before  # same bytes, same modification times
 
-    code, stdout, err = _run(capsys, "demo", "--out", out, "--cells", 1, "--force")
+    code, stdout, err = run_cli(capsys, "demo", "--out", out, "--cells", 1, "--force")
     assert (code, err) == (0, "")
     assert f"wrote {out}/" in stdout
     after = _snapshot(out)
@@ -344,7 +338,7 @@ def test_demo_refuses_to_overwrite_and_force_overwrites(
 def test_demo_refuses_if_any_output_exists(existing: str, tmp_path: Path,
                                            capsys: pytest.CaptureFixture[str]) -> None:
     (tmp_path / existing).write_bytes(b"precious")
-    code, _, err = _run(capsys, "demo", "--out", tmp_path, "--cells", 1)
+    code, _, err = run_cli(capsys, "demo", "--out", tmp_path, "--cells", 1)
     assert code != 0
     _error_line(err, tmp_path / existing, "--force")
     assert [p.name for p in tmp_path.iterdir()] == [existing]
@@ -373,13 +367,13 @@ def test_existing_output_needs_force(kind: str, name: str, data: dict[str, Path]
     target = tmp_path / name
     target.write_bytes(PRECIOUS)
     mtime = target.stat().st_mtime_ns
-    code, stdout, err = _run(capsys, *_writing_command(kind, data, target))
+    code, stdout, err = run_cli(capsys, *_writing_command(kind, data, target))
     assert code != 0
     _error_line(err, target, "--force")
     assert stdout == "", "a refused run should stop before doing any work"
     assert target.read_bytes() == PRECIOUS and target.stat().st_mtime_ns == mtime
 
-    code, _, err = _run(capsys, *_writing_command(kind, data, target), "--force")
+    code, _, err = run_cli(capsys, *_writing_command(kind, data, target), "--force")
     assert (code, err) == (0, "")
     if name.endswith(".json"):
         written = json.loads(target.read_text(encoding="utf-8"))
@@ -428,7 +422,7 @@ def _assert_rejected(capsys: pytest.CaptureFixture[str], argv: list[object], out
                      folder: Path, *fragments: object) -> str:
     """Exit code 2, one error line with the fragments, and nothing new in `folder`."""
     before = _snapshot(folder)
-    code, _, err = _run(capsys, *argv)
+    code, _, err = run_cli(capsys, *argv)
     assert code == 2
     line = _error_line(err, *fragments)
     assert not out.exists()
@@ -535,7 +529,7 @@ def test_fit_slope_cap_reaches_every_capped_family(model: str, data: dict[str, P
 
     out = tmp_path / "m.json"
     cap = 0.05  # far below the default 1: the cap binds for most parameter sets
-    code, _, err = _run(capsys, "fit", data["fit"], "--model", model, "--slope-cap", str(cap),
+    code, _, err = run_cli(capsys, "fit", data["fit"], "--model", model, "--slope-cap", str(cap),
                         "--out", out)
     assert code in (0, 3), err  # 3: written, but a guard fired (not this test's concern)
     assert json.loads(out.read_text(encoding="utf-8"))["structure"]["slope_cap"] == cap

@@ -13,12 +13,7 @@ from hystkit.cli import main
 from hystkit.errors import OutputError, OutputExistsError
 from hystkit.io import check_output_format, check_output_path, write_json
 
-
-def _run(capsys, *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
+from ..cli_support import run_cli
 
 
 @pytest.fixture(scope="module")
@@ -57,7 +52,7 @@ def test_wrong_extension_is_one_line_before_work(case, inputs, tmp_path, capsys)
     template, name, accepted = CASES[case]
     out = tmp_path / name
     argv = [str(out) if a == "OUT" else a.format(**inputs) for a in template]
-    code, stdout, err = _run(capsys, *argv)
+    code, stdout, err = run_cli(capsys, *argv)
     assert code == 2
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("hystkit: error: "), err

@@ -13,19 +13,14 @@ import pytest
 
 from hystkit.cli import main
 
+from ..cli_support import run_cli
+
 
 def test_cli_losses_are_the_library_losses():
     from hystkit.cli._fit_cost_options import LOSSES as CLI_LOSSES
     from hystkit.identification import LOSSES
 
     assert CLI_LOSSES == LOSSES
-
-
-def _run(capsys, *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")
@@ -51,7 +46,7 @@ def _with_weight(recording: Path, folder: Path, row: int, value: object) -> Path
 
 def test_robust_weighted_fit_is_recorded_and_summarised(recording, tmp_path, capsys):
     model = tmp_path / "m.json"
-    code, out, err = _run(capsys, "fit", recording, "--cells", 1, "--loss", "huber",
+    code, out, err = run_cli(capsys, "fit", recording, "--cells", 1, "--loss", "huber",
                           "--f-scale", 0.05, "--weights", "w", "--out", model)
     assert code == 0, err
     assert "minimised the huber cost (f_scale 0.05, weighted by column 'w')" in out
@@ -79,7 +74,7 @@ def test_robust_weighted_fit_is_recorded_and_summarised(recording, tmp_path, cap
 
 
 def test_robust_loss_without_f_scale_warns_once(recording, tmp_path, capsys):
-    code, _, err = _run(capsys, "fit", recording, "--cells", 1, "--loss", "cauchy", "--out",
+    code, _, err = run_cli(capsys, "fit", recording, "--cells", 1, "--loss", "cauchy", "--out",
                         tmp_path / "m.json")
     assert code in (0, 3)
     warnings = [line for line in err.splitlines() if "without --f-scale" in line]
@@ -87,14 +82,14 @@ def test_robust_loss_without_f_scale_warns_once(recording, tmp_path, capsys):
                 "loss close to the SSE on the normalised data (max |.| = 1); set --f-scale to "
                 "5-10 times the plain fit's RMS residual")
     assert warnings == [expected]
-    _, _, err = _run(capsys, "fit", recording, "--cells", 1, "--loss", "cauchy", "--f-scale",
+    _, _, err = run_cli(capsys, "fit", recording, "--cells", 1, "--loss", "cauchy", "--f-scale",
                      0.05, "--out", tmp_path / "m2.json")
     assert "without --f-scale" not in err
 
 
 def test_plain_fit_records_the_sse(recording, tmp_path, capsys):
     model = tmp_path / "m.json"
-    code, out, err = _run(capsys, "fit", recording, "--cells", 1, "--out", model)
+    code, out, err = run_cli(capsys, "fit", recording, "--cells", 1, "--out", model)
     assert code == 0, err
     assert "minimised" not in out and "indicative only" not in out
     fit = json.loads(model.read_text())["fit"]
@@ -107,7 +102,7 @@ def test_plain_fit_records_the_sse(recording, tmp_path, capsys):
                                                       (30, "abc", "'abc'")])
 def test_bad_weight_names_file_column_and_row(recording, tmp_path, capsys, row, value, shown):
     bad = _with_weight(recording, tmp_path, row, value)
-    code, _, err = _run(capsys, "fit", bad, "--weights", "w", "--out", tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", bad, "--weights", "w", "--out", tmp_path / "m.json")
     assert code == 2
     line = err.strip()
     assert line.startswith(f"hystkit: error: {bad}: column 'w', row {row + 1}: weight "), line
@@ -116,7 +111,7 @@ def test_bad_weight_names_file_column_and_row(recording, tmp_path, capsys, row, 
 
 
 def test_missing_weights_column(recording, tmp_path, capsys):
-    code, _, err = _run(capsys, "fit", recording, "--weights", "v", "--out", tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", recording, "--weights", "v", "--out", tmp_path / "m.json")
     assert code == 2
     assert err.strip() == f"hystkit: error: {recording}: no weights column 'v' (its other " \
                           f"columns: 'w')"
@@ -127,7 +122,7 @@ def test_all_zero_weights(recording, tmp_path, capsys):
     frame["w"] = 0.0
     zero = tmp_path / "zero.csv"
     frame.to_csv(zero, index=False)
-    code, _, err = _run(capsys, "fit", zero, "--weights", "w", "--out", tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", zero, "--weights", "w", "--out", tmp_path / "m.json")
     assert code == 2 and "every value of the weights column 'w' is 0" in err
 
 
@@ -140,7 +135,7 @@ def test_all_zero_weights(recording, tmp_path, capsys):
     (["--weights", "w", "--weight-sum-max", "100"], "--weight-sum-max is solved on the SSE"),
 ])
 def test_refused_before_any_work(recording, tmp_path, capsys, argv, message):
-    code, out, err = _run(capsys, "fit", recording, *argv, "--out", tmp_path / "m.json")
+    code, out, err = run_cli(capsys, "fit", recording, *argv, "--out", tmp_path / "m.json")
     assert code == 2
     assert message in err
     assert "fitting" not in out  # refused before the data were read
@@ -160,7 +155,7 @@ def test_weights_drop_samples_for_a_linear_least_squares_model(recording, tmp_pa
         path = tmp_path / f"{name}.csv"
         moved.to_csv(path, index=False)
         out = tmp_path / f"{name}.json"
-        code, _, err = _run(capsys, "fit", path, "--model", "preisach", "--weights", "w",
+        code, _, err = run_cli(capsys, "fit", path, "--model", "preisach", "--weights", "w",
                             "--out", out)
         assert code in (0, 3), err
         models.append(json.loads(out.read_text()))

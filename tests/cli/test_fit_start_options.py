@@ -16,14 +16,9 @@ from hystkit.cli._fit_start_options import parse_init
 from hystkit.errors import InputError
 from hystkit.models import get_family
 
+from ..cli_support import run_cli
+
 MPL = get_family("mpl")
-
-
-def _run(capsys, *argv):
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def _one_error(err: str, *fragments: str) -> None:
@@ -99,7 +94,7 @@ def test_bad_init_is_one_clear_line(text, fragments):
 def test_init_list_prints_the_presets_of_the_model_wherever_it_stands(capsys, model):
     # the listing needs neither recordings nor --out, and --model may come after --init
     for argv in (["--model", model, "--init", "list"], ["--init", "list", "--model", model]):
-        code, out, err = _run(capsys, "fit", *argv)
+        code, out, err = run_cli(capsys, "fit", *argv)
         assert code == 0 and not err
         presets = get_family(model).presets()
         assert presets  # the premise: every family that takes --init has presets
@@ -117,7 +112,7 @@ def test_mpl_g_weight_sum_floor_is_refused_before_the_data_are_read(recordings, 
         raise AssertionError("the data were read")
 
     monkeypatch.setattr(hystkit.io, "read_recording", unread)
-    code, _, err = _run(capsys, "fit", recordings["sine"], "--model", "mpl-g",
+    code, _, err = run_cli(capsys, "fit", recordings["sine"], "--model", "mpl-g",
                         "--weight-sum-max", "1", "--out", tmp_path / "g.json")
     assert code == 2
     _one_error(err, "--weight-sum-max for mpl-g must be above 1", "w_0 = 1")
@@ -126,7 +121,7 @@ def test_mpl_g_weight_sum_floor_is_refused_before_the_data_are_read(recordings, 
 def test_no_limit_fit_warns_saves_the_flag_and_its_divergence_is_reported(
         recordings, tmp_path, capsys):
     model = tmp_path / "free.json"
-    code, out, err = _run(capsys, "fit", recordings["sine"], "--no-limit", "--init",
+    code, out, err = run_cli(capsys, "fit", recordings["sine"], "--no-limit", "--init",
                           "table-5.2", "--out", model)
     assert code == 3  # written for inspection: a guard, not a compensator to use
     assert "can diverge (sec. 5.3.3" in err and "not for use" in err
@@ -134,17 +129,17 @@ def test_no_limit_fit_warns_saves_the_flag_and_its_divergence_is_reported(
     assert json.loads(model.read_text())["structure"]["limit"] is False
     # sec. 5.3.3 reproduced: trained on the sine, the unlimited model diverges on the chirp;
     # evaluate and compensate say so in one line (exit 2) and write no NaN
-    code, out, err = _run(capsys, "evaluate", model, recordings["chirp"])
+    code, out, err = run_cli(capsys, "evaluate", model, recordings["chirp"])
     _one_error(err, "diverged at sample", "sec. 5.3.3")
     assert code == 2 and "nan" not in out.lower()
     estimate = tmp_path / "estimate.csv"
-    code, _, err = _run(capsys, "compensate", model, recordings["chirp"], "--out", estimate)
+    code, _, err = run_cli(capsys, "compensate", model, recordings["chirp"], "--out", estimate)
     assert code == 2 and "diverged at sample" in err.splitlines()[-1]
     assert not estimate.exists()
 
 
 def test_clipped_start_is_reported(recordings, tmp_path, capsys):
-    code, out, _ = _run(capsys, "fit", recordings["sine"], "--init", "table-5.2-fitted",
+    code, out, _ = run_cli(capsys, "fit", recordings["sine"], "--init", "table-5.2-fitted",
                         "--out", tmp_path / "m.json")
     assert code == 0
     assert "--init: log_G[1] = " in out and "outside the fit's box" in out
@@ -152,7 +147,7 @@ def test_clipped_start_is_reported(recordings, tmp_path, capsys):
 
 def test_weight_sum_max_bounds_the_saved_weights(recordings, tmp_path, capsys):
     model = tmp_path / "c.json"
-    code, out, _ = _run(capsys, "fit", recordings["sine"], "--weight-sum-max", "1.2", "--out",
+    code, out, _ = run_cli(capsys, "fit", recordings["sine"], "--weight-sum-max", "1.2", "--out",
                         model)
     w = json.loads(model.read_text())["params"]["w"]
     assert_allclose(np.abs(w).sum(), 1.2, rtol=1e-8)
@@ -163,7 +158,7 @@ def test_weight_sum_max_bounds_the_saved_weights(recordings, tmp_path, capsys):
     assert caveat.endswith("the fit ended on its active constraint sum |w| <= 1.2, where the "
                            "SSE is not stationary")
     assert f"    ({caveat})" in out.splitlines()
-    _, out, _ = _run(capsys, "fit", recordings["sine"], "--weight-sum-max", "100", "--out",
+    _, out, _ = run_cli(capsys, "fit", recordings["sine"], "--weight-sum-max", "100", "--out",
                      tmp_path / "free.json")
     assert "(inactive" in out and "indicative only" not in out
 
@@ -178,7 +173,7 @@ def test_weight_sum_max_bounds_the_saved_weights(recordings, tmp_path, capsys):
     (["--init", "i_s=nan,v_t=0.2,w=1:0.4,v_b=-0.6"], ("error: --init: i_s must be finite",)),
 ])
 def test_bad_options_exit_2_with_one_line(recordings, tmp_path, capsys, argv, fragments):
-    code, _, err = _run(capsys, "fit", recordings["sine"], *argv, "--out", tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", recordings["sine"], *argv, "--out", tmp_path / "m.json")
     assert code == 2
     _one_error(err, *fragments)
     assert not (tmp_path / "m.json").exists()

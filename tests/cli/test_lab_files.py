@@ -12,16 +12,11 @@ import pytest
 
 from hystkit.cli import main
 
+from ..cli_support import run_cli
+
 OWN = ["--columns", "time=t_ms,position=displacement_mm,sensor=resistance_ohm",
        "--time-unit", "ms"]
 NOTICE = "semicolon-separated, decimal comma, 2 comment lines before the header skipped"
-
-
-def _run(capsys, *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")
@@ -47,11 +42,11 @@ def test_fit_evaluate_compensate_read_the_excel_file_as_the_standard_one(files, 
     scores = {}
     for name, extra in (("std", []), ("eu", OWN)):
         model, report = tmp_path / f"{name}.json", tmp_path / f"{name}-scores.json"
-        code, out, err = _run(capsys, "fit", files[name], "--cells", 1, "--out", model, *extra)
+        code, out, err = run_cli(capsys, "fit", files[name], "--cells", 1, "--out", model, *extra)
         assert code == 0, err
         said = [line for line in out.splitlines() if line.startswith(f"reading {files[name]}")]
         assert said == ([f"reading {files['eu']}: {NOTICE}"] if name == "eu" else [])
-        code, _, err = _run(capsys, "evaluate", model, files[name], "--json", report, *extra)
+        code, _, err = run_cli(capsys, "evaluate", model, files[name], "--json", report, *extra)
         assert code == 0, err
         scores[name] = json.loads(report.read_text())
     assert scores["eu"]["r2"] > 0.9
@@ -59,7 +54,7 @@ def test_fit_evaluate_compensate_read_the_excel_file_as_the_standard_one(files, 
         # %.17g through a decimal comma: the same numbers, so the same scores to rounding
         assert scores["eu"][key] == pytest.approx(scores["std"][key], rel=1e-9), key
     out = tmp_path / "comp.csv"
-    code, _, err = _run(capsys, "compensate", tmp_path / "eu.json", files["eu"], "--out", out,
+    code, _, err = run_cli(capsys, "compensate", tmp_path / "eu.json", files["eu"], "--out", out,
                         *OWN)
     assert code == 0, err
     written = pd.read_csv(out)
@@ -69,7 +64,7 @@ def test_fit_evaluate_compensate_read_the_excel_file_as_the_standard_one(files, 
 
 def test_a_given_separator_still_wins(files, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    code, _, err = _run(capsys, "fit", files["eu"], "--cells", 1, "--out", "never.json",
+    code, _, err = run_cli(capsys, "fit", files["eu"], "--cells", 1, "--out", "never.json",
                         "--sep", ",", *OWN)
     assert code == 2
     assert err.splitlines() == [
@@ -83,7 +78,7 @@ def test_a_given_separator_still_wins(files, capsys, tmp_path, monkeypatch):
 def test_an_ambiguous_file_is_one_line_naming_file_line_and_option(tmp_path, capsys):
     path = tmp_path / "odd.csv"
     path.write_text("time;position,sensor\n0;1,2\n0.1;2,3\n", encoding="utf-8")
-    code, _, err = _run(capsys, "fit", path, "--cells", 1, "--out", tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", path, "--cells", 1, "--out", tmp_path / "m.json")
     assert code == 2
     assert err.splitlines() == [
         (f"hystkit: error: {path}: line 1: cannot tell the field separator: comma and "

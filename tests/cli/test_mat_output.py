@@ -22,12 +22,7 @@ from hystkit.compensation import compensator_to_dict, load_compensator, save_com
 from hystkit.errors import InputError, NonFiniteError
 from hystkit.io import read_recording, write_mat
 
-
-def _run(capsys, *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
+from ..cli_support import run_cli
 
 
 @pytest.fixture(scope="module")
@@ -62,11 +57,11 @@ def test_model_mat_holds_every_field_for_matlab(run):
 
 def test_fit_writes_a_mat_model_that_evaluate_and_compensate_read(run, tmp_path, capsys):
     model = tmp_path / "fit.mat"
-    code, _, err = _run(capsys, "fit", run["rec"], "--cells", 1, "--out", model)
+    code, _, err = run_cli(capsys, "fit", run["rec"], "--cells", 1, "--out", model)
     assert code == 0, err
     for kind in ("json", "mat"):
         path = run[kind] if kind == "json" else model
-        code, _, err = _run(capsys, "evaluate", path, run["rec"], "--json",
+        code, _, err = run_cli(capsys, "evaluate", path, run["rec"], "--json",
                             tmp_path / f"{kind}.json")
         assert code == 0, err
     scores = [json.loads((tmp_path / f"{k}.json").read_text()) for k in ("json", "mat")]
@@ -97,7 +92,7 @@ def test_mat_without_model_text_is_one_line(tmp_path):
 def test_compensate_to_mat_matches_csv(run, tmp_path, capsys):
     csv, mat = tmp_path / "c.csv", tmp_path / "c.mat"
     for out in (csv, mat):
-        code, _, err = _run(capsys, "compensate", run["json"], run["rec"], "--out", out)
+        code, _, err = run_cli(capsys, "compensate", run["json"], run["rec"], "--out", out)
         assert code == 0, err
     frame = pd.read_csv(csv)
     m = loadmat(mat)
@@ -113,7 +108,7 @@ def test_compensate_to_mat_matches_csv(run, tmp_path, capsys):
 
 def test_evaluate_out_mat_equals_json(run, tmp_path, capsys):
     js, mat = tmp_path / "e.json", tmp_path / "e.mat"
-    code, _, err = _run(capsys, "evaluate", run["json"], run["rec"], "--json", js, "--out", mat)
+    code, _, err = run_cli(capsys, "evaluate", run["json"], run["rec"], "--json", js, "--out", mat)
     assert code == 0, err
     scores = json.loads(js.read_text())
     m = loadmat(mat, simplify_cells=True)
@@ -149,7 +144,7 @@ def test_write_mat_types(tmp_path):
 @pytest.mark.skipif(shutil.which("octave") is None, reason="octave is not installed")
 def test_octave_reads_the_outputs(run, tmp_path, capsys):
     out = tmp_path / "c.mat"
-    assert _run(capsys, "compensate", run["mat"], run["rec"], "--out", out)[0] == 0
+    assert run_cli(capsys, "compensate", run["mat"], run["rec"], "--out", out)[0] == 0
     script = (f"c = load('{out}'); m = load('{run['mat']}'); "
               "printf('%s %d %d %s\\n', class(c.sensor_outside), numel(c.position_estimate), "
               "isstruct(m.params), m.model);")

@@ -14,14 +14,9 @@ from hystkit.cli import main
 from hystkit.io import write_recording
 from hystkit.sensors import simulate_experiment
 
+from ..cli_support import run_cli
+
 HOLES = {"position": [100, 900], "sensor": [2000, 2001]}  # 4 rows inside
-
-
-def _run(capsys, *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +42,7 @@ def files(tmp_path_factory) -> dict[str, Path]:
 
 
 def test_fit_refuses_by_default_in_one_line_naming_the_option(files, tmp_path, capsys):
-    code, _, err = _run(capsys, "fit", files["holes"], "--cells", 1, "--out",
+    code, _, err = run_cli(capsys, "fit", files["holes"], "--cells", 1, "--out",
                         tmp_path / "m.json")
     assert code == 2
     assert err.splitlines() == [
@@ -57,7 +52,7 @@ def test_fit_refuses_by_default_in_one_line_naming_the_option(files, tmp_path, c
 
 
 def test_fit_interpolates_and_says_how_many_rows(files, tmp_path, capsys):
-    code, out, err = _run(capsys, "fit", files["holes"], "--cells", 1, "--no-band",
+    code, out, err = run_cli(capsys, "fit", files["holes"], "--cells", 1, "--no-band",
                           "--missing", "interpolate", "--out", tmp_path / "m.json")
     assert code == 0, err
     assert [line for line in err.splitlines() if "miss a value" in line] == [
@@ -72,7 +67,7 @@ def test_compensate_drops_rows_and_keeps_other_columns_aligned(files, tmp_path, 
     assert main(["fit", str(files["std"]), "--cells", "1", "--no-band", "--out",
                  str(model)]) == 0
     out_csv = tmp_path / "c.csv"
-    code, _, err = _run(capsys, "compensate", model, files["ends"], "--missing", "drop",
+    code, _, err = run_cli(capsys, "compensate", model, files["ends"], "--missing", "drop",
                         "--out", out_csv)
     assert code == 0, err
     assert "2 of 8000 rows miss a value: 2 dropped (row 1 (line 2), row 8000 (line 8001))" \
@@ -89,16 +84,16 @@ def test_settings_key_and_the_command_line_over_it(files, tmp_path, capsys):
     data.write_bytes(files["holes"].read_bytes())
     data.with_suffix(".toml").write_text('missing = "interpolate"\n')
     model = tmp_path / "m.json"
-    code, out, err = _run(capsys, "fit", data, "--cells", 1, "--no-band", "--out", model)
+    code, out, err = run_cli(capsys, "fit", data, "--cells", 1, "--no-band", "--out", model)
     assert code == 0, err
     assert f"reading {data} with the settings in {data.with_suffix('.toml')}" in out
     assert "4 interpolated linearly in time" in err
-    code, _, err = _run(capsys, "evaluate", model, data, "--missing", "error")
+    code, _, err = run_cli(capsys, "evaluate", model, data, "--missing", "error")
     assert code == 2 and "--missing interpolate or --missing drop reads past them" in err
 
 
 def test_bad_value_is_refused_while_parsing(files, capsys):
-    code, _, err = _run(capsys, "fit", files["holes"], "--missing", "fill")
+    code, _, err = run_cli(capsys, "fit", files["holes"], "--missing", "fill")
     assert code == 2
     assert "argument --missing: invalid choice: 'fill'" in err
 
@@ -107,7 +102,7 @@ def test_stream_refuses_interpolate(files, tmp_path, capsys):
     model = tmp_path / "m.json"
     assert main(["fit", str(files["std"]), "--cells", "1", "--no-band", "--center", "track",
                  "--out", str(model)]) == 0
-    code, out, err = _run(capsys, "stream", model, "--in", files["holes"], "--missing",
+    code, out, err = run_cli(capsys, "stream", model, "--in", files["holes"], "--missing",
                           "interpolate")
     assert code == 2 and out == ""
     assert err.splitlines() == [

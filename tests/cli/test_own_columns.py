@@ -11,15 +11,10 @@ import pytest
 
 from hystkit.cli import main
 
+from ..cli_support import run_cli
+
 OWN = ["--columns", "time=t_ms,position=displacement_mm,sensor=resistance_ohm",
        "--time-unit", "ms", "--sep", ";"]
-
-
-def _run(capsys, *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")
@@ -39,9 +34,9 @@ def test_fit_and_evaluate_own_csv_match_the_standard_file(files, tmp_path, capsy
     scores = {}
     for name, extra in (("std", []), ("own", OWN)):
         model, report = tmp_path / f"{name}.json", tmp_path / f"{name}-scores.json"
-        code, _, err = _run(capsys, "fit", files[name], "--cells", 1, "--out", model, *extra)
+        code, _, err = run_cli(capsys, "fit", files[name], "--cells", 1, "--out", model, *extra)
         assert code == 0, err
-        code, _, err = _run(capsys, "evaluate", model, files[name], "--json", report, *extra)
+        code, _, err = run_cli(capsys, "evaluate", model, files[name], "--json", report, *extra)
         assert code == 0, err
         scores[name] = json.loads(report.read_text())
     assert scores["own"]["r2"] > 0.9
@@ -51,9 +46,9 @@ def test_fit_and_evaluate_own_csv_match_the_standard_file(files, tmp_path, capsy
 
 def test_compensate_keeps_the_inputs_names_and_time_unit(files, tmp_path, capsys):
     model = tmp_path / "m.json"
-    assert _run(capsys, "fit", files["own"], "--cells", 1, "--out", model, *OWN)[0] == 0
+    assert run_cli(capsys, "fit", files["own"], "--cells", 1, "--out", model, *OWN)[0] == 0
     out = tmp_path / "out.csv"
-    code, _, err = _run(capsys, "compensate", model, files["own"], "--out", out, *OWN)
+    code, _, err = run_cli(capsys, "compensate", model, files["own"], "--out", out, *OWN)
     assert code == 0, err
     written = pd.read_csv(out)
     assert list(written.columns[:4]) == ["t_ms", "displacement_mm", "resistance_ohm",
@@ -73,7 +68,7 @@ def test_compensate_keeps_the_inputs_names_and_time_unit(files, tmp_path, capsys
 ])
 def test_bad_options_are_one_line_before_any_work(files, tmp_path, capsys, option, fragments):
     out = tmp_path / "m.json"
-    code, stdout, err = _run(capsys, "fit", files["own"], "--out", out, *option)
+    code, stdout, err = run_cli(capsys, "fit", files["own"], "--out", out, *option)
     assert code == 2
     assert stdout == ""
     assert len(err.splitlines()) == 1 and err.startswith("hystkit: error: "), err
@@ -84,7 +79,7 @@ def test_bad_options_are_one_line_before_any_work(files, tmp_path, capsys, optio
 
 def test_unknown_column_names_the_users_column(files, tmp_path, capsys):
     out = tmp_path / "m.json"
-    code, _, err = _run(capsys, "fit", files["own"], "--out", out, "--columns",
+    code, _, err = run_cli(capsys, "fit", files["own"], "--out", out, "--columns",
                         "time=t_ms,position=displacement_mm,sensor=R_ohm", "--time-unit", "ms",
                         "--sep", ";")
     assert code == 2

@@ -16,6 +16,8 @@ from hystkit.cli import main
 from hystkit.errors import InputError
 from hystkit.io import ReadOptions, options_for, read_recording, read_recording_config
 
+from ..cli_support import run_cli
+
 SETTINGS = """time_unit = "ms"
 units_row = true
 sep = ";"
@@ -30,13 +32,6 @@ temp_C = "degC"
 """
 OWN = ["--columns", "time=t_ms,position=displacement_mm,sensor=resistance_ohm",
        "--time-unit", "ms", "--sep", ";", "--units-row"]
-
-
-def _run(capsys, *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture(scope="module")
@@ -82,11 +77,11 @@ def test_settings_file_reads_as_the_options(files):
 
 
 def test_fit_with_settings_file_equals_fit_with_options(files, tmp_path, capsys):
-    code, out, err = _run(capsys, "fit", files["with_toml"], "--cells", 1, "--out",
+    code, out, err = run_cli(capsys, "fit", files["with_toml"], "--cells", 1, "--out",
                           tmp_path / "a.json")
     assert code == 0, err
     assert out.count("with the settings in") == 1
-    code, out, err = _run(capsys, "fit", files["plain"], "--cells", 1, "--out",
+    code, out, err = run_cli(capsys, "fit", files["plain"], "--cells", 1, "--out",
                           tmp_path / "b.json", *OWN)
     assert code == 0, err
     assert "with the settings in" not in out
@@ -101,9 +96,9 @@ def test_command_line_overrides_the_settings_file(tmp_path, files, capsys):
     data = folder / "my.csv"
     data.write_bytes(files["with_toml"].read_bytes())
     (folder / "my.toml").write_text(SETTINGS.replace('"ms"', '"s"'), encoding="utf-8")
-    code, _, err = _run(capsys, "fit", data, "--cells", 1, "--out", tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", data, "--cells", 1, "--out", tmp_path / "m.json")
     assert code == 2 and "the file gives the time unit 'ms' but time is read in s" in err
-    code, _, err = _run(capsys, "fit", data, "--cells", 1, "--time-unit", "ms", "--out",
+    code, _, err = run_cli(capsys, "fit", data, "--cells", 1, "--time-unit", "ms", "--out",
                         tmp_path / "m.json")
     assert code == 0, err
 
@@ -125,13 +120,13 @@ def test_bad_settings_file_is_one_line(tmp_path, files, capsys, text, fragments)
     assert str(info.value).startswith(str(tmp_path / "x.toml"))
     for fragment in fragments:
         assert fragment in str(info.value)
-    code, _, err = _run(capsys, "fit", data, "--out", tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", data, "--out", tmp_path / "m.json")
     assert code == 2 and len(err.strip().splitlines()) == 1
 
 
 def test_forgotten_units_row_says_so(files, tmp_path, capsys):
     argv = [a for a in OWN if a != "--units-row"]
-    code, _, err = _run(capsys, "fit", files["plain"], *argv, "--out", tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", files["plain"], *argv, "--out", tmp_path / "m.json")
     assert code == 2
     assert "row 1 (line 2): non-numeric value 'ms'; if this line holds units, pass " \
            "--units-row" in err
@@ -139,9 +134,9 @@ def test_forgotten_units_row_says_so(files, tmp_path, capsys):
 
 def test_compensate_keeps_other_columns_and_units(files, tmp_path, capsys):
     model = tmp_path / "m.json"
-    assert _run(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
+    assert run_cli(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
     out = tmp_path / "c.csv"
-    code, stdout, err = _run(capsys, "compensate", model, files["with_toml"], "--out", out)
+    code, stdout, err = run_cli(capsys, "compensate", model, files["with_toml"], "--out", out)
     assert code == 0, err
     assert "displacement_mm_estimate' [mm]" in stdout and "kept 2 other column(s)" in stdout
     written = pd.read_csv(out, keep_default_na=False, na_values=[""])
@@ -161,7 +156,7 @@ def test_compensate_keeps_other_columns_and_units(files, tmp_path, capsys):
     assert dict(back.units)["displacement_mm_estimate"] == "mm"
     assert dict(back.units)["temp_C"] == "degC"
     mat = tmp_path / "c.mat"
-    assert _run(capsys, "compensate", model, files["with_toml"], "--out", mat)[0] == 0
+    assert run_cli(capsys, "compensate", model, files["with_toml"], "--out", mat)[0] == 0
     m = loadmat(mat, simplify_cells=True)
     assert m["units"] == {"t_ms": "ms", "displacement_mm": "mm", "resistance_ohm": "Ohm",
                           "displacement_mm_estimate": "mm", "displacement_mm_lower": "mm",
@@ -176,9 +171,9 @@ def test_compensate_keeps_other_columns_and_units(files, tmp_path, capsys):
 
 def test_compensate_refuses_an_existing_units_file_before_work(files, tmp_path, capsys):
     model = tmp_path / "m.json"
-    assert _run(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
+    assert run_cli(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
     (tmp_path / "c.toml").write_text("precious\n")
-    code, _, err = _run(capsys, "compensate", model, files["with_toml"], "--out",
+    code, _, err = run_cli(capsys, "compensate", model, files["with_toml"], "--out",
                         tmp_path / "c.csv")
     assert code == 2 and "c.toml already exists" in err
     assert not (tmp_path / "c.csv").exists()
@@ -186,8 +181,8 @@ def test_compensate_refuses_an_existing_units_file_before_work(files, tmp_path, 
 
 def test_evaluate_reports_units(files, tmp_path, capsys):
     model = tmp_path / "m.json"
-    assert _run(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
-    code, _, err = _run(capsys, "evaluate", model, files["with_toml"], "--json",
+    assert run_cli(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
+    code, _, err = run_cli(capsys, "evaluate", model, files["with_toml"], "--json",
                         tmp_path / "e.json")
     assert code == 0, err
     scores = json.loads((tmp_path / "e.json").read_text())
@@ -202,7 +197,7 @@ def test_a_raw_recordings_settings_of_the_same_stem_are_left_alone(files, tmp_pa
                                        encoding="utf-8")
     options, settings = options_for(data)
     assert settings is None and options == ReadOptions()
-    code, out, err = _run(capsys, "fit", data, "--cells", 1, "--out", tmp_path / "m.json")
+    code, out, err = run_cli(capsys, "fit", data, "--cells", 1, "--out", tmp_path / "m.json")
     assert code == 0, err
     assert "with the settings in" not in out
     with pytest.raises(InputError, match="key 'r_bridge' .*raw scope files.*preprocess"):
@@ -211,9 +206,9 @@ def test_a_raw_recordings_settings_of_the_same_stem_are_left_alone(files, tmp_pa
 
 def test_compensate_with_resample_leaves_out_text_and_gappy_columns(files, tmp_path, capsys):
     model = tmp_path / "m.json"
-    assert _run(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
+    assert run_cli(capsys, "fit", files["with_toml"], "--cells", 1, "--out", model)[0] == 0
     out = tmp_path / "c.csv"
-    code, stdout, err = _run(capsys, "compensate", model, files["with_toml"], "--resample", 40,
+    code, stdout, err = run_cli(capsys, "compensate", model, files["with_toml"], "--resample", 40,
                              "--out", out)
     assert code == 0, err
     assert "columns with text or empty cells cannot be and are left out" in stdout
@@ -246,13 +241,13 @@ def test_report_reads_each_recording_with_its_settings_file(files, tmp_path, cap
     model = tmp_path / "m.json"
     assert main(["fit", str(files["std"]), "--cells", "1", "--out", str(model)]) == 0
     figures = tmp_path / "f"
-    code, out, err = _run(capsys, "report", model, files["with_toml"], "--out",
+    code, out, err = run_cli(capsys, "report", model, files["with_toml"], "--out",
                           tmp_path / "r.html", "--figures", figures, "--format", "svg")
     assert code == 0, err
     assert "with the settings in" in out
     # the user's sensor name and unit (from the units line the settings file asks for)
     assert "resistance_ohm [Ohm]" in (figures / "loops.svg").read_text(encoding="utf-8")
-    code, _, err = _run(capsys, "report", model, files["plain"], "--out", tmp_path / "p.html")
+    code, _, err = run_cli(capsys, "report", model, files["plain"], "--out", tmp_path / "p.html")
     assert code == 2 and "missing required column" in err
 
 
@@ -260,7 +255,7 @@ def test_pl_search_and_stability_read_the_settings_file(files, tmp_path, capsys)
     grid = ["--n", 1, "--p", 2, "--m", 2, "--s", 0, "--workers", 1]
     found = []
     for data in (files["with_toml"], files["std"]):
-        code, out, err = _run(capsys, "pl-search", data, *grid)
+        code, out, err = run_cli(capsys, "pl-search", data, *grid)
         assert code == 0, err
         found.append([line for line in out.splitlines() if line.startswith("best:")])
     assert found[0] == found[1] and found[0]
@@ -268,11 +263,11 @@ def test_pl_search_and_stability_read_the_settings_file(files, tmp_path, capsys)
     assert main(["fit", str(files["std"]), "--cells", "1", "--out", str(model)]) == 0
     steps = []
     for data, options in ((files["with_toml"], []), (files["plain"], OWN), (files["std"], [])):
-        code, out, err = _run(capsys, "stability", model, "--data", data, *options)
+        code, out, err = run_cli(capsys, "stability", model, "--data", data, *options)
         assert code == 0, err
         steps.append([line for line in out.splitlines() if "eigenvalues" in line])
     assert steps[0] == steps[1] == steps[2] and steps[0]
-    code, _, err = _run(capsys, "pl-search", files["plain"], *grid)
+    code, _, err = run_cli(capsys, "pl-search", files["plain"], *grid)
     assert code == 2 and "missing required column" in err
 
 
@@ -281,7 +276,7 @@ def test_control_reads_its_training_recording_with_the_settings_file(files, tmp_
     for name, data, options in (("own", files["with_toml"], []), ("cli", files["plain"], OWN),
                                 ("std", files["std"], [])):
         out = tmp_path / name
-        code, _, err = _run(capsys, "control", "--scheme", "direct", "--experiment", "sine",
+        code, _, err = run_cli(capsys, "control", "--scheme", "direct", "--experiment", "sine",
                             "--training-data", data, *options, "--out", out)
         assert code == 0, err
         table = json.loads((out / "metrics.json").read_text())

@@ -8,17 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from hystkit.cli import main
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.io import write_recording
 from hystkit.sensors import simulate_experiment
 
-
-def _run(capsys: pytest.CaptureFixture[str], *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
+from ..cli_support import run_cli
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +27,7 @@ def inputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 def test_report_writes_a_page_and_figure_files(inputs: dict, tmp_path: Path,
                                                capsys: pytest.CaptureFixture[str]) -> None:
     out, figures = tmp_path / "r.html", tmp_path / "figs"
-    code, stdout, err = _run(capsys, "report", inputs["model"], inputs["data"], "--out", out,
+    code, stdout, err = run_cli(capsys, "report", inputs["model"], inputs["data"], "--out", out,
                              "--figures", figures, "--format", "svg")
     assert (code, err) == (0, "")
     assert f"wrote {out}" in stdout
@@ -50,7 +44,7 @@ def test_report_writes_a_page_and_figure_files(inputs: dict, tmp_path: Path,
 
 
 def test_pdf_figures(inputs: dict, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = _run(capsys, "report", inputs["model"], inputs["data"], "--out",
+    code, _, err = run_cli(capsys, "report", inputs["model"], inputs["data"], "--out",
                         tmp_path / "r.html", "--figures", tmp_path / "f", "--format", "pdf")
     assert (code, err) == (0, "")
     for name in ("loops.pdf", "time_series.pdf"):
@@ -61,13 +55,13 @@ def test_existing_page_is_refused_without_force(inputs: dict, tmp_path: Path,
                                                 capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "r.html"
     out.write_text("precious", encoding="utf-8")
-    code, _, err = _run(capsys, "report", inputs["model"], inputs["data"], "--out", out,
+    code, _, err = run_cli(capsys, "report", inputs["model"], inputs["data"], "--out", out,
                         "--figures", tmp_path / "figs")
     assert code == 2
     assert err.startswith("hystkit: error: ") and "--force" in err and err.count("\n") == 1
     assert out.read_text(encoding="utf-8") == "precious"
     assert not (tmp_path / "figs").exists()
-    code, _, err = _run(capsys, "report", inputs["model"], inputs["data"], "--out", out,
+    code, _, err = run_cli(capsys, "report", inputs["model"], inputs["data"], "--out", out,
                         "--force")
     assert (code, err) == (0, "")
     assert out.read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
@@ -79,7 +73,7 @@ def test_existing_figure_file_is_refused_and_nothing_written(
     figures.mkdir()
     (figures / "time_series.png").write_bytes(b"precious")
     out = tmp_path / "r.html"
-    code, _, err = _run(capsys, "report", inputs["model"], inputs["data"], "--out", out,
+    code, _, err = run_cli(capsys, "report", inputs["model"], inputs["data"], "--out", out,
                         "--figures", figures)
     assert code == 2 and "time_series.png" in err and "--force" in err
     assert not out.exists()
@@ -93,7 +87,7 @@ def test_existing_figure_file_is_refused_and_nothing_written(
 ])
 def test_bad_options_are_one_line(argv: list, fragment: str, inputs: dict, tmp_path: Path,
                                   capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = _run(capsys, "report", inputs["model"], inputs["data"], "--out",
+    code, _, err = run_cli(capsys, "report", inputs["model"], inputs["data"], "--out",
                         tmp_path / "r.html", *argv)
     assert code == 2 and fragment in err and err.count("\n") == 1
     assert not (tmp_path / "r.html").exists()
@@ -110,7 +104,7 @@ def test_bad_inputs_are_one_line(inputs: dict, tmp_path: Path,
         ([inputs["model"], tmp_path / "missing.csv"], "file not found"),
     ]
     for given, fragment in cases:
-        code, _, err = _run(capsys, "report", *given, "--out", tmp_path / "r.html")
+        code, _, err = run_cli(capsys, "report", *given, "--out", tmp_path / "r.html")
         assert code == 2, given
         assert fragment in err and err.count("\n") == 1, (given, err)
     assert not (tmp_path / "r.html").exists()
@@ -124,7 +118,7 @@ def test_own_column_names_label_the_sensor_axis(inputs: dict, tmp_path: Path,
     own = tmp_path / "own.csv"
     own.write_text("\n".join(text) + "\n", encoding="utf-8")
     out, figures = tmp_path / "r.html", tmp_path / "f"
-    code, _, err = _run(capsys, "report", inputs["model"], own, "--out", out, "--columns",
+    code, _, err = run_cli(capsys, "report", inputs["model"], own, "--out", out, "--columns",
                         "sensor=resistance_ohm,position=disp_mm", "--figures", figures,
                         "--format", "svg")
     assert (code, err) == (0, "")
@@ -157,7 +151,7 @@ def test_a_training_recording_is_pointed_out(tmp_path: Path,
     val = write_recording(simulate_experiment("sine", 2), tmp_path / "val.csv")
     model = save_compensator(fit_compensator(read_recording(fit), 1), tmp_path / "m.json")
     out = tmp_path / "r.html"
-    code, _, err = _run(capsys, "report", model, fit, val, "--out", out)
+    code, _, err = run_cli(capsys, "report", model, fit, val, "--out", out)
     assert (code, err) == (0, "")
     page = out.read_text(encoding="utf-8")
     assert "train.csv: the file name of a recording the model was fitted on" in page

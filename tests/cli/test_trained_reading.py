@@ -20,18 +20,13 @@ from scipy.io import loadmat, savemat
 
 from hystkit.cli import main
 
+from ..cli_support import run_cli
+
 COLUMNS = "time=t_ms,position=x_mm,sensor=R_ohm"
 OWN = ["--columns", COLUMNS, "--time-unit", "ms"]
 SAID = "as the model's training data were read: columns t_ms,x_mm,R_ohm, time in ms"
 OUTPUT = ["t_ms", "x_mm", "R_ohm", "x_mm_estimate", "x_mm_lower", "x_mm_upper",
           "sensor_outside", "estimate_outside"]
-
-
-def _run(capsys, *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def _own(frame: pd.DataFrame) -> pd.DataFrame:
@@ -72,7 +67,7 @@ def test_fit_writes_how_it_read_into_the_model_file(lab):
 def test_compensate_without_options_reads_as_trained_and_writes_the_inputs_names(
         lab, tmp_path, capsys):
     out, std_out = tmp_path / "c.csv", tmp_path / "std.csv"
-    code, stdout, err = _run(capsys, "compensate", lab["model"], lab["val"], "--out", out)
+    code, stdout, err = run_cli(capsys, "compensate", lab["model"], lab["val"], "--out", out)
     assert code == 0, err
     assert f"reading {lab['val']} {SAID}" in stdout.splitlines()
     assert "'x_mm_estimate'" in stdout and "'x_mm_lower', 'x_mm_upper'" in stdout
@@ -82,7 +77,7 @@ def test_compensate_without_options_reads_as_trained_and_writes_the_inputs_names
     for column in ("t_ms", "x_mm", "R_ohm"):  # as in the input, time in ms
         assert_array_equal(written[column].to_numpy(), val[column].to_numpy())
     # the same run in hystkit's names: read as it is, written as today, the same estimate
-    code, stdout, err = _run(capsys, "compensate", lab["model"], lab["val_std"], "--out",
+    code, stdout, err = run_cli(capsys, "compensate", lab["model"], lab["val_std"], "--out",
                              std_out)
     assert code == 0, err
     assert "training data were read" not in stdout
@@ -97,14 +92,14 @@ def test_compensate_without_options_reads_as_trained_and_writes_the_inputs_names
 
 def test_the_settings_written_beside_the_output_read_it_back(lab, tmp_path, capsys):
     out = tmp_path / "c.csv"
-    assert _run(capsys, "compensate", lab["model"], lab["val"], "--out", out)[0] == 0
+    assert run_cli(capsys, "compensate", lab["model"], lab["val"], "--out", out)[0] == 0
     settings = (tmp_path / "c.toml").read_text(encoding="utf-8")
     assert 'time_unit = "ms"' in settings and '"sensor" = "R_ohm"' in settings
-    code, stdout, err = _run(capsys, "evaluate", lab["model"], out, "--json",
+    code, stdout, err = run_cli(capsys, "evaluate", lab["model"], out, "--json",
                              tmp_path / "back.json")
     assert code == 0, err
     assert f"reading {out} with the settings in {tmp_path / 'c.toml'}" in stdout
-    code, _, err = _run(capsys, "evaluate", lab["model"], lab["val"], "--json",
+    code, _, err = run_cli(capsys, "evaluate", lab["model"], lab["val"], "--json",
                         tmp_path / "val.json")
     assert code == 0, err
     back, val = (json.loads((tmp_path / f"{n}.json").read_text()) for n in ("back", "val"))
@@ -115,7 +110,7 @@ def test_evaluate_without_options_scores_as_with_them(lab, tmp_path, capsys):
     scores = {}
     for name, extra in (("remembered", []), ("given", OWN)):
         path = tmp_path / f"{name}.json"
-        code, stdout, err = _run(capsys, "evaluate", lab["model"], lab["val"], *extra,
+        code, stdout, err = run_cli(capsys, "evaluate", lab["model"], lab["val"], *extra,
                                  "--json", path)
         assert code == 0, err
         # the command line's --columns describes the file: nothing remembered is applied
@@ -127,7 +122,7 @@ def test_evaluate_without_options_scores_as_with_them(lab, tmp_path, capsys):
 
 def test_a_mat_file_of_the_same_names_in_and_out(lab, tmp_path, capsys):
     out = tmp_path / "c.mat"
-    code, stdout, err = _run(capsys, "compensate", lab["model"], lab["val_mat"], "--out", out)
+    code, stdout, err = run_cli(capsys, "compensate", lab["model"], lab["val_mat"], "--out", out)
     assert code == 0, err
     assert f"reading {lab['val_mat']} {SAID}" in stdout.splitlines()
     m = loadmat(out, simplify_cells=True)
@@ -142,11 +137,11 @@ def test_a_mat_file_of_the_same_names_in_and_out(lab, tmp_path, capsys):
 
 def test_a_model_fitted_on_the_mat_file_reads_the_csv(lab, tmp_path, capsys):
     model = tmp_path / "m.mat"
-    code, _, err = _run(capsys, "fit", lab["val_mat"], *OWN, "--cells", 1, "--no-band",
+    code, _, err = run_cli(capsys, "fit", lab["val_mat"], *OWN, "--cells", 1, "--no-band",
                         "--out", model)
     assert code == 0, err
     path = tmp_path / "scores.json"
-    code, stdout, err = _run(capsys, "evaluate", model, lab["train"], "--json", path)
+    code, stdout, err = run_cli(capsys, "evaluate", model, lab["train"], "--json", path)
     assert code == 0, err
     assert f"reading {lab['train']} {SAID}" in stdout.splitlines()
     assert json.loads(path.read_text())["n_samples"] == len(pd.read_csv(lab["train"]))
@@ -154,7 +149,7 @@ def test_a_model_fitted_on_the_mat_file_reads_the_csv(lab, tmp_path, capsys):
 
 def test_parquet_output_keeps_the_names_and_time_unit(lab, tmp_path, capsys):
     out = tmp_path / "c.parquet"
-    assert _run(capsys, "compensate", lab["model"], lab["val"], "--out", out)[0] == 0
+    assert run_cli(capsys, "compensate", lab["model"], lab["val"], "--out", out)[0] == 0
     written = pd.read_parquet(out)
     assert list(written.columns) == OUTPUT
     assert_array_equal(written["t_ms"].to_numpy(), pd.read_csv(lab["val"])["t_ms"].to_numpy())
@@ -166,10 +161,10 @@ def test_an_old_model_file_without_the_key_still_works(lab, tmp_path, capsys):
     old = tmp_path / "old.json"
     old.write_text(json.dumps(data), encoding="utf-8")
     # nothing remembered: the lab's file needs its options, as before
-    code, _, err = _run(capsys, "evaluate", old, lab["val"])
+    code, _, err = run_cli(capsys, "evaluate", old, lab["val"])
     assert code == 2 and "missing required column 'time'" in err
     out = tmp_path / "c.csv"
-    code, stdout, err = _run(capsys, "compensate", old, lab["val"], *OWN, "--out", out)
+    code, stdout, err = run_cli(capsys, "compensate", old, lab["val"], *OWN, "--out", out)
     assert code == 0, err
     assert "training data were read" not in stdout
     assert list(pd.read_csv(out).columns) == OUTPUT
@@ -188,15 +183,15 @@ def test_an_explicit_option_wins_over_the_remembered_one(tmp_path, capsys):
                                      "r": frame["sensor"]})
         frames[name].to_csv(tmp_path / f"{name}.csv", index=False)
     model = tmp_path / "m.json"
-    code, _, err = _run(capsys, "fit", tmp_path / "train.csv", "--columns",
+    code, _, err = run_cli(capsys, "fit", tmp_path / "train.csv", "--columns",
                         "time=t,position=x,sensor=r", "--time-unit", "ms", "--cells", 1,
                         "--no-band", "--out", model)
     assert code == 0, err
-    code, _, err = _run(capsys, "compensate", model, tmp_path / "val.csv", "--out",
+    code, _, err = run_cli(capsys, "compensate", model, tmp_path / "val.csv", "--out",
                         tmp_path / "wrong.csv")
     assert code == 2 and "sampled every 2.5e-05 s, but the model was fitted at 0.025 s" in err
     out = tmp_path / "c.csv"
-    code, stdout, err = _run(capsys, "compensate", model, tmp_path / "val.csv",
+    code, stdout, err = run_cli(capsys, "compensate", model, tmp_path / "val.csv",
                              "--time-unit", "s", "--out", out)
     assert code == 0, err
     assert (f"reading {tmp_path / 'val.csv'} as the model's training data were read: "
@@ -212,7 +207,7 @@ def test_a_settings_file_of_its_own_wins(lab, tmp_path, capsys):
     (tmp_path / "val.toml").write_text('time_unit = "ms"\n\n[columns]\ntime = "t_ms"\n'
                                        'position = "x_mm"\nsensor = "R_ohm"\n\n[units]\n'
                                        'position = "um"\n', encoding="utf-8")
-    code, stdout, err = _run(capsys, "evaluate", lab["model"], data, "--json",
+    code, stdout, err = run_cli(capsys, "evaluate", lab["model"], data, "--json",
                              tmp_path / "s.json")
     assert code == 0, err
     assert f"reading {data} with the settings in {tmp_path / 'val.toml'}" in stdout
@@ -231,13 +226,13 @@ def test_a_units_line_is_read_where_the_file_has_one(tmp_path, capsys):
     plain = tmp_path / "plain.csv"
     own.to_csv(plain, index=False)
     model = tmp_path / "m.json"
-    code, _, err = _run(capsys, "fit", with_units, *OWN, "--units-row", "--cells", 1,
+    code, _, err = run_cli(capsys, "fit", with_units, *OWN, "--units-row", "--cells", 1,
                         "--no-band", "--out", model)
     assert code == 0, err
     assert json.loads(model.read_text())["reading"]["units_row"] is True
     for path, said in ((with_units, f"{SAID}, a units line"), (plain, SAID)):
         out = tmp_path / f"{path.stem}-out.csv"
-        code, stdout, err = _run(capsys, "compensate", model, path, "--out", out)
+        code, stdout, err = run_cli(capsys, "compensate", model, path, "--out", out)
         assert code == 0, err
         assert f"reading {path} {said}" in stdout.splitlines(), stdout
         assert "'x_mm_estimate' [mm]" in stdout  # the training position's unit
@@ -245,12 +240,12 @@ def test_a_units_line_is_read_where_the_file_has_one(tmp_path, capsys):
 
 
 def test_stream_in_and_report_read_as_trained(lab, tmp_path, capsys):
-    code, stdout, err = _run(capsys, "stream", lab["model"], "--in", lab["val"])
+    code, stdout, err = run_cli(capsys, "stream", lab["model"], "--in", lab["val"])
     assert code == 0, err
     assert f"hystkit stream: reading {lab['val']} {SAID}" in err.splitlines()
     rows = stdout.splitlines()
     assert len(rows) == len(pd.read_csv(lab["val"])) + 1  # the header, then every sample
-    code, stdout, err = _run(capsys, "report", lab["model"], lab["val"], "--out",
+    code, stdout, err = run_cli(capsys, "report", lab["model"], lab["val"], "--out",
                              tmp_path / "r.html")
     assert code == 0, err
     assert f"reading {lab['val']} {SAID}" in stdout.splitlines()
@@ -263,7 +258,7 @@ def test_files_read_differently_are_not_remembered(lab, tmp_path, capsys):
                                        'position = "x_mm"\nsensor = "R_ohm"\n',
                                        encoding="utf-8")
     model = tmp_path / "m.json"
-    code, stdout, err = _run(capsys, "fit", own, lab["val_std"], "--cells", 1, "--no-band",
+    code, stdout, err = run_cli(capsys, "fit", own, lab["val_std"], "--cells", 1, "--no-band",
                              "--out", model)
     assert code == 0, err
     assert "note: the training files were read differently" in stdout

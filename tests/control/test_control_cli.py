@@ -11,10 +11,11 @@ import pytest
 from numpy.testing import assert_allclose
 
 from hystkit import control as hc
-from hystkit.cli import main
 from hystkit.cli.cmd_control import _models
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.sensors import simulate_experiment
+
+from ..cli_support import run_cli
 
 matplotlib.use("Agg")  # figures are written; never open a window
 
@@ -27,13 +28,6 @@ def models() -> hc.SensorModels:
     # the CLI's in-memory memo of fit_sensor_models() with the CLI defaults: the CLI tests
     # below then reuse this fit instead of repeating it (about 2 s each)
     return _models("recording", "sine", 3, None)
-
-
-def _run(capsys, *argv) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def _one_error_line(err: str, *fragments: str) -> None:
@@ -110,7 +104,7 @@ def test_disturbance_metrics(models):
 
 def test_cli_sine_writes_metrics_figures_and_config(capsys, tmp_path):
     out = tmp_path / "run"
-    code, stdout, err = _run(capsys, "control", "--scheme", "direct", "--experiment", "sine",
+    code, stdout, err = run_cli(capsys, "control", "--scheme", "direct", "--experiment", "sine",
                              "--bode", "--out", out)
     assert code == 0, err
     assert sorted(p.name for p in out.iterdir()) == ["bode.png", "config.json", "metrics.json",
@@ -127,7 +121,7 @@ def test_cli_sine_writes_metrics_figures_and_config(capsys, tmp_path):
 
 def test_cli_sweep_writes_one_entry_and_figure_per_case(capsys, tmp_path):
     out = tmp_path / "sweep"
-    code, _, err = _run(capsys, "control", "--scheme", "weighting", "--experiment",
+    code, _, err = run_cli(capsys, "control", "--scheme", "weighting", "--experiment",
                         "frequency", "--dob", "--dob-hz", "20", "--out", out)
     assert code == 0, err
     metrics = json.loads((out / "metrics.json").read_text())
@@ -141,13 +135,13 @@ def test_cli_sweep_writes_one_entry_and_figure_per_case(capsys, tmp_path):
 
 def test_cli_never_overwrites_without_force(capsys, tmp_path):
     out = tmp_path / "once"
-    assert _run(capsys, "control", "--scheme", "direct", "--bode", "--out", out)[0] == 0
+    assert run_cli(capsys, "control", "--scheme", "direct", "--bode", "--out", out)[0] == 0
     before = {p.name: p.read_bytes() for p in out.iterdir()}
-    code, _, err = _run(capsys, "control", "--scheme", "direct", "--bode", "--out", out)
+    code, _, err = run_cli(capsys, "control", "--scheme", "direct", "--bode", "--out", out)
     assert code == 2
     _one_error_line(err, "already exists", "--force")
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
-    code, _, err = _run(capsys, "control", "--scheme", "direct", "--bode", "--out", out,
+    code, _, err = run_cli(capsys, "control", "--scheme", "direct", "--bode", "--out", out,
                         "--force")
     assert code == 0, err
 
@@ -159,7 +153,7 @@ def test_cli_never_overwrites_without_force(capsys, tmp_path):
     (["--scheme", "direct", "--bode", "--tune", "20", "95"], "--tune PM_DEG: must be < 90"),
 ])
 def test_cli_bad_options_give_one_error_line(capsys, tmp_path, argv, fragment):
-    code, _, err = _run(capsys, "control", *argv, "--out", tmp_path / "x")
+    code, _, err = run_cli(capsys, "control", *argv, "--out", tmp_path / "x")
     assert code == 2
     _one_error_line(err, fragment)
     assert not Path(tmp_path / "x" / "metrics.json").exists()
@@ -167,7 +161,7 @@ def test_cli_bad_options_give_one_error_line(capsys, tmp_path, argv, fragment):
 
 def test_cli_reports_an_unbounded_run_without_failing(capsys, tmp_path):
     out = tmp_path / "unstable"
-    code, stdout, err = _run(capsys, "control", "--scheme", "direct", "--experiment", "sine",
+    code, stdout, err = run_cli(capsys, "control", "--scheme", "direct", "--experiment", "sine",
                              "--pid", "-545", "0.029", "0.0573", "--out", out)
     assert code == 0, err
     metrics = json.loads((out / "metrics.json").read_text())
@@ -179,7 +173,7 @@ def test_cli_runs_a_saved_compensator(capsys, tmp_path):
     model = tmp_path / "chirp.json"
     save_compensator(fit_compensator(simulate_experiment("chirp", 4), 1), model)
     out = tmp_path / "own"
-    code, _, err = _run(capsys, "control", "--scheme", "direct", "--bode", "--compensator",
+    code, _, err = run_cli(capsys, "control", "--scheme", "direct", "--bode", "--compensator",
                         model, "--out", out)
     assert code == 0, err
     config = json.loads((out / "config.json").read_text())

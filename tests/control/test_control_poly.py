@@ -10,11 +10,12 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from hystkit import control as hc
-from hystkit.cli import main
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.models import mpl_poly
 from hystkit.models.mpl_poly import PAPER_9_2_TABLE_II, paper_9_2_params
 from hystkit.sensors import simulate_experiment
+
+from ..cli_support import run_cli
 
 TS = hc.TS
 
@@ -154,15 +155,9 @@ def test_sensor_outside_the_branch_stops_the_loop_not_nan():
     assert np.all(np.isfinite(res.y))
 
 
-def _run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
-
-
 def test_cli_table_ii_sensor(capsys, tmp_path):
     out = tmp_path / "t2"
-    code, _, err = _run(capsys, "control", "--scheme", "weighting", "--sensor",
+    code, _, err = run_cli(capsys, "control", "--scheme", "weighting", "--sensor",
                          "table-ii-noise", "--experiment", "sine", "--out", out)
     assert code == 0, err
     config = json.loads((out / "config.json").read_text())
@@ -175,7 +170,7 @@ def test_cli_runs_a_saved_mpl_poly_compensator(capsys, tmp_path):
     model = tmp_path / "poly.json"
     save_compensator(fit_compensator(simulate_experiment("sine", 4), 1, model="mpl-poly"), model)
     out = tmp_path / "own"
-    code, _, err = _run(capsys, "control", "--scheme", "direct", "--experiment", "sine",
+    code, _, err = run_cli(capsys, "control", "--scheme", "direct", "--experiment", "sine",
                         "--compensator", model, "--out", out)
     assert code == 0, err
     metrics = json.loads((out / "metrics.json").read_text())

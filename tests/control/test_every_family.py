@@ -18,6 +18,8 @@ from hystkit.io import write_recording
 from hystkit.models import FAMILIES
 from hystkit.sensors import simulate_experiment
 
+from ..cli_support import run_cli
+
 NAMES = sorted(FAMILIES)
 
 
@@ -35,12 +37,6 @@ def model_files(tmp_path_factory):
     return files
 
 
-def _run(capsys, *args) -> tuple[int, str, str]:
-    code = main([str(a) for a in args])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 def _one_line_refusal(code: int, out: str, err: str) -> None:
     assert code == 2 and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1 and err.startswith("hystkit: error:")
@@ -55,7 +51,7 @@ def test_fit_writes_a_model_file(model_files, name):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_direct_scheme_with_the_family_as_compensator(model_files, name, tmp_path, capsys):
-    code, _, err = _run(capsys, "control", "--scheme", "direct", "--experiment", "sine",
+    code, _, err = run_cli(capsys, "control", "--scheme", "direct", "--experiment", "sine",
                           "--compensator", model_files[name][1], "--out", tmp_path / "a")
     assert code == 0, err
     metrics = json.loads((tmp_path / "a" / "metrics.json").read_text())
@@ -75,7 +71,7 @@ def test_direct_scheme_with_the_family_as_compensator(model_files, name, tmp_pat
 @pytest.mark.parametrize("name", NAMES)
 def test_weighting_scheme_with_the_family_as_s_m(model_files, name, tmp_path, capsys):
     """S_m runs position -> sensor: a direct-mode file through its family's inverse."""
-    code, out, err = _run(capsys, "control", "--scheme", "weighting", "--experiment", "sine",
+    code, out, err = run_cli(capsys, "control", "--scheme", "weighting", "--experiment", "sine",
                           "--model-file", model_files[name][1], "--out", tmp_path / "b")
     if FAMILIES[name].has_inverse:
         assert code == 0, err
@@ -87,7 +83,7 @@ def test_weighting_scheme_with_the_family_as_s_m(model_files, name, tmp_path, ca
 
 @pytest.mark.parametrize("name", NAMES)
 def test_stability_of_every_family(model_files, name, capsys):
-    code, out, err = _run(capsys, "stability", model_files[name][1])
+    code, out, err = run_cli(capsys, "stability", model_files[name][1])
     assert code == 0, err
     assert "eigenvalues of A" in out
 

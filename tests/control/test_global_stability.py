@@ -11,8 +11,9 @@ import pytest
 from numpy.testing import assert_allclose
 
 from hystkit import control as hc
-from hystkit.cli import main
 from hystkit.sensors import simulate_experiment
+
+from ..cli_support import run_cli
 
 TS = hc.TS
 G_S = 0.0184  # m per sensor unit: the scheme (b) gain of the virtual sensor's fits
@@ -222,16 +223,9 @@ def test_report_is_json_safe(preisach_sensor):
 # --------------------------------------------------------------------------- CLI
 
 
-def _run(capsys, *argv):
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 def test_cli_stability_of_a_control_setup(capsys, tmp_path):
     out = tmp_path / "stab.json"
-    code, stdout, err = _run(capsys, "stability", "--control", "--scheme", "direct",
+    code, stdout, err = run_cli(capsys, "stability", "--control", "--scheme", "direct",
                              "--json", out)
     assert code == 0, err
     report = json.loads(out.read_text())
@@ -251,7 +245,7 @@ def test_cli_stability_of_a_control_setup(capsys, tmp_path):
     (["stability", "m.json", "--scheme", "direct"], "need --control"),
 ])
 def test_cli_stability_bad_combinations_are_one_line(capsys, argv, fragment):
-    code, _, err = _run(capsys, *argv)
+    code, _, err = run_cli(capsys, *argv)
     assert code == 2
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("hystkit: error: ") and fragment in lines[0]

@@ -12,7 +12,6 @@ from pathlib import Path
 
 import pytest
 
-from hystkit.cli import main
 from hystkit.datasets import (
     DataNotFoundError,
     _files,
@@ -23,14 +22,9 @@ from hystkit.datasets import (
 )
 from hystkit.errors import InputError
 
+from ..cli_support import run_cli
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-
-
-def _run(capsys, *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 @pytest.fixture
@@ -69,12 +63,12 @@ def test_the_sources_name_the_files_the_loaders_read():
 
 
 def test_list_says_what_is_missing_and_where_to_look(capsys, empty_root):
-    code, out, err = _run(capsys, "datasets", "list")
+    code, out, err = run_cli(capsys, "datasets", "list")
     assert (code, err) == (0, "")
     names = ", ".join(info.name for info in list_datasets())
     assert out.splitlines()[-1] == (f"not here: {names}; where each comes from and where to put "
                                     "it: hystkit datasets show NAME")
-    code, out, _ = _run(capsys, "datasets", "list", "piezo_actuator")
+    code, out, _ = run_cli(capsys, "datasets", "list", "piezo_actuator")
     assert code == 0
     assert ("  source github.com/chandratue/SmartHysteresis; the files and where they go: "
             "hystkit datasets show piezo_actuator") in out
@@ -82,7 +76,7 @@ def test_list_says_what_is_missing_and_where_to_look(capsys, empty_root):
 
 @pytest.mark.parametrize("info", list_datasets(), ids=lambda info: info.name)
 def test_show_lists_source_licence_and_every_file(capsys, empty_root, info):
-    code, out, err = _run(capsys, "datasets", "show", info.name)
+    code, out, err = run_cli(capsys, "datasets", "show", info.name)
     assert (code, err) == (0, "")
     source = info.provenance()
     assert f"  source:  {source.repository}" in out
@@ -98,7 +92,7 @@ def test_show_marks_the_files_that_are_here(capsys, empty_root):
     folder = empty_root / "piezo_actuator_150V_1Hz"
     folder.mkdir()
     (folder / "hysteresis_v_150_1hz.csv").write_text("")
-    code, out, _ = _run(capsys, "datasets", "show", "piezo_actuator")
+    code, out, _ = run_cli(capsys, "datasets", "show", "piezo_actuator")
     assert code == 0
     assert f"      -> {folder}/hysteresis_v_150_1hz.csv\n" in out
     assert "  here: 1 of 1 file(s)" in out
@@ -107,7 +101,7 @@ def test_show_marks_the_files_that_are_here(capsys, empty_root):
 @pytest.mark.parametrize("info", list_datasets(), ids=lambda info: info.name)
 def test_export_without_the_data_is_one_line_saying_where_they_come_from(
         capsys, empty_root, tmp_path, info):
-    code, out, err = _run(capsys, "datasets", "export", info.name, "--out",
+    code, out, err = run_cli(capsys, "datasets", "export", info.name, "--out",
                           tmp_path / "x.csv")
     assert code == 2 and out == ""
     lines = err.splitlines()
@@ -141,7 +135,7 @@ def test_no_shared_data_anywhere(capsys, tmp_path, monkeypatch):
                                                 r".*; piezo_actuator comes from github.com/"
                                                 r"chandratue/SmartHysteresis"):
         load_piezo_actuator()
-    code, out, err = _run(capsys, "datasets", "show", "piezo_actuator")
+    code, out, err = run_cli(capsys, "datasets", "show", "piezo_actuator")
     assert (code, err) == (0, "")
     assert "      -> SHARED_DATA/piezo_actuator_150V_1Hz/hysteresis_v_150_1hz.csv  (missing)" in out
     assert "  shared data root: shared data not found" in out

@@ -17,7 +17,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hystkit.cli import main
 from hystkit.compensation import fit_compensator
 from hystkit.datasets import (
     DATASETS,
@@ -37,6 +36,8 @@ from hystkit.datasets import (
 )
 from hystkit.errors import InputError
 from hystkit.io import Recording, read_recording
+
+from ..cli_support import run_cli
 
 MM = "piezo_micromanipulator"
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "piezo_micromanipulator.py"
@@ -70,13 +71,6 @@ def _tiny(**changes: object) -> Dataset:
               "time_note": "synthetic", "segments": {"first": (0.0, 0.2)},
               "channels": {"ref": 2 * t}, "channel_units": {"ref": "um"}}
     return Dataset(**(fields | changes))
-
-
-def _run(capsys: pytest.CaptureFixture[str], *argv: object) -> tuple[int, str, str]:
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def _one_error_line(err: str, *fragments: object) -> None:
@@ -326,21 +320,21 @@ def test_example_prints_the_table(capsys: pytest.CaptureFixture[str]) -> None:
 
 def test_cli_list_shows_every_data_set_and_the_excerpts(
         capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
-    code, out, err = _run(capsys, "datasets", "list", "--root", tmp_path)
+    code, out, err = run_cli(capsys, "datasets", "list", "--root", tmp_path)
     assert (code, err) == (0, "")
     assert f"shared data: {tmp_path} (root argument)" in out
     for info in list_datasets():
         line = next(line for line in out.splitlines() if line.startswith(info.name + " "))
         assert line.endswith(f" no    {info.licence}"), line  # 'here' column: absent
     assert "shipped excerpts (--excerpt, always available): piezo_micromanipulator" in out
-    code, out, _ = _run(capsys, "datasets", "list", "mr_damper")
+    code, out, _ = run_cli(capsys, "datasets", "list", "mr_damper")
     assert code == 0 and "earthquake_0.2A" in out and "25mm_0.1Hz_0.75A" in out
 
 
 def test_cli_export_round_trips_through_read_recording(
         capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     out = tmp_path / "ff.csv"
-    code, stdout, err = _run(capsys, "datasets", "export", MM, "--excerpt", "--variant",
+    code, stdout, err = run_cli(capsys, "datasets", "export", MM, "--excerpt", "--variant",
                              "test_feedforward", "--out", out)
     assert (code, err) == (0, ""), err
     ds = load_excerpt(MM, "test_feedforward")
@@ -361,14 +355,14 @@ def test_cli_export_refuses_overwrite_unless_forced(
         capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     out = tmp_path / "id.csv"
     args = ("datasets", "export", MM, "--excerpt", "--out", out)
-    assert _run(capsys, *args)[0] == 0
+    assert run_cli(capsys, *args)[0] == 0
     before = out.read_bytes()
-    code, _, err = _run(capsys, *args, "--role", "forward")
+    code, _, err = run_cli(capsys, *args, "--role", "forward")
     assert code == 2 and out.read_bytes() == before
     _one_error_line(err, out, "--force")
     for forced in (("datasets", "export", MM, "--excerpt", "--role", "forward", "--out", out,
                     "--force"), ("datasets", "--force", "export", MM, "--excerpt", "--out", out)):
-        assert _run(capsys, *forced)[0] == 0
+        assert run_cli(capsys, *forced)[0] == 0
     forward = read_recording(out)  # the last run was role inverse again
     assert np.array_equal(forward.position, load_excerpt(MM).input)
 
@@ -386,7 +380,7 @@ def test_cli_export_errors_are_one_line_and_write_nothing(
         capsys: pytest.CaptureFixture[str], tmp_path: Path, args: tuple[str, ...],
         out_name: str, fragments: tuple[str, ...]) -> None:
     args = tuple(a.replace("{tmp}", str(tmp_path)) for a in args)
-    code, _, err = _run(capsys, "datasets", "export", MM, *args, "--out", tmp_path / out_name)
+    code, _, err = run_cli(capsys, "datasets", "export", MM, *args, "--out", tmp_path / out_name)
     assert code == 2
     _one_error_line(err, *(f.replace("{tmp}", str(tmp_path)) for f in fragments))
     assert list(tmp_path.iterdir()) == [], "nothing may be written"
@@ -466,7 +460,7 @@ def test_other_loaders_match_their_readmes(shared_root: Path) -> None:
 def test_cli_exports_a_full_data_segment(shared_root: Path, tmp_path: Path,
                                          capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "unc.parquet"
-    code, _, err = _run(capsys, "datasets", "export", MM, "--variant", "test", "--segment",
+    code, _, err = run_cli(capsys, "datasets", "export", MM, "--variant", "test", "--segment",
                         "uncompensated", "--root", shared_root, "--out", out)
     assert (code, err) == (0, "")
     rec = read_recording(out)

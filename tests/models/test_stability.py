@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from hystkit.cli import main
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.errors import FitDivergedError
 from hystkit.io import write_recording
@@ -17,6 +16,8 @@ from hystkit.models import _cells, family_of, mpl, mpl_poly
 from hystkit.models.mpl_poly import PAPER_9_2_TABLE_II, paper_9_2_params
 from hystkit.sensors import simulate_experiment
 from hystkit.signals import exponential_chirp
+
+from ..cli_support import run_cli
 
 DT = 0.025
 
@@ -162,16 +163,10 @@ def model_files(tmp_path_factory):
     return files
 
 
-def _run(capsys, *argv):
-    capsys.readouterr()
-    code = main([str(a) for a in argv])
-    return (code, *capsys.readouterr())
-
-
 @pytest.mark.parametrize("model", ["mpl", "mpl-poly"])
 def test_cli_prints_and_writes_the_analysis(model_files, model, tmp_path, capsys):
     out = tmp_path / "stability.json"
-    code, stdout, stderr = _run(capsys, "stability", model_files[model], "--json", out)
+    code, stdout, stderr = run_cli(capsys, "stability", model_files[model], "--json", out)
     assert code == 0, stderr
     assert f": {model} (" in stdout and "1 state(s)" in stdout
     assert "knees x- = " in stdout and "augmented constant state has eigenvalue 1" in stdout
@@ -188,12 +183,12 @@ def test_cli_prints_and_writes_the_analysis(model_files, model, tmp_path, capsys
 
 
 def test_cli_uses_a_recording_as_the_probe(model_files, capsys):
-    code, stdout, stderr = _run(capsys, "stability", model_files["mpl-poly"], "--data",
+    code, stdout, stderr = run_cli(capsys, "stability", model_files["mpl-poly"], "--data",
                                 model_files["recording"])
     assert code == 0, stderr
     assert f"driven by {model_files['recording']}" in stdout
 
 
 def test_cli_missing_model_file_is_one_line(tmp_path, capsys):
-    code, _, stderr = _run(capsys, "stability", tmp_path / "missing.json")
+    code, _, stderr = run_cli(capsys, "stability", tmp_path / "missing.json")
     assert code == 2 and "file not found" in stderr

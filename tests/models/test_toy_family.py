@@ -12,12 +12,13 @@ from numba import njit
 from numpy.testing import assert_allclose
 
 from hystkit import control as hc
-from hystkit.cli import main
 from hystkit.compensation import load_compensator
 from hystkit.identification import FitResult, check_fit_data
 from hystkit.io import write_recording
 from hystkit.models import Block, Family, Record, register, unregister
 from hystkit.sensors import simulate_experiment
+
+from ..cli_support import run_cli
 
 RATES = np.geomspace(0.05, 20.0, 25)  # candidate lag rates [1/s] for the grid search
 
@@ -73,7 +74,7 @@ class LagFamily(Family):
         u = (y - params.w1 * x[0] - params.bias) / params.w0
         return float(u), np.array([x[0] + params.rate * structure.dt * (u - x[0])])
 
-    def _run(self, step, structure, params, u, x0, inverse):
+    def run_cli(self, step, structure, params, u, x0, inverse):
         u = np.asarray(u, dtype=float)
         x = self.rest_state(structure, params, float(u[0]), inverse) if x0 is None else x0
         y = np.empty_like(u)
@@ -82,10 +83,10 @@ class LagFamily(Family):
         return y, x
 
     def simulate(self, structure, params, u, x0=None):
-        return self._run(self.step, structure, params, u, x0, False)
+        return self.run_cli(self.step, structure, params, u, x0, False)
 
     def invert(self, structure, params, y, x0=None):
-        return self._run(self.invert_step, structure, params, y, x0, True)
+        return self.run_cli(self.invert_step, structure, params, y, x0, True)
 
     def fit(self, u, y, structure, *, accept=None, accept_reason="", **options):
         u, y = check_fit_data(u, y)
@@ -120,15 +121,9 @@ def recording(tmp_path_factory):
     return path
 
 
-def _run(capsys, *args) -> tuple[int, str, str]:
-    code = main([str(a) for a in args])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 def test_toy_family_is_fitted_saved_and_loaded(toy, recording, tmp_path, capsys):
     model = tmp_path / "toy.json"
-    code, _out, err = _run(capsys, "fit", recording, "--model", "toy-lag", "--out", model)
+    code, _out, err = run_cli(capsys, "fit", recording, "--model", "toy-lag", "--out", model)
     assert code == 0, err
     comp = load_compensator(model)
     assert comp.model == "toy-lag" and isinstance(comp.params, LagParams)
@@ -136,7 +131,7 @@ def test_toy_family_is_fitted_saved_and_loaded(toy, recording, tmp_path, capsys)
 
 
 def test_toy_family_in_compare(toy, recording, tmp_path, capsys):
-    code, out, err = _run(capsys, "compare", recording, recording, "--models", "toy-lag,mpl",
+    code, out, err = run_cli(capsys, "compare", recording, recording, "--models", "toy-lag,mpl",
                           "--out", tmp_path / "cmp")
     assert code == 0, err
     table = json.loads((tmp_path / "cmp" / "compare.json").read_text())
@@ -146,9 +141,9 @@ def test_toy_family_in_compare(toy, recording, tmp_path, capsys):
 @pytest.mark.parametrize("scheme", ["direct", "weighting"])
 def test_toy_family_in_the_closed_loop(toy, recording, tmp_path, capsys, scheme):
     model = tmp_path / "toy.json"
-    _run(capsys, "fit", recording, "--model", "toy-lag", "--mode", "inverse", "--out", model)
+    run_cli(capsys, "fit", recording, "--model", "toy-lag", "--mode", "inverse", "--out", model)
     slot = "--compensator" if scheme == "direct" else "--model-file"
-    code, _out, err = _run(capsys, "control", "--scheme", scheme, "--experiment", "sine", slot,
+    code, _out, err = run_cli(capsys, "control", "--scheme", scheme, "--experiment", "sine", slot,
                           model, "--out", tmp_path / "loop")
     assert code == 0, err
     metrics = json.loads((tmp_path / "loop" / "metrics.json").read_text())
@@ -168,8 +163,8 @@ def test_toy_family_blocks_run_compiled_like_the_readable_loop(toy):
 
 def test_toy_family_in_stability(toy, recording, tmp_path, capsys):
     model = tmp_path / "toy.json"
-    _run(capsys, "fit", recording, "--model", "toy-lag", "--out", model)
-    code, out, err = _run(capsys, "stability", model)
+    run_cli(capsys, "fit", recording, "--model", "toy-lag", "--out", model)
+    code, out, err = run_cli(capsys, "stability", model)
     assert code == 0, err
     rate = load_compensator(model).params.rate
     # one state, x+ = (1 - rate dt) x + ...: its eigenvalue, exactly
