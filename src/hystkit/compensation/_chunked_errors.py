@@ -21,7 +21,13 @@ from typing import Any
 import numpy as np
 
 from ..models import Family
-from ._diagnostics import error_steps, errors_from_factor, fixed_mask, parameter_names
+from ._diagnostics import (
+    error_steps,
+    errors_from_factor,
+    fixed_mask,
+    parameter_names,
+    step_within_domain,
+)
 from ._param_vector import flatten_params
 
 __all__ = ["chunked_standard_errors"]
@@ -53,7 +59,10 @@ def chunked_standard_errors(family: Family, structure: Any, params: Any,
     theta, rebuild = flatten_params(params)
     free = ~fixed_mask(family, structure, params)
     steps = error_steps(theta)[free]
-    shifted = [params] + [rebuild(theta + h * e) for h, e in zip(steps, np.eye(theta.size)[free])]
+    shifted = [params]
+    for j, e in enumerate(np.eye(theta.size)[free]):
+        moved, steps[j] = step_within_domain(rebuild, theta, e, steps[j])
+        shifted.append(params if moved is None else moved)
     rows = chunk or max(256, _CHUNK_ENTRIES // max(steps.size, 1))
     r_factor, sse, n = np.zeros((0, steps.size)), 0.0, 0
     for u, target in zip(inputs, targets, strict=True):

@@ -20,7 +20,7 @@ from ._verdict import verdict
 
 __all__ = ["BOUND_TOLERANCE", "COLLAPSE_RATIO", "MIN_SAMPLES_PER_PARAM", "bound_flags",
            "error_steps", "errors_from_factor", "fit_status", "fixed_mask", "parameter_names",
-           "standard_errors"]
+           "standard_errors", "step_within_domain"]
 
 # A fit needs at least this many samples per fitted number (with fewer, the residual has too
 # few degrees of freedom for the noise level, hence for standard errors).
@@ -29,6 +29,39 @@ MIN_SAMPLES_PER_PARAM = 2
 COLLAPSE_RATIO = 1e-3
 # A parameter within this share of its bound interval of a bound is "on the bound".
 BOUND_TOLERANCE = 1e-4
+
+
+def step_within_domain(rebuild: Callable[[np.ndarray], Any], theta: np.ndarray,
+                       e: np.ndarray, h: float) -> tuple[Any, float]:
+    """A finite-difference step that stays in the family's domain.
+
+    Parameters
+    ----------
+    rebuild : callable
+        Parameter vector -> the family's parameters (raises ValueError outside the domain).
+    theta : numpy.ndarray
+        The fitted parameter vector.
+    e : numpy.ndarray
+        The unit vector of the parameter to move.
+    h : float
+        The step.
+
+    Returns
+    -------
+    params : object or None
+        The parameters moved by ``+h`` along `e` (a forward difference), else by ``-h`` (a
+        backward one) where the forward step leaves the domain (two PI dead-zone thresholds
+        4e-7 apart swap order); None if both do: that Jacobian column is zero and the
+        parameter is reported as not determined.
+    step : float
+        The signed step taken.
+    """
+    for step in (h, -h):
+        try:
+            return rebuild(theta + step * e), step
+        except ValueError:
+            continue
+    return None, h
 
 
 def standard_errors(residual: Callable[[np.ndarray], np.ndarray], params: Any,
@@ -54,9 +87,8 @@ def standard_errors(residual: Callable[[np.ndarray], np.ndarray], params: Any,
     steps = error_steps(theta)
     jac = np.empty((r0.size, int(free.sum())))
     for col, j in enumerate(np.flatnonzero(free)):
-        shifted = theta.copy()
-        shifted[j] += steps[j]
-        jac[:, col] = (residual(rebuild(shifted)) - r0) / steps[j]
+        moved, step = step_within_domain(rebuild, theta, np.eye(theta.size)[j], steps[j])
+        jac[:, col] = 0.0 if moved is None else (residual(moved) - r0) / step
     return errors_from_factor(theta, jac, float(r0 @ r0), n_data, free, parameter_names(params))
 
 
