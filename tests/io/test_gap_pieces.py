@@ -5,6 +5,7 @@ recordings are (``hk.fit``; the CLI's ``read_recordings_args``)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,7 @@ import pytest
 from numpy.testing import assert_array_equal
 
 import hystkit as hk
+from hystkit.cli import main
 from hystkit.cli._common import Parser, add_read_options, read_recordings_args
 from hystkit.compensation import fit_compensator
 from hystkit.errors import InputError
@@ -140,3 +142,14 @@ def test_the_cli_reads_pieces_for_a_joint_fit(tmp_path, capsys):
     assert joint.fit_info["joint_fit"].startswith("joint polish over 4 recordings")
     with pytest.raises(InputError, match="a time gap: split the recording there"):
         read_recordings_args(parser.parse_args([]), [path])
+
+
+def test_hystkit_fit_gaps_split_fits_the_pieces_jointly(tmp_path, capsys):
+    path = _gapped(tmp_path / "run.csv")
+    model = tmp_path / "m.json"
+    assert main(["fit", str(path), "--gaps", "split", "--no-band", "--out", str(model)]) == 0
+    info = json.loads(model.read_text())["fit"]
+    assert info["joint_fit"].startswith("joint polish over 3 recordings")
+    assert info["training_samples"] == 8000
+    assert main(["fit", str(path), "--out", str(tmp_path / "refused.json")]) == 2
+    assert "--gaps split" in capsys.readouterr().err

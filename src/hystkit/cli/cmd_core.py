@@ -93,7 +93,7 @@ def _fit(args: argparse.Namespace) -> int:
         return list_presets(args)
     check_inputs_exist(args.data)  # a misspelt name is refused before the heavy imports
     from ..compensation import MODEL_SUFFIXES, center_label, fit_compensator, save_compensator
-    from ..io import check_output_path, read_recording
+    from ..io import check_output_path, read_pieces, read_recording
     from ..models import get_family
 
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
@@ -111,7 +111,10 @@ def _fit(args: argparse.Namespace) -> int:
     reading, recs = [], []
     for path in args.data:
         reading.append(read_options(args, path))
-        recs.append(read_recording(path, options=reading[-1]))
+        if reading[-1].gaps == "split":  # the pieces between time gaps, fitted jointly
+            recs += read_pieces(path, options=reading[-1])
+        else:
+            recs.append(read_recording(path, options=reading[-1]))
     size = family.default_size if args.cells is None else args.cells
     fit_options = {**start_options(args, family, recs[0].dt, size, options), **constraint}
     shown = "".join(f", {name} {str(value).lower() if isinstance(value, bool) else f'{value:g}'}"
