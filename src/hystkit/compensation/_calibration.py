@@ -60,7 +60,8 @@ def with_band(comp, recordings: Sequence[Recording], size: int, options: dict | 
 
 
 def calibrate_band(comp, recordings: Sequence[Recording], size: int,
-                   options: dict | None = None, *, level: float = DEFAULT_LEVEL) -> tuple[Band | None, str]:
+                   options: dict | None = None, *,
+                   level: float = DEFAULT_LEVEL) -> tuple[Band | None, str]:
     """The band of `comp`, calibrated on the validation folds of its training recordings.
 
     Each fold refits the same model (family, size, mode, centring, `options`) on the fold's
@@ -116,8 +117,9 @@ def calibrate_band(comp, recordings: Sequence[Recording], size: int,
         errors.append(np.abs(fold.scored.position - estimate)[held])
         rates.append(rate[held])
         excess.append((position_width(fold_comp) * outside)[held])
-    if failed and not errors:
-        return None, f"no band: every fold's fit failed ({failed[0]})"
+    if not errors:
+        return None, (f"no band: every fold's fit failed ({failed[0]})" if failed else
+                      "no band: no fold's held-out position moves (nothing to score)")
     error, rate, extra = (np.concatenate(v) for v in (errors, rates, excess))
     if error.size < MIN_CALIBRATION:
         return None, (f"no band: {error.size} held-out samples, fewer than "
