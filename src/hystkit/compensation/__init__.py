@@ -24,7 +24,7 @@ __getattr__, __dir__ = lazy_exports(
      "_estimator": ("CompensatorEstimator",),
      "_evaluate": ("evaluate", "use_flags"),
      "_fitting": ("fit_compensator",),
-     "_folds": ("EXTRAPOLATION_NOTE", "ONE_RUN_CAVEAT", "PROTOCOLS", "Fold", "admissible_size",
+     "_folds": ("EXTRAPOLATION_NOTE", "ONE_RUN_CAVEAT", "Candidate", "PROTOCOLS", "Fold", "admissible_size",
                 "fit_fold", "fits_in", "fold_scores", "folds", "protocol"),
      "_model_file": ("MODEL_SUFFIXES", "compensator_from_dict", "compensator_to_dict",
                      "load_compensator", "save_compensator"),

@@ -222,15 +222,20 @@ def band_features(s: np.ndarray, dt: float, tau: float, training_range: tuple[fl
 
 def local_scale(band: Band, rate: np.ndarray) -> np.ndarray:
     """The scale ``sigma`` of the module docstring, per sample (1 at the reference rate)."""
-    share = band.rate_share
-    return (1.0 - share + share * rate / band.rate_reference
-            + np.maximum(rate / band.rate_high - 1.0, 0.0))
+    return rate_scale(rate, band.rate_share, band.rate_reference, band.rate_high)
 
 
-def half_width(band: Band, rate: np.ndarray, outside: np.ndarray, position_width: float,
-               level: float | None = None) -> np.ndarray:
-    """The band's half-width [position units] per sample."""
-    return band.quantile(level) * local_scale(band, rate) + position_width * outside
+def rate_scale(rate: np.ndarray, share: float, reference: float, high: float) -> np.ndarray:
+    """``sigma`` from its three numbers (:func:`local_scale`; the calibration needs it before
+    the band exists)."""
+    return 1.0 - share + share * rate / reference + np.maximum(rate / high - 1.0, 0.0)
+
+
+def half_width(band: Band, quantile: float, rate: np.ndarray, outside: np.ndarray,
+               position_width: float) -> np.ndarray:
+    """The band's half-width [position units] per sample, ``quantile`` being
+    ``band.quantile(level)`` (a stream computes it once)."""
+    return quantile * local_scale(band, rate) + position_width * outside
 
 
 def position_width(comp) -> float:
@@ -265,7 +270,7 @@ def interval(comp, recording: Recording, estimate: np.ndarray,
                          f"without one, or by a hystkit before bands); fit it again")
     s = comp.normalised_sensor(recording.sensor)
     rate, outside, _ = band_features(s, comp.structure.dt, band.tau, comp.training_range)
-    h = half_width(band, rate, outside, position_width(comp), level)
+    h = half_width(band, band.quantile(level), rate, outside, position_width(comp))
     return estimate - h, estimate + h
 
 

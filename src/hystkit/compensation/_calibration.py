@@ -8,7 +8,7 @@ normalised by the band's local scale, give the conformal quantiles the model fil
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
@@ -24,10 +24,10 @@ from ._band import (
     Band,
     band_features,
     check_level,
-    local_scale,
     position_width,
+    rate_scale,
 )
-from ._folds import fit_fold, folds, protocol
+from ._folds import Candidate, fit_fold, folds, protocol
 
 __all__ = ["calibrate_band", "with_band"]
 
@@ -106,7 +106,7 @@ def calibrate_band(comp, recordings: Sequence[Recording], size: int,
     failed = []
     for fold in folds(recordings):
         try:
-            fold_comp = fit_fold(_Same(comp.model, size, comp.mode, comp.center), fold, options)
+            fold_comp = fit_fold(Candidate(comp.model, size, comp.mode, comp.center), fold, options)
             estimate = fold_comp.estimate(fold.scored, rest_position=_rest(fold_comp, fold))
         except (FitDivergedError, InputError, ValueError, np.linalg.LinAlgError) as exc:
             failed.append(f"{fold.label}: {exc}")
@@ -124,13 +124,12 @@ def calibrate_band(comp, recordings: Sequence[Recording], size: int,
     if error.size < MIN_CALIBRATION:
         return None, (f"no band: {error.size} held-out samples, fewer than "
                       f"{MIN_CALIBRATION}")
-    share = _rate_share(np.maximum(error - extra, 0.0), rate / rate_reference)
-    trial = Band(level, tuple(np.zeros(QUANTILE_GRID.size)), error.size, tau, rate_reference,
-                 rate_high, share, protocol(recordings))
-    scores = np.maximum(error - extra, 0.0) / local_scale(trial, rate)
+    beyond = np.maximum(error - extra, 0.0)
+    share = _rate_share(beyond, rate / rate_reference)
+    scores = beyond / rate_scale(rate, share, rate_reference, rate_high)
     band = Band(level, tuple(np.quantile(scores, QUANTILE_GRID)), error.size, tau,
-                rate_reference, rate_high, share, trial.protocol)
-    note = f"band: {trial.protocol}, {error.size} held-out samples"
+                rate_reference, rate_high, share, protocol(recordings))
+    note = f"band: {band.protocol}, {error.size} held-out samples"
     if len(recordings) == 1:
         note += ("; one recording: it holds for runs like this one, not for an offset, gain or "
                  "excitation that changes between runs (give several recordings)")
@@ -165,13 +164,3 @@ def _rest(comp, fold) -> float | None:
         return None
     n_tare = max(1, round(comp.tare_seconds / fold.scored.dt))
     return float(np.mean(fold.scored.position[:n_tare]))
-
-
-@dataclass(frozen=True)
-class _Same:
-    """The model configuration a fold refits (what :func:`._folds.fit_fold` needs)."""
-
-    model: str
-    size: int
-    mode: str
-    center: str

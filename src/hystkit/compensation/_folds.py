@@ -22,8 +22,20 @@ from ..models import get_family
 from ._fitting import fit_compensator
 from ._training_checks import MIN_SAMPLES_PER_PARAM, count_fitted
 
-__all__ = ["EXTRAPOLATION_NOTE", "N_FOLDS", "ONE_RUN_CAVEAT", "PROTOCOLS", "Fold",
-           "admissible_size", "fit_fold", "fits_in", "fold_scores", "folds", "protocol"]
+__all__ = [
+    "EXTRAPOLATION_NOTE",
+    "N_FOLDS",
+    "ONE_RUN_CAVEAT",
+    "PROTOCOLS",
+    "Candidate",
+    "Fold",
+    "admissible_size",
+    "fit_fold",
+    "fits_in",
+    "fold_scores",
+    "folds",
+    "protocol",
+]
 
 N_FOLDS = 3
 # Pieces of one recording: N_FOLDS interleaved sets of N_SEGMENTS / N_FOLDS each.
@@ -81,6 +93,32 @@ class Fold:
             lo, hi = (float(f(self.scored.position[~self.held])) for f in (np.min, np.max))
             p = self.scored.position[self.held]
         return float(np.mean((p < lo) | (p > hi)))
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One model configuration: what ``select`` validates and a fold refits.
+
+    Parameters
+    ----------
+    model : str
+        Registered family name.
+    size : int
+        The family's size (mPL: cells N).
+    mode : {"direct", "inverse"}
+        Compensator mode.
+    center : {"fit", "tare", "track", "recording", "none"}
+        Centring (:func:`hystkit.compensation.fit_compensator`).
+    """
+
+    model: str
+    size: int
+    mode: str
+    center: str
+
+    @property
+    def label(self) -> str:
+        return f"{self.model}:{self.size}:{self.mode}:{self.center}"
 
 
 def protocol(recordings: Sequence[Recording]) -> str:
@@ -177,14 +215,13 @@ def admissible_size(model: str, dt: float, n_samples: int) -> int | None:
                  if fits_in(model, size, dt, n_samples)), None)
 
 
-def fit_fold(cand, fold: Fold, options: dict):
+def fit_fold(cand: Candidate, fold: Fold, options: dict):
     """A model configuration fitted on a fold's training part (no standard errors).
 
     Parameters
     ----------
-    cand : object
-        Anything with ``model``, ``size``, ``mode`` and ``center`` (select's candidates, the
-        band's refits).
+    cand : Candidate
+        The configuration (select's candidates, the band's refits).
     fold : Fold
         The fold; its held-out samples get weight zero (one recording) or are another
         recording.

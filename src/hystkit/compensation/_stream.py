@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import FitDivergedError, InputError
 from ..io import MAX_MAGNITUDE
-from ._band import BandState, band_features, local_scale, position_width
+from ._band import BandState, band_features, half_width, position_width
 from ._centring import ORACLE_CENTER
 from ._compensator import (
     MAX_NORMALISED,
@@ -318,8 +318,7 @@ def _half_width(path: _Path, s: np.ndarray,
         return None, state
     rate, outside, nxt = band_features(s, comp.structure.dt, comp.band.tau, comp.training_range,
                                        state)
-    return (path.band_quantile * local_scale(comp.band, rate)
-            + position_width(comp) * outside), nxt
+    return half_width(comp.band, path.band_quantile, rate, outside, position_width(comp)), nxt
 
 
 def _run_model(comp: Compensator, s: np.ndarray,

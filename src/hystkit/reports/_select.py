@@ -11,7 +11,6 @@ all the data passes the fit's guards.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -21,6 +20,7 @@ from ..compensation import (
     DEFAULT_CENTER,
     EXTRAPOLATION_NOTE,
     ONE_RUN_CAVEAT,
+    Candidate,
     Fold,
     admissible_size,
     check_fitting_data,
@@ -41,32 +41,6 @@ from ._compare import DISQUALIFYING, FAMILY_FAILURES
 __all__ = ["Candidate", "candidates", "plot_selection", "select_model"]
 
 MAX_REFITS = 5
-
-
-@dataclass(frozen=True)
-class Candidate:
-    """One model configuration that :func:`select_model` validates.
-
-    Parameters
-    ----------
-    model : str
-        Registered family name.
-    size : int
-        The family's size (mPL: cells N).
-    mode : {"direct", "inverse"}
-        Compensator mode.
-    center : {"fit", "tare", "track", "recording", "none"}
-        Centring (:func:`hystkit.compensation.fit_compensator`).
-    """
-
-    model: str
-    size: int
-    mode: str
-    center: str
-
-    @property
-    def label(self) -> str:
-        return f"{self.model}:{self.size}:{self.mode}:{self.center}"
 
 
 def candidates(models: Sequence[str] | None = None, centers: Sequence[str] = (DEFAULT_CENTER,),
