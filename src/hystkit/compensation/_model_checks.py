@@ -105,12 +105,7 @@ def check_model_dict(d: dict, source: str) -> None:
     if band is not None:
         if not isinstance(band, dict):
             _fail(source, "band", f"must be null or a JSON object, got {_show(band)}")
-        for path, value in _leaves(band, "band"):
-            if path == "band.protocol":
-                if not isinstance(value, str):
-                    _fail(source, path, f"must be a string, got {_show(value)}")
-            else:
-                _check_number(source, path, value)
+        _check_band_types(band, source)
     check_reading(d.get("reading"), source)
 
 
@@ -232,6 +227,23 @@ def check_model_domain(d: dict, source: str) -> None:
             _within(source, name, d[name], _TINY, high,
                     f"s (positive, at most {MAX_WINDOW_SAMPLES:g} samples of dt)")
     _check_band_domain(d.get("band"), step, source)
+
+
+def _check_band_types(band: dict, source: str) -> None:
+    """The band's JSON types: ``quantiles`` a list of numbers, ``protocol`` a string, every
+    other key a number (its domain is checked by :func:`_check_band_domain`)."""
+    for key, value in band.items():
+        path = f"band.{key}"
+        if key == "protocol":
+            if not isinstance(value, str):
+                _fail(source, path, f"must be a string, got {_show(value)}")
+        elif key == "quantiles":
+            if not isinstance(value, list):
+                _fail(source, path, f"must be a list of numbers, got {_show(value)}")
+            for i, item in enumerate(value):
+                _check_number(source, f"{path}[{i}]", item)
+        else:
+            _check_number(source, path, value)
 
 
 def _check_band_domain(band: dict | None, step: float | None, source: str) -> None:
