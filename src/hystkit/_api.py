@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
 
+from .batch._reading import remember_reading, training_units
 from .compensation import (
     DEFAULT_CENTER,
     DEFAULT_LEVEL,
@@ -144,7 +145,16 @@ def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None
     Compensator
         ``fit_info["status"]`` is ``"ok"`` only when the fit converged, beats a straight line
         and has no parameter on a bound; ``estimate(recording)`` gives the position [mm],
-        ``estimate_with_band(recording)`` the position with its band.
+        ``estimate_with_band(recording)`` the position with its band. Fitted on file paths
+        read alike (one column mapping and time unit), its ``reading`` remembers how, as
+        ``hystkit fit``'s model file does, so ``hystkit evaluate``, ``compensate``,
+        ``report`` and ``stream --in`` read files of that layout without options; files read
+        differently: None, and a note on stderr says so.
+
+    Raises
+    ------
+    InputError
+        A file that cannot be read, or recordings whose position or sensor units differ.
 
     Examples
     --------
@@ -156,13 +166,22 @@ def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None
     ('ok', True)
     """
     items = list(data) if isinstance(data, list | tuple) else [data]
-    recordings = [rec for item in items for rec in _as_recordings(item)]
+    files = all(isinstance(item, str | os.PathLike) for item in items)
+    reading = [_reading(item) if isinstance(item, str | os.PathLike) else None
+               for item in items]
+    recordings = [rec for item, how in zip(items, reading) for rec in _as_recordings(item, how)]
+    units = training_units(recordings)  # recordings in different units are refused first
     comp = fit_compensator(recordings, size, model=model, mode=mode, center=center, **options)
-    if not band:
-        return comp
-    options.pop("diagnose", None)
-    return with_band(comp, recordings, get_family(model).default_size if size is None else size,
-                     options, level=level)
+    if band:
+        options.pop("diagnose", None)
+        comp = with_band(comp, recordings,
+                         get_family(model).default_size if size is None else size, options,
+                         level=level)
+    # the model file remembers how its files were read, as ``hystkit fit``'s does
+    comp, note = remember_reading(comp, units, reading if files else None, items)
+    if note:
+        print(f"hystkit: note: {note}", file=sys.stderr)
+    return comp
 
 
 def evaluate(compensator: Compensator, data: Data, *,
@@ -356,11 +375,12 @@ def save(compensator: Compensator, path: str | os.PathLike, *, force: bool = Fal
     return save_compensator(compensator, path, force=force)
 
 
-def _as_recordings(data: Data) -> list[Recording]:
+def _as_recordings(data: Data, options: ReadOptions | None = None) -> list[Recording]:
     """`data` as recordings to fit jointly: a file whose settings say ``gaps = "split"`` as
-    its pieces between time gaps (`hystkit.io.read_pieces`), anything else as one."""
+    its pieces between time gaps (`hystkit.io.read_pieces`), anything else as one. A file is
+    read with `options` (default: `_reading`'s)."""
     if isinstance(data, str | os.PathLike):
-        options = _reading(data)
+        options = _reading(data) if options is None else options
         if options.gaps == "split":
             return read_pieces(data, need_position=False, options=options)
         return [read_recording(data, need_position=False, options=options)]

@@ -42,6 +42,7 @@ from ..io import (
 from ..models import get_family
 from ..parallel import Executor, SerialExecutor
 from ._manifest import SensorJob
+from ._reading import remember_reading, training_units
 
 __all__ = ["RESULT_COLUMNS", "fit_sensor", "pending", "run_batch"]
 
@@ -86,11 +87,15 @@ def fit_sensor(job: SensorJob, *, read_options: Reading = None) -> dict:
                center=DEFAULT_CENTER if job.center is None else job.center)
     try:
         fit_recs, val_recs = _recordings(job, read_options)
+        units = training_units(fit_recs)  # recordings in different units fail the sensor
         options = {} if job.center is None else {"center": job.center}
         comp = fit_compensator(fit_recs, job.size, model=job.model, mode=job.mode, **options)
         if comp.fit_info["status"] == "ok":  # a band for a model that may be used
             options.pop("center", None)
             comp = with_band(comp, fit_recs, row["size"], options)
+        # the model file remembers how the fit files were read, as ``hystkit fit``'s does
+        comp, _ = remember_reading(comp, units, [_options(p, read_options) for p in job.fit],
+                                   job.fit)
         scores = [evaluate(comp, rec) for rec in val_recs]
     except Exception as exc:  # noqa: BLE001  (one sensor never stops the batch)
         _raise_interrupt(exc)
@@ -176,7 +181,7 @@ def _part(rec: Recording, half: int, label: str) -> Recording:
     cut = slice(0, mid) if half == 0 else slice(mid, rec.n_samples)
     time_ = rec.time[cut] - rec.time[cut][0]
     return Recording(time=time_, sensor=rec.sensor[cut], position=rec.position[cut],
-                     source=f"{rec.source} ({label})")
+                     source=f"{rec.source} ({label})", units=rec.units)
 
 
 def fingerprint(job: SensorJob) -> list:
