@@ -8,6 +8,7 @@ import argparse
 import math
 
 from ..control import SLOW_GROWTH_S, TYPICAL_RUN_S
+from ..control._analysis import slow_cell_words
 from ._common import UsageError
 
 __all__ = ["closed_loop", "fmt", "noise_study", "print_table", "resolve_tune_options", "tune"]
@@ -41,6 +42,11 @@ def closed_loop(margins) -> str:
         return ("marginally stable (a pole on the unit circle, to within the rounding of its "
                 "eigenvalue: a state the linearised loop neither corrects nor amplifies, e.g. a "
                 "sticking element at rest or a double integrator)")
+    if getattr(margins, "slow_cell", None) is not None:
+        # slower than the slowest cell: a marginal mode, not a blow-up (the cause stays in
+        # metrics.json's "linear")
+        return slow_cell_words(margins.max_pole_radius, margins.growth_time_s,
+                               margins.slow_cell, margins.slow_cell_s, TYPICAL_RUN_S)
     cause = f"; {margins.cause}" if margins.cause else ""
     if margins.growth_time_s >= SLOW_GROWTH_S:
         # a real but glacial instability (a slow cell's zero beyond z = 1): say what it means

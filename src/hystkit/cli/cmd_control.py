@@ -204,9 +204,8 @@ def _control(args: argparse.Namespace) -> int:
     print(f"PID Kp = {p.kp:.4g}, Ti = {p.ti:.4g} s, Td = {p.td:.4g} s, Tf = {p.tf:.3g} s; "
           f"linearised at rest: crossover {report.fmt(margins.crossover_hz)} Hz, phase margin "
           f"{report.fmt(margins.phase_margin_deg)} deg, gain margin "
-          f"{report.fmt(margins.gain_margin_db, 'inf')} dB,"
-          f" closed loop "
-          + report.closed_loop(margins))
+          f"{report.fmt(margins.gain_margin_db, 'inf')} dB")
+    print(f"  closed loop {report.closed_loop(margins)}")  # the verdict on a line of its own
     config = {
         "hystkit_version": __version__, "scheme": args.scheme, "sensor": args.sensor, "experiment": args.experiment,
         "ts": loop.ts, "mass": loop.plant.mass, "u_max": loop.plant.u_max

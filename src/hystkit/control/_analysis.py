@@ -29,7 +29,7 @@ from ._blocks import (
 from ._loop import ControlLoop, LoopState, rest_state
 
 __all__ = ["LoopMargins", "bode_data", "classify_poles", "design_dob", "loop_margins", "open_loop",
-           "static_sign_flips", "tune_pid"]
+           "slow_cell_words", "slowest_cell", "static_sign_flips", "tune_pid"]
 
 
 def _ss(a, b, c, d, ts, inputs, outputs, name) -> control.StateSpace:
@@ -193,6 +193,14 @@ class LoopMargins:
         None when no pole lies outside the unit circle (beyond its rounding).
     cause : str or None
         For an unstable loop, a known cause in words (:func:`static_sign_flips`), else None.
+    slow_cell : str or None
+        For a loop whose growth is no faster than the slowest cell of its sensor and
+        compensator blocks decays (``growth_time_s`` at least that cell's time constant: the
+        pole lies outside the unit circle by no more than the cell's pole lies inside it), the
+        block with that cell; the growing mode is a marginal one from a slow cell, see
+        :func:`slow_cell_words`. None otherwise.
+    slow_cell_s : float or None
+        That cell's time constant [s]; None with `slow_cell`.
     marginal : bool
         No pole outside the unit circle and at least one on it (within the rounding of its
         eigenvalue, see :func:`classify_poles`): a state the linearised loop neither corrects
@@ -209,6 +217,8 @@ class LoopMargins:
     growth_time_s: float | None = None
     marginal: bool = False
     cause: str | None = None
+    slow_cell: str | None = None
+    slow_cell_s: float | None = None
 
     def to_dict(self) -> dict:
         """The fields as a dict (JSON-safe: floats, bools and None)."""
@@ -217,6 +227,69 @@ class LoopMargins:
 
 MARGINAL = 1e-12
 """Least tolerance on a pole radius for counting it on the unit circle."""
+
+
+def slowest_cell(loop: ControlLoop, state: LoopState | None = None) -> tuple[str, float] | None:
+    """``(block, time constant [s])`` of the slowest decaying cell of the loop's sensor and
+    compensator blocks (their linearisation's pole nearest to, and inside, the unit circle);
+    None when they have no state or none inside the circle."""
+    slowest = None
+    for sys in _blocks(loop, state):
+        if sys.name not in ("sensor", "compensator") or sys.nstates == 0:
+            continue
+        radii = np.abs(np.linalg.eigvals(sys.A))
+        inside = radii[(radii < 1.0) & (radii > 0.0)]
+        if inside.size:
+            tau = float(-loop.ts / np.log(inside.max()))
+            if slowest is None or tau > slowest[1]:
+                slowest = (sys.name, tau)
+    return slowest
+
+
+def slow_cell_words(max_pole_radius: float, growth_time_s: float, block: str,
+                    time_constant_s: float, run_s: float) -> str:
+    """A growing mode no faster than a slow cell, in one plain line (``hystkit control`` and
+    ``report``): marginal, from that cell, with its e-folding time and its growth over a run.
+
+    The mode is slower than every cell of the loop's models: what grows is one of the
+    integrators (plant, PID) at ``z = 1``, moved beyond the circle by less than the slow cell
+    sits inside it. A cell that slow is often at the fit's bound, where the data cannot tell
+    it from an integrator (e.g. mPL's 1e4 s floor, ``hystkit.models.mpl.fit``), and a
+    slightly faster one moves the pole inside: the sign of ``|pole| - 1`` at that level says
+    what the fitted numbers give, not what the sensor does.
+
+    Parameters
+    ----------
+    max_pole_radius : float
+        The growing pole's radius.
+    growth_time_s : float
+        Its e-folding time [s].
+    block : str
+        The block with the slow cell (``sensor``, ``compensator``).
+    time_constant_s : float
+        The cell's time constant [s].
+    run_s : float
+        The run length [s] over which the growth is quoted.
+
+    Returns
+    -------
+    str
+        ``marginal, from a slow cell: ...`` (no leading ``closed loop``).
+    """
+    factor = np.exp(run_s / growth_time_s)
+    return (f"marginal, from a slow cell: one mode (|pole| 1 + {max_pole_radius - 1:.2g}), "
+            f"slower than the slowest cell of the {block} (time constant {time_constant_s:.3g} s), "
+            f"drifts e-fold in {_duration(growth_time_s)}, a factor {factor:.4f} over a "
+            f"{run_s / 60:g}-minute run: bounded over runs much shorter than that, not "
+            f"asymptotically stable")
+
+
+def _duration(seconds: float) -> str:
+    """``8.1e+05 s (9.38 days)``: seconds, and in hours or days when that long."""
+    for unit, size in (("days", 86400.0), ("hours", 3600.0)):
+        if seconds >= 2 * size:
+            return f"{seconds:.3g} s ({seconds / size:.3g} {unit})"
+    return f"{seconds:.3g} s"
 
 
 def classify_poles(a: np.ndarray) -> tuple[float, bool, bool, float]:
@@ -338,12 +411,17 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
         f_c = brentq(lambda x: np.log(abs(h(x))), f[i], f[i + 1], xtol=1e-12 * f[i])
         pm = float(np.degrees(np.angle(-h(f_c))))
     gm, f_pc = _gain_margin(h, f, resp, unstable=growth_time is not None)
+    slow = slowest_cell(loop, state) if growth_time is not None else None
+    if slow is not None and growth_time < slow[1]:
+        slow = None  # faster than every cell: not the slow cell's, a real instability
     return LoopMargins(crossover_hz=f_c, phase_margin_deg=pm, gain_margin_db=gm,
                        phase_crossover_hz=f_pc, closed_loop_stable=stable,
                        max_pole_radius=radius,
                        growth_time_s=growth_time, marginal=marginal,
                        cause=("; ".join(static_sign_flips(loop, state, growth_time)) or None)
-                       if growth_time is not None else None)
+                       if growth_time is not None else None,
+                       slow_cell=None if slow is None else slow[0],
+                       slow_cell_s=None if slow is None else slow[1])
 
 
 def bode_data(loop: ControlLoop, state: LoopState | None = None,

@@ -10,6 +10,7 @@ import math
 from pathlib import Path
 
 from ..control import SLOW_GROWTH_S, TYPICAL_RUN_S
+from ..control._analysis import slow_cell_words
 from ..errors import InputError
 from ._html import Section, definition_list, note, table
 from ._report_folders import read_json
@@ -38,6 +39,10 @@ def stability_verdict(linear: dict) -> tuple[str, str]:
     if linear.get("marginal"):
         return (_MARGINAL, "note")
     growth = linear.get("growth_time_s")
+    if growth is not None and linear.get("slow_cell") is not None:  # as `hystkit control`
+        words = slow_cell_words(linear["max_pole_radius"], growth, linear["slow_cell"],
+                                linear["slow_cell_s"], TYPICAL_RUN_S)
+        return f"closed loop {words} (linearised at rest)", "note"
     if growth is not None and growth >= SLOW_GROWTH_S:  # as `hystkit control` words it
         return (f"closed loop unstable only over days (linearised at rest): max |pole| "
                 f"{linear.get('max_pole_radius', float('nan')):.10f}, grows e-fold in "
