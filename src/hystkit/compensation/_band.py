@@ -165,6 +165,17 @@ class BandState:
     outside: float = 0.0
 
 
+@njit(cache=True, inline="always")
+def feature_step(v, started, previous, r, o, dt, decay, low, high, width):  # pragma: no cover
+    """One sample of :func:`band_features`: the rate and range memory after normalised sensor
+    sample `v` (the compiled stream runs the same arithmetic, `._stream_kernel`)."""
+    d = abs(v - previous) / dt if started > 0.0 else 0.0
+    r = decay * r + (1.0 - decay) * d
+    beyond = max(low - v, v - high, 0.0) / width
+    o = max(beyond, decay * o)
+    return r, o
+
+
 @njit(cache=True)
 def _features_kernel(s, dt, decay, low, high, state):  # pragma: no cover - compiled
     n = s.size
@@ -174,10 +185,7 @@ def _features_kernel(s, dt, decay, low, high, state):  # pragma: no cover - comp
     width = high - low
     for k in range(n):
         v = s[k]
-        d = abs(v - previous) / dt if started > 0.0 else 0.0
-        r = decay * r + (1.0 - decay) * d
-        beyond = max(low - v, v - high, 0.0) / width
-        o = max(beyond, decay * o)
+        r, o = feature_step(v, started, previous, r, o, dt, decay, low, high, width)
         rate[k] = r
         outside[k] = o
         previous = v
@@ -212,12 +220,23 @@ def band_features(s: np.ndarray, dt: float, tau: float, training_range: tuple[fl
         Where this chunk leaves off: the next chunk continues from it exactly.
     """
     state = state or BandState()
-    low, high = training_range
-    high = high if high > low else low + 1.0  # a range of one value: distances in its units
+    low, high = feature_range(training_range)
     start = np.array([float(state.started), state.previous, state.rate, state.outside])
     rate, outside, end = _features_kernel(np.ascontiguousarray(s, dtype=np.float64), float(dt),
-                                          math.exp(-dt / tau), float(low), float(high), start)
+                                          feature_decay(dt, tau), low, high, start)
     return rate, outside, BandState(bool(end[0]), float(end[1]), float(end[2]), float(end[3]))
+
+
+def feature_range(training_range: tuple[float, float]) -> tuple[float, float]:
+    """The range the excursion is measured from: the training range, or for a range of one
+    value the unit range above it (distances in its units)."""
+    low, high = training_range
+    return float(low), float(high if high > low else low + 1.0)
+
+
+def feature_decay(dt: float, tau: float) -> float:
+    """The memory's factor per sample."""
+    return math.exp(-dt / tau)
 
 
 def local_scale(band: Band, rate: np.ndarray) -> np.ndarray:

@@ -12,6 +12,13 @@ family's compiled ``simulate`` / ``invert`` continued from the stored model stat
 the whole run for every family (the PI inverse to rounding: it rebuilds its inverse-play states
 from the forward state at each chunk start).
 
+That is the readable path (:func:`advance`). :class:`Stream` runs the same arithmetic compiled,
+one kernel call per sample or chunk with the state in arrays (:mod:`._stream_kernel`), when the
+family's compiled block reproduces the offline run bit for bit, which each stream checks on a
+probe signal when it is made; otherwise (a family whose output is summed by numpy after its
+kernel, the PI inverse), for the first sample of a stream at rest and for a refused sample, it
+takes the readable path.
+
 Start-up (``start``):
 
 - ``"rest"``: the model at rest at the first sample (what ``estimate`` does);
@@ -46,6 +53,8 @@ __all__ = ["StartUp", "StepOutput", "Stream", "StreamOutput", "StreamState", "ad
            "initial_state"]
 
 StartUp = str | np.ndarray
+# Samples of the signal on which a stream checks its compiled kernel against the Python path.
+PROBE_SAMPLES = 256
 
 
 @dataclass(frozen=True, eq=False)
@@ -468,6 +477,100 @@ def _advance_one(path: _Path, state: StreamState, v: float, label: str,
             _Previous(nxt, state.x, s))
 
 
+def compiled_engine(path: _Path):
+    """The compiled kernel's engine for `path` (:mod:`._stream_kernel`), or None when the
+    family has no compiled block or its block does not give the Python path's bits on a probe
+    signal (then every sample takes the Python path)."""
+    from ._stream_kernel import Engine
+
+    try:
+        engine = Engine(path)
+    except NotImplementedError:  # a family without a block
+        return None
+    probe = _probe(path.comp)
+    start = StreamState(None)
+    try:
+        with np.errstate(all="ignore"):
+            want, want_state = _advance(path, start, probe, "probe")
+            first, state = _advance(path, start, probe[:1], "probe")
+    except (FitDivergedError, ValueError):  # the probe ran away: nothing to compare with
+        return None
+    engine.load(state)
+    rows, taken = engine.run(probe[1:])
+    if taken != probe.size - 1:
+        return None
+    got = _concatenate(path, [first, _chunk_output(path, rows)])
+    same = all(_same_bits(a, b) for a, b in zip(got, want, strict=True)) and \
+        _same_state(engine.state(), want_state)
+    return engine if same else None
+
+
+def _probe(comp: Compensator) -> np.ndarray:
+    """Raw sensor samples that drive the model through the training range and 30 % beyond
+    it (an inverse: through its forward model's outputs), growing and shrinking swings."""
+    n = np.arange(PROBE_SAMPLES)
+    swing = np.sin(2 * np.pi * n / 61.0) * (0.3 + np.abs(np.sin(2 * np.pi * n / 173.0)))
+    lo, hi = comp.training_range if comp.training_range is not None else (-1.0, 1.0)
+    s = 0.5 * (lo + hi) + 0.5 * (hi - lo) * swing  # up to 1.3 half-ranges from the middle
+    if comp.mode == "inverse":
+        try:
+            with np.errstate(all="ignore"):
+                s, _ = comp.family.simulate(comp.structure, comp.params, s / 1.3)
+        except (FitDivergedError, ValueError):
+            pass  # the forward run failed: probe the inverse with the swing itself
+    return comp.scaling.sensor_offset + s * comp.scaling.sensor_scale / comp.polarity
+
+
+def _same_bits(a, b) -> bool:
+    if a is None or b is None:
+        return a is b
+    return bool(np.array_equal(a, b))
+
+
+def _same_state(a: StreamState, b: StreamState) -> bool:
+    return (np.array_equal(a.x, b.x) and a.n_samples == b.n_samples
+            and (a.tare_sum, a.track_value, a.track_weight) == (b.tare_sum, b.track_value,
+                                                                b.track_weight)
+            and a.band == b.band)
+
+
+def _step_output(path: _Path, column: list[float]) -> StepOutput:
+    """A sample's StepOutput from its column of the kernel's ``out``."""
+    estimate, lower, upper, sensor_outside, estimate_outside = column
+    return StepOutput(estimate,
+                      None if path.sensor_bounds is None else sensor_outside != 0.0,
+                      None if path.estimate_bounds is None else estimate_outside != 0.0,
+                      *((None, None) if path.comp.band is None else (lower, upper)))
+
+
+def _chunk_output(path: _Path, rows: np.ndarray) -> StreamOutput:
+    """A chunk's StreamOutput from the kernel's ``out`` rows."""
+    estimate, lower, upper, sensor_outside, estimate_outside = rows
+    return StreamOutput(estimate.copy(),
+                        None if path.sensor_bounds is None else sensor_outside != 0.0,
+                        None if path.estimate_bounds is None else estimate_outside != 0.0,
+                        *((None, None) if path.comp.band is None else (lower.copy(),
+                                                                       upper.copy())))
+
+
+def _as_chunk(path: _Path, out: StepOutput) -> StreamOutput:
+    """One sample's StepOutput as a chunk of one."""
+    return StreamOutput(*(None if v is None else np.array([v]) for v in out))
+
+
+def _concatenate(path: _Path, parts: list[StreamOutput]) -> StreamOutput:
+    """Chunks' outputs joined (no chunk: an empty output)."""
+    if not parts:
+        empty = np.empty(0)
+        band = (None, None) if path.comp.band is None else (empty, empty)
+        flags = _flags(path, empty, empty)
+        return StreamOutput(empty, *flags, *band)
+    if len(parts) == 1:
+        return parts[0]
+    return StreamOutput(*(None if values[0] is None else np.concatenate(values)
+                          for values in zip(*parts, strict=True)))
+
+
 def _of(comp: Compensator) -> str:
     return "" if comp.source is None else f" of {comp.source}"
 
@@ -496,6 +599,12 @@ class Stream:
     The object holds only the present :class:`StreamState` (``state`` gives it, ``from_state``
     resumes from one); two signals need two streams. :func:`advance` is the same computation
     without an object.
+
+    Samples run through one compiled kernel (:mod:`._stream_kernel`) when the family's compiled
+    block gives the offline run's bits, which is checked on a probe signal when the stream is
+    made (``compiled`` says the outcome); otherwise, for the first sample of a stream at rest
+    and for a sample the kernel refuses, through the readable Python path. Both give the same
+    bits (tested).
     """
 
     def __init__(self, compensator: Compensator, start: StartUp = "rest", *,
@@ -504,6 +613,9 @@ class Stream:
         self._path = _Path(compensator, rest_position, level)
         self._state = initial_state(compensator, start)
         self._previous: _Previous | None = None  # speeds up step; never changes a result
+        self._engine = compiled_engine(self._path)
+        # Where the present state is: in _state, in the engine's arrays, or in both.
+        self._state_ok, self._engine_ok = True, False
         self.label = label
 
     @classmethod
@@ -516,7 +628,7 @@ class Stream:
             initial_state(compensator, state.x)  # checks its size
         elif state.n_samples:
             raise InputError(f"stream state: {state.n_samples} samples seen but no model state")
-        stream._state = state
+        stream._set_state(state)
         return stream
 
     @classmethod
@@ -530,9 +642,32 @@ class Stream:
         return self._path.comp
 
     @property
+    def compiled(self) -> bool:
+        """Whether samples run through the compiled kernel (see the class notes)."""
+        return self._engine is not None
+
+    @property
     def state(self) -> StreamState:
         """The present state (immutable; safe to keep and to resume from)."""
+        if not self._state_ok:
+            self._state, self._state_ok = self._engine.state(), True
         return self._state
+
+    def _set_state(self, state: StreamState) -> None:
+        self._state, self._state_ok, self._engine_ok = state, True, False
+
+    def _engine_ready(self) -> bool:
+        """Whether the next sample can run compiled: there is an engine and it holds the
+        present state (loaded now if needed; a stream at rest has no model state before its
+        first sample, which the Python path takes)."""
+        if self._engine is None:
+            return False
+        if not self._engine_ok:
+            if self._state.x is None:
+                return False
+            self._engine.load(self._state)
+            self._engine_ok = True
+        return True
 
     def step(self, sensor: float) -> float:
         """Estimate [mm] for one raw sensor sample (the same bits as :meth:`process`)."""
@@ -540,15 +675,67 @@ class Stream:
 
     def step_flagged(self, sensor: float) -> StepOutput:
         """Estimate and use-time flags for one raw sensor sample."""
-        out, self._state, self._previous = _advance_one(self._path, self._state, sensor,
-                                                        self.label, self._previous)
+        if self._engine_ready():
+            column = self._engine.step(sensor)
+            if column is not None:
+                self._state_ok = False
+                return _step_output(self._path, column)
+        return self.step_flagged_python(sensor)
+
+    def step_flagged_python(self, sensor: float) -> StepOutput:
+        """:meth:`step_flagged` through the readable Python path (the reference the compiled
+        kernel is checked against; a refused sample raises here)."""
+        out, state, self._previous = _advance_one(self._path, self.state, sensor, self.label,
+                                                  self._previous)
+        self._set_state(state)
         return out
+
+    def step_many(self, sensor: np.ndarray) -> StreamOutput:
+        """:meth:`step_flagged` on each sample of a chunk in turn (compiled: one call for the
+        chunk), up to the first sample whose estimate is refused as a runaway: the state is
+        then the one before it, and ``step_flagged`` on it raises FitDivergedError saying why.
+
+        Returns
+        -------
+        StreamOutput
+            The samples taken: fewer than `sensor` holds when one was refused.
+        """
+        s_raw = np.ascontiguousarray(sensor, dtype=np.float64).reshape(-1)
+        parts, k = [], 0
+        while k < s_raw.size:
+            if self._engine_ready():
+                out, n = self._engine.run(s_raw[k:])
+                if n:
+                    self._state_ok = False
+                    parts.append(_chunk_output(self._path, out[:, :n]))
+                k += n
+                if k == s_raw.size:
+                    break
+            try:  # the Python path: a stream's first sample, or one the kernel refused
+                parts.append(_as_chunk(self._path, self.step_flagged_python(s_raw[k])))
+            except FitDivergedError:
+                break
+            k += 1
+        return _concatenate(self._path, parts)
 
     def process(self, sensor: np.ndarray) -> np.ndarray:
         """Estimates [mm] for a chunk of raw sensor samples (compiled per chunk)."""
         return self.process_flagged(sensor).estimate
 
     def process_flagged(self, sensor: np.ndarray) -> StreamOutput:
-        """Estimates and use-time flags for a chunk; see :class:`StreamOutput`."""
-        out, self._state = _advance(self._path, self._state, sensor, self.label)
+        """Estimates and use-time flags for a chunk; see :class:`StreamOutput`. A chunk with
+        a refused sample raises FitDivergedError, the state left as it was."""
+        s_raw = np.ascontiguousarray(sensor, dtype=np.float64).reshape(-1)
+        before = self.state
+        if self._engine is not None and s_raw.size:
+            try:
+                out = self.step_many(s_raw)
+            except BaseException:
+                self._set_state(before)
+                raise
+            if out.estimate.size == s_raw.size:
+                return out
+            self._set_state(before)  # the Python path raises for the chunk, as offline
+        out, state = _advance(self._path, before, s_raw, self.label)
+        self._set_state(state)
         return out
