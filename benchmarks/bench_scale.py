@@ -175,7 +175,6 @@ log("phase", "interpreter", launch, T_SCRIPT)
 from hystkit.cli import _main
 if not any(os.environ.get(name) for name in _main._BLAS_THREAD_VARIABLES):
     os.environ["OPENBLAS_NUM_THREADS"] = "1"  # as the program's main() does, before numpy loads
-_main.hide_yaml_from_numba_config()  # as main() does, here before numba loads
 import hystkit.identification._least_squares as least_squares
 import hystkit.parallel as parallel
 import hystkit.parallel._executor as executors

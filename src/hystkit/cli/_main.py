@@ -11,7 +11,6 @@ failed commands leave no partial output: every writer publishes atomically.
 
 from __future__ import annotations
 
-import atexit
 import errno
 import gc
 import importlib
@@ -19,7 +18,6 @@ import os
 import pkgutil
 import signal
 import sys
-import threading
 import traceback
 from collections.abc import Sequence
 from typing import NoReturn
@@ -28,15 +26,15 @@ from .. import __version__
 from .._compilation import announce
 from ..errors import HystkitError, Terminated
 from ._common import INTERNAL_EXIT, Parser
-from ._numba_config import hide_yaml_from_numba_config
 from ._signals import forked_workers, received_signal, signals_as_exceptions
 
 __all__ = ["main", "program"]
 
-# The CLI process's garbage collector: full collections only after 100 (not 10) young ones.
-# Loading numba and its cached kernels builds ~500 000 long-lived objects, and with Python's
-# default every 25 % of that growth costs a full pass over all of them (2-3 passes, ~0.06 s of a
-# 1-cell `fit`); young garbage is collected as before (benchmarks/README.md, start-up).
+# The program's garbage collector, the one start-up setting kept (issue 28: measured 2026-11-28,
+# benchmarks/bench_startup.py): full collections only after 100 (not 10) young ones, and the
+# heap frozen before the interpreter's shutdown. Loading numba and its cached kernels builds
+# ~500 000 long-lived objects that Python's default walks again every 25 % of growth and at
+# shutdown; the two together cut 22 % of a 1-cell `fit`'s and 33 % of an `evaluate`'s wall time.
 _PROGRAM_GC_THRESHOLDS = (700, 10, 100)
 # Thread counts OpenBLAS reads when it loads (numpy's and scipy's copies each start their pool
 # then); the CLI process sets the first to 1 unless one of them is set. Every BLAS call of
@@ -101,10 +99,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     Run as the program (`argv` None) it tunes the process's garbage collector for a short
     life (`_PROGRAM_GC_THRESHOLDS`, and a frozen heap at the end, which the interpreter's
-    shutdown does not walk again) and has OpenBLAS start one thread unless the environment
-    says otherwise (`_BLAS_THREAD_VARIABLES`), and numba loads without PyYAML unless the working
-    directory has a numba config file (`hide_yaml_from_numba_config`), and a run that has to
-    compile numba kernels says so on stderr (`COMPILING_NOTICE`); stopped by a signal after
+    shutdown does not walk again), has OpenBLAS start one thread unless the environment says
+    otherwise (`_BLAS_THREAD_VARIABLES`), and a run that has to compile numba kernels says
+    so on stderr (`COMPILING_NOTICE`); stopped by a signal after
     forking workers, it ends the process itself: multiprocessing's exit handlers would otherwise
     wait forever to flush queues to the workers it stopped.
 
@@ -126,15 +123,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         gc.set_threshold(*_PROGRAM_GC_THRESHOLDS)
         if not any(os.environ.get(name) for name in _BLAS_THREAD_VARIABLES):
             os.environ["OPENBLAS_NUM_THREADS"] = "1"  # before numpy is imported
-        hide_yaml_from_numba_config()
         announce(COMPILING_NOTICE)
     code = _main(argv)
     if argv is None:
-        # Nothing but the interpreter's shutdown follows, whose garbage collections walk the
-        # whole heap again (~0.1 s after a fit): frozen objects are skipped. Exit handlers
-        # still run and objects are still released as usual; only those in reference cycles
-        # are left for the operating system to reclaim.
-        gc.freeze()
+        gc.freeze()  # the shutdown's collections skip the frozen heap
     if argv is None and code in (130, 143) and forked_workers():
         code = _flush_streams(code)
         os._exit(code)
@@ -158,22 +150,8 @@ def _flush_streams(code: int) -> int:
 
 def program() -> NoReturn:
     """The ``hystkit`` program (its console script and ``python -m hystkit``): `main` on
-    ``sys.argv``, then the end of the process.
-
-    The process ends with its exit handlers run but without the interpreter's teardown, which
-    releases every module's objects one by one, numba's and LLVM's included: ~0.03 s of a
-    1-cell ``fit``, for memory the operating system reclaims anyway (benchmarks/README.md,
-    start-up). What a normal exit guarantees is done first: the ``atexit`` handlers run
-    (logging, ``weakref.finalize``, multiprocessing, Dask) and the standard streams are
-    flushed. While a non-daemon thread still runs, the exit is the normal one, which waits for
-    it. Every file hystkit writes is closed before its command returns (the atomic writers), so
-    no buffered output is lost.
-    """
-    code = main()
-    if all(t.daemon for t in threading.enumerate() if t is not threading.main_thread()):
-        atexit._run_exitfuncs()  # CPython's own exit step, here without the teardown after it
-        os._exit(_flush_streams(code))
-    sys.exit(code)
+    ``sys.argv``, then the end of the process with its exit code."""
+    sys.exit(main())
 
 
 def _main(argv: Sequence[str] | None) -> int:

@@ -19,7 +19,7 @@ import numpy as np
 
 from hystkit.errors import NonFiniteError
 
-from ._writing import atomic_output, check_output_format
+from ._atomic import atomic_output, check_output_format
 
 __all__ = ["matlab_name", "to_matlab", "write_mat"]
 

@@ -3,8 +3,8 @@
 A logger that stops for a few seconds (a buffer flush, a paused test) leaves a time step far
 above the others. hystkit's models step at a fixed Δt, so such a file is refused by default,
 naming the gap's row; ``--resample`` does not bridge it either (it would invent samples).
-`read_pieces` cuts the recording at every step longer than `GAP_STEPS` median steps (as
-`hystkit.io._resample` calls a gap) into pieces, each a `Recording` checked as any other
+`read_pieces` cuts the recording at every gap (`hystkit.io._resample.time_gaps`: a step longer
+than `MAX_GAP_STEPS` median steps) into pieces, each a `Recording` checked as any other
 (uniform, resampled if asked), which ``fit`` fits jointly as it fits several files: each
 piece starts from its own rest state, so no model runs across a gap.
 """
@@ -19,32 +19,12 @@ import numpy as np
 
 from hystkit._read_options import ReadOptions
 
-from ._resample import MAX_GAP_STEPS, resample_arrays
+from ._recording import _adopt, _validate, read_unvalidated, say
+from ._resample import resample_arrays, time_gaps
 
-__all__ = ["GAP_STEPS", "read_pieces", "time_gaps"]
+__all__ = ["read_pieces"]
 
-GAP_STEPS = MAX_GAP_STEPS
-"""A step longer than this many median steps is a gap."""
 _LISTED = 3  # gaps described in the notice
-
-
-def time_gaps(time: np.ndarray) -> np.ndarray:
-    """Where a time column has gaps: steps longer than `GAP_STEPS` median steps.
-
-    Parameters
-    ----------
-    time : ndarray, shape (n,)
-        Sample times [s], increasing.
-
-    Returns
-    -------
-    ndarray of int
-        Indices i with ``time[i + 1] - time[i]`` a gap; empty for none.
-    """
-    step = np.diff(time)
-    if step.size == 0:
-        return np.zeros(0, dtype=np.intp)
-    return np.flatnonzero(step > GAP_STEPS * float(np.median(step)))
 
 
 def read_pieces(path: str | os.PathLike[str], *, need_position: bool = True,
@@ -83,7 +63,6 @@ def read_pieces(path: str | os.PathLike[str], *, need_position: bool = True,
     >>> [piece.n_samples for piece in read_pieces("gap.csv")]
     [100, 100]
     """
-    from ._recording import _adopt, _validate, read_unvalidated, say
 
     options = ReadOptions() if options is None else options
     arrays, where, units = read_unvalidated(Path(path), need_position, options)

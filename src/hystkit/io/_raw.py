@@ -32,9 +32,9 @@ from numba import njit
 
 from hystkit.errors import InputError
 
+from ._atomic import atomic_output, check_output_path
 from ._mat_reader import load_mat
 from ._recording import _Where
-from ._writing import atomic_output, check_output_path
 
 __all__ = ["RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter", "open_raw"]
 

@@ -17,9 +17,9 @@ import numpy as np
 
 from hystkit.errors import InputError
 
+from ._atomic import atomic_output
 from ._raw import MAX_SKIP_ROWS
 from ._toml import load_toml
-from ._writing import atomic_output
 
 __all__ = ["CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_config"]
 

@@ -25,7 +25,7 @@ from ._cells import as_vector
 from ._csv_reader import read_csv
 from ._mat_reader import read_mat
 from ._missing import fill_missing
-from ._resample import resample_arrays
+from ._resample import MAX_GAP_STEPS, resample_arrays, time_gaps
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -244,7 +244,6 @@ def read_recording(path: str | os.PathLike[str], *, need_position: bool = True,
 def _refuse_pieces(time: np.ndarray, where: _Where) -> None:
     """``gaps = "split"`` where one recording is read: a file with gaps is refused (its
     pieces are for commands that fit several recordings jointly, `read_pieces`)."""
-    from ._pieces import time_gaps
 
     gaps = time_gaps(time)
     if gaps.size:
@@ -429,10 +428,9 @@ def _validate(arrays: dict[str, np.ndarray], where: _Where, *, uniform: bool = T
     bad = np.flatnonzero(np.abs(step - median) > _MAX_STEP_DEVIATION * median)
     if bad.size:
         i = int(bad[0]) + 1
-        from ._pieces import GAP_STEPS
 
         fix = ("a time gap: split the recording there, or read the pieces between gaps "
-               "with --gaps split to fit them jointly" if step[i - 1] > GAP_STEPS * median else
+               "with --gaps split to fit them jointly" if step[i - 1] > MAX_GAP_STEPS * median else
                "resample it to a uniform time grid (--resample HZ)")
         raise where.fail(f"non-uniform sampling: step {step[i - 1]:.6g} s deviates more than "
                          f"{_MAX_STEP_DEVIATION:.0%} from the median step {median:.6g} s; "

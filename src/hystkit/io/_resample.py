@@ -23,7 +23,8 @@ import numpy as np
 
 from ._cells import Where
 
-__all__ = ["DECIMATION_BELOW", "FILTER_ORDER", "LOWPASS_FRACTION", "MAX_GAP_STEPS", "resample_arrays"]
+__all__ = ["DECIMATION_BELOW", "FILTER_ORDER", "LOWPASS_FRACTION", "MAX_GAP_STEPS", "resample_arrays",
+           "time_gaps"]
 
 MAX_GAP_STEPS = 3.0
 LOWPASS_FRACTION = 0.4  # of the new rate: 80 % of its Nyquist frequency
@@ -31,6 +32,25 @@ FILTER_ORDER = 8  # one way; forwards-backwards doubles the attenuation
 DECIMATION_BELOW = 0.95  # low-pass only when the new rate is below 95 % of the mean rate
 _MIN_FILTERED = 3 * (2 * (FILTER_ORDER // 2) + 1)  # sosfiltfilt's default padding
 _SAME_RATE = 1e-9  # relative rounding allowance: a grid point at the last sample is kept
+
+
+def time_gaps(time: np.ndarray) -> np.ndarray:
+    """Where a time column has gaps: steps longer than `MAX_GAP_STEPS` median steps.
+
+    Parameters
+    ----------
+    time : ndarray, shape (n,)
+        Sample times [s], increasing.
+
+    Returns
+    -------
+    ndarray of int
+        Indices i with ``time[i + 1] - time[i]`` a gap; empty for none.
+    """
+    step = np.diff(time)
+    if step.size == 0:
+        return np.zeros(0, dtype=np.intp)
+    return np.flatnonzero(step > MAX_GAP_STEPS * float(np.median(step)))
 
 
 def resample_arrays(arrays: dict[str, np.ndarray], rate_hz: float,
