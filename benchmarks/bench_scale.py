@@ -82,7 +82,7 @@ import json, time
 from hystkit.io import read_recording
 from hystkit.models import FAMILIES
 from hystkit.parallel import SerialExecutor
-from hystkit.parallel._warm import warm_kernels
+from hystkit.models._warm import warm_kernels
 from hystkit.reports import candidates, compare_models, generalization_matrix, select_model
 from hystkit.sensors import simulate_experiment
 from hystkit.signals import EXPERIMENTS
@@ -177,7 +177,7 @@ if not any(os.environ.get(name) for name in _main._BLAS_THREAD_VARIABLES):
     os.environ["OPENBLAS_NUM_THREADS"] = "1"  # as the program's main() does, before numpy loads
 import hystkit.identification._least_squares as least_squares
 import hystkit.parallel as parallel
-import hystkit.parallel._executor as executors
+import hystkit.parallel._contract as executors
 opened = parallel.open_executor
 
 @contextmanager

@@ -50,7 +50,7 @@ def parallel_executor(request, cluster_address):
 @pytest.fixture
 def current():
     """Makes an executor current for one test, as `open_executor` does while it is open."""
-    from hystkit.parallel._executor import _CURRENT
+    from hystkit.parallel._contract import _CURRENT
 
     tokens = []
     yield lambda executor: tokens.append(_CURRENT.set(executor))

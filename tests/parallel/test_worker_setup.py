@@ -1,4 +1,5 @@
-"""Worker start-up: kernels loaded once before the fork, not again in each forked worker."""
+"""Worker start-up: the command's set-up (the kernels loaded) once before the fork, not again in
+each forked worker."""
 
 from __future__ import annotations
 
@@ -6,8 +7,7 @@ import numpy as np
 import pytest
 
 import hystkit.parallel._dask as dask_executor
-from hystkit.models import FAMILIES
-from hystkit.parallel import _warm
+from hystkit.models import FAMILIES, _warm
 
 
 def test_the_warm_up_signal_fits_every_family():
@@ -28,11 +28,26 @@ def test_the_play_operator_follows_the_input_within_its_radius():
     assert np.all(np.abs(y - u) <= 0.2 + 1e-15)
 
 
-@pytest.mark.parametrize("warmed", [True, False])
-def test_dask_workers_warm_only_if_they_did_not_inherit_the_kernels(warmed, monkeypatch):
+@pytest.mark.parametrize("ran_here", [True, False])
+def test_dask_workers_run_the_setup_only_if_they_did_not_inherit_it(ran_here, monkeypatch):
     calls = []
-    monkeypatch.setattr(_warm, "_warmed", warmed)
-    monkeypatch.setattr(_warm, "warm_kernels", lambda: calls.append(1))
+
+    def setup():
+        calls.append(1)
+
+    monkeypatch.setattr(dask_executor, "_RUN_HERE", set())
     monkeypatch.setattr("threadpoolctl.threadpool_limits", lambda limits: None)
+    if ran_here:  # as in a worker forked from a process that ran it
+        dask_executor.run_setup(setup)
+        calls.clear()
+    dask_executor.WorkerSetup(setup).setup(worker=None)
+    assert calls == ([] if ran_here else [1])
+    dask_executor.WorkerSetup(setup).setup(worker=None)  # a second plugin start: not again
+    assert calls == ([] if ran_here else [1])
+
+
+def test_a_worker_without_a_setup_only_limits_blas(monkeypatch):
+    limits = []
+    monkeypatch.setattr("threadpoolctl.threadpool_limits", limits.append)
     dask_executor.WorkerSetup().setup(worker=None)
-    assert calls == ([] if warmed else [1])
+    assert limits == [1]

@@ -41,12 +41,13 @@ def add_parallel_options(p: argparse.ArgumentParser) -> None:
 
 def executor_for(args: argparse.Namespace, n_pieces: int):
     """The executor (context manager) of ``--workers`` / ``--scheduler`` for `n_pieces`."""
+    from ..models._warm import warm_kernels
     from ..parallel import open_executor
 
     if args.scheduler_timeout is not None and args.scheduler is None:
         raise UsageError("--scheduler-timeout applies to --scheduler only")
     return open_executor(args.workers, args.scheduler, n_pieces=n_pieces,
-                         connect_timeout=args.scheduler_timeout)
+                         connect_timeout=args.scheduler_timeout, worker_setup=warm_kernels)
 
 
 def say_where(executor, n_pieces: int) -> None:

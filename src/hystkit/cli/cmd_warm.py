@@ -69,7 +69,7 @@ def run_steps(steps: Sequence[WarmStep], progress: Callable[[str], None]) -> flo
     """Run `steps`, one line each to `progress` (seconds, note, estimate of the rest); the
     wall seconds of all."""
     from .._compilation import compiler_seconds, listen
-    from ..parallel._meanwhile import make_numba_ready
+    from ..parallel._contract import make_numba_ready
 
     listen()
     make_numba_ready()  # numba's one-off start (~0.2 s), not a kernel: outside the estimate

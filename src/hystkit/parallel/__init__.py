@@ -13,14 +13,9 @@ screens its starts on the workers (:func:`hystkit.identification.fit_multistart`
 imported only when a parallel run starts.
 """
 
+from ._contract import Executor, SerialExecutor, available_cores, current_executor
 from ._cost import fit_cost
-from ._executor import (
-    Executor,
-    SerialExecutor,
-    available_cores,
-    current_executor,
-    open_executor,
-)
+from ._executor import open_executor
 from ._meanwhile import loading_meanwhile
 
 __all__ = ["Executor", "SerialExecutor", "available_cores", "current_executor", "fit_cost",

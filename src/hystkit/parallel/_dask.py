@@ -3,10 +3,10 @@ cluster where the platform cannot fork (elsewhere `._forked` starts faster).
 
 Imported only when such a run starts. A local cluster's workers are forked where possible:
 they inherit the libraries this process has imported and the model kernels it loaded from
-numba's on-disk cache (``cache=True``, `warm_kernels`, once before the fork), so a worker is
-ready in a fraction of a second, where a spawned one re-imports numpy, scipy, numba and hystkit
-(2-3 s on a loaded 2-core machine). Spawned workers and those of a remote cluster load the
-kernels at start-up (`WorkerSetup`); forked ones skip that (measured: it cost each of two forked
+numba's on-disk cache (the command's ``worker_setup``, run once before the fork), so a worker
+is ready in a fraction of a second, where a spawned one re-imports numpy, scipy, numba and
+hystkit (2-3 s on a loaded 2-core machine). Spawned workers and those of a remote cluster run
+the set-up at their start (`WorkerSetup`); forked ones skip it (measured: it cost each of two forked
 workers 0.6-2.6 s of CPU at every start, for kernels they already had). Every worker limits its
 BLAS to one thread: a worker has one core, and idle OpenBLAS threads spin, taking CPU from the
 other workers (measured: ``select`` at 2 workers used 40 % more CPU than serially without it).
@@ -26,9 +26,8 @@ import dask
 from distributed import Client, LocalCluster, WorkerPlugin, as_completed
 
 from .. import __version__
-from . import _warm
+from ._contract import Cost, OnDone, can_fork
 from ._cost import cost_order
-from ._executor import Cost, OnDone, can_fork
 from ._reach import DEFAULT_CONNECT_TIMEOUT, SchedulerError, check_handshake
 
 __all__ = ["DaskExecutor", "SchedulerError", "WorkerSetup", "dask_executor"]
@@ -43,17 +42,33 @@ CLOSE_TIMEOUT = 3
 NO_DASHBOARD = {"dashboard_address": None, "scheduler_kwargs": {"dashboard_address": ":0"}}
 
 
+# The worker set-ups this process has run: a worker forked from it has them too.
+_RUN_HERE: set[str] = set()
+
+
+def run_setup(setup: Callable[[], None]) -> None:
+    """`setup` unless this process (or the one it was forked from) has run it."""
+    key = f"{setup.__module__}.{setup.__qualname__}"
+    if key not in _RUN_HERE:
+        setup()
+        _RUN_HERE.add(key)
+
+
 class WorkerSetup(WorkerPlugin):
-    """Worker start-up: BLAS on one thread, and the model kernels loaded (`warm_kernels`)."""
+    """Worker start-up: BLAS on one thread, and the command's `setup` (`open_executor`'s
+    ``worker_setup``) unless the worker was forked from a process that ran it."""
 
     name = "hystkit-worker-setup"
+
+    def __init__(self, setup: Callable[[], None] | None = None):
+        self.setup_once = setup
 
     def setup(self, worker: Any) -> None:
         from threadpoolctl import threadpool_limits
 
         threadpool_limits(1)  # kept for the worker's life (not used as a context manager)
-        if not _warm.warmed():  # forked from a process that loaded them: it has them too
-            _warm.warm_kernels()
+        if self.setup_once is not None:
+            run_setup(self.setup_once)
 
 
 def _worker_version() -> str:
@@ -113,15 +128,17 @@ def _fork_if_possible() -> str:
 
 @contextmanager
 def dask_executor(n_workers: int | None, scheduler: str | None,
-                  connect_timeout: float | None = None) -> Iterator[DaskExecutor]:
+                  connect_timeout: float | None = None,
+                  worker_setup: Callable[[], None] | None = None) -> Iterator[DaskExecutor]:
     """A local cluster of `n_workers` processes (one thread each), or a client of `scheduler`
     reached within `connect_timeout` seconds (default `CONNECT_TIMEOUT`); both closed on
-    leaving, also on Ctrl-C and SIGTERM."""
+    leaving, also on Ctrl-C and SIGTERM. Every worker runs `worker_setup` at its start (a
+    forked one inherits it from this process, which runs it once before the fork)."""
     with ExitStack() as stack:
         if scheduler is None:
             method = _fork_if_possible()
-            if method == "fork":
-                _warm.warm_kernels()
+            if method == "fork" and worker_setup is not None:
+                run_setup(worker_setup)
             # for the cluster's whole life: a worker the nanny restarts is forked too (a
             # spawned one would also leave semaphores for multiprocessing's tracker to warn of)
             stack.enter_context(dask.config.set({"distributed.worker.multiprocessing-method":
@@ -136,7 +153,7 @@ def dask_executor(n_workers: int | None, scheduler: str | None,
                               else connect_timeout)
             where = scheduler
         stack.callback(client.close, timeout=CLOSE_TIMEOUT)
-        _check_workers(client, where)
+        _check_workers(client, where, worker_setup)
         yield DaskExecutor(client, where)
 
 
@@ -151,7 +168,8 @@ def _connect(address: str, timeout: float) -> Client:
                              f"there ({type(exc).__name__}: {exc})") from None
 
 
-def _check_workers(client: Client, where: str) -> None:
+def _check_workers(client: Client, where: str,
+                   worker_setup: Callable[[], None] | None) -> None:
     """Same hystkit on every worker (a different version could give different numbers), then
     `WorkerSetup` on each and on every worker that joins later."""
     try:
@@ -165,4 +183,4 @@ def _check_workers(client: Client, where: str) -> None:
     if other:
         raise SchedulerError(f"the Dask workers ({where}) run hystkit {', '.join(other)}, "
                              f"this is {__version__}: install the same version on both")
-    client.register_plugin(WorkerSetup())
+    client.register_plugin(WorkerSetup(worker_setup))

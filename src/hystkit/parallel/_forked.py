@@ -36,9 +36,8 @@ import dask
 import dask.multiprocessing
 from dask.callbacks import Callback
 
+from ._contract import _CURRENT, Cost, OnDone, make_numba_ready
 from ._cost import cost_order
-from ._executor import _CURRENT, Cost, OnDone
-from ._meanwhile import make_numba_ready
 
 __all__ = ["ForkedExecutor"]
 

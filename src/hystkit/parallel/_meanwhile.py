@@ -15,9 +15,9 @@ import threading
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 
-from ._executor import Executor
+from ._contract import Executor, make_numba_ready
 
-__all__ = ["loading_meanwhile", "make_numba_ready"]
+__all__ = ["loading_meanwhile"]
 
 
 @contextmanager
@@ -60,15 +60,3 @@ def _load(modules: tuple[str, ...], numba_ready: bool) -> None:
             continue
     if numba_ready:
         make_numba_ready()
-
-
-def make_numba_ready() -> None:
-    """Make numba ready to load cached kernels: its target context (every implementation
-    registry, scipy.linalg for LAPACK; ~0.2 s), which the first kernel call of a process would
-    otherwise set up. Under numba's compiler lock, so never beside a kernel load in another
-    thread."""
-    from numba.core.compiler_lock import global_compiler_lock
-    from numba.core.registry import cpu_target
-
-    with global_compiler_lock:
-        cpu_target.target_context.refresh()

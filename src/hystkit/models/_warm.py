@@ -1,18 +1,18 @@
-"""Loading every model kernel at a ``distributed`` worker's start (`._dask.WorkerSetup`).
+"""Loading every model kernel: what a Dask worker runs at its start (the ``worker_setup`` that
+the commands hand to `hystkit.parallel.open_executor`).
 
 The default forked workers do not use it: each loads the kernels its pieces use when it first
-runs them (`._forked`), which on 2 cores costs less wall time than loading all of them in the
-parent before the fork.
+runs them (`hystkit.parallel._forked`), which on 2 cores costs less wall time than loading all
+of them in the parent before the fork.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["warm_kernels", "warmed"]
+from . import FAMILIES
 
-# Whether this process (or the one it was forked from) has run `warm_kernels`.
-_warmed = False
+__all__ = ["warm_kernels"]
 
 
 def warm_kernels() -> None:
@@ -21,9 +21,6 @@ def warm_kernels() -> None:
     (``cache=True``). The signal is a play operator's (every family fits it; a family's own
     random parameters left Bouc-Wen unfitted, its fit kernels unloaded) and short: ~1.05 s of
     CPU on the 2-core machine, of which ~0.6 s runs the fits (2026-11-24)."""
-    global _warmed
-    from ..models import FAMILIES
-
     u = 0.8 * np.sin(np.linspace(0, 6 * np.pi, 150)) * np.linspace(1.0, 0.5, 150)
     y = 0.6 * u + 0.4 * _play(u, 0.15)
     for family in FAMILIES.values():
@@ -36,12 +33,6 @@ def warm_kernels() -> None:
                 family.invert(structure, params, y)
         except Exception:  # noqa: BLE001, S112
             continue
-    _warmed = True
-
-
-def warmed() -> bool:
-    """Whether this process, or the one it was forked from, has run `warm_kernels`."""
-    return _warmed
 
 
 def _play(u: np.ndarray, radius: float) -> np.ndarray:
