@@ -1,4 +1,9 @@
-"""Which centring should be the default? Deployable R² of every mode on held-out data.
+"""
+Which centring should be the default? Deployable R² of every mode on held-out data
+==================================================================================
+
+Not run when the site is built: about 50 s of fitting on two cores, and its real cases need the
+shared data. Its table is in :doc:`/centring`.
 
 For each case a compensator (mPL, 3 cells, direct mode) is fitted on training data only and
 scored on held-out data with each centring: ``fit``, ``tare``, ``track`` (deployable) and

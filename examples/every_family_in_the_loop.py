@@ -1,4 +1,9 @@
-"""Every registered model family in the document's closed loop (ch. 7), as a new user would run it.
+"""
+Every registered model family in the document's closed loop (ch. 7), as a new user would run it
+===============================================================================================
+
+Not run when the site is built: about a minute of fits and loops on two cores. Its table is in
+:doc:`/control` ("Any family in any slot").
 
 For each family: ``hystkit fit`` on the virtual sensor's sine recording (seed 2, direct mode,
 the family's default size; 3 cells for the mPL as in ch. 7), then ``hystkit control --scheme

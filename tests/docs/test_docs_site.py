@@ -3,7 +3,9 @@
 One build, as ``docs/index.md`` documents it (``python -m sphinx -W --keep-going -b html docs
 OUT``, here into a temporary folder), then what it must show: the API pages of
 ``fit_compensator``, ``Stream`` and ``CompensatorEstimator``, a section per subcommand that
-``hystkit --help`` lists, every example script, and no link to a missing page. A Sphinx
+``hystkit --help`` lists, the tutorial and every example script run by sphinx-gallery with
+their output and figures (an example that raises fails the build), and no link to a missing
+page. A Sphinx
 warning, a broken cross-reference (``nitpicky``) or a page the build leaves out fails it.
 Skipped when the docs packages are not installed (``pip install ".[docs]"``; the ``test``
 extra brings them).
@@ -23,7 +25,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
-PACKAGES = ("sphinx", "numpydoc", "myst_parser", "pydata_sphinx_theme")
+PACKAGES = ("sphinx", "numpydoc", "myst_parser", "pydata_sphinx_theme", "sphinx_gallery")
 MISSING = [name for name in PACKAGES if importlib.util.find_spec(name) is None]
 
 pytestmark = pytest.mark.skipif(
@@ -84,18 +86,47 @@ def test_cli_reference_has_every_subcommand(site):
     assert "--columns" in page and "--slope-cap" in page  # options, with their help
 
 
-def test_every_example_script_is_on_the_examples_page(site):
-    page = (DOCS / "examples.md").read_text(encoding="utf-8")
+def test_gallery_and_tutorial_are_run_with_their_figures(site):
+    """Every script of examples/ has its gallery page; those the build runs (conf.py's
+    filename_pattern) show their output and figures, the others say why they are not run;
+    the tutorial runs and shows the figures it makes."""
+    sys.path.insert(0, str(DOCS))
+    try:
+        conf = importlib.import_module("conf")
+    finally:
+        sys.path.remove(str(DOCS))
+    pattern = re.compile(conf.sphinx_gallery_conf["filename_pattern"])
     scripts = sorted((ROOT / "examples").glob("*.py"))
-    missing = [p.name for p in scripts if f"../examples/{p.name}" not in page]
-    assert not missing, f"docs/examples.md does not include {missing}"
-    built = (site / "examples.html").read_text(encoding="utf-8")
-    assert built.count('class="highlight-python') >= len(scripts)  # the listings themselves
+    assert scripts
+    index = (site / "gallery" / "index.html").read_text(encoding="utf-8")
+    run = 0
+    for script in scripts:
+        page = site / "gallery" / f"{script.stem}.html"
+        assert page.is_file(), f"no gallery page for {script.name}"
+        assert f"{script.stem}.html" in index, f"{script.name} missing from the gallery index"
+        html = page.read_text(encoding="utf-8")
+        if pattern.search(f"/{script.name}"):
+            run += 1
+            assert "sphx-glr-script-out" in html or "sphx-glr-single-img" in html, \
+                f"{script.name} is run by the build but shows no output"
+        else:
+            assert "Not run when the site is built" in html, \
+                f"{script.name} is not run by the build and does not say why"
+    assert run >= 3
+    figures = [p for p in (site / "_images").glob("sphx_glr_plot_*") if p.suffix == ".png"]
+    assert len(figures) >= 3, "the plot_ examples made no figures"
+    tutorial = (site / "tutorial" / "plot_first_recording.html").read_text(encoding="utf-8")
+    assert tutorial.count("sphx-glr-single-img") >= 4, "the tutorial's figures are missing"
+    for command in ("hystkit fit", "hystkit evaluate", "hystkit select", "hystkit compensate",
+                    "hystkit report"):
+        assert f"$ {command} " in tutorial, f"the tutorial's output of {command} is missing"
 
 
 def test_every_page_is_built_and_no_link_is_broken(site):
     sources = {p.relative_to(DOCS).with_suffix("").as_posix() for p in DOCS.rglob("*.md")
                if "_build" not in p.parts}
+    sources |= {f"gallery/{p.stem}" for p in (ROOT / "examples").glob("*.py")}
+    sources |= {f"tutorial/{p.stem}" for p in (DOCS / "tutorial_src").glob("*.py")}
     built = {p.relative_to(site).with_suffix("").as_posix() for p in site.rglob("*.html")}
     assert not sources - built, f"pages left out of the site: {sorted(sources - built)}"
     broken = []
