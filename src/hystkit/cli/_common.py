@@ -25,9 +25,10 @@ from .._read_options import (
 from ..errors import HystkitError, OutputError
 
 __all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Deferred", "Parser", "UsageError", "add_read_options",
-           "check_size", "deferred", "failures_exit", "given_read_options", "integer", "number",
-           "positive_float", "positive_int", "read_options", "read_recording_args",
-           "read_recordings_args", "size_limit", "slope_cap", "stdout_for"]
+           "check_size", "deferred", "failures_exit", "given_read_options", "integer",
+           "next_step", "number", "positive_float", "positive_int", "read_options",
+           "read_recording_args", "read_recordings_args", "say_next", "size_limit", "slope_cap",
+           "stdout_for"]
 
 # Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
 # bounds, not converged; a family failed in compare/select); 2 is kept for errors that stop a
@@ -179,14 +180,109 @@ def _label(option: str, size: int) -> str:
     return f"{option}{'' if option.endswith('=') else ' '}{size}"
 
 
-def failures_exit(failed: list[str], what: str = "model(s)") -> int:
-    """Exit code after everything else was written: GUARD_EXIT (and a line on stderr) when
-    something failed, else 0."""
+def failures_exit(failed: list[str], what: str = "model(s)", next_step: str | None = None
+                  ) -> int:
+    """Exit code after everything else was written: GUARD_EXIT (a line on stderr, then the
+    `say_next` line: `next_step`, or what suits `what`) when something failed, else 0."""
     if failed:
         print(f"hystkit: {len(failed)} {what} failed: {', '.join(failed)} (reasons above)",
               file=sys.stderr)
+        say_next(next_step or _NEXT_AFTER_FAILED.get(what, _NEXT_AFTER_FAILED["model(s)"]))
         return GUARD_EXIT
     return 0
+
+
+# What to try when part of a command failed, by what failed (failures_exit's `what`)
+_NEXT_AFTER_FAILED = {
+    "model(s)": "one failed family alone, 'hystkit fit DATA --model NAME --out m.json' (its "
+                "refusal names the reason and what to try), or leave it out with --models",
+    "sensor(s)": "'hystkit fit' on one failed sensor's recordings alone: its refusal names the "
+                 "reason and what to try (e.g. --model auto)",
+    "trace(s)": "--model drop (3 parameters) for a trace that does not rise first, or a longer "
+                "log that reaches its rest",
+}
+
+
+def say_next(step: str) -> None:
+    """The last line of a refusal (exit GUARD_EXIT): ``next: try STEP``. On standard output,
+    after the refusal's line on stderr: the guard tests read that line as stderr's last."""
+    print(f"next: try {step}", flush=True)
+
+
+_AUTO = ("--model auto (mpl with 1-3 cells, mpl-poly, pi and pl, each scored on held-out "
+         "data)")
+_COLUMNS = ("checking the columns: the sensor column may not carry the position "
+            "(--columns position=NAME,sensor=NAME); no model recovers a signal that is not there")
+
+
+def next_step(status: str, *, command: str = "fit", model: str | None = None,
+              size: int | None = None, mode: str = "direct", line_r2: float | None = None
+              ) -> str:
+    """What to try after a refusal whose reason is `status`, as the words after ``next: try``.
+
+    Parameters
+    ----------
+    status : str
+        A fit's status (``on_bounds``, ``not_converged``, ``collapsed``, ``no_signal``,
+        ``worse_than_line``, ``no_limit``), a use verdict (``extrapolated``), or a selection's
+        (``failed``: every candidate failed; ``refit``: the best ones' fits on all the data
+        failed their guards; ``skipped``: candidates left out for the time budget).
+    command : {"fit", "evaluate", "select", "guided"}
+        The refusing command (``guided``: ``fit --model auto``): the same status asks for
+        another step after a fit than after an evaluation or a selection.
+    model, size, mode : optional
+        The refused model's family, size and mode (``fit``); a selection's best candidate.
+    line_r2 : float, optional
+        R² of the straight line on the same data: a model below a line that explains nothing
+        either (a noise-only sensor) is a sensor problem, not a model's.
+    """
+    from ..compensation import MIN_EXPLAINED
+
+    if status == "worse_than_line" and line_r2 is not None and line_r2 < MIN_EXPLAINED:
+        status = "no_signal"
+    if command == "evaluate":
+        return {
+            "no_signal": "checking that this file's columns are the training files' "
+                         "(--columns position=NAME,sensor=NAME): a sensor read from another "
+                         "column, or wired differently, carries nothing the model learnt",
+            "extrapolated": "refitting on recordings that cover this range, e.g. 'hystkit fit "
+                            "TRAIN.csv THIS.csv' (fitted jointly)",
+        }.get(status, "refitting on recordings like these, e.g. 'hystkit fit TRAIN.csv "
+                      "THIS.csv' (fitted jointly), or 'hystkit fit --model auto' on them")
+    if status == "no_signal":
+        return _COLUMNS
+    if command in ("select", "guided"):  # a selection (select, fit --model auto) refused
+        centers = "--centers" if command == "select" else "--center"
+        return {
+            "worse_than_line": f"{centers} track (an offset that drifts) or one recording per "
+                               f"run; if the straight line still wins, the sensor is linear "
+                               f"enough for a straight-line calibration",
+            "failed": "'hystkit fit DATA --model mpl --out m.json': one fit's own error says "
+                      "what stops them",
+            "skipped": "--budget with more seconds, or fewer samples (--resample HZ)",
+        }.get(status, f"'hystkit fit DATA --model {model or 'NAME'}"
+                      f"{'' if size is None else f' --size {size}'}' (the best candidate): "
+                      f"its refusal names what failed and what to try")
+    smaller = None if size is None or size <= 1 else size - 1
+    if status == "on_bounds":
+        if model == "mpl":
+            fewer = f"--cells {smaller}" if smaller else "--cells 2"
+            return (f"--model mpl-poly (a curved static curve in one cell) or {fewer}; "
+                    f"{_AUTO} compares them")
+        return (f"--size {smaller} (fewer parameters to pin) or {_AUTO}" if smaller
+                else _AUTO)
+    if status == "not_converged":
+        return (f"--cells {smaller} (a smaller model settles within its evaluation budget) or "
+                f"{_AUTO}" if smaller else f"another start (--init list) or {_AUTO}")
+    if status == "collapsed":
+        return ("--mode direct, or " + _AUTO if mode == "inverse"
+                else f"{_AUTO}; if every model collapses, {_COLUMNS}")
+    if status == "worse_than_line":
+        return (f"{_AUTO}: {model or 'this model'} does no better than a straight line on "
+                f"these data")
+    if status == "no_limit":
+        return "the fit without --no-limit (the stability limit keeps its Euler step bounded)"
+    return _AUTO
 
 
 def _columns(text: str) -> tuple[tuple[str, str], ...]:
@@ -202,8 +298,14 @@ def _separator(text: str) -> str:
     return text
 
 
-OUTPUT_NAMES_NOTE = ("written files use hystkit's column names (time [s], position, sensor, "
-                     "...) whatever --columns and --time-unit read")
+# What the commands write, as they do since issue 27.4 (compensate replaces this note with its
+# own, cmd_core.COMPENSATE_NAMES_NOTE).
+OUTPUT_NAMES_NOTE = ("fit and select remember the column names, time unit and units line in "
+                     "the model file, so that later commands read files laid out alike "
+                     "without options; compensate writes the "
+                     "input's column names and time unit; scores, reports and stream's lines "
+                     "use hystkit's column names (time [s], position, sensor, "
+                     "position_estimate)")
 
 
 def add_read_options(p: argparse.ArgumentParser) -> None:

@@ -15,10 +15,12 @@ from ._common import (
     check_size,
     deferred,
     integer,
+    next_step,
     number,
     positive_float,
     positive_int,
     read_options,
+    say_next,
     size_limit,
     slope_cap,
 )
@@ -89,6 +91,13 @@ def _simulate_sensor(args: argparse.Namespace) -> int:
 
 
 def _fit(args: argparse.Namespace) -> int:
+    if args.model == GUIDED_MODEL:
+        from ._guided_fit import run_guided_fit
+
+        return run_guided_fit(args)
+    if args.budget is not None:
+        raise UsageError(f"--budget applies to --model {GUIDED_MODEL} (a named model is one "
+                         f"fit, not a selection)")
     if args.init == "list":
         return list_presets(args)
     check_inputs_exist(args.data)  # a misspelt name is refused before the heavy imports
@@ -158,6 +167,8 @@ def _fit(args: argparse.Namespace) -> int:
         print(f"hystkit: fit {info['status'].replace('_', ' ')}: {info['status_message']}; the "
               f"model was written for inspection, do not use it as a compensator",
               file=sys.stderr)
+        say_next(next_step(info["status"], model=args.model, size=size, mode=args.mode,
+                           line_r2=info["training_linear_r2"]))
         return GUARD_EXIT
     print(f"  status: ok ({info['status_message']})")
     return 0
@@ -427,8 +438,8 @@ def _evaluate(args: argparse.Namespace) -> int:
         print(f"wrote {args.out}")
     if status not in ("ok", "undetermined"):
         print(f"hystkit: evaluate: {status.replace('_', ' ')}: {message}; do not use the "
-              f"{comp.model} compensator on data like these (try `hystkit select` on "
-              f"recordings that cover them)", file=sys.stderr)
+              f"{comp.model} compensator on data like these", file=sys.stderr)
+        say_next(next_step(status, command="evaluate", line_r2=scores["linear_r2"]))
         return GUARD_EXIT
     print(f"verdict: {status} ({message})")
     return 0
@@ -537,6 +548,12 @@ def _add_rest_position(p: argparse.ArgumentParser) -> None:
 
 
 _MODEL_HELP = "model file written by fit or select (.json or .mat)"
+# fit --model auto (cli/_guided_fit.py, imported only when chosen)
+GUIDED_MODEL = "auto"
+GUIDED_HELP = ("mpl with 1, 2 and 3 cells, mpl-poly, pi and pl, each fitted and scored on "
+               "held-out data as select does, the best usable one written with its band and "
+               "the choice explained in three lines (about 15-30 s for 10,000 samples on 2 "
+               "cores)")
 # The reading options' note of compensate, whose output keeps the input's names
 COMPENSATE_NAMES_NOTE = ("the output keeps the input's column names and time unit, the "
                          "estimate named after the position column")
@@ -565,9 +582,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("data", type=Path, nargs="+",
                    help="recording(s): time, position, sensor (CSV/Parquet/.mat); several are "
                         "fitted jointly, each with its own initial state and tare")
-    # The registry's mapping as the choices: checking a name imports that family only.
-    deferred(p.add_argument("--model", default="mpl"), choices=_families,
-             help=lambda: "; ".join(f"{f.name}: {f.title}" for f in _families().values()))
+    # The registry's names and the guided fit's as the choices: checking a name imports that
+    # family only.
+    deferred(p.add_argument("--model", default="mpl"), choices=lambda: [*_families(),
+                                                                        GUIDED_MODEL],
+             help=lambda: "; ".join([*(f"{f.name}: {f.title}" for f in _families().values()),
+                                     f"{GUIDED_MODEL}: a guided first fit, {GUIDED_HELP}"]))
+    p.add_argument("--budget", type=number(1, 24 * 3600), default=None, metavar="SECONDS",
+                   help=f"--model {GUIDED_MODEL} only: seconds for the whole selection "
+                        f"(default 60); a candidate not validated within half of it is "
+                        f"skipped, said so")
     deferred(p.add_argument("--cells", "--size", type=positive_int, default=None),
              help=lambda: "model size: " + "; ".join(f"{f.name}: {f.size_help} (default "
                                                      f"{f.default_size}, at most "

@@ -13,9 +13,12 @@ from ._common import (
     UsageError,
     add_read_options,
     deferred,
+    next_step,
     positive_int,
     read_options,
+    say_next,
 )
+from ._guided_fit import selection_status
 from ._own_layout import training_reading
 from .cmd_compare import _models, add_parallel_options, executor_for
 
@@ -106,8 +109,12 @@ def _select(args: argparse.Namespace) -> int:
                              force=args.force)
     print(f"wrote {report / 'selection.json'}, .csv, .png ({summary['seconds']:.1f} s)")
     if result["winner"] is None:
+        sys.stdout.flush()  # the table before the refusal
         print(f"hystkit: select: no usable model, none written: {result['refusal']}",
               file=sys.stderr)
+        best = next((r for r in rows if "error" not in r), None)
+        say_next(next_step(selection_status(result), command="select",
+                           model=best and best["model"], size=best and best["size"]))
         return GUARD_EXIT
     if not_remembered:
         print(f"  note: {not_remembered}")

@@ -1,0 +1,122 @@
+"""``hystkit fit --model auto``: the guided first fit (issue 27.5), both directions: a real
+device comes out ``ok`` with the choice explained in three lines and a model file usable on its
+next run; a noise-only sensor never does. No timing here (measured in the report of the
+commit; the budget's mechanics are checked by what they skip)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from hystkit.cli._common import GUARD_EXIT, next_step
+from hystkit.cli._guided_fit import (
+    SHORT_LIST,
+    SKIPPED,
+    _Budgeted,
+    guided_candidates,
+    guided_select,
+    selection_status,
+)
+from hystkit.compensation import folds, load_compensator, protocol
+from hystkit.datasets import load_excerpt
+from hystkit.io import write_recording
+from hystkit.parallel import SerialExecutor
+
+from ..cli_support import run_cli
+from ..compensation.test_verdict_corpus import data  # noqa: F401 (the labelled corpus)
+
+
+@pytest.fixture(scope="module")
+def device(tmp_path_factory):
+    """The micromanipulator's identification and test runs (real, shipped excerpts)."""
+    folder = tmp_path_factory.mktemp("device")
+    return {name: write_recording(load_excerpt("piezo_micromanipulator", variant)
+                                  .to_recording(), folder / f"{name}.csv")
+            for name, variant in (("ident", "identification"), ("test", "test_uncompensated"))}
+
+
+def test_a_real_device_gets_a_usable_model_and_three_lines(device, tmp_path, capsys):
+    model = tmp_path / "auto.json"
+    code, out, err = run_cli(capsys, "fit", device["ident"], "--model", "auto", "--out", model)
+    assert code == 0, err
+    lines = out.splitlines()
+    first = next(i for i, line in enumerate(lines) if line.startswith("chose "))
+    chose, score, others = lines[first:first + 3]
+    comp = load_compensator(model)
+    # what won, its held-out score under the protocol's name, the runner-up and the others
+    assert chose.startswith(f"chose {comp.model} (size ")
+    assert "deployable R² " in score and "interleaved cycles of the training recording" in score
+    assert others.startswith("  runner-up ")
+    size = int(chose.split("(size ")[1].split(",")[0])
+    losers = {f"{name}:{n}" for name, n in SHORT_LIST} - {f"{comp.model}:{size}"}
+    assert len(losers) == len(SHORT_LIST) - 1 and all(f"{c} " in others for c in losers)
+    assert "status: ok" in out and comp.fit_info["status"] == "ok"
+    assert comp.fit_info["selection"] == [chose, score, others]
+    assert comp.band is not None  # written as select writes its winner
+    assert json.loads(model.read_text())["reading"] is not None  # the reading remembered
+    # usable on the device's next run, as a model fitted by name would be
+    code, out, err = run_cli(capsys, "evaluate", model, device["test"])
+    assert code == 0 and "verdict: ok" in out, err
+
+
+def test_a_noise_only_sensor_is_never_ok(data, tmp_path, capsys):  # noqa: F811
+    model = tmp_path / "auto.json"
+    code, out, err = run_cli(capsys, "fit", data["noise_only"], "--model", "auto", "--out",
+                             model)
+    assert code == GUARD_EXIT and not model.exists()
+    assert "status: ok" not in out
+    assert err.strip().splitlines()[-1].startswith("hystkit: fit: no usable model among ")
+    assert out.strip().splitlines()[-1].startswith("next: try checking the columns")
+
+
+@pytest.mark.parametrize("option", [("--cells", "3"), ("--slope-cap", "0.5"), ("--init", "list"),
+                                    ("--loss", "huber"), ("--no-limit",)])
+def test_a_model_option_without_a_model_is_one_line(data, tmp_path, capsys, option):  # noqa: F811
+    code, _, err = run_cli(capsys, "fit", data["sine1"], "--model", "auto", *option, "--out",
+                           tmp_path / "m.json")
+    assert code == 2 and err.count("\n") == 1
+    assert f"{option[0]} applies to a named model" in err
+    assert not (tmp_path / "m.json").exists()
+
+
+def test_budget_belongs_to_the_guided_fit(data, tmp_path, capsys):  # noqa: F811
+    code, _, err = run_cli(capsys, "fit", data["sine1"], "--budget", "30", "--out",
+                           tmp_path / "m.json")
+    assert code == 2 and "--budget applies to --model auto" in err
+
+
+def test_the_candidates_are_the_short_list_cheapest_first(data):  # noqa: F811
+    from hystkit.io import read_recording
+    from hystkit.parallel import fit_cost
+
+    rec = read_recording(data["sine1"])
+    cands = guided_candidates([rec])
+    assert {(c.model, c.size) for c in cands} == set(SHORT_LIST)
+    n = min(f.n_train for f in folds([rec]))
+    costs = [fit_cost(c.model, c.size, n) for c in cands]
+    assert costs == sorted(costs) and {c.mode for c in cands} == {"direct"}
+
+
+def test_a_budget_too_small_for_any_candidate_says_so_and_what_to_try(data):  # noqa: F811
+    from hystkit.io import read_recording
+
+    rec = read_recording(data["sine1"])
+    # 0.1 s for validation, serially: below every candidate's a-priori floor on 5333 samples
+    result = guided_select([rec], budget=0.2, executor=SerialExecutor())
+    assert result["winner"] is None and result["ranking"] == []
+    assert [label for label, _ in result["skipped"]] == [c.label for c in
+                                                          guided_candidates([rec])]
+    assert result["protocol"] == protocol([rec])
+    assert selection_status(result) == "skipped"
+    assert next_step("skipped", command="guided").startswith("--budget with more seconds")
+
+
+def test_pieces_after_the_deadline_are_skipped_not_run():
+    def must_not_run(item):
+        raise AssertionError(f"piece {item} ran after the deadline")
+
+    done = []
+    results = _Budgeted(SerialExecutor(), deadline=0.0).map(
+        must_not_run, [1, 2, 3], on_done=lambda i, r: done.append(i))
+    assert results == [{"error": SKIPPED}] * 3 and done == [0, 1, 2]

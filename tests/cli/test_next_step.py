@@ -1,0 +1,145 @@
+"""Every refusal (exit 3) of fit, evaluate and select ends with one line ``next: try ...``,
+chosen by the refusal's reason (issue 27.5); each mapping on a real refusal case: the labelled
+corpus of tests/compensation/test_verdict_corpus.py, the micromanipulator excerpt, and the MR
+damper from the shared data where it is here."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from hystkit.cli._common import GUARD_EXIT
+from hystkit.io import write_recording
+
+from ..cli_support import run_cli
+from ..compensation.test_verdict_corpus import data  # noqa: F401 (the labelled corpus)
+from ..reports.test_compare_failures import broken_chua  # noqa: F401 (a family that raises)
+from .test_use_guards_cli import _patched
+
+
+def _next(out: str) -> str:
+    """The refusal's last line (on stdout, after the refusal's own line on stderr)."""
+    last = out.strip().splitlines()[-1]
+    assert last.startswith("next: try "), out
+    return last
+
+
+def _fit(capsys, data, tmp_path, train, *options):  # noqa: F811 (the fixture's values)
+    model = tmp_path / "model.json"
+    return run_cli(capsys, "fit", data[train], "--out", model, *options)
+
+
+@pytest.mark.parametrize(("train", "options", "status", "step"), [
+    # the micromanipulator's 2-cell mpl-g pins a conductance on its floor
+    ("ident", ("--model", "mpl-g", "--size", "2"), "on bounds", "next: try --size 1 "),
+    ("sine1", ("--cells", "4"), "not converged", "next: try --cells 3 (a smaller model"),
+    ("ident", ("--cells", "4"), "not converged", "next: try --cells 3 (a smaller model"),
+    # Bouc-Wen is the virtual sensor's straight line, 1e-4 below it in training
+    ("sine1", ("--model", "boucwen"), "worse than line",
+     "next: try --model auto (mpl with 1-3 cells"),
+    ("noise_only", ("--model", "mpl"), "no signal", "next: try checking the columns"),
+    # the line explains nothing either: a sensor problem, whatever the status's name
+    ("unrelated", (), "", "next: try checking the columns"),
+    ("sine1", ("--no-limit",), "no limit", "next: try the fit without --no-limit"),
+])
+def test_a_refused_fit_names_what_to_try(data, tmp_path, capsys, train, options, status,  # noqa: F811
+                                         step):
+    code, out, err = _fit(capsys, data, tmp_path, train, *options)
+    assert code == GUARD_EXIT, err
+    assert f"hystkit: fit {status}" in err
+    assert _next(out).startswith(step)
+
+
+def test_mpl_on_bounds_is_sent_to_mpl_poly_or_fewer_cells(tmp_path, capsys):
+    """The issue's case on real data: the MR damper's 3-cell mPL ends 'on bounds' (w[2]);
+    the guided fit's winner there is mpl-poly (test_guided_fit)."""
+    from hystkit.datasets import load
+    from hystkit.errors import InputError
+
+    try:
+        rec = load("mr_damper", "10mm_1Hz_0.5A").to_recording()
+    except InputError as exc:
+        pytest.skip(f"shared data absent: {exc}")
+    path = write_recording(rec, tmp_path / "mr.csv")
+    code, out, err = run_cli(capsys, "fit", path, "--cells", "3", "--out", tmp_path / "m.json")
+    assert code == GUARD_EXIT and "hystkit: fit on bounds" in err
+    assert _next(out).startswith("next: try --model mpl-poly (a curved static curve in one "
+                                 "cell) or --cells 2; --model auto")
+
+
+def test_a_collapsed_fit_is_sent_to_the_guided_fit_and_the_columns(tmp_path, capsys,
+                                                                   monkeypatch):
+    """A constructed collapse (all output weights zero), as tests/cli/test_use_guards_cli."""
+    from hystkit.models import get_family
+    from hystkit.models.mpl import MplParams
+    from hystkit.sensors import simulate_experiment
+
+    real = get_family("mpl")
+
+    def collapsed_fit(u, y, structure, **kwargs):
+        result = real.fit(u, y, structure, **kwargs)
+        return replace(result, params=MplParams(i_s=result.params.i_s, v_t=result.params.v_t,
+                                                w=np.zeros(structure.n_cells + 1), v_b=0.0))
+
+    _patched(monkeypatch, fit=collapsed_fit)
+    path = write_recording(simulate_experiment("sine", 1), tmp_path / "sine.csv")
+    code, out, err = run_cli(capsys, "fit", path, "--out", tmp_path / "m.json")
+    assert code == GUARD_EXIT and "hystkit: fit collapsed" in err
+    assert _next(out).startswith("next: try --model auto")
+    assert "if every model collapses, checking the columns" in _next(out)
+
+
+@pytest.mark.parametrize(("test", "cells", "status", "step"), [
+    # far below its own line on another excitation, the line itself good
+    ("chirp2", "1", "worse_than_line", "next: try refitting on recordings like these"),
+    # the scored file's sensor and position swapped, or the sensor wired the other way
+    ("swapped", "1", "no_signal", "next: try checking that this file's columns"),
+    ("flipped", "1", "worse_than_line", "next: try checking that this file's columns"),
+])
+def test_a_refused_evaluation_names_what_to_try(data, tmp_path, capsys, test, cells,  # noqa: F811
+                                                status, step):
+    code, _, err = _fit(capsys, data, tmp_path, "sine1", "--cells", cells)
+    assert code == 0, err
+    scores = tmp_path / "scores.json"
+    code, out, err = run_cli(capsys, "evaluate", tmp_path / "model.json", data[test],
+                             "--json", scores)
+    assert code == GUARD_EXIT and json.loads(scores.read_text())["verdict"] == status
+    assert err.strip().splitlines()[-1].startswith("hystkit: evaluate: ")
+    assert _next(out).startswith(step)
+
+
+def test_an_extrapolating_evaluation_asks_for_data_that_cover_the_range(data, tmp_path,  # noqa: F811
+                                                                         capsys):
+    assert _fit(capsys, data, tmp_path, "decay_tail")[0] == 0
+    code, out, err = run_cli(capsys, "evaluate", tmp_path / "model.json", data["sine2"])
+    assert code == GUARD_EXIT and "extrapolated" in err
+    assert _next(out).startswith("next: try refitting on recordings that cover this range")
+
+
+def test_a_refused_selection_names_what_to_try(data, tmp_path, capsys):  # noqa: F811
+    out_model = tmp_path / "best.json"
+    code, out, err = run_cli(capsys, "select", data["noise_only"], "--models", "mpl,pi",
+                             "--centers", "fit", "--out", out_model)
+    assert code == GUARD_EXIT and "no usable model" in err and not out_model.exists()
+    assert _next(out).startswith("next: try checking the columns")
+    # Bouc-Wen alone on the virtual sensor: its straight line, which explains the position
+    code, out, err = run_cli(capsys, "select", data["sine1"], "--models", "boucwen",
+                             "--centers", "fit", "--out", out_model, "--force")
+    assert code == GUARD_EXIT and "beats its straight line" in err
+    assert _next(out).startswith("next: try --centers track (an offset that drifts)")
+
+
+def test_a_partly_failed_comparison_names_what_to_try(broken_chua, tmp_path, capsys):  # noqa: F811
+    """failures_exit, the exit of compare and generalize, with a family whose fit raises."""
+    from hystkit.sensors import simulate_experiment
+
+    f = write_recording(simulate_experiment("sine", 1), tmp_path / "f.csv")
+    v = write_recording(simulate_experiment("sine", 2), tmp_path / "v.csv")
+    code, out, err = run_cli(capsys, "compare", f, v, "--models", "mpl,mpl-poly", "--out",
+                             tmp_path / "cmp")
+    assert code == GUARD_EXIT and "1 model(s) failed: mpl-poly" in err
+    assert _next(out).startswith("next: try one failed family alone, 'hystkit fit DATA "
+                                 "--model NAME")
