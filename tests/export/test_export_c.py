@@ -194,12 +194,13 @@ def test_existing_folder_needs_force(compensators, tmp_path, capsys):
 def test_untranslated_family_is_refused_with_its_reason(mode, recordings, tmp_path, capsys,
                                                         monkeypatch):
     """Every registered family is translated today; a family without a translation (one added
-    later) is refused with the reason its entry in REFUSALS gives, on one line, nothing
-    written."""
-    from hystkit.export import _families
+    later: ``export = None``) is refused with the reason its ``no_export_reason`` gives, on one
+    line, nothing written."""
+    from hystkit.models import get_family
 
-    monkeypatch.delitem(_families.TRANSLATED, "pl")
-    monkeypatch.setitem(_families.REFUSALS, "pl", "the pl block is not translated")
+    family = type(get_family("pl"))
+    monkeypatch.setattr(family, "export", None)
+    monkeypatch.setattr(family, "no_export_reason", "the pl block is not translated")
     train, val = recordings
     comp = build_compensator(train, val, "pl", 1, mode, "fit")
     with pytest.raises(InputError, match=f"cannot export the pl {mode} compensator: the pl "
@@ -215,10 +216,9 @@ def test_untranslated_family_is_refused_with_its_reason(mode, recordings, tmp_pa
 
 
 def test_every_registered_family_is_translated():
-    from hystkit.export import _families
     from hystkit.models import FAMILIES
 
-    assert set(FAMILIES) <= set(_families.TRANSLATED)
+    assert [name for name, family in FAMILIES.items() if family.export is None] == []
 
 
 def test_oracle_centring_is_refused(compensators):

@@ -3,10 +3,11 @@
 
 The generated code repeats :meth:`hystkit.compensation.Compensator.estimate` sample by sample:
 the causal centring (fit / tare / track), polarity and scaling, and the family's compiled
-block (``Family.block``), translated per family in :mod:`._families`; and, when the
-compensator carries one, its prediction band (:meth:`Compensator.estimate_with_band`: lower
-and upper [mm] per sample, the same code for every family). A family, mode or
-centring without a translation is refused with the reason (``InputError``), never stubbed.
+block (``Family.block``), translated by the family itself (``Family.export``, from its
+``export.py``); and, when the compensator carries one, its prediction band
+(:meth:`Compensator.estimate_with_band`: lower and upper [mm] per sample, the same code for
+every family). A family, mode or centring without a translation is refused with the reason
+(``Family.export_refusal``, an ``InputError``), never stubbed.
 """
 
 from ._c import COMPILE_LINE, c_files, float_warning

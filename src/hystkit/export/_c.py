@@ -20,7 +20,6 @@ from collections.abc import Callable
 import numpy as np
 
 from ._comments import c_comment_text, comment_text
-from ._families import translator
 from ._plan import ExportPlan
 
 __all__ = ["COMPILE_LINE", "c_files", "float_warning"]
@@ -261,7 +260,7 @@ void {n}_sync({n}_state *st)
     reset_centring(st);{_BAND_RESET if plan.band else ''}
 }}
 """
-    model = translator(plan.model).c_model(plan, lit)
+    model = plan.translation.c_model(plan, lit)
     return _comment(plan, f"{n}.c", double) + f"""
 #include <math.h>
 #include "{n}.h"

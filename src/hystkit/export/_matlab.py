@@ -21,7 +21,6 @@ from __future__ import annotations
 import numpy as np
 
 from ._comments import comment_text
-from ._families import translator
 from ._plan import ExportPlan
 
 __all__ = ["matlab_files"]
@@ -105,7 +104,7 @@ end
 
 def _init(plan: ExportPlan) -> str:
     n = plan.name
-    load = getattr(translator(plan.model), "M_LOAD", _LOAD)
+    load = plan.translation.m_load or _LOAD
     return _comment(plan, f"{n}_init.m") + f"""function state = {n}_init(first_sensor, x_model)
 % state = {n}_init(first_sensor): at rest at the first sensor sample (pass that sample to
 % {n} too). state = {n}_init([], x_model): from a saved model state (the family block's state
@@ -123,7 +122,7 @@ end
 {load}
 {_centring(plan)}
 {_body(plan)}
-{translator(plan.model).m_model(plan, lit)}"""
+{plan.translation.m_model(plan, lit)}"""
 
 
 _BAND_FIELDS = (", ...\n               'band_started', 0, 'band_previous', 0.0, 'band_rate', 0.0, "
@@ -194,7 +193,7 @@ end
 {sub}
 {_centring(plan)}
 {_body(plan)}
-{translator(plan.model).m_model(plan, lit)}"""
+{plan.translation.m_model(plan, lit)}"""
 
 
 def _block(plan: ExportPlan) -> str:

@@ -26,7 +26,7 @@ from .. import __version__
 from ..compensation import Compensator
 from ..compensation._compensator import MAX_NORMALISED, POSITION_MARGIN, SENSOR_MARGIN
 from ..errors import InputError
-from ._families import translator
+from ..models._protocol import Translation
 
 __all__ = ["C_KEYWORDS", "FLOAT_SENSITIVITY_LIMIT", "ExportPlan", "band_constants",
            "float_sensitivity", "identifier", "make_plan"]
@@ -38,16 +38,12 @@ FLOAT_SENSITIVITY_LIMIT = 1e-5
 
 C_KEYWORDS = frozenset(
     ["auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else", "enum", "extern", "float", "for", "goto", "if", "inline", "int", "long", "register", "restrict", "return", "short", "signed", "sizeof", "static", "struct", "switch", "typedef", "union", "unsigned", "void", "volatile", "while", "main"])
-# Names the MATLAB/Octave side would shadow (functions a generated file calls).
+# Names the MATLAB/Octave side would shadow: functions a generated file calls and the
+# subfunctions every export defines (a family's own are its Translation.m_functions).
 _MATLAB_TAKEN = frozenset([
     "abs", "sinh", "cosh", "exp", "log", "tanh", "asinh", "max", "min", "fix", "round", "sum",
     "zeros", "ones", "numel", "isempty", "isfinite", "struct", "end",
-    # subfunctions of the generated files: a main function of the same name would shadow them
-    "body", "normalised", "model_step", "model_rest", "model_load", "layout", "superposition",
-    "move", "current", "mpl_current", "dead_zone", "cubic", "cells", "solve_output", "everett",
-    "term", "load_sums", "make_room", "update", "combine", "last_index", "running_sum",
-    "branch_output", "rhs", "project", "restoring", "restoring_inverse", "dissipation",
-    "dissipation_inverse", "rest_input", "f_of", "f_inverse", "a", "p", "band_half",
+    "body", "normalised", "model_step", "model_rest", "model_load", "band_half",
     # NAME_step of the C side would clash with its static model_step
     "model"])
 # Fit-date keys a model file's ``fit`` section may carry (none is written by hystkit yet).
@@ -112,32 +108,43 @@ class ExportPlan:
         return self.mode == "inverse"
 
     @property
+    def translation(self) -> Translation:
+        """The family's C and MATLAB translation (``Family.export``)."""
+        from ..models import get_family
+
+        return get_family(self.model).export
+
+    @property
     def n_state(self) -> int:
         """Length of the translated model state (the block's, or more where a translation
         keeps derived values such as running sums)."""
-        return translator(self.model).state_size(self)
+        return self.translation.state_size(self)
 
 
-def identifier(text: str) -> str:
+def identifier(text: str, taken: tuple[str, ...] = ()) -> str:
     """A C and MATLAB identifier from a file name.
 
     Parameters
     ----------
     text : str
         A file name or any text.
+    taken : tuple of str
+        More names to avoid, in any case: the family's MATLAB subfunctions
+        (``Translation.m_functions``).
 
     Returns
     -------
     str
         The letters (in their case: MATLAB finds ``bestA.m`` only as ``bestA`` on a
         case-sensitive file system), digits and ``_`` of `text` (at most 40 of them),
-        starting with a letter (``m_`` is put in front otherwise); C and Python keywords and
-        names the generated code calls get a ``_model`` suffix.
+        starting with a letter (``m_`` is put in front otherwise); C and Python keywords,
+        names the generated code calls and `taken` get a ``_model`` suffix.
     """
     name = re.sub(r"[^0-9A-Za-z_]+", "_", text).strip("_")[:40].strip("_")
     if not name or not name[0].isalpha():
         name = f"m_{name}".rstrip("_")
-    if name in C_KEYWORDS or name in _MATLAB_TAKEN or keyword.iskeyword(name):
+    if (name in C_KEYWORDS or name in _MATLAB_TAKEN or keyword.iskeyword(name)
+            or name.lower() in {t.lower() for t in taken}):
         name = f"{name}_model"
     return name
 
@@ -178,17 +185,17 @@ def make_plan(comp: Compensator, name: str | None = None, *,
         raise InputError(f"{source}: centring 'recording' is an oracle (it removes the whole "
                          f"recording's mean, unknown while the sensor is in use) and cannot run "
                          f"sample by sample; refit with --center fit, tare or track")
-    trans = translator(comp.model)
-    if trans is None or (comp.mode == "inverse" and not trans.HAS_INVERSE):
-        from ._families import refusal
+    refusal = comp.family.export_refusal(comp.mode == "inverse")
+    if refusal:
         raise InputError(f"{source}: cannot export the {comp.model} {comp.mode} compensator: "
-                         f"{refusal(comp.model, comp.mode)}")
+                         f"{refusal}")
+    trans = comp.family.export
     if name is None:
-        name = identifier(Path(source).stem if comp.source else comp.model)
-    elif identifier(name) != name:
+        name = identifier(Path(source).stem if comp.source else comp.model, trans.m_functions)
+    elif identifier(name, trans.m_functions) != name:
         raise InputError(f"--name {name!r}: not usable as a C/MATLAB identifier (letters, "
                          f"digits and _, starting with a letter, not a keyword); e.g. "
-                         f"{identifier(name)!r}")
+                         f"{identifier(name, trans.m_functions)!r}")
     band = band_constants(comp, level)
     block = comp.family.block(comp.structure, comp.params, comp.mode == "inverse")
     return ExportPlan(

@@ -21,6 +21,9 @@ Conventions, shared by every family:
   ``step(body, x, xn, off, u) -> out`` and the flat float64 ``body`` it reads: the output from
   ``x[off:off + n_state]``, the next state written to ``xn[off:off + n_state]``. The closed
   loop calls these for every slot, so any family runs compiled in any slot.
+- **Export.** :attr:`Family.export` is the block written as C99 and MATLAB (a
+  :class:`Translation`, from the family's ``export.py``); ``None`` makes ``hystkit export``
+  refuse the family with ``no_export_reason`` (:meth:`Family.export_refusal`).
 """
 
 from __future__ import annotations
@@ -33,7 +36,8 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
-__all__ = ["Block", "Family", "FitStart", "Record", "Reduction", "numerical_linearisation"]
+__all__ = ["Block", "Family", "FitStart", "Record", "Reduction", "Translation",
+           "numerical_linearisation"]
 
 
 class Record:
@@ -183,6 +187,58 @@ class Reduction(NamedTuple):
     params: Any
 
 
+def _no_extra(comp: Any) -> dict:
+    return {}
+
+
+def _block_state(plan: Any) -> int:
+    return plan.n_block_state
+
+
+@dataclasses.dataclass(frozen=True)
+class Translation:
+    """A family's compiled block (:meth:`Family.block`) written as C99 and as MATLAB code, for
+    :mod:`hystkit.export`; each family builds its own in ``<family>/export.py``.
+
+    The generated code reads the block's ``body`` at the same indices as the numba kernel:
+    ``BODY[i]`` in C (``real``), ``B(i + 1)`` in MATLAB (a column). ``plan`` is the
+    :class:`hystkit.export.ExportPlan`; ``lit`` formats a number as a literal of the export's
+    precision.
+
+    Parameters
+    ----------
+    c_model : callable
+        ``c_model(plan, lit) -> str``: C defining ``static void model_rest(real *x, real
+        value)`` and ``static real model_step(real *x, real u)`` (the block's step, the state
+        updated in place).
+    m_model : callable
+        ``m_model(plan, lit) -> str``: MATLAB subfunctions ``x = model_rest(B, value)`` and
+        ``[out, x] = model_step(B, x, u)``.
+    m_functions : tuple of str
+        The other MATLAB subfunctions ``m_model`` (and ``m_load``) define; an export named like
+        one of them gets a ``_model`` suffix, as it would shadow it.
+    extra : callable
+        ``extra(comp) -> dict``: numbers beyond the body (rest-state constants), as
+        ``plan.extra``; default none.
+    state_size : callable
+        ``state_size(plan) -> int``: length of the translated state; default the block's.
+    inverse : bool
+        Whether ``block_inverse`` is translated (an inverse-mode compensator is refused
+        otherwise).
+    m_load : str or None
+        MATLAB ``x = model_load(B, x_block)`` turning a block state into the translated one,
+        for a translation that keeps more state than the block; None: the block's as is.
+    """
+
+    c_model: Callable[[Any, Callable[[float], str]], str]
+    m_model: Callable[[Any, Callable[[float], str]], str]
+    m_functions: tuple[str, ...] = ()
+    extra: Callable[[Any], dict] = _no_extra
+    state_size: Callable[[Any], int] = _block_state
+    inverse: bool = True
+    m_load: str | None = None
+
+
 class Family(ABC):
     """One hysteresis model family. Subclass it once per family; export an instance as FAMILY.
 
@@ -205,6 +261,10 @@ class Family(ABC):
         The family's frozen dataclasses (both derive from :class:`Record`).
     no_inverse_reason : str
         Empty when the family has an inverse; otherwise why not (``invert`` is then None).
+    export : Translation or None
+        The block in C and MATLAB (the family's ``export.py``); None: not exportable.
+    no_export_reason : str
+        Why there is no ``export`` (``hystkit export`` says it); a default names the file.
     """
 
     name: ClassVar[str]
@@ -216,6 +276,8 @@ class Family(ABC):
     Structure: ClassVar[type]
     Params: ClassVar[type]
     no_inverse_reason: ClassVar[str] = ""
+    export: ClassVar[Translation | None] = None
+    no_export_reason: ClassVar[str] = ""
 
     model: ClassVar[ModuleType | None] = None
     """The module of the family's pure functions. ``rest_state``, ``step``, ``simulate`` and,
@@ -268,6 +330,16 @@ class Family(ABC):
 
     def __repr__(self) -> str:
         return f"<hystkit model family {self.name!r}>"
+
+    def export_refusal(self, inverse: bool = False) -> str:
+        """Why the family (its inverse when `inverse`) cannot be exported; empty when it can."""
+        if self.export is None:
+            return self.no_export_reason or (
+                f"no translation of family {self.name!r} (a family's C and MATLAB code is its "
+                f"export.py, see docs/models/README.md)")
+        if inverse and not self.export.inverse:
+            return f"the {self.name} family has no inverse to translate"
+        return ""
 
     # -- structure --------------------------------------------------------------------------
 

@@ -8,6 +8,7 @@ import numpy as np
 
 from ..._lazy import lazy
 from .._protocol import Block, Family
+from .export import TRANSLATION
 
 if TYPE_CHECKING:
     from . import model as bobbio
@@ -24,6 +25,7 @@ class BobbioFamily(Family):
     default_size = 10
     max_size = 100
     docs = "docs/models/circuits.md"
+    export = TRANSLATION  # export.py: the block in C and MATLAB
     # The equations, fit and numba kernels load on first use, not with the registry.
     Structure = lazy(".model", "BobbioStructure")
     Params = lazy(".model", "BobbioParams")

@@ -8,6 +8,7 @@ import numpy as np
 
 from ..._lazy import lazy
 from .._protocol import Block, Family
+from .export import TRANSLATION
 
 if TYPE_CHECKING:
     from . import model as boucwen
@@ -25,6 +26,7 @@ class BoucWenFamily(Family):
     default_size = 2
     max_size = 64
     docs = "docs/models/boucwen.md"
+    export = TRANSLATION  # export.py: the block in C and MATLAB
     # The equations, fit and numba kernels load on first use, not with the registry.
     Structure = lazy(".model", "BoucWenStructure")
     Params = lazy(".model", "BoucWenParams")

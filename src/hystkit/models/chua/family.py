@@ -9,6 +9,7 @@ import numpy as np
 
 from ..._lazy import lazy
 from .._protocol import Block, Family
+from .export import TRANSLATION
 
 if TYPE_CHECKING:
     from . import model as chua
@@ -25,6 +26,7 @@ class ChuaFamily(Family):
     default_size = 1
     max_size = 20
     docs = "docs/models/circuits.md"
+    export = TRANSLATION  # export.py: the block in C and MATLAB
     # The equations, fit and numba kernels load on first use, not with the registry.
     Structure = lazy(".model", "ChuaStructure")
     Params = lazy(".model", "ChuaParams")

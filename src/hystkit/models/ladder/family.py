@@ -10,6 +10,7 @@ import numpy as np
 from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._protocol import Block, Family
+from .export import TRANSLATION
 
 if TYPE_CHECKING:
     from . import model as ladder
@@ -26,6 +27,7 @@ class LadderFamily(Family):
     default_size = 2
     max_size = 50
     docs = "docs/models/circuits.md"
+    export = TRANSLATION  # export.py: the block in C and MATLAB
     # The equations, fit and numba kernels load on first use, not with the registry.
     Structure = lazy(".model", "LadderStructure")
     Params = lazy(".model", "LadderParams")

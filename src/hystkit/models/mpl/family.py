@@ -9,6 +9,7 @@ import numpy as np
 from ..._lazy import lazy
 from .._cells import Cells, cell_reductions, cell_report
 from .._protocol import Block, Family, FitStart
+from .export import TRANSLATION
 
 if TYPE_CHECKING:
     from . import model as mpl
@@ -25,6 +26,7 @@ class MplFamily(Family):
     default_size = 1
     max_size = 50
     docs = "docs/models/mpl.md"
+    export = TRANSLATION  # export.py: the block in C and MATLAB
     # The equations, fit and numba kernels load on first use, not with the registry.
     Structure = lazy(".model", "MplStructure")
     Params = lazy(".model", "MplParams")

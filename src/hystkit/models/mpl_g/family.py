@@ -11,6 +11,7 @@ from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._cells import Cells, cell_reductions, cell_report
 from .._protocol import Block, Family, FitStart
+from .export import TRANSLATION
 
 if TYPE_CHECKING:
     from . import model as mpl_g
@@ -30,6 +31,7 @@ class MplGFamily(Family):
     default_size = 1
     max_size = 50
     docs = "docs/models/mpl_g.md"
+    export = TRANSLATION  # export.py: the block in C and MATLAB
     # The equations, fit and numba kernels load on first use, not with the registry.
     Structure = lazy(".model", "MplGStructure")
     Params = lazy(".model", "MplGParams")

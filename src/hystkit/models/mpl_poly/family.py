@@ -10,6 +10,7 @@ from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._cells import Cells, cell_report
 from .._protocol import Block, Family, FitStart
+from .export import TRANSLATION
 
 if TYPE_CHECKING:
     from . import model as mpl_poly
@@ -26,6 +27,7 @@ class MplPolyFamily(Family):
     default_size = 1
     max_size = 30
     docs = "docs/models/mpl_poly.md"
+    export = TRANSLATION  # export.py: the block in C and MATLAB
     # The equations, fit and numba kernels load on first use, not with the registry.
     Structure = lazy(".model", "MplPolyStructure")
     Params = lazy(".model", "MplPolyParams")

@@ -10,6 +10,7 @@ import numpy as np
 from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._protocol import Block, Family
+from .export import TRANSLATION
 
 __all__ = ["PiFamily"]
 
@@ -24,6 +25,7 @@ class PiFamily(Family):
     default_size = 10
     max_size = 200
     docs = "docs/models/pi.md"
+    export = TRANSLATION  # export.py: the block in C and MATLAB
     # The equations, fit and numba kernels load on first use, not with the registry.
     Structure = lazy(".model", "PiStructure")
     Params = lazy(".model", "PiParams")

@@ -9,6 +9,7 @@ import numpy as np
 from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._protocol import Block, Family
+from .export import TRANSLATION
 
 if TYPE_CHECKING:
     from . import model as pl
@@ -25,6 +26,7 @@ class PlFamily(Family):
     default_size = 1
     max_size = 50
     docs = "docs/models/pl.md"
+    export = TRANSLATION  # export.py: the block in C and MATLAB
     # The equations, fit and numba kernels load on first use, not with the registry.
     Structure = lazy(".model", "PlStructure")
     Params = lazy(".model", "PlParams")

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..._lazy import lazy
 from .._protocol import Block, Family
+from .export import TRANSLATION
 
 if TYPE_CHECKING:
     from . import model as preisach
@@ -54,6 +55,7 @@ class StaircaseFamily(Family):
     which every method here wraps (so the protocol's ``model`` defaults are not used).
     """
 
+    export = TRANSLATION  # export.py: the staircase block in C and MATLAB (gpreisach's too)
     stairs: ClassVar[ModuleType]
 
     def at(self, structure, dt):

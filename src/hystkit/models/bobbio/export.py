@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-HAS_INVERSE = True
+from .._protocol import Translation
 
 
 def extra(comp) -> dict:
@@ -185,3 +185,12 @@ end
 x = project(B, x, f);
 end
 """
+
+
+# The family's block in C and MATLAB: FAMILY.export (family.py).
+TRANSLATION = Translation(
+    c_model=c_model,
+    m_model=m_model,
+    m_functions=("project",),
+    extra=extra,
+    state_size=state_size)

@@ -11,7 +11,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-HAS_INVERSE = True
+from .._cubic_output_code import C_SOLVE, M_CUBIC, M_SOLVE
+from .._protocol import Translation
 
 
 def extra(comp) -> dict:
@@ -22,10 +23,6 @@ def extra(comp) -> dict:
     p = comp.params
     v_rest = np.asarray(rest_voltages(comp.structure, p), float)
     return {"V_REST": v_rest, "W_SUM": float(p.w.sum()), "W_V": float(p.w[1:] @ v_rest)}
-
-
-def state_size(plan) -> int:
-    return plan.n_block_state
 
 
 def c_model(plan, lit: Callable[[float], str]) -> str:
@@ -42,7 +39,7 @@ def c_model(plan, lit: Callable[[float], str]) -> str:
               if plan.inverse and e["W_SUM"] != 0 else
               "    (void)value;\n" if plan.inverse else "")
     step = _C_INVERSE if plan.inverse else _C_FORWARD
-    solver = _C_SOLVE if plan.inverse else ""
+    solver = C_SOLVE if plan.inverse else ""
     return f"""#define N_CELLS {n}
 #define IG 9
 #define IF 13
@@ -96,57 +93,6 @@ static real model_step(real *x, real u)
     y = cubic(BODY + IG, z, 0);
     cells(x, u);
     return y;
-}
-"""
-
-_C_SOLVE = """
-/* The z on the rest branch [lo, hi] of g with g(z) = i: safeguarded Newton inside a
-   bisection bracket (kernels.solve_output); *ok = 0 when i is outside the branch's range */
-static real solve_output(real i, int *ok)
-{
-    const real *g = BODY + IG;
-    const real lo = BODY[5], hi = BODY[6], sign = BODY[7], centre = BODY[8];
-    real width = R(1.0), a, b, h_a, h_b, z;
-    int it;
-    *ok = 0;
-    a = isfinite(lo) ? lo : centre - width;
-    h_a = sign * (cubic(g, a, 0) - i);
-    while (h_a > R(0.0)) {
-        if (isfinite(lo) || width > R(1e15)) return R(0.0);
-        width *= R(2.0);
-        a = centre - width;
-        h_a = sign * (cubic(g, a, 0) - i);
-    }
-    width = R(1.0);
-    b = isfinite(hi) ? hi : centre + width;
-    h_b = sign * (cubic(g, b, 0) - i);
-    while (h_b < R(0.0)) {
-        if (isfinite(hi) || width > R(1e15)) return R(0.0);
-        width *= R(2.0);
-        b = centre + width;
-        h_b = sign * (cubic(g, b, 0) - i);
-    }
-    z = g[1] != R(0.0) ? (i - g[0]) / g[1] : a;
-    if (!(a < z && z < b)) z = R(0.5) * (a + b);
-    for (it = 0; it < 200; it++) {
-        real dg, gz = cubic(g, z, &dg), h, z_new;
-        int newton;
-        h = sign * (gz - i);
-        if (h == R(0.0)) break;
-        if (h < R(0.0)) a = z;
-        else b = z;
-        newton = dg != R(0.0);
-        z_new = newton ? z - (gz - i) / dg : z;
-        if (!newton || !(a < z_new && z_new < b)) z_new = R(0.5) * (a + b);
-        if (FABS(z_new - z) <= R(4e-16) * (R(1.0) + FABS(z))
-            || b - a <= R(4e-16) * (R(1.0) + FABS(z))) {
-            z = z_new;
-            break;
-        }
-        z = z_new;
-    }
-    *ok = 1;
-    return z;
 }
 """
 
@@ -227,51 +173,10 @@ end
 """
 
 
-# Shared with translations whose output resistor is this cubic ``g`` (mpl_g.py): plain text,
-# no format fields.
-M_CUBIC = """function [v, slope] = cubic(c, x)
-v = c(1) + x * (c(2) + x * (c(3) + x * c(4)));
-slope = c(2) + x * (2.0 * c(3) + 3.0 * c(4) * x);
-end
 
-"""
-
-M_SOLVE = """function [z, ok] = solve_output(B, i)
-g = B(10:13); lo = B(6); hi = B(7); sign_ = B(8); centre = B(9);
-z = NaN; ok = false;
-width = 1.0;
-if isfinite(lo), a = lo; else, a = centre - width; end
-h_a = sign_ * (cubic(g, a) - i);
-while h_a > 0
-    if isfinite(lo) || width > 1e15, return; end
-    width = width * 2.0;
-    a = centre - width;
-    h_a = sign_ * (cubic(g, a) - i);
-end
-width = 1.0;
-if isfinite(hi), b = hi; else, b = centre + width; end
-h_b = sign_ * (cubic(g, b) - i);
-while h_b < 0
-    if isfinite(hi) || width > 1e15, return; end
-    width = width * 2.0;
-    b = centre + width;
-    h_b = sign_ * (cubic(g, b) - i);
-end
-if g(2) ~= 0, z = (i - g(1)) / g(2); else, z = NaN; end
-if ~(a < z && z < b), z = 0.5 * (a + b); end
-for it = 1:200
-    [gz, dg] = cubic(g, z);
-    h = sign_ * (gz - i);
-    if h == 0, break; end
-    if h < 0, a = z; else, b = z; end
-    if dg ~= 0, z_new = z - (gz - i) / dg; else, z_new = NaN; end
-    if ~(a < z_new && z_new < b), z_new = 0.5 * (a + b); end
-    if abs(z_new - z) <= 4e-16 * (1.0 + abs(z)) || b - a <= 4e-16 * (1.0 + abs(z))
-        z = z_new;
-        break;
-    end
-    z = z_new;
-end
-ok = true;
-end
-"""
+# The family's block in C and MATLAB: FAMILY.export (family.py).
+TRANSLATION = Translation(
+    c_model=c_model,
+    m_model=m_model,
+    m_functions=("cells", "cubic", "solve_output"),
+    extra=extra)

@@ -15,7 +15,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-HAS_INVERSE = True
+from .._protocol import Translation
+
 REST_TOL = 1e-12  # kernels.REST_TOL
 FLOAT_TOL = 2e-6  # in float, REST_TOL is below the resolution: ~16 float epsilons instead
 
@@ -26,10 +27,6 @@ def extra(comp) -> dict:
     p = comp.params
     return {"MAX_K": float(np.max(np.maximum(p.k0, p.k_inf))),
             "MAX_SPREAD": float(np.max(np.abs(p.k0 - p.k_inf) * p.y_s))}
-
-
-def state_size(plan) -> int:
-    return plan.n_block_state
 
 
 def c_model(plan, lit: Callable[[float], str]) -> str:
@@ -303,3 +300,12 @@ for k = 1:n
 end
 end
 """
+
+
+# The family's block in C and MATLAB: FAMILY.export (family.py).
+TRANSLATION = Translation(
+    c_model=c_model,
+    m_model=m_model,
+    m_functions=("P", "dissipation", "dissipation_inverse", "rest_input", "restoring",
+                 "restoring_inverse"),
+    extra=extra)

@@ -13,7 +13,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-HAS_INVERSE = True
+from .._protocol import Translation
+
 REST_TOL = 1e-12  # kernels.REST_TOL
 # In float the inverse's tolerances (the rest test and the bisection's bracket, 1e-12 for
 # double) are ~16 float epsilons: below that the bisection only collects rounding noise.
@@ -516,3 +517,14 @@ end
 x(1) = n;
 end
 """
+
+
+# The family's block in C and MATLAB: FAMILY.export (family.py).
+TRANSLATION = Translation(
+    c_model=c_model,
+    m_model=m_model,
+    m_functions=("A", "branch_output", "combine", "everett", "last_index", "load_sums",
+                 "make_room", "running_sum", "term", "update"),
+    extra=extra,
+    state_size=state_size,
+    m_load=M_LOAD)

@@ -9,16 +9,12 @@ from collections.abc import Callable
 
 import numpy as np
 
-HAS_INVERSE = True
+from .._protocol import Translation
 
 
 def extra(comp) -> dict:
     """``W_SUM``: ``sum(w)``, the divisor of the inverse's rest input ``(y + V_b) / sum(w)``."""
     return {"W_SUM": float(np.sum(comp.params.w))}
-
-
-def state_size(plan) -> int:
-    return plan.n_block_state
 
 
 def c_model(plan, lit: Callable[[float], str]) -> str:
@@ -110,3 +106,11 @@ else
 end
 end
 """
+
+
+# The family's block in C and MATLAB: FAMILY.export (family.py).
+TRANSLATION = Translation(
+    c_model=c_model,
+    m_model=m_model,
+    m_functions=("mpl_current",),
+    extra=extra)

@@ -12,7 +12,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-HAS_INVERSE = True
+from .._protocol import Translation
 
 
 def extra(comp) -> dict:
@@ -24,10 +24,6 @@ def extra(comp) -> dict:
     d_inv, ws_inv = inverse_superposition(p.d_s, p.w_s)
     return {"GAIN": float(p.w_h.sum() + p.w_k.sum()), "B": float(p.b),
             "D_INV": np.asarray(d_inv, float), "WS_INV": np.asarray(ws_inv, float)}
-
-
-def state_size(plan) -> int:
-    return plan.n_block_state
 
 
 def _c_array(name, values, lit) -> str:
@@ -213,3 +209,11 @@ end
 x = move(B, x, u_hat);
 end
 """
+
+
+# The family's block in C and MATLAB: FAMILY.export (family.py).
+TRANSLATION = Translation(
+    c_model=c_model,
+    m_model=m_model,
+    m_functions=("layout", "move", "superposition"),
+    extra=extra)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-HAS_INVERSE = False
+from .._protocol import Translation
 
 
 def extra(comp) -> dict:
@@ -16,10 +16,6 @@ def extra(comp) -> dict:
     ``z = alpha y``)."""
     s, p = comp.structure, comp.params
     return {"EQUILIBRIUM": s.start != "rest", "K0": float(p.k0), "ALPHA": float(p.alpha)}
-
-
-def state_size(plan) -> int:
-    return plan.n_block_state
 
 
 def c_model(plan, lit: Callable[[float], str]) -> str:
@@ -115,3 +111,12 @@ x = [y; v; z; u];
 out = y;
 end
 """
+
+
+# The family's block in C and MATLAB: FAMILY.export (family.py).
+TRANSLATION = Translation(
+    c_model=c_model,
+    m_model=m_model,
+    m_functions=("rhs",),
+    extra=extra,
+    inverse=False)

@@ -12,18 +12,13 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .mpl_poly import _C_SOLVE, M_CUBIC, M_SOLVE
-
-HAS_INVERSE = True
+from .._cubic_output_code import C_SOLVE, M_CUBIC, M_SOLVE
+from .._protocol import Translation
 
 
 def extra(comp) -> dict:
     """``W_SUM``: ``sum(w)``, the divisor of the inverse's rest input ``(z_0 + V_b) / sum(w)``."""
     return {"W_SUM": float(np.sum(comp.params.w))}
-
-
-def state_size(plan) -> int:
-    return plan.n_block_state
 
 
 def c_model(plan, lit: Callable[[float], str]) -> str:
@@ -64,7 +59,7 @@ static void cells(real *x, real drive)
     int k;
     for (k = 0; k < N_CELLS; k++) x[k] = x[k] + current(drive - x[k], k) * BODY[3];
 }}
-{_C_SOLVE if plan.inverse else ""}
+{C_SOLVE if plan.inverse else ""}
 static void model_rest(real *x, real value)
 {{
     int k;
@@ -158,3 +153,11 @@ if ok, u_hat = acc / B(iw); else, u_hat = NaN; end
 x = cells(B, x, u_hat);
 end
 """
+
+
+# The family's block in C and MATLAB: FAMILY.export (family.py).
+TRANSLATION = Translation(
+    c_model=c_model,
+    m_model=m_model,
+    m_functions=("cells", "cubic", "solve_output"),
+    extra=extra)
