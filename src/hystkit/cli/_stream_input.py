@@ -1,19 +1,26 @@
 """``hystkit stream``'s input read as ``fit`` reads a file: the same reading options.
 
-``stream`` parses ``time,sensor[,reference]`` lines one at a time. A user's file has its own
-layout: another separator, a decimal comma, ``#`` comment lines, a units line, its own column
-names, time in ms; ``--in FILE`` also has a settings file beside it (``my.toml``). Here each
-input line is rewritten into ``stream``'s own form before it is parsed (one line out per line
-in, so line numbers stay the file's): comment, units and skipped lines become blank lines,
-the header becomes ``time,sensor[,reference]``, a data line its time [s], sensor and
-reference with decimal points (blank lines stay blank). Anything that does not fit (a missing field, text) stays
-recognisably bad, so ``stream`` counts and skips it as before. Time read in another unit is
-written (and echoed) in seconds. Without any of this (a plain ``time,sensor`` input and no
-option), the lines pass through untouched.
+``stream`` parses ``time,sensor[,reference]`` lines. A user's file has its own layout: another
+separator, a decimal comma, ``#`` comment lines, a units line, its own column names, time in
+ms; ``--in FILE`` also has a settings file beside it (``my.toml``). Here each input line is
+rewritten into ``stream``'s own form before it is parsed (one line out per line in, so line
+numbers stay the file's): comment, units and skipped lines become blank lines, the header
+becomes ``time,sensor[,reference]``, a data line its time (in the input's unit, which the
+parser converts: `StreamFormat.time_scale`), sensor and reference with decimal points (blank
+lines stay blank). Anything that does not fit (a missing field, text) stays recognisably bad,
+so ``stream`` counts and skips it as before. Without any of this (a plain ``time,sensor`` input
+and no option), the lines pass through untouched.
 
 In a file (``--in``), a first line that is neither numbers nor a header naming the time and
 sensor columns as the options say is refused at once, with the fix (``--columns``), instead
 of every line being skipped; a live input may start mid-line, so there it is only skipped.
+
+The output keeps the input's names as ``compensate`` does (`output_header`): the time column
+under the input's name and unit (echoed as received), the estimate and band named after the
+position column (``x_mm_estimate``, ...). A model that remembers how its training files were
+read (their ``reading``) reads stdin and a serial port that way too unless ``--columns`` or
+``--time-unit`` say otherwise (`live_as_trained`): a live input cannot be looked at before the
+output's header is written.
 """
 
 from __future__ import annotations
@@ -21,13 +28,13 @@ from __future__ import annotations
 import argparse
 import re
 import sys
-from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..errors import InputError
 
-__all__ = ["StreamFormat", "nothing_compensated", "stream_format", "stream_lines"]
+__all__ = ["Rewriter", "StreamFormat", "live_as_trained", "nothing_compensated",
+           "output_header", "stream_format"]
 
 _NUMBER = re.compile(r"\s*[+-]?(\d+[.,]?\d*|[.,]\d+)([eE][+-]?\d+)?\s*")
 
@@ -53,6 +60,8 @@ class StreamFormat:
     comment_header : int
         The line (from 1) of a header written as a comment (``# time,position,sensor``, as
         ``numpy.savetxt`` writes it, `hystkit.io.CsvLayout`); 0: none.
+    position : str
+        The input's name of the position column (the output names its estimate after it).
     """
 
     sep: str = ","
@@ -63,11 +72,13 @@ class StreamFormat:
     after_header: int = 0
     check_header: bool = False
     comment_header: int = 0
+    position: str = "position"
 
     @property
     def plain(self) -> bool:
-        """Whether lines need no rewriting (``stream``'s own form)."""
-        return self == StreamFormat()
+        """Whether lines need no rewriting (``stream``'s own form; the names of the output
+        play no part)."""
+        return replace(self, position="position", time_scale=1.0) == StreamFormat()
 
 
 def stream_format(args: argparse.Namespace) -> StreamFormat:
@@ -128,47 +139,107 @@ def _format(options, sep: str, decimal: str, check_header: bool = False,
             comment_header: int = 0) -> StreamFormat:
     return StreamFormat(sep, decimal, options.name("time"), options.name("sensor"),
                         options.time_scale, options.units_row + options.skip_rows, check_header,
-                        comment_header)
+                        comment_header, options.name("position"))
+
+
+def output_header(fmt: StreamFormat, banded: bool) -> str:
+    """The output's header line: ``time,position_estimate,flags`` (and the band's
+    ``position_lower,position_upper``) in the input's names, as ``compensate`` names them
+    (`hystkit.cli._own_layout.estimate_names`)."""
+    from ._own_layout import estimate_names
+
+    new = estimate_names({"position": fmt.position})
+    band = f",{new['position_lower']},{new['position_upper']}" if banded else ""
+    return f"{fmt.time},{new['position_estimate']},flags{band}\n"
+
+
+def live_as_trained(args: argparse.Namespace, reading) -> None:
+    """stdin or a serial port read as the model's training files were (their columns and
+    time unit, `reading`), unless ``--columns`` or ``--time-unit`` is given: put it on `args`
+    as if given, and say so on stderr. No units line: a live input has none to look for."""
+    from .._read_options import FIELDS
+    from ._common import given_read_options
+
+    if args.input is not None or reading is None or not (reading.columns
+                                                         or reading.time_unit != "s"):
+        return
+    given = given_read_options(args)
+    if "columns" in given or "time_unit" in given:
+        return
+    args.columns, args.time_unit = reading.columns, reading.time_unit
+    parts = [f"columns {','.join(reading.name(field) for field in FIELDS)}"] \
+        if reading.columns else []
+    parts.append(f"time in {reading.time_unit}")
+    source = "<stdin>" if args.serial is None else str(args.serial)
+    _say(f"reading {source} as the model's training data were read: {', '.join(parts)} "
+         "(--columns and --time-unit read it otherwise)")
 
 
 def _say(line: str) -> None:
     print(f"hystkit stream: {line}", file=sys.stderr, flush=True)
 
 
-def stream_lines(lines: Iterator[str], fmt: StreamFormat, source: str,
-                 too_long: str) -> Iterator[str]:
-    """`lines` rewritten into ``time,sensor[,reference]`` lines as `fmt` says (see the
-    module); `too_long` (stream's marker of an overlong line) passes through."""
-    columns: tuple[int, int, int | None] | None = None
-    skip = 0
-    for line_no, line in enumerate(lines, start=1):
-        if line is too_long:
-            yield line
-            continue
+class Rewriter:
+    """Input lines rewritten one by one into ``time,sensor[,reference]`` lines as `fmt`
+    says (see the module); `too_long` (stream's marker of an overlong line) passes through.
+
+    Parameters
+    ----------
+    fmt : StreamFormat
+        How the input is written.
+    source : str
+        Names the input in errors.
+    too_long : str
+        The marker, passed through as it is.
+    """
+
+    def __init__(self, fmt: StreamFormat, source: str, too_long: str) -> None:
+        self.fmt, self.source, self.too_long = fmt, source, too_long
+        self.columns: tuple[int, int, int | None] | None = None
+        self.skip = 0
+        self.line_no = 0
+        # once the header is behind: lines already in stream's form (a comma, decimal points,
+        # time and sensor first) pass as they are, since stream's parser reads them alike
+        self.same = False
+
+    def chunk(self, lines: list[str]) -> list[str]:
+        """A chunk of lines rewritten (in order: the header decides how)."""
+        done: list[str] = []
+        for k, line in enumerate(lines):
+            if self.same:
+                self.line_no += len(lines) - k
+                return done + lines[k:] if done else lines[k:]
+            done.append(self(line))
+        return done
+
+    def __call__(self, line: str) -> str:
+        self.line_no += 1
+        if line is self.too_long:
+            return line
+        fmt = self.fmt
         end = "\n" if line.endswith("\n") else ""
         text = line.rstrip("\r\n")
-        if columns is None:
+        if self.columns is None:
             text = text.lstrip("\ufeff")  # a UTF-8 BOM first
-            if line_no == fmt.comment_header:
+            if self.line_no == fmt.comment_header:
                 text = text.lstrip().lstrip("#")  # the header, written as a comment
             elif not text.strip() or text.lstrip().startswith("#"):
-                yield end  # blank and comment lines before the header
-                continue
+                return end  # blank and comment lines before the header
             fields = _split(text, fmt.sep)
-            columns = _header(fields, fmt)
-            if columns is not None:
-                skip = fmt.after_header
-                yield "time,sensor,reference" + end if columns[2] is not None \
-                    else "time,sensor" + end
-                continue
+            self.columns = _header(fields, fmt)
+            if self.columns is not None:
+                self.skip = fmt.after_header
+                return ("time,sensor,reference" if self.columns[2] is not None
+                        else "time,sensor") + end
             if fmt.check_header and not any(_NUMBER.fullmatch(f) for f in fields[:2]):
-                raise InputError(_no_header(source, line_no, fields, fmt))
-            columns = (0, 1, 2)  # no header: time, sensor, reference in this order
-        if skip:
-            skip -= 1
-            yield end
-            continue
-        yield _rewrite(text, fmt, columns) + end if text.strip() else line
+                raise InputError(_no_header(self.source, self.line_no, fields, fmt))
+            self.columns = (0, 1, 2)  # no header: time, sensor, reference in this order
+        if self.skip:
+            self.skip -= 1
+            return end
+        self.same = (fmt.sep, fmt.decimal) == (",", ".") and self.columns[:2] == (0, 1) \
+            and self.columns[2] in (None, 2)
+        return _rewrite(text, fmt, self.columns) + end if text.strip() else line
 
 
 def nothing_compensated(source: str, count: dict[str, int], first: dict[str, int]) -> str:
@@ -203,17 +274,13 @@ def _no_header(source: str, line_no: int, fields: list[str], fmt: StreamFormat) 
 
 
 def _rewrite(text: str, fmt: StreamFormat, columns: tuple[int, int, int | None]) -> str:
-    """One data line as ``time,sensor[,reference]``; a field it lacks stays empty (stream
-    counts the line as missing a field), text stays text (not a number)."""
+    """One data line as ``time,sensor[,reference]``, time in its own unit; a field it lacks
+    stays empty (stream counts the line as missing a field), text stays text (not a
+    number)."""
     fields = _split(text, fmt.sep)
     picked = [fields[j] if j is not None and j < len(fields) else "" for j in columns]
     if fmt.decimal == ",":
         picked = [f if "." in f else f.replace(",", ".") for f in picked]
     elif fmt.sep != ",":
         picked = [f.replace(",", ";") for f in picked]  # a stray comma is no separator here
-    if fmt.time_scale != 1.0 and picked[0]:
-        try:
-            picked[0] = repr(float(picked[0]) * fmt.time_scale)  # stream's time is in s
-        except ValueError:
-            pass
     return ",".join(picked if picked[2] else picked[:2])
