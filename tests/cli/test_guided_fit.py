@@ -113,10 +113,15 @@ def test_a_budget_too_small_for_any_candidate_says_so_and_what_to_try(data):  # 
 
 
 def test_pieces_after_the_deadline_are_skipped_not_run():
+    from hystkit.compensation import Candidate
+
     def must_not_run(item):
         raise AssertionError(f"piece {item} ran after the deadline")
 
+    cand = Candidate("mpl", 1, "direct", "fit")
     done = []
-    results = _Budgeted(SerialExecutor(), deadline=0.0).map(
-        must_not_run, [1, 2, 3], on_done=lambda i, r: done.append(i))
+    budgeted = _Budgeted(SerialExecutor(), deadline=0.0)
+    results = budgeted.map(must_not_run, [(cand, k, {}) for k in range(3)],
+                           on_done=lambda i, r: done.append(i))
     assert results == [{"error": SKIPPED}] * 3 and done == [0, 1, 2]
+    assert budgeted.late == {cand.label}

@@ -12,9 +12,10 @@ hysteretic sensor usually shows with the cheapest families that show it:
 - ``mpl`` 2 and 3 cells: more time scales, for relaxation and drift beside the hysteresis;
 - ``pl`` 1 cell: the Power-Law as published, another shape of the static curve.
 
-Measured today on 2 cores (6 candidates x 3 folds, the winner's refit and band): 15 s on a
-simulated piezoresistive sensor of 10,000 samples, 30 s on the MR damper's 11,274 and 18 s on
-the micromanipulator's 14,154. Candidates run cheapest first (:func:`hystkit.parallel.fit_cost`);
+Measured on 2 cores at load 2-6 (6 candidates x 3 folds, the winner's refit and band, wall
+time of the command): 23 s on a simulated piezoresistive sensor of 10,000 samples, 31 s on the
+MR damper's 11,274, 18 s on the micromanipulator's 14,154; on the piezo actuator's 50,001, 49 s
+with mpl:3 skipped for the budget. Candidates run cheapest first (:func:`hystkit.parallel.fit_cost`);
 a piece of work not started within ``VALIDATION_SHARE`` of the budget is skipped (its
 candidate said so), which leaves the rest to the winner's refit and band; a candidate whose
 a-priori cost alone (a floor: measured on easy data) exceeds that share is not started at all.
@@ -78,18 +79,27 @@ def _unless_late(func: Callable, deadline: float, item, **shared):
 
 class _Budgeted:
     """An executor that runs the pieces in the order given (cheapest candidates first) and
-    starts none after `deadline` (seconds since the epoch)."""
+    starts none after `deadline` (seconds since the epoch); ``late`` collects the labels of
+    the candidates (a piece's first element) with a piece skipped."""
 
     def __init__(self, inner, deadline: float):
         self.inner, self.deadline, self.n_workers = inner, deadline, inner.n_workers
+        self.late: set[str] = set()
 
     def describe(self) -> str:
         return self.inner.describe()
 
     def map(self, func, items, *, shared=None, on_done=None, cost=None) -> list:
         rank = {id(item): i for i, item in enumerate(items)}
+
+        def done(i: int, result) -> None:
+            if isinstance(result, dict) and result.get("error") == SKIPPED:
+                self.late.add(items[i][0].label)
+            if on_done is not None:
+                on_done(i, result)
+
         return self.inner.map(partial(_unless_late, func, self.deadline), items, shared=shared,
-                              on_done=on_done, cost=lambda item: -rank[id(item)])
+                              on_done=done, cost=lambda item: -rank[id(item)])
 
 
 def guided_select(recordings: Sequence, *, budget: float = DEFAULT_BUDGET, mode: str = "direct",
@@ -142,8 +152,14 @@ def guided_select(recordings: Sequence, *, budget: float = DEFAULT_BUDGET, mode:
         return {"winner": None, "compensator": None, "ranking": [], "skipped": skipped,
                 "candidates": [], "protocol": protocol(recordings), "caveats": [], "folds": [],
                 "refusal": f"no candidate can be validated within the {budget:g} s budget"}
-    result = select_model(recordings, cands, executor=_Budgeted(executor, t0 + share),
-                          progress=progress, **options)
+    budgeted = _Budgeted(executor, t0 + share)
+
+    def say(line: str) -> None:  # select_model counts a skipped candidate as validated
+        if line.strip().split(": ")[0] in budgeted.late:
+            line = line.replace(": validated", ": skipped (time budget)")
+        progress(line)
+
+    result = select_model(recordings, cands, executor=budgeted, progress=say, **options)
     late = [r for r in result["ranking"] if r.get("error") == SKIPPED]
     result["ranking"] = [r for r in result["ranking"] if r.get("error") != SKIPPED]
     result["skipped"] = skipped + [(r["candidate"], SKIPPED) for r in late]
@@ -179,8 +195,8 @@ def explain(result: dict, n_folds: int) -> list[str]:
     usable = [r for r in result["ranking"] if "error" not in r and not r["guard_failed"]
               and r["verdict"] == "ok" and r is not w]
     first = (f"chose {w['model']} (size {w['size']}, {w['mode']} mode, centring "
-             f"{w['center']}): the best held-out score of {len(result['candidates'])} "
-             f"candidates, beating its straight line")
+             f"{w['center']}): the best held-out score of {len(result['ranking'])} "
+             f"candidates validated, beating its straight line")
     oracle = "" if w["cv_r2_oracle"] is None else f", oracle {w['cv_r2_oracle']:.4f}"
     second = (f"  deployable R² {w['cv_r2']:.4f} on held-out data ({result['protocol']}, mean "
               f"over {n_folds} fold(s); worst fold {w['cv_r2_min']:.4f}); straight line "
