@@ -32,7 +32,8 @@ pytestmark = pytest.mark.skipif(
     bool(MISSING), reason=f"the docs packages are not installed ({', '.join(MISSING)}): "
                           "pip install '.[docs]'")
 
-_HREF = re.compile(r'(?:href|src)="([^"#]+)(?:#[^"]*)?"')
+_LINK = re.compile(r'(?:href|src)="([^"]+)"')
+_ID = re.compile(r'\bid="([^"]+)"')
 
 
 @pytest.fixture(scope="module")
@@ -129,12 +130,22 @@ def test_every_page_is_built_and_no_link_is_broken(site):
     sources |= {f"tutorial/{p.stem}" for p in (DOCS / "tutorial_src").glob("*.py")}
     built = {p.relative_to(site).with_suffix("").as_posix() for p in site.rglob("*.html")}
     assert not sources - built, f"pages left out of the site: {sorted(sources - built)}"
-    broken = []
+    ids: dict[Path, set[str]] = {}
+    broken, anchors = [], 0
     for page in (p for p in site.rglob("*.html") if "_static" not in p.parts):
-        for target in _HREF.findall(page.read_text(encoding="utf-8")):
+        for target in _LINK.findall(page.read_text(encoding="utf-8")):
             parsed = urlparse(target)
-            if parsed.scheme or parsed.netloc or not parsed.path:
+            if parsed.scheme or parsed.netloc or not (parsed.path or parsed.fragment):
                 continue
-            if not (page.parent / unquote(parsed.path)).exists():
+            dest = page.parent / unquote(parsed.path) if parsed.path else page
+            if not dest.exists():
                 broken.append(f"{page.relative_to(site)} -> {target}")
+            elif parsed.fragment and dest.suffix == ".html":
+                # a section anchor (#...) must name an element of the page it points to
+                if dest not in ids:
+                    ids[dest] = set(_ID.findall(dest.read_text(encoding="utf-8")))
+                anchors += 1
+                if unquote(parsed.fragment) not in ids[dest]:
+                    broken.append(f"{page.relative_to(site)} -> {target} (no such anchor)")
+    assert anchors > 100  # the check ran: the API and CLI pages alone link hundreds of sections
     assert not broken, "broken internal links:\n" + "\n".join(broken[:20])
