@@ -1,0 +1,281 @@
+"""Forward kernels against the fastest plain C (issue 29, items 1-2): every ratio is to ``fast C``.
+
+Run:  python benchmarks/bench_kernels.py [--quick]   (about a minute; writes
+      benchmarks/last_run_kernels.txt; --quick: fewer rounds, for a loaded machine)
+
+Models: mPL with 1, 3 and 5 cells and PL with 2 cells, each fitted (direct mode, centring fit)
+on the virtual sensor's sine recording (seed 1): realistic parameters, e.g. the 5-cell mPL has
+two nearly linear cells (V_T ~ 1e3). Inputs: that recording's normalised sensor (8000 samples)
+and the sine recordings of seeds 2, 3, ... normalised the same way and joined (100 000).
+
+Columns, ns per sample, each built in this run and called on the same input:
+
+* ``fast C``: ``_c_fast_reference.c``, ``cc -O3 -march=native`` (no -ffast-math): one exp per
+  cell, sinh from its series below |a| = 0.5, per-cell constants out of the loop (mPL); one pow
+  per cell (PL). The yardstick;
+* ``C no guard``: the same without the series, sinh = (e - 1/e) / 2 everywhere (mPL only):
+  what the guard costs, and (agreement table) what it saves;
+* ``slow C``: ``_c_reference.c`` as ``bench_mpl.py`` builds it (``cc -O2``, libm's sinh, the
+  kernel's operation order; mPL only, PL has none);
+* ``simulate``: ``family.simulate`` (the numba kernel with its Python wrapper: checks, knees);
+* ``export``: the model written by ``hystkit export --double`` (the command line, on the model
+  file ``hystkit fit`` would write), its ``model_step`` called per sample from a driver that
+  includes the generated C file, compiled with the fast C's flags (the compensator around it,
+  centring and flags, is ``bench_export.py``'s).
+
+Timing: rounds paired and interleaved (each round calls every column once, in turn: A B C A B
+C ...; the first call of each is untimed), ``perf_counter`` around a call; the table gives the
+median ns per sample and, per column, the median over rounds of that round's ratio to the
+round's ``fast C`` (pairing cancels most of the load from other processes).
+
+Agreement: per column, max |y - y_ref| / max |y_ref| on the 8000-sample input, ``y_ref`` the
+family's readable reference (``simulate_reference``, a Python loop over ``step``).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+if __name__ == "__main__":
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numba
+import numpy as np
+
+from hystkit.compensation import fit_compensator, save_compensator
+from hystkit.models.mpl import model as mpl
+from hystkit.models.pl import model as pl
+from hystkit.sensors import simulate_experiment
+
+HERE = Path(__file__).parent
+FAST_FLAGS = ("-O3", "-march=native", "-shared", "-fPIC")
+SLOW_FLAGS = ("-O2", "-shared", "-fPIC")  # as bench_mpl.py builds _c_reference.c
+CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2))
+SIZES = (8000, 100_000)
+ROUNDS = {8000: 41, 100_000: 15}
+QUICK_ROUNDS = {8000: 15, 100_000: 7}
+COLUMNS = ("fast C", "C no guard", "slow C", "simulate", "export")
+
+_ARR = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
+_I64, _DBL = ctypes.c_int64, ctypes.c_double
+_MPL_ARGS = [_ARR, _I64, _ARR, _I64, _ARR, _ARR, _ARR, _DBL, _ARR, _DBL, _DBL, _ARR]
+_PL_ARGS = [_ARR, _I64, _ARR, _I64, _DBL, _ARR, _ARR, _DBL, _DBL, _DBL, _ARR, _DBL, _ARR, _I64,
+            _ARR, _ARR]
+
+# Calls the exported model's static model_rest / model_step: the generated file is included.
+_EXPORT_DRIVER = r"""#include <stdint.h>
+#include "{name}.c"
+void export_run(const double *u, int64_t n, double *y)
+{{
+    static real x[1024];
+    model_rest(x, u[0]);
+    for (int64_t i = 0; i < n; ++i) y[i] = model_step(x, u[i]);
+}}
+"""
+
+
+def _compile(cc: str, flags, source: Path, out: Path, include: Path | None = None) -> ctypes.CDLL:
+    extra = ["-I", str(include)] if include else []
+    subprocess.run([cc, *flags, *extra, "-o", str(out), str(source), "-lm"], check=True,
+                   capture_output=True, text=True)
+    return ctypes.CDLL(str(out))
+
+
+def _function(lib: ctypes.CDLL, name: str, argtypes) -> ctypes._CFuncPtr:
+    fn = getattr(lib, name)
+    fn.argtypes, fn.restype = argtypes, None
+    return fn
+
+
+@dataclass
+class Case:
+    """One fitted model, its inputs and a callable per column (``fn(u) -> y``)."""
+
+    family: str
+    size: int
+    comp: object
+    inputs: dict = field(default_factory=dict)
+    columns: dict = field(default_factory=dict)
+
+    @property
+    def label(self) -> str:
+        return f"{self.family} {self.size}"
+
+
+def _inputs(comp, fit_rec) -> dict:
+    parts, seed = [comp.normalised_sensor(fit_rec.sensor)], 2
+    while sum(p.size for p in parts[1:]) < SIZES[1]:
+        parts.append(comp.normalised_sensor(simulate_experiment("sine", seed).sensor))
+        seed += 1
+    return {SIZES[0]: np.ascontiguousarray(parts[0]),
+            SIZES[1]: np.ascontiguousarray(np.concatenate(parts[1:])[:SIZES[1]])}
+
+
+def _mpl_columns(comp, fast, slow) -> dict:
+    s, p = comp.structure, comp.params
+    knee = mpl.knee_voltage(s, p)
+    cap, dt = s.slope_cap / s.dt, s.dt
+
+    def c_run(fn):
+        def run(u):
+            x, y = np.full(s.n_cells, u[0]), np.empty(u.size)
+            fn(u, u.size, x, s.n_cells, p.i_s, p.v_t, p.w, p.v_b, knee, cap, dt, y)
+            return y
+        return run
+
+    return {"fast C": c_run(_function(fast, "mpl_fast", _MPL_ARGS)),
+            "C no guard": c_run(_function(fast, "mpl_fast_unguarded", _MPL_ARGS)),
+            "slow C": c_run(_function(slow, "mpl_simulate", _MPL_ARGS))}
+
+
+def _pl_columns(comp, fast) -> dict:
+    s, p = comp.structure, comp.params
+    i_t, thr, knee, power, g_lin, dt = pl.kernel_args(s, p)
+    brk = pl.basis_breakpoints(s.n_basis)
+    a = np.ascontiguousarray(p.a, dtype=float)
+    fn = _function(fast, "pl_fast", _PL_ARGS)
+
+    def run(u):
+        x, y = np.full(s.n_cells, u[0]), np.empty(u.size)
+        fn(u, u.size, x, s.n_cells, i_t, thr, knee, power, g_lin, dt, p.w, p.v_b, brk, a.size,
+           a, y)
+        return y
+
+    return {"fast C": run}
+
+
+def _export_column(comp, label: str, cc: str, tmp: Path):
+    """``hystkit export --double`` on the saved model, its model_step compiled as fast C."""
+    name = label.replace(" ", "_").replace("-", "_")
+    model_file = tmp / f"{name}.json"
+    save_compensator(comp, model_file)
+    folder = tmp / f"{name}_c"
+    subprocess.run([sys.executable, "-m", "hystkit", "export", str(model_file), "--double",
+                    "--name", name, "--out", str(folder)], check=True, capture_output=True)
+    driver = folder / "bench_driver.c"
+    driver.write_text(_EXPORT_DRIVER.format(name=name))
+    lib = _compile(cc, FAST_FLAGS, driver, folder / "driver.so", include=folder)
+    fn = _function(lib, "export_run", [_ARR, _I64, _ARR])
+
+    def run(u):
+        y = np.empty(u.size)
+        fn(u, u.size, y)
+        return y
+
+    return run
+
+
+def build_cases(cc: str, tmp: Path) -> list[Case]:
+    fast = _compile(cc, FAST_FLAGS, HERE / "_c_fast_reference.c", tmp / "fast.so")
+    slow = _compile(cc, SLOW_FLAGS, HERE / "_c_reference.c", tmp / "slow.so")
+    fit_rec = simulate_experiment("sine", 1)
+    cases = []
+    for family, size in CASES:
+        comp = fit_compensator(fit_rec, size, model=family, diagnose=False)
+        case = Case(family, size, comp, _inputs(comp, fit_rec))
+        case.columns = _mpl_columns(comp, fast, slow) if family == "mpl" else _pl_columns(comp,
+                                                                                          fast)
+        model = comp.family
+        case.columns["simulate"] = (
+            lambda u, m=model, s=comp.structure, p=comp.params: m.simulate(s, p, u)[0])
+        case.columns["export"] = _export_column(comp, case.label, cc, tmp)
+        cases.append(case)
+    return cases
+
+
+def agreement(case: Case) -> dict:
+    u = case.inputs[SIZES[0]]
+    module = mpl if case.family == "mpl" else pl
+    ref, _ = module.simulate_reference(case.comp.structure, case.comp.params, u)
+    scale = float(np.max(np.abs(ref)))
+    return {name: float(np.max(np.abs(fn(u) - ref))) / scale for name, fn in case.columns.items()}
+
+
+def time_case(case: Case, n: int, rounds: int) -> dict:
+    """Median ns per sample per column, and the median of the per-round ratios to fast C."""
+    u = case.inputs[n]
+    for fn in case.columns.values():
+        fn(u)
+    seconds = {name: [] for name in case.columns}
+    for _ in range(rounds):
+        for name, fn in case.columns.items():
+            t0 = time.perf_counter()
+            fn(u)
+            seconds[name].append(time.perf_counter() - t0)
+    ns = {name: statistics.median(t) * 1e9 / n for name, t in seconds.items()}
+    ratio = {name: statistics.median(a / b for a, b in zip(t, seconds["fast C"], strict=True))
+             for name, t in seconds.items()}
+    return {"ns": ns, "ratio": ratio}
+
+
+def _cpu() -> str:
+    for line in Path("/proc/cpuinfo").read_text().splitlines():
+        if line.startswith("model name"):
+            return line.split(":", 1)[1].strip()
+    return platform.processor() or "unknown"
+
+
+def main() -> int:
+    quick = "--quick" in sys.argv
+    rounds = QUICK_ROUNDS if quick else ROUNDS
+    cc = os.environ.get("CC", "cc")
+    version = subprocess.run([cc, "--version"], capture_output=True, text=True,
+                             check=True).stdout.splitlines()[0]
+    head = git_head()
+    lines = [f"# bench_kernels.py{' --quick' if quick else ''}, hystkit {head}; {_cpu()}, "
+             f"{os.cpu_count()} cores, load {', '.join(f'{x:.2f}' for x in os.getloadavg())}",
+             f"# {version}; fast C / export: cc {' '.join(FAST_FLAGS)}; slow C: cc "
+             f"{' '.join(SLOW_FLAGS)}; numpy {np.__version__}, numba {numba.__version__}",
+             f"# rounds paired and interleaved: {rounds[SIZES[0]]} (8000 samples), "
+             f"{rounds[SIZES[1]]} (100k); ns = median ns/sample; x = median of per-round "
+             f"ratios to fast C"]
+
+    def emit(text: str = "") -> None:
+        lines.append(text)
+        print(text, flush=True)
+
+    print("\n".join(lines), flush=True)
+    with tempfile.TemporaryDirectory(prefix="hystkit-kernels-") as tmp:
+        t0 = time.perf_counter()
+        cases = build_cases(cc, Path(tmp))
+        emit(f"# fits, exports and builds: {time.perf_counter() - t0:.1f} s")
+        emit()
+        emit("Agreement with the readable reference (simulate_reference), 8000 samples: "
+             "max|y - y_ref| / max|y_ref|")
+        emit(f"{'model':<8}" + "".join(f"{c:>12}" for c in COLUMNS))
+        for case in cases:
+            agree = agreement(case)
+            emit(f"{case.label:<8}" + "".join(
+                f"{agree[c]:>12.1e}" if c in agree else f"{'-':>12}" for c in COLUMNS))
+        for n in SIZES:
+            emit()
+            emit(f"{n} samples: ns/sample (ratio to fast C)")
+            emit(f"{'model':<8}" + "".join(f"{c:>18}" for c in COLUMNS) + f"{'ns/cell fast':>14}")
+            for case in cases:
+                r = time_case(case, n, rounds[n])
+                cells = "".join(
+                    f"{r['ns'][c]:>10.1f} ({r['ratio'][c]:4.2f})" if c in r["ns"] else f"{'-':>18}"
+                    for c in COLUMNS)
+                emit(f"{case.label:<8}{cells}{r['ns']['fast C'] / case.size:>14.1f}")
+    emit(f"# load at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    (HERE / "last_run_kernels.txt").write_text("\n".join(lines) + "\n")
+    return 0
+
+
+def git_head() -> str:
+    out = subprocess.run(["git", "-C", str(HERE), "rev-parse", "--short", "HEAD"],
+                         capture_output=True, text=True, check=False).stdout.strip()
+    return out or "?"
+
+
+if __name__ == "__main__":
+    sys.exit(main())
