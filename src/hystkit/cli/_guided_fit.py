@@ -35,7 +35,7 @@ from ._inputs import check_inputs_exist
 from .cmd_core import GUIDED_MODEL as GUIDED
 
 __all__ = ["DEFAULT_BUDGET", "GUIDED", "SHORT_LIST", "guided_candidates", "guided_select",
-           "run_guided_fit", "selection_status"]
+           "model_options_given", "run_guided_fit", "selection_status"]
 
 # Seconds for the whole guided fit (issue 27.5: <= 60 s for 10,000 samples on 2 cores)
 DEFAULT_BUDGET = 60.0
@@ -227,11 +227,16 @@ def _short(row: dict) -> str:
     return f"{row['model']}:{row['size']}"
 
 
+def model_options_given(args: argparse.Namespace) -> list[str]:
+    """The options of one named model on `args` (``--cells``, ``--init``, ``--loss``, ...)."""
+    return [option for dest, (option, unset) in _MODEL_OPTIONS.items()
+            if getattr(args, dest, unset) != unset]
+
+
 def _refuse_model_options(args: argparse.Namespace) -> None:
-    for dest, (option, unset) in _MODEL_OPTIONS.items():
-        if getattr(args, dest, unset) != unset:
-            raise UsageError(f"{option} applies to a named model (e.g. --model mpl {option} "
-                             f"...); --model {GUIDED} tries its own short list")
+    for option in model_options_given(args)[:1]:
+        raise UsageError(f"{option} applies to a named model (e.g. --model mpl {option} "
+                         f"...); --model {GUIDED} tries its own short list")
 
 
 def run_guided_fit(args: argparse.Namespace) -> int:
