@@ -7,8 +7,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from ..control import SLOW_GROWTH_S, TYPICAL_RUN_S
-from ..control._analysis import slow_cell_words
+from ..control import SLOW_GROWTH_S, TYPICAL_RUN_S, slow_cell_words
 from ._common import UsageError
 
 __all__ = ["closed_loop", "fmt", "noise_study", "print_table", "resolve_tune_options", "tune"]

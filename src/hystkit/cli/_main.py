@@ -150,7 +150,8 @@ def _flush_streams(code: int) -> int:
 
 def program() -> NoReturn:
     """The ``hystkit`` program (its console script and ``python -m hystkit``): `main` on
-    ``sys.argv``, then the end of the process with its exit code."""
+    ``sys.argv``, then the end of the process with its exit code.
+    """
     sys.exit(main())
 
 

@@ -230,9 +230,22 @@ MARGINAL = 1e-12
 
 
 def slowest_cell(loop: ControlLoop, state: LoopState | None = None) -> tuple[str, float] | None:
-    """``(block, time constant [s])`` of the slowest decaying cell of the loop's sensor and
-    compensator blocks (their linearisation's pole nearest to, and inside, the unit circle);
-    None when they have no state or none inside the circle."""
+    """The slowest decaying cell of the loop's sensor and compensator blocks: their
+    linearisation's pole nearest to, and inside, the unit circle.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The closed loop.
+    state : LoopState, optional
+        The operating point to linearise at (default: the loop's rest state).
+
+    Returns
+    -------
+    tuple of (str, float) or None
+        ``(block, time constant [s])``; None when the blocks have no state or none inside
+        the circle.
+    """
     slowest = None
     for sys in _blocks(loop, state):
         if sys.name not in ("sensor", "compensator") or sys.nstates == 0:

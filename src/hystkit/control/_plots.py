@@ -155,14 +155,23 @@ def plot_bode(f: np.ndarray, mag_db: np.ndarray, phase_deg: np.ndarray,
                        f"{margins.phase_margin_deg:.1f} deg, gain margin "
                        + ("inf" if margins.gain_margin_db is None
                           else f"{margins.gain_margin_db:.1f} dB")
-                       + ("" if margins.closed_loop_stable else
-                          ",\nclosed loop marginally stable (a pole on the unit circle)"
-                          if margins.growth_time_s is None else
-                          f",\nclosed loop UNSTABLE: e-fold growth in "
-                          f"{margins.growth_time_s:.3g} s"),
+                       + _closed_loop_words(margins),
                        fontsize=8)
     for ax in (ax_m, ax_p):
         ax.grid(alpha=0.3, which="both")
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
+
+
+def _closed_loop_words(margins) -> str:
+    """The title's second line for a loop that is not asymptotically stable, in the words of
+    ``hystkit control`` (a mode slower than a slow cell is marginal, not UNSTABLE)."""
+    if margins.closed_loop_stable:
+        return ""
+    if margins.growth_time_s is None:
+        return ",\nclosed loop marginally stable (a pole on the unit circle)"
+    if margins.slow_cell is not None:
+        return (f",\nclosed loop marginal, from a slow cell of the {margins.slow_cell}: e-fold "
+                f"in {margins.growth_time_s:.3g} s")
+    return f",\nclosed loop UNSTABLE: e-fold growth in {margins.growth_time_s:.3g} s"

@@ -9,8 +9,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ..control import SLOW_GROWTH_S, TYPICAL_RUN_S
-from ..control._analysis import slow_cell_words
+from ..control import SLOW_GROWTH_S, TYPICAL_RUN_S, slow_cell_words
 from ..errors import InputError
 from ._html import Section, definition_list, note, table
 from ._report_folders import read_json
