@@ -190,6 +190,21 @@ def test_existing_folder_needs_force(compensators, tmp_path, capsys):
                                                      "m.c", "m.h"]
 
 
+@pytest.mark.parametrize("force", [[], ["--force"]])
+def test_missing_parent_folders_are_created(force, compensators, tmp_path, capsys):
+    """``--out new/dir/m``: the folders above are created (as fit does), not an internal error;
+    a file in the way is refused in one line."""
+    model = tmp_path / "m.json"
+    save_compensator(compensators("mpl1", "direct", "fit"), model)
+    out = tmp_path / "new" / "dir" / "m"
+    assert main(["export", str(model), "--out", str(out), *force]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["README", "example_main.c", "m.c", "m.h"]
+    (tmp_path / "file").write_text("in the way")
+    assert main(["export", str(model), "--out", str(tmp_path / "file" / "m"), *force]) != 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot create the folder above it" in err
+
+
 @pytest.mark.parametrize("mode", ["direct", "inverse"])
 def test_untranslated_family_is_refused_with_its_reason(mode, recordings, tmp_path, capsys,
                                                         monkeypatch):

@@ -93,12 +93,22 @@ def export_compensator(comp: Compensator, out: str | Path, lang: str = "c", *,
     sync_state, sync_note = sync_state_of(comp)
     plan = make_plan(comp, name, sync_state=sync_state, sync_note=sync_note, level=level)
     files = c_files(plan, double) if lang == "c" else matlab_files(plan)
+    _make_parent(out)
     if force:  # into the folder, existing or not: same-named files replaced, others kept
         with atomic_folder(out, force=True, names=files) as tmp:
             _write_files(tmp, files)
     else:
         _create_folder(out, files)
     return plan, files
+
+
+def _make_parent(out: Path) -> None:
+    """Create the folders above `out`, as ``hystkit fit --out dir/model.json`` does (the golden
+    run of issue 28 found ``--out new/dir`` ending in an internal error)."""
+    try:
+        Path(os.path.abspath(out)).parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"{out}: cannot create the folder above it ({exc.strerror})") from None
 
 
 def _write_files(folder: Path, files: dict[str, str]) -> None:
