@@ -119,3 +119,19 @@ def test_many_recordings_wrap_into_bands_of_loop_columns() -> None:
     assert [ax.get_title() for ax in visible if ax.get_title().endswith(": sensor")] == [
         f"r{k}: sensor" for k in range(LOOP_COLUMNS + 2)]
     assert fig.get_size_inches()[0] == pytest.approx(3.4 * LOOP_COLUMNS)
+
+
+def test_position_axes_carry_the_files_unit_else_mm() -> None:
+    """A recording in µm is drawn in µm (the tutorial's piezo excerpts); one without units in
+    hystkit's mm."""
+    rec, estimate, linear = _results()["run"]
+    microns = Recording(time=rec.time, sensor=rec.sensor, position=rec.position,
+                        units={"position": "µm", "sensor": "V"})
+    for run, unit in ((rec, "mm"), (microns, "µm")):
+        results = {"run": (run, estimate, linear)}
+        loops = plot_loops(results).axes
+        assert [ax.get_xlabel() for ax in loops] == [f"position [{unit}]"] * 3
+        assert loops[1].get_ylabel() == f"estimate [{unit}]"
+        series = plot_time_series(results).axes
+        assert series[0].get_ylabel() == unit
+        assert series[2].get_ylabel() == f"estimate − position [{unit}]"  # row 2, left

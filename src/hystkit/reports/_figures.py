@@ -1,8 +1,9 @@
 """Figures of a compensation result. Each returns its Figure; nothing is shown or styled globally.
 
 Both figures take ``{name: (recording, estimate, linear estimate)}``: the compensator's and the
-straight line's position estimates [mm] on each recording. The error shown is the estimate minus
-the measured position [mm], as the compensator delivers it (no mean removed). Long recordings are
+straight line's position estimates on each recording, in the position's unit (the file's, else
+mm). The error shown is the estimate minus the measured position, as the compensator delivers
+it (no mean removed). Long recordings are
 drawn through :func:`envelope_indices`, which keeps every bin's extremes, so a spike still shows.
 """
 
@@ -110,7 +111,8 @@ def plot_loops(results: Results, *, sensor_label: str = DEFAULT_SENSOR_LABEL,
         band, col = divmod(k, n_cols)
         top, mid, low = axes[3 * band:3 * band + 3, col]
         top.plot(p[keep], rec.sensor[keep], lw=0.6, color=_COLORS["sensor"])
-        top.set(title=f"{name}: sensor", xlabel="position [mm]", ylabel=sensor_label)
+        unit = _position_unit(rec)
+        top.set(title=f"{name}: sensor", xlabel=f"position [{unit}]", ylabel=sensor_label)
         lo, hi = float(p.min()), float(p.max())
         mid.plot([lo, hi], [lo, hi], color="k", lw=0.8, ls="--", label="ideal")
         for (label, key), values in zip((("straight line", "line"), (model_label, "model")),
@@ -118,14 +120,14 @@ def plot_loops(results: Results, *, sensor_label: str = DEFAULT_SENSOR_LABEL,
             alpha = 0.6 if key == "line" else 1.0
             mid.plot(p[keep], values[keep], lw=0.6, color=_COLORS[key], alpha=alpha,
                      label=label)
-        mid.set(title=f"{name}: compensated", xlabel="position [mm]",
-                ylabel="estimate [mm]")
+        mid.set(title=f"{name}: compensated", xlabel=f"position [{unit}]",
+                ylabel=f"estimate [{unit}]")
         low.axhline(0.0, color="k", lw=0.8, ls="--")
         for key, values in zip(("line", "model"), errors):
             low.plot(p[keep], values[keep], lw=0.6, color=_COLORS[key],
                      alpha=0.6 if key == "line" else 1.0)
-        low.set(title=f"{name}: error", xlabel="position [mm]",
-                ylabel="estimate − position [mm]")
+        low.set(title=f"{name}: error", xlabel=f"position [{unit}]",
+                ylabel=f"estimate − position [{unit}]")
     _legend_below(fig, axes[1, 0])
     return fig
 
@@ -160,7 +162,7 @@ def plot_time_series(results: Results, *, model_label: str = "mPL",
     fig = Figure(figsize=(12.0, 3.6 * n + 0.6), layout="constrained")
     axes = fig.subplots(2 * n, 2, squeeze=False, width_ratios=(3, 1))
     for k, (name, (rec, estimate, linear)) in enumerate(results.items()):
-        t, p = rec.time, rec.position
+        t, p, unit = rec.time, rec.position, _position_unit(rec)
         error, line_error = estimate - p, linear - p
         start, stop = zoom_window(t, error)
         for col, span in enumerate((slice(None), slice(start, stop))):
@@ -186,10 +188,16 @@ def plot_time_series(results: Results, *, model_label: str = "mPL",
             low.plot(tt[keep], series[4][keep], color=_COLORS["model"], lw=0.7)
             low.set_xlabel("time [s]")
             if col == 0:
-                top.set(title=f"{name}: whole run ({t[-1] - t[0]:.4g} s)", ylabel="mm")
-                low.set(title=f"{name}: error", ylabel="estimate − position [mm]")
+                top.set(title=f"{name}: whole run ({t[-1] - t[0]:.4g} s)", ylabel=unit)
+                low.set(title=f"{name}: error", ylabel=f"estimate − position [{unit}]")
             else:
                 top.set_title(f"zoom: largest {model_label} error, "
                               f"t = {t[start]:.4g}–{t[stop - 1]:.4g} s", fontsize="small")
     _legend_below(fig, axes[0, 0])
     return fig
+
+
+def _position_unit(rec) -> str:
+    """The position's unit as the recording's file gave it; mm (hystkit's convention) when the
+    file gave none."""
+    return rec.unit("position") or "mm"
