@@ -252,7 +252,13 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
         Registered model family (``hystkit.models.FAMILIES``).
     mode : {"direct", "inverse"}
     center : {"fit", "tare", "track", "recording", "none"}
-        See :mod:`hystkit.compensation._centring`; ``recording`` is the oracle protocol.
+        Where the sensor's offset comes from. Deployable (from the sensor up to each sample
+        and the model file): ``fit`` the training recording's offsets, ``tare`` the sensor
+        level over the first `tare_seconds` of every recording (the device at rest), ``track``
+        a causal low-pass of time constant `track_seconds` that follows slow drift. Oracle:
+        ``recording``, the whole recording's mean (the document's protocol; not available in
+        use). ``none``: no offsets. The measurements behind the default: the how-to page
+        "Centring".
     tare_seconds, track_seconds : float
         Tare window and drift-tracker time constant [s], stored in the model.
     diagnose : bool
