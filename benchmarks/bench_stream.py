@@ -1,126 +1,344 @@
-"""Latency of the streaming compensator in Python: ``Stream.step``, ``Stream.process`` on chunks
-of 64 samples, and a plain-Python loop over the family's readable ``step`` as the reference.
+"""The live path's speed (issue 29, item 4): ``hystkit stream`` and ``Stream.step``, this tree
+against an earlier revision, paired in one run.
 
-Run:  python benchmarks/bench_stream.py [--quick]      (a few minutes on 2 cores; --quick: a
-      quarter of the samples and repeats)
+Run:  python benchmarks/bench_stream.py [--before REV] [--after REV] [--rounds N] [--quick]
+      [--out FILE]        (~5 min with the defaults on 2 cores)
 
-Compensators are fitted (direct mode) on the virtual sensor's sine run (8000 samples at 40 Hz)
-and run on its decay run. Per family and method, every repeat times the same samples; methods
-alternate inside each repeat (A B C A B C ...) so bursts of load hit all alike; the table gives
-the median over repeats of each repeat's median per-sample latency (and the p99 of ``step``).
+Variants: ``after`` is this tree's ``src`` as it is at the start (or revision ``--after``),
+``before`` revision ``--before`` (``git archive``; 'none' skips it). Every measurement runs in
+a child process with ``PYTHONPATH`` on the variant's ``src``, its own numba cache and bytecode
+folders (filled by an untimed warm-up run). Model files are written once by the ``before``
+variant (the older code: both read its files) and shared.
 
-- ``step``: ``Stream.step(v)`` per sample (the whole data path: centring, scaling, the family's
-  compiled run of one sample, guards, flags);
-- ``process/64``: ``Stream.process`` on chunks of 64 samples, time per chunk / 64;
-- ``python loop``: the family's readable ``step(structure, params, x, u)`` in a Python loop on
-  the normalised sensor: the model alone, no conventions (the reference the issue asks for).
+1. **Command**: ``hystkit stream MODEL --in big.csv`` on ``--samples`` lines (default 100 000,
+   the virtual sensor's decay run repeated, time continued) and on 10 lines (start-up: the
+   interpreter, the imports, the model file, the kernel's cache); and the same 100 000 lines
+   through stdin, written by this process into a pipe. Wall time per run; samples/s whole
+   (N / wall) and after start-up ((N - 10) / (wall_N - wall_10)); ``same``: the outputs of the
+   variants are the same text (the estimates printed with repr: bit for bit).
+2. **Live**: one line written into the pipe at a time, the next only once its answer is read:
+   the round trip per line (write, the command's read, parse, compensate, format, write, our
+   read), median and p99 over ``--live`` lines after the first 20.
+3. **In-process** (``Stream`` in the child): ``Stream.step`` per sample (p50 and p99 of each
+   round's samples), ``Stream.process`` on chunks of 64 (per sample), and a plain-Python loop
+   over the family's readable ``step`` on the normalised sensor (the model alone); direct
+   compensators of several families fitted on the virtual sine run, and the command's model
+   (mPL 1 cell with its band).
 
-``same`` says whether the chunked stream reproduced ``Compensator.estimate`` bit for bit (it
-does the same work). :func:`python_latency` is the measurement for one compensator, importable
-by other benchmarks (``benchmarks/bench_export.py`` adds the C and MATLAB rows).
+Rounds alternate the variants (A B A B ...; B A in every other round) so that bursts of load
+hit both; tables give medians over rounds and the median of per-round ratios before / after.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
+import shutil
 import statistics
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 
-if __name__ == "__main__":
-    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-
-import numpy as np
-
-from hystkit.compensation import Compensator, Stream, fit_compensator
-from hystkit.sensors import simulate_experiment
-
+REPO = Path(__file__).resolve().parents[1]
 FAMILIES = (("mpl", 1), ("mpl", 3), ("mpl-poly", 3), ("pi", 10), ("preisach", 20),
             ("ladder", 3))
 CHUNK = 64
+SMALL = 10
 
 
-def _per_sample_step(comp: Compensator, sensor: np.ndarray) -> np.ndarray:
-    stream = Stream(comp)
-    times = np.empty(sensor.size)
-    clock = time.perf_counter
-    for k, v in enumerate(sensor.tolist()):
-        t0 = clock()
-        stream.step(v)
-        times[k] = clock() - t0
-    return times
+# -- the child's side: in-process latency ------------------------------------------------------
 
-
-def _per_sample_chunks(comp: Compensator, sensor: np.ndarray, chunk: int) -> np.ndarray:
-    stream = Stream(comp)
-    times = []
-    clock = time.perf_counter
-    for k in range(0, sensor.size - chunk + 1, chunk):
-        part = sensor[k:k + chunk]
-        t0 = clock()
-        stream.process(part)
-        times.append((clock() - t0) / chunk)
-    return np.array(times)
-
-
-def _per_sample_python(comp: Compensator, sensor: np.ndarray) -> np.ndarray:
-    family, structure, params = comp.family, comp.structure, comp.params
-    u = comp.normalised_sensor(sensor).tolist()
-    x = family.rest_state(structure, params, u[0])
-    times = np.empty(len(u))
-    clock = time.perf_counter
-    for k, v in enumerate(u):
-        t0 = clock()
-        _, x = family.step(structure, params, x, v)
-        times[k] = clock() - t0
-    return times
-
-
-def python_latency(comp: Compensator, sensor: np.ndarray, *, repeats: int = 5,
-                   chunk: int = CHUNK) -> dict[str, float]:
+def python_latency(comp, sensor, *, repeats: int = 5, chunk: int = CHUNK) -> dict[str, float]:
     """Per-sample latency [µs] of ``Stream.step`` (median and p99), ``Stream.process`` on
-    chunks of ``chunk`` samples and the plain-Python loop, medians over ``repeats`` interleaved
-    repeats on ``sensor`` (raw sensor samples). Warms up (compiles) first."""
+    chunks of ``chunk`` samples and the plain-Python loop over the family's readable ``step``,
+    medians over ``repeats`` interleaved repeats on ``sensor`` (raw sensor samples). Warms up
+    (compiles) first. (``benchmarks/bench_export.py`` adds its C and MATLAB rows to these.)"""
+    import numpy as np
+
+    from hystkit.compensation import Stream
+
     Stream(comp).process(sensor[:2])
     Stream(comp).step(float(sensor[0]))
+    clock = time.perf_counter
     runs: dict[str, list[float]] = {"step_us": [], "step_p99_us": [], "process_chunk_us": [],
                                     "python_loop_us": []}
     for _ in range(repeats):
-        step = _per_sample_step(comp, sensor) * 1e6
-        runs["step_us"].append(float(np.median(step)))
-        runs["step_p99_us"].append(float(np.percentile(step, 99)))
-        runs["process_chunk_us"].append(float(np.median(_per_sample_chunks(comp, sensor,
-                                                                           chunk))) * 1e6)
-        runs["python_loop_us"].append(float(np.median(_per_sample_python(comp, sensor))) * 1e6)
+        stream, times = Stream(comp), np.empty(sensor.size)
+        for k, v in enumerate(sensor.tolist()):
+            t0 = clock()
+            stream.step(v)
+            times[k] = clock() - t0
+        runs["step_us"].append(float(np.median(times)) * 1e6)
+        runs["step_p99_us"].append(float(np.percentile(times, 99)) * 1e6)
+        stream, chunks = Stream(comp), []
+        for k in range(0, sensor.size - chunk + 1, chunk):
+            part = sensor[k:k + chunk]
+            t0 = clock()
+            stream.process(part)
+            chunks.append((clock() - t0) / chunk)
+        runs["process_chunk_us"].append(float(np.median(chunks)) * 1e6)
+        u = comp.normalised_sensor(sensor).tolist()
+        x = comp.family.rest_state(comp.structure, comp.params, u[0])
+        loop = np.empty(len(u))
+        for k, v in enumerate(u):
+            t0 = clock()
+            _, x = comp.family.step(comp.structure, comp.params, x, v)
+            loop[k] = clock() - t0
+        runs["python_loop_us"].append(float(np.median(loop)) * 1e6)
     return {key: statistics.median(values) for key, values in runs.items()}
 
 
-def _same_as_offline(comp: Compensator, recording) -> bool:
-    stream = Stream(comp)
-    parts = [stream.process(recording.sensor[k:k + CHUNK])
-             for k in range(0, recording.n_samples, CHUNK)]
-    return bool(np.array_equal(np.concatenate(parts), comp.estimate(recording)))
+def _latency(models: Path, n_samples: int) -> dict:
+    """`python_latency` (one repeat) of every model file in `models`, on `n_samples` of the
+    virtual sensor's decay run (seed 2); and whether the stream ran compiled."""
+    from hystkit.compensation import Stream, load_compensator
+    from hystkit.sensors import simulate_experiment
+
+    sensor = simulate_experiment("decay", 2).sensor[:n_samples]
+    found = {}
+    for path in sorted(models.glob("*.json")):
+        comp = load_compensator(path)
+        found[path.stem] = {**python_latency(comp, sensor, repeats=1),
+                            "compiled": getattr(Stream(comp), "compiled", None)}
+    return found
+
+
+def _make_models(folder: Path) -> None:
+    """The in-process table's compensators (direct, no band) and the command's model."""
+    from hystkit.cli import main as cli
+    from hystkit.compensation import fit_compensator, save_compensator
+    from hystkit.io import write_recording
+    from hystkit.sensors import simulate_experiment
+
+    train = simulate_experiment("sine", 1)
+    models = folder / "models"
+    models.mkdir()
+    for name, size in FAMILIES:
+        comp = fit_compensator(train, size, model=name, diagnose=False)
+        save_compensator(comp, models / f"{name}_{size}.json")
+    write_recording(train, folder / "train.csv")
+    code = cli(["fit", str(folder / "train.csv"), "--cells", "1", "--out",
+                str(models / "command_mpl_1_band.json")])
+    assert code == 0, code
+
+
+# -- the parent's side -------------------------------------------------------------------------
+
+def _source(rev: str, folder: Path) -> Path:
+    """The ``src`` of revision `rev` (or of this tree, 'tree') copied into `folder`."""
+    if rev == "tree":
+        shutil.copytree(REPO / "src", folder / "src",
+                        ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    else:
+        folder.mkdir(parents=True, exist_ok=True)
+        archive = subprocess.run(["git", "-C", str(REPO), "archive", rev, "src"],
+                                 capture_output=True, check=True).stdout
+        subprocess.run(["tar", "-x", "-C", str(folder)], input=archive, check=True)
+    return folder / "src"
+
+
+class Variant:
+    """A source tree and the environment of its children."""
+
+    def __init__(self, name: str, rev: str, tmp: Path) -> None:
+        self.name, self.rev = name, rev
+        root = tmp / name
+        self.src = _source(rev, root)
+        self.env = {**os.environ, "PYTHONPATH": str(self.src),
+                    "NUMBA_CACHE_DIR": str(root / "numba"),
+                    "PYTHONPYCACHEPREFIX": str(root / "pycache"), "OPENBLAS_NUM_THREADS": "1"}
+        self.env.pop("PYTHONDONTWRITEBYTECODE", None)
+
+    def python(self, args: list[str], **run) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, *args], env=self.env, check=True, **run)
+
+    def stream(self, model: Path, data: Path | None, text: bytes | None = None
+               ) -> tuple[float, bytes]:
+        """Wall seconds of ``hystkit stream`` on a file (or stdin fed `text`), its stdout."""
+        args = ["-m", "hystkit", "stream", str(model)] + ([] if data is None
+                                                          else ["--in", str(data)])
+        t0 = time.perf_counter()
+        done = self.python(args, input=text, capture_output=True)
+        return time.perf_counter() - t0, done.stdout
+
+    def live(self, model: Path, lines: list[bytes]) -> list[float]:
+        """Round trip [s] of each line written alone, its answer read before the next."""
+        proc = subprocess.Popen([sys.executable, "-m", "hystkit", "stream", str(model)],
+                                env=self.env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                stderr=subprocess.DEVNULL, bufsize=0)
+        assert proc.stdin is not None and proc.stdout is not None
+        out = proc.stdout
+        _read_line(out)  # the header: the command is ready
+        trips = []
+        for line in lines:
+            t0 = time.perf_counter()
+            proc.stdin.write(line)
+            _read_line(out)
+            trips.append(time.perf_counter() - t0)
+        proc.stdin.close()
+        proc.wait()
+        return trips
+
+
+def _read_line(stream) -> bytes:
+    line = b""
+    while not line.endswith(b"\n"):
+        byte = os.read(stream.fileno(), 1)
+        if not byte:
+            raise RuntimeError(f"the stream's output ended mid-line: {line!r}")
+        line += byte
+    return line
+
+
+def _data(folder: Path, n: int) -> tuple[Path, Path]:
+    """`n` and SMALL lines of the decay run (seed 2) repeated, time continued, as CSV."""
+    import numpy as np
+
+    from hystkit.sensors import simulate_experiment
+
+    rec = simulate_experiment("decay", 2)
+    sensor = np.tile(rec.sensor, -(-n // rec.n_samples))[:n]
+    time_s = np.arange(n) * rec.dt
+    rows = [f"{t!r},{s!r}\n" for t, s in zip(time_s.tolist(), sensor.tolist(), strict=True)]
+    big, small = folder / "big.csv", folder / "small.csv"
+    big.write_text("time,sensor\n" + "".join(rows))
+    small.write_text("time,sensor\n" + "".join(rows[:SMALL]))
+    return big, small
+
+
+def _median(values: list[float]) -> float:
+    return statistics.median(values) if values else float("nan")
+
+
+def _ratio(pairs: list[tuple[float, float]]) -> str:
+    return f"{statistics.median(b / a for a, b in pairs):.2f}" if pairs else "-"
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="fewer samples and repeats")
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--before", default="none", metavar="REV",
+                        help="git revision to compare with ('none': this tree alone)")
+    parser.add_argument("--after", default="tree", metavar="REV",
+                        help="git revision to measure (default: this tree as it is)")
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--samples", type=int, default=100_000)
+    parser.add_argument("--live", type=int, default=2000, help="lines of the live table")
+    parser.add_argument("--quick", action="store_true", help="20 000 samples, 3 rounds")
+    parser.add_argument("--out", type=Path, help="also write the report here")
+    parser.add_argument("--latency-child", nargs=2, metavar=("MODELS", "N"),
+                        help=argparse.SUPPRESS)
+    parser.add_argument("--models-child", metavar="FOLDER", help=argparse.SUPPRESS)
     args = parser.parse_args()
-    n_samples, repeats = (500, 3) if args.quick else (2000, 7)
-    fit_rec, use_rec = simulate_experiment("sine", 1), simulate_experiment("decay", 2)
+    if args.latency_child:
+        print(json.dumps(_latency(Path(args.latency_child[0]), int(args.latency_child[1]))))
+        return
+    if args.models_child:
+        _make_models(Path(args.models_child))
+        return
+    if args.quick:
+        args.samples, args.rounds, args.live = 20_000, 3, 500
+    report = _run(args)
+    print(report)
+    if args.out:
+        args.out.write_text(report + "\n", encoding="utf-8")
+
+
+def _run(args: argparse.Namespace) -> str:
+    t_start = time.perf_counter()
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
-    print(f"# {platform.processor() or platform.machine()}, {os.cpu_count()} cores, load "
-          f"{load}; {n_samples} samples, {repeats} repeats; µs per sample (medians)")
-    print(f"{'model':<14} {'step':>8} {'step p99':>9} {'process/64':>11} {'python loop':>12} "
-          f"{'same':>5}")
-    for name, size in FAMILIES:
-        comp = fit_compensator(fit_rec, size, model=name, diagnose=False)
-        found = python_latency(comp, use_rec.sensor[:n_samples], repeats=repeats)
-        print(f"{f'{name} {size}':<14} {found['step_us']:>8.1f} {found['step_p99_us']:>9.1f} "
-              f"{found['process_chunk_us']:>11.2f} {found['python_loop_us']:>12.1f} "
-              f"{_same_as_offline(comp, use_rec)!s:>5}", flush=True)
-    print(f"# load at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    lines = [(f"hystkit stream and Stream.step: medians of {args.rounds} rounds, variants "
+             f"alternating (A B, B A, ...)"),
+             (f"machine: {platform.platform()}; {os.cpu_count()} cpus; load {load} at start; "
+             f"python {platform.python_version()}")]
+    with tempfile.TemporaryDirectory() as folder:
+        tmp = Path(folder)
+        variants = [Variant("after", args.after, tmp)]
+        if args.before != "none":
+            variants.insert(0, Variant("before", args.before, tmp))
+        lines.append("variants: " + "; ".join(f"{v.name} = {v.rev}" for v in variants))
+        variants[0].python([__file__, "--models-child", str(tmp)], capture_output=True)
+        models = tmp / "models"
+        model = models / "command_mpl_1_band.json"
+        big, small = _data(tmp, args.samples)
+        text = big.read_bytes()
+        live_lines = [line + b"\n" for line in
+                      text.splitlines()[1:args.live + 21]]
+        for v in variants:  # warm-up: compile or load every kernel once, untimed
+            v.stream(model, small)
+            v.python([__file__, "--latency-child", str(models), "50"], capture_output=True)
+        runs: dict[str, dict[str, list]] = {v.name: {} for v in variants}
+        outputs: dict[str, set[bytes]] = {v.name: set() for v in variants}
+        for r in range(args.rounds):
+            for v in (variants if r % 2 == 0 else variants[::-1]):
+                row = runs[v.name]
+                seconds, out = v.stream(model, big)
+                outputs[v.name].add(out)
+                row.setdefault("file", []).append(seconds)
+                row.setdefault("small", []).append(v.stream(model, small)[0])
+                seconds, out = v.stream(model, None, text)
+                outputs[v.name].add(out)
+                row.setdefault("stdin", []).append(seconds)
+                if r < 3:
+                    row.setdefault("live", []).append(v.live(model, live_lines)[20:])
+                found = json.loads(v.python([__file__, "--latency-child", str(models),
+                                             "2000"], capture_output=True, text=True).stdout)
+                row.setdefault("latency", []).append(found)
+        lines += _tables(args, variants, runs, outputs)
+    lines.append(f"load at the end {', '.join(f'{x:.2f}' for x in os.getloadavg())}; "
+                 f"benchmark {time.perf_counter() - t_start:.0f} s")
+    return "\n".join(lines)
+
+
+def _tables(args, variants, runs, outputs) -> list[str]:
+    import numpy as np
+
+    n = args.samples
+    names = [v.name for v in variants]
+    same = len(set().union(*outputs.values())) == 1 and all(len(o) == 1 for o in outputs.values())
+    lines = ["", (f"Table 1. hystkit stream, mPL 1 cell with its band: {n} samples (and "
+                 f"{SMALL}: start-up); wall seconds, samples/s; outputs the same text in "
+                 f"every run and variant: {same}"),
+             (f"  {'variant':<8} {'--in s':>8} {'start-up s':>10} {'stdin s':>8} "
+             f"{'whole /s':>10} {'after start /s':>15} {'stdin whole /s':>15}")]
+    for name in names:
+        row = runs[name]
+        file_s, small_s, stdin_s = (_median(row[k]) for k in ("file", "small", "stdin"))
+        steady = [(n - SMALL) / (f - s) for f, s in zip(row["file"], row["small"], strict=True)]
+        lines.append(f"  {name:<8} {file_s:>8.2f} {small_s:>10.2f} {stdin_s:>8.2f} "
+                     f"{n / file_s:>10.0f} {_median(steady):>15.0f} {n / stdin_s:>15.0f}")
+    if len(names) == 2:
+        pairs = list(zip(runs["after"]["file"], runs["before"]["file"], strict=True))
+        lines.append(f"  before / after, --in whole command (median of rounds): "
+                     f"{_ratio(pairs)}")
+    lines += ["", (f"Table 2. live: one line at a time through a pipe, its answer read before "
+                  f"the next; round trip per line [µs] over {args.live} lines"),
+              f"  {'variant':<8} {'median':>8} {'p99':>8}"]
+    for name in names:
+        trips = np.concatenate(runs[name]["live"]) * 1e6
+        lines.append(f"  {name:<8} {np.median(trips):>8.1f} {np.percentile(trips, 99):>8.1f}")
+    lines += ["", ("Table 3. in-process, µs per sample (2000 samples of the decay run; direct "
+                  "compensators fitted on the sine run): Stream.step p50 / p99, "
+                  "Stream.process on chunks of 64, a plain-Python loop over the family's step"),
+              (f"  {'model':<22} {'variant':<7} {'compiled':>8} {'step p50':>9} "
+              f"{'step p99':>9} {'process/64':>11} {'python loop':>12} {'step / loop':>12}")]
+    for model in runs[names[-1]]["latency"][0]:
+        for name in names:
+            rounds = [found[model] for found in runs[name]["latency"]]
+            step = _median([f["step_us"] for f in rounds])
+            loop = _median([f["python_loop_us"] for f in rounds])
+            lines.append(f"  {model:<22} {name:<7} {rounds[0]['compiled']!s:>8} {step:>9.2f} "
+                         f"{_median([f['step_p99_us'] for f in rounds]):>9.2f} "
+                         f"{_median([f['process_chunk_us'] for f in rounds]):>11.2f} "
+                         f"{loop:>12.2f} {step / loop:>12.3f}")
+        if len(names) == 2:
+            pairs = [(a[model]["step_us"], b[model]["step_us"]) for a, b in
+                     zip(runs["after"]["latency"], runs["before"]["latency"], strict=True)]
+            lines.append(f"  {model:<22} before / after, step p50: {_ratio(pairs)}")
+    return lines
 
 
 if __name__ == "__main__":
