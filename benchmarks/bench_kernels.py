@@ -61,8 +61,8 @@ FAST_FLAGS = ("-O3", "-march=native", "-shared", "-fPIC")
 SLOW_FLAGS = ("-O2", "-shared", "-fPIC")  # as bench_mpl.py builds _c_reference.c
 CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2))
 SIZES = (8000, 100_000)
-ROUNDS = {8000: 41, 100_000: 15}
-QUICK_ROUNDS = {8000: 15, 100_000: 7}
+ROUNDS = {8000: 101, 100_000: 31}
+QUICK_ROUNDS = {8000: 31, 100_000: 11}
 COLUMNS = ("fast C", "C no guard", "slow C", "simulate", "export")
 
 _ARR = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
@@ -231,13 +231,14 @@ def main() -> int:
     version = subprocess.run([cc, "--version"], capture_output=True, text=True,
                              check=True).stdout.splitlines()[0]
     head = git_head()
-    lines = [f"# bench_kernels.py{' --quick' if quick else ''}, hystkit {head}; {_cpu()}, "
-             f"{os.cpu_count()} cores, load {', '.join(f'{x:.2f}' for x in os.getloadavg())}",
-             f"# {version}; fast C / export: cc {' '.join(FAST_FLAGS)}; slow C: cc "
-             f"{' '.join(SLOW_FLAGS)}; numpy {np.__version__}, numba {numba.__version__}",
-             f"# rounds paired and interleaved: {rounds[SIZES[0]]} (8000 samples), "
-             f"{rounds[SIZES[1]]} (100k); ns = median ns/sample; x = median of per-round "
-             f"ratios to fast C"]
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
+    lines = [(f"# bench_kernels.py{' --quick' if quick else ''}, hystkit {head}; {_cpu()}, "
+              f"{os.cpu_count()} cores, load {load}"),
+             (f"# {version}; fast C / export: cc {' '.join(FAST_FLAGS)}; slow C: cc "
+              f"{' '.join(SLOW_FLAGS)}; numpy {np.__version__}, numba {numba.__version__}"),
+             (f"# rounds paired and interleaved: {rounds[SIZES[0]]} (8000 samples), "
+              f"{rounds[SIZES[1]]} (100k); ns = median ns/sample; (x) = median of per-round "
+              f"ratios to fast C")]
 
     def emit(text: str = "") -> None:
         lines.append(text)

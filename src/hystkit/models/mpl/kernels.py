@@ -2,6 +2,11 @@
 
 All arrays are float64 and already validated by the caller. ``knee`` is the per-cell voltage
 beyond which the resistor is linear with slope ``cap`` (eq. 5.29, see ``model.py``).
+
+The runs, the blocks and the fit's pass advance a cell by :func:`cell_increment`: one ``exp``
+per cell and sample (:func:`sinh_cosh`), the per-cell constants (:func:`cell_constants`) taken
+out of the sample loop. ``benchmarks/bench_kernels.py`` times them against the fastest plain C
+of the same recursion (issue 29).
 """
 
 from __future__ import annotations
@@ -14,11 +19,78 @@ from numba import njit
 
 @njit(cache=True, inline="always")
 def current(v, i_s, v_t, knee, cap):
-    """Limited sinh resistor current and its slope at ``v``."""
+    """Limited sinh resistor current and its slope at ``v`` (libm's sinh; the linearisation and
+    mpl-g's kernels use it, the mPL runs :func:`cell_increment`)."""
     if abs(v) <= knee:
         return 2.0 * i_s * np.sinh(v / v_t), 2.0 * i_s / v_t * np.cosh(v / v_t)
     s = 1.0 if v > 0 else -1.0
     return s * 2.0 * i_s * np.sinh(knee / v_t) + cap * (v - s * knee), cap
+
+
+@njit(cache=True, inline="always")
+def sinh_series(a):
+    """``sinh a`` for ``|a| < 0.5``: ``a (1 + a^2 / 3! + ... + a^14 / 15!)``, the next term below
+    5e-20 relative; pairs of terms (Estrin's scheme), so that its latency hides under the
+    ``exp`` computed beside it."""
+    a2 = a * a
+    a4 = a2 * a2
+    a8 = a4 * a4
+    p01 = 1.0 + a2 * (1.0 / 6.0)
+    p23 = 1.0 / 120.0 + a2 * (1.0 / 5040.0)
+    p45 = 1.0 / 362880.0 + a2 * (1.0 / 39916800.0)
+    p67 = 1.0 / 6227020800.0 + a2 * (1.0 / 1307674368000.0)
+    return a * ((p01 + a4 * p23) + a8 * (p45 + a4 * p67))
+
+
+@njit(cache=True, inline="always")
+def sinh_cosh(a):
+    """``(sinh a, cosh a)`` from one ``exp``: a few ulp from libm's, at half the cost.
+
+    libm's ``sinh`` is the recursion's most expensive operation (its ``expm1`` and case
+    analysis cost about twice an ``exp``), and the sensitivities need ``cosh`` as well. ``cosh =
+    (e + 1/e) / 2`` has no cancellation; ``sinh = (e - 1/e) / 2`` loses ``coth a`` ulp to it,
+    so for ``|a| < 0.5`` (where ``coth a > 2.2``) ``sinh`` comes from its series. Without it a
+    nearly linear cell (``V_T ~ 1e3``, as fits give) would be 1e-13 off at every step.
+    """
+    t = abs(a)  # both are even or odd: e >= 1, so 1 / e neither divides by 0 nor overflows
+    e = np.exp(t)
+    e_inv = 1.0 / e
+    # both computed, one selected: a data-dependent branch here mispredicts often
+    sh = sinh_series(a) if t < 0.5 else math.copysign(0.5 * (e - e_inv), a)
+    return sh, 0.5 * (e + e_inv)
+
+
+@njit(cache=True, inline="always")
+def cell_constants(i_s, v_t, knee, cap, dt):
+    """What a cell's update needs that does not change per sample: ``1 / V_T``, ``2 I_S dt`` and
+    ``c0 = (f(knee) - cap knee) dt``, with which the straight branch beyond the knee is
+    ``f dt = s c0 + cap dt v`` (``s`` the sign of ``v``). Every caller computes them with this
+    one function, so that runs and blocks advance their cells bit for bit alike."""
+    return 1.0 / v_t, 2.0 * i_s * dt, straight_offset(i_s, v_t, knee, cap, dt)
+
+
+@njit(cache=True, inline="always")
+def straight_offset(i_s, v_t, knee, cap, dt):
+    """``c0`` of :func:`cell_constants` (0 without a knee: the sinh everywhere)."""
+    return (2.0 * i_s * np.sinh(knee / v_t) - cap * knee) * dt if knee < np.inf else 0.0
+
+
+@njit(cache=True, inline="always")
+def cell_increment(v, inv_vt, two_i_s_dt, knee, c0, cap_dt):
+    """``f(v) dt`` of the limited sinh resistor (eq. 5.1, 5.29): one ``exp`` inside the knee."""
+    if abs(v) <= knee:
+        return two_i_s_dt * sinh_cosh(v * inv_vt)[0]
+    return (c0 if v > 0 else -c0) + cap_dt * v
+
+
+@njit(cache=True)
+def constants(i_s, v_t, knee, cap, dt):
+    """:func:`cell_constants` of every cell, as arrays ``(1 / V_T, 2 I_S dt, c0)``."""
+    n = i_s.size
+    inv_vt, two_i_s_dt, c0 = np.empty(n), np.empty(n), np.empty(n)
+    for k in range(n):
+        inv_vt[k], two_i_s_dt[k], c0[k] = cell_constants(i_s[k], v_t[k], knee[k], cap, dt)
+    return inv_vt, two_i_s_dt, c0
 
 
 @njit(cache=True)
@@ -26,14 +98,16 @@ def simulate(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
     n_cells = x0.size
     x = x0.copy()
     y = np.empty(u.size)
+    inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
+    cap_dt = cap * dt
     for n in range(u.size):
-        acc = w[0] * u[n] - v_b
+        u_n = u[n]
+        acc = w[0] * u_n - v_b
         for k in range(n_cells):
             acc += w[k + 1] * x[k]
         y[n] = acc
         for k in range(n_cells):
-            f, _ = current(u[n] - x[k], i_s[k], v_t[k], knee[k], cap)
-            x[k] += f * dt
+            x[k] += cell_increment(u_n - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
     return y, x
 
 
@@ -47,6 +121,8 @@ def invert(y, x0, i_s, v_t, w, v_b, knee, cap, dt):
     x = x0.copy()
     u_hat = np.empty(y.size)
     bound = 1e6 * (1.0 + np.max(np.abs(y)))
+    inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
+    cap_dt = cap * dt
     for n in range(y.size):
         acc = y[n] + v_b
         for k in range(n_cells):
@@ -56,25 +132,58 @@ def invert(y, x0, i_s, v_t, w, v_b, knee, cap, dt):
             return u_hat, x, n
         u_hat[n] = e
         for k in range(n_cells):
-            f, _ = current(e - x[k], i_s[k], v_t[k], knee[k], cap)
-            x[k] += f * dt
+            x[k] += cell_increment(e - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
     return u_hat, x, -1
+
+
+@njit(cache=True, inline="always")
+def cell_sensitivity_step(v, inv_vt, two_i_s_dt, two_i_s, g, knee, c0, f_knee, dvt_knee, cap,
+                          cap_dt):
+    """``(f dt, d f / d log G, d f / d log V_T, f')`` at ``v``; ``f dt`` is
+    :func:`cell_increment`'s, in the same arithmetic, from the same ``exp``.
+
+    Inside the knee ``df/dlog G = f`` and ``df/dlog V_T = f - v f'(v)``; on the straight
+    continuation the knee's own dependence cancels because ``f'(knee) = cap``, leaving the same
+    terms at the knee (``f_knee = f(knee)``, ``dvt_knee = f_knee - knee cap``).
+    """
+    if abs(v) <= knee:
+        sh, ch = sinh_cosh(v * inv_vt)
+        f = two_i_s * sh
+        slope = g * ch
+        return two_i_s_dt * sh, f, f - v * slope, slope
+    if v > 0:
+        return c0 + cap_dt * v, f_knee, dvt_knee, cap
+    return -c0 + cap_dt * v, -f_knee, -dvt_knee, cap
+
+
+@njit(cache=True)
+def knee_constants(i_s, v_t, knee, cap):
+    """Per cell ``2 I_S``, ``G = 2 I_S / V_T``, ``f(knee)`` and ``f(knee) - knee cap``."""
+    two_i_s = 2.0 * i_s
+    g = 2.0 * i_s / v_t
+    f_knee = np.zeros(i_s.size)
+    for k in range(i_s.size):
+        if knee[k] < np.inf:
+            f_knee[k] = 2.0 * i_s[k] * np.sinh(knee[k] / v_t[k])
+    return two_i_s, g, f_knee, f_knee - knee * cap
 
 
 @njit(cache=True)
 def simulate_with_jacobian(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
-    """Forward model output and its exact Jacobian by forward sensitivities.
+    """Forward model output (:func:`simulate`'s, bit for bit) and its exact Jacobian by forward
+    sensitivities (:func:`cell_sensitivity_step`).
 
     Columns follow ``MplParams.to_vector``: per cell ``log G_k`` and ``log V_Tk``
-    (``G = 2 I_S / V_T``), then ``w_0 .. w_N`` and ``V_b``. Inside the knee
-    ``df/dlog G = f`` and ``df/dlog V_T = f - v f'(v)``; on the straight continuation the knee's
-    own dependence cancels because ``f'(knee) = cap``, leaving the same terms at the knee.
+    (``G = 2 I_S / V_T``), then ``w_0 .. w_N`` and ``V_b``.
     """
     n_cells = x0.size
     x = x0.copy()
     sens = np.zeros((n_cells, 2))
     y = np.empty(u.size)
     jac = np.empty((u.size, 3 * n_cells + 2))
+    inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
+    two_i_s, g, f_knee, dvt_knee = knee_constants(i_s, v_t, knee, cap)
+    cap_dt = cap * dt
     for n in range(u.size):
         acc = w[0] * u[n] - v_b
         for k in range(n_cells):
@@ -86,46 +195,13 @@ def simulate_with_jacobian(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
         jac[n, 2 * n_cells] = u[n]
         jac[n, 3 * n_cells + 1] = -1.0
         for k in range(n_cells):
-            v = u[n] - x[k]
-            f, slope = current(v, i_s[k], v_t[k], knee[k], cap)
-            if abs(v) <= knee[k]:
-                d_log_g = f
-                d_log_vt = f - v * slope
-            else:
-                s = 1.0 if v > 0 else -1.0
-                f_knee = 2.0 * i_s[k] * np.sinh(knee[k] / v_t[k])
-                d_log_g = s * f_knee
-                d_log_vt = s * (f_knee - knee[k] * cap)
+            step, d_log_g, d_log_vt, slope = cell_sensitivity_step(
+                u[n] - x[k], inv_vt[k], two_i_s_dt[k], two_i_s[k], g[k], knee[k], c0[k],
+                f_knee[k], dvt_knee[k], cap, cap_dt)
             sens[k, 0] += (d_log_g - slope * sens[k, 0]) * dt
             sens[k, 1] += (d_log_vt - slope * sens[k, 1]) * dt
-            x[k] += f * dt
+            x[k] += step
     return y, jac
-
-
-# 1 / (2k + 1)! for k = 7 .. 0: sinh(a) = a * sum_k a^2k / (2k + 1)!, truncated after a^15
-# (the next term is below 1e-19 relative for |a| < 0.5)
-_SINH_TAYLOR = tuple(1.0 / math.factorial(2 * k + 1) for k in range(7, -1, -1))
-
-
-@njit(cache=True, inline="always")
-def sinh_cosh(a):
-    """``(sinh a, cosh a)`` from one ``exp``: a few ulp from libm's, at half the cost.
-
-    libm's ``sinh`` is the fit's most expensive operation (its ``expm1`` and case analysis
-    cost about twice an ``exp``), and the sensitivities need ``cosh`` as well. ``cosh =
-    (e + 1/e) / 2`` has no cancellation; ``sinh = (e - 1/e) / 2`` loses ``coth a`` ulp to it,
-    so for ``|a| < 0.5`` (where ``coth a > 2.2``) ``sinh`` comes from its Taylor series.
-    """
-    t = abs(a)  # both are even or odd: e >= 1, so 1 / e neither divides by 0 nor overflows
-    e = np.exp(t)
-    e_inv = 1.0 / e
-    a2 = a * a
-    series = 0.0
-    for c in _SINH_TAYLOR:
-        series = series * a2 + c
-    # both computed, one selected: a data-dependent branch here mispredicts often
-    sh = a * series if t < 0.5 else math.copysign(0.5 * (e - e_inv), a)
-    return sh, 0.5 * (e + e_inv)
 
 
 # Rows of J gathered, column-major, before they are folded into J^T J: a block of 256 samples
@@ -202,21 +278,17 @@ def normal_equations(u, y_target, x0, i_s, v_t, w, v_b, knee, cap, dt):
 
     The same forward sensitivities and column order as :func:`simulate_with_jacobian`, but
     the Jacobian rows are folded into the (p x p) and (p,) sums block by block as they are
-    formed, so memory is independent of ``u.size``. The state follows :func:`simulate`'s
-    arithmetic except that ``sinh`` and ``cosh`` come from one ``exp`` (:func:`sinh_cosh`), a
-    few ulp from libm's ``sinh``: ``sum(r^2)`` agrees with :func:`simulate`'s to rounding;
-    per-cell constants are taken out of the loop.
+    formed, so memory is independent of ``u.size``. The state and the outputs are
+    :func:`simulate`'s, bit for bit (:func:`cell_sensitivity_step`), so ``sum(r^2)`` is the
+    sequential sum of the squared residuals of :func:`simulate`.
     """
     n_cells = x0.size
     p = 3 * n_cells + 2
     x = x0.copy()
     sens_g, sens_vt = np.zeros(n_cells), np.zeros(n_cells)
-    two_i_s = 2.0 * i_s
-    g = 2.0 * i_s / v_t
-    # on the straight continuation: f(knee) and d f / d log V_T at the knee (see
-    # simulate_with_jacobian), constants per cell
-    f_knee = 2.0 * i_s * np.sinh(knee / v_t)
-    dvt_knee = f_knee - knee * cap
+    inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
+    two_i_s, g, f_knee, dvt_knee = knee_constants(i_s, v_t, knee, cap)
+    cap_dt = cap * dt
     cols = np.empty((p, NORMAL_BLOCK))
     res = np.empty(NORMAL_BLOCK)
     jtj = np.zeros((p, p))
@@ -240,22 +312,12 @@ def normal_equations(u, y_target, x0, i_s, v_t, w, v_b, knee, cap, dt):
             fold_block(cols, res, m, jtj, jtr)
             m = 0
         for k in range(n_cells):
-            v = u[n] - x[k]
-            if abs(v) <= knee[k]:
-                sh, ch = sinh_cosh(v / v_t[k])
-                f = two_i_s[k] * sh
-                slope = g[k] * ch
-                d_log_g = f
-                d_log_vt = f - v * slope
-            else:
-                s = 1.0 if v > 0 else -1.0
-                f = s * f_knee[k] + cap * (v - s * knee[k])
-                slope = cap
-                d_log_g = s * f_knee[k]
-                d_log_vt = s * dvt_knee[k]
+            step, d_log_g, d_log_vt, slope = cell_sensitivity_step(
+                u[n] - x[k], inv_vt[k], two_i_s_dt[k], two_i_s[k], g[k], knee[k], c0[k],
+                f_knee[k], dvt_knee[k], cap, cap_dt)
             sens_g[k] += (d_log_g - slope * sens_g[k]) * dt
             sens_vt[k] += (d_log_vt - slope * sens_vt[k]) * dt
-            x[k] += f * dt
+            x[k] += step
     return sse, mirror_upper(jtj), jtr
 
 
@@ -283,6 +345,22 @@ def theta_normal_equations(u, y_target, x0, theta, slope_cap, dt):
 # Loop blocks (protocol in ``hystkit.models._protocol``): body = [n, v_b, cap, dt,
 # i_s (n), v_t (n), knee (n), w (n + 1)].
 
+@njit(cache=True, inline="always")
+def _block_cells(body, x, xn, off, drive):
+    """The cells driven by ``drive`` (eq. 5.6), in :func:`simulate`'s arithmetic: the per-cell
+    constants are recomputed per call in the same arithmetic (:func:`cell_constants`; the
+    straight branch's offset only where it is taken), so a stream or a loop advances the state
+    bit for bit as the offline run does."""
+    n = int(body[0])
+    cap, dt = body[2], body[3]
+    cap_dt = cap * dt
+    for k in range(n):
+        i_s, v_t, knee = body[4 + k], body[4 + n + k], body[4 + 2 * n + k]
+        v = drive - x[off + k]
+        c0 = 0.0 if abs(v) <= knee else straight_offset(i_s, v_t, knee, cap, dt)
+        xn[off + k] = x[off + k] + cell_increment(v, 1.0 / v_t, 2.0 * i_s * dt, knee, c0, cap_dt)
+
+
 @njit(cache=True)
 def block_forward(body, x, xn, off, u):
     """``y = w_0 u + sum w_k x_k - V_b`` (eq. 5.2), then the cells driven by ``u`` (eq. 5.6)."""
@@ -291,10 +369,7 @@ def block_forward(body, x, xn, off, u):
     acc = body[iw] * u - body[1]
     for k in range(n):
         acc += body[iw + 1 + k] * x[off + k]
-    for k in range(n):
-        f, _ = current(u - x[off + k], body[4 + k], body[4 + n + k], body[4 + 2 * n + k],
-                       body[2])
-        xn[off + k] = x[off + k] + f * body[3]
+    _block_cells(body, x, xn, off, u)
     return acc
 
 
@@ -307,8 +382,5 @@ def block_inverse(body, x, xn, off, y):
     for k in range(n):
         acc -= body[iw + 1 + k] * x[off + k]
     u_hat = acc / body[iw]
-    for k in range(n):
-        f, _ = current(u_hat - x[off + k], body[4 + k], body[4 + n + k], body[4 + 2 * n + k],
-                       body[2])
-        xn[off + k] = x[off + k] + f * body[3]
+    _block_cells(body, x, xn, off, u_hat)
     return u_hat
