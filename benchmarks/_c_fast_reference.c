@@ -1,8 +1,10 @@
 /* The fastest plain C of two families' forward recursions: the yardstick of issue 29.
  *
  * benchmarks/bench_kernels.py compiles this file in the same run as it times, with
- * `cc -O3 -march=native -shared -fPIC` (no -ffast-math: the results must stay those of the
- * model, see below), and states every kernel's speed as a ratio to it.
+ * `cc -O3 -march=native -fno-math-errno -shared -fPIC` and states every kernel's speed as a
+ * ratio to it. No -ffast-math: the results must stay those of the model (see below);
+ * -fno-math-errno changes no result, it only lets the compiler treat exp and pow as pure
+ * functions (keep values in registers across the calls, schedule around them).
  *
  * mpl_fast: the mPL recursion of hystkit.models.mpl.kernels.simulate (forward Euler, eq. 5.6;
  * sinh resistor continued by straight lines beyond the knee, eq. 5.29 as corrected), with

@@ -1,7 +1,8 @@
 """Forward kernels against the fastest plain C (issue 29, items 1-2): every ratio is to ``fast C``.
 
-Run:  python benchmarks/bench_kernels.py [--quick]   (about a minute; writes
-      benchmarks/last_run_kernels.txt; --quick: fewer rounds, for a loaded machine)
+Run:  python benchmarks/bench_kernels.py [--quick] [--before REV]   (about a minute; writes
+      benchmarks/last_run_kernels.txt; --quick: fewer rounds; --before REV: two more mPL
+      columns, the bare kernel of this tree and of git revision REV, paired in the same rounds)
 
 Models: mPL with 1, 3 and 5 cells and PL with 2 cells, each fitted (direct mode, centring fit)
 on the virtual sensor's sine recording (seed 1): realistic parameters, e.g. the 5-cell mPL has
@@ -10,11 +11,12 @@ and the sine recordings of seeds 2, 3, ... normalised the same way and joined (1
 
 Columns, ns per sample, each built in this run and called on the same input:
 
-* ``fast C``: ``_c_fast_reference.c``, ``cc -O3 -march=native`` (no -ffast-math): one exp per
+* ``fast C``: ``_c_fast_reference.c``, ``cc -O3 -march=native -fno-math-errno`` (no
+  -ffast-math; -fno-math-errno changes no result, only errno): one exp per
   cell, sinh from its series below |a| = 0.5, per-cell constants out of the loop (mPL); one pow
   per cell (PL). The yardstick;
 * ``C no guard``: the same without the series, sinh = (e - 1/e) / 2 everywhere (mPL only):
-  what the guard costs, and (agreement table) what it saves;
+  what the guard costs (measured: nothing, 0.96-1.10x), and (agreement table) what it saves;
 * ``slow C``: ``_c_reference.c`` as ``bench_mpl.py`` builds it (``cc -O2``, libm's sinh, the
   kernel's operation order; mPL only, PL has none);
 * ``simulate``: ``family.simulate`` (the numba kernel with its Python wrapper: checks, knees);
@@ -24,9 +26,12 @@ Columns, ns per sample, each built in this run and called on the same input:
   centring and flags, is ``bench_export.py``'s).
 
 Timing: rounds paired and interleaved (each round calls every column once, in turn: A B C A B
-C ...; the first call of each is untimed), ``perf_counter`` around a call; the table gives the
-median ns per sample and, per column, the median over rounds of that round's ratio to the
-round's ``fast C`` (pairing cancels most of the load from other processes).
+C ...; the first call of each is untimed), the thread's CPU time (``time.thread_time``) and the
+wall time (``perf_counter``) around a call; each table gives the median ns per sample and, per
+column, the median over rounds of that round's ratio to the round's ``fast C`` (pairing cancels
+most of the load from other processes). CPU time is the cost: on a busy 2-core machine a
+100k-sample call (2-7 ms) outlasts the scheduler's slice and its wall time includes waiting for
+other processes (measured: up to 2-4x on some columns, none at 8000 samples).
 
 Agreement: per column, max |y - y_ref| / max |y_ref| on the 8000-sample input, ``y_ref`` the
 family's readable reference (``simulate_reference``, a Python loop over ``step``).
@@ -34,7 +39,9 @@ family's readable reference (``simulate_reference``, a Python loop over ``step``
 
 from __future__ import annotations
 
+import argparse
 import ctypes
+import importlib.util
 import os
 import platform
 import statistics
@@ -52,18 +59,24 @@ import numba
 import numpy as np
 
 from hystkit.compensation import fit_compensator, save_compensator
+from hystkit.models.mpl import kernels as mpl_kernels
 from hystkit.models.mpl import model as mpl
 from hystkit.models.pl import model as pl
 from hystkit.sensors import simulate_experiment
 
 HERE = Path(__file__).parent
-FAST_FLAGS = ("-O3", "-march=native", "-shared", "-fPIC")
+# -fno-math-errno changes no value (exp and pow only stop setting errno), but lets the compiler
+# treat them as pure: the 5-cell mPL ran 18 % faster with it (24.6 -> 20.1 ns/sample, same bits)
+FAST_FLAGS = ("-O3", "-march=native", "-fno-math-errno", "-shared", "-fPIC")
 SLOW_FLAGS = ("-O2", "-shared", "-fPIC")  # as bench_mpl.py builds _c_reference.c
 CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2))
 SIZES = (8000, 100_000)
 ROUNDS = {8000: 101, 100_000: 31}
 QUICK_ROUNDS = {8000: 31, 100_000: 11}
 COLUMNS = ("fast C", "C no guard", "slow C", "simulate", "export")
+# CPU time first: on a shared machine a call longer than the scheduler's slice (~2 ms here)
+# waits for the other processes, which wall time counts and CPU time does not.
+CLOCKS = {"cpu": "CPU time (thread)", "wall": "wall time"}
 
 _ARR = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
 _I64, _DBL = ctypes.c_int64, ctypes.c_double
@@ -174,10 +187,36 @@ def _export_column(comp, label: str, cc: str, tmp: Path):
     return run
 
 
-def build_cases(cc: str, tmp: Path) -> list[Case]:
+def load_kernels_at(rev: str, tmp: Path):
+    """``models/mpl/kernels.py`` of git revision ``rev`` as a module of its own (it imports
+    only numpy and numba), for a paired before/after in one run."""
+    source = f"{rev}:src/hystkit/models/mpl/kernels.py"
+    text = subprocess.run(["git", "-C", str(HERE), "show", source], capture_output=True,
+                          text=True, check=True).stdout
+    path = tmp / f"mpl_kernels_{rev.replace('/', '_')}.py"
+    path.write_text(text)
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _kernel_columns(comp, current, before, rev: str) -> dict:
+    """The bare numba kernel (no wrapper) of this tree and of revision ``rev``."""
+    s, p = comp.structure, comp.params
+    rest = (p.i_s, p.v_t, p.w, p.v_b, mpl.knee_voltage(s, p), s.slope_cap / s.dt, s.dt)
+
+    def run(module):
+        return lambda u: module.simulate(u, np.full(s.n_cells, u[0]), *rest)[0]
+
+    return {"kernel": run(current), f"kernel@{rev}": run(before)}
+
+
+def build_cases(cc: str, tmp: Path, before_rev: str | None = None) -> list[Case]:
     fast = _compile(cc, FAST_FLAGS, HERE / "_c_fast_reference.c", tmp / "fast.so")
     slow = _compile(cc, SLOW_FLAGS, HERE / "_c_reference.c", tmp / "slow.so")
     fit_rec = simulate_experiment("sine", 1)
+    before = load_kernels_at(before_rev, tmp) if before_rev else None
     cases = []
     for family, size in CASES:
         comp = fit_compensator(fit_rec, size, model=family, diagnose=False)
@@ -188,6 +227,8 @@ def build_cases(cc: str, tmp: Path) -> list[Case]:
         case.columns["simulate"] = (
             lambda u, m=model, s=comp.structure, p=comp.params: m.simulate(s, p, u)[0])
         case.columns["export"] = _export_column(comp, case.label, cc, tmp)
+        if before is not None and family == "mpl":
+            case.columns.update(_kernel_columns(comp, mpl_kernels, before, before_rev))
         cases.append(case)
     return cases
 
@@ -201,20 +242,25 @@ def agreement(case: Case) -> dict:
 
 
 def time_case(case: Case, n: int, rounds: int) -> dict:
-    """Median ns per sample per column, and the median of the per-round ratios to fast C."""
+    """Per clock (``cpu``: this thread's CPU time, ``wall``: perf_counter): median ns per
+    sample per column, and the median of the per-round ratios to fast C."""
     u = case.inputs[n]
     for fn in case.columns.values():
         fn(u)
-    seconds = {name: [] for name in case.columns}
+    seconds = {clock: {name: [] for name in case.columns} for clock in CLOCKS}
     for _ in range(rounds):
         for name, fn in case.columns.items():
-            t0 = time.perf_counter()
+            c0, t0 = time.thread_time(), time.perf_counter()
             fn(u)
-            seconds[name].append(time.perf_counter() - t0)
-    ns = {name: statistics.median(t) * 1e9 / n for name, t in seconds.items()}
-    ratio = {name: statistics.median(a / b for a, b in zip(t, seconds["fast C"], strict=True))
-             for name, t in seconds.items()}
-    return {"ns": ns, "ratio": ratio}
+            seconds["wall"][name].append(time.perf_counter() - t0)
+            seconds["cpu"][name].append(time.thread_time() - c0)
+    out = {}
+    for clock, by_name in seconds.items():
+        base = by_name["fast C"]
+        out[clock] = {name: (statistics.median(t) * 1e9 / n,
+                             statistics.median(a / b for a, b in zip(t, base, strict=True)))
+                      for name, t in by_name.items()}
+    return out
 
 
 def _cpu() -> str:
@@ -225,14 +271,21 @@ def _cpu() -> str:
 
 
 def main() -> int:
-    quick = "--quick" in sys.argv
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer rounds")
+    parser.add_argument("--before", metavar="REV", help="add the bare mPL kernel of this tree "
+                        "and of git revision REV (paired before/after)")
+    args = parser.parse_args()
+    quick = args.quick
+    columns = [*COLUMNS, *(["kernel", f"kernel@{args.before}"] if args.before else [])]
     rounds = QUICK_ROUNDS if quick else ROUNDS
     cc = os.environ.get("CC", "cc")
     version = subprocess.run([cc, "--version"], capture_output=True, text=True,
                              check=True).stdout.splitlines()[0]
     head = git_head()
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
-    lines = [(f"# bench_kernels.py{' --quick' if quick else ''}, hystkit {head}; {_cpu()}, "
+    flags = " ".join(sys.argv[1:])
+    lines = [(f"# bench_kernels.py {flags}, hystkit {head}; {_cpu()}, "
               f"{os.cpu_count()} cores, load {load}"),
              (f"# {version}; fast C / export: cc {' '.join(FAST_FLAGS)}; slow C: cc "
               f"{' '.join(SLOW_FLAGS)}; numpy {np.__version__}, numba {numba.__version__}"),
@@ -247,26 +300,28 @@ def main() -> int:
     print("\n".join(lines), flush=True)
     with tempfile.TemporaryDirectory(prefix="hystkit-kernels-") as tmp:
         t0 = time.perf_counter()
-        cases = build_cases(cc, Path(tmp))
+        cases = build_cases(cc, Path(tmp), args.before)
         emit(f"# fits, exports and builds: {time.perf_counter() - t0:.1f} s")
         emit()
         emit("Agreement with the readable reference (simulate_reference), 8000 samples: "
              "max|y - y_ref| / max|y_ref|")
-        emit(f"{'model':<8}" + "".join(f"{c:>12}" for c in COLUMNS))
+        emit(f"{'model':<8}" + "".join(f"{c:>16}" for c in columns))
         for case in cases:
             agree = agreement(case)
             emit(f"{case.label:<8}" + "".join(
-                f"{agree[c]:>12.1e}" if c in agree else f"{'-':>12}" for c in COLUMNS))
+                f"{agree[c]:>16.1e}" if c in agree else f"{'-':>16}" for c in columns))
         for n in SIZES:
-            emit()
-            emit(f"{n} samples: ns/sample (ratio to fast C)")
-            emit(f"{'model':<8}" + "".join(f"{c:>18}" for c in COLUMNS) + f"{'ns/cell fast':>14}")
-            for case in cases:
-                r = time_case(case, n, rounds[n])
-                cells = "".join(
-                    f"{r['ns'][c]:>10.1f} ({r['ratio'][c]:4.2f})" if c in r["ns"] else f"{'-':>18}"
-                    for c in COLUMNS)
-                emit(f"{case.label:<8}{cells}{r['ns']['fast C'] / case.size:>14.1f}")
+            results = [time_case(case, n, rounds[n]) for case in cases]
+            for clock, clock_name in CLOCKS.items():
+                emit()
+                emit(f"{n} samples, {clock_name}: ns/sample (ratio to fast C)")
+                emit(f"{'model':<8}" + "".join(f"{c:>18}" for c in columns)
+                     + f"{'ns/cell fast':>14}")
+                for case, r in zip(cases, results, strict=True):
+                    row = r[clock]
+                    cells = "".join(f"{row[c][0]:>10.1f} ({row[c][1]:4.2f})" if c in row
+                                    else f"{'-':>18}" for c in columns)
+                    emit(f"{case.label:<8}{cells}{row['fast C'][0] / case.size:>14.1f}")
     emit(f"# load at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
     (HERE / "last_run_kernels.txt").write_text("\n".join(lines) + "\n")
     return 0
