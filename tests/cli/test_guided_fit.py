@@ -81,8 +81,8 @@ def test_a_model_option_without_a_model_is_one_line(data, tmp_path, capsys, opti
 
 
 def test_budget_belongs_to_the_guided_fit(data, tmp_path, capsys):  # noqa: F811
-    code, _, err = run_cli(capsys, "fit", data["sine1"], "--budget", "30", "--out",
-                           tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", data["sine1"], "--model", "mpl", "--budget", "30",
+                           "--out", tmp_path / "m.json")
     assert code == 2 and "--budget applies to --model auto" in err
 
 
@@ -125,3 +125,22 @@ def test_pieces_after_the_deadline_are_skipped_not_run():
                            on_done=lambda i, r: done.append(i))
     assert results == [{"error": SKIPPED}] * 3 and done == [0, 1, 2]
     assert budgeted.late == {cand.label}
+
+
+def test_an_option_of_a_named_model_means_mpl_whatever_the_default(data, tmp_path, capsys,  # noqa: F811
+                                                                    monkeypatch):
+    """--cells 3 alone is the 3-cell mpl (as the issue's user typed it), also once the default
+    without --model is the guided fit (cmd_core.DEFAULT_MODEL)."""
+    from hystkit.cli import cmd_core
+    from hystkit.cli._main import _parser
+
+    def chosen(*argv):
+        return cmd_core._chosen_model(_parser().parse_args(["fit", "x.csv", "--out", "m.json",
+                                                            *argv]))
+
+    monkeypatch.setattr(cmd_core, "DEFAULT_MODEL", "auto")
+    assert chosen() == "auto" and chosen("--model", "pi") == "pi"
+    assert chosen("--cells", "3") == chosen("--loss", "huber") == "mpl"
+    code, out, err = run_cli(capsys, "fit", data["sine1"], "--cells", "1", "--out",
+                             tmp_path / "m.json")
+    assert code == 0 and out.startswith("fitting mpl (cells N (3N + 2 params): 1,"), err

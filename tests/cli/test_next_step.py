@@ -42,7 +42,7 @@ def _fit(capsys, data, tmp_path, train, *options):  # noqa: F811 (the fixture's 
      "next: try --model auto (mpl with 1-3 cells"),
     ("noise_only", ("--model", "mpl"), "no signal", "next: try checking the columns"),
     # the line explains nothing either: a sensor problem, whatever the status's name
-    ("unrelated", (), "", "next: try checking the columns"),
+    ("unrelated", ("--model", "mpl"), "", "next: try checking the columns"),
     ("sine1", ("--no-limit",), "no limit", "next: try the fit without --no-limit"),
 ])
 def test_a_refused_fit_names_what_to_try(data, tmp_path, capsys, train, options, status,  # noqa: F811
@@ -86,7 +86,7 @@ def test_a_collapsed_fit_is_sent_to_the_guided_fit_and_the_columns(tmp_path, cap
 
     _patched(monkeypatch, fit=collapsed_fit)
     path = write_recording(simulate_experiment("sine", 1), tmp_path / "sine.csv")
-    code, out, err = run_cli(capsys, "fit", path, "--out", tmp_path / "m.json")
+    code, out, err = run_cli(capsys, "fit", path, "--model", "mpl", "--out", tmp_path / "m.json")
     assert code == GUARD_EXIT and "hystkit: fit collapsed" in err
     assert _next(out).startswith("next: try --model auto")
     assert "if every model collapses, checking the columns" in _next(out)
