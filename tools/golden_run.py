@@ -27,12 +27,17 @@ output file normalised to text:
   ``compile s`` / ``simulation s`` columns of ``control``'s table;
 * versions: JSON ``hystkit_version`` and the text ``hystkit X.Y.Z`` -> ``<VERSION>``;
 * wall-clock dates ``YYYY-MM-DD HH:MM[:SS]`` (an export's time, a model file's mtime) ->
-  ``<DATE>``;
+  ``<DATE>``; a temporary folder's random suffix (``.tmp-XXXXXXXX``) -> ``<RANDOM>``;
 * binary files: Parquet -> its columns, dtypes and every value (repr); .mat -> every variable
   (the header, which holds the creation time, is left out); PNG and other binaries -> SHA-256;
-  base64 images inside HTML -> the SHA-256 of their bytes; SVG/PDF dates -> ``<DATE>``.
+  base64 images inside HTML -> the SHA-256 of their bytes; SVG/PDF dates -> ``<DATE>`` and
+  matplotlib's random SVG clip-path ids -> ``<ID>``; a file without a known suffix is text
+  when it is UTF-8 (an export's README).
 
-Nothing else is touched: a changed number, word or file is a difference. ``compare`` prints,
+Nothing else is touched: a changed number, word or file is a difference. Not normalised yet
+(they show as differences between two runs of one revision): ``compare``'s and
+``pl-search``'s seconds columns, ``fit_seconds`` inside .mat files, ``batch``'s fit-seconds
+column and the recordings' mtimes in its sensor files. ``compare`` prints,
 per command, ``same`` or ``differs`` with the first differing lines of each differing step, and
 exits 1 if anything differs.
 """
@@ -68,11 +73,15 @@ TIMING_PATTERNS = [
     re.compile(rf"(: )({_NUM})( s \(about )({_NUM})( s left\))"),
     re.compile(rf"(: )({_NUM})( s)$", re.MULTILINE),
     re.compile(rf"(about )({_NUM})( s left)"),
+    re.compile(rf"(\()({_NUM})( s, )({_NUM})( M samples/s)"),  # preprocess's throughput
+    re.compile(rf"(median )({_NUM})( µs, p99 )({_NUM})( µs, max )({_NUM})( µs)"),  # stream
 ]
 COMPILE_NOTICE = re.compile(r"^hystkit: compiling numba kernels.*\n?", re.MULTILINE)
 VERSION_TEXT = re.compile(r"(hystkit )\d+\.\d+\.\d+\S*")
 DATE_TEXT = re.compile(r"(<dc:date>|/CreationDate \(|/ModDate \()[^<)]*")
 CLOCK_TEXT = re.compile(r"\d{4}-\d{2}-\d{2}[ T]\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?")
+TEMP_NAME = re.compile(r"(\.tmp-)[A-Za-z0-9_]{8}\b")  # tempfile.mkdtemp's suffix
+SVG_ID = re.compile(r"(url\(#|id=\"|xlink:href=\"#)[pm][0-9a-f]{10}")  # matplotlib's random ids
 DATA_URI = re.compile(r"data:(image/[a-z+]+);base64,([A-Za-z0-9+/=]+)")
 
 
@@ -133,6 +142,7 @@ class Recorder:
         text = _control_timing_columns(text)
         text = VERSION_TEXT.sub(r"\1<VERSION>", text)
         text = CLOCK_TEXT.sub("<DATE>", text)
+        text = TEMP_NAME.sub(r"\1<RANDOM>", text)
         return DATE_TEXT.sub(r"\1<DATE>", text)
 
     def keep(self, path: Path, target: Path) -> None:
@@ -156,10 +166,19 @@ class Recorder:
             return self.text(_parquet_text(path))
         if suffix == ".mat":
             return self.text(_mat_text(path))
-        if suffix in TEXT_SUFFIXES:
-            text = path.read_text(errors="replace")
-            return self.text(DATA_URI.sub(_hash_data_uri, text))
+        data = path.read_bytes()
+        if suffix in TEXT_SUFFIXES or (b"\0" not in data and _is_utf8(data)):  # README too
+            text = data.decode("utf-8", errors="replace")
+            return self.text(SVG_ID.sub(r"\1<ID>", DATA_URI.sub(_hash_data_uri, text)))
         return f"sha256 {hashlib.sha256(path.read_bytes()).hexdigest()}  {path.stat().st_size} bytes\n"
+
+
+def _is_utf8(data: bytes) -> bool:
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    return True
 
 
 def _timing_groups(match: re.Match) -> str:
