@@ -66,7 +66,8 @@ def test_a_noise_only_sensor_is_never_ok(data, tmp_path, capsys):  # noqa: F811
                              model)
     assert code == GUARD_EXIT and not model.exists()
     assert "status: ok" not in out
-    assert err.strip().splitlines()[-1].startswith("hystkit: fit: no usable model among ")
+    refusal = err.strip().splitlines()[-1]
+    assert refusal.startswith("hystkit: fit: no usable model among ") and "no signal" in refusal
     assert out.strip().splitlines()[-1].startswith("next: try checking the columns")
 
 

@@ -285,7 +285,8 @@ def run_guided_fit(args: argparse.Namespace) -> int:
         status = selection_status(result)
         sys.stdout.flush()  # the progress lines before the refusal
         print(f"hystkit: fit: no usable model among {len(SHORT_LIST)} candidates, none "
-              f"written ({seconds:.1f} s): {result['refusal']}", file=sys.stderr)
+              f"written ({seconds:.1f} s): {status.replace('_', ' ')}: {result['refusal']}",
+              file=sys.stderr)
         best = next((r for r in result["ranking"] if "error" not in r), None)
         say_next(next_step(status, command="guided", model=best and best["model"],
                            size=best and best["size"]))
