@@ -463,7 +463,7 @@ def _plain_chunk(stream: Stream, chunk: Chunk, reading: _Reading, tally: _Tally,
         return None
     parts = text[:-1].replace("\n", ",").split(",")
     try:
-        values = np.array([float(v) for v in parts])  # as _parse reads them
+        values = np.array(list(map(float, parts)))  # as _parse reads them
     except ValueError:
         return None
     t = values[0::2] * reading.time_scale

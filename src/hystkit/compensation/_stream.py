@@ -29,6 +29,7 @@ Start-up (``start``):
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
@@ -487,6 +488,18 @@ def compiled_engine(path: _Path):
         engine = Engine(path)
     except NotImplementedError:  # a family without a block
         return None
+    if path.comp.center != "track":
+        return engine if _reproduces(engine, path) else None
+    # The family's block is what the probe checks; the tracker is the same code for every
+    # family (tested), and its Python path would import scipy.signal (~0.7 s).
+    probed = _Path(dataclasses.replace(path.comp, center="fit"), path.rest_position,
+                   path.level)
+    return engine if _reproduces(Engine(probed), probed) else None
+
+
+def _reproduces(engine, path: _Path) -> bool:
+    """Whether `engine` gives the Python path's bits (estimates, flags, band, end state) on
+    the probe signal, from a stream at rest (its first sample by the Python path)."""
     probe = _probe(path.comp)
     start = StreamState(None)
     try:
@@ -494,15 +507,14 @@ def compiled_engine(path: _Path):
             want, want_state = _advance(path, start, probe, "probe")
             first, state = _advance(path, start, probe[:1], "probe")
     except (FitDivergedError, ValueError):  # the probe ran away: nothing to compare with
-        return None
+        return False
     engine.load(state)
     rows, taken = engine.run(probe[1:])
     if taken != probe.size - 1:
-        return None
+        return False
     got = _concatenate(path, [first, _chunk_output(path, rows)])
-    same = all(_same_bits(a, b) for a, b in zip(got, want, strict=True)) and \
+    return all(_same_bits(a, b) for a, b in zip(got, want, strict=True)) and \
         _same_state(engine.state(), want_state)
-    return engine if same else None
 
 
 def _probe(comp: Compensator) -> np.ndarray:
@@ -680,9 +692,9 @@ class Stream:
             if column is not None:
                 self._state_ok = False
                 return _step_output(self._path, column)
-        return self.step_flagged_python(sensor)
+        return self._step_python(sensor)
 
-    def step_flagged_python(self, sensor: float) -> StepOutput:
+    def _step_python(self, sensor: float) -> StepOutput:
         """:meth:`step_flagged` through the readable Python path (the reference the compiled
         kernel is checked against; a refused sample raises here)."""
         out, state, self._previous = _advance_one(self._path, self.state, sensor, self.label,
@@ -712,7 +724,7 @@ class Stream:
                 if k == s_raw.size:
                     break
             try:  # the Python path: a stream's first sample, or one the kernel refused
-                parts.append(_as_chunk(self._path, self.step_flagged_python(s_raw[k])))
+                parts.append(_as_chunk(self._path, self._step_python(s_raw[k])))
             except FitDivergedError:
                 break
             k += 1
