@@ -8,9 +8,10 @@ from .._lazy import lazy_exports
 
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"_names": ("EXPERIMENTS", "MASS", "SCHEMES", "SLOW_GROWTH_S", "TRAININGS", "TYPICAL_RUN_S"),
+    {"_words": ("slow_cell_words",),
+     "_names": ("EXPERIMENTS", "MASS", "SCHEMES", "SLOW_GROWTH_S", "TRAININGS", "TYPICAL_RUN_S"),
      "_analysis": ("DOB_CANDIDATES_HZ", "LoopMargins", "bode_data", "classify_poles",
-                   "design_dob", "loop_margins", "open_loop", "slow_cell_words", "slowest_cell",
+                   "design_dob", "loop_margins", "open_loop", "slowest_cell",
                    "static_sign_flips", "tune_pid"),
      "_blocks": ("DOCUMENT_PID_DIRECT", "DOCUMENT_PID_WEIGHTING", "PID", "TS",
                  "DisturbanceObserver", "Plant", "plant_matrices"),
