@@ -234,8 +234,9 @@ def model_options_given(args: argparse.Namespace) -> list[str]:
 
 
 def _refuse_model_options(args: argparse.Namespace) -> None:
-    for option in model_options_given(args)[:1]:
-        raise UsageError(f"{option} applies to a named model (e.g. --model mpl {option} "
+    given = model_options_given(args)
+    if given:
+        raise UsageError(f"{given[0]} applies to a named model (e.g. --model mpl {given[0]} "
                          f"...); --model {GUIDED} tries its own short list")
 
 
