@@ -206,7 +206,11 @@ def initial_state(comp: Compensator, start: StartUp = "rest") -> StreamState:
     comp : Compensator
         The compensator the stream runs.
     start : "rest", "sync" or array, default "rest"
-        Start-up (module docstring).
+        Start-up: ``"rest"``: the model at rest at the first sample (what ``estimate``
+        does); ``"sync"``: the state left by the synchronisation excitation (eq. 2.21-2.22,
+        :func:`sync_excitation`), once the device has been driven through it; an array: a
+        given model state (its length is the family's state size), e.g. one saved from an
+        earlier run.
 
     Returns
     -------
@@ -596,7 +600,11 @@ class Stream:
         Any deployable compensator (centring ``fit``, ``tare``, ``track`` or ``none``), direct or
         inverse, of any family.
     start : "rest", "sync" or array
-        Start-up (module docstring). Default: at rest at the first sample.
+        Start-up, default ``"rest"``: ``"rest"``: the model at rest at the first sample (what ``estimate``
+        does); ``"sync"``: the state left by the synchronisation excitation (eq. 2.21-2.22,
+        :func:`sync_excitation`), once the device has been driven through it; an array: a
+        given model state (its length is the family's state size), e.g. one saved from an
+        earlier run.
     rest_position : float, optional
         Where the device rests during the tare window [mm], if not where it rested in training
         (``tare`` only; as :meth:`Compensator.estimate`).
