@@ -30,8 +30,8 @@ def test_warm_compiles_what_fit_needs_and_a_cold_run_says_it_compiles(tmp_path):
 
     warm = _hystkit(cache, "warm", "--models", "mpl", "--no-control", cwd=tmp_path)
     lines = warm.stdout.splitlines()
-    assert lines[0].startswith("hystkit warm: compiling the numba kernels of fit, evaluate and "
-                               "compare")
+    assert lines[0].startswith("hystkit warm: compiling the numba kernels of fit, evaluate, "
+                               "stream and compare")
     assert str(cache) in lines[0]
     assert [line.split(":")[0].strip() for line in lines[1:3]] == ["[1/2] recordings",
                                                                    "[2/2] mpl"]
@@ -40,8 +40,10 @@ def test_warm_compiles_what_fit_needs_and_a_cold_run_says_it_compiles(tmp_path):
     assert list(cache.rglob("_trust_region_steps.prepare-*.nbi"))  # the solver's kernels
     assert list(cache.rglob("kernels.normal_equations-*.nbi"))  # the mPL's
 
-    fit = _hystkit(cache, "fit", "fit.csv", "--out", "mpl.json", cwd=tmp_path)
+    fit = _hystkit(cache, "fit", "fit.csv", "--model", "mpl", "--out", "mpl.json", cwd=tmp_path)
     assert COMPILING_NOTICE not in fit.stderr  # everything loaded from the cache
+    stream = _hystkit(cache, "stream", "mpl.json", "--in", "fit.csv", cwd=tmp_path)
+    assert COMPILING_NOTICE not in stream.stderr  # its per-sample kernel too
 
     cold = _hystkit(cache, "fit", "fit.csv", "--model", "pi", "--out", "pi.json",
                     cwd=tmp_path)

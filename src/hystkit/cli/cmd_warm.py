@@ -4,7 +4,7 @@ installation (issue 29), with a line per step and an estimate of the rest.
 Without it the first ``fit``, ``compare`` or ``control`` compiles what it needs itself (and
 says so on stderr): 10-60 s on 2 cores. ``warm`` runs those commands once, in a temporary
 folder, on short recordings of the virtual sensor: for each family ``fit`` (with its band),
-``evaluate`` and ``compare``, then ``control --experiment sine`` in both schemes; their output
+``evaluate``, ``stream --in`` (its compiled per-sample kernel) and ``compare``, then ``control --experiment sine`` in both schemes; their output
 is dropped. What gets compiled, with which argument types, is therefore what the commands use
 today, not a list kept beside them. numba keeps the kernels in its on-disk cache, where every
 later process loads them (see numba's ``NUMBA_CACHE_DIR``). Run again, it only loads them.
@@ -98,15 +98,15 @@ def _write_recordings(folder: Path) -> None:
         write_recording(short, folder / name)
 
 
-def _command(*argv: str) -> str | None:
-    """Run ``hystkit ARGV`` here with its output dropped; None, or why it failed (a fit that
-    fails its guards, exit 3, has run all the same)."""
+def _command(*argv: str, ran: Sequence[int] = (0, 3)) -> str | None:
+    """Run ``hystkit ARGV`` here with its output dropped; None, or why it failed. An exit code
+    in `ran` counts as run (a fit that fails its guards, exit 3, has compiled all the same)."""
     from ._main import main
 
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         code = main(list(argv))
-    if code in (0, 3):
+    if code in ran:
         return None
     lines = err.getvalue().strip().splitlines()
     return f"{argv[0]} exited {code}: {lines[-1] if lines else 'no message'}"
@@ -118,6 +118,8 @@ def _family_step(folder: Path, name: str) -> Callable[[], str | None]:
         notes = [_command("fit", fit, "--model", name, "--out", str(model))]
         if model.exists():
             notes.append(_command("evaluate", str(model), val))
+            # a model that failed its guards is refused by stream (exit 2): nothing to compile
+            notes.append(_command("stream", str(model), "--in", val, ran=(0, 2)))
         notes.append(_command("compare", fit, val, "--models", name,
                               "--out", str(folder / f"compare-{name}")))
         return "; ".join(note for note in notes if note) or None
@@ -164,7 +166,8 @@ def _warm(args: argparse.Namespace) -> int:
 
     _compilation.announce(None)  # the progress lines say it
     models, control = _models(args.models), not args.no_control
-    commands = "fit, evaluate, compare and control" if control else "fit, evaluate and compare"
+    commands = ("fit, evaluate, stream, compare and control" if control
+                else "fit, evaluate, stream and compare")
     with tempfile.TemporaryDirectory(prefix="hystkit-warm-") as folder:
         steps = warm_steps(Path(folder), models, control)
         estimate = sum(s.work_seconds + s.compile_seconds for s in steps)
@@ -178,8 +181,8 @@ def _warm(args: argparse.Namespace) -> int:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``warm`` subcommand to the ``hystkit`` parser."""
-    p = sub.add_parser("warm", help="compile the numba kernels of fit, compare and control "
-                                    "ahead, once per installation")
+    p = sub.add_parser("warm", help="compile the numba kernels of fit, stream, compare and "
+                                    "control ahead, once per installation")
     p.add_argument("--models", metavar="NAME,...",
                    help="only these model families (default: all)")
     p.add_argument("--no-control", action="store_true", help="skip the control loop")
