@@ -15,7 +15,6 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
 
-from .batch._reading import remember_reading, training_units
 from .compensation import (
     DEFAULT_CENTER,
     DEFAULT_LEVEL,
@@ -29,6 +28,7 @@ from .compensation import (
 from .compensation import evaluate as _evaluate
 from .compensation import use_flags as _use_flags
 from .io import ReadOptions, Recording, options_for, read_pieces, read_recording, settings_for
+from .io._training_reading import remember_reading, training_units
 from .models import get_family
 
 if TYPE_CHECKING:

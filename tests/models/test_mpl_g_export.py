@@ -1,4 +1,4 @@
-"""The mpl-g translation (export/_families/mpl_g.py): the exported C (double, strict flags) and
+"""The mpl-g translation (models/mpl_g/export.py): the exported C (double, strict flags) and
 MATLAB (GNU Octave) reproduce Compensator.estimate to 1e-9 mm, both modes, every centring.
 (The export suite's own cases are a fixed list of families; this is the same check for mpl-g.)"""
 

@@ -39,10 +39,10 @@ from ..io import (
     read_recording,
     write_json,
 )
+from ..io._training_reading import remember_reading, training_units
 from ..models import get_family
 from ..parallel import Executor, SerialExecutor
 from ._manifest import SensorJob
-from ._reading import remember_reading, training_units
 
 __all__ = ["RESULT_COLUMNS", "fit_sensor", "pending", "run_batch"]
 

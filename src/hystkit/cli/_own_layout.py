@@ -23,52 +23,18 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
-from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 
 from .._read_options import FIELDS, ReadOptions
 from ..errors import InputError
+from ..io._training_reading import training_reading  # the rule fit and select store by
 from ._common import given_read_options, read_options
 
 __all__ = ["TRAINED_NOTE", "add_trained_note", "estimate_names", "options_as_trained",
            "output_names", "remembered_options", "stream_args", "training_reading"]
 
 _HEAD_BYTES = 1 << 16  # as io._csv_layout: the header must end within it
-
-
-def training_reading(options: Sequence[ReadOptions], paths: Sequence[Path],
-                     units: dict[str, str]) -> tuple[ReadOptions | None, str]:
-    """What a model file remembers of how its training recordings were read.
-
-    Parameters
-    ----------
-    options : sequence of ReadOptions
-        How each training recording was read.
-    paths : sequence of Path
-        The recordings, in the same order.
-    units : dict
-        Units of position and sensor of the training recordings (``fit_info["units"]``).
-
-    Returns
-    -------
-    reading : ReadOptions or None
-        Their columns and time unit, a units line when every CSV among them had one, and
-        `units`; None when the recordings were read with different columns or time units.
-    note : str
-        Why nothing is remembered, else "".
-    """
-    layouts = {(o.columns, o.time_unit) for o in options}
-    if len(layouts) > 1:
-        shown = "; ".join(f"{p}: {_describe(o)}" for p, o in zip(paths, options, strict=True))
-        return None, (f"the training files were read differently ({shown}): the model file "
-                      f"does not remember how; later commands read each file as their "
-                      f"options and settings files say")
-    csvs = [o for o, p in zip(options, paths, strict=True) if p.suffix.lower() == ".csv"]
-    units_row = bool(csvs) and all(o.units_row for o in csvs)
-    first = options[0]
-    return ReadOptions(columns=first.columns, time_unit=first.time_unit, units_row=units_row,
-                       units=tuple(units.items())), ""
 
 
 def remembered_options(args: argparse.Namespace, path: Path, reading: ReadOptions | None,
@@ -216,11 +182,6 @@ def _number(cell: str, decimal: str) -> bool:
     except ValueError:
         return False
     return True
-
-
-def _describe(options: ReadOptions) -> str:
-    columns = ",".join(options.name(field) for field in FIELDS)
-    return f"columns {columns}, time in {options.time_unit}"
 
 
 def output_names(options: ReadOptions) -> dict[str, str]:

@@ -1,6 +1,5 @@
-"""What a model file remembers of how its training recordings were read (its ``reading``), for
-the library's fits of files: `hystkit.fit` given paths and `run_batch`, as ``hystkit fit``
-remembers it (`hystkit.cli._own_layout.training_reading`, the same rule).
+"""What a model file remembers of how its training recordings were read (its ``reading``): one
+rule for ``hystkit fit`` and ``select``, `hystkit.fit` given paths and `run_batch`.
 
 A model fitted on files read with one column mapping and time unit remembers them, with a units
 line when every CSV among them had one and the units of position and sensor; ``evaluate``,
