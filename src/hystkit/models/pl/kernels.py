@@ -13,14 +13,40 @@ from numba import njit
 
 
 @njit(cache=True, inline="always")
-def _current(v, i_t, thr, knee, power, g_lin):
-    """Cell resistor current: odd power law inside the knee (eq. 2.16), straight line outside."""
+def _scale(i_t, power):
+    """``I_T / (p - 1)``, the power law's factor (eq. 2.16)."""
+    return i_t / (power - 1.0)
+
+
+@njit(cache=True, inline="always")
+def _knee_current(scale, thr, knee, power):
+    """The power law's current at the knee, ``scale (knee / thr)^p``: the straight branch's
+    offset (0 without a knee)."""
+    return scale * (knee / thr) ** power if knee < np.inf else 0.0
+
+
+@njit(cache=True, inline="always")
+def _current(v, scale, thr, knee, power, g_lin, at_knee):
+    """Cell resistor current: odd power law inside the knee (eq. 2.16), straight line outside.
+
+    ``scale`` and ``at_knee`` (:func:`_scale`, :func:`_knee_current`) do not change per
+    sample; the runs compute them once per cell, the blocks per call in the same arithmetic
+    (``at_knee`` only where the straight branch is taken), so both give the same bits.
+    """
     a = abs(v)
     s = 1.0 if v >= 0 else -1.0
-    scale = i_t / (power - 1.0)
     if a <= knee:
         return s * scale * (a / thr) ** power
-    return s * (scale * (knee / thr) ** power + g_lin * (a - knee))
+    return s * (at_knee + g_lin * (a - knee))
+
+
+@njit(cache=True)
+def _knee_currents(scale, thr, knee, power):
+    """:func:`_knee_current` of every cell."""
+    out = np.empty(thr.size)
+    for k in range(thr.size):
+        out[k] = _knee_current(scale, thr[k], knee[k], power)
+    return out
 
 
 @njit(cache=True, inline="always")
@@ -65,10 +91,12 @@ def states(u, x0, i_t, thr, knee, power, g_lin, dt):
     n_cells = x0.size
     x = x0.copy()
     out = np.empty((u.size, n_cells))
+    scale = _scale(i_t, power)
+    at_knee = _knee_currents(scale, thr, knee, power)
     for n in range(u.size):
         for k in range(n_cells):
             out[n, k] = x[k]
-            x[k] += _current(u[n] - x[k], i_t, thr[k], knee[k], power, g_lin) * dt
+            x[k] += _current(u[n] - x[k], scale, thr[k], knee[k], power, g_lin, at_knee[k]) * dt
     return out, x
 
 
@@ -77,13 +105,15 @@ def simulate(u, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
     n_cells = x0.size
     x = x0.copy()
     y = np.empty(u.size)
+    scale = _scale(i_t, power)
+    at_knee = _knee_currents(scale, thr, knee, power)
     for n in range(u.size):
         acc = w[0] * u[n] - v_b
         for k in range(n_cells):
             acc += w[k + 1] * x[k]
         y[n] = _f_inverse(acc, brk, a)
         for k in range(n_cells):
-            x[k] += _current(u[n] - x[k], i_t, thr[k], knee[k], power, g_lin) * dt
+            x[k] += _current(u[n] - x[k], scale, thr[k], knee[k], power, g_lin, at_knee[k]) * dt
     return y, x
 
 
@@ -97,6 +127,8 @@ def invert(y, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
     x = x0.copy()
     e_hat = np.empty(y.size)
     bound = 1e6 * (1.0 + np.max(np.abs(y)))
+    scale = _scale(i_t, power)
+    at_knee = _knee_currents(scale, thr, knee, power)
     for n in range(y.size):
         acc = _f(y[n], brk, a) + v_b
         for k in range(n_cells):
@@ -106,7 +138,7 @@ def invert(y, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
             return e_hat, x, n
         e_hat[n] = e
         for k in range(n_cells):
-            x[k] += _current(e - x[k], i_t, thr[k], knee[k], power, g_lin) * dt
+            x[k] += _current(e - x[k], scale, thr[k], knee[k], power, g_lin, at_knee[k]) * dt
     return e_hat, x, -1
 
 
@@ -115,11 +147,16 @@ def invert(y, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
 
 @njit(cache=True, inline="always")
 def _block_cells(body, x, xn, off, drive):
-    """The cells' Euler update driven by ``drive`` (eq. 2.16 with the straight branches)."""
+    """The cells' Euler update driven by ``drive`` (eq. 2.16 with the straight branches), in
+    the runs' arithmetic (:func:`_current`)."""
     n = int(body[0])
+    power, g_lin, dt = body[3], body[4], body[5]
+    scale = _scale(body[2], power)
     for k in range(n):
-        xn[off + k] = x[off + k] + _current(drive - x[off + k], body[2], body[7 + k],
-                                            body[7 + n + k], body[3], body[4]) * body[5]
+        thr, knee = body[7 + k], body[7 + n + k]
+        v = drive - x[off + k]
+        at_knee = 0.0 if abs(v) <= knee else _knee_current(scale, thr, knee, power)
+        xn[off + k] = x[off + k] + _current(v, scale, thr, knee, power, g_lin, at_knee) * dt
 
 
 @njit(cache=True, inline="always")
