@@ -1,8 +1,9 @@
 """Compiled hot loops of the ch. 7 compensator; ``model.py`` holds the reference and the checks.
 
-All arrays are float64 and validated by the caller. The cells are the mPL's (``current``: the
-limited sinh resistor, eq. 5.1 with 5.29), the inverse of the output resistor is the
-mpl-poly's (``solve_output``); ``gc`` (4,) holds ``g``'s cubic coefficients.
+All arrays are float64 and validated by the caller. The cells are the mPL's, advanced as the
+mPL's runs advance them (``cell_increment``: the limited sinh resistor, eq. 5.1 with 5.29, one
+``exp`` per cell, the per-cell ``constants`` out of the sample loop); the inverse of the output
+resistor is the mpl-poly's (``solve_output``); ``gc`` (4,) holds ``g``'s cubic coefficients.
 """
 
 from __future__ import annotations
@@ -10,7 +11,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..mpl.kernels import current
+from ..mpl.kernels import (
+    cell_increment,
+    cell_sensitivity_step,
+    constants,
+    knee_constants,
+    straight_offset,
+)
 from ..mpl_poly.kernels import solve_output
 
 
@@ -27,14 +34,15 @@ def simulate(u, x0, gc, w, v_b, i_s, v_t, knee, cap, dt):
     n_cells = x0.size
     x = x0.copy()
     y = np.empty(u.size)
+    inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
+    cap_dt = cap * dt
     for n in range(u.size):
         z = w[0] * u[n] - v_b
         for k in range(n_cells):
             z += w[k + 1] * x[k]
         y[n], _ = _output(gc, z)
         for k in range(n_cells):
-            f, _ = current(u[n] - x[k], i_s[k], v_t[k], knee[k], cap)
-            x[k] += f * dt
+            x[k] += cell_increment(u[n] - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
     return y, x
 
 
@@ -52,6 +60,9 @@ def simulate_with_jacobian(u, x0, gc, w, v_b, i_s, v_t, knee, cap, dt):
     y = np.empty(u.size)
     jac = np.empty((u.size, 3 * n_cells + 6))
     col_g, col_w, col_vb = 2 * n_cells, 2 * n_cells + 4, 3 * n_cells + 5
+    inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
+    two_i_s, g, f_knee, dvt_knee = knee_constants(i_s, v_t, knee, cap)
+    cap_dt = cap * dt
     for n in range(u.size):
         z = w[0] * u[n] - v_b
         for k in range(n_cells):
@@ -67,20 +78,13 @@ def simulate_with_jacobian(u, x0, gc, w, v_b, i_s, v_t, knee, cap, dt):
             jac[n, 2 * k] = dg * w[k + 1] * sens[k, 0]
             jac[n, 2 * k + 1] = dg * w[k + 1] * sens[k, 1]
             jac[n, col_w + 1 + k] = dg * x[k]
-        for k in range(n_cells):
-            v = u[n] - x[k]
-            f, slope = current(v, i_s[k], v_t[k], knee[k], cap)
-            if abs(v) <= knee[k]:
-                d_log_g = f
-                d_log_vt = f - v * slope
-            else:  # the knee's own motion cancels (f'(knee) = cap)
-                s = 1.0 if v > 0 else -1.0
-                f_knee = 2.0 * i_s[k] * np.sinh(knee[k] / v_t[k])
-                d_log_g = s * f_knee
-                d_log_vt = s * (f_knee - knee[k] * cap)
+        for k in range(n_cells):  # the state as simulate's, bit for bit
+            step, d_log_g, d_log_vt, slope = cell_sensitivity_step(
+                u[n] - x[k], inv_vt[k], two_i_s_dt[k], two_i_s[k], g[k], knee[k], c0[k],
+                f_knee[k], dvt_knee[k], cap, cap_dt)
             sens[k, 0] += (d_log_g - slope * sens[k, 0]) * dt
             sens[k, 1] += (d_log_vt - slope * sens[k, 1]) * dt
-            x[k] += f * dt
+            x[k] += step
     return y, jac
 
 
@@ -93,6 +97,8 @@ def invert(y, x0, gc, lo, hi, sign, centre, w, v_b, i_s, v_t, knee, cap, dt, bou
     n_cells = x0.size
     x = x0.copy()
     e_hat = np.empty(y.size)
+    inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
+    cap_dt = cap * dt
     for n in range(y.size):
         z, ok = solve_output(y[n], gc, lo, hi, sign, centre)
         if not ok:
@@ -105,8 +111,7 @@ def invert(y, x0, gc, lo, hi, sign, centre, w, v_b, i_s, v_t, knee, cap, dt, bou
             return e_hat, x, n, 2
         e_hat[n] = e
         for k in range(n_cells):
-            f, _ = current(e - x[k], i_s[k], v_t[k], knee[k], cap)
-            x[k] += f * dt
+            x[k] += cell_increment(e - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
     return e_hat, x, -1, 0
 
 
@@ -121,12 +126,16 @@ _IC = 13  # first cell parameter
 @njit(cache=True, inline="always")
 def _block_cells(body, x, xn, off, drive):
     """The cells' Euler update (eq. 5.6, sinh resistors limited by eq. 5.29) driven by
-    ``drive``."""
+    ``drive``, in :func:`simulate`'s arithmetic: the constants per call as ``mpl.kernels``'
+    blocks compute them (the straight branch's offset only where it is taken)."""
     n = int(body[0])
+    cap, dt = body[2], body[3]
+    cap_dt = cap * dt
     for k in range(n):
-        f, _ = current(drive - x[off + k], body[_IC + k], body[_IC + n + k],
-                       body[_IC + 2 * n + k], body[2])
-        xn[off + k] = x[off + k] + f * body[3]
+        i_s, v_t, knee = body[_IC + k], body[_IC + n + k], body[_IC + 2 * n + k]
+        v = drive - x[off + k]
+        c0 = 0.0 if abs(v) <= knee else straight_offset(i_s, v_t, knee, cap, dt)
+        xn[off + k] = x[off + k] + cell_increment(v, 1.0 / v_t, 2.0 * i_s * dt, knee, c0, cap_dt)
 
 
 @njit(cache=True)
