@@ -24,7 +24,7 @@ def files(tmp_path_factory):
     simulate_experiment("chirp", 1).to_frame().to_csv(train, index=False)
     simulate_experiment("chirp", 2).to_frame().to_csv(test, index=False)
     model = folder / "m.json"
-    assert main(["fit", str(train), "--out", str(model)]) == 0
+    assert main(["fit", str(train), "--model", "mpl", "--out", str(model)]) == 0
     return {"train": train, "test": test, "model": model, "folder": folder}
 
 
@@ -33,7 +33,8 @@ def test_fit_stores_a_band_and_says_so(files, capsys):
     assert comp.band is not None and comp.band.level == 0.9
     assert comp.band.protocol == "interleaved cycles of the training recording"
     model = files["folder"] / "none.json"
-    assert main(["fit", str(files["train"]), "--no-band", "--out", str(model)]) == 0
+    assert main(["fit", str(files["train"]), "--model", "mpl", "--no-band", "--out",
+                 str(model)]) == 0
     assert load_compensator(model).band is None
 
 
@@ -68,7 +69,8 @@ def test_evaluate_reports_coverage_width_and_interval_score(files, capsys):
 
 def test_level_without_a_band_is_refused(files, capsys):
     model = files["folder"] / "bare.json"
-    assert main(["fit", str(files["train"]), "--no-band", "--out", str(model)]) == 0
+    assert main(["fit", str(files["train"]), "--model", "mpl", "--no-band", "--out",
+                 str(model)]) == 0
     code = main(["compensate", str(model), str(files["test"]), "--level", "0.8", "--out",
                  str(files["folder"] / "x.csv")])
     assert code == 2 and "has no prediction band" in capsys.readouterr().err
@@ -91,7 +93,8 @@ def test_export_bakes_the_level_in_and_refuses_it_without_a_band(files, capsys):
     assert "80% prediction band" in capsys.readouterr().out
     assert "#define M_BAND_LEVEL 0.8\n" in (out / "m.h").read_text()
     bare = files["folder"] / "bare_export.json"
-    assert main(["fit", str(files["train"]), "--no-band", "--out", str(bare)]) == 0
+    assert main(["fit", str(files["train"]), "--model", "mpl", "--no-band", "--out",
+                 str(bare)]) == 0
     assert main(["export", str(bare), "--out", str(files["folder"] / "c2"), "--level",
                  "0.8"]) == 2
     assert "no prediction band" in capsys.readouterr().err

@@ -584,7 +584,8 @@ def test_output_below_a_regular_file(data: dict[str, Path], tmp_path: Path,
                                      capsys: pytest.CaptureFixture[str]) -> None:
     (tmp_path / "afile").write_bytes(b"")
     out = tmp_path / "afile" / "m.json"
-    _assert_rejected(capsys, ["fit", data["fit"], "--out", out], out, tmp_path, out)
+    _assert_rejected(capsys, ["fit", data["fit"], "--model", "mpl", "--out", out], out, tmp_path,
+                     out)
 
 
 def test_fit_prints_its_parameters_as_an_aligned_table(tmp_path, capsys):

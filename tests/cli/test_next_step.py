@@ -113,7 +113,7 @@ def test_a_refused_evaluation_names_what_to_try(data, tmp_path, capsys, test, ce
 
 def test_an_extrapolating_evaluation_asks_for_data_that_cover_the_range(data, tmp_path,  # noqa: F811
                                                                          capsys):
-    assert _fit(capsys, data, tmp_path, "decay_tail")[0] == 0
+    assert _fit(capsys, data, tmp_path, "decay_tail", "--model", "mpl")[0] == 0
     code, out, err = run_cli(capsys, "evaluate", tmp_path / "model.json", data["sine2"])
     assert code == GUARD_EXIT and "extrapolated" in err
     assert _next(out).startswith("next: try refitting on recordings that cover this range")

@@ -79,7 +79,8 @@ def test_bad_options_are_one_line_before_any_work(files, tmp_path, capsys, optio
 
 def test_unknown_column_names_the_users_column(files, tmp_path, capsys):
     out = tmp_path / "m.json"
-    code, _, err = run_cli(capsys, "fit", files["own"], "--out", out, "--columns",
+    code, _, err = run_cli(capsys, "fit", files["own"], "--model", "mpl", "--out", out,
+                        "--columns",
                         "time=t_ms,position=displacement_mm,sensor=R_ohm", "--time-unit", "ms",
                         "--sep", ";")
     assert code == 2

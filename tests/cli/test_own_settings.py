@@ -120,13 +120,14 @@ def test_bad_settings_file_is_one_line(tmp_path, files, capsys, text, fragments)
     assert str(info.value).startswith(str(tmp_path / "x.toml"))
     for fragment in fragments:
         assert fragment in str(info.value)
-    code, _, err = run_cli(capsys, "fit", data, "--out", tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", data, "--model", "mpl", "--out", tmp_path / "m.json")
     assert code == 2 and len(err.strip().splitlines()) == 1
 
 
 def test_forgotten_units_row_says_so(files, tmp_path, capsys):
     argv = [a for a in OWN if a != "--units-row"]
-    code, _, err = run_cli(capsys, "fit", files["plain"], *argv, "--out", tmp_path / "m.json")
+    code, _, err = run_cli(capsys, "fit", files["plain"], *argv, "--model", "mpl", "--out",
+                           tmp_path / "m.json")
     assert code == 2
     assert "row 1 (line 2): non-numeric value 'ms'; if this line holds units, pass " \
            "--units-row" in err
