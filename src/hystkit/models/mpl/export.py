@@ -17,6 +17,28 @@ def extra(comp) -> dict:
     return {"W_SUM": float(np.sum(comp.params.w))}
 
 
+def _cell_constants_c(plan, lit: Callable[[float], str]) -> str:
+    """The per-cell constants of ``kernels.cell_constants`` (1 / V_T, 2 I_S dt, the straight
+    branch's offset c0) and cap dt, computed here by the kernel itself, so the exported step
+    does per sample exactly what ``kernels.simulate`` does (bit for bit in double)."""
+    from .kernels import constants  # numba: loaded only when a C export is written
+
+    n = int(plan.body[0])
+    cap, dt = float(plan.body[2]), float(plan.body[3])
+    i_s, v_t, knee = (np.ascontiguousarray(plan.body[4 + j * n:4 + (j + 1) * n])
+                      for j in range(3))
+    inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
+    rows = [("INV_VT", inv_vt), ("TWO_IS_DT", two_i_s_dt), ("C0", c0)]
+    arrays = "".join(f"static const real {name}[N_CELLS] = {{{', '.join(lit(v) for v in vals)}}};\n"
+                     for name, vals in rows)
+    return arrays + f"#define CAP_DT {lit(cap * dt)}\n"
+
+
+# sinh(a) below |a| = 0.5 (kernels.sinh_series): a (1 + a^2 / 3! + ... + a^14 / 15!), Estrin
+_SERIES = (1.0 / 6.0, 1.0 / 120.0, 1.0 / 5040.0, 1.0 / 362880.0, 1.0 / 39916800.0,
+           1.0 / 6227020800.0, 1.0 / 1307674368000.0)
+
+
 def c_model(plan, lit: Callable[[float], str]) -> str:
     n = int(plan.body[0])
     w_sum = plan.extra["W_SUM"]
@@ -31,18 +53,38 @@ def c_model(plan, lit: Callable[[float], str]) -> str:
     for (k = 0; k < N_CELLS; k++) acc += BODY[IW + 1 + k] * x[k];
     drive = u;"""
     out = "drive" if plan.inverse else "acc"
+    c = [lit(v) for v in _SERIES]
     return f"""#define N_CELLS {n}
 #define IW (4 + 3 * N_CELLS)
 
-/* Limited sinh resistor current (eq. 5.1 with eq. 5.29): kernels.current */
-static real current(real v, int k)
+/* Per cell, fixed at export (kernels.cell_constants): 1 / V_T, 2 I_S dt and c0 = (f(knee) -
+ * cap knee) dt, the straight branch beyond the knee being f dt = s c0 + cap dt v. */
+{_cell_constants_c(plan, lit)}
+/* sinh(a) from one exp (kernels.sinh_cosh): (e - 1/e) / 2, and below |a| = 0.5, where that
+ * cancels, the series a (1 + a^2 / 3! + ... + a^14 / 15!) (kernels.sinh_series) */
+static real sinh_one_exp(real a)
 {{
-    const real i_s = BODY[4 + k], v_t = BODY[4 + N_CELLS + k];
-    const real knee = BODY[4 + 2 * N_CELLS + k], cap = BODY[2];
-    real s;
-    if (FABS(v) <= knee) return R(2.0) * i_s * SINH(v / v_t);
-    s = v > R(0.0) ? R(1.0) : R(-1.0);
-    return s * R(2.0) * i_s * SINH(knee / v_t) + cap * (v - s * knee);
+    const real t = FABS(a);
+    const real e = EXP(t);
+    const real e_inv = R(1.0) / e;
+    const real a2 = a * a;
+    const real a4 = a2 * a2;
+    const real a8 = a4 * a4;
+    const real p01 = R(1.0) + a2 * {c[0]};
+    const real p23 = {c[1]} + a2 * {c[2]};
+    const real p45 = {c[3]} + a2 * {c[4]};
+    const real p67 = {c[5]} + a2 * {c[6]};
+    const real half = R(0.5) * (e - e_inv);
+    if (t < R(0.5)) return a * ((p01 + a4 * p23) + a8 * (p45 + a4 * p67));
+    return a < R(0.0) ? -half : half;  /* copysign: a is not 0 here */
+}}
+
+/* f(v) dt of the limited sinh resistor (eq. 5.1 with eq. 5.29): kernels.cell_increment */
+static real cell_increment(real v, int k)
+{{
+    const real knee = BODY[4 + 2 * N_CELLS + k];
+    if (FABS(v) <= knee) return TWO_IS_DT[k] * sinh_one_exp(v * INV_VT[k]);
+    return (v > R(0.0) ? C0[k] : -C0[k]) + CAP_DT * v;
 }}
 
 static void model_rest(real *x, real value)
@@ -58,7 +100,7 @@ static real model_step(real *x, real u)
     int k;
     real drive;
 {head}
-    for (k = 0; k < N_CELLS; k++) x[k] = x[k] + current(drive - x[k], k) * BODY[3];
+    for (k = 0; k < N_CELLS; k++) x[k] = x[k] + cell_increment(drive - x[k], k);
     return {out};
 }}
 """
