@@ -49,7 +49,7 @@ def test_cli_evaluate_prints_the_reason_once_and_writes_it(tmp_path, capsys):
     data, model, out = tmp_path / "id.csv", tmp_path / "m.json", tmp_path / "scores.json"
     assert main(["datasets", "export", "piezo_micromanipulator", "--excerpt", "--variant",
                  "identification", "--out", str(data)]) == 0
-    assert main(["fit", str(data), "--out", str(model)]) == 0
+    assert main(["fit", str(data), "--model", "mpl", "--out", str(model)]) == 0
     capsys.readouterr()
     assert main(["evaluate", str(model), str(data), "--json", str(out)]) == 0
     stdout = capsys.readouterr().out

@@ -121,7 +121,7 @@ def test_bad_noise_only_sensor(data, tmp_path, capsys):
 
 
 def test_bad_position_unrelated_to_the_sensor(data, tmp_path, capsys):
-    code, _ = _fit(data, tmp_path, "unrelated")
+    code, _ = _fit(data, tmp_path, "unrelated", "--model", "mpl")
     assert code == GUARD_EXIT and "no signal" in capsys.readouterr().err
 
 
@@ -181,7 +181,7 @@ def test_bad_fit_on_swapped_data_used_as_laid_out(data, tmp_path, capsys, train,
 def test_bad_extrapolation_far_beyond_the_training_range(data, tmp_path, capsys):
     """Trained on the decay's small last third, used on a full-amplitude sine: most samples
     lie far outside what the model has seen; however it scores there, it is not 'ok'."""
-    code, model = _fit(data, tmp_path, "decay_tail")
+    code, model = _fit(data, tmp_path, "decay_tail", "--model", "mpl")
     assert code == 0
     capsys.readouterr()
     code, scores = _evaluate(data, tmp_path, model, "sine2")
