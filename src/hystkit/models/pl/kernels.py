@@ -8,45 +8,51 @@ All arrays are float64 and already validated by the caller. Per cell ``k`` (0-ba
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
 
 @njit(cache=True, inline="always")
-def _scale(i_t, power):
-    """``I_T / (p - 1)``, the power law's factor (eq. 2.16)."""
-    return i_t / (power - 1.0)
+def _scale_dt(i_t, power, dt):
+    """``I_T / (p - 1) dt``: the power law's factor (eq. 2.16) times the Euler step."""
+    return i_t / (power - 1.0) * dt
 
 
 @njit(cache=True, inline="always")
-def _knee_current(scale, thr, knee, power):
-    """The power law's current at the knee, ``scale (knee / thr)^p``: the straight branch's
-    offset (0 without a knee)."""
-    return scale * (knee / thr) ** power if knee < np.inf else 0.0
+def _straight_offset(scale_dt, thr, knee, power, g_dt):
+    """``c0 = (scale (knee / thr)^p - g_lin knee) dt``, with which the straight branch beyond
+    the knee is ``d dt = s c0 + g_lin dt v`` (``s`` the sign of ``v``); 0 without a knee."""
+    return scale_dt * (knee * (1.0 / thr)) ** power - g_dt * knee if knee < np.inf else 0.0
 
 
 @njit(cache=True, inline="always")
-def _current(v, scale, thr, knee, power, g_lin, at_knee):
-    """Cell resistor current: odd power law inside the knee (eq. 2.16), straight line outside.
+def _increment(v, inv_thr, scale_dt, knee, power, c0, g_dt):
+    """``d(v) dt``, the cell's Euler increment: odd power law inside the knee (eq. 2.16),
+    straight line outside.
 
-    ``scale`` and ``at_knee`` (:func:`_scale`, :func:`_knee_current`) do not change per
-    sample; the runs compute them once per cell, the blocks per call in the same arithmetic
-    (``at_knee`` only where the straight branch is taken), so both give the same bits.
+    ``1 / thr``, ``scale_dt``, ``c0`` and ``g_dt`` do not change per sample: the runs compute
+    them once per cell, the blocks per call in the same arithmetic (``c0`` only where the
+    straight branch is taken), so both give the same bits. Beyond the knee the recursion's
+    dependency chain is two operations, not six (most samples of fitted models are there).
     """
     a = abs(v)
-    s = 1.0 if v >= 0 else -1.0
     if a <= knee:
-        return s * scale * (a / thr) ** power
-    return s * (at_knee + g_lin * (a - knee))
+        return math.copysign(scale_dt * (a * inv_thr) ** power, v)
+    return (c0 if v >= 0 else -c0) + g_dt * v
 
 
 @njit(cache=True)
-def _knee_currents(scale, thr, knee, power):
-    """:func:`_knee_current` of every cell."""
-    out = np.empty(thr.size)
+def _constants(i_t, thr, knee, power, g_lin, dt):
+    """Per cell ``1 / thr`` and ``c0`` (:func:`_straight_offset`), and ``scale dt``,
+    ``g_lin dt``."""
+    scale_dt, g_dt = _scale_dt(i_t, power, dt), g_lin * dt
+    inv_thr, c0 = np.empty(thr.size), np.empty(thr.size)
     for k in range(thr.size):
-        out[k] = _knee_current(scale, thr[k], knee[k], power)
-    return out
+        inv_thr[k] = 1.0 / thr[k]
+        c0[k] = _straight_offset(scale_dt, thr[k], knee[k], power, g_dt)
+    return inv_thr, c0, scale_dt, g_dt
 
 
 @njit(cache=True, inline="always")
@@ -91,12 +97,11 @@ def states(u, x0, i_t, thr, knee, power, g_lin, dt):
     n_cells = x0.size
     x = x0.copy()
     out = np.empty((u.size, n_cells))
-    scale = _scale(i_t, power)
-    at_knee = _knee_currents(scale, thr, knee, power)
+    inv_thr, c0, scale_dt, g_dt = _constants(i_t, thr, knee, power, g_lin, dt)
     for n in range(u.size):
         for k in range(n_cells):
             out[n, k] = x[k]
-            x[k] += _current(u[n] - x[k], scale, thr[k], knee[k], power, g_lin, at_knee[k]) * dt
+            x[k] += _increment(u[n] - x[k], inv_thr[k], scale_dt, knee[k], power, c0[k], g_dt)
     return out, x
 
 
@@ -105,15 +110,14 @@ def simulate(u, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
     n_cells = x0.size
     x = x0.copy()
     y = np.empty(u.size)
-    scale = _scale(i_t, power)
-    at_knee = _knee_currents(scale, thr, knee, power)
+    inv_thr, c0, scale_dt, g_dt = _constants(i_t, thr, knee, power, g_lin, dt)
     for n in range(u.size):
         acc = w[0] * u[n] - v_b
         for k in range(n_cells):
             acc += w[k + 1] * x[k]
         y[n] = _f_inverse(acc, brk, a)
         for k in range(n_cells):
-            x[k] += _current(u[n] - x[k], scale, thr[k], knee[k], power, g_lin, at_knee[k]) * dt
+            x[k] += _increment(u[n] - x[k], inv_thr[k], scale_dt, knee[k], power, c0[k], g_dt)
     return y, x
 
 
@@ -127,8 +131,7 @@ def invert(y, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
     x = x0.copy()
     e_hat = np.empty(y.size)
     bound = 1e6 * (1.0 + np.max(np.abs(y)))
-    scale = _scale(i_t, power)
-    at_knee = _knee_currents(scale, thr, knee, power)
+    inv_thr, c0, scale_dt, g_dt = _constants(i_t, thr, knee, power, g_lin, dt)
     for n in range(y.size):
         acc = _f(y[n], brk, a) + v_b
         for k in range(n_cells):
@@ -138,7 +141,7 @@ def invert(y, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
             return e_hat, x, n
         e_hat[n] = e
         for k in range(n_cells):
-            x[k] += _current(e - x[k], scale, thr[k], knee[k], power, g_lin, at_knee[k]) * dt
+            x[k] += _increment(e - x[k], inv_thr[k], scale_dt, knee[k], power, c0[k], g_dt)
     return e_hat, x, -1
 
 
@@ -148,15 +151,15 @@ def invert(y, x0, i_t, thr, knee, power, g_lin, dt, w, v_b, brk, a):
 @njit(cache=True, inline="always")
 def _block_cells(body, x, xn, off, drive):
     """The cells' Euler update driven by ``drive`` (eq. 2.16 with the straight branches), in
-    the runs' arithmetic (:func:`_current`)."""
+    the runs' arithmetic (:func:`_increment`)."""
     n = int(body[0])
-    power, g_lin, dt = body[3], body[4], body[5]
-    scale = _scale(body[2], power)
+    power, dt = body[3], body[5]
+    scale_dt, g_dt = _scale_dt(body[2], power, dt), body[4] * dt
     for k in range(n):
         thr, knee = body[7 + k], body[7 + n + k]
         v = drive - x[off + k]
-        at_knee = 0.0 if abs(v) <= knee else _knee_current(scale, thr, knee, power)
-        xn[off + k] = x[off + k] + _current(v, scale, thr, knee, power, g_lin, at_knee) * dt
+        c0 = 0.0 if abs(v) <= knee else _straight_offset(scale_dt, thr, knee, power, g_dt)
+        xn[off + k] = x[off + k] + _increment(v, 1.0 / thr, scale_dt, knee, power, c0, g_dt)
 
 
 @njit(cache=True, inline="always")
