@@ -1,8 +1,9 @@
 """Forward kernels against the fastest plain C (issue 29, items 1-2): every ratio is to ``fast C``.
 
 Run:  python benchmarks/bench_kernels.py [--quick] [--before REV]   (about a minute; writes
-      benchmarks/last_run_kernels.txt; --quick: fewer rounds; --before REV: two more mPL
-      columns, the bare kernel of this tree and of git revision REV, paired in the same rounds)
+      benchmarks/last_run_kernels.txt; --quick: fewer rounds; --before REV: two more mPL and
+      PL columns, the bare kernel of this tree and of git revision REV, paired in the same
+      rounds)
 
 Models: mPL with 1, 3 and 5 cells and PL with 2 cells, each fitted (direct mode, centring fit)
 on the virtual sensor's sine recording (seed 1): realistic parameters, e.g. the 5-cell mPL has
@@ -61,6 +62,7 @@ import numpy as np
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.models.mpl import kernels as mpl_kernels
 from hystkit.models.mpl import model as mpl
+from hystkit.models.pl import kernels as pl_kernels
 from hystkit.models.pl import model as pl
 from hystkit.sensors import simulate_experiment
 
@@ -187,13 +189,13 @@ def _export_column(comp, label: str, cc: str, tmp: Path):
     return run
 
 
-def load_kernels_at(rev: str, tmp: Path):
-    """``models/mpl/kernels.py`` of git revision ``rev`` as a module of its own (it imports
-    only numpy and numba), for a paired before/after in one run."""
-    source = f"{rev}:src/hystkit/models/mpl/kernels.py"
+def load_kernels_at(rev: str, tmp: Path, family: str = "mpl"):
+    """``models/<family>/kernels.py`` of git revision ``rev`` as a module of its own (mpl's and
+    pl's import only numpy and numba), for a paired before/after in one run."""
+    source = f"{rev}:src/hystkit/models/{family}/kernels.py"
     text = subprocess.run(["git", "-C", str(HERE), "show", source], capture_output=True,
                           text=True, check=True).stdout
-    path = tmp / f"mpl_kernels_{rev.replace('/', '_')}.py"
+    path = tmp / f"{family}_kernels_{rev.replace('/', '_')}.py"
     path.write_text(text)
     spec = importlib.util.spec_from_file_location(path.stem, path)
     module = importlib.util.module_from_spec(spec)
@@ -212,11 +214,24 @@ def _kernel_columns(comp, current, before, rev: str) -> dict:
     return {"kernel": run(current), f"kernel@{rev}": run(before)}
 
 
+def _pl_kernel_columns(comp, current, before, rev: str) -> dict:
+    """PL's bare numba kernel (no wrapper) of this tree and of revision ``rev``."""
+    s, p = comp.structure, comp.params
+    rest = (*pl.kernel_args(s, p), p.w, p.v_b, pl.basis_breakpoints(s.n_basis),
+            np.ascontiguousarray(p.a, dtype=float))
+
+    def run(module):
+        return lambda u: module.simulate(u, np.full(s.n_cells, u[0]), *rest)[0]
+
+    return {"kernel": run(current), f"kernel@{rev}": run(before)}
+
+
 def build_cases(cc: str, tmp: Path, before_rev: str | None = None) -> list[Case]:
     fast = _compile(cc, FAST_FLAGS, HERE / "_c_fast_reference.c", tmp / "fast.so")
     slow = _compile(cc, SLOW_FLAGS, HERE / "_c_reference.c", tmp / "slow.so")
     fit_rec = simulate_experiment("sine", 1)
     before = load_kernels_at(before_rev, tmp) if before_rev else None
+    pl_before = load_kernels_at(before_rev, tmp, "pl") if before_rev else None
     cases = []
     for family, size in CASES:
         comp = fit_compensator(fit_rec, size, model=family, diagnose=False)
@@ -229,6 +244,8 @@ def build_cases(cc: str, tmp: Path, before_rev: str | None = None) -> list[Case]
         case.columns["export"] = _export_column(comp, case.label, cc, tmp)
         if before is not None and family == "mpl":
             case.columns.update(_kernel_columns(comp, mpl_kernels, before, before_rev))
+        if pl_before is not None and family == "pl":
+            case.columns.update(_pl_kernel_columns(comp, pl_kernels, pl_before, before_rev))
         cases.append(case)
     return cases
 
@@ -273,8 +290,8 @@ def _cpu() -> str:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer rounds")
-    parser.add_argument("--before", metavar="REV", help="add the bare mPL kernel of this tree "
-                        "and of git revision REV (paired before/after)")
+    parser.add_argument("--before", metavar="REV", help="add the bare mPL and PL kernels of "
+                        "this tree and of git revision REV (paired before/after)")
     args = parser.parse_args()
     quick = args.quick
     columns = [*COLUMNS, *(["kernel", f"kernel@{args.before}"] if args.before else [])]
