@@ -51,8 +51,8 @@ def test_two_rows_are_refused_for_every_family(cli, good, tmp_path, model):
 
 def test_ten_rows_are_refused(cli, good, tmp_path):
     data = _recording(good, tmp_path, "ten.csv", 10)
-    _refused(cli, tmp_path, ["fit", data, "--out", tmp_path / "m.json"], "ten.csv",
-             "10 samples")
+    _refused(cli, tmp_path, ["fit", data, "--model", "mpl", "--out", tmp_path / "m.json"],
+             "ten.csv", "10 samples")
 
 
 def test_samples_per_parameter_checked_before_the_fit(cli, good, tmp_path):
@@ -65,8 +65,8 @@ def test_samples_per_parameter_checked_before_the_fit(cli, good, tmp_path):
 def test_constant_column_is_refused(cli, good, tmp_path, column):
     const = {column: lambda x: np.full_like(x, 0.3)}
     data = _recording(good, tmp_path, "flat.csv", 400, **const)
-    _refused(cli, tmp_path, ["fit", data, "--out", tmp_path / "m.json"], "flat.csv",
-             f"column '{column}'", "constant")
+    _refused(cli, tmp_path, ["fit", data, "--model", "mpl", "--out", tmp_path / "m.json"],
+             "flat.csv", f"column '{column}'", "constant")
 
 
 def test_a_single_spike_is_refused(cli, good, tmp_path):
@@ -74,27 +74,27 @@ def test_a_single_spike_is_refused(cli, good, tmp_path):
         return np.where(np.arange(x.size) == x.size // 2, 1.0, 0.0)
 
     data = _recording(good, tmp_path, "spike.csv", 400, position=spike, sensor=spike)
-    _refused(cli, tmp_path, ["fit", data, "--out", tmp_path / "m.json"], "spike.csv",
-             "position", "spike")
+    _refused(cli, tmp_path, ["fit", data, "--model", "mpl", "--out", tmp_path / "m.json"],
+             "spike.csv", "position", "spike")
 
 
 def test_huge_offset_with_tiny_variation_is_refused(cli, good, tmp_path):
     data = _recording(good, tmp_path, "offset.csv", 400, position=lambda x: 1e90 + 1e-3 * x,
                       sensor=lambda x: 1e90 + 1e-3 * x)
-    _refused(cli, tmp_path, ["fit", data, "--out", tmp_path / "m.json"], "offset.csv",
-             "position", "constant")
+    _refused(cli, tmp_path, ["fit", data, "--model", "mpl", "--out", tmp_path / "m.json"],
+             "offset.csv", "position", "constant")
 
 
 def test_variation_below_float_resolution_is_refused(cli, good, tmp_path):
     data = _recording(good, tmp_path, "offset.csv", 400, sensor=lambda x: 1e14 + x)
-    _refused(cli, tmp_path, ["fit", data, "--out", tmp_path / "m.json"], "offset.csv",
-             "sensor", "resolves")
+    _refused(cli, tmp_path, ["fit", data, "--model", "mpl", "--out", tmp_path / "m.json"],
+             "offset.csv", "sensor", "resolves")
 
 
 def test_a_large_offset_that_float_resolves_still_fits(cli, good, tmp_path):
     """1e10 mm offset, millimetres of motion: well within float64; the fit runs and passes."""
     data = _recording(good, tmp_path, "offset.csv", 400, position=lambda x: x + 1e10)
-    run = cli("fit", data, "--out", tmp_path / "m.json")
+    run = cli("fit", data, "--model", "mpl", "--out", tmp_path / "m.json")
     run.clean()
     assert run.code == 0, run.err
     assert json.loads((tmp_path / "m.json").read_text())["fit"]["status"] == "ok"

@@ -126,7 +126,7 @@ LONG = "a" * 300
     ["compensate", "model.json", "val.csv", "--out", f"{LONG}.csv"],
     ["compensate", "model.json", "val.csv", "--out", f"{LONG}/x.csv"],
     ["evaluate", "model.json", "val.csv", "--json", f"{LONG}.json"],
-    ["fit", "fit.csv", "--out", f"{LONG}.json"],
+    ["fit", "fit.csv", "--model", "mpl", "--out", f"{LONG}.json"],
     ["spectrum", "fit.csv", "--out", LONG],
     ["report", "model.json", "val.csv", "--out", f"{LONG}.html"],
     ["export", "model.json", "--out", LONG],

@@ -127,7 +127,8 @@ def test_a_fit_of_a_clean_csv_loads_neither_pandas_nor_scipy_optimize(tmp_path):
     for options, loaded in ((["--no-band"], ["False", "False"]), ([], ["False", "True"])):
         model = tmp_path / f"m{len(options)}.json"
         code = ("import sys; from hystkit.cli import main; "
-                f"code = main(['fit', {str(path)!r}, '--out', {str(model)!r}, *{options!r}]); "
+                f"code = main(['fit', {str(path)!r}, '--model', 'mpl', '--out', {str(model)!r}, "
+                f"*{options!r}]); "
                 "print(code, 'pandas' in sys.modules, 'scipy.optimize' in sys.modules)")
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                              check=True)

@@ -147,9 +147,10 @@ def test_the_cli_reads_pieces_for_a_joint_fit(tmp_path, capsys):
 def test_hystkit_fit_gaps_split_fits_the_pieces_jointly(tmp_path, capsys):
     path = _gapped(tmp_path / "run.csv")
     model = tmp_path / "m.json"
-    assert main(["fit", str(path), "--gaps", "split", "--no-band", "--out", str(model)]) == 0
+    assert main(["fit", str(path), "--model", "mpl", "--gaps", "split", "--no-band", "--out",
+                 str(model)]) == 0
     info = json.loads(model.read_text())["fit"]
     assert info["joint_fit"].startswith("joint polish over 3 recordings")
     assert info["training_samples"] == 8000
-    assert main(["fit", str(path), "--out", str(tmp_path / "refused.json")]) == 2
+    assert main(["fit", str(path), "--model", "mpl", "--out", str(tmp_path / "refused.json")]) == 2
     assert "--gaps split" in capsys.readouterr().err
