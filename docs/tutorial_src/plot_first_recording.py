@@ -85,14 +85,17 @@ plt.show()
 # %%
 # 2. Fit
 # ------
-# ``hystkit fit`` fits the default model, a 1-cell modified Power-Law (mPL) compensator in
-# direct mode (sensor -> position), in a fraction of a second. It prints the parameters
+# ``hystkit fit --model mpl`` fits one model, a 1-cell modified Power-Law (mPL) compensator
+# in direct mode (sensor -> position), in a fraction of a second. (Without ``--model``,
+# ``hystkit fit`` is a guided first fit: mpl with 1-3 cells, mpl-poly, pi and pl, each
+# scored on held-out data, the best usable one kept, in a few tens of seconds; ``select``
+# below does that over every family.) It prints the parameters
 # with their standard errors, the training R² beside the straight line's, and a 90 %
 # prediction band. It also says how the band was calibrated. With one recording that is
 # interleaved cycles of that recording, and the note warns that it holds for runs like
 # this one, not for an offset, gain or excitation that changes between runs.
 
-hystkit("fit first.csv --out model.json")
+hystkit("fit first.csv --model mpl --out model.json")
 
 # %%
 # 3. Evaluate on another run

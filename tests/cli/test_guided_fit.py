@@ -128,10 +128,10 @@ def test_pieces_after_the_deadline_are_skipped_not_run():
     assert budgeted.late == {cand.label}
 
 
-def test_an_option_of_a_named_model_means_mpl_whatever_the_default(data, tmp_path, capsys,  # noqa: F811
-                                                                    monkeypatch):
-    """--cells 3 alone is the 3-cell mpl (as the issue's user typed it), also once the default
-    without --model is the guided fit (cmd_core.DEFAULT_MODEL)."""
+def test_without_model_the_guided_fit_and_an_option_of_a_named_model_means_mpl(
+        data, tmp_path, capsys):  # noqa: F811
+    """fit without --model is the guided fit (cmd_core.DEFAULT_MODEL, issue 27.5); --cells 3
+    alone is still the 3-cell mpl (as the issue's user typed it)."""
     from hystkit.cli import cmd_core
     from hystkit.cli._main import _parser
 
@@ -139,7 +139,6 @@ def test_an_option_of_a_named_model_means_mpl_whatever_the_default(data, tmp_pat
         return cmd_core._chosen_model(_parser().parse_args(["fit", "x.csv", "--out", "m.json",
                                                             *argv]))
 
-    monkeypatch.setattr(cmd_core, "DEFAULT_MODEL", "auto")
     assert chosen() == "auto" and chosen("--model", "pi") == "pi"
     assert chosen("--cells", "3") == chosen("--loss", "huber") == "mpl"
     code, out, err = run_cli(capsys, "fit", data["sine1"], "--cells", "1", "--out",

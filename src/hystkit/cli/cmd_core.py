@@ -561,10 +561,9 @@ def _add_rest_position(p: argparse.ArgumentParser) -> None:
 _MODEL_HELP = "model file written by fit or select (.json or .mat)"
 # fit --model auto (cli/_guided_fit.py, imported only when chosen)
 GUIDED_MODEL = "auto"
-# fit's model without --model. Issue 27.5 asks for GUIDED_MODEL here; left at the one-fit
-# default until the ~230 calls of fit without --model in tests/ say --model mpl (with 'auto',
-# each would run the guided fit, 15-30 s instead of 1-3 s)
-DEFAULT_MODEL = "mpl"
+# fit's model without --model: the guided first fit (issue 27.5); tests and docs that mean one
+# mPL fit say --model mpl (the guided fit takes 15-30 s where one fit takes 1-3 s)
+DEFAULT_MODEL = GUIDED_MODEL
 GUIDED_HELP = ("mpl with 1, 2 and 3 cells, mpl-poly, pi and pl, each fitted and scored on "
                "held-out data as select does, the best usable one written with its band and "
                "the choice explained in three lines (about 15-30 s for 10,000 samples on 2 "
