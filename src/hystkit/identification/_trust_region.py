@@ -17,7 +17,7 @@ problems", SIAM J. Sci. Comput. 21(1); scipy's ``optimize/_lsq/trf.py``) with ev
   reflection off the first bound hit, and the scaled gradient -- all as scipy.
 * ``x_scale="jac"``: the running maximum of the column norms ``sqrt(diag(J^T J))``.
 
-The ``p x p`` arithmetic of an iteration is compiled (:mod:`._trust_region_steps`); here
+The ``p x p`` arithmetic of an iteration is in :mod:`._trust_region_steps`; here
 remain the model runs, the radius update and the stopping rules.
 
 Stopping rules are scipy's (``ftol = xtol = gtol = 1e-8``): ``gtol`` on ``||v g||_inf``;
@@ -43,7 +43,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ._normal_equations import NormalEquations, RunCounter, SolveResult
-from ._trust_region_steps import coleman_li, prepare, propose, strictly_feasible
+from ._trust_region_steps import coleman_li, propose, scaled_problem, strictly_feasible
 
 __all__ = ["solve_trust_region"]
 
@@ -85,7 +85,8 @@ def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations]
     alpha, status = 0.0, None
     while True:
         # raises scale_inv to the column norms at x (once per accepted point, as scipy)
-        d, diag_h, g_h, h_h, eig, vecs, sg, g_norm = prepare(x, ne.jtj, ne.jtr, lb, ub, scale_inv)
+        d, diag_h, g_h, h_h, eig, vecs, sg, g_norm = scaled_problem(x, ne.jtj, ne.jtr, lb, ub,
+                                                                    scale_inv)
         if g_norm < gtol:
             status = 1
         if status is not None or runs.nfev >= max_nfev:
