@@ -1,13 +1,9 @@
 """Deferred imports, so that ``import hystkit`` and listing the model families stay instant.
 
 :func:`lazy_exports` gives a package a PEP 562 ``__getattr__`` that imports a public name's
-submodule when the name is first used (``hystkit``, the family folders).
-
-A family's metadata (name, title, size help, sizes, docs page) is what ``hystkit fit --help``,
-``get_family`` and the registry need; its equations, fit and numba kernels are needed only to
-run it. Each family folder's ``__init__`` therefore exports ``FAMILY`` at once and the rest of
-its public names through :func:`lazy_exports` (PEP 562), and each ``family.py`` names its
-heavy class attributes (``Structure``, ``Params``, ``model``) with :class:`lazy`.
+submodule when the name is first used (``hystkit`` and its sub-packages, the family folders,
+whose ``__init__`` holds only the light ``INFO`` the registry reads; see
+:mod:`hystkit.models._registry`).
 """
 
 from __future__ import annotations
@@ -15,31 +11,7 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable, Mapping
 
-__all__ = ["lazy", "lazy_exports"]
-
-
-class lazy:
-    """A class attribute taken from a module of the same package on first use.
-
-    ``Structure = lazy(".model", "MplStructure")`` in a class defined in
-    ``hystkit.models.mpl.family`` imports ``hystkit.models.mpl.model`` when ``Structure`` is
-    first read (on the class or an instance) and then replaces itself by the value, so later
-    reads are plain attribute reads. ``lazy(".model")`` gives the module itself.
-    """
-
-    def __init__(self, module: str, name: str | None = None) -> None:
-        self.module = module
-        self.name = name
-
-    def __set_name__(self, owner: type, attribute: str) -> None:
-        self.attribute = attribute
-        self.package = owner.__module__.rpartition(".")[0]
-
-    def __get__(self, instance: object, owner: type) -> object:
-        module = importlib.import_module(self.module, self.package)
-        value = module if self.name is None else getattr(module, self.name)
-        setattr(owner, self.attribute, value)
-        return value
+__all__ = ["lazy_exports"]
 
 
 def lazy_exports(package: str, namespace: dict[str, object],

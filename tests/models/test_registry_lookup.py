@@ -1,8 +1,9 @@
 """Looking up one family by name imports only its folder, and finds what discovery finds.
 
-`hystkit.models._registry`: before anything is discovered or registered, ``get_family(name)``
-and ``name in FAMILIES`` import the family's own folder only (``fit --model mpl`` reads no other
-family and no entry points). Checked in fresh interpreters, since this test session has long
+`hystkit.models._registry`: before anything is discovered or registered, ``family_info(name)``
+and ``name in FAMILIES`` import the family's own folder only (its light ``INFO``), and
+``get_family(name)`` adds its ``family.py`` and what that imports (``fit --model mpl`` reads no
+other family and no entry points). Checked in fresh interpreters, since this test session has long
 discovered every family.
 """
 
@@ -24,7 +25,7 @@ _FOLDERS = ("sorted(m for m in sys.modules if m.startswith('hystkit.models.')\n"
 
 def _fresh(code: str) -> str:
     probe = ("import sys\nimport hystkit.models._registry as registry\n"
-             "from hystkit.models import FAMILIES, get_family\n"
+             "from hystkit.models import FAMILIES, family_info, get_family\n"
              f"{code}\n")
     return subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                           check=True, timeout=120).stdout.strip()
@@ -32,18 +33,33 @@ def _fresh(code: str) -> str:
 
 @pytest.mark.parametrize("name", ["mpl", "mpl-g", "preisach"])
 def test_one_name_imports_only_its_own_folder(name):
-    out = _fresh(f"family = get_family({name!r})\n"
-                 f"assert family.name == {name!r} and {name!r} in FAMILIES\n"
-                 f"print(registry._found is None, {_FOLDERS})")
+    """Its INFO from its folder's light ``__init__``; no discovery, no other family."""
+    out = _fresh(f"info = family_info({name!r})\n"
+                 f"assert info.name == {name!r} and {name!r} in FAMILIES\n"
+                 f"print(registry._found is None, 'numba' in sys.modules, {_FOLDERS})")
     folder = name.replace("-", "_")
-    assert out == f"True ['hystkit.models.{folder}']"
+    assert out == f"True False ['hystkit.models.{folder}']"
+
+
+@pytest.mark.parametrize("name", ["mpl", "mpl-g", "preisach"])
+def test_the_family_loads_its_own_code_only(name):
+    """``get_family`` imports the folder's family.py and what it imports (mpl-g reuses the mPL
+    cells and mpl-poly's output resistor), nothing else: no discovery, no other family."""
+    folder = name.replace("-", "_")
+    alone = _fresh(f"import hystkit.models.{folder}.family\nprint({_FOLDERS})")
+    out = _fresh(f"family = get_family({name!r})\n"
+                 f"assert family.name == {name!r} and family is FAMILIES[{name!r}]\n"
+                 f"print(registry._found is None, {_FOLDERS})")
+    assert out == f"True {alone}" and f"'hystkit.models.{folder}'" in alone
 
 
 def test_the_same_family_objects_as_discovery():
-    """Every name: the lookup's family is the one the full discovery lists."""
+    """Every name: the lookup's family and record are the ones the full discovery lists."""
     out = _fresh("before = {n: get_family(n) for n in " + repr(sorted(FAMILIES)) + "}\n"
                  "assert registry._found is None\n"
-                 "print(all(FAMILIES[n] is f for n, f in before.items()),\n"
+                 "from hystkit.models import FAMILY_INFO, FamilyInfo\n"
+                 "print(all(FAMILIES[n] is f and FAMILY_INFO[n] == FamilyInfo.of(f)\n"
+                 "          for n, f in before.items()),\n"
                  "      sorted(FAMILIES) == sorted(before), registry._found is not None)")
     assert out == "True True True"
 

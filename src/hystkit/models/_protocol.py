@@ -1,7 +1,9 @@
 """The family protocol: what every hysteresis model family provides, in one place.
 
-A *family* (mPL, Preisach, PI, ...) is one folder ``hystkit/models/<family>/`` whose
-``__init__`` exports ``FAMILY``, an instance of a :class:`Family` subclass. Generic code (fit,
+A *family* (mPL, Preisach, PI, ...) is one folder ``hystkit/models/<family>/``: its
+``__init__`` declares ``INFO``, a :class:`FamilyInfo` (what the CLI lists before any model
+loads), and its ``family.py`` exports ``FAMILY``, an instance of a :class:`Family` subclass
+whose ``info`` is that record. Generic code (fit,
 compensator, compare, control loop, stability, python-control adapter) talks to families only
 through this protocol, so adding a family is one new folder and no edit elsewhere.
 
@@ -36,7 +38,7 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
-__all__ = ["Block", "Family", "FitStart", "Record", "Reduction", "Translation",
+__all__ = ["Block", "Family", "FamilyInfo", "FitStart", "Record", "Reduction", "Translation",
            "numerical_linearisation"]
 
 
@@ -239,11 +241,57 @@ class Translation:
     m_load: str | None = None
 
 
+@dataclasses.dataclass(frozen=True)
+class FamilyInfo:
+    """What the registry knows of a family before its code loads (``hystkit fit --help``).
+
+    A family folder's ``__init__`` declares it as ``INFO``; its :class:`Family` subclass sets
+    ``info = INFO`` and so carries the same values (:attr:`Family.name`, ...). The fields are
+    those of :class:`Family` of the same names.
+
+    Parameters
+    ----------
+    name : str
+        CLI name (``hystkit fit --model NAME``).
+    title : str
+        Human name with the reference document's section.
+    size_help : str, default "model size"
+        What the size knob means.
+    default_size : int, default 1
+    max_size : int, default 50
+        Largest size a fit is offered.
+    docs : str, default ""
+        Path of the family's page under ``docs/``.
+    no_inverse_reason : str, default ""
+        Empty when the family has an inverse; otherwise why not.
+    """
+
+    name: str
+    title: str
+    size_help: str = "model size"
+    default_size: int = 1
+    max_size: int = 50
+    docs: str = ""
+    no_inverse_reason: str = ""
+
+    @property
+    def has_inverse(self) -> bool:
+        return not self.no_inverse_reason
+
+    @classmethod
+    def of(cls, family: Family) -> FamilyInfo:
+        """The record of a family object (one registered at run time or by a plugin)."""
+        return cls(**{f.name: getattr(family, f.name) for f in dataclasses.fields(cls)})
+
+
 class Family(ABC):
     """One hysteresis model family. Subclass it once per family; export an instance as FAMILY.
 
     Attributes
     ----------
+    info : FamilyInfo or None
+        The folder's ``INFO``; when set, the metadata below (``name`` to ``max_size``,
+        ``docs``, ``no_inverse_reason``) are taken from it.
     name : str
         CLI name (``hystkit fit --model NAME``).
     title : str
@@ -267,6 +315,7 @@ class Family(ABC):
         Why there is no ``export`` (``hystkit export`` says it); a default names the file.
     """
 
+    info: ClassVar[FamilyInfo | None] = None
     name: ClassVar[str]
     title: ClassVar[str]
     size_help: ClassVar[str] = "model size"
@@ -302,6 +351,10 @@ class Family(ABC):
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
+        info = cls.__dict__.get("info")
+        if info is not None:  # the metadata are declared once, in the folder's INFO
+            for field in dataclasses.fields(info):
+                setattr(cls, field.name, getattr(info, field.name))
         fit_function = cls.__dict__.get("fit_function")
         if fit_function is not None and not isinstance(fit_function, staticmethod):
             cls.fit_function = staticmethod(fit_function)  # a plain function, not a method

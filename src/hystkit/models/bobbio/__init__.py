@@ -6,13 +6,19 @@
 """
 
 from ..._lazy import lazy_exports
-from .family import BobbioFamily
+from .._protocol import FamilyInfo
 
-FAMILY = BobbioFamily()
+INFO = FamilyInfo(
+    name="bobbio",
+    title="Bobbio-Marrucci springs and friction pistons (sec. 2.1.4, eq. 2.5)",
+    size_help="springs N, with N - 1 pistons (2N params)",
+    default_size=10,
+    max_size=100,
+    docs="docs/models/circuits.md")
 
-# The model's equations, its fit and its numba kernels load when one of their names is first
-# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
+# equations, fit and numba kernels load when one of their names is first used.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*",), "fit": ("*",)},
-    first=("FAMILY", "BobbioFamily"))
+    {"family": ("FAMILY", "BobbioFamily"), "model": ("*",), "fit": ("*",)},
+    first=("INFO",))

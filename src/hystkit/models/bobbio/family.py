@@ -2,38 +2,30 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from ..._lazy import lazy
 from .._protocol import Block, Family
+from . import INFO, kernels
+from . import model as bobbio
 from .export import TRANSLATION
 
-if TYPE_CHECKING:
-    from . import model as bobbio
-
-__all__ = ["BobbioFamily"]
+__all__ = ["FAMILY", "BobbioFamily"]
 
 
 class BobbioFamily(Family):
     """The Bobbio-Marrucci spring/piston chain (sec. 2.1.4) as a registered family."""
 
-    name = "bobbio"
-    title = "Bobbio-Marrucci springs and friction pistons (sec. 2.1.4, eq. 2.5)"
-    size_help = "springs N, with N - 1 pistons (2N params)"
-    default_size = 10
-    max_size = 100
-    docs = "docs/models/circuits.md"
+    info = INFO
     export = TRANSLATION  # export.py: the block in C and MATLAB
-    # The equations, fit and numba kernels load on first use, not with the registry.
-    Structure = lazy(".model", "BobbioStructure")
-    Params = lazy(".model", "BobbioParams")
-    model = lazy(".model")
+    Structure = bobbio.BobbioStructure
+    Params = bobbio.BobbioParams
+    model = bobbio
 
     @staticmethod
     def fit_function(u, y, structure, **options):
         """:func:`.fit.fit_bobbio`."""
+        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
+        # so only what fits imports it; running a model does not.
         from .fit import fit_bobbio
 
         return fit_bobbio(u, y, structure, **options)
@@ -45,8 +37,6 @@ class BobbioFamily(Family):
         return self.model.invert_step(structure, params, x, y)
 
     def make_structure(self, dt: float, size: int) -> bobbio.BobbioStructure:
-        from . import model as bobbio
-
         return bobbio.BobbioStructure(n_springs=size, dt=dt)
 
     def random_params(self, structure, rng):
@@ -55,8 +45,6 @@ class BobbioFamily(Family):
         ``A_N-1 = sum a_k`` is log-uniform in the fit's ``[0.1, 1.5]`` times the input's
         half-range 1 (each ``a_k >= 0.1 A_N-1 / (N - 1)``), offset in ``[-1, 1]``. Bounded:
         every spring force is a play of ``u``, so ``|y| <= sum c_k max|u| + |b|``."""
-        from . import model as bobbio
-
         n = structure.n_springs
         compliance = np.exp(rng.uniform(np.log(0.1), np.log(10.0))) * rng.dirichlet(np.ones(n))
         m = n - 1
@@ -72,8 +60,6 @@ class BobbioFamily(Family):
         return super().at(structure, dt)
 
     def block(self, structure, params, inverse=False):
-        from . import kernels
-
         body = np.concatenate([[params.n_springs, params.offset], params.compliance,
                                params.friction])
         step = kernels.block_inverse if inverse else kernels.block_forward
@@ -87,8 +73,6 @@ class BobbioFamily(Family):
         derivative along the motion the chain is making there (where ``D = 0``, a flat
         segment, the numerical default is used). A piston exactly on its threshold (where
         sliding stopped) is a kink; it counts as sticking."""
-        from . import model as bobbio
-
         x = np.asarray(x, dtype=float)
         m = x.size
         u_op = bobbio.invert_step(structure, params, x, u)[0] if inverse else u
@@ -108,3 +92,6 @@ class BobbioFamily(Family):
         if d == 0:
             return super().linearise(structure, params, x, u, inverse=True)
         return a_mat - np.outer(b, c) / d, b / d, -c / d, 1.0 / d
+
+
+FAMILY = BobbioFamily()

@@ -2,50 +2,36 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from ..._lazy import lazy
 from .._protocol import Block, Family
+from . import INFO, kernels
+from . import model as boucwen
 from .export import TRANSLATION
 
-if TYPE_CHECKING:
-    from . import model as boucwen
-
-__all__ = ["BoucWenFamily"]
+__all__ = ["FAMILY", "BoucWenFamily"]
 
 
 class BoucWenFamily(Family):
     """The Bouc-Wen oscillator (Noel and Schoukens' benchmark) as a registered family."""
 
-    name = "boucwen"
-    title = ("Bouc-Wen oscillator, m y'' + c y' + k y + z = u (beyond the document; "
-             "Noel-Schoukens benchmark)")
-    size_help = "RK4 substeps per sample (7 parameters whatever the size)"
-    default_size = 2
-    max_size = 64
-    docs = "docs/models/boucwen.md"
+    info = INFO
     export = TRANSLATION  # export.py: the block in C and MATLAB
-    # The equations, fit and numba kernels load on first use, not with the registry.
-    Structure = lazy(".model", "BoucWenStructure")
-    Params = lazy(".model", "BoucWenParams")
-    model = lazy(".model")
+    Structure = boucwen.BoucWenStructure
+    Params = boucwen.BoucWenParams
+    model = boucwen
 
     @staticmethod
     def fit_function(u, y, structure, **options):
         """:func:`.fit.fit_family`."""
+        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
+        # so only what fits imports it; running a model does not.
         from .fit import fit_family
 
         return fit_family(u, y, structure, **options)
-    no_inverse_reason = ("its input is a force and its output a displacement of a second-order "
-                         "system: the inverse needs the measured output differentiated twice "
-                         "(dynamic inversion), which is not implemented")
 
     def make_structure(self, dt: float, size: int, input_hold: str = "linear",
                        start: str = "equilibrium") -> boucwen.BoucWenStructure:
-        from . import model as boucwen
-
         # Recordings start wherever the sensor happens to be, not at rest with zero force.
         return boucwen.BoucWenStructure(dt=dt, substeps=size, input_hold=input_hold, start=start)
 
@@ -61,8 +47,6 @@ class BoucWenFamily(Family):
         and raise ``FitDivergedError`` (:func:`~hystkit.models.boucwen.model.simulate_states`).
         Bounded: by passivity ``|y| <= sqrt(2 (E_0 + T max u^2 / (4 c)) / k)`` over a run of
         ``T`` seconds (:func:`~hystkit.models.boucwen.model.divergence_bound`)."""
-        from . import model as boucwen
-
         k0 = np.exp(rng.uniform(np.log(0.1), np.log(10.0)))
         zeta = np.exp(rng.uniform(np.log(0.1), np.log(10.0)))
         fastest = max(1.0, zeta + np.sqrt(max(zeta**2 - 1.0, 0.0)))  # |lambda| / w0
@@ -88,10 +72,11 @@ class BoucWenFamily(Family):
         between the previous sample and this one (causal). It cannot band-limit the force the
         way :func:`~hystkit.models.boucwen.bandlimited_upsample` does over a whole record;
         docs/models/boucwen.md says how far the two differ."""
-        from . import kernels
-
         if inverse:
             raise ValueError(f"model {self.name!r} has no inverse ({self.no_inverse_reason})")
         body = np.concatenate([params.as_array(), [structure.dt, structure.substeps,
                                                    structure.input_hold == "linear"]])
         return Block(kernels.block_forward, np.ascontiguousarray(body, dtype=np.float64), 4)
+
+
+FAMILY = BoucWenFamily()

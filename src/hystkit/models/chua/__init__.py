@@ -5,13 +5,19 @@
 """
 
 from ..._lazy import lazy_exports
-from .family import ChuaFamily
+from .._protocol import FamilyInfo
 
-FAMILY = ChuaFamily()
+INFO = FamilyInfo(
+    name="chua",
+    title="Chua-Stromsmoe, dy/dt = g(u - f(y)) (sec. 2.1.3, eq. 2.3)",
+    size_help="elements in series N, output the sum of their states (6N params; 1 = eq. 2.3)",
+    default_size=1,
+    max_size=20,
+    docs="docs/models/circuits.md")
 
-# The model's equations, its fit and its numba kernels load when one of their names is first
-# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
+# equations, fit and numba kernels load when one of their names is first used.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*",), "fit": ("*",)},
-    first=("FAMILY", "ChuaFamily"))
+    {"family": ("FAMILY", "ChuaFamily"), "model": ("*",), "fit": ("*",)},
+    first=("INFO",))

@@ -3,38 +3,31 @@
 from __future__ import annotations
 
 import dataclasses
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..._lazy import lazy
 from .._protocol import Block, Family
+from . import INFO, kernels
+from . import model as chua
 from .export import TRANSLATION
 
-if TYPE_CHECKING:
-    from . import model as chua
-
-__all__ = ["ChuaFamily"]
+__all__ = ["FAMILY", "ChuaFamily"]
 
 
 class ChuaFamily(Family):
     """The Chua-Stromsmoe model (sec. 2.1.3) as a registered family."""
 
-    name = "chua"
-    title = "Chua-Stromsmoe, dy/dt = g(u - f(y)) (sec. 2.1.3, eq. 2.3)"
-    size_help = "elements in series N, output the sum of their states (6N params; 1 = eq. 2.3)"
-    default_size = 1
-    max_size = 20
-    docs = "docs/models/circuits.md"
+    info = INFO
     export = TRANSLATION  # export.py: the block in C and MATLAB
-    # The equations, fit and numba kernels load on first use, not with the registry.
-    Structure = lazy(".model", "ChuaStructure")
-    Params = lazy(".model", "ChuaParams")
-    model = lazy(".model")
+    Structure = chua.ChuaStructure
+    Params = chua.ChuaParams
+    model = chua
 
     @staticmethod
     def fit_function(u, y, structure, **options):
         """:func:`.fit.fit_chua`."""
+        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
+        # so only what fits imports it; running a model does not.
         from .fit import fit_chua
 
         return fit_chua(u, y, structure, **options)
@@ -46,8 +39,6 @@ class ChuaFamily(Family):
         return self.model.invert_step(structure, params, x, y)
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0) -> chua.ChuaStructure:
-        from . import model as chua
-
         return chua.ChuaStructure(n_elements=size, dt=dt, slope_cap=slope_cap)
 
     def random_params(self, structure, rng):
@@ -70,9 +61,6 @@ class ChuaFamily(Family):
         return dataclasses.replace(structure, dt=dt, slope_cap=cap)
 
     def block(self, structure, params, inverse=False):
-        from . import kernels
-        from . import model as chua
-
         *per_element, dt = chua.kernel_args(structure, params)
         body = np.concatenate([[params.n_elements, dt], *per_element])
         step = kernels.block_inverse if inverse else kernels.block_forward
@@ -83,8 +71,6 @@ class ChuaFamily(Family):
         and the output ``y = sum x+``. The inverse solves that output for ``u`` at the
         operating point's input ``u_hat``: ``du = (dy - C dx) / D``; where no element moves
         (``D = 0``, dead bands) it has no derivative and the numerical default is used."""
-        from . import model as chua
-
         x = np.asarray(x, dtype=float)
         u_op = chua.invert_step(structure, params, x, u)[0] if inverse else u
         fx_slope = params.k_inf + (params.k0 - params.k_inf) / np.cosh(x / params.y_s) ** 2
@@ -97,3 +83,6 @@ class ChuaFamily(Family):
         if d == 0:
             return super().linearise(structure, params, x, u, inverse=True)
         return a - np.outer(b, c) / d, b / d, -c / d, 1.0 / d
+
+
+FAMILY = ChuaFamily()

@@ -7,13 +7,20 @@ reference, ``fit`` the identification, ``family`` the protocol adapter exported 
 """
 
 from ..._lazy import lazy_exports
-from .family import GPreisachFamily
+from .._protocol import FamilyInfo
 
-FAMILY = GPreisachFamily()
+INFO = FamilyInfo(
+    name="gpreisach",
+    title="generalised (non-linear) Preisach, input-dependent weight and reversible part (sec. "
+          "2.1.2, eq. 2.2)",
+    size_help="grid levels L of the two Preisach weights ((L - 1) (L - 2) relay cells)",
+    default_size=16,
+    max_size=64,
+    docs="docs/models/preisach.md")
 
-# The model's equations, its fit and its numba kernels load when one of their names is first
-# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
+# equations, fit and numba kernels load when one of their names is first used.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*",), "fit": ("*",)},
-    first=("FAMILY", "GPreisachFamily"))
+    {"family": ("FAMILY", "GPreisachFamily"), "model": ("*",), "fit": ("*",)},
+    first=("INFO",))

@@ -7,47 +7,37 @@ rest states, the shared compiled block, the branch linearisation, rate independe
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from ..._lazy import lazy
 from .. import preisach
-from ..preisach import StaircaseFamily
-from ..preisach.family import orientation_sign, random_masses
+from ..preisach.family import StaircaseFamily, orientation_sign, random_masses
+from . import INFO
+from . import model as gpreisach
 
-if TYPE_CHECKING:
-    from . import model as gpreisach
-
-__all__ = ["GPreisachFamily"]
+__all__ = ["FAMILY", "GPreisachFamily"]
 
 
 class GPreisachFamily(StaircaseFamily):
     """The generalised Preisach model (sec. 2.1.2, eq. 2.2) as a registered family."""
 
-    name = "gpreisach"
-    title = ("generalised (non-linear) Preisach, input-dependent weight and reversible part "
-             "(sec. 2.1.2, eq. 2.2)")
-    size_help = "grid levels L of the two Preisach weights ((L - 1) (L - 2) relay cells)"
-    default_size = 16
-    max_size = 64
-    docs = "docs/models/preisach.md"
-    # The equations, fit and numba kernels load on first use, not with the registry.
-    Structure = lazy(".model", "GPreisachStructure")
-    Params = lazy(".model", "GPreisachParams")
-    stairs = lazy(".model")
+    info = INFO
+    Structure = gpreisach.GPreisachStructure
+    Params = gpreisach.GPreisachParams
+    stairs = gpreisach
 
     @staticmethod
     def fit_function(u, y, structure, **options):
         """:func:`.fit.fit_gpreisach`."""
+        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
+        # so only what fits imports it; running a model does not.
         from .fit import fit_gpreisach
 
         return fit_gpreisach(u, y, structure, **options)
 
     def make_structure(self, dt: float, size: int,
                        **options: Any) -> gpreisach.GPreisachStructure:
-        from . import model as gpreisach
-
         return gpreisach.GPreisachStructure(levels=size, dt=dt, **options)
 
     def random_params(self, structure, rng):
@@ -56,8 +46,6 @@ class GPreisachFamily(StaircaseFamily):
         ``sum |m|`` log-uniform in ``[0.1, 10]``; ``nu_k >= 0`` with ``int nu`` log-uniform in
         ``[0.01, 10]``; offset in ``[-1, 1]``. Bounded: ``|y - y_0| <= max(sum |m_-|,
         sum |m_+|) + int nu`` for ``|u| <= 1``."""
-        from . import model as gpreisach
-
         levels, degree = structure.levels, structure.degree
         sign = orientation_sign(structure, rng)
         tables = [preisach.everett_from_masses(random_masses(levels, sign, rng, diagonal=False))
@@ -72,3 +60,6 @@ class GPreisachFamily(StaircaseFamily):
         """Off-diagonal masses of both weights (the fit keeps the diagonal at zero), the
         Bernstein coefficients of ``nu`` and the offset."""
         return (structure.levels - 1) * (structure.levels - 2) + params.nu.size + 1
+
+
+FAMILY = GPreisachFamily()

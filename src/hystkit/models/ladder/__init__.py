@@ -6,13 +6,19 @@
 """
 
 from ..._lazy import lazy_exports
-from .family import LadderFamily
+from .._protocol import FamilyInfo
 
-FAMILY = LadderFamily()
+INFO = FamilyInfo(
+    name="ladder",
+    title="PWL ladder circuit, Parodi-Storace-Cincotti (sec. 2.1.5)",
+    size_help="ladder sections N, a PWL resistor and a capacitor each (3N + 2 params)",
+    default_size=2,
+    max_size=50,
+    docs="docs/models/circuits.md")
 
-# The model's equations, its fit and its numba kernels load when one of their names is first
-# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
+# equations, fit and numba kernels load when one of their names is first used.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*",), "fit": ("*",)},
-    first=("FAMILY", "LadderFamily"))
+    {"family": ("FAMILY", "LadderFamily"), "model": ("*",), "fit": ("*",)},
+    first=("INFO",))

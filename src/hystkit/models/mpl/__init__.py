@@ -6,14 +6,20 @@
 """
 
 from ..._lazy import lazy_exports
-from .family import MplFamily
+from .._protocol import FamilyInfo
 
-FAMILY = MplFamily()
+INFO = FamilyInfo(
+    name="mpl",
+    title="modified Power-Law, sinh resistors (sec. 5.3.1, eq. 5.1-5.6)",
+    size_help="cells N (3N + 2 params)",
+    default_size=1,
+    max_size=50,
+    docs="docs/models/mpl.md")
 
-# The model's equations, its fit and its numba kernels load when one of their names is first
-# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
+# equations, fit and numba kernels load when one of their names is first used.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*",), "fit": ("default_starts", "fit_box", "fit_mpl"),
-     "presets": ("PRESETS", "preset")},
-    first=("FAMILY", "MplFamily"))
+    {"family": ("FAMILY", "MplFamily"), "model": ("*",),
+     "fit": ("default_starts", "fit_box", "fit_mpl"), "presets": ("PRESETS", "preset")},
+    first=("INFO",))

@@ -2,40 +2,35 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import dataclasses
 
 import numpy as np
 
-from ..._lazy import lazy
 from .._cells import Cells, cell_reductions, cell_report
 from .._protocol import Block, Family, FitStart
+from . import INFO, kernels
+from . import model as mpl
 from .export import TRANSLATION
+from .presets import PRESETS, preset
 
-if TYPE_CHECKING:
-    from . import model as mpl
-
-__all__ = ["MplFamily"]
+__all__ = ["FAMILY", "MplFamily"]
 
 
 class MplFamily(Family):
     """The modified Power-Law model with sinh resistors (sec. 5.3.1) as a registered family."""
 
-    name = "mpl"
-    title = "modified Power-Law, sinh resistors (sec. 5.3.1, eq. 5.1-5.6)"
-    size_help = "cells N (3N + 2 params)"
-    default_size = 1
-    max_size = 50
-    docs = "docs/models/mpl.md"
+    info = INFO
     export = TRANSLATION  # export.py: the block in C and MATLAB
-    # The equations, fit and numba kernels load on first use, not with the registry.
-    Structure = lazy(".model", "MplStructure")
-    Params = lazy(".model", "MplParams")
-    model = lazy(".model")  # step, simulate, invert, invert_step
+    Structure = mpl.MplStructure
+    Params = mpl.MplParams
+    model = mpl  # step, simulate, invert, invert_step
     fit_options = frozenset({"init", "weight_sum_max"})
 
     @staticmethod
     def fit_function(u, y, structure, **options):
         """:func:`.fit.fit_mpl`."""
+        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
+        # so only what fits imports it; running a model does not.
         from .fit import fit_mpl
 
         return fit_mpl(u, y, structure, **options)
@@ -54,8 +49,6 @@ class MplFamily(Family):
         """The reference document's one-cell sets (:mod:`.presets`): ``table-5.2`` (initial
         conditions), ``table-5.2-fitted`` (its fmincon result, unlimited sinh) and
         ``paper-9.1`` (initial conditions), normalised units, at 40 Hz."""
-        from .presets import PRESETS, preset
-
         return {name: preset(name, limit=name != "table-5.2-fitted") for name in PRESETS}
 
     def start_options(self, structure, params):
@@ -88,9 +81,6 @@ class MplFamily(Family):
         return np.full(structure.n_cells, float(value))
 
     def block(self, structure, params, inverse=False):
-        from . import kernels
-        from . import model as mpl
-
         body = np.concatenate([[params.n_cells, params.v_b, structure.slope_cap / structure.dt,
                                 structure.dt], params.i_s, params.v_t,
                                mpl.knee_voltage(structure, params), params.w])
@@ -102,9 +92,6 @@ class MplFamily(Family):
         ``dx+ = (1 - f' dt) dx + f' dt d(drive)``, ``f'`` the slope of the limited resistor
         (eq. 5.29) at the operating point; the inverse's drive ``(u - w.x + V_b) / w_0`` feeds
         back into every cell."""
-        from . import kernels
-        from . import model as mpl
-
         x = np.asarray(x, dtype=float)
         knee = mpl.knee_voltage(structure, params)
         cap = structure.slope_cap / structure.dt
@@ -121,10 +108,6 @@ class MplFamily(Family):
         """The model as the eq. 5.18-5.28 analysis sees it (linear output ``g(z) = z``). Without
         the limit the resistor is the sinh everywhere; the knees reported are still where
         ``f' dt`` reaches the slope cap (where the limit would act), as mpl-poly's."""
-        import dataclasses
-
-        from . import model as mpl
-
         knee = mpl.knee_voltage(structure, params)
         limited = structure  # mpl-g's structure, which reuses these cells, has no limit field
         if not getattr(structure, "limit", True):
@@ -147,3 +130,6 @@ class MplFamily(Family):
 
     def stability_details(self, structure, params, u):
         return cell_report(self.cells(structure, params), u)
+
+
+FAMILY = MplFamily()

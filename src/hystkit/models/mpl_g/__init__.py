@@ -7,14 +7,21 @@ paper 9.2's table II sensors, ``family`` the protocol adapter exported as ``FAMI
 """
 
 from ..._lazy import lazy_exports
-from .family import MplGFamily
+from .._protocol import FamilyInfo
 
-FAMILY = MplGFamily()
+INFO = FamilyInfo(
+    name="mpl-g",
+    title="ch. 7 compensator: sinh cells with a cubic output resistor g (sec. 7.2, eq. 5.1-5.6, "
+          "5.16-5.17)",
+    size_help="cells N (3N + 4 fitted params)",
+    default_size=1,
+    max_size=50,
+    docs="docs/models/mpl_g.md")
 
-# The model's equations, its fit and its numba kernels load when one of their names is first
-# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
+# equations, fit and numba kernels load when one of their names is first used.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*",), "fit": ("canonical", "fit_mpl_g"),
+    {"family": ("FAMILY", "MplGFamily"), "model": ("*",), "fit": ("canonical", "fit_mpl_g"),
      "presets": ("ch7_compensator", "table_ii_response")},
-    first=("FAMILY", "MplGFamily"))
+    first=("INFO",))

@@ -3,20 +3,19 @@ resistor, eq. 5.16-5.17) behind the family protocol."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._cells import Cells, cell_reductions, cell_report
 from .._protocol import Block, Family, FitStart
+from ..mpl.family import FAMILY as MPL
+from ..mpl.kernels import current
+from ..mpl_poly.presets import PAPER_9_2_TABLE_II
+from . import INFO, kernels
+from . import model as mpl_g
 from .export import TRANSLATION
 
-if TYPE_CHECKING:
-    from . import model as mpl_g
-
-__all__ = ["MplGFamily"]
+__all__ = ["FAMILY", "MplGFamily"]
 
 
 class MplGFamily(Family):
@@ -24,23 +23,18 @@ class MplGFamily(Family):
     family.
     """
 
-    name = "mpl-g"
-    title = ("ch. 7 compensator: sinh cells with a cubic output resistor g (sec. 7.2, "
-             "eq. 5.1-5.6, 5.16-5.17)")
-    size_help = "cells N (3N + 4 fitted params)"
-    default_size = 1
-    max_size = 50
-    docs = "docs/models/mpl_g.md"
+    info = INFO
     export = TRANSLATION  # export.py: the block in C and MATLAB
-    # The equations, fit and numba kernels load on first use, not with the registry.
-    Structure = lazy(".model", "MplGStructure")
-    Params = lazy(".model", "MplGParams")
-    model = lazy(".model")  # step, simulate, invert, rest_state
+    Structure = mpl_g.MplGStructure
+    Params = mpl_g.MplGParams
+    model = mpl_g  # step, simulate, invert, rest_state
     fit_options = frozenset({"init", "weight_sum_max"})
 
     @staticmethod
     def fit_function(u, y, structure, **options):
         """:func:`.fit.fit_mpl_g`."""
+        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
+        # so only what fits imports it; running a model does not.
         from .fit import fit_mpl_g
 
         return fit_mpl_g(u, y, structure, **options)
@@ -51,8 +45,6 @@ class MplGFamily(Family):
     def invert_step(self, structure, params, x, y):
         """As :func:`model.invert_step`; NaN input estimate and state when ``y`` is outside
         the range of ``g``'s branch (no input gives it), as the compiled block."""
-        from . import model as mpl_g
-
         if not mpl_g._solve(params, y)[1]:
             return np.nan, np.full(np.size(x), np.nan)
         return mpl_g.invert_step(structure, params, x, y)
@@ -91,7 +83,6 @@ class MplGFamily(Family):
         """The sec. 7.2 compensators of paper 9.2's table II sensors, ``ch7-table-ii-COLUMN``,
         fitted on first use (about 1-3 s each; :mod:`.presets` says why table II's own weights
         cannot be presets of this family)."""
-        from ..mpl_poly.presets import PAPER_9_2_TABLE_II
         from .presets import ch7_compensator
 
         return {f"ch7-table-ii-{column}": ch7_compensator(column)
@@ -113,9 +104,6 @@ class MplGFamily(Family):
         return cell_reductions(structure, params)
 
     def block(self, structure, params, inverse=False):
-        from . import kernels
-        from . import model as mpl_g
-
         if inverse:
             if params.w[0] == 0:
                 raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
@@ -133,9 +121,6 @@ class MplGFamily(Family):
         ``dy = g'(z) (w_0 du + w . dx)``. Inverse: ``dz = dy / g'(z)``,
         ``de = (dz - w . dx) / w_0``, the cells driven by ``e``. ``f'`` is the slope of the
         limited sinh resistor (eq. 5.29) at the operating point."""
-        from ..mpl.kernels import current
-        from . import model as mpl_g
-
         x = np.asarray(x, dtype=float)
         w0, w = params.w[0], params.w[1:]
         if inverse:
@@ -159,9 +144,6 @@ class MplGFamily(Family):
 
     def cells(self, structure, params) -> Cells:
         """The model as the eq. 5.18-5.28 analysis sees it (sinh cells, cubic output ``g``)."""
-        from ..mpl import FAMILY as MPL
-        from . import model as mpl_g
-
         sinh = MPL.cells(structure, params)  # duck-typed: the cells read i_s, v_t, w, v_b
         return Cells(current=sinh.current, slope=sinh.slope,
                      output=lambda z: mpl_g.output_current(params, z),
@@ -174,3 +156,6 @@ class MplGFamily(Family):
     def stability_details(self, structure, params, u):
         """eq. 5.28 per cell at every rest point and along a run on ``u`` (``_cells``)."""
         return cell_report(self.cells(structure, params), u)
+
+
+FAMILY = MplGFamily()

@@ -6,14 +6,21 @@ tables, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
 from ..._lazy import lazy_exports
-from .family import MplPolyFamily
+from .._protocol import FamilyInfo
 
-FAMILY = MplPolyFamily()
+INFO = FamilyInfo(
+    name="mpl-poly",
+    title="polynomial modified Power-Law, cubic resistors (sec. 5.3.5, eq. 5.16-5.17, 5.29)",
+    size_help="cells N (5N + 6 params)",
+    default_size=1,
+    max_size=30,
+    docs="docs/models/mpl_poly.md")
 
-# The model's equations, its fit and its numba kernels load when one of their names is first
-# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
+# equations, fit and numba kernels load when one of their names is first used.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*",), "fit": ("canonical", "default_starts", "fit_box", "fit_mpl_poly"),
+    {"family": ("FAMILY", "MplPolyFamily"), "model": ("*",),
+     "fit": ("canonical", "default_starts", "fit_box", "fit_mpl_poly"),
      "presets": ("PAPER_9_2_TABLE_I", "PAPER_9_2_TABLE_II", "paper_9_2_params")},
-    first=("FAMILY", "MplPolyFamily"))
+    first=("INFO",))

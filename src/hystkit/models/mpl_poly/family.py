@@ -2,36 +2,27 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._cells import Cells, cell_report
 from .._protocol import Block, Family, FitStart
+from . import INFO, kernels
+from . import model as mpl_poly
 from .export import TRANSLATION
+from .presets import PAPER_9_2_TABLE_I, PAPER_9_2_TABLE_II, paper_9_2_params
 
-if TYPE_CHECKING:
-    from . import model as mpl_poly
-
-__all__ = ["MplPolyFamily"]
+__all__ = ["FAMILY", "MplPolyFamily"]
 
 
 class MplPolyFamily(Family):
     """The polynomial modified Power-Law model (sec. 5.3.5, paper 9.2) as a registered family."""
 
-    name = "mpl-poly"
-    title = "polynomial modified Power-Law, cubic resistors (sec. 5.3.5, eq. 5.16-5.17, 5.29)"
-    size_help = "cells N (5N + 6 params)"
-    default_size = 1
-    max_size = 30
-    docs = "docs/models/mpl_poly.md"
+    info = INFO
     export = TRANSLATION  # export.py: the block in C and MATLAB
-    # The equations, fit and numba kernels load on first use, not with the registry.
-    Structure = lazy(".model", "MplPolyStructure")
-    Params = lazy(".model", "MplPolyParams")
-    model = lazy(".model")
+    Structure = mpl_poly.MplPolyStructure
+    Params = mpl_poly.MplPolyParams
+    model = mpl_poly
     # no weight_sum_max: the output resistor's gauge (z -> alpha z, g re-expanded) gives every
     # model an equivalent one with sum |w| below any bound, so the constraint restricts nothing
     fit_options = frozenset({"init"})
@@ -39,6 +30,8 @@ class MplPolyFamily(Family):
     @staticmethod
     def fit_function(u, y, structure, **options):
         """:func:`.fit.fit_mpl_poly`."""
+        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
+        # so only what fits imports it; running a model does not.
         from .fit import fit_mpl_poly
 
         return fit_mpl_poly(u, y, structure, **options)
@@ -59,8 +52,6 @@ class MplPolyFamily(Family):
 
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0,
                        limit: bool = True) -> mpl_poly.MplPolyStructure:
-        from . import model as mpl_poly
-
         return mpl_poly.MplPolyStructure(n_cells=size, dt=dt, slope_cap=slope_cap, limit=limit)
 
     def at(self, structure, dt):
@@ -81,9 +72,6 @@ class MplPolyFamily(Family):
         """Paper 9.2's table II columns: direct compensators (sensor -> position) fitted on
         normalised 40 Hz data, N = 1, as printed (``f2^2``, ``f3^3``); and table I, the
         initial conditions of its fits (``paper-9.2-table-i``, for ``--init``)."""
-        from . import model as mpl_poly
-        from .presets import PAPER_9_2_TABLE_I, PAPER_9_2_TABLE_II, paper_9_2_params
-
         structure = mpl_poly.MplPolyStructure(n_cells=1, dt=0.025)
         presets = {f"table-ii-{name}": (structure, paper_9_2_params(printed),
                                         {"source": f"paper 9.2 table II, {name} column (as "
@@ -108,9 +96,6 @@ class MplPolyFamily(Family):
     def invert_step(self, structure, params, x, y):
         """As :func:`model.invert_step`; NaN input estimate and state when ``y`` is outside
         the range of ``g``'s branch (no input gives it), as the compiled block."""
-        from . import kernels
-        from . import model as mpl_poly
-
         lo, hi, sign, centre = mpl_poly.inverse_branch(structure, params)
         if not kernels.solve_output(float(y), np.ascontiguousarray(params.g), lo, hi, sign,
                                     centre)[1]:
@@ -118,9 +103,6 @@ class MplPolyFamily(Family):
         return mpl_poly.invert_step(structure, params, x, y)
 
     def block(self, structure, params, inverse=False):
-        from . import kernels
-        from . import model as mpl_poly
-
         mpl_poly.check_rest(structure, params)  # the loop runs only models of the domain
         if inverse:
             if params.w[0] == 0:
@@ -140,9 +122,6 @@ class MplPolyFamily(Family):
         ``dy = g'(z) (w_0 du + w . dx)``. Inverse: ``dz = dy / g'(z)``,
         ``de = (dz - w . dx) / w_0``, the cells driven by ``e``. ``f'`` is the slope of the
         limited cubic (eq. 5.29) at the operating point."""
-        from . import kernels
-        from . import model as mpl_poly
-
         x = np.asarray(x, dtype=float)
         w0, w = params.w[0], params.w[1:]
         if inverse:
@@ -165,8 +144,6 @@ class MplPolyFamily(Family):
 
     def cells(self, structure, params) -> Cells:
         """The model as the eq. 5.18-5.28 analysis sees it (cubic output ``g``)."""
-        from . import model as mpl_poly
-
         return Cells(current=lambda v: mpl_poly.resistor_current(structure, params, v),
                      slope=lambda v: mpl_poly.resistor_slope(structure, params, v),
                      output=lambda z: mpl_poly.output_current(params, z),
@@ -180,3 +157,6 @@ class MplPolyFamily(Family):
     def stability_details(self, structure, params, u):
         """eq. 5.28 per cell at every rest point and along a run on ``u`` (``_cells``)."""
         return cell_report(self.cells(structure, params), u)
+
+
+FAMILY = MplPolyFamily()

@@ -6,13 +6,20 @@ bounded linear least-squares solve), ``family`` the protocol adapter exported as
 """
 
 from ..._lazy import lazy_exports
-from .family import PiFamily
+from .._protocol import FamilyInfo
 
-FAMILY = PiFamily()
+INFO = FamilyInfo(
+    name="pi",
+    title="Kuhnen / modified Prandtl-Ishlinskii with creep (sec. 2.1.6, eq. 2.6-2.19)",
+    size_help="play operators n (thresholds i/n, i < n; plus 2 x 2 dead zones, 4 creep operators "
+              "by default)",
+    default_size=10,
+    max_size=200,
+    docs="docs/models/pi.md")
 
-# The model's equations, its fit and its numba kernels load when one of their names is first
-# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
+# equations, fit and numba kernels load when one of their names is first used.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*",), "fit": ("*",)},
-    first=("FAMILY", "PiFamily"))
+    {"family": ("FAMILY", "PiFamily"), "model": ("*",), "fit": ("*",)},
+    first=("INFO",))

@@ -7,33 +7,29 @@ import dataclasses
 
 import numpy as np
 
-from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._protocol import Block, Family
+from . import INFO, kernels
+from . import model as pi
 from .export import TRANSLATION
 
-__all__ = ["PiFamily"]
+__all__ = ["FAMILY", "PiFamily"]
 
 
 class PiFamily(Family):
     """Kuhnen's modified Prandtl-Ishlinskii model with creep (sec. 2.1.6) as a registered family."""
 
-    name = "pi"
-    title = "Kuhnen / modified Prandtl-Ishlinskii with creep (sec. 2.1.6, eq. 2.6-2.19)"
-    size_help = ("play operators n (thresholds i/n, i < n; plus 2 x 2 dead zones, 4 creep "
-                 "operators by default)")
-    default_size = 10
-    max_size = 200
-    docs = "docs/models/pi.md"
+    info = INFO
     export = TRANSLATION  # export.py: the block in C and MATLAB
-    # The equations, fit and numba kernels load on first use, not with the registry.
-    Structure = lazy(".model", "PiStructure")
-    Params = lazy(".model", "PiParams")
-    model = lazy(".model")  # rest_state, step, simulate, invert, invert_step: the module's functions
+    Structure = pi.PiStructure
+    Params = pi.PiParams
+    model = pi  # rest_state, step, simulate, invert, invert_step: the module's functions
 
     @staticmethod
     def fit_function(u, y, structure, **options):
         """:func:`.fit.fit_pi`."""
+        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
+        # so only what fits imports it; running a model does not.
         from .fit import fit_pi
 
         return fit_pi(u, y, structure, **options)
@@ -76,9 +72,6 @@ class PiFamily(Family):
         return dataclasses.replace(structure, dt=float(dt))
 
     def block(self, structure, params, inverse=False):
-        from . import kernels
-        from . import model as pi
-
         pi.simulate(structure, params, np.zeros(2))  # checks that params fit the structure
         head = [structure.n_play, structure.n_creep, params.d_s.size]
         r, c = np.asarray(structure.play_thresholds), structure.creep_gains
@@ -108,8 +101,6 @@ class PiFamily(Family):
         slopes exactly on a threshold. The inverse follows from the forward Jacobian at the
         estimate ``u_hat``: ``du = (dy - C dx) / D``.
         """
-        from . import model as pi
-
         x = np.asarray(x, dtype=float)
         if inverse:
             u = pi.invert_step(structure, params, x, u)[0]
@@ -129,3 +120,6 @@ class PiFamily(Family):
         if not inverse:
             return a, b, cc, d
         return a - np.outer(b, cc) / d, b / d, -cc / d, 1.0 / d
+
+
+FAMILY = PiFamily()

@@ -6,15 +6,21 @@ structural search behind ``hystkit pl-search``, ``family`` the protocol adapter 
 """
 
 from ..._lazy import lazy_exports
-from .family import PlFamily
+from .._protocol import FamilyInfo
 
-FAMILY = PlFamily()
+INFO = FamilyInfo(
+    name="pl",
+    title="Power-Law model as published, Biggio et al. (sec. 2.1.7, eq. 2.16-2.18)",
+    size_help="cells N (N + M + 4 params; p, M, S via options or 'hystkit pl-search')",
+    default_size=1,
+    max_size=50,
+    docs="docs/models/pl.md")
 
-# The model's equations, its fit and its numba kernels load when one of their names is first
-# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
+# equations, fit and numba kernels load when one of their names is first used.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*",), "fit": ("default_starts", "fit_pl", "solve_weights"),
-     "grid": ("DEFAULT_GRID",),
+    {"family": ("FAMILY", "PlFamily"), "model": ("*",),
+     "fit": ("default_starts", "fit_pl", "solve_weights"), "grid": ("DEFAULT_GRID",),
      "search": ("format_search_table", "structural_search")},
-    first=("FAMILY", "PlFamily"))
+    first=("INFO",))

@@ -2,39 +2,31 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from ..._lazy import lazy
 from ...errors import FitDivergedError
 from .._protocol import Block, Family
+from . import INFO, kernels
+from . import model as pl
 from .export import TRANSLATION
 
-if TYPE_CHECKING:
-    from . import model as pl
-
-__all__ = ["PlFamily"]
+__all__ = ["FAMILY", "PlFamily"]
 
 
 class PlFamily(Family):
     """The Power-Law model of hysteresis and creep (sec. 2.1.7) as a registered family."""
 
-    name = "pl"
-    title = "Power-Law model as published, Biggio et al. (sec. 2.1.7, eq. 2.16-2.18)"
-    size_help = "cells N (N + M + 4 params; p, M, S via options or 'hystkit pl-search')"
-    default_size = 1
-    max_size = 50
-    docs = "docs/models/pl.md"
+    info = INFO
     export = TRANSLATION  # export.py: the block in C and MATLAB
-    # The equations, fit and numba kernels load on first use, not with the registry.
-    Structure = lazy(".model", "PlStructure")
-    Params = lazy(".model", "PlParams")
-    model = lazy(".model")
+    Structure = pl.PlStructure
+    Params = pl.PlParams
+    model = pl
 
     @staticmethod
     def fit_function(u, y, structure, **options):
         """:func:`.fit.fit_pl`."""
+        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
+        # so only what fits imports it; running a model does not.
         from .fit import fit_pl
 
         return fit_pl(u, y, structure, **options)
@@ -47,8 +39,6 @@ class PlFamily(Family):
 
     def make_structure(self, dt: float, size: int, power: float = 21.0, n_basis: int = 1,
                        smoothing: float = 0.001, slope_cap: float = 1.0) -> pl.PlStructure:
-        from . import model as pl
-
         return pl.PlStructure(n_cells=size, power=power, n_basis=n_basis, smoothing=smoothing,
                               dt=dt, slope_cap=slope_cap)
 
@@ -69,9 +59,6 @@ class PlFamily(Family):
         return super().at(structure, dt)
 
     def block(self, structure, params, inverse=False):
-        from . import kernels
-        from . import model as pl
-
         if inverse and params.w[0] == 0:
             raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 2.20)")
         i_t, thr, knee, power, g_lin, dt = pl.kernel_args(structure, params)
@@ -87,8 +74,6 @@ class PlFamily(Family):
         Forward: ``di = (w_0 de + w . dx) / f'(i)``; inverse: ``de = (f'(i) di - w . dx) / w_0``,
         the cells driven by ``e``. ``f'`` is the slope ``a_j`` of the output resistor's segment
         (on a breakpoint the left one; the numerical default would average the two)."""
-        from . import model as pl
-
         x = np.asarray(x, dtype=float)
         w0, w = params.w[0], params.w[1:]
         if inverse:
@@ -102,3 +87,6 @@ class PlFamily(Family):
         if inverse:
             return np.diag(1.0 - g) - np.outer(g, w) / w0, g * a / w0, -w / w0, a / w0
         return np.diag(1.0 - g), g, w / a, float(w0 / a)
+
+
+FAMILY = PlFamily()

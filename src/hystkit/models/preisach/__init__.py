@@ -6,14 +6,20 @@ squares and FORCs), ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
 from ..._lazy import lazy_exports
-from .family import PreisachFamily
-from .family import StaircaseFamily as StaircaseFamily
+from .._protocol import FamilyInfo
 
-FAMILY = PreisachFamily()
+INFO = FamilyInfo(
+    name="preisach",
+    title="classical Preisach, Everett function on a grid (sec. 2.1.1, eq. 2.1, 9.4-9.13)",
+    size_help="grid levels L over the normalised input (L (L - 1) / 2 Preisach cells)",
+    default_size=20,
+    max_size=100,
+    docs="docs/models/preisach.md")
 
-# The model's equations, its fit and its numba kernels load when one of their names is first
-# used, so that the registry (hystkit fit --help) lists the family without compiling anything.
+# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
+# equations, fit and numba kernels load when one of their names is first used.
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"model": ("*", "INVERT_TOL"), "fit": ("*",)},
-    first=("FAMILY", "PreisachFamily", "StaircaseFamily", "kernels"))
+    {"family": ("FAMILY", "PreisachFamily", "StaircaseFamily"), "model": ("*", "INVERT_TOL"),
+     "fit": ("*",)},
+    first=("INFO", "kernels"))

@@ -9,18 +9,16 @@ from __future__ import annotations
 
 import dataclasses
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
-from ..._lazy import lazy
 from .._protocol import Block, Family
+from . import INFO, kernels
+from . import model as preisach
 from .export import TRANSLATION
 
-if TYPE_CHECKING:
-    from . import model as preisach
-
-__all__ = ["PreisachFamily", "StaircaseFamily", "orientation_sign", "random_masses"]
+__all__ = ["FAMILY", "PreisachFamily", "StaircaseFamily", "orientation_sign", "random_masses"]
 
 _LOG_MASS = (np.log(0.1), np.log(10.0))  # total |mass| of a random weight (random_params)
 
@@ -63,13 +61,9 @@ class StaircaseFamily(Family):
         return dataclasses.replace(structure, dt=float(dt))
 
     def _unpack(self, structure, x):
-        from . import model as preisach
-
         return preisach.unpack_state(x, structure.capacity)
 
     def _pack(self, structure, staircase):
-        from . import model as preisach
-
         return preisach.pack_state(staircase, structure.capacity)
 
     def rest_state(self, structure, params, value, inverse=False):
@@ -105,9 +99,6 @@ class StaircaseFamily(Family):
         forgotten, exactly as in :meth:`simulate` (``PreisachStructure``): a documented
         degradation of the memory, never an overflow.
         """
-        from . import kernels
-        from . import model as preisach
-
         self.simulate(structure, params, np.zeros(2))  # checks that params fit the structure
         tables, weighted, poly, slope = self.stairs.kernel_parts(params)
         if inverse:  # the inverse's own checks: a major loop that rises enough to invert
@@ -160,27 +151,21 @@ class StaircaseFamily(Family):
 class PreisachFamily(StaircaseFamily):
     """The classical Preisach model (sec. 2.1.1, appendix 9.3-9.5) as a registered family."""
 
-    name = "preisach"
-    title = "classical Preisach, Everett function on a grid (sec. 2.1.1, eq. 2.1, 9.4-9.13)"
-    size_help = "grid levels L over the normalised input (L (L - 1) / 2 Preisach cells)"
-    default_size = 20
-    max_size = 100
-    docs = "docs/models/preisach.md"
-    # The equations, fit and numba kernels load on first use, not with the registry.
-    Structure = lazy(".model", "PreisachStructure")
-    Params = lazy(".model", "PreisachParams")
-    stairs = lazy(".model")
+    info = INFO
+    Structure = preisach.PreisachStructure
+    Params = preisach.PreisachParams
+    stairs = preisach
 
     @staticmethod
     def fit_function(u, y, structure, **options):
         """:func:`.fit.fit_preisach`."""
+        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
+        # so only what fits imports it; running a model does not.
         from .fit import fit_preisach
 
         return fit_preisach(u, y, structure, **options)
 
     def make_structure(self, dt: float, size: int, **options: Any) -> preisach.PreisachStructure:
-        from . import model as preisach
-
         return preisach.PreisachStructure(levels=size, dt=dt, **options)
 
     def random_params(self, structure, rng):
@@ -189,11 +174,12 @@ class PreisachFamily(StaircaseFamily):
         off-diagonal ``<= 0`` and diagonal ``>= 0`` -- spread at random (Dirichlet) with total
         ``sum |m|`` log-uniform in ``[0.1, 10]`` (1: a major loop spanning [-1, 1], eq. 5.10),
         offset in ``[-1, 1]``. Bounded: ``|y - y_0| <= sum |m| max(1, |u|)``."""
-        from . import model as preisach
-
         masses = random_masses(structure.levels, orientation_sign(structure, rng), rng)
         return preisach.PreisachParams.from_masses(masses, offset=rng.uniform(-1.0, 1.0))
 
     def n_params(self, structure, params) -> int:
         """The Everett nodes below the diagonal (one per cell mass) and the offset."""
         return structure.levels * (structure.levels - 1) // 2 + 1
+
+
+FAMILY = PreisachFamily()
