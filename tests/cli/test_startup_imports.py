@@ -58,12 +58,13 @@ def test_subcommand_help_still_names_every_family():
 
 def test_the_family_registry_and_metadata_load_no_numba_or_scipy():
     """What ``fit --help`` asks of the families (names, titles, sizes, docs) comes without
-    their numba kernels, scipy or pandas: each family folder loads its model on first use."""
-    code = ("from hystkit.models import FAMILIES, get_family\n"
+    their numba kernels, scipy or pandas: the registry reads each folder's INFO and imports its
+    family.py only when the family itself is asked for."""
+    code = ("from hystkit.models import FAMILIES, FAMILY_INFO, family_info\n"
             "rows = [(f.name, f.title, f.size_help, f.default_size, f.max_size, f.docs,\n"
             "         f.has_inverse, f.no_inverse_reason)\n"
-            "        for f in FAMILIES.values()]\n"
-            "assert get_family('mpl').name == 'mpl' and len(rows) == len(FAMILIES)\n"
+            "        for f in FAMILY_INFO.values()]\n"
+            "assert family_info('mpl').name == 'mpl' and len(rows) == len(FAMILIES)\n"
             "assert all(r[6] == (r[7] == '') for r in rows)  # an inverse unless said why\n"
             "assert sum(r[6] for r in rows) == len(rows) - 1  # all but boucwen")
     assert set(_loaded_after(code)) <= {"numpy"}

@@ -521,6 +521,12 @@ def _families() -> dict:
     return FAMILIES
 
 
+def _family_info() -> dict:
+    from ..models import FAMILY_INFO  # names, titles, sizes: no model loads for the help
+
+    return FAMILY_INFO
+
+
 def _experiment_names() -> list[str]:
     from ..signals import EXPERIMENTS
 
@@ -600,7 +606,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     # family only.
     deferred(p.add_argument("--model", default=None), choices=lambda: [*_families(),
                                                                         GUIDED_MODEL],
-             help=lambda: "; ".join([*(f"{f.name}: {f.title}" for f in _families().values()),
+             help=lambda: "; ".join([*(f"{f.name}: {f.title}" for f in _family_info().values()),
                                      f"{GUIDED_MODEL}: a guided first fit, {GUIDED_HELP}"])
              + f" (default {DEFAULT_MODEL}; mpl when --cells or another option of a named "
                f"model is given)")
@@ -612,7 +618,7 @@ def register(sub: argparse._SubParsersAction) -> None:
              help=lambda: "model size: " + "; ".join(f"{f.name}: {f.size_help} (default "
                                                      f"{f.default_size}, at most "
                                                      f"{size_limit(f)})"
-                                                     for f in _families().values()))
+                                                     for f in _family_info().values()))
     p.add_argument("--mode", default="direct",
                    help="direct: fit sensor->position (paper 9.2); inverse: fit "
                         "position->sensor and invert it (paper 9.1)")
