@@ -41,7 +41,7 @@ def add_parallel_options(p: argparse.ArgumentParser) -> None:
 
 def executor_for(args: argparse.Namespace, n_pieces: int):
     """The executor (context manager) of ``--workers`` / ``--scheduler`` for `n_pieces`."""
-    from ..models._warm import warm_kernels
+    from ..models import warm_kernels
     from ..parallel import open_executor
 
     if args.scheduler_timeout is not None and args.scheduler is None:

@@ -15,11 +15,9 @@ A kernel is compiled once per block step (numba inlines the step, as the control
 
 from __future__ import annotations
 
-import hashlib
-
 import numpy as np
-from numba import njit
 
+from .._closure_cache import compile_closure
 from ..io import MAX_MAGNITUDE
 from ._band import feature_decay, feature_range, feature_step, position_width
 from ._compensator import MAX_NORMALISED
@@ -140,19 +138,8 @@ def kernel(step):
     """The compiled kernel for block step `step`, cached on disk when the step has a stable
     name (as the control loop's, whose cache machinery it shares)."""
     if step not in _COMPILED:
-        # the control loop's: numba's closure key pickles the step with a per-process id
-        from ..control._kernel import _LoopCache, _stable_name
-
-        run = _make(step)
-        names = [_stable_name(step), _stable_name(feature_step)]  # and this file: numba's
-        if not all(names):
-            _COMPILED[step] = njit(run)
-        else:
-            combination = hashlib.sha256("|".join(names).encode()).hexdigest()[:16]
-            run.__qualname__ = f"{run.__qualname__}_{combination}"  # its own symbols
-            compiled = njit(run)
-            compiled._cache = _LoopCache(run, combination)
-            _COMPILED[step] = compiled
+        # keyed by this file's band step too: numba's own key would pickle the step
+        _COMPILED[step] = compile_closure(_make(step), (step, feature_step))
     return _COMPILED[step]
 
 

@@ -23,14 +23,12 @@ Signals recorded per step (rows of ``out``): see :data:`SIGNALS`.
 
 from __future__ import annotations
 
-import hashlib
-import os
-import sys
 import time
 
 import numpy as np
 from numba import njit
-from numba.core.caching import FunctionCache
+
+from .._closure_cache import compile_closure
 
 N_FIXED = 10
 SIGNALS = ("y", "s", "y_hat", "s_hat", "y_hat_plant", "e", "u", "d_hat")
@@ -110,55 +108,8 @@ def compile_run(r, d_out, d_in, noise, x0, direct, plant, pid, dob, y_limit, siz
 def _kernel(step_r, step_c, step_m):
     key = (step_r, step_c, step_m)
     if key not in _COMPILED:
-        loop = _make(step_r, step_c, step_m)
-        names = [_stable_name(step) for step in key]
-        if not all(names):
-            _COMPILED[key] = njit(loop)
-        else:
-            combination = hashlib.sha256("|".join(names).encode()).hexdigest()[:16]
-            # numba names a compiled function by its qualified name and a number counted per
-            # process; loops of two combinations compiled in two processes can get the same
-            # number, and their symbols (the function, its environment) then clash in a
-            # process that loads both from the cache. The combination in the name keeps them
-            # apart.
-            loop.__qualname__ = f"{loop.__qualname__}_{combination}"
-            kernel = njit(loop)
-            kernel._cache = _LoopCache(loop, combination)
-            _COMPILED[key] = kernel
+        _COMPILED[key] = compile_closure(_make(*key), key)
     return _COMPILED[key]
-
-
-def _stable_name(step) -> str | None:
-    """The name that means `step`'s code in every process: module, qualified name and the
-    module file's modification time and size (so that a cached loop does not outlive an edit
-    of the step); None for a step that is not a module-level function of a file."""
-    func = step.py_func
-    module = sys.modules.get(func.__module__)
-    path = getattr(module, "__file__", None)
-    if path is None or getattr(module, func.__qualname__, None) is not step:
-        return None
-    stat = os.stat(path)
-    return f"{func.__module__}:{func.__qualname__}:{stat.st_mtime_ns}:{stat.st_size}"
-
-
-class _LoopCache(FunctionCache):
-    """numba's on-disk cache of one loop kernel, keyed by its block steps' names.
-
-    numba keys a closure's entries by its bytecode and its pickled closure variables; the
-    steps are dispatchers, which pickle with a random id of their process, so with plain
-    ``cache=True`` no other process would find an entry (the loop compiled on every run:
-    0.6-1.5 s of each ``hystkit control``). The key here is numba's with the hash of the
-    steps' names (`_stable_name`) in place of the pickle; the loop's qualified name, which
-    names the cache files, carries it too.
-    """
-
-    def __init__(self, py_func, combination: str) -> None:
-        super().__init__(py_func)
-        self._combination = combination
-
-    def _index_key(self, sig, codegen):
-        code_hash = hashlib.sha256(self._py_func.__code__.co_code).hexdigest()
-        return sig, codegen.magic_tuple(), (code_hash, self._combination)
 
 
 def _make(step_r, step_c, step_m):

@@ -26,7 +26,8 @@ from ._registry import (
                         unregister,
 )
 from ._stability import stability_report
+from ._warm import warm_kernels
 
 __all__ = ["DT_RANGE", "FAMILIES", "FAMILY_INFO", "Block", "Family", "FamilyInfo", "FitStart",
            "Record", "Reduction", "family_info", "family_of", "get_family",
-           "numerical_linearisation", "register", "stability_report", "unregister"]
+           "numerical_linearisation", "register", "stability_report", "unregister", "warm_kernels"]

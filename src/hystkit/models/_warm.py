@@ -20,7 +20,9 @@ def warm_kernels() -> None:
     this loads their simulation, fit and inverse kernels from numba's on-disk cache
     (``cache=True``). The signal is a play operator's (every family fits it; a family's own
     random parameters left Bouc-Wen unfitted, its fit kernels unloaded) and short: ~1.05 s of
-    CPU on the 2-core machine, of which ~0.6 s runs the fits (2026-11-24)."""
+    CPU on the 2-core machine, of which ~0.6 s runs the fits (2026-11-24). It is what a Dask
+    worker runs at its start (``open_executor(..., worker_setup=warm_kernels)``).
+    """
     u = 0.8 * np.sin(np.linspace(0, 6 * np.pi, 150)) * np.linspace(1.0, 0.5, 150)
     y = 0.6 * u + 0.4 * _play(u, 0.15)
     for family in FAMILIES.values():
