@@ -248,7 +248,8 @@ def next_step(status: str, *, command: str = "fit", model: str | None = None,
             "extrapolated": "refitting on recordings that cover this range, e.g. 'hystkit fit "
                             "TRAIN.csv THIS.csv' (fitted jointly)",
         }.get(status, "refitting on recordings like these, e.g. 'hystkit fit TRAIN.csv "
-                      "THIS.csv' (fitted jointly), or 'hystkit fit --model auto' on them")
+                      "THIS.csv' (fitted jointly; without --model it chooses among small "
+                      "models on held-out data)")
     if status == "no_signal":
         return _COLUMNS
     if command in ("select", "guided"):  # a selection (select, fit --model auto) refused
