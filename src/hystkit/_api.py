@@ -27,8 +27,16 @@ from .compensation import (
 )
 from .compensation import evaluate as _evaluate
 from .compensation import use_flags as _use_flags
-from .io import ReadOptions, Recording, options_for, read_pieces, read_recording, settings_for
-from .io._training_reading import remember_reading, training_units
+from .io import (
+    ReadOptions,
+    Recording,
+    options_for,
+    read_pieces,
+    read_recording,
+    remember_reading,
+    settings_for,
+    training_units,
+)
 from .models import get_family
 
 if TYPE_CHECKING:

@@ -37,9 +37,10 @@ from ..io import (
     check_output_path,
     options_for,
     read_recording,
+    remember_reading,
+    training_units,
     write_json,
 )
-from ..io._training_reading import remember_reading, training_units
 from ..models import get_family
 from ..parallel import Executor, SerialExecutor
 from ._manifest import SensorJob

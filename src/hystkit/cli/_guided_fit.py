@@ -31,12 +31,18 @@ from dataclasses import replace
 from functools import partial
 
 from ._common import GUARD_EXIT, UsageError, next_step, read_options, say_next
+from ._fit_report import print_band, print_parameters, print_standard_errors, units_label
 from ._inputs import check_inputs_exist
-from .cmd_core import GUIDED_MODEL as GUIDED
 
-__all__ = ["DEFAULT_BUDGET", "GUIDED", "SHORT_LIST", "guided_candidates", "guided_select",
+__all__ = ["DEFAULT_BUDGET", "GUIDED", "GUIDED_HELP", "GUIDED_MODEL", "SHORT_LIST", "guided_candidates", "guided_select",
            "model_options_given", "run_guided_fit", "selection_status"]
 
+# fit's --model value for the guided fit, its default (issue 27.5)
+GUIDED_MODEL = GUIDED = "auto"
+GUIDED_HELP = ("mpl with 1, 2 and 3 cells, mpl-poly, pi and pl, each fitted and scored on "
+               "held-out data as select does, the best usable one written with its band and "
+               "the choice explained in three lines (about 15-30 s for 10,000 samples on 2 "
+               "cores)")
 # Seconds for the whole guided fit (issue 27.5: <= 60 s for 10,000 samples on 2 cores)
 DEFAULT_BUDGET = 60.0
 # (family, size), see the module docstring for why these
@@ -245,16 +251,9 @@ def run_guided_fit(args: argparse.Namespace) -> int:
     _refuse_model_options(args)
     check_inputs_exist(args.data)  # a misspelt name is refused before the heavy imports
     from ..compensation import MODEL_SUFFIXES, folds, save_compensator
-    from ..io import check_output_path, read_pieces, read_recording
+    from ..io import check_output_path, read_pieces, read_recording, training_units
     from ..parallel import loading_meanwhile, open_executor
     from ._own_layout import training_reading
-    from .cmd_core import (
-        _print_band,
-        _print_parameters,
-        _print_standard_errors,
-        _training_units,
-        _units_label,
-    )
 
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
                       what="a model file")
@@ -266,11 +265,11 @@ def run_guided_fit(args: argparse.Namespace) -> int:
             recs += read_pieces(path, options=reading[-1])
         else:
             recs.append(read_recording(path, options=reading[-1]))
-    units = _training_units(recs, args.data)
+    units = training_units(recs)
     remembered, not_remembered = training_reading(reading, args.data, units)
     n_folds = len(folds(recs))
     print(f"guided fit on {', '.join(map(str, args.data))}: "
-          f"{sum(r.n_samples for r in recs)} samples at {recs[0].fs:g} Hz{_units_label(recs[0])}"
+          f"{sum(r.n_samples for r in recs)} samples at {recs[0].fs:g} Hz{units_label(recs[0])}"
           f"; trying {', '.join(f'{m}:{s}' for m, s in SHORT_LIST)} ({args.mode} mode, "
           f"centring {args.center}), scored on held-out data, within {budget:g} s",
           flush=True)
@@ -307,9 +306,9 @@ def run_guided_fit(args: argparse.Namespace) -> int:
     print("\n".join(lines))
     for caveat in result["caveats"]:
         print(f"  note: {caveat}")
-    _print_band(comp)
-    _print_parameters(comp, info.get("standard_errors"))
-    _print_standard_errors(info.get("standard_errors"))
+    print_band(comp)
+    print_parameters(comp, info.get("standard_errors"))
+    print_standard_errors(info.get("standard_errors"))
     print(f"  training R² {info['training_r2']:.4f}, straight line "
           f"{info['training_linear_r2']:.4f}; sensor polarity {comp.polarity:+g}")
     for note in [*(info.get("at_model_limits") or ()), *(info.get("redundant") or ()),

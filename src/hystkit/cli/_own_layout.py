@@ -28,7 +28,7 @@ from pathlib import Path
 
 from .._read_options import FIELDS, ReadOptions
 from ..errors import InputError
-from ..io._training_reading import training_reading  # the rule fit and select store by
+from ..io import training_reading  # the rule fit and select store by
 from ._common import given_read_options, read_options
 
 __all__ = ["TRAINED_NOTE", "add_trained_note", "estimate_names", "options_as_trained",

@@ -8,6 +8,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from ..io import training_units
 from ._common import (
     GUARD_EXIT,
     UsageError,
@@ -25,6 +26,7 @@ from ._common import (
     slope_cap,
 )
 from ._fit_cost_options import add_cost_options, cost_options, print_cost_summary
+from ._fit_report import print_band, print_parameters, print_standard_errors, units_label
 from ._fit_start_options import (
     add_start_options,
     list_presets,
@@ -32,6 +34,7 @@ from ._fit_start_options import (
     structure_options,
     weight_sum_options,
 )
+from ._guided_fit import GUIDED_HELP, GUIDED_MODEL, model_options_given, run_guided_fit
 from ._inputs import check_inputs_exist
 from ._own_layout import (
     add_trained_note,
@@ -93,8 +96,6 @@ def _simulate_sensor(args: argparse.Namespace) -> int:
 def _fit(args: argparse.Namespace) -> int:
     args.model = _chosen_model(args)
     if args.model == GUIDED_MODEL:
-        from ._guided_fit import run_guided_fit
-
         return run_guided_fit(args)
     if args.budget is not None:
         raise UsageError(f"--budget applies to --model {GUIDED_MODEL} (a named model is one "
@@ -132,7 +133,7 @@ def _fit(args: argparse.Namespace) -> int:
     print(f"fitting {args.model} ({family.size_help}: {size}{shown}, {args.mode} mode, centring: "
           f"{center_label(args.center)}) on {', '.join(map(str, args.data))}: "
           f"{sum(r.n_samples for r in recs)} samples at {recs[0].fs:g} Hz"
-          f"{_units_label(recs[0])} ...", flush=True)
+          f"{units_label(recs[0])} ...", flush=True)
     fit_arguments = {"tare_seconds": args.tare_seconds, "track_seconds": args.track_seconds,
                      **costs.fit_arguments(args, recs), "fit_options": fit_options, **options}
     comp = fit_compensator(recs, size, model=args.model, mode=args.mode, center=args.center,
@@ -142,7 +143,7 @@ def _fit(args: argparse.Namespace) -> int:
         comp = _module.with_band(comp, recs, size, fit_arguments, level=args.level)
     elif not args.no_band:
         comp.fit_info["band"] = "no band: the fit did not pass its guards"
-    units = _training_units(recs, args.data)
+    units = training_units(recs)
     if units:
         comp.fit_info["units"] = units
     remembered, not_remembered = training_reading(reading, args.data, units)
@@ -151,10 +152,10 @@ def _fit(args: argparse.Namespace) -> int:
     info = comp.fit_info
     print(f"done in {info['fit_seconds']:.2f} s: SSE {info['cost']:.4g} (normalised), solver: "
           f"{info['message']}")
-    _print_band(comp)
+    print_band(comp)
     print_cost_summary(info)
-    _print_parameters(comp, info.get("standard_errors"))
-    _print_standard_errors(info.get("standard_errors"))
+    print_parameters(comp, info.get("standard_errors"))
+    print_standard_errors(info.get("standard_errors"))
     print(f"  training R² {info['training_r2']:.4f}, straight line "
           f"{info['training_linear_r2']:.4f}; AIC {info['aic']:.1f}, BIC {info['bic']:.1f}; "
           f"sensor polarity {comp.polarity:+g}")
@@ -178,24 +179,9 @@ def _fit(args: argparse.Namespace) -> int:
 def _chosen_model(args: argparse.Namespace) -> str:
     """``--model``, or without it `DEFAULT_MODEL`; mpl when an option of a named model is
     given (``--cells 3`` alone is the 3-cell mpl, whatever the default)."""
-    from ._guided_fit import model_options_given
-
     if args.model is not None:
         return args.model
     return "mpl" if model_options_given(args) else DEFAULT_MODEL
-
-
-def _print_band(comp) -> None:
-    """The band line of ``fit``: its half-width at the reference rate, or why there is none."""
-    note = comp.fit_info.get("band")
-    if comp.band is None:
-        if note:
-            print(f"  {note}")
-        return
-    unit = (comp.fit_info.get("units") or {}).get("position", "")
-    print(f"  prediction band {comp.band.level:.0%}: ±{comp.band.quantile():.4g}"
-          f"{' ' + unit if unit else ''} at the training rate, wider when faster or outside the "
-          f"training range ({note})")
 
 
 def has_slope_cap(family) -> bool:
@@ -208,12 +194,6 @@ def has_slope_cap(family) -> bool:
 
 def _slope_cap_models() -> list[str]:
     return [name for name, family in _families().items() if has_slope_cap(family)]
-
-
-def _units_label(rec) -> str:
-    """`` (position [mm], sensor [Ohm])`` when the file gave units, else ""."""
-    shown = ", ".join(f"{name} [{unit}]" for name, unit in rec.units)
-    return f" ({shown})" if shown else ""
 
 
 def _pl_options(args: argparse.Namespace, family) -> dict:
@@ -231,62 +211,6 @@ def _pl_options(args: argparse.Namespace, family) -> dict:
     except ValueError as exc:
         raise UsageError(f"--p/--m/--s: {exc}") from None
     return given
-
-
-def _training_units(recs: list, paths: list[Path]) -> dict[str, str]:
-    """Units of position and sensor of the training recordings (saved in the model file, so
-    compensate can label its estimate); several recordings must agree."""
-    units: dict[str, str] = {}
-    for rec, path in zip(recs, paths):
-        for name, unit in rec.units:
-            if units.setdefault(name, unit) != unit:
-                raise UsageError(f"{path}: {name} is in {unit!r}, an earlier recording's in "
-                                 f"{units[name]!r}; fit recordings in one unit")
-    return units
-
-
-# Parameters printed by `fit`; a larger model's others are in its file.
-MAX_SHOWN = 24
-
-
-def _print_parameters(comp, se: dict | None) -> None:
-    """The fitted parameters as an aligned table (name, value, standard error, relative), as
-    lmfit's fit report: n/a where the data do not determine one, 'fixed' where the fit holds
-    it (a gauge)."""
-    from ..compensation import named_floats
-    from ..reports import text_table
-
-    names = [name for name, _ in named_floats(comp.params.to_dict())]
-    values = [value for _, value in named_floats(comp.params.to_dict())]
-    if se and len(se["standard_errors"]) == len(values):
-        fixed = set(se.get("fixed", []))
-        errors = ["fixed" if n in fixed else e for n, e in zip(names, se["standard_errors"],
-                                                               strict=True)]
-        relative = ["" if n in fixed else r for n, r in zip(names, se["relative"], strict=True)]
-    else:
-        errors = relative = [""] * len(values)
-    def g(x: object, digits: int) -> object:  # significant digits, for people
-        return f"{x:.{digits}g}" if isinstance(x, float) else ("n/a" if x is None else x)
-
-    rows = [(f"  {n}", g(v, 6), g(e, 2), g(r, 2))
-            for n, v, e, r in zip(names, values, errors, relative, strict=True)]
-    print(text_table(("  parameter", "value", "std error", "relative"), rows[:MAX_SHOWN]))
-    if len(rows) > MAX_SHOWN:  # a Preisach grid has 191: the rest is in the model file
-        print(f"  ... {len(rows) - MAX_SHOWN} more parameter(s): see the model file")
-
-
-def _print_standard_errors(se: dict | None) -> None:
-    if not se:
-        return
-    rel = [r for r in se["relative"] if r is not None]
-    fixed = se.get("fixed", [])  # held fixed by the fit (a gauge): no SE, not undetermined
-    n_blind = sum(r is None for r in se["standard_errors"]) - len(fixed)
-    worst = f"largest relative SE {max(rel):.3g}" if rel else "no finite SE"
-    print(f"  standard errors (Gauss-Newton, finite-difference Jacobian): {worst}"
-          f"{f'; {n_blind} parameter(s) not determined by the data' if n_blind else ''}"
-          f"{'; fixed by the fit: ' + ', '.join(fixed) if fixed else ''}")
-    if se.get("caveat"):  # a robust or weighted cost, an active constraint
-        print(f"    ({se['caveat']})")
 
 
 def _compensate(args: argparse.Namespace) -> int:
@@ -565,15 +489,10 @@ def _add_rest_position(p: argparse.ArgumentParser) -> None:
 
 
 _MODEL_HELP = "model file written by fit or select (.json or .mat)"
-# fit --model auto (cli/_guided_fit.py, imported only when chosen)
-GUIDED_MODEL = "auto"
 # fit's model without --model: the guided first fit (issue 27.5); tests and docs that mean one
 # mPL fit say --model mpl (the guided fit takes 15-30 s where one fit takes 1-3 s)
 DEFAULT_MODEL = GUIDED_MODEL
-GUIDED_HELP = ("mpl with 1, 2 and 3 cells, mpl-poly, pi and pl, each fitted and scored on "
-               "held-out data as select does, the best usable one written with its band and "
-               "the choice explained in three lines (about 15-30 s for 10,000 samples on 2 "
-               "cores)")
+
 # The reading options' note of compensate, whose output keeps the input's names
 COMPENSATE_NAMES_NOTE = ("the output keeps the input's column names and time unit, the "
                          "estimate named after the position column")

@@ -18,6 +18,7 @@ __getattr__, __dir__ = lazy_exports(
      "_raw_config": ("CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_config"),
      "_recording": ("MAX_MAGNITUDE", "Recording", "Sampled", "read_recording"),
      "_resample": ("time_gaps",),
+     "_training_reading": ("remember_reading", "training_reading", "training_units"),
      "_recording_config": ("find_recording_config", "options_for", "read_recording_config",
                            "settings_for"),
      "_atomic": ("atomic_folder", "atomic_output", "atomic_outputs", "check_output_folder",

@@ -24,6 +24,18 @@ def training_units(recordings: Sequence, sources: Sequence[str | Path] | None = 
     """Units of the training recordings' columns (``fit_info["units"]``, which ``compensate``
     labels its estimate with); the recordings must agree.
 
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        The training recordings (pieces of one file count as recordings).
+    sources : sequence of path, optional
+        Their names for the message; default each recording's ``source``.
+
+    Returns
+    -------
+    dict
+        Column name -> unit, for the columns whose unit a file gave.
+
     Raises
     ------
     InputError
@@ -79,6 +91,17 @@ def remember_reading(comp, units: dict[str, str], options: Sequence[ReadOptions]
     """`comp` with its training data's `units` (`training_units`) in ``fit_info["units"]``
     and, when it was fitted on files only (`options` and `paths`, one per file), how they
     were read (``reading``).
+
+    Parameters
+    ----------
+    comp : Compensator
+        The fitted compensator.
+    units : dict
+        Units of its training recordings (`training_units`).
+    options : sequence of ReadOptions or None
+        How each training file was read; None when not all the data came from files.
+    paths : sequence of path, optional
+        The training files, in the order of `options`.
 
     Returns
     -------

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import FAMILIES
+from ._registry import FAMILIES
 
 __all__ = ["warm_kernels"]
 
