@@ -83,21 +83,21 @@ def strictly_feasible(x, lb, ub):
     return x
 
 
-def _finite(a: np.ndarray) -> np.ndarray:
-    # numba's np.linalg refuses these too (the fit reports the error)
-    if not np.isfinite(a).all():
-        raise np.linalg.LinAlgError("Array must not contain infs or NaNs.")
-    return a
+def _refuse_non_finite() -> None:
+    # numba's np.linalg refused these too (the fit reports the error)
+    raise np.linalg.LinAlgError("Array must not contain infs or NaNs.")
 
 
 def square_root(jtj: np.ndarray) -> np.ndarray:
     """An ``R`` with ``R^T R = J^T J``: the Cholesky factor, else from the eigendecomposition
     (see the accuracy note in :mod:`._trust_region`)."""
     # potrf reads the lower triangle of C-ordered jtj (the upper one of its transpose), as
-    # numba's np.linalg.cholesky did
-    factor, info = lapack.dpotrf(_finite(jtj).T, lower=0, clean=1)
+    # numba's np.linalg.cholesky did; a NaN or inf fails it (info > 0)
+    factor, info = lapack.dpotrf(jtj.T, lower=0, clean=1)
     if info == 0:
         return np.ascontiguousarray(factor)
+    if not np.isfinite(jtj).all():
+        _refuse_non_finite()
     eig, vecs, info = lapack.dsyevd(jtj, compute_v=1, lower=1)
     if info != 0:
         raise np.linalg.LinAlgError("Eigenvalues did not converge")
@@ -124,9 +124,11 @@ def scaled_problem(x, jtj, g, lb, ub, scale_inv):
     ||v g||_inf`` (the gtol measure).
     """
     root = square_root(jtj)
-    d, diag_h, g_h, h_h, stacked, g_norm = prepare(x, jtj, root, g, lb, ub, scale_inv)
-    _, sv, vecs_t, info = lapack.dgesdd(_finite(stacked), compute_uv=1, full_matrices=0,
-                                        lwork=_svd_workspace(*stacked.shape))
+    d, diag_h, g_h, h_h, stacked, g_norm, finite = prepare(x, jtj, root, g, lb, ub, scale_inv)
+    if not finite:
+        _refuse_non_finite()
+    _, sv, vecs_t, info = lapack.dgesdd(stacked, compute_uv=1, full_matrices=0,
+                                        lwork=_svd_workspace(*stacked.shape), overwrite_a=1)
     if info != 0:
         raise np.linalg.LinAlgError("SVD did not converge")
     return (d, diag_h, g_h, h_h, sv ** 2, np.ascontiguousarray(vecs_t.T), vecs_t @ g_h,
@@ -135,8 +137,9 @@ def scaled_problem(x, jtj, g, lb, ub, scale_inv):
 
 @njit(**_JIT)
 def prepare(x, jtj, root, g, lb, ub, scale_inv):
-    """:func:`scaled_problem` up to the SVD: ``(d, diag_h, g_h, h_h, stacked, g_norm)``,
-    ``stacked`` the matrix to decompose (``scale_inv`` raised in place)."""
+    """:func:`scaled_problem` up to the SVD: ``(d, diag_h, g_h, h_h, stacked, g_norm,
+    finite)``, ``stacked`` the matrix to decompose (Fortran order, as LAPACK takes it) and
+    whether it is finite (``scale_inv`` raised in place)."""
     p = x.size
     for i in range(p):
         scale_inv[i] = max(scale_inv[i], math.sqrt(max(jtj[i, i], 0.0)))
@@ -144,7 +147,7 @@ def prepare(x, jtj, root, g, lb, ub, scale_inv):
     g_norm = 0.0
     for i in range(p):
         a = abs(g[i] * v[i])
-        if g_norm == g_norm and not a <= g_norm:  # np.max's: a NaN stays
+        if not math.isnan(g_norm) and not a <= g_norm:  # np.max's: a NaN stays
             g_norm = a
     for i in range(p):
         if dv[i] != 0:
@@ -155,13 +158,17 @@ def prepare(x, jtj, root, g, lb, ub, scale_inv):
         diag_h[i] = g[i] * dv[i] / scale_inv[i]
         g_h[i] = d[i] * g[i]
     h_h = np.empty((p, p))
-    stacked = np.zeros((2 * p, p))
+    stacked_t = np.zeros((p, 2 * p))
     for i in range(p):
         for j in range(p):
             h_h[i, j] = jtj[i, j] * (d[i] * d[j])
-            stacked[i, j] = root[i, j] * d[j]
-        stacked[p + i, i] = math.sqrt(diag_h[i])
-    return d, diag_h, g_h, h_h, stacked, g_norm
+            stacked_t[j, i] = root[i, j] * d[j]
+        stacked_t[i, p + i] = math.sqrt(diag_h[i])
+    finite = True
+    for i in range(p):
+        for j in range(2 * p):
+            finite = finite and math.isfinite(stacked_t[i, j])
+    return d, diag_h, g_h, h_h, stacked_t.T, g_norm, finite
 
 
 @njit(**_JIT)
@@ -257,6 +264,11 @@ def _quadratic_1d(h_h, g_h, s, diag_h, s0):
 
 
 @njit(**_JIT)
+def _quadratic(h_h, g_h, s, diag_h):
+    return 0.5 * (_dot(s, _matvec(h_h, s)) + _dot(_times(s, diag_h), s)) + _dot(g_h, s)
+
+
+@njit(**_JIT)
 def _minimize_1d(a, b, lo, hi, c):
     """Minimum of ``a t^2 + b t + c`` on ``[lo, hi]``: ``(t, value)``, ends first on ties."""
     best_t, best = lo, lo * (a * lo + b) + c
@@ -307,14 +319,12 @@ def propose(x, h_h, diag_h, g_h, eig, vecs, sg, d, delta, alpha, lb, ub, theta):
     """
     p_h, alpha = _trust_region_step(eig, vecs, sg, delta, alpha)
     p = _times(d, p_h)
-    zero = np.zeros(x.size)
     inside = True
     for i in range(x.size):
         if not (lb[i] <= x[i] + p[i] <= ub[i]):
             inside = False
     if inside:
-        a, b, _ = _quadratic_1d(h_h, g_h, p_h, diag_h, zero)
-        step, step_h, predicted = p, p_h, -(a + b)
+        step, step_h, predicted = p, p_h, -_quadratic(h_h, g_h, p_h, diag_h)
     else:
         p_stride, hits = _step_to_bound(x, p, lb, ub)
         r_h = p_h.copy()
@@ -339,14 +349,13 @@ def propose(x, h_h, diag_h, g_h, eig, vecs, sg, d, delta, alpha, lb, ub, theta):
         else:
             r_value = math.inf
         p, p_h = _scaled(p, theta), _scaled(p_h, theta)
-        a, b, _ = _quadratic_1d(h_h, g_h, p_h, diag_h, zero)
-        p_value = a + b
+        p_value = _quadratic(h_h, g_h, p_h, diag_h)
         ag_h = _scaled(g_h, -1.0)
         ag = _times(d, ag_h)
         to_tr = delta / _norm(ag_h)
         to_bound, _ = _step_to_bound(x, ag, lb, ub)
         ag_stride = theta * to_bound if to_bound < to_tr else to_tr
-        a, b, _ = _quadratic_1d(h_h, g_h, ag_h, diag_h, zero)
+        a, b, _ = _quadratic_1d(h_h, g_h, ag_h, diag_h, np.zeros(x.size))
         ag_stride, ag_value = _minimize_1d(a, b, 0.0, ag_stride, 0.0)
         if p_value < r_value and p_value < ag_value:
             step, step_h, predicted = p, p_h, -p_value
