@@ -251,9 +251,14 @@ def run_guided_fit(args: argparse.Namespace) -> int:
     _refuse_model_options(args)
     check_inputs_exist(args.data)  # a misspelt name is refused before the heavy imports
     from ..compensation import MODEL_SUFFIXES, folds, save_compensator
-    from ..io import check_output_path, read_pieces, read_recording, training_units
+    from ..io import (
+        check_output_path,
+        read_pieces,
+        read_recording,
+        training_reading,
+        training_units,
+    )
     from ..parallel import loading_meanwhile, open_executor
-    from ._own_layout import training_reading
 
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
                       what="a model file")

@@ -28,11 +28,10 @@ from pathlib import Path
 
 from .._read_options import FIELDS, ReadOptions
 from ..errors import InputError
-from ..io import training_reading  # the rule fit and select store by
 from ._common import given_read_options, read_options
 
 __all__ = ["TRAINED_NOTE", "add_trained_note", "estimate_names", "options_as_trained",
-           "output_names", "remembered_options", "stream_args", "training_reading"]
+           "output_names", "remembered_options", "stream_args"]
 
 _HEAD_BYTES = 1 << 16  # as io._csv_layout: the header must end within it
 

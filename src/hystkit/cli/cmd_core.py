@@ -8,7 +8,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from ..io import training_units
+from ..io import training_reading, training_units
 from ._common import (
     GUARD_EXIT,
     UsageError,
@@ -41,7 +41,6 @@ from ._own_layout import (
     estimate_names,
     options_as_trained,
     output_names,
-    training_reading,
 )
 from .cmd_preprocess import add_simulation_options, run_raw_simulation, sensor_from_args
 

@@ -19,7 +19,6 @@ from ._common import (
     say_next,
 )
 from ._guided_fit import selection_status
-from ._own_layout import training_reading
 from .cmd_compare import _models, add_parallel_options, executor_for
 
 __all__ = ["register"]
@@ -47,6 +46,7 @@ def _select(args: argparse.Namespace) -> int:
         check_output_folder,
         check_output_path,
         read_recording,
+        training_reading,
         write_json,
     )
     from ..parallel import loading_meanwhile
