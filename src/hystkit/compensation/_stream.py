@@ -48,6 +48,8 @@ from ._compensator import (
     runaway_kind,
     runaway_samples,
 )
+from ._stream_kernel import Engine
+from ._stream_state import StreamState
 from ._sync import sync_excitation
 
 __all__ = ["StartUp", "StepOutput", "Stream", "StreamOutput", "StreamState", "advance",
@@ -56,42 +58,6 @@ __all__ = ["StartUp", "StepOutput", "Stream", "StreamOutput", "StreamState", "ad
 StartUp = str | np.ndarray
 # Samples of the signal on which a stream checks its compiled kernel against the Python path.
 PROBE_SAMPLES = 256
-
-
-@dataclass(frozen=True, eq=False)
-class StreamState:
-    """Everything a stream remembers between samples.
-
-    Parameters
-    ----------
-    x : array or None
-        The model's state vector (for an inverse compensator its forward model's, which every
-        family's ``invert`` carries); None before the first sample of a stream that starts at
-        rest (the rest state depends on that sample).
-    n_samples : int, default 0
-        Samples processed so far (the next sample's index).
-    tare_sum : float, default 0.0
-        Sum of the sensor samples [sensor units] inside the tare window so far (``tare``).
-    track_value : float, default 0.0
-        Last output of the tracker's un-normalised low-pass [sensor units] (``track``).
-    track_weight : float, default 0.0
-        Last output of the same low-pass run on ones: its weight sum (``track``).
-    band : BandState, default BandState()
-        What the prediction band's local scale remembers (:mod:`._band`).
-    """
-
-    x: np.ndarray | None
-    n_samples: int = 0
-    tare_sum: float = 0.0
-    track_value: float = 0.0
-    track_weight: float = 0.0
-    band: BandState = field(default_factory=BandState)
-
-    def __post_init__(self) -> None:
-        if self.x is not None:
-            x = np.array(self.x, dtype=np.float64)
-            x.flags.writeable = False
-            object.__setattr__(self, "x", x)
 
 
 class StreamOutput(NamedTuple):
@@ -486,7 +452,6 @@ def compiled_engine(path: _Path):
     """The compiled kernel's engine for `path` (:mod:`._stream_kernel`), or None when the
     family has no compiled block or its block does not give the Python path's bits on a probe
     signal (then every sample takes the Python path)."""
-    from ._stream_kernel import Engine
 
     try:
         engine = Engine(path)

@@ -19,8 +19,9 @@ import numpy as np
 
 from .._closure_cache import compile_closure
 from ..io import MAX_MAGNITUDE
-from ._band import feature_decay, feature_range, feature_step, position_width
+from ._band import BandState, feature_decay, feature_range, feature_step, position_width
 from ._compensator import MAX_NORMALISED
+from ._stream_state import StreamState
 
 __all__ = ["Engine"]
 
@@ -166,16 +167,14 @@ class Engine:
         self._one_out = np.zeros((5, 1))
 
     def load(self, state) -> None:
-        """Take `state` (a :class:`~._stream.StreamState` with a model state) as the present."""
+        """Take `state` (a :class:`~._stream_state.StreamState` with a model state) as the present."""
         self.x[:] = state.x
         band = state.band
         self.mem[:] = (state.n_samples, state.tare_sum, state.track_value, state.track_weight,
                        float(band.started), band.previous, band.rate, band.outside)
 
     def state(self):
-        """The present state as a :class:`~._stream.StreamState`."""
-        from ._band import BandState
-        from ._stream import StreamState
+        """The present state as a :class:`~._stream_state.StreamState`."""
 
         m = self.mem.tolist()
         return StreamState(self.x.copy(), int(m[M_N_SAMPLES]), m[M_TARE_SUM], m[M_TRACK_VALUE],
