@@ -315,7 +315,9 @@ def propose(x, h_h, diag_h, g_h, eig, vecs, sg, d, delta, alpha, lb, ub, theta):
     part, its reflection off the first bound hit, and the scaled gradient (scipy's
     ``select_step``); ``x_new`` is made strictly feasible as in scipy. One kernel, not a
     call of a ``select_step`` kernel: numba emits a kernel's callees again into each caller,
-    so every level of calls costs compile time (issue 29).
+    so every level of calls costs compile time (issue 29). Not split either (the selection
+    compiled only when a step leaves the box): the default mPL fit's steps do leave it, and
+    the two kernels took 2.8 s to compile against this one's 2.4 s.
     """
     p_h, alpha = _trust_region_step(eig, vecs, sg, delta, alpha)
     p = _times(d, p_h)
