@@ -58,6 +58,17 @@ if __name__ == "__main__":
 
 import numba
 import numpy as np
+from _c_build import (
+    ARR,
+    FAST_FLAGS,
+    MPL_ARGS,
+    PL_ARGS,
+    SLOW_FLAGS,
+    SLOW_SOURCE,
+    build_fast_reference,
+    compile_shared,
+    function,
+)
 
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.models.mpl import kernels as mpl_kernels
@@ -67,10 +78,6 @@ from hystkit.models.pl import model as pl
 from hystkit.sensors import simulate_experiment
 
 HERE = Path(__file__).parent
-# -fno-math-errno changes no value (exp and pow only stop setting errno), but lets the compiler
-# treat them as pure: the 5-cell mPL ran 18 % faster with it (24.6 -> 20.1 ns/sample, same bits)
-FAST_FLAGS = ("-O3", "-march=native", "-fno-math-errno", "-shared", "-fPIC")
-SLOW_FLAGS = ("-O2", "-shared", "-fPIC")  # as bench_mpl.py builds _c_reference.c
 CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2))
 SIZES = (8000, 100_000)
 ROUNDS = {8000: 101, 100_000: 31}
@@ -79,12 +86,6 @@ COLUMNS = ("fast C", "C no guard", "slow C", "simulate", "export")
 # CPU time first: on a shared machine a call longer than the scheduler's slice (~2 ms here)
 # waits for the other processes, which wall time counts and CPU time does not.
 CLOCKS = {"cpu": "CPU time (thread)", "wall": "wall time"}
-
-_ARR = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
-_I64, _DBL = ctypes.c_int64, ctypes.c_double
-_MPL_ARGS = [_ARR, _I64, _ARR, _I64, _ARR, _ARR, _ARR, _DBL, _ARR, _DBL, _DBL, _ARR]
-_PL_ARGS = [_ARR, _I64, _ARR, _I64, _DBL, _ARR, _ARR, _DBL, _DBL, _DBL, _ARR, _DBL, _ARR, _I64,
-            _ARR, _ARR]
 
 # Calls the exported model's static model_rest / model_step: the generated file is included.
 _EXPORT_DRIVER = r"""#include <stdint.h>
@@ -96,19 +97,6 @@ void export_run(const double *u, int64_t n, double *y)
     for (int64_t i = 0; i < n; ++i) y[i] = model_step(x, u[i]);
 }}
 """
-
-
-def _compile(cc: str, flags, source: Path, out: Path, include: Path | None = None) -> ctypes.CDLL:
-    extra = ["-I", str(include)] if include else []
-    subprocess.run([cc, *flags, *extra, "-o", str(out), str(source), "-lm"], check=True,
-                   capture_output=True, text=True)
-    return ctypes.CDLL(str(out))
-
-
-def _function(lib: ctypes.CDLL, name: str, argtypes) -> ctypes._CFuncPtr:
-    fn = getattr(lib, name)
-    fn.argtypes, fn.restype = argtypes, None
-    return fn
 
 
 @dataclass
@@ -147,9 +135,9 @@ def _mpl_columns(comp, fast, slow) -> dict:
             return y
         return run
 
-    return {"fast C": c_run(_function(fast, "mpl_fast", _MPL_ARGS)),
-            "C no guard": c_run(_function(fast, "mpl_fast_unguarded", _MPL_ARGS)),
-            "slow C": c_run(_function(slow, "mpl_simulate", _MPL_ARGS))}
+    return {"fast C": c_run(function(fast, "mpl_fast", MPL_ARGS)),
+            "C no guard": c_run(function(fast, "mpl_fast_unguarded", MPL_ARGS)),
+            "slow C": c_run(function(slow, "mpl_simulate", MPL_ARGS))}
 
 
 def _pl_columns(comp, fast) -> dict:
@@ -157,7 +145,7 @@ def _pl_columns(comp, fast) -> dict:
     i_t, thr, knee, power, g_lin, dt = pl.kernel_args(s, p)
     brk = pl.basis_breakpoints(s.n_basis)
     a = np.ascontiguousarray(p.a, dtype=float)
-    fn = _function(fast, "pl_fast", _PL_ARGS)
+    fn = function(fast, "pl_fast", PL_ARGS)
 
     def run(u):
         x, y = np.full(s.n_cells, u[0]), np.empty(u.size)
@@ -178,8 +166,8 @@ def _export_column(comp, label: str, cc: str, tmp: Path):
                     "--name", name, "--out", str(folder)], check=True, capture_output=True)
     driver = folder / "bench_driver.c"
     driver.write_text(_EXPORT_DRIVER.format(name=name))
-    lib = _compile(cc, FAST_FLAGS, driver, folder / "driver.so", include=folder)
-    fn = _function(lib, "export_run", [_ARR, _I64, _ARR])
+    lib = compile_shared(cc, FAST_FLAGS, driver, folder / "driver.so", include=folder)
+    fn = function(lib, "export_run", [ARR, ctypes.c_int64, ARR])
 
     def run(u):
         y = np.empty(u.size)
@@ -227,8 +215,8 @@ def _pl_kernel_columns(comp, current, before, rev: str) -> dict:
 
 
 def build_cases(cc: str, tmp: Path, before_rev: str | None = None) -> list[Case]:
-    fast = _compile(cc, FAST_FLAGS, HERE / "_c_fast_reference.c", tmp / "fast.so")
-    slow = _compile(cc, SLOW_FLAGS, HERE / "_c_reference.c", tmp / "slow.so")
+    fast = build_fast_reference(cc, tmp)
+    slow = compile_shared(cc, SLOW_FLAGS, SLOW_SOURCE, tmp / "slow.so")
     fit_rec = simulate_experiment("sine", 1)
     before = load_kernels_at(before_rev, tmp) if before_rev else None
     pl_before = load_kernels_at(before_rev, tmp, "pl") if before_rev else None

@@ -27,6 +27,9 @@ trust-region reflective on one-pass normal equations) with the previous one (``s
 ``scipy.optimize.least_squares`` on the dense exact Jacobian), interleaved A B A B, with the
 medians, their ratio and both final SSEs. Reference for N = 1: ``least_squares`` with a
 finite-difference ('2-point') Jacobian from the same first start.
+The same fits are also given in simulations' worth of the fast C reference
+(``_c_fast_reference.c``'s ``mpl_fast`` at ``-O3 -march=native``, built by ``_c_build.py`` as
+``bench_kernels.py`` builds it), timed interleaved with every ``mpl.simulate`` call (issue 29.5).
 
 BLAS: unless OPENBLAS_NUM_THREADS is already set, this script sets it to 1 before numpy loads.
 The trf path's linear algebra (scipy's SVD in least_squares) is on n x <= 17 matrices, too small
@@ -56,6 +59,7 @@ if __name__ == "__main__":
 import numba
 import numpy as np
 import scipy
+from _c_build import FAST_FLAGS, SLOW_FLAGS, SLOW_SOURCE, fast_mpl
 from scipy.optimize import least_squares
 
 import hystkit
@@ -77,8 +81,8 @@ SIM_TIMING_REPEATS = 7
 FIT_ONLY = "--fit-only" in sys.argv
 QUICK = "--quick" in sys.argv
 FIT_SEED = 1  # the demo report's fitting seed (hystkit.reports._demo.FIT_SEED)
-C_FLAGS = ("-O2", "-shared", "-fPIC")
-C_SOURCE = Path(__file__).with_name("_c_reference.c")
+C_FLAGS = SLOW_FLAGS
+C_SOURCE = SLOW_SOURCE
 
 
 # ----------------------------------------------------------------------------- machine
@@ -381,16 +385,23 @@ def summarise(runs: list[dict]) -> dict:
     return out
 
 
-def simulate_seconds(structure: mpl.MplStructure, params: mpl.MplParams,
-                     u: np.ndarray) -> list[tuple[float, float]]:
+def simulate_seconds(structure: mpl.MplStructure, params: mpl.MplParams, u: np.ndarray,
+                     fast_c=None) -> dict[str, list[tuple[float, float]]]:
     """(wall, CPU) seconds of ``SIM_TIMING_REPEATS`` compiled ``mpl.simulate`` calls (wrapper
-    included) over ``u``, after one untimed call."""
-    mpl.simulate(structure, params, u)
-    times = []
+    included) over ``u``, after one untimed call: ``{"sim": [...]}``; with ``fast_c`` (the fast
+    C reference's ``mpl_fast``) also ``"fast"``, the same run in it, interleaved A B A B."""
+    args = kernel_args(structure, params, u)
+    calls = {"sim": lambda: mpl.simulate(structure, params, u)}
+    if fast_c is not None:
+        calls["fast"] = lambda: c_simulate(fast_c, *args)
+    times: dict[str, list[tuple[float, float]]] = {name: [] for name in calls}
+    for call in calls.values():
+        call()
     for _ in range(SIM_TIMING_REPEATS):
-        t0, c0 = time.perf_counter(), time.process_time()
-        mpl.simulate(structure, params, u)
-        times.append((time.perf_counter() - t0, time.process_time() - c0))
+        for name, call in calls.items():
+            t0, c0 = time.perf_counter(), time.process_time()
+            call()
+            times[name].append((time.perf_counter() - t0, time.process_time() - c0))
     return times
 
 
@@ -399,35 +410,47 @@ def fit_line(label: str, r: dict) -> str:
             f"{r['cost']:10.4f} {r['runs']:>6} {'yes' if r['converged'] else 'no':>5}")
 
 
-def solver_row(n_cells: int, n_samples: int, u: np.ndarray, y: np.ndarray, dt: float) -> dict:
-    """Interleaved tr / trf fits and the simulate time of the same data, in one row."""
+def solver_row(n_cells: int, n_samples: int, u: np.ndarray, y: np.ndarray, dt: float,
+               fast_c=None) -> dict:
+    """Interleaved tr / trf fits and the simulate (and fast C) time of the same data, in one
+    row."""
     structure = mpl.MplStructure(n_cells=n_cells, dt=dt)
     runs: dict[str, list] = {"tr": [], "trf": []}
-    sim = []
+    sims: dict[str, list] = {"sim": [], "fast": []}
     for _ in range(FIT_REPEATS[n_samples]):
         for solver in ("tr", "trf"):
             runs[solver].append(hystkit_fit(u, y, structure, solver=solver))
             # after each fit, so that the denominator samples the load as the fits met it
-            sim += simulate_seconds(structure, runs["tr"][-1]["params"], u)
+            for name, times in simulate_seconds(structure, runs["tr"][-1]["params"], u,
+                                                fast_c).items():
+                sims[name] += times
     row = {solver: summarise(r) for solver, r in runs.items()}
-    row.update(n=n_cells, size=n_samples, sim=statistics.median(w for w, _ in sim),
-               sim_cpu=statistics.median(c for _, c in sim))
+    row.update(n=n_cells, size=n_samples)
+    for name, times in sims.items():
+        if times:
+            row[name] = statistics.median(w for w, _ in times)
+            row[f"{name}_cpu"] = statistics.median(c for _, c in times)
     return row
 
 
 def print_solver_row(r: dict) -> None:
     new, old, sim, sim_cpu = r["tr"], r["trf"], r["sim"], r["sim_cpu"]
+    fast, fast_cpu = r.get("fast"), r.get("fast_cpu")
 
     def part(f: dict) -> str:
+        in_fast = (f"{f['seconds'] / fast:6.0f} {f['cpu'] / fast_cpu:6.0f}" if fast
+                   else f"{'-':>6} {'-':>6}")
         return (f"{f['seconds']:7.3f} {f['seconds'] / sim:6.0f} {f['cpu'] / sim_cpu:6.0f} "
-                f"{f['cost']:11.6f} {f['runs']:>5} {'yes' if f['converged'] else 'no':>4}")
+                f"{in_fast} {f['cost']:11.6f} {f['runs']:>5} "
+                f"{'yes' if f['converged'] else 'no':>4}")
 
-    print(f"  {r['n']:>2} {r['size']:>7} {sim * 1e3:7.2f} | {part(new)} | {part(old)} | "
-          f"{old['seconds'] / new['seconds']:5.2f} {old['cpu'] / new['cpu']:5.2f} "
+    fast_ms = f"{fast * 1e3:7.2f}" if fast else f"{'-':>7}"
+    print(f"  {r['n']:>2} {r['size']:>7} {sim * 1e3:7.2f} {fast_ms} | {part(new)} | "
+          f"{part(old)} | {old['seconds'] / new['seconds']:5.2f} {old['cpu'] / new['cpu']:5.2f} "
           f"{abs(new['cost'] - old['cost']) / old['cost']:8.1e}", flush=True)
 
 
-def print_fit_table() -> None:
+def print_fit_table(fast_c=None) -> None:
     u8, y8, dt = fit_data()
     # Warm-up outside the timed runs: the first call of each path pays the kernel load.
     for solver in ("tr", "trf"):
@@ -443,16 +466,19 @@ def print_fit_table() -> None:
           "Jacobian evaluations, one kernel run each pair); cost = SSE (eq. 5.9)")
     print("  sims = fit / simulate by wall time; cpu = the same by process CPU time "
           "(time.process_time), which a loaded machine distorts far less")
-    head = (f"  {'N':>2} {'samples':>7} {'sim ms':>7} | {'tr s':>7} {'sims':>6} {'cpu':>6} "
-            f"{'tr cost':>11} {'runs':>5} {'conv':>4} | {'trf s':>7} {'sims':>6} {'cpu':>6} "
-            f"{'trf cost':>11} {'runs':>5} {'conv':>4} | {'trf/tr':>5} {'cpu':>5} "
-            f"{'|dcost|':>8}")
+    print(f"  C ms = the fast C reference (_c_fast_reference.c, cc {' '.join(FAST_FLAGS)}), "
+          f"timed interleaved with each simulate call; Csims / Ccpu = fit / fast C by wall / "
+          f"CPU time (issue 29.5: <= 100 at 1 cell, <= 300 at 3 cells, 8000 samples)")
+    head = (f"  {'N':>2} {'samples':>7} {'sim ms':>7} {'C ms':>7} | {'tr s':>7} {'sims':>6} "
+            f"{'cpu':>6} {'Csims':>6} {'Ccpu':>6} {'tr cost':>11} {'runs':>5} {'conv':>4} | "
+            f"{'trf s':>7} {'sims':>6} {'cpu':>6} {'Csims':>6} {'Ccpu':>6} {'trf cost':>11} "
+            f"{'runs':>5} {'conv':>4} | {'trf/tr':>5} {'cpu':>5} {'|dcost|':>8}")
     print(head)
     print("  " + "-" * (len(head) - 2))
     for size in FIT_SIZES:
         u, y, _ = (u8, y8, dt) if size == u8.size else fit_data(size)
         for n in FIT_CELLS[:1] if QUICK and size != u8.size else FIT_CELLS:
-            print_solver_row(solver_row(n, size, u, y, dt))
+            print_solver_row(solver_row(n, size, u, y, dt, fast_c))
     print("  trf/tr = ratio of median wall times (cpu: of median CPU times); "
           "|dcost| = |SSE_tr - SSE_trf| / SSE_trf")
     print()
@@ -493,7 +519,7 @@ def main() -> int:
         if not FIT_ONLY:
             print_compile_costs(c_seconds)
             print_simulation_table(c_func, cc)
-    print_fit_table()
+        print_fit_table(fast_mpl(cc, Path(workdir)) if cc else None)
     print(f"Total benchmark time {time.perf_counter() - t_total:.1f} s")
     return 0
 
