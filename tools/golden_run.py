@@ -416,8 +416,26 @@ def _no_recipes(recorder: Recorder, subcommands: list[str]) -> None:
 # --------------------------------------------------------------------------------- compare
 
 
-def compare(a: Path, b: Path, commands: set[str] | None, lines: int) -> bool:
-    """Print per command: same, or differs with the first differing lines; True if all same."""
+_NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
+
+
+def same_within(text_a: str, text_b: str, rtol: float) -> bool:
+    """Whether two texts are the same but for numbers that agree to `rtol` relative (the words,
+    the punctuation and the count of numbers the same): rounding-level changes of a kernel, a
+    fit that ends a few ulps elsewhere. Integers are compared the same way."""
+    if _NUMBER.sub("#", text_a) != _NUMBER.sub("#", text_b):
+        return False
+    for x, y in zip(_NUMBER.findall(text_a), _NUMBER.findall(text_b), strict=True):
+        u, v = float(x), float(y)
+        if abs(u - v) > rtol * max(abs(u), abs(v)):
+            return False
+    return True
+
+
+def compare(a: Path, b: Path, commands: set[str] | None, lines: int,
+            rtol: float = 0.0) -> bool:
+    """Print per command: same, or differs with the first differing lines; True if all same.
+    With `rtol`, files whose numbers agree to it count as the same (said per command)."""
     golden_a, golden_b = a / "golden", b / "golden"
     names = sorted({p.name for p in golden_a.iterdir()} | {p.name for p in golden_b.iterdir()})
     all_same = True
@@ -426,21 +444,25 @@ def compare(a: Path, b: Path, commands: set[str] | None, lines: int) -> bool:
             continue
         files_a = _files(golden_a / command)
         files_b = _files(golden_b / command)
-        differing = []
+        differing, close = [], 0
         for rel in sorted(set(files_a) | set(files_b)):
             if rel not in files_a or rel not in files_b:
                 differing.append((rel, [f"only in {'B' if rel in files_b else 'A'}"]))
+            elif rtol and files_a[rel] != files_b[rel] and same_within(files_a[rel],
+                                                                        files_b[rel], rtol):
+                close += 1
             elif files_a[rel] != files_b[rel]:
                 diff = difflib.unified_diff(files_a[rel].splitlines(), files_b[rel].splitlines(),
                                             "A", "B", n=0, lineterm="")
                 differing.append((rel, [d for d in diff if not d.startswith(("---", "+++"))]))
+        within = f", {close} of them only within rtol {rtol:g}" if close else ""
         if not differing:
-            print(f"{command}: same ({len(files_a)} files)")
+            print(f"{command}: same ({len(files_a)} files{within})")
             continue
         all_same = False
         steps = sorted({rel.split("/")[0] for rel, _ in differing})
         print(f"{command}: differs in {len(differing)} of {len(set(files_a) | set(files_b))} "
-              f"files (steps: {', '.join(steps)})")
+              f"files (steps: {', '.join(steps)}){within}")
         for rel, diff in differing:
             print(f"  {rel}")
             for line in diff[:lines]:
@@ -473,6 +495,9 @@ def main() -> int:
     cmp.add_argument("b", type=Path)
     cmp.add_argument("--commands", help="comma-separated commands to compare (default: all)")
     cmp.add_argument("--lines", type=int, default=6, help="diff lines shown per file")
+    cmp.add_argument("--rtol", type=float, default=0.0,
+                     help="count files whose numbers agree to this relative tolerance as the "
+                          "same (default 0: exact)")
     again = sub.add_parser("normalise", help="rebuild OUT/golden (after changing the rules)")
     again.add_argument("out", type=Path)
     args = parser.parse_args()
@@ -488,7 +513,7 @@ def main() -> int:
         return 0
     if args.action == "compare":
         commands = set(args.commands.split(",")) if args.commands else None
-        return 0 if compare(args.a, args.b, commands, args.lines) else 1
+        return 0 if compare(args.a, args.b, commands, args.lines, args.rtol) else 1
     out = args.out.resolve()
     if out.exists():
         if not args.force:
