@@ -158,14 +158,16 @@ def cell_sensitivity_step(v, inv_vt, two_i_s_dt, two_i_s, g, knee, c0, f_knee, d
 
 @njit(cache=True)
 def knee_constants(i_s, v_t, knee, cap):
-    """Per cell ``2 I_S``, ``G = 2 I_S / V_T``, ``f(knee)`` and ``f(knee) - knee cap``."""
-    two_i_s = 2.0 * i_s
-    g = 2.0 * i_s / v_t
-    f_knee = np.zeros(i_s.size)
-    for k in range(i_s.size):
-        if knee[k] < np.inf:
-            f_knee[k] = 2.0 * i_s[k] * np.sinh(knee[k] / v_t[k])
-    return two_i_s, g, f_knee, f_knee - knee * cap
+    """Per cell ``2 I_S``, ``G = 2 I_S / V_T``, ``f(knee)`` and ``f(knee) - knee cap`` (one loop:
+    numba compiles it in half the time of the same array expressions, issue 29)."""
+    n = i_s.size
+    two_i_s, g, f_knee, dvt_knee = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    for k in range(n):
+        two_i_s[k] = 2.0 * i_s[k]
+        g[k] = 2.0 * i_s[k] / v_t[k]
+        f_knee[k] = 2.0 * i_s[k] * np.sinh(knee[k] / v_t[k]) if knee[k] < np.inf else 0.0
+        dvt_knee[k] = f_knee[k] - knee[k] * cap
+    return two_i_s, g, f_knee, dvt_knee
 
 
 @njit(cache=True)
@@ -322,24 +324,38 @@ def normal_equations(u, y_target, x0, i_s, v_t, w, v_b, knee, cap, dt):
 
 
 @njit(cache=True)
-def theta_normal_equations(u, y_target, x0, theta, slope_cap, dt):
-    """:func:`normal_equations` at optimiser coordinates ``theta`` (``MplParams.to_vector``).
-
-    ``MplParams.from_vector`` and ``model.knee_voltage`` in the same arithmetic, without
-    their validation (the fit's bounds keep ``theta`` in the domain): as NumPy calls they cost
-    a tenth of a pass on short recordings, and a fit makes hundreds.
-    """
-    n_cells = x0.size
-    v_t = np.exp(theta[1: 2 * n_cells: 2])
-    i_s = 0.5 * np.exp(theta[0: 2 * n_cells: 2]) * v_t
-    ratio = slope_cap / (dt * (2 * i_s / v_t))
-    knee = np.zeros(n_cells)
+def theta_cells(theta, slope_cap, dt):
+    """Rows ``i_s``, ``v_t`` and a third array ``knee`` of the cells at optimiser coordinates
+    ``theta`` (``MplParams.to_vector``): ``MplParams.from_vector`` and ``model.knee_voltage``
+    in the same arithmetic, without their validation (the fit's bounds keep ``theta`` in the
+    domain)."""
+    n_cells = (theta.size - 2) // 3
+    resistors, knee = np.empty((2, n_cells)), np.empty(n_cells)
     for k in range(n_cells):
-        if ratio[k] > 1:
-            knee[k] = v_t[k] * np.arccosh(ratio[k])
-    w = theta[2 * n_cells: 3 * n_cells + 1].copy()
-    return normal_equations(u, y_target, x0, i_s, v_t, w, theta[3 * n_cells + 1], knee,
-                            slope_cap / dt, dt)
+        v_t = np.exp(theta[2 * k + 1])
+        i_s = 0.5 * np.exp(theta[2 * k]) * v_t
+        ratio = slope_cap / (dt * (2 * i_s / v_t))
+        knee[k] = v_t * np.arccosh(ratio) if ratio > 1 else 0.0
+        resistors[0, k], resistors[1, k] = i_s, v_t
+    return resistors, knee
+
+
+def theta_normal_equations(u, y_target, x0, theta, slope_cap, dt):
+    """:func:`normal_equations` at optimiser coordinates ``theta`` (:func:`theta_cells`; as
+    NumPy calls the unpacking costs a tenth of a pass on short recordings, and a fit makes
+    hundreds).
+
+    Not a compiled caller of :func:`normal_equations`: numba would compile that pass a second
+    time into it (~1.5 s of a cold first fit, issue 29). ``i_s``, ``v_t`` and ``w`` are passed
+    read-only, as ``MplParams``' are, so that the fit's linear start and its passes share one
+    specialisation of :func:`normal_equations`.
+    """
+    resistors, knee = theta_cells(theta, slope_cap, dt)
+    n_cells = knee.size
+    w = theta[2 * n_cells: 3 * n_cells + 1]
+    resistors.flags.writeable = w.flags.writeable = False  # views: theta stays writeable
+    return normal_equations(u, y_target, x0, resistors[0], resistors[1], w,
+                            theta[3 * n_cells + 1], knee, slope_cap / dt, dt)
 
 
 # Loop blocks (protocol in ``hystkit.models._protocol``): body = [n, v_b, cap, dt,
