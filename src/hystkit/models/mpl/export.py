@@ -17,7 +17,7 @@ def extra(comp) -> dict:
     return {"W_SUM": float(np.sum(comp.params.w))}
 
 
-def _cell_constants_c(plan, lit: Callable[[float], str]) -> str:
+def _cell_constants_c(plan, lit: Callable[[float], str], i_s_at: int) -> str:
     """The per-cell constants of ``kernels.cell_constants`` (1 / V_T, 2 I_S dt, the straight
     branch's offset c0) and cap dt, computed here by the kernel itself, so the exported step
     does per sample exactly what ``kernels.simulate`` does (bit for bit in double)."""
@@ -25,7 +25,7 @@ def _cell_constants_c(plan, lit: Callable[[float], str]) -> str:
 
     n = int(plan.body[0])
     cap, dt = float(plan.body[2]), float(plan.body[3])
-    i_s, v_t, knee = (np.ascontiguousarray(plan.body[4 + j * n:4 + (j + 1) * n])
+    i_s, v_t, knee = (np.ascontiguousarray(plan.body[i_s_at + j * n:i_s_at + (j + 1) * n])
                       for j in range(3))
     inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
     rows = [("INV_VT", inv_vt), ("TWO_IS_DT", two_i_s_dt), ("C0", c0)]
@@ -39,27 +39,15 @@ _SERIES = (1.0 / 6.0, 1.0 / 120.0, 1.0 / 5040.0, 1.0 / 362880.0, 1.0 / 39916800.
            1.0 / 6227020800.0, 1.0 / 1307674368000.0)
 
 
-def c_model(plan, lit: Callable[[float], str]) -> str:
-    n = int(plan.body[0])
-    w_sum = plan.extra["W_SUM"]
-    rest = ("x[k] = value;" if not plan.inverse else  # mpl.invert's start
-            f"x[k] = (value + BODY[1]) / {lit(w_sum)};" if w_sum != 0 else "x[k] = R(0.0);")
-    if plan.inverse:
-        head = """    real acc = u + BODY[1];
-    for (k = 0; k < N_CELLS; k++) acc -= BODY[IW + 1 + k] * x[k];
-    drive = acc / BODY[IW];"""
-    else:
-        head = """    real acc = BODY[IW] * u - BODY[1];
-    for (k = 0; k < N_CELLS; k++) acc += BODY[IW + 1 + k] * x[k];
-    drive = u;"""
-    out = "drive" if plan.inverse else "acc"
+def c_cells(plan, lit: Callable[[float], str], i_s_at: int) -> str:
+    """C of the cells' update, ``static real cell_increment(real v, int k)`` (``f(v) dt`` of
+    cell ``k``, ``kernels.cell_increment``) and the constants it reads, for any family whose
+    body is ``[n, v_b, cap, dt, ...]`` with ``i_s (n), v_t (n), knee (n)`` from ``BODY[i_s_at]``
+    on and ``N_CELLS`` defined: mPL and mpl-g advance their cells with this code."""
     c = [lit(v) for v in _SERIES]
-    return f"""#define N_CELLS {n}
-#define IW (4 + 3 * N_CELLS)
-
-/* Per cell, fixed at export (kernels.cell_constants): 1 / V_T, 2 I_S dt and c0 = (f(knee) -
+    return f"""/* Per cell, fixed at export (kernels.cell_constants): 1 / V_T, 2 I_S dt and c0 = (f(knee) -
  * cap knee) dt, the straight branch beyond the knee being f dt = s c0 + cap dt v. */
-{_cell_constants_c(plan, lit)}
+{_cell_constants_c(plan, lit, i_s_at)}
 /* sinh(a) from one exp (kernels.sinh_cosh): (e - 1/e) / 2, and below |a| = 0.5, where that
  * cancels, the series a (1 + a^2 / 3! + ... + a^14 / 15!) (kernels.sinh_series) */
 static real sinh_one_exp(real a)
@@ -82,11 +70,31 @@ static real sinh_one_exp(real a)
 /* f(v) dt of the limited sinh resistor (eq. 5.1 with eq. 5.29): kernels.cell_increment */
 static real cell_increment(real v, int k)
 {{
-    const real knee = BODY[4 + 2 * N_CELLS + k];
+    const real knee = BODY[{i_s_at} + 2 * N_CELLS + k];
     if (FABS(v) <= knee) return TWO_IS_DT[k] * sinh_one_exp(v * INV_VT[k]);
     return (v > R(0.0) ? C0[k] : -C0[k]) + CAP_DT * v;
 }}
+"""
 
+
+def c_model(plan, lit: Callable[[float], str]) -> str:
+    n = int(plan.body[0])
+    w_sum = plan.extra["W_SUM"]
+    rest = ("x[k] = value;" if not plan.inverse else  # mpl.invert's start
+            f"x[k] = (value + BODY[1]) / {lit(w_sum)};" if w_sum != 0 else "x[k] = R(0.0);")
+    if plan.inverse:
+        head = """    real acc = u + BODY[1];
+    for (k = 0; k < N_CELLS; k++) acc -= BODY[IW + 1 + k] * x[k];
+    drive = acc / BODY[IW];"""
+    else:
+        head = """    real acc = BODY[IW] * u - BODY[1];
+    for (k = 0; k < N_CELLS; k++) acc += BODY[IW + 1 + k] * x[k];
+    drive = u;"""
+    out = "drive" if plan.inverse else "acc"
+    return f"""#define N_CELLS {n}
+#define IW (4 + 3 * N_CELLS)
+
+{c_cells(plan, lit, 4)}
 static void model_rest(real *x, real value)
 {{
     int k;

@@ -1,6 +1,8 @@
 """The ch. 7 compensator (``models/mpl_g/kernels.py``): ``block_forward`` / ``block_inverse``
-and the rest state (``model.rest_state``). The sinh cells follow the mPL's translation, the
-inverse of the cubic output resistor is the mpl-poly's (``solve_output``, same body head).
+and the rest state (``model.rest_state``). The sinh cells are the mPL's exported code
+(``mpl.export.c_cells``: per-cell constants fixed at export, one exp per cell, bit for bit
+``mpl.kernels.cell_increment`` in double), the inverse of the cubic output resistor is the
+mpl-poly's (``solve_output``, same body head).
 
 Body: ``[n, v_b, cap, dt, 1, lo, hi, sign, centre, g0..g3, i_s (n), v_t (n), knee (n),
 w (n + 1)]``.
@@ -14,6 +16,9 @@ import numpy as np
 
 from .._cubic_output_code import C_SOLVE, M_CUBIC, M_SOLVE
 from .._protocol import Translation
+from ..mpl.export import c_cells
+
+_IC = 13  # body index of i_s (the C's IC, the MATLAB's ic)
 
 
 def extra(comp) -> dict:
@@ -33,7 +38,7 @@ def c_model(plan, lit: Callable[[float], str]) -> str:
         rest = "    const real e0 = R(0.0);\n    (void)value;\n"
     return f"""#define N_CELLS {n}
 #define IG 9
-#define IC 13
+#define IC {_IC}
 #define IW (IC + 3 * N_CELLS)
 
 /* g0 + g1 z + g2 z^2 + g3 z^3 and its slope (eq. 5.16-5.17): kernels._output */
@@ -43,21 +48,12 @@ static real cubic(const real *c, real x, real *slope)
     return c[0] + x * (c[1] + x * (c[2] + x * c[3]));
 }}
 
-/* Limited sinh resistor current (eq. 5.1 with eq. 5.29): mpl.kernels.current */
-static real current(real v, int k)
-{{
-    const real i_s = BODY[IC + k], v_t = BODY[IC + N_CELLS + k];
-    const real knee = BODY[IC + 2 * N_CELLS + k], cap = BODY[2];
-    real s;
-    if (FABS(v) <= knee) return R(2.0) * i_s * SINH(v / v_t);
-    s = v > R(0.0) ? R(1.0) : R(-1.0);
-    return s * R(2.0) * i_s * SINH(knee / v_t) + cap * (v - s * knee);
-}}
-
+{c_cells(plan, lit, _IC)}
+/* the cells driven by drive (eq. 5.6), as kernels.simulate / invert advance them */
 static void cells(real *x, real drive)
 {{
     int k;
-    for (k = 0; k < N_CELLS; k++) x[k] = x[k] + current(drive - x[k], k) * BODY[3];
+    for (k = 0; k < N_CELLS; k++) x[k] = x[k] + cell_increment(drive - x[k], k);
 }}
 {C_SOLVE if plan.inverse else ""}
 static void model_rest(real *x, real value)
