@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from hystkit.cli._common import GUARD_EXIT
-from hystkit.io import write_recording
+from hystkit.io import read_recording, write_recording
 
 from ..cli_support import run_cli
 from ..compensation.test_verdict_corpus import data  # noqa: F401 (the labelled corpus)
@@ -143,3 +143,20 @@ def test_a_partly_failed_comparison_names_what_to_try(broken_chua, tmp_path, cap
     assert code == GUARD_EXIT and "1 model(s) failed: mpl-poly" in err
     assert _next(out).startswith("next: try one failed family alone, 'hystkit fit DATA "
                                  "--model NAME")
+
+
+def test_data_far_outside_the_training_range_ask_for_a_refit_whatever_the_score(
+        data, tmp_path, capsys):  # noqa: F811
+    """A run at eight times the training amplitude: the model loses to its straight line
+    there, but the reason is that the data left the range it learnt, so the next step is data
+    that cover it (not the columns, which are right)."""
+    assert _fit(capsys, data, tmp_path, "sine1", "--model", "mpl")[0] == 0
+    sine2 = read_recording(data["sine2"])
+    big = tmp_path / "big.csv"
+    write_recording(replace(sine2, sensor=8 * sine2.sensor, position=8 * sine2.position), big)
+    scores = tmp_path / "scores.json"
+    code, out, _ = run_cli(capsys, "evaluate", tmp_path / "model.json", big, "--json", scores)
+    assert code == GUARD_EXIT
+    assert json.loads(scores.read_text())["verdict"] in ("worse_than_line", "no_signal",
+                                                          "extrapolated")
+    assert _next(out).startswith("next: try refitting on recordings that cover this range")

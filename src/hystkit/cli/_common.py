@@ -211,13 +211,15 @@ def say_next(step: str) -> None:
 
 _AUTO = ("--model auto (mpl with 1-3 cells, mpl-poly, pi and pl, each scored on held-out "
          "data)")
+_EVALUATE_COLUMNS = ("checking that this file's columns are the training files' "
+                     "(--columns position=NAME,sensor=NAME)")
 _COLUMNS = ("checking the columns: the sensor column may not carry the position "
             "(--columns position=NAME,sensor=NAME); no model recovers a signal that is not there")
 
 
 def next_step(status: str, *, command: str = "fit", model: str | None = None,
-              size: int | None = None, mode: str = "direct", line_r2: float | None = None
-              ) -> str:
+              size: int | None = None, mode: str = "direct", line_r2: float | None = None,
+              outside: float | None = None) -> str:
     """What to try after a refusal whose reason is `status`, as the words after ``next: try``.
 
     Parameters
@@ -235,16 +237,26 @@ def next_step(status: str, *, command: str = "fit", model: str | None = None,
     line_r2 : float, optional
         R² of the straight line on the same data: a model below a line that explains nothing
         either (a noise-only sensor) is a sensor problem, not a model's.
+    outside : float, optional
+        Share of the judged sensor samples far outside the training range (``evaluate``): when
+        it is above the verdict's limit, the data left the model's range, and a refit on data
+        that cover it comes first, whatever the scores.
     """
-    from ..compensation import MIN_EXPLAINED
+    from ..compensation import MAX_OUTSIDE, MIN_EXPLAINED
 
+    far_outside = command == "evaluate" and outside is not None and outside > MAX_OUTSIDE
     if status == "worse_than_line" and line_r2 is not None and line_r2 < MIN_EXPLAINED:
         status = "no_signal"
+    if far_outside and status == "no_signal":  # swapped columns, or data beyond the range
+        return (f"{_EVALUATE_COLUMNS}; if they are, refitting on recordings that cover this "
+                f"range ({outside:.0%} of its sensor samples lie far outside the training "
+                f"range), e.g. 'hystkit fit TRAIN.csv THIS.csv' (fitted jointly)")
+    if far_outside:
+        status = "extrapolated"
     if command == "evaluate":
         return {
-            "no_signal": "checking that this file's columns are the training files' "
-                         "(--columns position=NAME,sensor=NAME): a sensor read from another "
-                         "column, or wired differently, carries nothing the model learnt",
+            "no_signal": f"{_EVALUATE_COLUMNS}: a sensor read from another column, or "
+                         f"wired differently, carries nothing the model learnt",
             "extrapolated": "refitting on recordings that cover this range, e.g. 'hystkit fit "
                             "TRAIN.csv THIS.csv' (fitted jointly)",
         }.get(status, "refitting on recordings like these, e.g. 'hystkit fit TRAIN.csv "

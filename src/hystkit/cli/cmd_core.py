@@ -319,7 +319,7 @@ def _warn_if_outside(flags: dict, data: Path) -> None:
 
 def _evaluate(args: argparse.Namespace) -> int:
     check_inputs_exist([args.model, args.data])
-    from ..compensation import use_verdict
+    from ..compensation import FAR_MARGIN, use_verdict
     from ..io import check_output_path, read_recording, write_json, write_mat
 
     evaluate, load_compensator = _module.evaluate, _module.load_compensator
@@ -373,7 +373,9 @@ def _evaluate(args: argparse.Namespace) -> int:
     if status not in ("ok", "undetermined"):
         print(f"hystkit: evaluate: {status.replace('_', ' ')}: {message}; do not use the "
               f"{comp.model} compensator on data like these", file=sys.stderr)
-        say_next(next_step(status, command="evaluate", line_r2=scores["linear_r2"]))
+        far = comp.sensor_outside(rec, margin=FAR_MARGIN)
+        say_next(next_step(status, command="evaluate", line_r2=scores["linear_r2"],
+                           outside=None if far is None else float(far.mean())))
         return GUARD_EXIT
     print(f"verdict: {status} ({message})")
     return 0
