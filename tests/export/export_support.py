@@ -89,3 +89,42 @@ def run_lines(binary: Path, values: np.ndarray) -> np.ndarray:
     run = subprocess.run([str(binary)], input=text, capture_output=True, text=True,
                          timeout=120, check=True)
     return np.array(run.stdout.split(), dtype=float)
+
+
+# A C program that runs an exported model's own ``model_rest`` / ``model_step`` on stdin's
+# numbers and prints each output exactly (hex float)
+_DRIVER = r"""#include <stdio.h>
+#include "{name}.c"
+int main(void)
+{{
+    static real x[N_CELLS];
+    double value;
+    int started = 0;
+    while (scanf("%lf", &value) == 1) {{
+        if (!started) model_rest(x, value);
+        started = 1;
+        printf("%a\n", model_step(x, value));
+    }}
+    return 0;
+}}
+"""
+
+
+def model_steps_in_c(tmp_path: Path, compensator: Compensator, u: np.ndarray,
+                     name: str = "exported_model") -> np.ndarray:
+    """``model_rest`` at u[0], then ``model_step`` per sample, of the compensator's double C
+    export, built with ``-std=c99 -ffp-contract=off`` (no fused multiply-add: the compiled
+    model's arithmetic, bit for bit)."""
+    from hystkit.export import c_files, make_plan
+
+    cc = need("cc")
+    plan = make_plan(compensator, name=name)
+    for file_name, text in c_files(plan, double=True).items():
+        (tmp_path / file_name).write_text(text)
+    (tmp_path / "driver.c").write_text(_DRIVER.format(name=name))
+    subprocess.run([cc, "-O2", "-std=c99", "-ffp-contract=off", "driver.c", "-lm", "-o",
+                    "driver"], cwd=tmp_path, check=True, capture_output=True, text=True)
+    out = subprocess.run([str(tmp_path / "driver")], input="".join(f"{float(v)!r}\n" for v in u),
+                         capture_output=True, text=True, check=True).stdout.split()
+    return np.array([float.fromhex(v) for v in out])
+

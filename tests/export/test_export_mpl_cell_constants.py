@@ -5,8 +5,6 @@ knee and on nearly linear cells (where the plain (e - 1/e) / 2 would not)."""
 
 from __future__ import annotations
 
-import subprocess
-
 import numpy as np
 from numpy.testing import assert_array_equal
 
@@ -16,7 +14,7 @@ from hystkit.export import c_files, make_plan
 from hystkit.models import mpl
 from hystkit.models.mpl import kernels
 
-from .export_support import need
+from .export_support import model_steps_in_c
 
 DT = 0.025
 # Cell 1 crosses its knee on the noise; cells 2 and 3 are nearly linear (V_T ~ 1e3, |a| < 0.5:
@@ -25,21 +23,6 @@ PARAMS = mpl.MplParams(i_s=[0.05, 2500.0, 1800.0], v_t=[0.2, 1000.0, 900.0],
                        w=[1.0, 0.5, 20.0, -20.0], v_b=0.1)
 STRUCTURE = mpl.MplStructure(n_cells=3, dt=DT)
 
-_DRIVER = r"""#include <stdio.h>
-#include "{name}.c"
-int main(void)
-{{
-    static real x[N_CELLS];
-    double value;
-    int started = 0;
-    while (scanf("%lf", &value) == 1) {{
-        if (!started) model_rest(x, value);
-        started = 1;
-        printf("%a\n", model_step(x, value));
-    }}
-    return 0;
-}}
-"""
 
 
 def _compensator(mode: str) -> Compensator:
@@ -53,20 +36,6 @@ def _input(n: int = 3000) -> np.ndarray:
     return np.sin(0.5 * t) + 0.2 * np.random.default_rng(3).standard_normal(n)
 
 
-def _exported_steps(tmp_path, mode: str, u: np.ndarray) -> np.ndarray:
-    """``model_rest`` at u[0], then ``model_step`` per sample, of the double C export."""
-    cc = need("cc")
-    plan = make_plan(_compensator(mode), name="cells")
-    for file_name, text in c_files(plan, double=True).items():
-        (tmp_path / file_name).write_text(text)
-    (tmp_path / "driver.c").write_text(_DRIVER.format(name="cells"))
-    subprocess.run([cc, "-O2", "-std=c99", "-ffp-contract=off", "driver.c", "-lm", "-o",
-                    "driver"], cwd=tmp_path, check=True, capture_output=True, text=True)
-    out = subprocess.run([str(tmp_path / "driver")], input="".join(f"{float(v)!r}\n" for v in u),
-                         capture_output=True, text=True, check=True).stdout.split()
-    return np.array([float.fromhex(v) for v in out])
-
-
 def _kernel_args():
     return (PARAMS.i_s, PARAMS.v_t, PARAMS.w, PARAMS.v_b, mpl.knee_voltage(STRUCTURE, PARAMS),
             STRUCTURE.slope_cap / DT, DT)
@@ -77,7 +46,7 @@ def test_exported_forward_step_is_the_kernel_run_bit_for_bit(tmp_path):
     knee = mpl.knee_voltage(STRUCTURE, PARAMS)
     assert np.isfinite(knee[0])  # the straight branch is exercised
     y, _ = kernels.simulate(u, np.full(3, u[0]), *_kernel_args())
-    assert_array_equal(_exported_steps(tmp_path, "direct", u), y)
+    assert_array_equal(model_steps_in_c(tmp_path, _compensator("direct"), u), y)
 
 
 def test_exported_inverse_step_is_the_kernel_inversion_bit_for_bit(tmp_path):
@@ -85,7 +54,7 @@ def test_exported_inverse_step_is_the_kernel_inversion_bit_for_bit(tmp_path):
     x0 = np.full(3, (y_in[0] + PARAMS.v_b) / float(np.sum(PARAMS.w)))
     u_hat, _, bad = kernels.invert(y_in, x0, *_kernel_args())
     assert bad == -1
-    assert_array_equal(_exported_steps(tmp_path, "inverse", y_in), u_hat)
+    assert_array_equal(model_steps_in_c(tmp_path, _compensator("inverse"), y_in), u_hat)
 
 
 def test_export_has_no_libm_sinh_per_sample():
