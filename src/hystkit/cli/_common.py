@@ -27,8 +27,8 @@ from ..errors import HystkitError, OutputError
 __all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Deferred", "Parser", "UsageError", "add_read_options",
            "check_size", "deferred", "failures_exit", "given_read_options", "integer",
            "next_step", "number", "positive_float", "positive_int", "read_options",
-           "read_recording_args", "read_recordings_args", "say_next", "size_limit", "slope_cap",
-           "stdout_for"]
+           "read_recording_args", "read_recordings_args", "read_training_files", "say_next",
+           "size_limit", "slope_cap", "stdout_for"]
 
 # Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
 # bounds, not converged; a family failed in compare/select); 2 is kept for errors that stop a
@@ -395,6 +395,21 @@ def given_read_options(args: argparse.Namespace) -> dict:
         if value not in (None, (), False):
             given[name] = value
     return given
+
+
+def read_training_files(args: argparse.Namespace) -> tuple[list, list]:
+    """How each training file of ``args.data`` is read (`read_options`) and its recordings:
+    one per file, or its pieces between time gaps (``--gaps split``: fitted jointly)."""
+    from ..io import read_pieces, read_recording
+
+    reading, recs = [], []
+    for path in args.data:
+        reading.append(read_options(args, path))
+        if reading[-1].gaps == "split":
+            recs += read_pieces(path, options=reading[-1])
+        else:
+            recs.append(read_recording(path, options=reading[-1]))
+    return reading, recs
 
 
 def read_options(args: argparse.Namespace, path=None):

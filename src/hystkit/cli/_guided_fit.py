@@ -30,7 +30,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from functools import partial
 
-from ._common import GUARD_EXIT, UsageError, next_step, read_options, say_next
+from ._common import GUARD_EXIT, UsageError, next_step, read_training_files, say_next
 from ._fit_report import print_band, print_parameters, print_standard_errors, units_label
 from ._inputs import check_inputs_exist
 
@@ -253,8 +253,6 @@ def run_guided_fit(args: argparse.Namespace) -> int:
     from ..compensation import MODEL_SUFFIXES, folds, save_compensator
     from ..io import (
         check_output_path,
-        read_pieces,
-        read_recording,
         training_reading,
         training_units,
     )
@@ -263,13 +261,7 @@ def run_guided_fit(args: argparse.Namespace) -> int:
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
                       what="a model file")
     t0, budget = time.perf_counter(), args.budget or DEFAULT_BUDGET
-    reading, recs = [], []
-    for path in args.data:
-        reading.append(read_options(args, path))
-        if reading[-1].gaps == "split":  # the pieces between time gaps, fitted jointly
-            recs += read_pieces(path, options=reading[-1])
-        else:
-            recs.append(read_recording(path, options=reading[-1]))
+    reading, recs = read_training_files(args)
     units = training_units(recs)
     remembered, not_remembered = training_reading(reading, args.data, units)
     n_folds = len(folds(recs))

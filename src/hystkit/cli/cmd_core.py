@@ -20,7 +20,7 @@ from ._common import (
     number,
     positive_float,
     positive_int,
-    read_options,
+    read_training_files,
     say_next,
     size_limit,
     slope_cap,
@@ -103,7 +103,7 @@ def _fit(args: argparse.Namespace) -> int:
         return list_presets(args)
     check_inputs_exist(args.data)  # a misspelt name is refused before the heavy imports
     from ..compensation import MODEL_SUFFIXES, center_label, fit_compensator, save_compensator
-    from ..io import check_output_path, read_pieces, read_recording
+    from ..io import check_output_path
     from ..models import get_family
 
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
@@ -118,13 +118,7 @@ def _fit(args: argparse.Namespace) -> int:
     options.update(_pl_options(args, family))
     options.update(structure_options(args, family))
     check_size(args.model, args.cells, "--cells")
-    reading, recs = [], []
-    for path in args.data:
-        reading.append(read_options(args, path))
-        if reading[-1].gaps == "split":  # the pieces between time gaps, fitted jointly
-            recs += read_pieces(path, options=reading[-1])
-        else:
-            recs.append(read_recording(path, options=reading[-1]))
+    reading, recs = read_training_files(args)
     size = family.default_size if args.cells is None else args.cells
     fit_options = {**start_options(args, family, recs[0].dt, size, options), **constraint}
     shown = "".join(f", {name} {str(value).lower() if isinstance(value, bool) else f'{value:g}'}"
