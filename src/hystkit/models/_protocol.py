@@ -246,7 +246,7 @@ class FamilyInfo:
     """What the registry knows of a family before its code loads (``hystkit fit --help``).
 
     A family folder's ``__init__`` declares it as ``INFO``; its :class:`Family` subclass sets
-    ``info = INFO`` and so carries the same values (:attr:`Family.name`, ...). The fields are
+    ``info = INFO`` and so carries the same values (``Family.name``, ...). The fields are
     those of :class:`Family` of the same names.
 
     Parameters
