@@ -9,32 +9,19 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
 import pytest
 
 import hystkit as hk
 from hystkit.errors import InputError
 from hystkit.io import ReadOptions, Recording
-from hystkit.sensors import simulate_experiment
 
+from .cli_support import LAB_COLUMNS as COLUMNS
+from .cli_support import LAB_SAID as SAID
 from .cli_support import run_cli
+from .cli_support import write_lab_csv as _write_lab_csv
 
 SETTINGS = ('time_unit = "ms"\nunits_row = true\n\n'
             '[columns]\ntime = "t_ms"\nposition = "x_mm"\nsensor = "R_ohm"\n')
-COLUMNS = (("time", "t_ms"), ("position", "x_mm"), ("sensor", "R_ohm"))
-SAID = ("as the model's training data were read: columns t_ms,x_mm,R_ohm, time in ms, "
-        "a units line")
-
-
-def _write_lab_csv(path: Path, seed: int, n: int = 2400) -> None:
-    """The virtual sine as a lab writes it: its own names, time in whole ms, a units line."""
-    rec = simulate_experiment("sine", seed)
-    frame = pd.DataFrame({"t_ms": np.round(rec.time[:n] * 1e3), "x_mm": rec.position[:n],
-                          "R_ohm": rec.sensor[:n]})
-    with path.open("w", encoding="utf-8") as out:
-        out.write("t_ms,x_mm,R_ohm\nms,mm,Ohm\n")
-        frame.to_csv(out, index=False, header=False)
 
 
 @pytest.fixture(scope="module")

@@ -9,33 +9,21 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 import pytest
 
 from hystkit.batch import SensorJob, fit_sensor
 from hystkit.compensation import load_compensator
 from hystkit.io import ReadOptions
-from hystkit.sensors import simulate_experiment
 
+from ..cli_support import LAB_COLUMNS as COLUMNS
+from ..cli_support import LAB_SAID as SAID
 from ..cli_support import run_cli
+from ..cli_support import write_lab_csv as _write_lab_csv
 
 OWN = ["--columns", "time=t_ms,position=x_mm,sensor=R_ohm", "--time-unit", "ms",
        "--units-row"]
-COLUMNS = (("time", "t_ms"), ("position", "x_mm"), ("sensor", "R_ohm"))
 UNITS = (("position", "mm"), ("sensor", "Ohm"))
-SAID = ("as the model's training data were read: columns t_ms,x_mm,R_ohm, time in ms, "
-        "a units line")
-
-
-def _write_lab_csv(path: Path, seed: int, n: int = 2400) -> None:
-    """The virtual sine as a lab writes it: its own names, time in whole ms, a units line."""
-    rec = simulate_experiment("sine", seed)
-    frame = pd.DataFrame({"t_ms": np.round(rec.time[:n] * 1e3), "x_mm": rec.position[:n],
-                          "R_ohm": rec.sensor[:n]})
-    with path.open("w", encoding="utf-8") as out:
-        out.write("t_ms,x_mm,R_ohm\nms,mm,Ohm\n")
-        frame.to_csv(out, index=False, header=False)
 
 
 @pytest.fixture(scope="module")
