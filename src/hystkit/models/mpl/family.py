@@ -72,14 +72,6 @@ class MplFamily(Family):
         """Each cell dropped, and merged into each other one (:func:`.._cells.cell_reductions`)."""
         return cell_reductions(structure, params)
 
-    def rest_state(self, structure, params, value, inverse=False):
-        # Forward: each cell equals its drive. Inverse: the drive is the input estimate, at rest
-        # (y + V_b) / sum(w), as mpl.invert starts.
-        if inverse:
-            w_sum = float(np.sum(params.w))
-            value = (value + params.v_b) / w_sum if w_sum != 0 else 0.0
-        return np.full(structure.n_cells, float(value))
-
     def block(self, structure, params, inverse=False):
         body = np.concatenate([[params.n_cells, params.v_b, structure.slope_cap / structure.dt,
                                 structure.dt], params.i_s, params.v_t,

@@ -31,17 +31,14 @@ import numpy as np
 from ...errors import FitDivergedError
 from .._cells import MAX_CELLS, CellStructure, state_bound
 from .._protocol import Record
+from .._run import Runs, family_runs
 from .._validation import (
-    check_finite_run,
     check_magnitude,
     check_range,
-    check_signal,
     check_size,
     check_structure_size,
     finite_floats,
     freeze_arrays,
-    initial_state,
-    run_steps,
 )
 from . import kernels
 
@@ -55,6 +52,7 @@ __all__ = [
     "knee_voltage",
     "output_bound",
     "resistor_current",
+    "rest_state",
     "simulate",
     "simulate_reference",
     "step",
@@ -304,9 +302,11 @@ def invert_step(structure: MplStructure, params: MplParams, x: np.ndarray,
     return float(u_hat), x_next
 
 
-def simulate(structure: MplStructure, params: MplParams, u: np.ndarray,
-             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Run the forward model over an input sequence (compiled kernel).
+def rest_state(structure: MplStructure, params: MplParams, value: float,
+               inverse: bool = False) -> np.ndarray:
+    """Cell voltages at rest under a constant input ``value``: each cell equals its drive.
+    With ``inverse``, ``value`` is an output and the drive is the input at rest,
+    ``(y + V_b) / sum(w)`` (0 when ``sum(w) = 0``).
 
     Parameters
     ----------
@@ -314,36 +314,29 @@ def simulate(structure: MplStructure, params: MplParams, u: np.ndarray,
         The model's structure.
     params : MplParams
         Its parameters.
-    u : array, shape (n,)
-        Model input ``e`` sampled every ``structure.dt``.
-    x0 : array, shape (N,), float or None
-        Initial cell voltages. ``None`` starts at rest at the first input (``u_k = e_0``), the
-        synchronised start of eq. 2.21-2.22, instead of the document's zero state.
+    value : float
+        Constant input (with `inverse`: output).
+    inverse : bool, default False
+        Rest state of the inverse.
 
     Returns
     -------
-    y : array, shape (n,)
-        Model output (eq. 5.2).
-    x_end : array, shape (N,)
-        State after the last sample; feeding it back as ``x0`` continues the run exactly.
-
-    Raises
-    ------
-    ValueError
-        If `params` and `structure` differ in the number of cells, `u` is empty, not 1-D or
-        not finite, or `x0` does not fit the cells.
-    FitDivergedError
-        If the output leaves the finite range (inputs near the float limit).
+    numpy.ndarray, shape (N,)
     """
-    _check_params(structure, params)
-    u = check_signal(u, "u")
-    x = initial_state(structure.n_cells, x0, u[0])
-    knee = knee_voltage(structure, params)
-    y, x_end = kernels.simulate(u, x, params.i_s, params.v_t, params.w, params.v_b, knee,
+    if inverse:
+        w_sum = float(np.sum(params.w))
+        value = (value + params.v_b) / w_sum if w_sum != 0 else 0.0
+    return np.full(structure.n_cells, float(value))
+
+
+def _forward(structure: MplStructure, params: MplParams, u: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    y, x_end = kernels.simulate(u, x, params.i_s, params.v_t, params.w, params.v_b,
+                                knee_voltage(structure, params),
                                 structure.slope_cap / structure.dt, structure.dt)
     if not structure.limit:
         _check_unlimited_run(structure, params, y, u, x)
-    return check_finite_run(y, "mpl"), x_end  # finite in the domain; inputs near 1e308 are not
+    return y, x_end
 
 
 def _check_unlimited_run(structure: MplStructure, params: MplParams, y: np.ndarray,
@@ -360,82 +353,11 @@ def _check_unlimited_run(structure: MplStructure, params: MplParams, y: np.ndarr
             f"f'(v) dt passes 2 (sec. 5.3.3)")
 
 
-def simulate_reference(structure: MplStructure, params: MplParams, u: np.ndarray,
-                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
-
-    Parameters
-    ----------
-    structure : MplStructure
-        The model's structure.
-    params : MplParams
-        Its parameters.
-    u : array, shape (n,)
-        Model input ``e`` sampled every ``structure.dt``.
-    x0 : array, shape (N,), float or None
-        Initial cell voltages, as for :func:`simulate`.
-
-    Returns
-    -------
-    y : array, shape (n,)
-        Model output (eq. 5.2).
-    x_end : array, shape (N,)
-        State after the last sample.
-
-    Raises
-    ------
-    ValueError
-        As :func:`simulate`.
-    """
-    _check_params(structure, params)
-    u = check_signal(u, "u")
-    x = initial_state(structure.n_cells, x0, u[0])
-    return run_steps(step, structure, params, u, x)
-
-
-def invert(structure: MplStructure, params: MplParams, y: np.ndarray,
-           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Run the analytical inverse (compensator) over an output sequence, eq. 5.13-5.14.
-
-    Parameters
-    ----------
-    structure : MplStructure
-        The model's structure.
-    params : MplParams
-        Its parameters.
-    y : array, shape (n,)
-        Measured model output (e.g. the sensor signal), sampled every ``structure.dt``.
-    x0 : array, shape (N,), float or None
-        Initial cell voltages; ``None`` starts at rest, ``u_k = e_0`` with
-        ``e_0 = (y_0 + V_b) / sum(w)``.
-
-    Returns
-    -------
-    u_hat : array, shape (n,)
-        Estimated input.
-    x_end : array, shape (N,)
-        State after the last sample.
-
-    Raises
-    ------
-    ValueError
-        If `params` and `structure` differ in the number of cells, `y` is empty, not 1-D or
-        not finite, or `x0` does not fit the cells.
-    FitDivergedError
-        If ``w_0 = 0`` (no inverse exists) or if the inverse leaves the finite range. Unlike
-        the forward model, the inverse's stability also depends on the weights (its cells see
-        ``-(1 + w_k / w_0)`` times their own voltage), so it is checked rather than guaranteed.
-    """
-    _check_params(structure, params)
-    y = check_signal(y, "y")
-    if params.w[0] == 0:
-        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
-    w_sum = params.w.sum()
-    rest = (y[0] + params.v_b) / w_sum if w_sum != 0 else 0.0
-    x = initial_state(structure.n_cells, x0, rest)
-    knee = knee_voltage(structure, params)
+def _inverse(structure: MplStructure, params: MplParams, y: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     u_hat, x_end, n_bad = kernels.invert(y, x, params.i_s, params.v_t, params.w, params.v_b,
-                                         knee, structure.slope_cap / structure.dt, structure.dt)
+                                         knee_voltage(structure, params),
+                                         structure.slope_cap / structure.dt, structure.dt)
     if n_bad >= 0:
         raise FitDivergedError(
             f"the inverse model diverged at sample {n_bad} of {y.size} (|u_hat| > 1e6 times the "
@@ -443,5 +365,21 @@ def invert(structure: MplStructure, params: MplParams, y: np.ndarray,
     return u_hat, x_end
 
 
-def _check_params(structure: MplStructure, params: MplParams) -> None:
+def _check(structure: MplStructure, params: MplParams, inverse: bool) -> None:
     check_size(params.n_cells, structure.n_cells, "cells")
+    if inverse and params.w[0] == 0:
+        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
+
+
+RUNS = Runs(label="mpl", step=step, n_state=lambda structure, params: structure.n_cells,
+            rest_state=rest_state, forward=_forward, inverse=_inverse, check=_check)
+simulate, simulate_reference, invert = family_runs(
+    RUNS, __name__, "the mPL model",
+    notes="The input is the source voltage ``e`` and the state the cell voltages ``u_k``; the "
+          "rest start ``u_k = e_0`` is the synchronised start of eq. 2.21-2.22 rather than the "
+          "document's zero state. With ``structure.limit`` false (the unlimited sinh) a run "
+          "that grows past 1e6 times the limited bound raises FitDivergedError.",
+    inverse_notes="eq. 5.13-5.14: ``u_hat = (y - sum w_k x_k + V_b) / w_0`` from the present "
+                  "state, then the cells advance with it. No inverse exists for ``w_0 = 0``; "
+                  "the inverse's cells see ``-(1 + w_k / w_0)`` times their own voltage, so its "
+                  "stability depends on the weights.")
