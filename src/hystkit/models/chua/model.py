@@ -29,26 +29,25 @@ slope is ``1 - dt g'(v) f'(y)`` and ``f' <= max(k_0, k_inf)``, so ``g`` is conti
 straight line beyond the knee where ``g' = slope_cap / (dt max(k_0, k_inf))``. With
 ``slope_cap <= 1`` every step is monotone: ``y_k`` never overshoots its equilibrium and stays
 between ``f^-1(min u - delta)`` and ``f^-1(max u + delta)`` (or its start) for any parameters.
+
+The records (structure, parameters, their domain) are in :mod:`.records`, importable from here.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from ...errors import FitDivergedError
-from .._protocol import Record
-from .._validation import (
-    broadcast_state,
-    check_cells,
-    check_finite_run,
-    check_signal,
-    check_size,
-    freeze_arrays,
-    run_steps,
-)
+from .._run import Runs, family_runs
+from .._validation import check_size
 from . import kernels
+from .records import (
+    DOMAIN,
+    MAX_ELEMENTS,
+    ChuaParams,
+    ChuaStructure,
+    output_bound,
+)
 
 __all__ = [
     "DOMAIN",
@@ -69,140 +68,6 @@ __all__ = [
     "simulate_reference",
     "step",
 ]
-
-_FIELDS = ("k0", "k_inf", "y_s", "g", "v_g", "delta")
-MAX_ELEMENTS = 100  # O(N) a sample; the fit's Jacobian holds 6 N columns: 4.8 kB a sample
-# Allowed range of each parameter (normalised units, eq. 5.10), wide around the fit's bounds
-# (slopes and scales 1e-2 .. 1e2, G 1e-3 .. 100 / dt, V_g 1e-3 .. 1e3, delta 0 .. 1): within
-# it the restoring function, its inverse and the limited sinh cannot overflow.
-DOMAIN = {"k0": (1e-6, 1e6), "k_inf": (1e-6, 1e6), "y_s": (1e-6, 1e6), "g": (1e-9, 1e12),
-          "v_g": (1e-6, 1e6), "delta": (0.0, 1e6)}
-
-
-@dataclass(frozen=True)
-class ChuaStructure(Record):
-    """What does not get fitted.
-
-    Parameters
-    ----------
-    n_elements : int
-        Elements in series, ``1 <= N <= MAX_ELEMENTS`` (100: a sample costs O(N), the fit's
-        finite-difference Jacobian holds ``6 N`` columns, 4.8 kB a sample, at the cap); 1 is
-        eq. 2.3 itself.
-    dt : float
-        Sample time [s].
-    slope_cap : float
-        Largest allowed Euler slope ``dt g' f'`` (stable below 2; <= 1 gives no overshoot).
-    """
-
-    n_elements: int = 1
-    dt: float = 0.025
-    slope_cap: float = 1.0
-
-    def __post_init__(self) -> None:
-        # the cap first: nothing is allocated or looped over before it holds (inf, 1e12)
-        if not (isinstance(self.n_elements, int | float) and self.n_elements <= MAX_ELEMENTS):
-            raise ValueError(f"n_elements must be an integer in [1, {MAX_ELEMENTS}], got "
-                             f"{self.n_elements!r}")
-        check_cells(self.n_elements, self.dt, self.slope_cap, "n_elements")
-
-    @property
-    def n_params(self) -> int:
-        return 6 * self.n_elements
-
-
-@dataclass(frozen=True, eq=False)
-class ChuaParams(Record):
-    """Restoring and dissipation functions of each element, arrays of shape (N,).
-
-    Parameters
-    ----------
-    k0, k_inf : array
-        Slopes of ``f`` at 0 and far from 0 (> 0) [input units per output unit].
-    y_s : array
-        Output scale of the transition between the two slopes (> 0).
-    g : array
-        Slope ``G`` of ``g`` at the edge of its dead band (> 0) [output units per s per input
-        unit].
-    v_g : array
-        Input scale of the sinh in ``g`` (> 0); large means linear.
-    delta : array
-        Half-width of the dead band of ``g`` (>= 0); 0 is the document's model.
-
-    Notes
-    -----
-    The optimiser sees ``[log k0, log k_inf, log y_s, log g, log v_g, delta]`` per element.
-
-    Domain (:data:`DOMAIN`): ``k_0, k_inf, y_s, V_g`` in ``[1e-6, 1e6]``, ``G`` in
-    ``[1e-9, 1e12]``, ``delta`` in ``[0, 1e6]``. Within it every element stays within
-    ``(max(|u|, |f(x0)|) + delta) / min(k_0, k_inf)`` of 0 (``slope_cap <= 1``: between
-    ``f^-1(min u - delta)`` and ``f^-1(max u + delta)`` or its start), times
-    ``s / (2 - s)`` for a slope cap ``s > 1`` (:func:`output_bound`). The inverse amplifies by ``1 / (dt g')``: it returns finite values
-    or raises ``FitDivergedError``.
-    """
-
-    k0: np.ndarray
-    k_inf: np.ndarray
-    y_s: np.ndarray
-    g: np.ndarray
-    v_g: np.ndarray
-    delta: np.ndarray
-    n_elements: int = field(init=False)
-
-    def __post_init__(self) -> None:
-        n = np.size(self.k0)
-        object.__setattr__(self, "n_elements", int(n))
-        freeze_arrays(self, **dict.fromkeys(_FIELDS, n))
-        for name in _FIELDS[:5]:
-            if np.any(getattr(self, name) <= 0):
-                raise ValueError(f"{name} must be positive (f and g strictly increasing, eq. 2.3)")
-        if np.any(self.delta < 0):
-            raise ValueError("delta (dead band of g) must be >= 0")
-        for name, (low, high) in DOMAIN.items():
-            values = getattr(self, name)
-            bad = values[(values < low) | (values > high)]
-            if bad.size:
-                raise ValueError(f"{name} must lie in [{low:g}, {high:g}] (the domain where "
-                                 f"runs stay bounded), got {float(bad[0]):g}")
-
-    def to_vector(self) -> np.ndarray:
-        cols = [np.log(getattr(self, name)) for name in _FIELDS[:5]] + [self.delta]
-        return np.column_stack(cols).reshape(-1)
-
-    @classmethod
-    def from_vector(cls, theta: np.ndarray, n_elements: int) -> ChuaParams:
-        t = np.asarray(theta, dtype=float).reshape(n_elements, 6)
-        return cls(*np.exp(t[:, :5]).T, delta=t[:, 5])
-
-
-def output_bound(structure: ChuaStructure, params: ChuaParams, u_max: float) -> float:
-    """``q sum_k (u_max + delta_k) / min(k_0, k_inf)_k`` with ``q = max(1, s / (2 - s))``,
-    ``s`` the slope cap: no output of a run whose inputs, and the restoring forces
-    ``f_k(x0_k)`` of its start, stay within ``u_max`` in magnitude exceeds it.
-
-    Each element's band of equilibria lies within ``E_k = (u_max + delta_k) / min(k_0,
-    k_inf)`` of 0 (``|f^-1(v)| <= |v| / min(k_0, k_inf)``), and a step multiplies the distance
-    to it by ``1 - dt g' f'`` in ``[1 - s, 1]``: no overshoot for ``s <= 1``; beyond, an
-    overshoot of at most ``s - 1`` times the distance, whose worst alternation settles at
-    ``s E_k / (2 - s)``.
-
-    Parameters
-    ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
-    u_max : float
-        Bound on the magnitude of the inputs and of the start's restoring forces.
-
-    Returns
-    -------
-    float
-        The bound on ``|y|``.
-    """
-    q = max(1.0, structure.slope_cap / (2.0 - structure.slope_cap))
-    return float(q * np.sum((u_max + params.delta) / np.minimum(params.k0, params.k_inf)))
-
 
 def limits(structure: ChuaStructure, params: ChuaParams) -> tuple[np.ndarray, np.ndarray]:
     """Per element: the cap on ``g'`` and the knee ``|v|`` beyond which ``g`` is straight.
@@ -408,10 +273,8 @@ def _g_inverse(r: float, params: ChuaParams, cap: np.ndarray, knee: np.ndarray,
     return np.sign(r) * np.where(a <= g_knee, inside, knee + (a - g_knee) / cap)
 
 
-def _check(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
-           name: str) -> np.ndarray:
+def _check(structure: ChuaStructure, params: ChuaParams, inverse: bool) -> None:
     check_size(params.n_elements, structure.n_elements, "elements")
-    return check_signal(u, name)
 
 
 def rest_state(structure: ChuaStructure, params: ChuaParams, value: float,
@@ -442,13 +305,6 @@ def rest_state(structure: ChuaStructure, params: ChuaParams, value: float,
     return restoring_inverse(params, value)
 
 
-def _initial_state(structure: ChuaStructure, params: ChuaParams,
-                   x0: np.ndarray | float | None, u0: float) -> np.ndarray:
-    if x0 is None:
-        return rest_state(structure, params, u0)
-    return broadcast_state(x0, params.n_elements)
-
-
 def kernel_args(structure: ChuaStructure, params: ChuaParams) -> tuple:
     """The compiled kernels' parameter arguments, in their order.
 
@@ -470,103 +326,34 @@ def kernel_args(structure: ChuaStructure, params: ChuaParams) -> tuple:
             structure.dt)
 
 
-def simulate(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
-             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Run the model over an input sequence (compiled kernel).
-
-    Parameters
-    ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
-    u : array, shape (n,)
-        Input sampled every ``structure.dt``.
-    x0 : array, shape (N,), float or None
-        Initial element outputs ``y_k``; ``None`` starts every element at rest at the first
-        input, ``y_k = f_k^-1(u_0)`` (``g = 0``).
-
-    Returns
-    -------
-    y : array, shape (n,)
-    x_end : array, shape (N,)
-        Element outputs after the last sample; feeding them back as ``x0`` continues the run.
-    """
-    u = _check(structure, params, u, "u")
-    x = _initial_state(structure, params, x0, u[0])
-    y, x_end = kernels.simulate(u, x, *kernel_args(structure, params))
-    return check_finite_run(y, "Chua-Stromsmoe"), x_end
+def _forward(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return kernels.simulate(u, x, *kernel_args(structure, params))
 
 
-def simulate_reference(structure: ChuaStructure, params: ChuaParams, u: np.ndarray,
-                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step`.
-
-    Parameters
-    ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
-    u : numpy.ndarray, shape (n,)
-        Input sampled every ``structure.dt``.
-    x0 : numpy.ndarray, float or None, optional
-        Initial element outputs, as for :func:`simulate`.
-
-    Returns
-    -------
-    y : numpy.ndarray, shape (n,)
-        Output.
-    x_end : numpy.ndarray
-        State after the last sample.
-    """
-    u = _check(structure, params, u, "u")
-    x = _initial_state(structure, params, x0, u[0])
-    return run_steps(step, structure, params, u, x)
-
-
-def invert(structure: ChuaStructure, params: ChuaParams, y: np.ndarray,
-           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Exact inverse of :func:`simulate`: the input sequence that produces ``y``.
-
-    Each sample solves the Euler step for its input by bisection (:func:`invert_step`), so
-    ``simulate(invert(y))`` returns ``y``. The input is unique wherever some element moves;
-    with dead bands and a constant output it is any point of the band, and the middle is
-    returned. An output equal to the present one to rounding (relative ``REST_TOL = 1e-12``
-    of ``max(1, |y|, sum |y_k|)``) counts as constant: otherwise the rounding of the state's
-    sum would pick one edge of the band or the other (a jump of ``2 delta``), and a constant
-    output from the start would not come back from ``simulate``'s rest start. The inverse amplifies output noise by ``1 / (dt g')``.
-
-    Parameters
-    ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
-    y : array, shape (n,)
-    x0 : array, shape (N,), float or None
-        Initial element outputs; ``None`` splits ``y_0`` over the elements as their rest
-        state for a common input ``u`` with ``sum_k f_k^-1(u) = y_0``.
-
-    Returns
-    -------
-    u : numpy.ndarray, shape (n,)
-        Input that gives `y`.
-    x_end : numpy.ndarray
-        State after the last sample.
-
-    Raises
-    ------
-    FitDivergedError
-        If the input estimate leaves the finite range (|u| > 1e6 (1 + max |y|)).
-    """
-    y = _check(structure, params, y, "y")
-    if x0 is None:
-        x = rest_state(structure, params, y[0], inverse=True)
-    else:
-        x = _initial_state(structure, params, x0, 0.0)
+def _inverse(structure: ChuaStructure, params: ChuaParams, y: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     u_hat, x_end, n_bad = kernels.invert(y, x, *kernel_args(structure, params))
     if n_bad >= 0:
         raise FitDivergedError(f"the inverse Chua-Stromsmoe model diverged at sample {n_bad} "
                                f"of {y.size}")
-    return check_finite_run(u_hat, "Chua-Stromsmoe", "inverse"), x_end
+    return u_hat, x_end
+
+
+RUNS = Runs(label="Chua-Stromsmoe", step=step,
+            n_state=lambda structure, params: params.n_elements, rest_state=rest_state,
+            forward=_forward, inverse=_inverse, check=_check)
+simulate, simulate_reference, invert = family_runs(
+    RUNS, __name__, "the Chua-Stromsmoe model",
+    notes="The state is the element outputs ``y_k``; at rest every element sits at "
+          "``y_k = f_k^-1(u_0)`` (``g = 0``).",
+    inverse_notes="The exact inverse of ``simulate``: each sample solves the Euler step for its "
+                  "input by bisection (:func:`invert_step`), so ``simulate(invert(y))`` returns "
+                  "``y``. The input is unique wherever some element moves; with dead bands and a "
+                  "constant output it is any point of the band, and the middle is returned. An "
+                  "output equal to the present one to rounding (relative ``REST_TOL = 1e-12`` of "
+                  "``max(1, |y|, sum |y_k|)``) counts as constant, so that a constant output "
+                  "from the start comes back from ``simulate``'s rest start. The rest start "
+                  "splits ``y_0`` over the elements for a common input ``u`` with "
+                  "``sum_k f_k^-1(u) = y_0``. The inverse amplifies output noise by "
+                  "``1 / (dt g')``.")
