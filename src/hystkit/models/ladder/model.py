@@ -37,14 +37,12 @@ import numpy as np
 from ...errors import FitDivergedError
 from .._cells import CellStructure
 from .._protocol import Record
+from .._run import Runs, family_runs
 from .._validation import (
-    check_finite_run,
     check_signal,
     check_size,
     finite_floats,
     freeze_arrays,
-    initial_state,
-    run_steps,
 )
 from . import kernels
 
@@ -300,10 +298,10 @@ def rest_state(structure: LadderStructure, params: LadderParams, value: float,
     return np.full(params.n_cells, _rest_input(params, value) if inverse else float(value))
 
 
-def _check(structure: LadderStructure, params: LadderParams, u: np.ndarray,
-           name: str) -> np.ndarray:
+def _check(structure: LadderStructure, params: LadderParams, inverse: bool) -> None:
     check_size(params.n_cells, structure.n_cells, "cells")
-    return check_signal(u, name)
+    if inverse and params.w[0] == 0:
+        raise FitDivergedError("the ladder model has w_0 = 0, so it has no inverse")
 
 
 def states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
@@ -330,106 +328,45 @@ def states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
     x_end : numpy.ndarray, shape (N,)
         Capacitor voltages after the last sample.
     """
-    u = _check(structure, params, u, "u")
-    x = initial_state(structure.n_cells, x0, u[0])
+    _check(structure, params, False)
+    u = check_signal(u, "u")
+    x = RUNS.initial(structure, params, x0, u[0], False)
+    return _states(structure, params, u, x)
+
+
+def _states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
+            x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return kernels.states(u, x, params.band, effective_conductance(structure, params),
-                                 structure.dt)
+                          structure.dt)
 
 
-def simulate(structure: LadderStructure, params: LadderParams, u: np.ndarray,
-             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Run the circuit over a source-voltage sequence (compiled kernel).
-
-    Parameters
-    ----------
-    structure : LadderStructure
-        The model's structure.
-    params : LadderParams
-        Its parameters.
-    u : array, shape (n,)
-        Source voltage ``e`` sampled every ``structure.dt``.
-    x0 : array, shape (N,), float or None
-        Initial capacitor voltages; ``None`` starts at rest at the first input (``U_k = e_0``,
-        no current), the synchronised start of eq. 2.21-2.22.
-
-    Returns
-    -------
-    y : array, shape (n,)
-    x_end : array, shape (N,)
-    """
-    s, x_end = states(structure, params, u, x0)
-    u = np.asarray(u, dtype=float)
+def _forward(structure: LadderStructure, params: LadderParams, u: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    s, x_end = _states(structure, params, u, x)
     with np.errstate(over="ignore", invalid="ignore"):  # inputs near the float range
-        y = params.w[0] * u + s @ params.w[1:] - params.v_b
-    return check_finite_run(y, "ladder"), x_end
+        return params.w[0] * u + s @ params.w[1:] - params.v_b, x_end
 
 
-def simulate_reference(structure: LadderStructure, params: LadderParams, u: np.ndarray,
-                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step`.
-
-    Parameters
-    ----------
-    structure : LadderStructure
-        The model's structure.
-    params : LadderParams
-        Its parameters.
-    u : numpy.ndarray, shape (n,)
-        Source voltage sampled every ``structure.dt``.
-    x0 : numpy.ndarray, float or None, optional
-        Initial capacitor voltages, as for :func:`simulate`.
-
-    Returns
-    -------
-    y : numpy.ndarray, shape (n,)
-        Output.
-    x_end : numpy.ndarray
-        State after the last sample.
-    """
-    u = _check(structure, params, u, "u")
-    x = initial_state(structure.n_cells, x0, u[0])
-    return run_steps(step, structure, params, u, x)
-
-
-def invert(structure: LadderStructure, params: LadderParams, y: np.ndarray,
-           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Analytical inverse: ``e = (y + V_b - sum_k w_k U_k) / w_0``, then the state update.
-
-    The same construction as the mPL's eq. 5.13-5.14, in the order of fig. 5.12.
-
-    Parameters
-    ----------
-    structure : LadderStructure
-        The model's structure.
-    params : LadderParams
-        Its parameters.
-    y : array, shape (n,)
-    x0 : array, shape (N,), float or None
-        ``None``: at rest at ``e_0 = (y_0 + V_b) / sum(w)``.
-
-    Returns
-    -------
-    u : numpy.ndarray, shape (n,)
-        Input that gives `y`.
-    x_end : numpy.ndarray
-        State after the last sample.
-
-    Raises
-    ------
-    FitDivergedError
-        If ``w_0 = 0`` or the inverse leaves the finite range, ``|e| >= 1e6 (1 + max |y|)``
-        (its stability depends on the weights, so it is checked, not guaranteed; an unstable
-        inverse follows the path its rounding picks, so :func:`invert_step` looped over the
-        samples may leave that range where this stays bounded, or the other way round).
-    """
-    y = _check(structure, params, y, "y")
-    if params.w[0] == 0:
-        raise FitDivergedError("the ladder model has w_0 = 0, so it has no inverse")
-    x = initial_state(structure.n_cells, x0, _rest_input(params, y[0]))
+def _inverse(structure: LadderStructure, params: LadderParams, y: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     u_hat, x_end, n_bad = kernels.invert(y, x, params.band,
-                                                effective_conductance(structure, params),
-                                                params.w, params.v_b, structure.dt)
+                                         effective_conductance(structure, params),
+                                         params.w, params.v_b, structure.dt)
     if n_bad >= 0:
         raise FitDivergedError(f"the inverse ladder model diverged at sample {n_bad} of "
                                f"{y.size}; the weights make it unstable on this data")
-    return check_finite_run(u_hat, "ladder", "inverse"), x_end
+    return u_hat, x_end
+
+
+RUNS = Runs(label="ladder", step=step, n_state=lambda structure, params: structure.n_cells,
+            rest_state=rest_state, forward=_forward, inverse=_inverse, check=_check)
+simulate, simulate_reference, invert = family_runs(
+    RUNS, __name__, "the ladder circuit",
+    notes="The input is the source voltage ``e`` and the state the capacitor voltages ``U_k``; "
+          "the rest start (``U_k = e_0``, no current) is the synchronised start of "
+          "eq. 2.21-2.22.",
+    inverse_notes="``e = (y + V_b - sum_k w_k U_k) / w_0``, then the state update: the mPL's "
+                  "eq. 5.13-5.14 in the order of fig. 5.12. No inverse exists for ``w_0 = 0``; "
+                  "an unstable inverse (``|e| >= 1e6 (1 + max |y|)``) is refused. It follows "
+                  "the path its rounding picks, so :func:`invert_step` looped over the samples "
+                  "may leave that range where this stays bounded, or the other way round.")
