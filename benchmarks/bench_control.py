@@ -1,7 +1,7 @@
 """Speed of hystkit's closed-loop simulation: against the loop before the family protocol, with
 other families' blocks, and against python-control and a plain Python loop.
 
-Run:  python benchmarks/bench_control.py      (about two minutes on 2 cores)
+Run:  python benchmarks/bench_control.py [--tables loop,command]   (about a minute on 2 cores)
 
 The loop is the document's 5 s closed loop (ch. 7): r = 3 mm sin(pi t) (eq. 7.3), Ts = 5.04e-4 s,
 so 9921 steps, plant 1 / (m s^2) (exact ZOH), the eq. 7.2 PID with the document's gains, the
@@ -15,6 +15,13 @@ temporary folder and fed the same blocks in its own packing. Both are called wit
 arguments; A and B alternate (A B A B ...) so bursts of load hit both alike; medians of the
 repeats and the median of the paired ratios are reported.
 
+Table 3 (whole command). Wall time of a warm ``hystkit control --scheme direct --experiment sine``
+(a fresh process each: interpreter, imports, sensor models, loop kernel from numba's cache, the
+run, metrics and figure written), this tree against ``REFERENCE`` (extracted with ``git archive``
+into a temporary folder and run with ``PYTHONPATH``); one untimed run of each first fills the
+caches (numba's, and this tree's sensor models in a temporary ``HYSTKIT_CACHE_DIR``), then
+``COMMAND_REPEATS`` pairs A B A B, medians and the median of the paired ratios.
+
 Table 2 (families and references). ``simulate_loop`` with a 3-cell mPL, a 10-operator PI and a
 20-level Preisach compensator (S_r stays the mPL; ``first call`` includes compiling the loop for
 that combination of blocks, 0 when table 1 compiled it already); ``Python``: ``simulate_loop_reference``, the
@@ -25,12 +32,15 @@ with hystkit's (max |y difference|, metres) to show they do the same work.
 
 from __future__ import annotations
 
+import argparse
 import importlib
+import io
 import os
 import platform
 import statistics
 import subprocess
 import sys
+import tarfile
 import tempfile
 import time
 from pathlib import Path
@@ -53,6 +63,9 @@ SECONDS = 5.0
 REPEATS = 21
 PY_REPEATS = 3
 BEFORE = "411a485"  # the last commit before the family protocol
+REFERENCE = "2bff934"  # before the sensor models were cached on disk (issue 29)
+COMMAND = ["control", "--scheme", "direct", "--experiment", "sine"]
+COMMAND_REPEATS = 9
 REPO = Path(__file__).resolve().parents[1]
 
 
@@ -167,9 +180,58 @@ def family_rows(r: np.ndarray, models: hc.SensorModels) -> list[tuple]:
     return rows
 
 
+def reference_source(folder: Path) -> Path:
+    """``REFERENCE``'s ``src`` extracted into `folder` (a checkout shared with others stays
+    untouched)."""
+    archive = subprocess.run(["git", "archive", REFERENCE, "src"], cwd=REPO, check=True,
+                             capture_output=True).stdout
+    with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
+        tar.extractall(folder, filter="data")
+    return folder / "src"
+
+
+def whole_command(folder: Path) -> tuple[float, float, float]:
+    """Medians of the warm command's wall time [s], this tree and the reference, and the median
+    of the paired ratios."""
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "OPENBLAS_NUM_THREADS")}
+    variants = {"hystkit": {**env, "HYSTKIT_CACHE_DIR": str(folder / "cache")},
+                "before": {**env, "PYTHONPATH": str(reference_source(folder / "ref"))}}
+    times: dict[str, list[float]] = {name: [] for name in variants}
+    for k in range(COMMAND_REPEATS + 1):
+        for name, variant_env in variants.items():
+            out = folder / f"run-{name}-{k}"
+            t0 = time.perf_counter()
+            subprocess.run([sys.executable, "-m", "hystkit", *COMMAND, "--out", str(out)],
+                           env=variant_env, cwd=folder, check=True, capture_output=True)
+            if k:  # the first pair fills the caches
+                times[name].append(time.perf_counter() - t0)
+    ratios = [a / b for a, b in zip(times["hystkit"], times["before"], strict=True)]
+    return (statistics.median(times["hystkit"]), statistics.median(times["before"]),
+            statistics.median(ratios))
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--tables", default="loop,command",
+                        help="loop (tables 1 and 2), command (table 3), or both (default)")
+    tables = parser.parse_args().tables.split(",")
     t_total = time.perf_counter()
     machine()
+    if "loop" in tables:
+        loop_tables()
+    if "command" in tables:
+        with tempfile.TemporaryDirectory() as folder:
+            new, before, ratio = whole_command(Path(folder))
+        print(f"Table 3. whole command, warm: hystkit {' '.join(COMMAND)}; medians of "
+              f"{COMMAND_REPEATS} A/B pairs of fresh processes")
+        print(f"  {'before (' + REFERENCE + ') s':>20}{'hystkit s':>11}"
+              f"{'ratio (median of pairs)':>25}")
+        print(f"  {before:>20.3f}{new:>11.3f}{ratio:>25.3f}")
+        print()
+    print(f"Total benchmark time {time.perf_counter() - t_total:.1f} s")
+
+
+def loop_tables() -> None:
     t0 = time.perf_counter()
     models = hc.fit_sensor_models()
     t_fit = time.perf_counter() - t0
@@ -201,7 +263,6 @@ def main() -> None:
         print(f"  {family:<13}{name:<16}{seconds * 1e3:>11.2f}{seconds / n * 1e6:>11.3f}"
               f"{ratio:>11.1f}{diff:>15.1e}{c:>14}")
     print()
-    print(f"Total benchmark time {time.perf_counter() - t_total:.1f} s")
 
 
 if __name__ == "__main__":

@@ -68,12 +68,12 @@ def _models(training: str, excitation: str, sensor_size: int | None, model_size:
             sensor: str = "virtual", sensor_model: str = "mpl",
             model: str = "mpl", sensor_options: ReadOptions | None = None,
             training_options: ReadOptions | None = None) -> SensorModels:
-    # In-memory only, per process (repeated main() calls in one session, e.g. tests); nothing
-    # is cached on disk, so every command line fits its models afresh (about 2 s).
-    from ..control import fit_sensor_models
+    # Kept on disk across runs (hystkit.control.cached_sensor_models, keyed by the inputs and
+    # the code) and in memory per process (repeated main() calls in one session, e.g. tests).
+    from ..control import cached_sensor_models
     from ..io import read_recording
 
-    return fit_sensor_models(
+    return cached_sensor_models(
         sensor=_sensor(sensor), training=training, training_excitation=excitation,
         sensor_cells=sensor_size, model_cells=model_size, sensor_model=sensor_model,
         model=model,

@@ -25,6 +25,7 @@ __getattr__, __dir__ = lazy_exports(
      "_loop": ("ControlLoop", "LoopResponse", "LoopState", "rest_state", "simulate_loop",
                "simulate_loop_reference", "tare"),
      "_nlsys": ("as_nlsys", "loop_initial_state", "loop_nlsys"),
+     "_model_cache": ("cached_sensor_models",),
      "_plots": ("plot_bode", "plot_cases", "plot_response"),
      "_sensors": ("SensorBlock", "SensorModels", "compensator_block", "fit_forward_sensor",
                   "fit_sensor_models", "forward_block", "linear_block", "sensor_block",
