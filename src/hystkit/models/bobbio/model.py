@@ -36,16 +36,14 @@ import numpy as np
 
 from ...errors import FitDivergedError
 from .._protocol import Record
+from .._run import Runs, family_runs
 from .._validation import (
     check_dt,
-    check_finite_run,
     check_positive_int,
     check_signal,
     check_size,
     finite_floats,
     freeze_arrays,
-    initial_state,
-    run_steps,
 )
 from . import kernels
 
@@ -260,10 +258,8 @@ def rest_state(structure: BobbioStructure, params: BobbioParams, value: float,
     return np.full(params.n_springs - 1, force)
 
 
-def _check(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
-           name: str) -> np.ndarray:
+def _check(structure: BobbioStructure, params: BobbioParams, inverse: bool) -> None:
     check_size(params.n_springs, structure.n_springs, "springs")
-    return check_signal(u, name)
 
 
 def forces(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
@@ -290,105 +286,43 @@ def forces(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
     x_end : numpy.ndarray, shape (N - 1,)
         The forces after the last sample.
     """
-    u = _check(structure, params, u, "u")
-    x = initial_state(structure.n_springs - 1, x0, u[0])
-    return kernels.forces(u, x, params.friction)
+    _check(structure, params, False)
+    u = check_signal(u, "u")
+    return kernels.forces(u, RUNS.initial(structure, params, x0, u[0], False), params.friction)
 
 
-def simulate(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
-             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Deformation ``Y`` for an applied-force sequence (compiled kernel).
-
-    Parameters
-    ----------
-    structure : BobbioStructure
-        The model's structure.
-    params : BobbioParams
-        Its parameters.
-    u : array, shape (n,)
-        Applied force, one value per sample (only the values matter, not ``dt``).
-    x0 : array, shape (N - 1,), float or None
-        Initial forces ``F_2 .. F_N``; any values obeying eq. 2.5 with ``F_1 = u_0`` are an
-        equilibrium, others are projected at the first sample. ``None`` starts at rest at the
-        first input, all springs carrying ``u_0`` and no piston loaded.
-
-    Returns
-    -------
-    y : array, shape (n,)
-    x_end : array, shape (N - 1,)
-    """
-    f, x_end = forces(structure, params, u, x0)
-    u = np.asarray(u, dtype=float)
+def _forward(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    f, x_end = kernels.forces(u, x, params.friction)
     with np.errstate(over="ignore", invalid="ignore"):  # inputs near the float range
-        y = params.compliance[0] * u + f @ params.compliance[1:] + params.offset
-    return check_finite_run(y, "Bobbio-Marrucci"), x_end
+        return params.compliance[0] * u + f @ params.compliance[1:] + params.offset, x_end
 
 
-def simulate_reference(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
-                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step`.
-
-    Parameters
-    ----------
-    structure : BobbioStructure
-        The model's structure.
-    params : BobbioParams
-        Its parameters.
-    u : numpy.ndarray, shape (n,)
-        Input, one value per sample.
-    x0 : numpy.ndarray, float or None, optional
-        Initial forces ``F_2 .. F_N``, as for :func:`simulate`.
-
-    Returns
-    -------
-    y : numpy.ndarray, shape (n,)
-        Output.
-    x_end : numpy.ndarray
-        State after the last sample.
-    """
-    u = _check(structure, params, u, "u")
-    x = initial_state(structure.n_springs - 1, x0, u[0])
-    return run_steps(step, structure, params, u, x)
-
-
-def invert(structure: BobbioStructure, params: BobbioParams, y: np.ndarray,
-           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Applied force from the deformation: the chain under displacement control.
-
-    Given the state, ``Y(F)`` is continuous, piecewise linear and non-decreasing in ``F``:
-    slope ``c_1`` while piston 1 sticks, and each further piston that starts sliding adds its
-    spring's compliance. The inverse walks these segments (O(N) per sample, breakpoints
-    ``F_k +- A_k`` already sorted by eq. 2.5) and then updates the state like the forward model,
-    so ``simulate(invert(y)) == y``. If ``c_1 = 0`` and ``Y`` stays on a flat segment, the
-    middle of the band ``F_2 +- a_1`` is returned.
-
-    Parameters
-    ----------
-    structure : BobbioStructure
-        The model's structure.
-    params : BobbioParams
-        Its parameters.
-    y : array, shape (n,)
-    x0 : array, shape (N - 1,), float or None
-        ``None``: at rest at the force ``(y_0 - b) / sum(c)``.
-
-    Returns
-    -------
-    u : numpy.ndarray, shape (n,)
-        Input that gives `y`.
-    x_end : numpy.ndarray
-        State after the last sample.
-
-    Raises
-    ------
-    FitDivergedError
-        If no force gives the output (every compliance zero).
-    """
-    y = _check(structure, params, y, "y")
-    x = initial_state(structure.n_springs - 1, x0, _rest_force(params, y[0]))
+def _inverse(structure: BobbioStructure, params: BobbioParams, y: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     u_hat, x_end, n_bad = kernels.invert(y, x, params.compliance, params.friction,
-                                                params.offset)
+                                         params.offset)
     if n_bad >= 0:
         raise FitDivergedError(f"no applied force gives the deformation at sample {n_bad} "
                                f"(all compliances are zero)")
-    return check_finite_run(u_hat, "Bobbio-Marrucci", "inverse"), x_end
+    return u_hat, x_end
+
+
+RUNS = Runs(label="Bobbio-Marrucci", step=step,
+            n_state=lambda structure, params: structure.n_springs - 1, rest_state=rest_state,
+            forward=_forward, inverse=_inverse, check=_check)
+simulate, simulate_reference, invert = family_runs(
+    RUNS, __name__, "the Bobbio-Marrucci chain",
+    notes="The input is the applied force (only the values matter, not ``dt``), the output "
+          "the deformation ``Y`` and the state the forces ``F_2 .. F_N``. A given state obeying "
+          "eq. 2.5 with ``F_1 = u_0`` is an equilibrium, others are projected at the first "
+          "sample; at rest every spring carries ``u_0`` and no piston is loaded.",
+    inverse_notes="The chain under displacement control. Given the state, ``Y(F)`` is "
+                  "continuous, piecewise linear and non-decreasing in ``F``: slope ``c_1`` while "
+                  "piston 1 sticks, and each further piston that starts sliding adds its "
+                  "spring's compliance. The inverse walks these segments (O(N) per sample, "
+                  "breakpoints ``F_k +- A_k`` sorted by eq. 2.5) and then updates the state like "
+                  "the forward model, so ``simulate(invert(y)) == y``. If ``c_1 = 0`` and ``Y`` "
+                  "stays on a flat segment, the middle of the band ``F_2 +- a_1`` is returned; "
+                  "with every compliance zero no force gives the output. The rest start is the "
+                  "force ``(y_0 - b) / sum(c)``.")
