@@ -80,7 +80,7 @@ FIT_REPEATS = {8000: 3, 128_000: 2}  # interleaved pairs (tr, trf) per row
 SIM_TIMING_REPEATS = 7
 FIT_ONLY = "--fit-only" in sys.argv
 QUICK = "--quick" in sys.argv
-FIT_SEED = 1  # the demo report's fitting seed (hystkit.reports._demo.FIT_SEED)
+FIT_SEED = 1  # the demo report's fitting seed (hystkit.studies._demo.FIT_SEED)
 C_FLAGS = SLOW_FLAGS
 C_SOURCE = SLOW_SOURCE
 

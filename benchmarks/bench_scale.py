@@ -63,7 +63,7 @@ import json, sys, time
 t0 = time.perf_counter()
 from hystkit.io import read_recording
 from hystkit.parallel import open_executor
-from hystkit.reports import compare_models
+from hystkit.studies import compare_models
 fit, val = read_recording("fit.csv"), read_recording("val.csv")
 t1 = time.perf_counter()
 with open_executor(int(sys.argv[1])) as executor:
@@ -83,7 +83,7 @@ from hystkit.io import read_recording
 from hystkit.models import FAMILIES
 from hystkit.parallel import SerialExecutor
 from hystkit.models._warm import warm_kernels
-from hystkit.reports import candidates, compare_models, generalization_matrix, select_model
+from hystkit.studies import candidates, compare_models, generalization_matrix, select_model
 from hystkit.sensors import simulate_experiment
 from hystkit.signals import EXPERIMENTS
 

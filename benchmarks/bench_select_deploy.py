@@ -23,8 +23,8 @@ import numpy as np
 from hystkit.compensation import evaluate, folds, protocol
 from hystkit.io import Recording
 from hystkit.parallel import open_executor
-from hystkit.reports import candidates, compare_models, select_model
 from hystkit.sensors import simulate_experiment
+from hystkit.studies import candidates, compare_models, select_model
 
 # the shared real data's separate runs, as the centring example pairs them
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))

@@ -59,7 +59,7 @@ def python_latency(comp, sensor, *, repeats: int = 5, chunk: int = CHUNK) -> dic
     (compiles) first. (``benchmarks/bench_export.py`` adds its C and MATLAB rows to these.)"""
     import numpy as np
 
-    from hystkit.compensation import Stream
+    from hystkit.live import Stream
 
     Stream(comp).process(sensor[:2])
     Stream(comp).step(float(sensor[0]))
@@ -95,7 +95,8 @@ def python_latency(comp, sensor, *, repeats: int = 5, chunk: int = CHUNK) -> dic
 def _latency(models: Path, n_samples: int) -> dict:
     """`python_latency` (one repeat) of every model file in `models`, on `n_samples` of the
     virtual sensor's decay run (seed 2); and whether the stream ran compiled."""
-    from hystkit.compensation import Stream, load_compensator
+    from hystkit.compensation import load_compensator
+    from hystkit.live import Stream
     from hystkit.sensors import simulate_experiment
 
     sensor = simulate_experiment("decay", 2).sensor[:n_samples]

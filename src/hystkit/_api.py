@@ -1,6 +1,6 @@
 """The notebook interface: ``import hystkit as hk``, then ``hk.read``, ``hk.fit``, ``hk.evaluate``.
 
-Thin wrappers over the library (``hystkit.io``, ``hystkit.compensation``, ``hystkit.reports``)
+Thin wrappers over the library (``hystkit.io``, ``hystkit.compensation``, ``hystkit.studies``)
 that take a recording in whatever form a notebook holds it -- a `Recording`, a pandas
 DataFrame with columns ``time`` [s], ``position`` [mm] and ``sensor``, or a file path -- and give
 tables back as DataFrames. ``hystkit/__init__`` exports these names lazily (PEP 562), so
@@ -309,7 +309,7 @@ def compare(fit_data: Data, val_data: Data, models: Sequence[str] | None = None,
     -------
     pandas.DataFrame
         One row per model (the index), the columns of
-        `hystkit.reports.compare_models`: ``n_params``, ``fit_seconds``, ``r2_forward``,
+        `hystkit.studies.compare_models`: ``n_params``, ``fit_seconds``, ``r2_forward``,
         ``r2_compensated``, ``r2_direct`` (deployable), ``linear_r2``, the ``_oracle`` scores,
         ``direct_status``, ...; a family whose fit failed has its reason in ``error``.
 
@@ -326,7 +326,7 @@ def compare(fit_data: Data, val_data: Data, models: Sequence[str] | None = None,
     """
     import pandas as pd
 
-    from .reports import compare_models
+    from .studies import compare_models
 
     table = compare_models(_as_recording(fit_data), _as_recording(val_data), models, sizes)
     return pd.DataFrame.from_dict(table, orient="index")

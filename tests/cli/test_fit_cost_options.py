@@ -68,7 +68,7 @@ def test_robust_weighted_fit_is_recorded_and_summarised(recording, tmp_path, cap
     import html
 
     from hystkit.compensation import load_compensator
-    from hystkit.reports._report_model import fit_section
+    from hystkit.studies._report_model import fit_section
 
     assert f"Caveat: {caveat}." in html.unescape(fit_section(load_compensator(model)).to_html())
 

@@ -17,8 +17,7 @@ def _write(path, position_unit: str, gap: bool = False) -> None:
     sensor = 1.0 + 0.3 * x + 0.02 * np.tanh(5 * np.gradient(x))
     with open(path, "w") as out:
         out.write(f"time,position,sensor\ns,{position_unit},V\n")
-        for row in zip(t, x, sensor, strict=True):
-            out.write(",".join(f"{v:.9g}" for v in row) + "\n")
+        out.writelines(",".join(f"{v:.9g}" for v in row) + "\n" for row in zip(t, x, sensor, strict=True))
 
 
 def test_files_in_different_units_are_refused_in_one_line(tmp_path, capsys):

@@ -16,7 +16,7 @@ from hystkit.io import read_recording, write_recording
 
 from ..cli_support import run_cli
 from ..compensation.test_verdict_corpus import data  # noqa: F401 (the labelled corpus)
-from ..reports.test_compare_failures import broken_chua  # noqa: F401 (a family that raises)
+from ..studies.test_compare_failures import broken_chua  # noqa: F401 (a family that raises)
 from .test_use_guards_cli import _patched
 
 

@@ -8,11 +8,11 @@ import pytest
 
 import hystkit
 import hystkit.compensation
-import hystkit.reports
+import hystkit.studies
 
 SRC = Path(hystkit.__file__).parent
 CHECKED = [SRC / "cli" / "cmd_core.py", SRC / "cli" / "cmd_compare.py",
-           SRC / "cli" / "cmd_select.py", *sorted((SRC / "reports").glob("*.py")),
+           SRC / "cli" / "cmd_select.py", *sorted((SRC / "studies").glob("*.py")),
            *sorted((SRC / "compensation").glob("*.py")), *sorted((SRC / "metrics").glob("*.py"))]
 
 
@@ -38,17 +38,17 @@ def test_no_private_module_of_another_package_is_imported(path):
 def test_the_checker_sees_a_private_import(tmp_path):
     probe = tmp_path / "probe.py"
     probe.write_text("from ..compensation._compensator import POSITION_MARGIN\n"
-                     "from hystkit.reports._select import folds\n"
+                     "from hystkit.studies._select import folds\n"
                      "from ._x import y\nfrom ..compensation import evaluate\n"
                      "from .._lazy import lazy_exports\n")
     assert _private_imports_across_packages(probe) == [
-        "probe.py:1: ..compensation._compensator", "probe.py:2: hystkit.reports._select"]
+        "probe.py:1: ..compensation._compensator", "probe.py:2: hystkit.studies._select"]
 
 
 @pytest.mark.parametrize(("package", "names"), [
     (hystkit.compensation, ["DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS", "POSITION_MARGIN",
                             "SENSOR_MARGIN", "use_flags", "centre_and_scale"]),
-    (hystkit.reports, ["compare_models", "format_compare", "generalization_matrix",
+    (hystkit.studies, ["compare_models", "format_compare", "generalization_matrix",
                        "plot_generalization", "candidates", "plot_selection", "select_model"]),
 ])
 def test_the_names_are_exported(package, names):

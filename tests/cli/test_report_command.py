@@ -129,7 +129,7 @@ def test_a_failure_while_writing_leaves_nothing(inputs: dict, tmp_path: Path) ->
     """The disk fills while the last figure file is written: neither the page nor any figure
     file appears, and no temporary file stays behind."""
     from hystkit.errors import OutputError
-    from hystkit.reports import build_report, write_report
+    from hystkit.studies import build_report, write_report
 
     content = build_report([inputs["model"], inputs["data"]])
 

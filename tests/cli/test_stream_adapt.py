@@ -5,13 +5,8 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from hystkit.cli import main
-from hystkit.compensation import (
-    Adaptation,
-    AdaptiveStream,
-    Stream,
-    fit_compensator,
-    save_compensator,
-)
+from hystkit.compensation import fit_compensator, save_compensator
+from hystkit.live import Adaptation, AdaptiveStream, Stream
 from hystkit.sensors import occasional_references, simulate_experiment, with_gain_drift
 
 N = 400
@@ -131,7 +126,7 @@ def test_weights_on_an_inverse_model_is_one_error_line(tmp_path, capsys):
 def test_the_parser_constants_are_the_library_s():
     # the parser keeps its own copies so that building it imports no numpy
     from hystkit.cli import cmd_stream
-    from hystkit.compensation import ADAPT_PARAMETERS, Refit
+    from hystkit.live import ADAPT_PARAMETERS, Refit
 
     assert cmd_stream.ADAPT_CHOICES == (*ADAPT_PARAMETERS, "full")
     assert cmd_stream.DEFAULT_FORGETTING == Adaptation().forgetting
@@ -140,7 +135,7 @@ def test_the_parser_constants_are_the_library_s():
 
 
 def test_adapt_full_gives_the_library_refitting_stream(model, tmp_path, capsys):
-    from hystkit.compensation import Refit, RefittingStream
+    from hystkit.live import Refit, RefittingStream
 
     comp, path = model
     rec = with_gain_drift(simulate_experiment("sine", 2), -0.10)

@@ -13,8 +13,9 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from hystkit.cli import main
-from hystkit.compensation import Stream, fit_compensator, save_compensator
+from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.io import Recording
+from hystkit.live import Stream
 from hystkit.sensors import simulate_experiment
 
 WAIT = 180  # seconds: a cold interpreter imports numpy, scipy and numba on a shared machine

@@ -12,7 +12,8 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from hystkit.cli import main
-from hystkit.compensation import Stream, fit_compensator, save_compensator
+from hystkit.compensation import fit_compensator, save_compensator
+from hystkit.live import Stream
 from hystkit.sensors import simulate_experiment
 
 N = 60

@@ -5,8 +5,9 @@ divergence only after writing wrong estimates)."""
 import pytest
 
 from hystkit.cli import main
-from hystkit.compensation import Stream, fit_compensator, save_compensator
+from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.errors import InputError
+from hystkit.live import Stream
 from hystkit.sensors import simulate_experiment
 
 

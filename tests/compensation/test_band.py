@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from hystkit.compensation import (
-    Stream,
     fit_compensator,
     interval_scores,
     load_compensator,
@@ -20,6 +19,7 @@ from hystkit.compensation import (
 from hystkit.compensation._band import QUANTILE_GRID, Band, band_features, local_scale
 from hystkit.errors import InputError
 from hystkit.io import Recording
+from hystkit.live import Stream
 from hystkit.sensors import simulate_experiment
 
 

@@ -11,8 +11,8 @@ import pytest
 from hystkit.cli import main
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.datasets import load_excerpt
-from hystkit.reports._report_model import score_section
 from hystkit.sensors import simulate_experiment
+from hystkit.studies._report_model import score_section
 
 SINAD_KEYS = ("sinad_db", "linear_sinad_db", "sinad_db_oracle", "linear_sinad_db_oracle")
 

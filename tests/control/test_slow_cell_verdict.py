@@ -21,7 +21,7 @@ import pytest
 from hystkit import control as hc
 from hystkit.cli._control_report import closed_loop
 from hystkit.models.mpl.model import MplParams, MplStructure
-from hystkit.reports._report_control import stability_verdict
+from hystkit.studies._report_control import stability_verdict
 
 from ..cli_support import run_cli
 

@@ -52,7 +52,7 @@ def site(tmp_path_factory) -> Path:
 
 def test_api_pages_name_the_main_objects(site):
     generated = site / "reference" / "api" / "generated"
-    for name in ("hystkit.compensation.fit_compensator", "hystkit.compensation.Stream",
+    for name in ("hystkit.compensation.fit_compensator", "hystkit.live.Stream",
                  "hystkit.compensation.CompensatorEstimator"):
         page = generated / f"{name}.html"
         assert page.is_file(), f"no API page {page.name}"

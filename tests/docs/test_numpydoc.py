@@ -31,10 +31,10 @@ DOCUMENTED = (
     "hystkit.compensation",
     "hystkit.control",
     "hystkit.datasets",
-    "hystkit.experiments",
     "hystkit.export",
     "hystkit.identification",
     "hystkit.io",
+    "hystkit.live",
     "hystkit.metrics",
     "hystkit.models",
     "hystkit.models.bobbio",
@@ -50,9 +50,9 @@ DOCUMENTED = (
     "hystkit.models.preisach",
     "hystkit.parallel",
     "hystkit.preprocess",
-    "hystkit.reports",
     "hystkit.sensors",
     "hystkit.signals",
+    "hystkit.studies",
 )
 
 # Being documented now, module by module (issue 11); the lead finishes them and moves each

@@ -19,9 +19,9 @@ import pytest
 
 from hystkit.compensation import fit_compensator, with_band
 from hystkit.compensation._band import band_features
-from hystkit.compensation._stream import Stream
 from hystkit.errors import InputError
 from hystkit.export import c_files, export_compensator, make_plan, matlab_files
+from hystkit.live._stream import Stream
 
 from .export_support import compile_c, need
 
@@ -153,7 +153,7 @@ def test_c_band_at_another_level_and_with_a_rate_share(banded, stretched, tmp_pa
 def test_c_sync_start_matches_the_streams_band(banded, stretched, tmp_path):
     """NAME_sync starts the band's features afresh, as Stream(start="sync") does."""
     need("cc")
-    from hystkit.compensation._sync import sync_excitation
+    from hystkit.live._sync import sync_excitation
 
     comp = banded("mpl3")
     binary = _build(tmp_path / "c", comp, True, start="comp_sync(&st)",

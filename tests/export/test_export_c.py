@@ -259,7 +259,7 @@ _SYNC_HARNESS = _HARNESS.replace("comp_init(&st, v)", "comp_sync(&st)")
 def test_c_sync_start_matches_the_stream(label, mode, center, compensators, recordings,
                                          tmp_path):
     """NAME_sync: the state after e_sync, centring from the next sample, as Stream("sync")."""
-    from hystkit.compensation._stream import Stream
+    from hystkit.live._stream import Stream
 
     _, val = recordings
     comp = compensators(label, mode, center)
@@ -275,7 +275,7 @@ def test_c_sync_start_matches_the_stream(label, mode, center, compensators, reco
 
 
 def _sync_state(comp):
-    from hystkit.compensation._sync import sync_excitation
+    from hystkit.live._sync import sync_excitation
 
     return sync_excitation(comp).state_after
 

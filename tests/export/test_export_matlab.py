@@ -83,8 +83,8 @@ def test_matlab_files_are_named_after_the_model(compensators):
 def test_matlab_sync_start_matches_the_stream(label, mode, center, compensators, recordings,
                                               tmp_path):
     """NAME_sync(): the state after e_sync, centring from the next sample, as Stream("sync")."""
-    from hystkit.compensation._stream import Stream
-    from hystkit.compensation._sync import sync_excitation
+    from hystkit.live._stream import Stream
+    from hystkit.live._sync import sync_excitation
 
     octave = need("octave")
     _, val = recordings

@@ -9,14 +9,9 @@ import json
 import numpy as np
 import pytest
 
-from hystkit.compensation import (
-    Stream,
-    fit_compensator,
-    load_compensator,
-    save_compensator,
-    with_band,
-)
+from hystkit.compensation import fit_compensator, load_compensator, save_compensator, with_band
 from hystkit.errors import InputError
+from hystkit.live import Stream
 from hystkit.sensors import simulate_experiment
 
 HOSTILE = [None, True, "x", -1, 0, 1e308, -1e308, [], {}, [1, 2], 1.5, 2, 1e-320, 0.5]

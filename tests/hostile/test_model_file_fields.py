@@ -23,10 +23,10 @@ import pytest
 from hystkit.compensation import Compensator, compensator_from_dict, compensator_to_dict
 from hystkit.compensation._compensator import MAX_NORMALISED
 from hystkit.compensation._conventions import LinearBaseline, prepare_training_data
-from hystkit.compensation._stream import Stream
 from hystkit.errors import FitDivergedError, InputError
 from hystkit.io import read_recording
 from hystkit.io._recording import MAX_MAGNITUDE
+from hystkit.live._stream import Stream
 from hystkit.models import FAMILIES
 
 from .conftest import assert_model_file_refused, snapshot

@@ -13,11 +13,12 @@ from numpy.testing import assert_array_equal
 
 import hystkit as hk
 from hystkit.cli import main
-from hystkit.compensation import Stream, fit_compensator, save_compensator
+from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.errors import InputError
 from hystkit.io import ReadOptions, _csv_reader, csv_layout, read_recording
 from hystkit.io._cells import Where
 from hystkit.io._other_columns import read_other_columns
+from hystkit.live import Stream
 from hystkit.sensors import simulate_experiment
 
 

@@ -13,7 +13,7 @@ from hystkit.cli._main import main
 from hystkit.compensation import DEFAULT_CENTER
 from hystkit.models.pl import structural_search
 from hystkit.parallel import open_executor
-from hystkit.reports import (
+from hystkit.studies import (
     Candidate,
     compare_models,
     generalization_matrix,

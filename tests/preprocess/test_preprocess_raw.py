@@ -383,7 +383,7 @@ def test_cli_raw_only_options_need_raw(tmp_path, capsys):
 
 
 def test_demo_raw_path_round_trip():
-    from hystkit.reports._demo import run_raw_path
+    from hystkit.studies._demo import run_raw_path
 
     lines = []
     raw = run_raw_path(1, scope_rate=2e4, progress=lines.append)
@@ -395,7 +395,7 @@ def test_demo_raw_path_round_trip():
 
 
 def test_demo_raw_flag_prints_the_raw_path(tmp_path, capsys, monkeypatch):
-    import hystkit.reports
+    import hystkit.studies
 
     canned = {"metrics": {}, "noise_trained": {}, "config": {},
               "raw_path": {"excitation": "sine", "scope_rate_hz": 5e4,
@@ -406,7 +406,7 @@ def test_demo_raw_flag_prints_the_raw_path(tmp_path, capsys, monkeypatch):
                                "position_max_error_um": 0.4, "position_max_error_counts": 0.08,
                                "sensor_rms_error": 4e-5, "n_illegal": 0, "n_edges": 240000}}}}
     calls = []
-    monkeypatch.setattr(hystkit.reports, "run_demo",
+    monkeypatch.setattr(hystkit.studies, "run_demo",
                         lambda out, **kw: calls.append(kw) or canned)
     assert main(["demo", "--out", str(tmp_path), "--cells", "1", "--raw"]) == 0
     out = capsys.readouterr().out

@@ -15,7 +15,7 @@ def print_parameters(comp, se: dict | None) -> None:
     lmfit's fit report: n/a where the data do not determine one, 'fixed' where the fit holds
     it (a gauge)."""
     from ..compensation import named_floats
-    from ..reports import text_table
+    from ..studies import text_table
 
     names = [name for name, _ in named_floats(comp.params.to_dict())]
     values = [value for _, value in named_floats(comp.params.to_dict())]

@@ -1,7 +1,7 @@
 """``hystkit fit --model auto``: a guided first fit (issue 27.5).
 
 A short, fixed list of small candidates goes through ``select``'s machinery (the same folds,
-score, verdict, refit of the winner and band: :func:`hystkit.reports.select_model`) under a
+score, verdict, refit of the winner and band: :func:`hystkit.studies.select_model`) under a
 time budget, and the choice is explained in three lines. The list covers what a cheap
 hysteretic sensor usually shows with the cheapest families that show it:
 
@@ -111,7 +111,7 @@ class _Budgeted:
 def guided_select(recordings: Sequence, *, budget: float = DEFAULT_BUDGET, mode: str = "direct",
                   center: str = "fit", executor=None,
                   progress: Callable[[str], None] = lambda _: None, **options) -> dict:
-    """`hystkit.reports.select_model` over `guided_candidates` within `budget` seconds.
+    """`hystkit.studies.select_model` over `guided_candidates` within `budget` seconds.
 
     Parameters
     ----------
@@ -137,7 +137,7 @@ def guided_select(recordings: Sequence, *, budget: float = DEFAULT_BUDGET, mode:
     """
     from ..compensation import check_fitting_data, folds, protocol
     from ..parallel import SerialExecutor, fit_cost
-    from ..reports import select_model
+    from ..studies import select_model
 
     t0 = time.time()
     check_fitting_data(recordings)

@@ -92,7 +92,7 @@ def _compare(args: argparse.Namespace) -> int:
     # Matplotlib and the fits load only for this command.
     from ..compensation import DEFAULT_CENTER
     from ..io import atomic_folder, check_output_folder, read_recording, write_json, write_mat
-    from ..reports import compare_models, format_compare
+    from ..studies import compare_models, format_compare
 
     models = _models(args.models)
     out = args.out
@@ -131,9 +131,9 @@ def _generalize(args: argparse.Namespace) -> int:
     from ..compensation import DEFAULT_CENTER
     from ..io import atomic_folder, check_output_folder, read_recording, write_json, write_mat
     from ..parallel import loading_meanwhile
-    from ..reports import FIGURE_MODULES, generalization_matrix, plot_generalization
     from ..sensors import simulate_experiment
     from ..signals import EXPERIMENTS
+    from ..studies import FIGURE_MODULES, generalization_matrix, plot_generalization
 
     models = _models(args.models)
     out = args.out or Path("hystkit-generalize")

@@ -390,7 +390,7 @@ def _fmt(x: float | None) -> str:
 def _demo(args: argparse.Namespace) -> int:
     # Imported here so the other subcommands do not pay for loading matplotlib.
     from ..compensation import DEFAULT_CENTER
-    from ..reports import DOCUMENT_TABLE_5_5, format_table, run_demo
+    from ..studies import DOCUMENT_TABLE_5_5, format_table, run_demo
 
     out = args.out or Path(f"hystkit-demo-{time.strftime('%Y%m%d-%H%M%S')}")
     check_size("mpl", args.cells, "--cells")
@@ -415,7 +415,7 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _print_raw_path(raw: dict) -> None:
-    from ..reports import format_table  # lazily, as in _demo
+    from ..studies import format_table  # lazily, as in _demo
 
     print()
     print(format_table({f"{raw['excitation']} raw": raw["metrics"]},

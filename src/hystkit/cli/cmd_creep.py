@@ -12,8 +12,8 @@ __all__ = ["register"]
 
 
 def _creep(args: argparse.Namespace) -> int:
-    from ..experiments import CREEP_COLUMNS, CreepPlan, creep_experiment, output_names
     from ..io import check_output_folder
+    from ..studies import CREEP_COLUMNS, CreepPlan, creep_experiment, output_names
     from .cmd_compare import _models, _sizes
 
     models = _models(args.models) if args.models else ["mpl", "pl"]
@@ -24,7 +24,7 @@ def _creep(args: argparse.Namespace) -> int:
     plan = CreepPlan(hold_seconds=hours * 3600.0 / 3, amplitude_mm=args.amplitude)
     result = creep_experiment(plan, models=models, sizes=sizes, seed=args.seed,
                               progress=print)
-    from ..experiments import format_markdown, write_table
+    from ..studies import format_markdown, write_table
 
     columns = CREEP_COLUMNS + tuple((f"{m}_creep_error_pct", f"{m} creep error (%)")
                                     for m in models)

@@ -17,7 +17,7 @@ FORMATS = ("png", "svg", "pdf")  # as reports.FIGURE_FORMATS, without loading th
 def _report(args: argparse.Namespace) -> int:
     from ..io import check_output_path
     from ..io._atomic import check_folder_writable
-    from ..reports import build_report, write_report
+    from ..studies import build_report, write_report
 
     if args.format != "png" and args.figures is None:
         raise UsageError("--format chooses the figure files' format; give --figures DIR too")

@@ -50,7 +50,7 @@ def _select(args: argparse.Namespace) -> int:
         write_json,
     )
     from ..parallel import loading_meanwhile
-    from ..reports import FIGURE_MODULES, candidates, plot_selection, select_model, text_table
+    from ..studies import FIGURE_MODULES, candidates, plot_selection, select_model, text_table
 
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
                       what="a model file")

@@ -13,7 +13,7 @@ Output, one line per accepted sample: ``time,position_estimate,flags`` after a h
 ``position_lower,position_upper`` (the prediction band, bit for bit ``hystkit compensate``'s)
 when the model has a band; the columns named as ``compensate`` names them (the input's time
 column, ``x_mm_estimate`` for an input whose position column is ``x_mm``); ``--adapt
-gain|weights`` re-scales the band from the references (:mod:`hystkit.compensation._adaptive`),
+gain|weights`` re-scales the band from the references (:mod:`hystkit.live._adaptive`),
 ``--adapt full`` has none. ``time`` is echoed as received (in the input's unit), the estimate
 [mm] is printed to full precision, ``flags`` is a bit mask: 1 = sensor outside the training
 range, 2 = estimate outside the training position range (the columns of ``hystkit
@@ -36,11 +36,11 @@ and first line number, and the latency per sample (from the read that brought it
 output line is ready: parse, compensate, format; writing it is one system call more).
 
 Online adaptation (``--adapt gain`` or ``--adapt weights``, see
-:mod:`hystkit.compensation._adaptive`): a third column ``reference`` (named in the header, or
+:mod:`hystkit.live._adaptive`): a third column ``reference`` (named in the header, or
 the third field without one) gives the true position [mm] now and then, empty (or ``nan``) when
 unknown; each known one re-fits the output's gain and offset (or cell weights) by recursive
 least squares with forgetting, after its own sample's estimate is made. ``--adapt full``
-(:mod:`hystkit.compensation._refit`) re-fits every parameter on the last ``--window`` seconds
+(:mod:`hystkit.live._refit`) re-fits every parameter on the last ``--window`` seconds
 after every ``--refit-every`` references. A reference that is not a number is ignored and
 counted. At the end stderr gets the references used, the a-priori error at them and the
 adapted parameters. Adapting streams run sample by sample in Python (their updates are).
@@ -73,7 +73,7 @@ from ._stream_input import (
 )
 
 if TYPE_CHECKING:
-    from ..compensation import AdaptiveStream, RefittingStream, Stream, SyncExcitation
+    from ..live import AdaptiveStream, RefittingStream, Stream, SyncExcitation
 
 __all__ = ["register"]
 
@@ -88,7 +88,7 @@ MAX_LINE = 4096
 CHUNK_BYTES = 1 << 16
 TOO_LONG = "\0 line too long"
 SERIAL_HINT = 'pip install "hystkit[serial]"'
-# As hystkit.compensation._adaptive and ._refit (not imported here: the parser stays light).
+# As hystkit.live._adaptive and ._refit (not imported here: the parser stays light).
 ADAPT_CHOICES = ("gain", "weights", "full")
 DEFAULT_FORGETTING = 0.9
 DEFAULT_WINDOW = 60.0
@@ -592,8 +592,9 @@ def _write(text: str) -> None:
 
 
 def _stream(args: argparse.Namespace) -> int:
-    from ..compensation import Stream, load_compensator, sync_excitation
-    from ..compensation._stream import check_streamable
+    from ..compensation import load_compensator
+    from ..live import Stream, sync_excitation
+    from ..live._stream import check_streamable
 
     if args.serial is None and args.baud is not None:
         raise InputError("--baud is for --serial")
@@ -666,7 +667,7 @@ def _verb(options: list[str]) -> str:
 
 def _adaptive_stream(args: argparse.Namespace, comp,
                      start) -> AdaptiveStream | RefittingStream:
-    from ..compensation import Adaptation, AdaptiveStream, Refit, RefittingStream
+    from ..live import Adaptation, AdaptiveStream, Refit, RefittingStream
 
     if args.adapt == "full":
         refit = Refit(DEFAULT_WINDOW if args.window is None else args.window,

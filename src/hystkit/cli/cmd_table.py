@@ -15,15 +15,15 @@ _SEED = integer(0, 2**32 - 1)
 
 def _check_out(args: argparse.Namespace, stem: str) -> None:
     """Refuse an existing output before any work (nothing is overwritten without --force)."""
-    from ..experiments import output_names
     from ..io import check_output_folder
+    from ..studies import output_names
 
     if args.out is not None:
         check_output_folder(args.out, output_names(stem), args.force)
 
 
 def _finish(args: argparse.Namespace, stem: str, result: dict, columns) -> None:
-    from ..experiments import format_markdown, write_table
+    from ..studies import format_markdown, write_table
 
     print(format_markdown(result["rows"], columns))
     if args.out is not None:
@@ -32,8 +32,8 @@ def _finish(args: argparse.Namespace, stem: str, result: dict, columns) -> None:
 
 
 def _table_5_4(args: argparse.Namespace) -> int:
-    from ..experiments import TABLE_5_4_COLUMNS, Table54Settings, measure_table_5_4
     from ..models import get_family
+    from ..studies import TABLE_5_4_COLUMNS, Table54Settings, measure_table_5_4
 
     family = get_family(args.model)
     if family.invert is None:
@@ -66,7 +66,7 @@ def _table_5_4(args: argparse.Namespace) -> int:
 
 
 def _table_2_2(args: argparse.Namespace) -> int:
-    from ..experiments import TABLE_2_2_COLUMNS, measure_table_2_2
+    from ..studies import TABLE_2_2_COLUMNS, measure_table_2_2
     from .cmd_compare import _models, _sizes
 
     models = _models(args.models) if args.models else ["pl", "pi", "mpl"]

@@ -1,5 +1,8 @@
 """Compensators: fitted models that turn a sensor signal into a position estimate.
 
+Fitting, the model file, the band, the verdict and offline evaluation; running a compensator
+sample by sample on a live sensor is :mod:`hystkit.live`.
+
 Names are imported on first use (PEP 562, :func:`hystkit._lazy.lazy_exports`), so a command
 that only needs the centring names (``hystkit fit --help``) loads no scipy, numba or pandas.
 """
@@ -8,10 +11,7 @@ from .._lazy import lazy_exports
 
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"_adaptive": ("ADAPT_PARAMETERS", "Adaptation", "AdaptiveState", "AdaptiveStream",
-                   "advance_adaptive"),
-     "_redundancy": ("redundancy_notes",),
-     "_refit": ("Refit", "RefitReport", "RefittingStream"),
+    {"_redundancy": ("redundancy_notes",),
      "_param_vector": ("named_floats",),
      "_centring": ("CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",
                    "DEPLOYABLE_CENTERS", "ORACLE_CENTER", "center_label"),
@@ -28,9 +28,6 @@ __getattr__, __dir__ = lazy_exports(
                 "fit_fold", "fits_in", "fold_scores", "folds", "protocol"),
      "_model_file": ("MODEL_SUFFIXES", "compensator_from_dict", "compensator_to_dict",
                      "load_compensator", "save_compensator"),
-     "_stream": ("StepOutput", "Stream", "StreamOutput", "advance"),
-     "_stream_state": ("StreamState",),
-     "_sync": ("SyncExcitation", "sync_excitation"),
      "_training_checks": ("MIN_SAMPLES_PER_PARAM", "check_excursion", "check_fitting_data",
                           "count_fitted"),
      "_verdict": ("FAR_MARGIN", "MAX_OUTSIDE", "MIN_EXPLAINED", "use_verdict", "verdict")},

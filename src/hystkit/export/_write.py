@@ -25,7 +25,7 @@ LANGUAGES = ("c", "matlab")
 def sync_state_of(comp: Compensator) -> tuple[np.ndarray | None, str]:
     """The model state after the synchronisation excitation (eq. 2.21-2.22) and a note; the
     state is None, and the note says why, when the model does not forget its history."""
-    from ..compensation._sync import sync_excitation
+    from ..live import sync_excitation
 
     try:
         sync = sync_excitation(comp)
