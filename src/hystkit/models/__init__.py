@@ -14,6 +14,7 @@ from ._protocol import (
                         FitStart,
                         Record,
                         Reduction,
+                        Translation,
                         numerical_linearisation,
 )
 from ._registry import (
@@ -29,5 +30,5 @@ from ._stability import stability_report
 from ._warm import warm_kernels
 
 __all__ = ["DT_RANGE", "FAMILIES", "FAMILY_INFO", "Block", "Family", "FamilyInfo", "FitStart",
-           "Record", "Reduction", "family_info", "family_of", "get_family",
+           "Record", "Reduction", "Translation", "family_info", "family_of", "get_family",
            "numerical_linearisation", "register", "stability_report", "unregister", "warm_kernels"]
