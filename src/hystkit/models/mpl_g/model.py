@@ -49,7 +49,9 @@ from .._validation import (
 )
 from ..mpl.model import I_S_RANGE, V_T_RANGE, knee_voltage, resistor_current
 from ..mpl_poly.kernels import solve_output
-from ..mpl_poly.model import G_MIN, POLY_MAX, branch_around, output_current, output_slope
+from ..mpl_poly.records import G_MIN, POLY_MAX
+from ..mpl_poly.resistors import output_current, output_slope
+from ..mpl_poly.rest import branch_around
 from . import kernels
 
 __all__ = [

@@ -196,7 +196,7 @@ def normal_equations(structure: mpl_poly.MplPolyStructure, params: mpl_poly.MplP
         mpl_poly.check_rest(structure, params)
     except FitDivergedError:
         return NormalEquations(np.inf, np.full((p, p), np.nan), np.full(p, np.nan))
-    x = mpl_poly._start(structure, params, None, u[0])
+    x = mpl_poly.rest_state(structure, params, u[0])
     fc, knees, s, limit, gc = mpl_poly._kernel_args(structure, params)
     slope = mpl_poly.resistor_slope(structure, params, u[0] - x)
     sens0 = np.array([kernels.cell_gradient(u[0] - x[k], fc[k], knees[k, 0], knees[k, 1], s,

@@ -1,0 +1,135 @@
+"""The polynomial mPL model's cubic resistors: the cell resistors ``f_k`` with the corrected
+stability limit of eq. 5.29 (knees and straight continuations) and the output resistor ``g``,
+with their slopes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .records import (
+    MplPolyParams,
+    MplPolyStructure,
+)
+
+
+def knee_points(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarray:
+    """Knees ``x-, x+`` of each cell, shape (N, 2): the extreme solutions of ``f'(x) = s``.
+
+    ``s = slope_cap / dt``. With ``c3 > 0`` ``f'`` is an upward parabola, so ``f' > s`` exactly
+    outside the knees; when it never drops to ``s`` both knees sit at its vertex.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 2)
+        ``x-, x+`` per cell.
+    """
+    s = structure.slope_cap / structure.dt
+    c1, c2, c3 = params.f[:, 1], params.f[:, 2], params.f[:, 3]
+    vertex = -c2 / (3 * c3)
+    half_width = np.sqrt(np.maximum(c2 * c2 - 3 * c3 * (c1 - s), 0.0)) / (3 * c3)
+    return np.column_stack([vertex - half_width, vertex + half_width])
+
+
+def _cubic(c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return (c[..., 0] + x * (c[..., 1] + x * (c[..., 2] + x * c[..., 3])),
+            c[..., 1] + x * (2 * c[..., 2] + 3 * c[..., 3] * x))
+
+
+def _resistor(structure: MplPolyStructure, params: MplPolyParams,
+              v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    v = np.asarray(v, dtype=float)
+    f, df = _cubic(params.f, v)
+    if not structure.limit:
+        return f, df
+    knees = knee_points(structure, params)
+    s = structure.slope_cap / structure.dt
+    x_b = np.where(v >= knees[:, 1], knees[:, 1], knees[:, 0])
+    outside = (v >= knees[:, 1]) | (v <= knees[:, 0])
+    return (np.where(outside, _cubic(params.f, x_b)[0] + s * (v - x_b), f),
+            np.where(outside, s, df))
+
+
+def resistor_current(structure: MplPolyStructure, params: MplPolyParams,
+                     v: np.ndarray) -> np.ndarray:
+    """Cell currents ``f_k,lim(v)`` (eq. 5.16 with 5.29 when ``structure.limit``).
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+    v : array, shape (..., N)
+        Voltage across each cell's resistor.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        The cell currents.
+    """
+    return _resistor(structure, params, v)[0]
+
+
+def resistor_slope(structure: MplPolyStructure, params: MplPolyParams,
+                   v: np.ndarray) -> np.ndarray:
+    """Slopes ``f'_k,lim(v)``, shape (..., N): the cells' rates in eq. 5.20 and 5.26.
+
+    Parameters
+    ----------
+    structure : MplPolyStructure
+        The model's structure.
+    params : MplPolyParams
+        Its parameters.
+    v : numpy.ndarray, shape (..., N)
+        Voltage across each cell's resistor.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., N)
+        The slopes.
+    """
+    return _resistor(structure, params, v)[1]
+
+
+def output_current(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
+    """Output resistor current ``g(z)`` (eq. 5.17).
+
+    Parameters
+    ----------
+    params : MplPolyParams
+        The model's parameters.
+    z : numpy.ndarray
+        Voltage across the output resistor.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``g(z)``, same shape as `z`.
+    """
+    return _cubic(params.g, np.asarray(z, dtype=float))[0]
+
+
+def output_slope(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
+    """Output resistor slope ``g'(z)`` (``g'_0`` of eq. 5.19).
+
+    Parameters
+    ----------
+    params : MplPolyParams
+        The model's parameters.
+    z : numpy.ndarray
+        Voltage across the output resistor.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``g'(z)``, same shape as `z`.
+    """
+    return _cubic(params.g, np.asarray(z, dtype=float))[1]
