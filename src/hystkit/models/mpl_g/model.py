@@ -34,8 +34,8 @@ from scipy.optimize import brentq
 from ...errors import FitDivergedError
 from .._cells import MAX_CELLS, CellStructure
 from .._protocol import Record
+from .._run import Runs, family_runs
 from .._validation import (
-    check_finite_run,
     check_magnitude,
     check_range,
     check_signal,
@@ -44,14 +44,12 @@ from .._validation import (
     finite_floats,
     freeze_arrays,
     frozen_shaped,
-    initial_state,
-    run_steps,
 )
 from ..mpl.model import I_S_RANGE, V_T_RANGE, knee_voltage, resistor_current
 from ..mpl_poly.kernels import solve_output
 from ..mpl_poly.records import G_MIN, POLY_MAX
 from ..mpl_poly.resistors import output_current, output_slope
-from ..mpl_poly.rest import branch_around
+from ..mpl_poly.rest import branch_around, check_branch_inverse
 from . import kernels
 
 __all__ = [
@@ -317,9 +315,10 @@ def invert_step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
     return float(e), x + resistor_current(structure, params, e - x) * structure.dt
 
 
-def _check(structure: MplGStructure, params: MplGParams, u, name: str) -> np.ndarray:
+def _check(structure: MplGStructure, params: MplGParams, inverse: bool) -> None:
     check_size(params.n_cells, structure.n_cells, "cells")
-    return check_signal(u, name)
+    if inverse and params.w[0] == 0:
+        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
 
 
 def _cell_args(structure: MplGStructure, params: MplGParams) -> tuple:
@@ -327,59 +326,33 @@ def _cell_args(structure: MplGStructure, params: MplGParams) -> tuple:
             structure.slope_cap / structure.dt, structure.dt)
 
 
-def simulate(structure: MplGStructure, params: MplGParams, u: np.ndarray,
-             x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Run the forward model over an input sequence (compiled kernel).
-
-    Parameters
-    ----------
-    structure : MplGStructure
-        The model's structure.
-    params : MplGParams
-        Its parameters.
-    u : array, shape (n,)
-        Model input ``e`` sampled every ``structure.dt`` (normalised units).
-    x0 : array, shape (N,), float or None
-        Initial cell voltages; ``None`` starts at rest at the first input (``u_k = e_0``).
-
-    Returns
-    -------
-    y : array, shape (n,)
-        Model output.
-    x_end : array, shape (N,)
-        State after the last sample; feeding it back as ``x0`` continues the run exactly.
-    """
-    u = _check(structure, params, u, "u")
-    x = initial_state(structure.n_cells, x0, u[0])
-    y, x_end = kernels.simulate(u, x, np.ascontiguousarray(params.g), params.w,
-                                float(params.v_b), *_cell_args(structure, params))
-    return check_finite_run(y, "mpl-g"), x_end
+def _forward(structure: MplGStructure, params: MplGParams, u: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return kernels.simulate(u, x, np.ascontiguousarray(params.g), params.w, float(params.v_b),
+                            *_cell_args(structure, params))
 
 
-def simulate_reference(structure: MplGStructure, params: MplGParams, u: np.ndarray,
-                       x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
+def _inverse(structure: MplGStructure, params: MplGParams, y: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    lo, hi, sign, centre = inverse_branch(params)
+    bound = min(1e6 * (1.0 + np.max(np.abs(y)) + np.max(np.abs(x))), 1e300)
+    e_hat, x_end, n_bad, why = kernels.invert(y, x, np.ascontiguousarray(params.g), lo, hi,
+                                              sign, centre, params.w, float(params.v_b),
+                                              *_cell_args(structure, params), bound)
+    check_branch_inverse(why, n_bad, y, lo, hi)
+    return e_hat, x_end
 
-    Parameters
-    ----------
-    structure : MplGStructure
-        The model's structure.
-    params : MplGParams
-        Its parameters.
-    u : numpy.ndarray, shape (n,)
-        Model input ``e`` sampled every ``structure.dt``.
-    x0 : numpy.ndarray, shape (N,), float or None, optional
-        Initial cell voltages, as for :func:`simulate`.
 
-    Returns
-    -------
-    y : numpy.ndarray, shape (n,)
-        Model output.
-    x_end : numpy.ndarray, shape (N,)
-        State after the last sample.
-    """
-    u = _check(structure, params, u, "u")
-    return run_steps(step, structure, params, u, initial_state(structure.n_cells, x0, u[0]))
+RUNS = Runs(label="mpl-g", step=step, n_state=lambda structure, params: structure.n_cells,
+            rest_state=rest_state, forward=_forward, inverse=_inverse, check=_check)
+simulate, simulate_reference, invert = family_runs(
+    RUNS, __name__, "the mPL model with a general output resistor",
+    notes="The input is ``e`` (normalised units), the state the cell voltages ``u_k`` (at rest: "
+          "``u_k = e_0``).",
+    inverse_notes="The compensator of a forward fit. FitDivergedError if ``w_0 = 0``, "
+                  "``g' = 0`` at the rest point, a sample lies outside the range of ``g``'s "
+                  "monotone branch (no input gives it), or the estimate leaves the finite range "
+                  "(the inverse's cells see ``-(1 + w_k / w_0)`` times their own voltage).")
 
 
 def simulate_with_jacobian(structure: MplGStructure, params: MplGParams,
@@ -402,58 +375,10 @@ def simulate_with_jacobian(structure: MplGStructure, params: MplGParams,
     jacobian : numpy.ndarray, shape (n, 3N + 6)
         ``dy/dtheta``, columns in the order of :meth:`MplGParams.to_vector`.
     """
-    u = _check(structure, params, u, "u")
+    check_size(params.n_cells, structure.n_cells, "cells")
+    u = check_signal(u, "u")
     x = np.full(structure.n_cells, u[0])
     return kernels.simulate_with_jacobian(u, x, np.ascontiguousarray(params.g), params.w,
                                           float(params.v_b), *_cell_args(structure, params))
 
 
-def invert(structure: MplGStructure, params: MplGParams, y: np.ndarray,
-           x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Run the inverse model (the compensator of a forward fit) over an output sequence.
-
-    Parameters
-    ----------
-    structure : MplGStructure
-        The model's structure.
-    params : MplGParams
-        Its parameters.
-    y : array, shape (n,)
-        Model output (e.g. the sensor signal), sampled every ``structure.dt``.
-    x0 : array, shape (N,), float or None
-        ``None`` starts at rest (:func:`rest_state` with ``inverse=True``).
-
-    Returns
-    -------
-    u_hat : array, shape (n,)
-        Input estimate, one per sample of ``y``.
-    x_end : array, shape (N,)
-        State after the last sample.
-
-    Raises
-    ------
-    FitDivergedError
-        If ``w_0 = 0``, ``g' = 0`` at the rest point, a sample lies outside the range of
-        ``g``'s monotone branch (no input gives it), or the estimate leaves the finite range
-        (the inverse's stability depends on the weights: its cells see ``-(1 + w_k / w_0)``
-        times their own voltage).
-    """
-    y = _check(structure, params, y, "y")
-    if params.w[0] == 0:
-        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
-    lo, hi, sign, centre = inverse_branch(params)
-    x = (rest_state(structure, params, y[0], inverse=True) if x0 is None
-         else initial_state(structure.n_cells, x0, 0.0))
-    bound = min(1e6 * (1.0 + np.max(np.abs(y)) + np.max(np.abs(x))), 1e300)
-    e_hat, x_end, n_bad, why = kernels.invert(y, x, np.ascontiguousarray(params.g), lo, hi,
-                                              sign, centre, params.w, float(params.v_b),
-                                              *_cell_args(structure, params), bound)
-    if why == 1:
-        raise FitDivergedError(
-            f"the inverse failed at sample {n_bad} of {y.size}: output {y[n_bad]:.4g} is outside "
-            f"the range of the output resistor g on its monotone branch [{lo:.4g}, {hi:.4g}]")
-    if why == 2:
-        raise FitDivergedError(
-            f"the inverse model diverged at sample {n_bad} of {y.size} (|e_hat| > 1e6 times the "
-            f"output range); the fitted weights make the compensator unstable on this data")
-    return e_hat, x_end

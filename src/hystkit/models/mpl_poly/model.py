@@ -57,6 +57,7 @@ from .resistors import (
     resistor_slope,
 )
 from .rest import (
+    check_branch_inverse,
     check_rest,
     equilibria,
     inverse_branch,
@@ -211,14 +212,7 @@ def _inverse(structure: MplPolyStructure, params: MplPolyParams, y: np.ndarray,
     e_hat, x_end, n_bad, why = kernels.invert(y, x, *_kernel_args(structure, params), lo, hi,
                                               sign, centre, params.w, params.v_b, structure.dt,
                                               bound)
-    if why == 1:
-        raise FitDivergedError(
-            f"the inverse failed at sample {n_bad} of {y.size}: output {y[n_bad]:.4g} is outside "
-            f"the range of the output resistor g on its monotone branch [{lo:.4g}, {hi:.4g}]")
-    if why == 2:
-        raise FitDivergedError(
-            f"the inverse model diverged at sample {n_bad} of {y.size} (|e_hat| > 1e6 times the "
-            f"output range); the fitted weights make the compensator unstable on this data")
+    check_branch_inverse(why, n_bad, y, lo, hi)
     return e_hat, x_end
 
 

@@ -275,3 +275,29 @@ def rest_state(structure: MplPolyStructure, params: MplPolyParams, value: float,
     w_sum = params.w.sum()
     e0 = (z0 + params.w[1:] @ v_rest + params.v_b) / w_sum if ok and w_sum != 0 else 0.0
     return e0 - v_rest
+
+
+def check_branch_inverse(why: int, n_bad: int, y: np.ndarray, lo: float, hi: float) -> None:
+    """Raise FitDivergedError for a failed run of a branch inverse kernel (mpl-poly, mpl-g):
+    ``why`` 1, a sample outside the range ``[lo, hi]`` of the output resistor's monotone
+    branch; 2, the estimate diverged; 0, no failure.
+
+    Parameters
+    ----------
+    why : int
+        The kernel's failure code.
+    n_bad : int
+        The sample it failed at.
+    y : numpy.ndarray
+        The output inverted.
+    lo, hi : float
+        The range of the monotone branch.
+    """
+    if why == 1:
+        raise FitDivergedError(
+            f"the inverse failed at sample {n_bad} of {y.size}: output {y[n_bad]:.4g} is outside "
+            f"the range of the output resistor g on its monotone branch [{lo:.4g}, {hi:.4g}]")
+    if why == 2:
+        raise FitDivergedError(
+            f"the inverse model diverged at sample {n_bad} of {y.size} (|e_hat| > 1e6 times the "
+            f"output range); the fitted weights make the compensator unstable on this data")
