@@ -7,8 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hystkit.compensation import fit_compensator
-from hystkit.compensation._fitting import weight_column
+from hystkit.compensation import fit_compensator, weight_column
 from hystkit.compensation._param_vector import flatten_params, simulate_segments
 from hystkit.errors import InputError
 from hystkit.io import Recording

@@ -16,7 +16,6 @@ model, and back to mm.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, NamedTuple
 
@@ -24,7 +23,7 @@ import numpy as np
 
 from .._read_options import ReadOptions
 from ..errors import FitDivergedError, InputError
-from ..io import MAX_MAGNITUDE, Recording
+from ..io import Recording
 from ..models import Family, get_family
 from ._band import Band, interval
 from ._centring import (
@@ -36,6 +35,7 @@ from ._centring import (
 )
 from ._conventions import LinearBaseline, Scaling
 from ._modes import MODES
+from ._runaway import MAX_NORMALISED, runaway_kind, runaway_samples
 
 __all__ = [
     "MAX_NORMALISED",
@@ -54,8 +54,6 @@ __all__ = [
 # on either side, an estimate beyond this share of the training position range.
 SENSOR_MARGIN = 0.05
 POSITION_MARGIN = 0.10
-# An estimate beyond this many times the (normalised, max |.| = 1) training positions is refused.
-MAX_NORMALISED = 1e6
 
 
 class BandedEstimate(NamedTuple):
@@ -384,74 +382,3 @@ class Compensator:
         """Share of samples whose sensor value lies outside the range seen in training."""
         mask = self.sensor_outside(recording, margin)
         return None if mask is None else float(np.mean(mask))
-
-
-def runaway_samples(p: np.ndarray, estimate: np.ndarray,
-                    bounds: tuple[float, float] | None = None) -> np.ndarray:
-    """Indices of the samples the runaway guard refuses: the model's normalised output beyond
-    ``MAX_NORMALISED`` (normalised training data have |p| <= 1), or, after de-normalisation,
-    an estimate that is not finite, beyond ``MAX_MAGNITUDE`` mm (no recording could hold it)
-    or outside `bounds` (:meth:`Compensator.runaway_bounds`: a position scale that does not
-    fit the training positions).
-
-    Parameters
-    ----------
-    p : numpy.ndarray, shape (n,)
-        The model's output in normalised units.
-    estimate : numpy.ndarray, shape (n,)
-        The same de-normalised [mm].
-    bounds : tuple of float, optional
-        ``(low, high)`` [mm] the estimates must lie within; None: no such bound.
-
-    Returns
-    -------
-    numpy.ndarray of int
-        The refused samples' indices, in order (empty if none).
-    """
-    estimate = np.asarray(estimate, dtype=float)
-    # NaN fails every comparison: written so that it is refused too
-    ok = (np.abs(np.asarray(p, dtype=float)) <= MAX_NORMALISED) \
-        & (np.abs(estimate) <= MAX_MAGNITUDE)
-    if bounds is not None:
-        ok &= (estimate >= bounds[0]) & (estimate <= bounds[1])
-    return np.flatnonzero(~ok)
-
-
-def runaway_kind(value: float) -> str:
-    """What is wrong with a refused estimate [mm] (:func:`runaway_samples`), for messages.
-
-    Parameters
-    ----------
-    value : float
-        The first refused estimate [mm].
-
-    Returns
-    -------
-    str
-        ``"not finite"``, or its value and the bound it passes.
-    """
-    if not np.isfinite(value):
-        return "not finite"
-    if abs(value) > MAX_MAGNITUDE:
-        return f"{value:.3g} mm, beyond the largest magnitude {MAX_MAGNITUDE:g} of any recording"
-    return f"{value:.3g} mm, beyond {MAX_NORMALISED:g} times the training range"
-
-
-def check_training_data(recordings: Sequence[Recording]) -> None:
-    """Every fitting recording needs a position column and the same sampling step."""
-    for rec in recordings:
-        if not rec.has_position():
-            raise InputError(f"{rec.source}: column 'position' is needed to fit")
-        if abs(rec.dt - recordings[0].dt) > 0.01 * recordings[0].dt:
-            raise InputError(f"{rec.source}: column 'time': sampled every {rec.dt:.6g} s, but "
-                             f"{recordings[0].source} every {recordings[0].dt:.6g} s; fit "
-                             f"recordings must share one rate")
-
-
-def inverse_is_bounded(family: Any, structure: Any, params: Any, s: np.ndarray) -> bool:
-    """Whether a candidate's inverse stays bounded on normalised training data."""
-    try:
-        p_hat, _ = family.invert(structure, params, s)
-    except FitDivergedError:
-        return False
-    return bool(np.max(np.abs(p_hat)) < 10.0)  # normalised data: |p| <= 1 when it works

@@ -13,22 +13,13 @@ R² and AIC/BIC stay on the plain SSE.
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from ..errors import FitDivergedError, HystkitError, InputError
-from ..identification import (
-    LOSSES,
-    MAX_WEIGHT,
-    FitResult,
-    check_cost,
-    cost_label,
-    objective,
-    require_linear_loss,
-)
+from ..identification import FitResult, objective
 from ..io import Recording
 from ..metrics import r2
 from ..models import Family, get_family
@@ -39,152 +30,30 @@ from ._centring import (
     DEFAULT_TRACK_SECONDS,
 )
 from ._chunked_errors import chunked_standard_errors
-from ._compensator import MODES, Compensator, check_training_data, inverse_is_bounded
+from ._compensator import MODES, Compensator
 from ._conventions import LinearBaseline, prepare_training_data
 from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status, fixed_mask
+from ._fit_costs import (
+    check_loss_available,
+    cost_info,
+    cost_options,
+    fit_module_constant,
+    standard_error_caveat,
+    weight_column,
+)
 from ._param_vector import flatten_params, simulate_segments
 from ._redundancy import redundancy_notes
-from ._training_checks import MIN_SAMPLES, check_fitting_data
+from ._training_checks import MIN_SAMPLES, check_fitting_data, check_training_data
 
-__all__ = ["MIN_SAMPLES", "check_loss_available", "fit_compensator", "fit_module_constant",
-           "supported_losses", "weight_column"]
+# check_loss_available and fit_module_constant live in ._fit_costs (exported by the package);
+# named here too for the CLI modules that still import them from this module.
+__all__ = ["MIN_SAMPLES", "check_loss_available", "fit_compensator", "fit_module_constant"]
 
 # The joint polish differentiates numerically, one model run per parameter: above this many
 # parameters (Preisach grids) it is skipped and the concatenated fit is kept.
 MAX_POLISH_PARAMS = 40
 # Residual of a parameter vector outside the family's domain (the polish has no bounds).
 _OUTSIDE = 1e3
-
-
-def fit_module_constant(model: str, name: str, default: Any) -> Any:
-    """A constant the fit module of family `model` declares (``hystkit.models.<family>.fit``),
-    or `default` where it declares none.
-
-    Parameters
-    ----------
-    model : str
-        A registered family name.
-    name : str
-        The constant's name, e.g. ``SUPPORTED_LOSSES`` or ``WEIGHT_SUM_FLOOR``.
-    default : object
-        The value for a family without it (or without a fit module of its own).
-
-    Returns
-    -------
-    object
-    """
-    package = type(get_family(model)).__module__.rpartition(".")[0]
-    if not package:  # a family object outside a package of its own (a test's stand-in)
-        return default
-    try:
-        fit_module = importlib.import_module(f"{package}.fit")
-    except ModuleNotFoundError:
-        return default
-    return getattr(fit_module, name, default)
-
-
-def supported_losses(model: str) -> tuple[str, ...]:
-    """The losses model family `model` can fit with (all of
-    :data:`hystkit.identification.LOSSES` unless its ``fit`` module says otherwise in
-    ``SUPPORTED_LOSSES``: the linear-least-squares families fit the SSE only).
-
-    Parameters
-    ----------
-    model : str
-        A registered family name.
-
-    Returns
-    -------
-    tuple of str
-    """
-    return tuple(fit_module_constant(model, "SUPPORTED_LOSSES", LOSSES))
-
-
-def weight_column(recordings: Sequence[Recording], column: str,
-                  other_columns: Sequence[Mapping[str, np.ndarray]] | None = None
-                  ) -> np.ndarray:
-    """Per-sample weights: column `column` of each recording, end to end.
-
-    Parameters
-    ----------
-    recordings : sequence of Recording
-        The training recordings, in fitting order.
-    column : str
-        The weights column's name in their files.
-    other_columns : sequence of mappings, optional
-        Each recording's columns other than time, position and sensor (as
-        :func:`hystkit.io.read_other_columns` returns them); default: read from each
-        recording's ``source`` file with the default read options.
-
-    Returns
-    -------
-    numpy.ndarray, shape (sum of samples,)
-        The weights, finite, in ``[0, MAX_WEIGHT]`` (1e100), not all zero.
-
-    Raises
-    ------
-    InputError
-        A recording without the column (naming the file and its other columns), a value that
-        is not a finite number in ``[0, MAX_WEIGHT]`` (naming file, column and row), or all
-        weights zero.
-    """
-    from ..io import read_other_columns
-
-    if other_columns is not None and len(other_columns) != len(recordings):
-        raise ValueError(f"other_columns must have one mapping per recording "
-                         f"({len(recordings)}), got {len(other_columns)}")
-    parts = []
-    for i, rec in enumerate(recordings):
-        if other_columns is not None:
-            columns = other_columns[i]
-        else:
-            try:
-                columns = read_other_columns(rec.source, rec.n_samples)
-            except (OSError, ValueError) as exc:
-                raise InputError(f"{rec.source}: cannot read the weights column {column!r} "
-                                 f"({exc})") from None
-        if column not in columns:
-            others = ", ".join(map(repr, columns)) or "none"
-            raise InputError(f"{rec.source}: no weights column {column!r} (its other columns: "
-                             f"{others})")
-        values = np.asarray(columns[column])
-        if values.shape != (rec.n_samples,):
-            raise InputError(f"{rec.source}: column {column!r} has {values.size} rows, the "
-                             f"recording {rec.n_samples}")
-        if values.dtype.kind not in "fiu":
-            numbers = _as_numbers(values)
-            bad = np.flatnonzero(np.isnan(numbers))
-            if bad.size:
-                raise InputError(f"{rec.source}: column {column!r}, row {bad[0] + 1}: weight "
-                                 f"{str(values[bad[0]])[:40]!r} is not a number")
-            values = numbers
-        values = values.astype(float)
-        bad = np.flatnonzero(~(np.isfinite(values) & (values >= 0)))
-        if bad.size:
-            raise InputError(f"{rec.source}: column {column!r}, row {bad[0] + 1}: weight "
-                             f"{values[bad[0]]:g} is not a finite number >= 0")
-        bad = np.flatnonzero(values > MAX_WEIGHT)
-        if bad.size:
-            raise InputError(f"{rec.source}: column {column!r}, row {bad[0] + 1}: weight "
-                             f"{values[bad[0]]:g} is above {MAX_WEIGHT:g} (only the ratios of "
-                             f"the weights matter: scale the column down)")
-        parts.append(values)
-    weights = np.concatenate(parts)
-    if not np.any(weights > 0):
-        raise InputError(f"{', '.join(r.source for r in recordings)}: every value of the "
-                         f"weights column {column!r} is 0")
-    return weights
-
-
-def _as_numbers(values: np.ndarray) -> np.ndarray:
-    """Text cells as floats, NaN where a cell is not a number (or empty)."""
-    out = np.full(values.size, np.nan)
-    for i, cell in enumerate(values):
-        try:
-            out[i] = float(cell)
-        except (TypeError, ValueError):
-            pass
-    return out
 
 
 def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.ndarray],
@@ -268,13 +137,13 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
     loss : {"linear", "soft_l1", "huber", "cauchy"}
         The cost the fit (and the joint polish) minimises: "linear" is the SSE (eq. 5.9);
         the robust losses are scipy's (:mod:`hystkit.identification._losses`). Families that
-        fit by linear least squares take "linear" only (:func:`supported_losses`).
+        fit by linear least squares take "linear" only (:func:`._fit_costs.supported_losses`).
     f_scale : float
         Residual scale of a robust loss, in normalised units (the data are scaled to
         max |.| = 1 before the fit, eq. 5.10).
     weights : str, optional
         Name of a column of the recordings' files holding one weight per sample (finite,
-        ``>= 0``; zero drops a sample from the cost), see :func:`weight_column`.
+        ``>= 0``; zero drops a sample from the cost), see :func:`._fit_costs.weight_column`.
     other_columns : sequence of mappings, optional
         Each recording's other columns, where `weights` is looked up; default: read from
         the recordings' files.
@@ -296,7 +165,7 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
     if not recs:
         raise InputError("no fitting recording given")
     family = get_family(model)
-    cost_options = _cost_options(model, loss, f_scale, fit_options)
+    costs = cost_options(model, loss, f_scale, fit_options)
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
     if center not in CENTERS:
@@ -318,9 +187,9 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
     s, p = _joined(s_list), _joined(p_list)
     inputs, targets = (s_list, p_list) if mode == "direct" else (p_list, s_list)
     if sample_weights is not None:
-        cost_options["weights"] = sample_weights
+        costs["weights"] = sample_weights
     result = _fit_family(family, structure, mode, s, p, recs[0].source,
-                         {**(fit_options or {}), **cost_options})
+                         {**(fit_options or {}), **costs})
     params, joint_note = result.params, ""
     fixed = fixed_mask(family, structure, params)
     if len(recs) > 1:
@@ -342,75 +211,12 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
     info = _fit_info(comp, result, recs, s, p, s_list, inputs, targets, diagnose,
                      (loss, f_scale, sample_weights))
     info["n_params"], info["joint_fit"] = n_params, joint_note or None
-    info.update(_cost_info(loss, f_scale, weights, sample_weights))
-    caveat = _standard_error_caveat(info, result)
+    info.update(cost_info(loss, f_scale, weights, sample_weights))
+    caveat = standard_error_caveat(info, result)
     if info.get("standard_errors") and caveat:
         info["standard_errors"]["caveat"] = caveat
     object.__setattr__(comp, "fit_info", info)
     return comp
-
-
-def check_loss_available(model: str, loss: str, f_scale: float) -> None:
-    """Refuse, before any work, a cost the family cannot fit with.
-
-    Parameters
-    ----------
-    model : str
-        A registered family name.
-    loss, f_scale
-        The requested cost (:func:`hystkit.identification.check_cost`).
-
-    Raises
-    ------
-    InputError
-        If the cost is not valid, or the family fits by linear least squares and `loss` is
-        a robust loss (:func:`hystkit.identification.require_linear_loss`, one line).
-    """
-    try:
-        check_cost(loss, f_scale)
-    except ValueError as exc:
-        raise InputError(str(exc)) from None
-    if loss not in supported_losses(model):
-        require_linear_loss(loss, f_scale, model, "linear least squares")
-
-
-def _cost_options(model: str, loss: str, f_scale: float,
-                  fit_options: Mapping[str, Any] | None) -> dict[str, Any]:
-    """The fit's cost options (empty for the plain SSE), checked before any work."""
-    check_loss_available(model, loss, f_scale)
-    clash = {"loss", "f_scale", "weights"} & set(fit_options or {})
-    if clash:
-        raise ValueError(f"give {', '.join(sorted(clash))} as fit_compensator's own "
-                         f"arguments, not in fit_options")
-    return {} if loss == "linear" else {"loss": loss, "f_scale": float(f_scale)}
-
-
-def _cost_info(loss: str, f_scale: float, column: str | None,
-               weights: np.ndarray | None) -> dict[str, Any]:
-    """What the fit minimised, for ``fit_info``: the loss, its scale, the weights column and
-    the label of the ``objective`` (the plain SSE's ``cost`` is stored beside it)."""
-    plain = loss == "linear" and weights is None
-    label = cost_label(loss, f_scale, None if weights is None else f"column {column!r}")
-    out = {"loss": loss, "f_scale": float(f_scale) if loss != "linear" else None,
-           "weights": column, "objective_label": label}
-    if not plain:
-        out["criteria_note"] = (f"R², AIC and BIC are on the plain SSE; the fit minimised the "
-                                f"{label}")
-    return out
-
-
-def _standard_error_caveat(info: Mapping[str, Any], result: FitResult) -> str | None:
-    """Why the Gauss-Newton standard errors (of the plain SSE) are indicative only at this
-    optimum, or None where they apply: the fit minimised another cost, or it stopped on an
-    active constraint, where the SSE is not stationary."""
-    reason = None
-    if info.get("criteria_note") is not None:
-        reason = f"the fit minimised the {info['objective_label']}"
-    elif result.constraint is not None:
-        reason = (f"the fit ended on its active constraint {result.constraint}, where the SSE "
-                  f"is not stationary")
-    return None if reason is None else (f"standard errors of the plain SSE at these "
-                                        f"parameters, indicative only: {reason}")
 
 
 def _fit_family(family: Family, structure: Any, mode: str, s: np.ndarray,
@@ -438,6 +244,15 @@ def _run_fit(family: Family, structure: Any, mode: str, s: np.ndarray,
         family, structure, params, s), accept_reason="their inverse diverges on the training "
                                                      "data; use --mode direct or a smaller model",
                       **options)
+
+
+def inverse_is_bounded(family: Any, structure: Any, params: Any, s: np.ndarray) -> bool:
+    """Whether a candidate's inverse stays bounded on normalised training data."""
+    try:
+        p_hat, _ = family.invert(structure, params, s)
+    except FitDivergedError:
+        return False
+    return bool(np.max(np.abs(p_hat)) < 10.0)  # normalised data: |p| <= 1 when it works
 
 
 def _joined(columns: list[np.ndarray]) -> np.ndarray:

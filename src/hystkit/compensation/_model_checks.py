@@ -28,7 +28,7 @@ from .._read_options import FIELDS, TIME_UNITS, ReadOptions
 from ..errors import InputError
 from ..io import MAX_MAGNITUDE
 from ..models import DT_RANGE
-from ._compensator import MAX_NORMALISED
+from ._runaway import MAX_NORMALISED
 
 __all__ = ["MAX_MODEL_BYTES", "MAX_PARAM_NUMBERS", "MAX_SCALE", "MAX_STRUCTURE_INT",
            "MAX_WINDOW_SAMPLES", "MIN_SCALE", "READING_KEYS", "check_keys", "check_like",

@@ -21,7 +21,7 @@ from ._diagnostics import MIN_SAMPLES_PER_PARAM
 from ._param_vector import flatten_params
 
 __all__ = ["MIN_MOVING_SAMPLES", "MIN_SAMPLES", "RESOLUTION", "check_excursion",
-           "check_fitting_data", "check_sample_count", "count_fitted"]
+           "check_fitting_data", "check_sample_count", "check_training_data", "count_fitted"]
 
 # Fewer samples than this cannot describe a loop at all, whatever the model.
 MIN_SAMPLES = 20
@@ -136,3 +136,14 @@ def check_sample_count(recordings: Sequence[Recording], n_params: int | None, mo
                                                   f"parameter, {model} has {n_params})")
         raise InputError(f"{recordings[0].source}: column 'position': {n} samples; a fit needs "
                          f"at least {need}{per}")
+
+
+def check_training_data(recordings: Sequence[Recording]) -> None:
+    """Every fitting recording needs a position column and the same sampling step."""
+    for rec in recordings:
+        if not rec.has_position():
+            raise InputError(f"{rec.source}: column 'position' is needed to fit")
+        if abs(rec.dt - recordings[0].dt) > 0.01 * recordings[0].dt:
+            raise InputError(f"{rec.source}: column 'time': sampled every {rec.dt:.6g} s, but "
+                             f"{recordings[0].source} every {recordings[0].dt:.6g} s; fit "
+                             f"recordings must share one rate")
