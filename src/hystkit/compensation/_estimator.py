@@ -134,6 +134,7 @@ class CompensatorEstimator:
 
     def __sklearn_tags__(self):
         """scikit-learn's tags: a regressor, one feature, no NaN, order matters."""
+        # scikit-learn is optional: only its own checks ask for the tags
         from sklearn.utils import InputTags, RegressorTags, Tags, TargetTags
 
         return Tags(estimator_type="regressor", target_tags=TargetTags(required=True),

@@ -25,10 +25,12 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from .. import __version__
 from .._read_options import ReadOptions
 from ..errors import InputError
-from ..io import check_output_format, write_json, write_mat
+from ..io import check_output_format, load_mat, matlab_name, write_json, write_mat
 from ..models import FAMILIES
 from ._band import Band
 from ._centring import CENTERS
@@ -329,10 +331,6 @@ def load_compensator(path: str | Path) -> Compensator:
 def _load_mat_model(path: Path) -> Compensator:
     """A ``.mat`` model file: the model in its ``hystkit_json`` text, after checking that its
     ``params`` variables (what a MATLAB user would edit) still equal the text's."""
-    import numpy as np
-
-    from ..io import load_mat, matlab_name
-
     source = str(path)
     contents = load_mat(path, ["params.*"], source, texts=(MAT_JSON_KEY,))
     if MAT_JSON_KEY not in contents.texts:
