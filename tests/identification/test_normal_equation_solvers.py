@@ -194,3 +194,26 @@ def test_trust_region_with_a_parameter_that_does_not_act_matches_scipy_trf():
     acting = [0, 2, 3]
     assert_allclose(sol.x[acting], ref.x[acting], atol=1e-4)
     assert_allclose(sol.cost, ref.cost, rtol=1e-8)
+
+
+@pytest.mark.parametrize("first", [1, 4, 9])
+def test_a_resumed_trust_region_solve_is_the_uninterrupted_one(first):
+    """Stopped on its budget and resumed from its state, the solve takes the same steps as one
+    that was never stopped (bit for bit), and does not run its last point again."""
+    lower, upper = np.array([-2.0, -2.0]), np.array([0.5, 2.0])
+    runs = []
+
+    def counted(x):
+        runs.append(x.copy())
+        return _rosenbrock_normal(x)
+
+    whole = solve_trust_region(counted, np.array([-1.2, 1.0]), lower, upper, max_nfev=30)
+    n_whole = len(runs)
+    runs.clear()
+    part = solve_trust_region(counted, np.array([-1.2, 1.0]), lower, upper, max_nfev=first)
+    assert part.status == 0 and len(runs) == first
+    rest = solve_trust_region(counted, None, lower, upper, max_nfev=30 - first,
+                              resume=part.state)
+    assert len(runs) == n_whole == part.n_runs + rest.n_runs
+    assert rest.status == whole.status and rest.cost == whole.cost
+    assert np.array_equal(rest.x, whole.x)

@@ -236,7 +236,7 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
                       key=lambda sol: sol.cost)
     # The first n_polish candidates are polished whatever happens (the loop below stops only
     # after n_polish accepted ones): on workers they run side by side, ahead of the loop.
-    polished = _solve_on(executor, solve, [sol.x for sol in screened[:n_polish]
+    polished = _solve_on(executor, solve, [(sol.x, sol.state) for sol in screened[:n_polish]
                                             if sol.status == 0], max_nfev)
     waiting = iter(range(len(polished)))
     best, rejected, n_polished = None, 0, 0
@@ -245,7 +245,7 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
             break
         if sol.status == 0:  # budget ran out: continue from where it stopped
             i = next(waiting, None)
-            sol = polished[i] if i is not None else solve(sol.x, max_nfev)
+            sol = polished[i] if i is not None else solve(sol.x, max_nfev, sol.state)
             n_eval += sol.n_runs
         if not np.isfinite(sol.cost):
             continue
@@ -288,7 +288,7 @@ def _settle(solve: Callable, best: SimpleNamespace, max_nfev: int, to_params: Ca
     are not determined."""
     if best.status > 0:
         return best, True, str(best.message), 0
-    more = solve(best.x, max(1, round(CONTINUATION * max_nfev)))
+    more = solve(best.x, max(1, round(CONTINUATION * max_nfev)), best.state)
     better = (np.isfinite(more.cost) and more.cost <= best.cost
               and (accept is None or accept(to_params(more.x))))
     change = (best.cost - more.cost) / max(best.cost, 1e-300) if better else 0.0
@@ -306,9 +306,14 @@ def _settle(solve: Callable, best: SimpleNamespace, max_nfev: int, to_params: Ca
 
 @dataclass(frozen=True)
 class _StartSolver:
-    """One start's bounded solve, ``(theta0, budget) -> SimpleNamespace(x, cost, status,
-    message, n_runs, column_norms)``; a pure function of its arguments, so a worker process
-    that gets a copy (closures travel by cloudpickle) returns what this process would."""
+    """One start's bounded solve, ``(theta0, budget[, resume]) -> SimpleNamespace(x, cost,
+    status, message, n_runs, column_norms, state)``; a pure function of its arguments, so a
+    worker process that gets a copy (closures travel by cloudpickle) returns what this process
+    would. ``resume``, an earlier result's ``state`` (solver "tr" only, else None), continues
+    that solve where it stopped instead of starting again from ``theta0``: its last point is
+    not run again and its radius and scaling go on. The budget counts as for a restart from
+    that point, whose first evaluation (the point itself) the resumed solve saves: it takes
+    the same number of new steps, one run fewer."""
 
     residual: Callable[[np.ndarray], np.ndarray]
     jac: Callable[[np.ndarray], np.ndarray] | str
@@ -321,19 +326,23 @@ class _StartSolver:
     loss: str = "linear"
     f_scale: float = 1.0
 
-    def __call__(self, theta0: np.ndarray, budget: int) -> SimpleNamespace:
+    def __call__(self, theta0: np.ndarray, budget: int, resume: Any = None) -> SimpleNamespace:
         # BLAS threads do not pay on (n x n_params) problems, and under load they cost 10-30x
         # (benchmarks/README.md).
         with _blas_controller().limit(limits=1, user_api="blas"):
             if self.solver != "trf":
                 # lm may stop on a bound, the margin keeps it inside as trf and tr stay
                 shrink = self.margin if self.solver == "lm" else 0.0
+                if resume is not None:
+                    budget, more = budget - 1, {"resume": resume}
+                else:
+                    more = {}
                 sol = _SOLVERS[self.solver](self.normal_equations, theta0, self.lower + shrink,
                                             self.upper - shrink, cost=self.cost,
-                                            max_nfev=budget)
+                                            max_nfev=budget, **more)
                 return SimpleNamespace(x=sol.x, cost=sol.cost, status=sol.status,
                                        message=sol.message, n_runs=sol.n_runs,
-                                       column_norms=sol.column_norms)
+                                       column_norms=sol.column_norms, state=sol.state)
             from scipy.optimize import least_squares  # here: ~0.4 s to import, trf only
 
             sol = least_squares(self.residual, theta0, jac=self.jac,
@@ -343,7 +352,7 @@ class _StartSolver:
         # residuals of every screened start alive together cost GBs on long recordings.
         return SimpleNamespace(x=sol.x, cost=float(sol.cost), status=sol.status,
                                message=sol.message, n_runs=sol.nfev + (sol.njev or 0),
-                               column_norms=_column_norms(sol.jac))
+                               column_norms=_column_norms(sol.jac), state=None)
 
 
 def _screen(solve: _StartSolver, thetas: list[np.ndarray],
@@ -366,20 +375,22 @@ def _screen(solve: _StartSolver, thetas: list[np.ndarray],
         return [first, *(solve(theta, budget) for theta in thetas[1:])], None
     if seconds * (len(thetas) - 1) < SPLIT_MIN_SECONDS:  # polishes still pay: longer
         return [first, *(solve(theta, budget) for theta in thetas[1:])], executor
-    return [first, *_solve_on(executor, solve, thetas[1:], budget)], executor
+    return [first, *_solve_on(executor, solve, [(theta, None) for theta in thetas[1:]],
+                              budget)], executor
 
 
-def _solve_on(executor: Executor | None, solve: _StartSolver, thetas: list[np.ndarray],
+def _solve_on(executor: Executor | None, solve: _StartSolver, starts: list[tuple],
               budget: int) -> list[SimpleNamespace]:
-    """``[solve(theta, budget) for theta in thetas]``, on `executor`'s workers if given and
-    there are two or more."""
-    if executor is None or len(thetas) < 2:
-        return [solve(theta, budget) for theta in thetas]
-    return executor.map(_solve_start, [(theta, budget) for theta in thetas],
+    """``[solve(theta, budget, resume) for theta, resume in starts]``, on `executor`'s
+    workers if given and there are two or more."""
+    if executor is None or len(starts) < 2:
+        return [solve(theta, budget, resume) for theta, resume in starts]
+    return executor.map(_solve_start, [(theta, budget, resume) for theta, resume in starts],
                         shared={"solve": solve})
 
 
-def _solve_start(start: tuple[np.ndarray, int], *, solve: _StartSolver) -> SimpleNamespace:
+def _solve_start(start: tuple[np.ndarray, int, Any], *,
+                 solve: _StartSolver) -> SimpleNamespace:
     """One piece of a parallel multi-start (module level: a worker finds it by name)."""
     return solve(*start)
 

@@ -65,6 +65,9 @@ class SolveResult:
         (the budget ``max_nfev`` applies to ``nfev``, as in scipy).
     column_norms : numpy.ndarray, shape (p,), or None
         ``sqrt(diag(J^T J))`` at ``x``; None when the start was not finite.
+    state : object, optional
+        What the solver needs to continue from ``x`` with more budget (its ``resume``
+        argument) as if it had not stopped; None if it cannot.
     """
 
     x: np.ndarray
@@ -75,6 +78,7 @@ class SolveResult:
     njev: int
     n_runs: int
     column_norms: np.ndarray | None
+    state: Any = None
 
     @property
     def success(self) -> bool:

@@ -39,13 +39,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
 from ._normal_equations import NormalEquations, RunCounter, SolveResult
 from ._trust_region_steps import coleman_li, propose, scaled_problem, strictly_feasible
 
-__all__ = ["solve_trust_region"]
+__all__ = ["TrustRegionState", "solve_trust_region"]
 
 
 def _norm(v: np.ndarray) -> float:
@@ -65,24 +66,33 @@ def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations]
                        x0: np.ndarray, lower: np.ndarray, upper: np.ndarray, *,
                        cost: Callable[[np.ndarray], float] | None = None,
                        max_nfev: int = 200, ftol: float = 1e-8, xtol: float = 1e-8,
-                       gtol: float = 1e-8) -> SolveResult:
+                       gtol: float = 1e-8, resume: TrustRegionState | None = None,
+                       ) -> SolveResult:
     """Minimise ``0.5 * sum(r(x)**2)`` over ``lower <= x <= upper`` (``x0`` strictly inside).
 
     Parameters as :func:`~._lm.solve_lm`: ``cost``, when given, judges trial points alone and
-    the normal equations are formed only at accepted ones.
+    the normal equations are formed only at accepted ones. ``resume``: the ``state`` of an
+    earlier result on the same problem, to continue it with ``max_nfev`` more evaluations
+    (``x0`` is then ignored): its point is not run again, and scaling and radius go on as if
+    it had not stopped.
     """
     lb, ub = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
-    x = strictly_feasible(np.asarray(x0, dtype=float), lb, ub)
     runs = RunCounter()
-    ne = runs.trial(normal_equations, x)
-    if not np.isfinite(ne.cost):
-        return _result(x, np.inf, -3, runs, None)
-    scale_inv = _column_norms(ne.jtj)
-    scale_inv[scale_inv == 0] = 1.0
-    v, dv = coleman_li(x, ne.jtr, lb, ub)
-    v[dv != 0] *= scale_inv[dv != 0]
-    delta = _norm(x * scale_inv / v ** 0.5) or 1.0
-    alpha, status = 0.0, None
+    if resume is not None:
+        x, ne, delta, alpha = resume.x, resume.ne, resume.delta, resume.alpha
+        scale_inv = resume.scale_inv.copy()
+    else:
+        x = strictly_feasible(np.asarray(x0, dtype=float), lb, ub)
+        ne = runs.trial(normal_equations, x)
+        if not np.isfinite(ne.cost):
+            return _result(x, np.inf, -3, runs, None)
+        scale_inv = _column_norms(ne.jtj)
+        scale_inv[scale_inv == 0] = 1.0
+        v, dv = coleman_li(x, ne.jtr, lb, ub)
+        v[dv != 0] *= scale_inv[dv != 0]
+        delta = _norm(x * scale_inv / v ** 0.5) or 1.0
+        alpha = 0.0
+    status = None
     while True:
         # raises scale_inv to the column norms at x (once per accepted point, as scipy)
         d, diag_h, g_h, h_h, eig, vecs, sg, g_norm = scaled_problem(x, ne.jtj, ne.jtr, lb, ub,
@@ -116,13 +126,26 @@ def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations]
         if actual > 0:
             x = x_new
             ne = trial if trial is not None else runs.normal(normal_equations, x)
-    return _result(x, ne.cost, 0 if status is None else status, runs, _column_norms(ne.jtj))
+    return _result(x, ne.cost, 0 if status is None else status, runs, _column_norms(ne.jtj),
+                   TrustRegionState(x, ne, scale_inv, delta, alpha))
 
 
-def _result(x, cost, status, runs, column_norms) -> SolveResult:
+@dataclass(frozen=True)
+class TrustRegionState:
+    """Where :func:`solve_trust_region` stopped: the last accepted point and its normal
+    equations, the running column norms, the radius and Moré's last ``alpha``."""
+
+    x: np.ndarray
+    ne: NormalEquations
+    scale_inv: np.ndarray
+    delta: float
+    alpha: float
+
+
+def _result(x, cost, status, runs, column_norms, state=None) -> SolveResult:
     return SolveResult(x=x, cost=float(cost), status=status, message=_MESSAGES[status],
                        nfev=runs.nfev, njev=runs.njev, n_runs=runs.n_runs,
-                       column_norms=column_norms)
+                       column_norms=column_norms, state=state)
 
 
 def _column_norms(jtj: np.ndarray) -> np.ndarray:
