@@ -38,7 +38,8 @@ import numpy as np
 from numpy.polynomial import Polynomial
 
 from .._protocol import Record
-from .._validation import check_finite_run, check_magnitude, run_steps
+from .._run import Runs, family_runs
+from .._validation import check_magnitude
 from ..preisach import (
     INVERT_TOL,
     MAX_VALUE,
@@ -47,8 +48,8 @@ from ..preisach import (
     antisymmetric,
     check_rise,
     kernels,
-    prepare_run,
     staircase_terms,
+    start_staircase,
     update_staircase,
 )
 
@@ -283,12 +284,10 @@ def step(structure: GPreisachStructure, params: GPreisachParams, x: np.ndarray,
     return float(_combine(params, relay, np.asarray(float(u)))), x_next
 
 
-def _check(structure: GPreisachStructure, params: GPreisachParams, v: np.ndarray, name: str,
-           x0: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+def _check(structure: GPreisachStructure, params: GPreisachParams, inverse: bool) -> None:
     if params.levels != structure.levels or params.nu.size != structure.degree + 1:
         raise ValueError(f"params (levels {params.levels}, {params.nu.size} nu) do not match "
                          f"the structure (levels {structure.levels}, degree {structure.degree})")
-    return prepare_run(structure, v, name, x0)
 
 
 def kernel_parts(params: GPreisachParams) -> tuple[np.ndarray, bool, np.ndarray, float]:
@@ -314,98 +313,34 @@ def kernel_parts(params: GPreisachParams) -> tuple[np.ndarray, bool, np.ndarray,
     return _tables(params), True, _poly(params), major_slope(params)
 
 
-def simulate(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarray,
-             x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Run the model over an input sequence (compiled kernel, amortised O(1) per sample).
-
-    Parameters
-    ----------
-    structure : GPreisachStructure
-        The model's structure.
-    params : GPreisachParams
-        Its parameters.
-    u : array, shape (n,)
-        Normalised input; values beyond [-1, 1] follow the straight-line extension.
-    x0 : array or None
-        Initial staircase (``preisach.simulate``); ``None`` is the demagnetised state.
-
-    Returns
-    -------
-    y : array, shape (n,)
-    x_end : array
-        Final staircase; passing it as ``x0`` continues the run exactly.
-    """
-    u, x = _check(structure, params, u, "u", x0)
+def _forward(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     relay, x_end = kernels.run_tables(u, x, _tables(params), structure.capacity)
     with np.errstate(over="ignore", invalid="ignore"):  # inputs near 1e308 on the extension
-        y = _combine(params, relay, u)
-    return check_finite_run(y, "gpreisach"), x_end
+        return _combine(params, relay, u), x_end
 
 
-def simulate_reference(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarray,
-                       x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
-
-    Parameters
-    ----------
-    structure : GPreisachStructure
-        The model's structure.
-    params : GPreisachParams
-        Its parameters.
-    u : numpy.ndarray, shape (n,)
-        Input, one value per sample.
-    x0 : numpy.ndarray, optional
-        Initial staircase; None is the demagnetised state.
-
-    Returns
-    -------
-    y : numpy.ndarray, shape (n,)
-        Output.
-    x_end : numpy.ndarray
-        State after the last sample.
-    """
-    u, x = _check(structure, params, u, "u", x0)
-    return run_steps(step, structure, params, u, x)
-
-
-def invert(structure: GPreisachStructure, params: GPreisachParams, y: np.ndarray,
-           x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Input that reproduces an output sequence, by bisection on each branch (``preisach.invert``).
-
-    The branches are continuous, so the search always returns an input reproducing the output;
-    it is the unique one where the branch is monotone. The input-dependent weight can fold a
-    branch even for non-negative weights (the term ``dw/du (P_+ - P_-)``); the search then
-    returns the solution nearest to the present input on the side the target lies.
-
-    Parameters
-    ----------
-    structure : GPreisachStructure
-        The model's structure.
-    params : GPreisachParams
-        Its parameters.
-    y : numpy.ndarray, shape (n,)
-        Output, one value per sample.
-    x0 : numpy.ndarray, optional
-        Initial staircase; None is the demagnetised state.
-
-    Returns
-    -------
-    u : numpy.ndarray, shape (n,)
-        Input that gives `y`.
-    x_end : numpy.ndarray
-        State after the last sample.
-
-    Raises
-    ------
-    FitDivergedError
-        If the major loop does not rise (mean slope <= 0): no inverse exists.
-    """
-    y, x = _check(structure, params, y, "y", x0)
+def _inverse(structure: GPreisachStructure, params: GPreisachParams, y: np.ndarray,
+             x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     tables, weighted, poly, slope = kernel_parts(params)
     check_rise(slope, _mass(params), "generalised Preisach")
-    u_hat, x_end = kernels.invert(y, x, tables, weighted, poly, slope, structure.capacity,
-                                  INVERT_TOL)
-    return check_finite_run(u_hat, "inverse gpreisach", "input estimate"), x_end
+    return kernels.invert(y, x, tables, weighted, poly, slope, structure.capacity, INVERT_TOL)
+
+
+RUNS = Runs(label="gpreisach", step=step, forward=_forward, inverse=_inverse, check=_check,
+            start=start_staircase)
+simulate, simulate_reference, invert = family_runs(
+    RUNS, __name__, "the generalised Preisach model",
+    notes="Amortised O(1) per sample. The state is the staircase (as for "
+          "``preisach.simulate``): ``x0=None`` is the demagnetised state. Inputs beyond "
+          "[-1, 1] follow the straight-line extension.",
+    inverse_notes="By bisection on each branch (``preisach.invert``). The branches are "
+                  "continuous, so the search always returns an input reproducing the output; it "
+                  "is the unique one where the branch is monotone. The input-dependent weight can "
+                  "fold a branch even for non-negative weights (the term ``dw/du (P_+ - P_-)``); "
+                  "the search then returns the solution nearest to the present input on the side "
+                  "the target lies. FitDivergedError if the major loop does not rise (mean slope "
+                  "<= 0): no inverse exists.")
 
 
 def invert_step(structure: GPreisachStructure, params: GPreisachParams, x: np.ndarray,
