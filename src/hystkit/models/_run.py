@@ -39,15 +39,15 @@ class Runs:
         The model's name in error messages (``"mpl"``, ``"Chua-Stromsmoe"``).
     step : callable
         The readable ``step(structure, params, x, u) -> (y, x_next)``.
-    n_state : callable
-        ``n_state(structure, params) -> int``: length of a given ``x0``.
-    rest_state : callable
-        ``rest_state(structure, params, value, inverse) -> x``: the start of a run with
-        ``x0=None`` at the first input (``inverse``: first output).
     forward : callable
         ``forward(structure, params, u, x) -> (y, x_end)``: the compiled run from the checked
         input and start. It raises its own divergence errors; non-finite outputs are refused
         here.
+    n_state : callable
+        ``n_state(structure, params) -> int``: length of a given ``x0`` (default start).
+    rest_state : callable
+        ``rest_state(structure, params, value, inverse) -> x``: the start of a run with
+        ``x0=None`` at the first input (``inverse``: first output) (default start).
     inverse : callable or None
         ``inverse(structure, params, y, x) -> (u_hat, x_end)``, likewise; None: no inverse.
     check : callable
@@ -55,16 +55,17 @@ class Runs:
         (and, for ``inverse``, have an inverse); called before the signal is looked at.
     start : callable or None
         ``start(structure, params, x0, value, inverse) -> x`` replacing the default start (rest
-        state for ``x0=None``, else ``x0`` broadcast to ``n_state`` floats).
+        state for ``x0=None``, else ``x0`` broadcast to ``n_state`` floats): for a state that
+        is not a vector of floats (a Preisach staircase).
     layout : str or None
         What the state's values are, for the message on a ``x0`` of the wrong size.
     """
 
     label: str
     step: Callable[..., tuple[float, np.ndarray]]
-    n_state: Callable[[Any, Any], int]
-    rest_state: Callable[..., np.ndarray]
     forward: Callable[[Any, Any, np.ndarray, np.ndarray], Run]
+    n_state: Callable[[Any, Any], int] | None = None
+    rest_state: Callable[..., np.ndarray] | None = None
     inverse: Callable[[Any, Any, np.ndarray, np.ndarray], Run] | None = None
     check: Callable[[Any, Any, bool], None] = _no_check
     start: Callable[..., np.ndarray] | None = None
