@@ -47,14 +47,25 @@ stays a preprocessing step, and a loop running on raw samples sees the droop ``s
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ...errors import FitDivergedError
-from .._protocol import Record
-from .._validation import check_dt, check_signal
+from .._validation import check_signal
 from . import kernels
+from .divergence import (
+    bounded_class,
+    divergence_bound,
+    divergence_message,
+)
+from .records import (
+    BENCHMARK_PARAMS,
+    HOLDS,
+    MAX_NU,
+    MAX_SUBSTEPS,
+    STARTS,
+    BoucWenParams,
+    BoucWenStructure,
+)
 
 __all__ = [
     "BENCHMARK_PARAMS",
@@ -75,165 +86,6 @@ __all__ = [
     "simulate_states",
     "step",
 ]
-
-HOLDS = ("linear", "zoh")
-STARTS = ("rest", "equilibrium")
-MAX_SUBSTEPS = 2048  # RK4 steps a sample; the cost at the cap is in BoucWenStructure
-MAX_NU = 8.0  # the fit's nu is <= 4; beyond 8, |z|^nu overflows for |z| > 1e38
-RK4_LIMIT = 2.785  # RK4 is stable on the imaginary axis up to |lambda h| = 2 sqrt(2)
-
-
-@dataclass(frozen=True)
-class BoucWenStructure(Record):
-    """What does not get fitted: sample time, RK4 substeps, force between samples, start.
-
-    Parameters
-    ----------
-    dt : float
-        Sample time of the input and output sequences [s].
-    substeps : int
-        RK4 steps per sample, ``1 <= substeps <= MAX_SUBSTEPS`` (2048: 57 ns a step, 0.12 ms a
-        sample, 2 min for a million samples at ``nu = 1``, 4x that otherwise; no memory);
-        the integration step is ``dt / substeps``.
-    input_hold : {"linear", "zoh"}
-        Force between samples: linear interpolation (first-order hold) or zero-order hold.
-    start : {"rest", "equilibrium"}
-        State at the first sample when a run gets no ``x0`` (module docstring).
-    """
-
-    dt: float = 0.025
-    substeps: int = 4
-    input_hold: str = "linear"
-    start: str = "rest"
-
-    def __post_init__(self) -> None:
-        check_dt(self.dt)
-        # Checked before anything loops over it: a model file may say 1e12 (or inf).
-        try:
-            whole = int(self.substeps) == self.substeps
-        except (TypeError, ValueError, OverflowError):
-            whole = False
-        if not whole or not 1 <= self.substeps <= MAX_SUBSTEPS:
-            raise ValueError(f"substeps must be an integer in [1, {MAX_SUBSTEPS}], "
-                             f"got {self.substeps!r}")
-        object.__setattr__(self, "substeps", int(self.substeps))
-        if self.input_hold not in HOLDS:
-            raise ValueError(f"input_hold must be one of {HOLDS}, got {self.input_hold!r}")
-        if self.start not in STARTS:
-            raise ValueError(f"start must be one of {STARTS}, got {self.start!r}")
-
-    @property
-    def step_size(self) -> float:
-        """RK4 step ``h = dt / substeps`` [s]."""
-        return self.dt / self.substeps
-
-
-@dataclass(frozen=True)
-class BoucWenParams(Record):
-    """Physical parameters of the oscillator (module docstring for the equations).
-
-    Parameters
-    ----------
-    m, c, k : float
-        Mass, viscous damping and linear stiffness (> 0); on the benchmark kg, N s/m, N/m.
-    alpha : float
-        Initial stiffness of the hysteretic element (> 0) [N/m].
-    beta, gamma : float
-        Shape of the hysteresis (any sign) [m^-1 N^(1 - nu)].
-    nu : float
-        Sharpness of the transition, ``1 <= nu <= MAX_NU`` (8): ``>= 1`` keeps the right-hand
-        side Lipschitz, the cap keeps ``|z|^nu`` finite for ``|z| < 1e38`` (the fit's nu is at
-        most 4).
-
-    Notes
-    -----
-    The optimiser works on :meth:`to_vector`: ``[log K0, log w0, log zeta, logit r,
-    beta + gamma, beta - gamma, nu]`` with the initial stiffness ``K0 = k + alpha``, the
-    undamped natural frequency ``w0 = sqrt(K0 / m)``, the damping ratio
-    ``zeta = c / (2 sqrt(K0 m))`` and the hysteretic share ``r = alpha / K0``. ``K0`` sets the
-    small-signal gain and ``w0`` the integration stability (``w0 h`` must stay small), so they
-    get their own bounds; the log and the logit keep ``m, c, k, alpha`` positive.
-    ``beta + gamma`` and ``beta - gamma`` set the element's tangent stiffness on loading
-    (``y' z > 0``: ``dz/dy = alpha - (beta + gamma) |z|^nu``) and on unloading (``y' z < 0``:
-    ``dz/dy = alpha + (beta - gamma) |z|^nu``). Both non-negative is the class whose ``z`` stays
-    bounded (``|z| <= (alpha / (beta + gamma))^(1/nu)`` from rest) and whose loops dissipate
-    (clockwise in the z-y plane); Ismail et al. 2009, sec. 3.
-    """
-
-    m: float
-    c: float
-    k: float
-    alpha: float
-    beta: float
-    gamma: float
-    nu: float = 1.0
-
-    def __post_init__(self) -> None:
-        for name in ("m", "c", "k", "alpha", "beta", "gamma", "nu"):
-            value = getattr(self, name)
-            try:
-                value = float(value)
-            except (TypeError, ValueError):
-                raise ValueError(f"{name} must be a number, got {value!r}") from None
-            if not np.isfinite(value):
-                raise ValueError(f"{name} must be finite, got {value}")
-            object.__setattr__(self, name, value)
-        for name in ("m", "c", "k", "alpha"):
-            if getattr(self, name) <= 0:
-                raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
-        if not 1 <= self.nu <= MAX_NU:
-            raise ValueError(f"nu must lie in [1, {MAX_NU:g}], got {self.nu}")
-
-    @classmethod
-    def from_benchmark(cls, m: float, c: float, k: float, alpha: float, beta: float,
-                       gamma: float, delta: float, nu: float) -> BoucWenParams:
-        """Parameters in the benchmark's notation (``z' = alpha y' - beta (gamma ... + delta
-        ...)``), mapped to ``beta = beta_b gamma_b``, ``gamma = beta_b delta_b``."""
-        return cls(m=m, c=c, k=k, alpha=alpha, beta=beta * gamma, gamma=beta * delta, nu=nu)
-
-    @property
-    def k0(self) -> float:
-        """Initial stiffness ``k + alpha`` (the small-signal stiffness at ``z = 0``)."""
-        return self.k + self.alpha
-
-    @property
-    def omega0(self) -> float:
-        """Undamped natural frequency at the initial stiffness [rad/s]."""
-        return float(np.sqrt(self.k0 / self.m))
-
-    @property
-    def zeta(self) -> float:
-        """Damping ratio at the initial stiffness."""
-        return self.c / (2.0 * np.sqrt(self.k0 * self.m))
-
-    def as_array(self) -> np.ndarray:
-        """``(m, c, k, alpha, beta, gamma, nu)``, the kernels' order."""
-        return np.array([self.m, self.c, self.k, self.alpha, self.beta, self.gamma, self.nu])
-
-    def to_vector(self) -> np.ndarray:
-        """Optimiser coordinates (see Notes of the class)."""
-        r = self.alpha / self.k0
-        return np.array([np.log(self.k0), np.log(self.omega0), np.log(self.zeta),
-                         np.log(r / (1.0 - r)), self.beta + self.gamma, self.beta - self.gamma,
-                         self.nu])
-
-    @classmethod
-    def from_vector(cls, theta: np.ndarray) -> BoucWenParams:
-        """Inverse of :meth:`to_vector`."""
-        log_k0, log_w0, log_zeta, logit_r, load, unload, nu = np.asarray(theta, dtype=float)
-        k0, w0 = np.exp(log_k0), np.exp(log_w0)
-        r = 1.0 / (1.0 + np.exp(-logit_r))
-        m = k0 / w0**2
-        return cls(m=m, c=2.0 * np.exp(log_zeta) * k0 / w0, k=k0 * (1.0 - r), alpha=k0 * r,
-                   beta=0.5 * (load + unload), gamma=0.5 * (load - unload), nu=nu)
-
-
-# The benchmark's system (Noel & Schoukens 2016, BoucWenBenchmark.pdf): m_L = 2 kg,
-# c_L = 10 N s/m, k_L = 5e4 N/m, alpha = 5e4 N/m, beta = 1e3 m^-1, gamma = 0.8, delta = -1.1,
-# nu = 1. They reproduce the noiseless validation data to 1e-7 m (docs/models/boucwen.md).
-BENCHMARK_PARAMS = BoucWenParams.from_benchmark(m=2.0, c=10.0, k=5e4, alpha=5e4, beta=1e3,
-                                                gamma=0.8, delta=-1.1, nu=1.0)
-
 
 def _rhs(params: BoucWenParams, y: float, v: float, z: float, u: float):
     p = abs(z) ** params.nu
@@ -390,102 +242,6 @@ def simulate_states(structure: BoucWenStructure, params: BoucWenParams, u: np.nd
         raise FitDivergedError(divergence_message(structure, params, x_end, n_bad, u.size,
                                                    bound))
     return states, x_end
-
-
-def bounded_class(params: BoucWenParams) -> bool:
-    """``beta + gamma >= 0`` and ``beta - gamma >= 0``: ``z`` stays bounded, loops dissipate.
-
-    Parameters
-    ----------
-    params : BoucWenParams
-        The model's parameters.
-
-    Returns
-    -------
-    bool
-        True when both sums are non-negative.
-    """
-    return params.beta + params.gamma >= 0 and params.beta - params.gamma >= 0
-
-
-def divergence_bound(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
-                     u: np.ndarray) -> float:
-    """A bound on ``|y|`` that the exact solution cannot exceed over a run of ``u`` from ``x``.
-
-    In the bounded class the element is passive: with ``E = m v^2 / 2 + k y^2 / 2 +
-    z^2 / (2 alpha)``, ``dE/dt = u v - c v^2 - |v| |z|^(nu+1) (beta + gamma sign(v z)) / alpha
-    <= u^2 / (4 c)``, so ``|y| <= sqrt(2 (E_0 + T max u^2 / (4 c)) / k)`` over the run's
-    duration ``T``. Twice that (room for the integration error) is returned; an RK4 run beyond
-    it has diverged numerically. Outside the class ``z`` may grow without limit and the bound
-    is ``inf`` (only a non-finite state stops the run).
-
-    Parameters
-    ----------
-    structure : BoucWenStructure
-        The model's structure.
-    params : BoucWenParams
-        Its parameters.
-    x : numpy.ndarray, shape (4,)
-        State ``(y, y', z, u_prev)`` at the start of the run.
-    u : numpy.ndarray, shape (n,)
-        The run's force.
-
-    Returns
-    -------
-    float
-        The bound on ``|y|``, ``inf`` outside the bounded class.
-    """
-    if not bounded_class(params):
-        return np.inf
-    y0, v0, z0, u_prev = np.asarray(x, dtype=np.float64)  # numpy floats overflow to inf
-    with np.errstate(over="ignore", invalid="ignore"):
-        energy = 0.5 * params.m * v0**2 + 0.5 * params.k * y0**2 + z0**2 / (2 * params.alpha)
-        u_max = max(float(np.max(np.abs(u))), abs(u_prev))
-        energy += u.size * structure.dt * u_max**2 / (4 * params.c)
-        return float(2.0 * np.sqrt(2.0 * energy / params.k))
-
-
-def divergence_message(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
-                        n_bad: int, n: int, bound: float) -> str:
-    """What happened (the state at the sample it diverged) and the likely cause.
-
-    Parameters
-    ----------
-    structure : BoucWenStructure
-        The model's structure.
-    params : BoucWenParams
-        Its parameters.
-    x : numpy.ndarray
-        State at the sample where the run diverged.
-    n_bad : int
-        That sample (0-based).
-    n : int
-        Samples in the run.
-    bound : float
-        The bound of :func:`divergence_bound` (``inf`` for none).
-
-    Returns
-    -------
-    str
-        One line for the error message.
-    """
-    w0h = params.omega0 * structure.step_size
-    state = f"(y, y', z) = ({x[0]:.3g}, {x[1]:.3g}, {x[2]:.3g})"
-    what = (f"the Bouc-Wen state diverged at sample {n_bad + 1} of {n}: {state}"
-            + ("" if np.isinf(bound) else f", beyond the bound |y| <= {bound:.3g}"))
-    if w0h > RK4_LIMIT:
-        cause = (f"the RK4 step {structure.step_size:.3g} s is too long for w0 = "
-                 f"{params.omega0:.3g} rad/s (w0 h = {w0h:.3g} > {RK4_LIMIT}); use more "
-                 f"substeps")
-    elif not bounded_class(params):
-        cause = (f"beta + gamma = {params.beta + params.gamma:.3g} and beta - gamma = "
-                 f"{params.beta - params.gamma:.3g} are not both >= 0, so the hysteretic force "
-                 f"z is not bounded")
-    else:
-        cause = (f"w0 h = {w0h:.3g} is within RK4's limit, so the hysteretic element (beta, "
-                 f"gamma, nu = {params.beta:.3g}, {params.gamma:.3g}, {params.nu:.3g}) is too "
-                 f"stiff for the RK4 step {structure.step_size:.3g} s; use more substeps")
-    return f"{what}; {cause}"
 
 
 def simulate(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
