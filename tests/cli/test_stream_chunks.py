@@ -11,27 +11,27 @@ import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
-from hystkit.cli import cmd_stream
+from hystkit.cli import _stream_chunks, _stream_read
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.io import Recording
 from hystkit.sensors import simulate_experiment
 
 from ..cli_support import run_cli
 
-MAX = cmd_stream.MAX_LINE
+MAX = _stream_read.MAX_LINE
 
 
 def _by_lines(text: str) -> list[str]:
     """The lines as read one by one (``readline``, a line too long given as the marker)."""
-    return [line for chunk in cmd_stream._bounded(io.StringIO(text).readline) for line in chunk]
+    return list(_stream_read.bounded(io.StringIO(text).readline))
 
 
 def _in_reads(text: str, cuts: list[int]) -> list[str]:
-    """The lines of `text` delivered in reads ending at `cuts`, through _line_chunks."""
+    """The lines of `text` delivered in reads ending at `cuts`, through line_chunks."""
     pieces = iter([text[a:b] for a, b in zip([0, *cuts], [*cuts, len(text)], strict=True)])
-    chunks = list(cmd_stream._line_chunks(lambda: next(pieces, "")))
+    chunks = list(_stream_read.line_chunks(lambda: next(pieces, "")))
     assert all(chunks)
-    return [line for chunk in chunks for line in chunk]
+    return [line for chunk in chunks for line in _stream_read.lines_of(chunk)]
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -44,7 +44,7 @@ def test_lines_cut_from_reads_are_the_lines_read_one_by_one(seed, last):
     want = _by_lines(text)
     assert _in_reads(text, cuts) == want
     assert _in_reads(text, []) == want
-    assert (cmd_stream.TOO_LONG in want) and any(len(w) == MAX for w in want)
+    assert (_stream_read.TOO_LONG in want) and any(len(w) == MAX for w in want)
 
 
 def test_reads_are_decoded_across_their_boundaries():
@@ -53,7 +53,7 @@ def test_reads_are_decoded_across_their_boundaries():
     data = "0.0,1\r\n0.025,2 µ\r\n0.05,3\rx\n".encode()
     for cut in range(1, len(data)):
         pieces = iter([data[:cut], data[cut:], b""])
-        read = cmd_stream._decoded(lambda size: next(pieces))
+        read = _stream_read.decoded(lambda size, pieces=pieces: next(pieces))
         got = ""
         while text := read():
             got += text
@@ -78,7 +78,7 @@ def test_a_file_of_many_chunks_is_the_offline_estimate(model, tmp_path, capsys):
     data = tmp_path / "in.csv"
     data.write_text("time,sensor\n" + "".join(
         f"{t!r},{s!r}\n" for t, s in zip(rec.time.tolist(), rec.sensor.tolist(), strict=True)))
-    assert data.stat().st_size > 3 * cmd_stream.CHUNK_BYTES  # lines cut between reads
+    assert data.stat().st_size > 3 * _stream_read.CHUNK_BYTES  # lines cut between reads
     code, out, err = run_cli(capsys, "stream", path, "--in", data)
     assert code == 0, err
     rows = [row.split(",") for row in out.splitlines()[1:]]
@@ -142,7 +142,7 @@ def test_plain_chunks_and_line_by_line_give_the_same_output(kind, model, tmp_pat
     data = tmp_path / "in.csv"
     data.write_text("".join(lines))
     plain = run_cli(capsys, "stream", path, "--in", data, *options)
-    monkeypatch.setattr(cmd_stream, "_plain_chunk", lambda *args: None)
+    monkeypatch.setattr(_stream_chunks, "plain_chunk", lambda *args: None)
     by_line = run_cli(capsys, "stream", path, "--in", data, *options)
     assert plain[0] == by_line[0] == 0, plain[2]
     assert plain[1] == by_line[1]
@@ -156,8 +156,8 @@ def test_plain_lines_take_the_plain_path(model, tmp_path, capsys, monkeypatch):
     data.write_text("time,sensor\n" + "".join(_plain_lines(simulate_experiment("decay", 2),
                                                              3000)))
     seen = []
-    any_chunk = cmd_stream._any_chunk
-    monkeypatch.setattr(cmd_stream, "_any_chunk",
+    any_chunk = _stream_chunks.any_chunk
+    monkeypatch.setattr(_stream_chunks, "any_chunk",
                         lambda stream, chunk, *args: seen.extend(chunk) or any_chunk(
                             stream, chunk, *args))
     code, out, err = run_cli(capsys, "stream", path, "--in", data)
@@ -180,7 +180,8 @@ def test_a_file_past_its_header_is_read_as_its_lines_rewritten_one_by_one(model,
     data.write_text("\ufefftime,sensor,temperature\n" + "".join(lines), encoding="utf-8")
     passed = run_cli(capsys, "stream", path, "--in", data)
     monkeypatch.setattr(_stream_input.Rewriter, "chunk",
-                        lambda self, chunk: [self(line) for line in chunk])
+                        lambda self, text: "".join(self(line)
+                                                   for line in _stream_read.lines_of(text)))
     rewritten = run_cli(capsys, "stream", path, "--in", data)
     assert passed[0] == rewritten[0] == 0, passed[2]
     assert passed[1] == rewritten[1] and len(passed[1].splitlines()) == 201

@@ -31,7 +31,12 @@ import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from .._read_options import FIELDS
 from ..errors import InputError
+from ..io import ReadOptions, csv_layout, options_for, settings_for
+from ._common import given_read_options
+from ._own_layout import estimate_names
+from ._stream_read import lines_of
 
 __all__ = ["Rewriter", "StreamFormat", "live_as_trained", "nothing_compensated",
            "output_header", "stream_format"]
@@ -93,9 +98,6 @@ def stream_format(args: argparse.Namespace) -> StreamFormat:
         ``--resample`` or ``--mat-var`` (a stream takes samples as they come), or a settings
         file or layout that `hystkit.io` refuses.
     """
-    from ..io import ReadOptions, csv_layout, options_for, settings_for
-    from ._common import given_read_options
-
     given = given_read_options(args)
     refused = [f"--{k}" for k in ("resample", "mat_var") if getattr(args, k, None) is not None]
     missing = given.get("missing") == "interpolate"
@@ -146,8 +148,6 @@ def output_header(fmt: StreamFormat, banded: bool) -> str:
     """The output's header line: ``time,position_estimate,flags`` (and the band's
     ``position_lower,position_upper``) in the input's names, as ``compensate`` names them
     (`hystkit.cli._own_layout.estimate_names`)."""
-    from ._own_layout import estimate_names
-
     new = estimate_names({"position": fmt.position})
     band = f",{new['position_lower']},{new['position_upper']}" if banded else ""
     return f"{fmt.time},{new['position_estimate']},flags{band}\n"
@@ -157,9 +157,6 @@ def live_as_trained(args: argparse.Namespace, reading) -> None:
     """stdin or a serial port read as the model's training files were (their columns and
     time unit, `reading`), unless ``--columns`` or ``--time-unit`` is given: put it on `args`
     as if given, and say so on stderr. No units line: a live input has none to look for."""
-    from .._read_options import FIELDS
-    from ._common import given_read_options
-
     if args.input is not None or reading is None or not (reading.columns
                                                          or reading.time_unit != "s"):
         return
@@ -202,15 +199,20 @@ class Rewriter:
         # time and sensor first) pass as they are, since stream's parser reads them alike
         self.same = False
 
-    def chunk(self, lines: list[str]) -> list[str]:
-        """A chunk of lines rewritten (in order: the header decides how)."""
+    def chunk(self, text: str) -> str:
+        """A chunk of lines (:mod:`._stream_read`) rewritten, in order: the header decides
+        how; once lines pass as they are, the rest of the chunk passes whole."""
+        if self.same:
+            return text
+        if text is self.too_long:
+            return self(text)
+        lines = lines_of(text)
         done: list[str] = []
         for k, line in enumerate(lines):
             if self.same:
-                self.line_no += len(lines) - k
-                return done + lines[k:] if done else lines[k:]
+                return "".join(done + lines[k:])
             done.append(self(line))
-        return done
+        return "".join(done)
 
     def __call__(self, line: str) -> str:
         self.line_no += 1
