@@ -1,0 +1,87 @@
+"""Marks given to the whole suite by rule (issue 28.5), so that no test file has to carry them.
+
+``slow``: a test that starts a process (an interpreter, the C compiler, GNU Octave, Chromium,
+Sphinx, a Dask cluster), in its own code, a fixture it uses or a helper of ``tests/`` it calls.
+``python -m pytest -m "not slow"`` is the quick local loop; CI runs everything.
+
+``xdist_group``: under ``pytest -n N --dist loadgroup`` the tests of a file that share a fixture
+of module or class scope run on one worker, so that the fixture (a site build, a demo run, a
+set of fits) is made once; the other tests are spread one by one.
+"""
+
+from __future__ import annotations
+
+import inspect
+import types
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+TESTS = Path(__file__).resolve().parent
+
+# What a test calls to start a process: the subprocess module (the interpreter, cc, octave,
+# chromium, sphinx), hostile's helper around it, and the Dask cluster's worker processes.
+PROCESS_STARTERS = frozenset({"subprocess", "run_subprocess", "Popen", "LocalCluster"})
+
+
+def _under_tests(code: types.CodeType) -> bool:
+    return Path(code.co_filename).resolve().is_relative_to(TESTS)
+
+
+def _in_tests(module: types.ModuleType) -> bool:
+    path = getattr(module, "__file__", None)
+    return path is not None and Path(path).resolve().is_relative_to(TESTS)
+
+
+def _codes(code: types.CodeType):
+    """`code` and the code of the functions, lambdas and comprehensions defined inside it."""
+    yield code
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            yield from _codes(const)
+
+
+@cache
+def _starts_process(func: types.FunctionType) -> bool:
+    """Whether `func`, or a function of ``tests/`` it names (recursively), names a process
+    starter. Only names are read: a test that calls a helper which may start a process counts."""
+    seen: set[types.CodeType] = set()
+    todo = [func]
+    while todo:
+        fn = inspect.unwrap(todo.pop())
+        fn = getattr(getattr(fn, "hypothesis", None), "inner_test", fn)
+        code = getattr(fn, "__code__", None)
+        if code is None or code in seen or not _under_tests(code):
+            continue
+        seen.add(code)
+        names = {n for c in _codes(code) for n in c.co_names}
+        if names & PROCESS_STARTERS:
+            return True
+        scope = getattr(fn, "__globals__", {})
+        for name in names:
+            obj = scope.get(name)
+            if isinstance(obj, types.ModuleType) and _in_tests(obj):  # helper.function(...)
+                todo += [vars(obj)[n] for n in names if inspect.isfunction(vars(obj).get(n))]
+            elif inspect.isfunction(obj):
+                todo.append(obj)
+    return False
+
+
+def _fixture_defs(item: pytest.Item):
+    """The definitions of every fixture `item` uses (directly or through other fixtures)."""
+    info = getattr(item, "_fixtureinfo", None)
+    if info is not None:
+        for defs in info.name2fixturedefs.values():
+            yield from defs
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        defs = list(_fixture_defs(item))
+        funcs = [getattr(item, "function", None), *(d.func for d in defs)]
+        if any(f is not None and _starts_process(f) for f in funcs):
+            item.add_marker(pytest.mark.slow)
+        if any(d.scope in ("module", "class", "package") for d in defs):
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
