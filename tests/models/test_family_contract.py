@@ -8,14 +8,24 @@ invariants every generic piece relies on. Family-specific property tests stay wi
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+import importlib
 import json
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from hystkit.models import FAMILIES, Family, get_family, numerical_linearisation
+from hystkit.identification import LOSSES
+from hystkit.models import (
+    ALL_LOSSES,
+    FAMILIES,
+    Capabilities,
+    Family,
+    get_family,
+    numerical_linearisation,
+)
 from hystkit.sensors import simulate_experiment
 
 NAMES = sorted(FAMILIES)
@@ -299,3 +309,73 @@ def test_random_parameters_give_bounded_output(name, factor):
         y, x_end = family.simulate(structure, p, u)
         assert np.all(np.isfinite(y)) and np.all(np.isfinite(x_end)), k
         assert np.max(np.abs(y)) < 1e9, (k, float(np.max(np.abs(y))))
+
+
+# -- declared capabilities (what generic code reads instead of field names and fit constants) --
+
+
+def test_all_losses_are_the_identification_losses():
+    assert ALL_LOSSES == LOSSES
+
+
+def test_a_family_that_declares_nothing_fits_the_plain_sse_only():
+    plain = Capabilities()
+    assert plain.losses == ("linear",) and plain.weight_sum_floor is None
+    assert not plain.output_is_linear(None) and not plain.start_from_params
+    assert plain.sync_amplitude is None and plain.fit_options == frozenset()
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_capabilities_agree_with_the_family_and_its_fit(name):
+    family = get_family(name)
+    caps = family.capabilities
+    assert set(caps.losses) <= set(LOSSES) and "linear" in caps.losses
+    assert caps.inverse == family.has_inverse
+    assert family.fit_options == caps.fit_options
+    # the fit module's own constants (read by name until every caller reads the record)
+    fit = importlib.import_module(f"{type(family).__module__.rpartition('.')[0]}.fit")
+    assert caps.losses == tuple(getattr(fit, "SUPPORTED_LOSSES", LOSSES))
+    if caps.weight_sum_floor is not None:
+        assert caps.weight_sum_floor == getattr(fit, "WEIGHT_SUM_FLOOR", 0.0)
+    structure, params, _ = _example(name)
+    if caps.start_from_params:
+        assert family.start_options(structure, params).options["init"] == params
+    else:
+        with pytest.raises(NotImplementedError):
+            family.start_options(structure, params)
+    if caps.sync_amplitude is not None:
+        assert caps.sync_amplitude(structure, params) > 0
+
+
+def _linear_in_weights(family, structure, params) -> bool:
+    """Whether the output is ``sum_k w_k y_k - v_b``, ``y_k`` the run with unit weight k."""
+    u = _probe()
+    whole = family.simulate(structure, params, u)[0]
+    parts = sum(w_k * family.simulate(structure, dataclasses.replace(
+        params, w=np.eye(params.w.size)[k], v_b=0.0), u)[0] for k, w_k in enumerate(params.w))
+    return bool(np.allclose(parts - params.v_b, whole, rtol=1e-9,
+                            atol=1e-9 * np.max(np.abs(whole))))
+
+
+WEIGHTED = ("ladder", "mpl", "mpl-g", "mpl-poly", "pl")  # families with output weights w, v_b
+
+
+@pytest.mark.parametrize("name", WEIGHTED)
+@pytest.mark.parametrize("factor", [1, 2])
+def test_linear_output_is_declared_exactly_where_the_output_is_linear_in_w(name, factor):
+    # both directions: mpl, ladder and pl with one output segment declare it and are linear;
+    # mpl-g and mpl-poly carry weights w and a bias v_b too, but behind a non-linear output
+    # resistor (pl with more segments: the test below)
+    family = get_family(name)
+    structure, params, _ = _example(name, factor)
+    declared = family.capabilities.output_is_linear(structure)
+    assert declared == _linear_in_weights(family, structure, params)
+
+
+def test_pl_output_is_linear_with_one_output_segment_only():
+    family = get_family("pl")
+    for n_basis, linear in ((1, True), (3, False)):
+        structure = family.make_structure(0.025, 2, n_basis=n_basis)
+        params = family.random_params(structure, np.random.default_rng(n_basis))
+        assert family.capabilities.output_is_linear(structure) is linear
+        assert _linear_in_weights(family, structure, params) is linear

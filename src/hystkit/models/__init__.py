@@ -6,9 +6,11 @@ light :class:`FamilyInfo` (what ``hystkit fit --help`` shows, no model loaded). 
 :mod:`hystkit.models._protocol` for what a family provides and how to add one.
 """
 
+from ._capabilities import ALL_LOSSES
 from ._cells import DT_RANGE
 from ._protocol import (
                         Block,
+                        Capabilities,
                         Family,
                         FamilyInfo,
                         FitStart,
@@ -29,6 +31,6 @@ from ._registry import (
 from ._stability import stability_report
 from ._warm import warm_kernels
 
-__all__ = ["DT_RANGE", "FAMILIES", "FAMILY_INFO", "Block", "Family", "FamilyInfo", "FitStart",
-           "Record", "Reduction", "Translation", "family_info", "family_of", "get_family",
+__all__ = ["ALL_LOSSES", "DT_RANGE", "FAMILIES", "FAMILY_INFO", "Block", "Capabilities", "Family",
+           "FamilyInfo", "FitStart", "Record", "Reduction", "Translation", "family_info", "family_of", "get_family",
            "numerical_linearisation", "register", "stability_report", "unregister", "warm_kernels"]

@@ -38,72 +38,16 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
-__all__ = ["Block", "Family", "FamilyInfo", "FitStart", "Record", "Reduction", "Translation",
-           "numerical_linearisation"]
+from ._capabilities import Capabilities
+from ._linearise import numerical_linearisation
+from ._record import (
+    Record,
+    _count_numbers,
+)
+from ._translation import Translation
 
-
-class Record:
-    """Mixin for a family's frozen ``Structure`` / ``Params`` dataclasses.
-
-    ``to_dict`` gives JSON-safe values (arrays and tuples as lists), ``from_dict`` rebuilds from
-    the ``__init__`` fields, ``==`` compares every ``__init__`` field (arrays element-wise).
-    Derived fields (``field(init=False)``) are left out of all three. Declare array-holding
-    classes ``@dataclass(frozen=True, eq=False)`` so that this ``==`` is used; a structure of
-    scalars and tuples may keep the dataclass's own ``==`` and hash.
-    """
-
-    @classmethod
-    def _init_fields(cls) -> list[str]:
-        return [f.name for f in dataclasses.fields(cls) if f.init]
-
-    def to_dict(self) -> dict:
-        return {name: _jsonable(getattr(self, name)) for name in self._init_fields()}
-
-    @classmethod
-    def from_dict(cls, d: dict):
-        missing = [name for name in cls._init_fields() if name not in d
-                   and _required(cls, name)]
-        if missing:
-            raise KeyError(f"{cls.__name__} needs {', '.join(missing)}")
-        return cls(**{name: d[name] for name in cls._init_fields() if name in d})
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return all(_same(getattr(self, name), getattr(other, name))
-                   for name in self._init_fields())
-
-    __hash__ = None
-
-
-def _required(cls: type, name: str) -> bool:
-    f = next(f for f in dataclasses.fields(cls) if f.name == name)
-    return f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, tuple | list):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
-
-
-def _count_numbers(value: Any) -> int:
-    if isinstance(value, dict):
-        return sum(_count_numbers(v) for v in value.values())
-    if isinstance(value, list | tuple):
-        return sum(_count_numbers(v) for v in value)
-    return int(isinstance(value, int | float) and not isinstance(value, bool))
-
-
-def _same(a: Any, b: Any) -> bool:
-    if isinstance(a, np.ndarray | list | tuple) or isinstance(b, np.ndarray | list | tuple):
-        a, b = np.asarray(a), np.asarray(b)
-        return a.shape == b.shape and bool(np.array_equal(a, b))
-    return bool(a == b)
+__all__ = ["Block", "Capabilities", "Family", "FamilyInfo", "FitStart", "Record", "Reduction",
+           "Translation", "numerical_linearisation"]
 
 
 class Block(NamedTuple):
@@ -189,58 +133,6 @@ class Reduction(NamedTuple):
     params: Any
 
 
-def _no_extra(comp: Any) -> dict:
-    return {}
-
-
-def _block_state(plan: Any) -> int:
-    return plan.n_block_state
-
-
-@dataclasses.dataclass(frozen=True)
-class Translation:
-    """A family's compiled block (:meth:`Family.block`) written as C99 and as MATLAB code, for
-    :mod:`hystkit.export`; each family builds its own in ``<family>/export.py``.
-
-    The generated code reads the block's ``body`` at the same indices as the numba kernel:
-    ``BODY[i]`` in C (``real``), ``B(i + 1)`` in MATLAB (a column). ``plan`` is the
-    :class:`hystkit.export.ExportPlan`; ``lit`` formats a number as a literal of the export's
-    precision.
-
-    Parameters
-    ----------
-    c_model : callable
-        ``c_model(plan, lit) -> str``: C defining ``static void model_rest(real *x, real
-        value)`` and ``static real model_step(real *x, real u)`` (the block's step, the state
-        updated in place).
-    m_model : callable
-        ``m_model(plan, lit) -> str``: MATLAB subfunctions ``x = model_rest(B, value)`` and
-        ``[out, x] = model_step(B, x, u)``.
-    m_functions : tuple of str
-        The other MATLAB subfunctions ``m_model`` (and ``m_load``) define; an export named like
-        one of them gets a ``_model`` suffix, as it would shadow it.
-    extra : callable
-        ``extra(comp) -> dict``: numbers beyond the body (rest-state constants), as
-        ``plan.extra``; default none.
-    state_size : callable
-        ``state_size(plan) -> int``: length of the translated state; default the block's.
-    inverse : bool
-        Whether ``block_inverse`` is translated (an inverse-mode compensator is refused
-        otherwise).
-    m_load : str or None
-        MATLAB ``x = model_load(B, x_block)`` turning a block state into the translated one,
-        for a translation that keeps more state than the block; None: the block's as is.
-    """
-
-    c_model: Callable[[Any, Callable[[float], str]], str]
-    m_model: Callable[[Any, Callable[[float], str]], str]
-    m_functions: tuple[str, ...] = ()
-    extra: Callable[[Any], dict] = _no_extra
-    state_size: Callable[[Any], int] = _block_state
-    inverse: bool = True
-    m_load: str | None = None
-
-
 @dataclasses.dataclass(frozen=True)
 class FamilyInfo:
     """What the registry knows of a family before its code loads (``hystkit fit --help``).
@@ -313,6 +205,10 @@ class Family(ABC):
         The block in C and MATLAB (the family's ``export.py``); None: not exportable.
     no_export_reason : str
         Why there is no ``export`` (``hystkit export`` says it); a default names the file.
+    capabilities : Capabilities
+        What the family can do beyond the abstract members (losses, the sum |w| constraint,
+        linear output, synchronisation amplitude, given starts, inverse); generic code reads
+        only this record. The default declares nothing: the plain SSE only.
     """
 
     info: ClassVar[FamilyInfo | None] = None
@@ -340,10 +236,13 @@ class Family(ABC):
     invert: ClassVar[Callable[..., tuple[np.ndarray, np.ndarray]] | None] = None
     invert_step: ClassVar[Callable[..., tuple[float, np.ndarray]] | None] = None
 
+    capabilities: ClassVar[Capabilities] = Capabilities()
+
     fit_options: ClassVar[frozenset[str]] = frozenset()
     """Optional keywords of the family's fit beyond the common ones (``init`` from
     :meth:`start_options`, ``weight_sum_max`` for the document's constraint sum |w| <= B), so
-    that a caller can refuse an option the family lacks before any work."""
+    that a caller can refuse an option the family lacks before any work; those of
+    :attr:`capabilities` (``Capabilities.fit_options``)."""
 
     fit_function: ClassVar[Callable[..., Any] | None] = None
     """The family's fit function, ``fit_x(u, y, structure, *, accept, accept_reason,
@@ -355,6 +254,10 @@ class Family(ABC):
         if info is not None:  # the metadata are declared once, in the folder's INFO
             for field in dataclasses.fields(info):
                 setattr(cls, field.name, getattr(info, field.name))
+        # the inverse is declared once, by no_inverse_reason; fit_options follow the record
+        cls.capabilities = dataclasses.replace(cls.capabilities,
+                                               inverse=not cls.no_inverse_reason)
+        cls.fit_options = cls.capabilities.fit_options
         fit_function = cls.__dict__.get("fit_function")
         if fit_function is not None and not isinstance(fit_function, staticmethod):
             cls.fit_function = staticmethod(fit_function)  # a plain function, not a method
@@ -527,52 +430,3 @@ class Family(ABC):
         :func:`hystkit.models.stability_report` (the mPL families: eq. 5.28 per cell, knees,
         rest points); None when the family has none."""
         return None
-
-
-def numerical_linearisation(step: Callable[[np.ndarray, float], tuple[float, np.ndarray]],
-                            x: np.ndarray, u: float,
-                            rel_step: float = 1e-6) -> tuple[np.ndarray, np.ndarray,
-                                                             np.ndarray, float]:
-    """``(A, B, C, D)`` of ``(y, x+) = step(x, u)`` by central differences.
-
-    The step is ``rel_step`` times ``max(1, |value|)`` per coordinate; a piecewise model
-    linearised exactly on a kink gets the mean of its two slopes.
-
-    Parameters
-    ----------
-    step : callable
-        ``step(x, u) -> (y, x_next)`` with the parameters bound.
-    x : numpy.ndarray, shape (n,)
-        State to linearise at.
-    u : float
-        Input to linearise at.
-    rel_step : float, default 1e-6
-        Relative finite-difference step.
-
-    Returns
-    -------
-    A : numpy.ndarray, shape (n, n)
-        d x_next / d x.
-    B : numpy.ndarray, shape (n,)
-        d x_next / d u.
-    C : numpy.ndarray, shape (n,)
-        d y / d x.
-    D : float
-        d y / d u.
-    """
-    x = np.array(x, dtype=float)
-    n = x.size
-    a = np.empty((n, n))
-    c = np.empty(n)
-    for k in range(n):
-        h = rel_step * max(1.0, abs(x[k]))
-        xp, xm = x.copy(), x.copy()
-        xp[k] += h
-        xm[k] -= h
-        (yp, xnp), (ym, xnm) = step(xp, u), step(xm, u)
-        a[:, k] = (np.asarray(xnp) - np.asarray(xnm)) / (2 * h)
-        c[k] = (yp - ym) / (2 * h)
-    h = rel_step * max(1.0, abs(u))
-    (yp, xnp), (ym, xnm) = step(x, u + h), step(x, u - h)
-    b = (np.asarray(xnp) - np.asarray(xnm)) / (2 * h)
-    return a, b, c, float((yp - ym) / (2 * h))

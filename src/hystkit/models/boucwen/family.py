@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._capabilities import ALL_LOSSES, Capabilities
 from .._protocol import Block, Family
 from . import INFO, kernels
 from . import model as boucwen
@@ -20,6 +21,7 @@ class BoucWenFamily(Family):
     Structure = boucwen.BoucWenStructure
     Params = boucwen.BoucWenParams
     model = boucwen
+    capabilities = Capabilities(losses=ALL_LOSSES)
 
     @staticmethod
     def fit_function(u, y, structure, **options):

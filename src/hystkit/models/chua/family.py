@@ -6,6 +6,7 @@ import dataclasses
 
 import numpy as np
 
+from .._capabilities import ALL_LOSSES, Capabilities
 from .._protocol import Block, Family
 from . import INFO, kernels
 from . import model as chua
@@ -22,6 +23,7 @@ class ChuaFamily(Family):
     Structure = chua.ChuaStructure
     Params = chua.ChuaParams
     model = chua
+    capabilities = Capabilities(losses=ALL_LOSSES)
 
     @staticmethod
     def fit_function(u, y, structure, **options):

@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._capabilities import ALL_LOSSES, Capabilities
 from .._protocol import Block, Family
 from . import INFO, kernels
 from . import model as ladder
@@ -23,6 +24,10 @@ class LadderFamily(Family):
     Structure = ladder.LadderStructure
     Params = ladder.LadderParams
     model = ladder
+    # the largest play threshold (eq. 2.21) is the sum of the bands
+    capabilities = Capabilities(
+        losses=ALL_LOSSES, linear_output=True,
+        sync_amplitude=lambda structure, params: float(np.sum(params.band)))
 
     @staticmethod
     def fit_function(u, y, structure, **options):

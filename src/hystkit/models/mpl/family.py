@@ -6,6 +6,7 @@ import dataclasses
 
 import numpy as np
 
+from .._capabilities import ALL_LOSSES, Capabilities
 from .._cells import Cells, cell_reductions, cell_report
 from .._protocol import Block, Family, FitStart
 from . import INFO, kernels
@@ -24,7 +25,8 @@ class MplFamily(Family):
     Structure = mpl.MplStructure
     Params = mpl.MplParams
     model = mpl  # step, simulate, invert, invert_step
-    fit_options = frozenset({"init", "weight_sum_max"})
+    capabilities = Capabilities(losses=ALL_LOSSES, weight_sum_floor=0.0, linear_output=True,
+                                start_from_params=True)
 
     @staticmethod
     def fit_function(u, y, structure, **options):

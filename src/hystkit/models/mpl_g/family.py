@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._capabilities import ALL_LOSSES, Capabilities
 from .._cells import Cells, cell_reductions, cell_report
 from .._protocol import Block, Family, FitStart
 from ..mpl.family import FAMILY as MPL
@@ -28,7 +29,9 @@ class MplGFamily(Family):
     Structure = mpl_g.MplGStructure
     Params = mpl_g.MplGParams
     model = mpl_g  # step, simulate, invert, rest_state
-    fit_options = frozenset({"init", "weight_sum_max"})
+    # the gauge fixes w_0 = 1, so a weight-sum bound must exceed 1
+    capabilities = Capabilities(losses=ALL_LOSSES, weight_sum_floor=mpl_g.WEIGHT_SUM_FLOOR,
+                                start_from_params=True)
 
     @staticmethod
     def fit_function(u, y, structure, **options):

@@ -37,6 +37,7 @@ from ...identification._normal_equations import dense_normal_equations
 from ..mpl import model as mpl
 from ..mpl.fit import fit_mpl, theta_limits
 from . import model as mpl_g
+from .model import WEIGHT_SUM_FLOOR
 
 __all__ = ["MONOTONE_RANGE", "WEIGHT_SUM_FLOOR", "bernstein_slopes", "canonical", "fit_box",
            "fit_mpl_g", "output_from_slopes", "random_params", "start_theta", "theta_names"]
@@ -44,9 +45,6 @@ __all__ = ["MONOTONE_RANGE", "WEIGHT_SUM_FLOOR", "bernstein_slopes", "canonical"
 MONOTONE_RANGE = 2.0
 """Half-width of the interval ``|z| <= R`` (normalised units, gauge ``w_0 = 1``, ``V_b = 0``) on
 which a fitted ``g`` is strictly monotone."""
-
-WEIGHT_SUM_FLOOR = 1.0
-"""A weight-sum bound must exceed this: the gauge fixes ``w_0 = 1``."""
 
 # Bounds in optimiser coordinates: the cells' are the mPL's; |w| <= 100 mirrors the document's
 # weight-sum constraint (sec. 5.3.3); g_0 only needs to stay finite; the Bernstein slopes of g

@@ -53,6 +53,7 @@ from ..mpl_poly.rest import branch_around, check_branch_inverse
 from . import kernels
 
 __all__ = [
+    "WEIGHT_SUM_FLOOR",
     "MplGParams",
     "MplGStructure",
     "inverse_branch",
@@ -69,6 +70,9 @@ __all__ = [
     "simulate_with_jacobian",
     "step",
 ]
+
+WEIGHT_SUM_FLOOR = 1.0
+"""A weight-sum bound (``weight_sum_max``) must exceed this: the gauge fixes ``w_0 = 1``."""
 
 
 @dataclass(frozen=True)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._capabilities import ALL_LOSSES, Capabilities
 from .._cells import Cells, cell_report
 from .._protocol import Block, Family, FitStart
 from . import INFO, kernels
@@ -25,7 +26,7 @@ class MplPolyFamily(Family):
     model = mpl_poly
     # no weight_sum_max: the output resistor's gauge (z -> alpha z, g re-expanded) gives every
     # model an equivalent one with sum |w| below any bound, so the constraint restricts nothing
-    fit_options = frozenset({"init"})
+    capabilities = Capabilities(losses=ALL_LOSSES, start_from_params=True)
 
     @staticmethod
     def fit_function(u, y, structure, **options):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._capabilities import ALL_LOSSES, Capabilities
 from .._protocol import Block, Family
 from . import INFO, kernels
 from . import model as pl
@@ -21,6 +22,11 @@ class PlFamily(Family):
     Structure = pl.PlStructure
     Params = pl.PlParams
     model = pl
+    # linear output: f(i) = a_1 i with a_1 = M = 1 for one output segment; synchronisation:
+    # eq. 2.21 with E_0 = N V_T, the largest play threshold
+    capabilities = Capabilities(
+        losses=ALL_LOSSES, linear_output=lambda structure: structure.n_basis == 1,
+        sync_amplitude=lambda structure, params: structure.n_cells * params.v_t)
 
     @staticmethod
     def fit_function(u, y, structure, **options):
