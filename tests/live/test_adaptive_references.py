@@ -8,7 +8,7 @@ from numpy.testing import assert_array_equal
 
 from hystkit.compensation import Compensator, LinearBaseline, Scaling
 from hystkit.live import Adaptation, AdaptiveStream, Stream
-from hystkit.live._adaptive import MAX_INNOVATION, MAX_MULTIPLIER, REFERENCE_MARGIN
+from hystkit.live._adaptive_records import MAX_INNOVATION, MAX_MULTIPLIER, REFERENCE_MARGIN
 from hystkit.live._refit import Refit, RefittingStream
 from hystkit.models import FAMILIES
 

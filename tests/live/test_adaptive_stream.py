@@ -17,7 +17,7 @@ from hystkit.compensation import (
 )
 from hystkit.errors import InputError
 from hystkit.live import Adaptation, AdaptiveStream, Stream, advance_adaptive
-from hystkit.live._adaptive import _Plan
+from hystkit.live._adaptive_plan import _Plan
 from hystkit.models import FAMILIES
 from hystkit.sensors import (
     gain_ramp,

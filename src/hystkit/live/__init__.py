@@ -16,10 +16,12 @@ from .._lazy import lazy_exports
 
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"_adaptive": ("ADAPT_PARAMETERS", "Adaptation", "AdaptiveState", "AdaptiveStream",
-                   "advance_adaptive"),
+    {"_adaptive": ("AdaptiveStream", "advance_adaptive"),
+     "_adaptive_records": ("ADAPT_PARAMETERS", "Adaptation", "AdaptiveState"),
      "_refit": ("Refit", "RefitReport", "RefittingStream"),
-     "_stream": ("StepOutput", "Stream", "StreamOutput", "advance"),
+     "_readable": ("advance",),
+     "_stream": ("Stream",),
+     "_stream_output": ("StepOutput", "StreamOutput"),
      "_stream_state": ("StreamState",),
      "_sync": ("SyncExcitation", "sync_excitation")},
     first=())

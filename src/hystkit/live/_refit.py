@@ -19,7 +19,7 @@ every refit, which no sample period allows.
   against the present parameters run the same way; otherwise the stream goes on with the
   present parameters and counts the refusal.
 - As in :mod:`._adaptive`, a reference is checked for plausibility (range and innovation,
-  :class:`~._adaptive.Plausible`) before it enters the window; a rejected one is counted
+  :class:`~._adaptive_records.Plausible`) before it enters the window; a rejected one is counted
   (``RefitReport.rejected``) and never fitted (one reference of 1e200 mm ended the stream with
   an OverflowError). It still counts towards ``every``, so the refits stay at fixed references.
 - As in :mod:`._adaptive`, a sample's estimate is made before its reference is learnt: the
@@ -41,17 +41,10 @@ import numpy as np
 from ..compensation import Compensator
 from ..errors import FitDivergedError, InputError
 from ..models import FAMILIES
-from ._adaptive import MAX_INNOVATION, REFERENCE_MARGIN, Plausible
-from ._stream import (
-    StartUp,
-    StepOutput,
-    StreamOutput,
-    StreamState,
-    _advance,
-    _Path,
-    advance_scaled,
-    initial_state,
-)
+from ._adaptive_records import MAX_INNOVATION, REFERENCE_MARGIN, Plausible
+from ._readable import StartUp, _advance, _Path, advance_scaled, initial_state
+from ._stream_output import StepOutput, StreamOutput
+from ._stream_state import StreamState
 
 __all__ = ["Refit", "RefitReport", "RefittingStream"]
 
@@ -74,7 +67,7 @@ class Refit:
         that stops on it is continued once with as much again, to tell a flat minimum from a
         failure (:func:`hystkit.identification.fit_multistart`).
     reference_margin, max_innovation : float
-        The plausibility gates of a reference, as :class:`~._adaptive.Adaptation`.
+        The plausibility gates of a reference, as :class:`~._adaptive_records.Adaptation`.
     """
 
     window_seconds: float = 60.0

@@ -5,7 +5,7 @@ runaway guard, the use-time flags and the band, with the state held in arrays.
 block (:meth:`hystkit.models.Family.block`, the closed loop's) reproduces the offline run bit for
 bit, which :func:`Engine.build` checks on a probe signal for each compensator; otherwise, and for
 every sample the kernel refuses (a runaway estimate, a sensor sample that normalises to no
-finite number), the stream takes the readable Python path of :mod:`._stream`, which raises as
+finite number), the stream takes the readable Python path of :mod:`._readable`, which raises as
 before. The arithmetic below repeats that path's operations in the same order, so both give the
 same bits (tests: tests/live/test_stream_compiled.py).
 
@@ -70,7 +70,7 @@ def _make(step):
         taken = 0
         for k in range(sensor.size):
             v = sensor[k]
-            # the centring: _stream._advance_one's operations
+            # the centring: _readable._advance_one's operations
             new_sum, new_value, new_weight = tare_sum, track_value, track_weight
             if center == 0.0:
                 offset = 0.0
@@ -156,7 +156,7 @@ class Engine:
 
     Parameters
     ----------
-    path : _stream._Path
+    path : _readable._Path
         The compensator's per-sample constants.
     """
 
