@@ -10,7 +10,8 @@ from hystkit.cli import main
 from hystkit.io import Recording
 from hystkit.parallel import SerialExecutor
 from hystkit.sensors import simulate_experiment
-from hystkit.studies._compare import compare_models, generalization_matrix
+from hystkit.studies._compare import compare_models
+from hystkit.studies._generalize import generalization_matrix
 from hystkit.studies._properties import measure_properties
 
 

@@ -19,8 +19,9 @@ FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
 
 __getattr__, __dir__ = lazy_exports(
     __name__, globals(),
-    {"_compare": ("compare_models", "format_compare", "generalization_matrix",
-                  "plot_generalization"),
+    {"_compare": ("compare_models", "format_compare"),
+     "_generalize": ("generalization_matrix",),
+     "_generalization_plot": ("plot_generalization",),
      "_demo": ("DEMO_FILES", "DOCUMENT_TABLE_5_5", "format_table", "run_demo"),
      "_figures": ("plot_loops", "plot_time_series"),
      "_report_model": ("ReportContent", "model_report"),

@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..errors import InputError
-from ._compare import plot_generalization
+from ._generalization_plot import plot_generalization
 from ._html import Section, note, paragraph, table
 from ._report_model import ReportContent
 

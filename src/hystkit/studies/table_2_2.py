@@ -95,7 +95,7 @@ def measure_table_2_2(repeats: int = 10, seed: int = 1, *, excitation: str = "no
         its straight line: its scores are kept, as ``generalize`` keeps them).
     """
     from ..sensors import simulate_experiment
-    from ._compare import generalization_matrix
+    from ._generalize import generalization_matrix
 
     if repeats < 2:
         raise ValueError(f"repeats must be >= 2 for a variance, got {repeats}")
