@@ -180,7 +180,7 @@ def test_loop_nlsys_matches_the_kernel(models, scheme):
 
 
 def test_states_nothing_reads_are_left_out_of_the_analysis():
-    from hystkit.control._analysis import _read_states
+    from hystkit.control._linearise import _read_states
 
     # state 1 follows state 0 but feeds nothing; state 2 is an isolated (even unstable) memory
     a = np.array([[0.5, 0.0, 0.0], [0.2, 1.0, 0.0], [0.0, 0.0, 2.0]])

@@ -141,7 +141,7 @@ def setup_loop(args: argparse.Namespace):
 
 def _loop(args: argparse.Namespace, models: SensorModels):
     """The configured loop; a library ValueError here is a bad option combination."""
-    from ..control import PID, DisturbanceObserver, Plant, build_loop, design_dob, tune_pid
+    from ..control import PID, DisturbanceObserver, Plant, build_loop
 
     try:
         plant = Plant(args.mass, args.u_max)
@@ -149,11 +149,11 @@ def _loop(args: argparse.Namespace, models: SensorModels):
         loop = build_loop(args.scheme, models, pid=pid, plant=plant,
                           zero_at_start=not args.no_zero)
         if args.tune is not None:
-            pid = tune_pid(args.tune[0], args.tune[1], loop=loop)
+            pid = _library("tune_pid")(args.tune[0], args.tune[1], loop=loop)
         pid = replace(pid or loop.pid, tf=args.tf, anti_windup=args.anti_windup)
         loop = replace(loop, pid=pid)
         if args.dob:
-            dob = (design_dob(loop) if args.dob_hz is None
+            dob = (_library("design_dob")(loop) if args.dob_hz is None
                    else DisturbanceObserver(args.dob_hz))
             loop = replace(loop, dob=dob)
         loop.kernel_arguments()  # every block at the loop's Ts, or the family's refusal
@@ -166,14 +166,7 @@ def _control(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .. import __version__
-    from ..control import (
-        bode_data,
-        loop_margins,
-        plot_bode,
-        plot_cases,
-        plot_response,
-        run_experiment,
-    )
+    from ..control import cached_loop_margins, plot_cases, plot_response, run_experiment
     from ..io import atomic_folder, check_output_folder, write_json
 
     if not (args.experiment or args.bode):
@@ -193,7 +186,7 @@ def _control(args: argparse.Namespace) -> int:
     tuned = report.tune(args, loop) if args.tune_nonlinear else None
     if tuned is not None:
         loop = replace(loop, pid=tuned.pid)
-    margins = loop_margins(loop)
+    margins = cached_loop_margins(loop)  # python-control loads only when not stored
     dob = f"{loop.dob.f_q:.3g} Hz" if loop.dob else "off"
     print(f"hystkit control: scheme {args.scheme}"
           + (f", experiment {args.experiment}" if args.experiment else "")
@@ -246,8 +239,8 @@ def _control(args: argparse.Namespace) -> int:
         else:
             write_json({"scheme": args.scheme, "linear": linear}, tmp / "analysis.json")
         if args.bode:
-            f, mag, phase = bode_data(loop)
-            plot_bode(f, mag, phase, margins, f"scheme {args.scheme}: linearised open loop at "
+            f, mag, phase = _library("bode_data")(loop)
+            _library("plot_bode")(f, mag, phase, margins, f"scheme {args.scheme}: linearised open loop at "
                       f"rest, cut at the plant input").savefig(tmp / "bode.png", dpi=110)
         config["seconds"] = time.perf_counter() - t_start
         write_json(config, tmp / "config.json")

@@ -24,7 +24,7 @@ from ._blocks import (
 from ._loop import ControlLoop, LoopResponse, simulate_loop, tare
 from ._names import EXPERIMENTS
 from ._noise import NoiseSpec
-from ._sensors import SensorModels
+from ._sensor_blocks import SensorModels
 
 __all__ = [
     "AMPLITUDES_MM",

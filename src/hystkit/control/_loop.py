@@ -23,7 +23,7 @@ import pandas as pd
 from . import _kernel
 from ._blocks import PID, TS, DisturbanceObserver, Plant, plant_matrices
 from ._names import SCHEMES
-from ._sensors import SensorBlock
+from ._sensor_blocks import SensorBlock
 
 __all__ = ["SCHEMES", "ControlLoop", "LoopResponse", "LoopState", "rest_state",
            "simulate_loop", "simulate_loop_reference", "tare"]

@@ -16,7 +16,7 @@ from ..compensation import Compensator
 from ..models import family_of
 from ._blocks import TS, plant_matrices
 from ._loop import ControlLoop, LoopState, rest_state
-from ._sensors import SensorBlock, compensator_block
+from ._sensor_blocks import SensorBlock, compensator_block
 
 __all__ = ["as_nlsys", "loop_initial_state", "loop_nlsys"]
 

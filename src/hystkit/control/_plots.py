@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from ._analysis import LoopMargins
 from ._experiments import ExperimentResult
 from ._loop import LoopResponse
+from ._loop_margins import LoopMargins
 
 __all__ = ["plot_bode", "plot_cases", "plot_response"]
 

@@ -35,9 +35,9 @@ import control
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ._analysis import _ss, classify_poles
 from ._blocks import extended_input, extended_matrices, plant_matrices
 from ._experiments import run_experiment, sine_reference
+from ._linearise import _ss, classify_poles
 from ._loop import ControlLoop
 
 __all__ = ["CircleResult", "Sector", "StabilityReport", "chord_sector", "circle_criterion",

@@ -24,10 +24,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import minimize
 
-from ._analysis import LoopMargins, loop_margins
+from ._analysis import loop_margins
 from ._blocks import PID
 from ._experiments import run_experiment
 from ._loop import ControlLoop
+from ._loop_margins import LoopMargins
 from ._noise import NoiseSpec
 
 __all__ = ["HELD_OUT", "OBJECTIVES", "TuneResult", "tune_nonlinear"]
