@@ -9,6 +9,8 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
+from ..io import atomic_folder, write_json
+
 __all__ = ["format_markdown", "output_names", "write_table"]
 
 
@@ -97,8 +99,6 @@ def write_table(out: str | os.PathLike[str], stem: str, result: dict, rows: Sequ
     OutputError
         If `out` is a file or cannot be written.
     """
-    from ..io import atomic_folder, write_json
-
     names = output_names(stem)
     keys = list(dict.fromkeys(key for row in rows for key in row))
     text = io.StringIO()

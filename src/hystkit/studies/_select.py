@@ -275,6 +275,7 @@ def plot_selection(ranking: Sequence[dict]) -> Figure:
     matplotlib.figure.Figure
         One row per candidate, best at the top, its R² written beside each marker.
     """
+    # with matplotlib (~0.3 s), which select without --report never needs
     from ._report_folders import plot_unexplained
 
     rows = [r for r in ranking if "error" not in r]

@@ -30,6 +30,9 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..compensation import fit_compensator
+from ..sensors import VirtualSensor, simulate_experiment
+
 __all__ = ["CREEP_COLUMNS", "CreepPlan", "creep_experiment", "creep_trajectory",
            "hold_levels"]
 
@@ -188,9 +191,6 @@ def creep_experiment(plan: CreepPlan = CreepPlan(), *, models: Sequence[str] = (
         hold the same at its end, and ``late_*``: what is left after five of the sensor's
         slowest Prony time constants.
     """
-    from ..compensation import fit_compensator
-    from ..sensors import VirtualSensor, simulate_experiment
-
     sensor = VirtualSensor() if sensor is None else sensor
     t, x, holds = creep_trajectory(plan, sensor.fs_internal)
     progress(f"virtual sensor: 3 holds of {plan.hold_seconds:g} s at +-{plan.amplitude_mm:g} mm "

@@ -22,6 +22,9 @@ from typing import Any
 
 import numpy as np
 
+from ..sensors import simulate_experiment
+from ._generalize import generalization_matrix
+
 __all__ = ["DOCUMENT_NAMES", "DOCUMENT_TABLE_2_2", "TABLE_2_2_COLUMNS", "measure_table_2_2",
            "rmse_statistics"]
 
@@ -94,9 +97,6 @@ def measure_table_2_2(repeats: int = 10, seed: int = 1, *, excitation: str = "no
         ``n_flagged`` counts repeats whose fit failed or was disqualified (collapsed, worse than
         its straight line: its scores are kept, as ``generalize`` keeps them).
     """
-    from ..sensors import simulate_experiment
-    from ._generalize import generalization_matrix
-
     if repeats < 2:
         raise ValueError(f"repeats must be >= 2 for a variance, got {repeats}")
     per_repeat = []

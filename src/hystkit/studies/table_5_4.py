@@ -30,15 +30,14 @@ import warnings
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from ..compensation import Compensator
-    from ..io import Recording
-    from ..preprocess import PreprocessResult
-    from ..sensors import ScopeSettings
+from ..compensation import Compensator, fit_compensator
+from ..io import Recording
+from ..metrics import loop_area, sinad_db
+from ..preprocess import PreprocessResult, PreprocessSettings, RawDataWarning, preprocess_raw
+from ..sensors import ScopeSettings, simulate_raw
 
 __all__ = ["DOCUMENT_TABLE_5_4", "SAME_CENTRING_NOTE", "TABLE_5_4_COLUMNS", "Table54Settings",
            "measure_table_5_4", "signal_scores"]
@@ -123,9 +122,6 @@ def measure_table_5_4(settings: Table54Settings = Table54Settings(),
     FitDivergedError
         The inverse fit or the compensator's run failed (said in one line).
     """
-    from ..compensation import fit_compensator
-    from ..sensors import ScopeSettings
-
     scope = ScopeSettings(fs=settings.scope_rate)
     caught: list[str] = []
     with tempfile.TemporaryDirectory(prefix="hystkit-table-5.4-") as tmp:
@@ -150,9 +146,6 @@ def _raw_run(folder: Path, name: str, seed: int, settings: Table54Settings,
              scope: ScopeSettings, caught: list[str],
              progress: Callable[[str], None]) -> PreprocessResult:
     """Write one raw recording of the virtual sensor and preprocess it as the lab would."""
-    from ..preprocess import PreprocessSettings, RawDataWarning, preprocess_raw
-    from ..sensors import simulate_raw
-
     path = folder / f"{name}.parquet"
     progress(f"raw {settings.excitation} recording, seed {seed}, scope {scope.fs:g} Hz -> "
              f"preprocess (bridge, encoder, 20 Hz filter, 40 Hz)")
@@ -166,8 +159,6 @@ def _raw_run(folder: Path, name: str, seed: int, settings: Table54Settings,
 
 
 def _row(signal: str, centring: str, position: np.ndarray, y: np.ndarray, fs: float) -> dict:
-    from ..metrics import loop_area, sinad_db
-
     sinad, area = DOCUMENT_TABLE_5_4[signal]
     try:
         measured, why = sinad_db(y, fs), None
