@@ -186,8 +186,9 @@ def test_the_band_of_compiled_steps_is_the_offline_band():
 
 
 def test_a_tracking_stream_does_not_load_scipy(tmp_path):
-    """The probe checks the block with the training offsets: the tracker's Python path (and
-    scipy.signal, ~0.7 s to import) is not needed to start a compiled stream."""
+    """The tracker's readable path repeats lfilter's operations: neither a compiled stream
+    nor the readable chunk path (advance) nor an adapting stream loads scipy.signal (~0.7 s
+    to import)."""
     import subprocess
     import sys
 
@@ -199,6 +200,10 @@ def test_a_tracking_stream_does_not_load_scipy(tmp_path):
              f"stream = Stream.from_file({str(path)!r})\n"
              "assert stream.compiled\n"
              "[stream.step(1200.0 + k) for k in range(50)]\n"
+             "from hystkit.live import AdaptiveStream, StreamState, advance\n"
+             "import numpy as np\n"
+             "advance(stream.compensator, StreamState(None), 1200.0 + np.arange(50.0))\n"
+             "AdaptiveStream(stream.compensator).step(1200.0, 0.1)\n"
              "print('scipy.signal' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                          check=True, timeout=300).stdout

@@ -189,8 +189,6 @@ class AdaptiveStream:
         self._state = AdaptiveState(initial_state(compensator, start), self._plan.start)
         self._previous: _Previous | None = None  # speeds up step; never changes a result
         self.label = label
-        if compensator.center == "track":
-            import scipy.signal  # noqa: F401  # now, not ~1 s late on the first sample
 
     @classmethod
     def from_state(cls, compensator: Compensator, adaptation: Adaptation,

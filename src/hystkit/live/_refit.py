@@ -179,8 +179,6 @@ class RefittingStream:
         self._report = RefitReport()
         self._options = {"max_nfev": self.refit.max_nfev}
         self._warm_up()
-        if compensator.center == "track":
-            import scipy.signal  # noqa: F401  # now, not ~1 s late on the first sample
 
     def _warm_up(self) -> None:
         """Load the fit's code and compiled kernels now, not inside the first refit of a

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..compensation import load_compensator
 from ..compensation._compensator import Compensator
 from ..errors import FitDivergedError, InputError
 from ._readable import (
@@ -123,7 +124,6 @@ class Stream:
     @classmethod
     def from_file(cls, model_path: str | Path, start: StartUp = "rest", **options) -> Stream:
         """A stream of the compensator in a model file (``hystkit fit`` output)."""
-        from ..compensation import load_compensator
         return cls(load_compensator(model_path), start, **options)
 
     @property

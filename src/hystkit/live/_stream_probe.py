@@ -4,8 +4,6 @@ band, end state)."""
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 
 from ..compensation._compensator import Compensator
@@ -25,18 +23,11 @@ def compiled_engine(path: _Path):
     """The compiled kernel's engine for `path` (:mod:`._stream_kernel`), or None when the
     family has no compiled block or its block does not give the Python path's bits on a probe
     signal (then every sample takes the Python path)."""
-
     try:
         engine = Engine(path)
     except NotImplementedError:  # a family without a block
         return None
-    if path.comp.center != "track":
-        return engine if _reproduces(engine, path) else None
-    # The family's block is what the probe checks; the tracker is the same code for every
-    # family (tested), and its Python path would import scipy.signal (~0.7 s).
-    probed = _Path(dataclasses.replace(path.comp, center="fit"), path.rest_position,
-                   path.level)
-    return engine if _reproduces(Engine(probed), probed) else None
+    return engine if _reproduces(engine, path) else None
 
 
 def _reproduces(engine, path: _Path) -> bool:
