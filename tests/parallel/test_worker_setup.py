@@ -36,7 +36,7 @@ def test_dask_workers_run_the_setup_only_if_they_did_not_inherit_it(ran_here, mo
         calls.append(1)
 
     monkeypatch.setattr(dask_executor, "_RUN_HERE", set())
-    monkeypatch.setattr("threadpoolctl.threadpool_limits", lambda limits: None)
+    monkeypatch.setattr(dask_executor, "threadpool_limits", lambda limits: None)
     if ran_here:  # as in a worker forked from a process that ran it
         dask_executor.run_setup(setup)
         calls.clear()
@@ -48,6 +48,6 @@ def test_dask_workers_run_the_setup_only_if_they_did_not_inherit_it(ran_here, mo
 
 def test_a_worker_without_a_setup_only_limits_blas(monkeypatch):
     limits = []
-    monkeypatch.setattr("threadpoolctl.threadpool_limits", limits.append)
+    monkeypatch.setattr(dask_executor, "threadpool_limits", limits.append)
     dask_executor.WorkerSetup().setup(worker=None)
     assert limits == [1]

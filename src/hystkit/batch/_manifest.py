@@ -22,7 +22,9 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from ..compensation import CENTERS, MODES
 from ..errors import InputError
+from ..models import FAMILIES
 
 __all__ = ["RECORDING_SUFFIXES", "SensorJob", "jobs_from_folder", "read_manifest"]
 
@@ -190,9 +192,6 @@ def _job(path: Path, where: str, entry: dict, defaults: Mapping[str, object]) ->
 
 def _with_options(job: SensorJob, options: Mapping[str, object], where: str) -> SensorJob:
     """`job` with the model options, each checked against the registry (one-line errors)."""
-    from ..compensation import CENTERS, MODES
-    from ..models import FAMILIES
-
     model = str(options.get("model") or "mpl")
     if model not in FAMILIES:
         raise InputError(f"{where}: unknown model {model!r}; known: "

@@ -19,6 +19,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict
 from pathlib import Path
 
+import pandas as pd
+
 from .. import __version__
 from ..compensation import (
     DEFAULT_CENTER,
@@ -330,8 +332,6 @@ def _summary(row: dict) -> str:
 
 
 def _write_table(out: Path, table: list[dict]) -> None:
-    import pandas as pd
-
     frame = pd.DataFrame(table, columns=list(RESULT_COLUMNS))
     # derived from the records: rebuilt (replaced) on every run of the batch
     with atomic_outputs([out / "results.parquet", out / "results.csv"], force=True) as (pq, cs):

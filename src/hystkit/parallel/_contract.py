@@ -3,11 +3,14 @@ every worker process does before its first piece (`make_numba_ready`)."""
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from contextvars import ContextVar
 from typing import Any, Protocol
+
+from threadpoolctl import threadpool_limits
 
 __all__ = ["Cost", "Executor", "OnDone", "SerialExecutor", "available_cores", "can_fork",
            "current_executor", "make_numba_ready"]
@@ -59,8 +62,6 @@ class SerialExecutor:
     def map(self, func: Callable[..., Any], items: Sequence[Any], *,
             shared: Mapping[str, Any] | None = None, on_done: OnDone | None = None,
             cost: Cost | None = None) -> list:
-        from threadpoolctl import threadpool_limits
-
         results = []  # in the given order: `cost` changes nothing for one worker
         with threadpool_limits(1):
             for i, item in enumerate(items):
@@ -103,8 +104,6 @@ def current_executor() -> Executor | None:
 
 def can_fork() -> bool:
     """Whether worker processes can be forked from this one (Linux)."""
-    import multiprocessing  # only for a parallel run
-
     return sys.platform.startswith("linux") and \
         "fork" in multiprocessing.get_all_start_methods()
 
@@ -114,6 +113,7 @@ def make_numba_ready() -> None:
     registry, scipy.linalg for LAPACK; ~0.2 s), which the first kernel call of a process would
     otherwise set up. Under numba's compiler lock, so never beside a kernel load in another
     thread."""
+    # numba (~0.2 s) only here: hystkit.parallel itself loads no compiled code
     from numba.core.compiler_lock import global_compiler_lock
     from numba.core.registry import cpu_target
 

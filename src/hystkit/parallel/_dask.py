@@ -24,6 +24,7 @@ from typing import Any
 
 import dask
 from distributed import Client, LocalCluster, WorkerPlugin, as_completed
+from threadpoolctl import threadpool_limits
 
 from .. import __version__
 from ._contract import Cost, OnDone, can_fork
@@ -64,8 +65,6 @@ class WorkerSetup(WorkerPlugin):
         self.setup_once = setup
 
     def setup(self, worker: Any) -> None:
-        from threadpoolctl import threadpool_limits
-
         threadpool_limits(1)  # kept for the worker's life (not used as a context manager)
         if self.setup_once is not None:
             run_setup(self.setup_once)

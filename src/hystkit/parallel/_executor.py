@@ -65,6 +65,7 @@ def _parallel_executor(n_workers: int | None, scheduler: str | None,
     fastest to start, `._forked`); elsewhere a `distributed` LocalCluster of spawned workers,
     and for a scheduler address a client of it (`._dask`). Dask loads only here."""
     if scheduler is None and can_fork():
+        # Dask (~0.5 s) only for a parallel run: a serial one never imports it
         from ._forked import ForkedExecutor
 
         executor = ForkedExecutor(n_workers)

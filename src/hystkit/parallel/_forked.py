@@ -35,6 +35,7 @@ from typing import Any
 import dask
 import dask.multiprocessing
 from dask.callbacks import Callback
+from threadpoolctl import threadpool_limits
 
 from ._contract import _CURRENT, Cost, OnDone, make_numba_ready
 from ._cost import cost_order
@@ -47,8 +48,6 @@ def _worker_start() -> None:
     other worker's core), no executor current (the parent's was copied by the fork; a fit
     inside a piece stays serial), and numba made ready to load cached kernels (its target
     context, ~0.2 s), which every piece's first kernel call would otherwise do."""
-    from threadpoolctl import threadpool_limits
-
     threadpool_limits(1)  # kept for the worker's life
     _CURRENT.set(None)
     make_numba_ready()

@@ -18,6 +18,9 @@ import time
 from collections.abc import Coroutine
 from typing import Any
 
+from distributed.comm import connect
+from distributed.comm.addressing import parse_address, parse_host_port
+
 from ..errors import HystkitError
 
 __all__ = ["DEFAULT_CONNECT_TIMEOUT", "SchedulerError", "check_handshake"]
@@ -61,8 +64,6 @@ def check_handshake(address: str, timeout: float) -> None:
 
 
 async def _handshake(address: str, timeout: float) -> None:
-    from distributed.comm import connect
-
     comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
     await comm.close()
 
@@ -116,8 +117,6 @@ def _what_answers(address: str, exc: BaseException, timed_out: bool, timeout: fl
 def _look(address: str) -> tuple[str, bytes | str] | None:
     """("refused", ""), ("error", reason) or ("reply", its first bytes) from a TCP connection
     to `address` given an HTTP HEAD request; None for an address that is not TCP."""
-    from distributed.comm.addressing import parse_address, parse_host_port
-
     try:
         scheme, location = parse_address(address)
         if scheme != "tcp":
