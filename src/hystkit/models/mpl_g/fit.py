@@ -38,13 +38,15 @@ from ..mpl import model as mpl
 from ..mpl.fit import fit_mpl, theta_limits
 from . import model as mpl_g
 from .model import WEIGHT_SUM_FLOOR
+from .slopes import (
+    MONOTONE_RANGE,
+    bernstein_slopes,
+    output_from_slopes,
+    slope_matrix,
+)
 
 __all__ = ["MONOTONE_RANGE", "WEIGHT_SUM_FLOOR", "bernstein_slopes", "canonical", "fit_box",
            "fit_mpl_g", "output_from_slopes", "random_params", "start_theta", "theta_names"]
-
-MONOTONE_RANGE = 2.0
-"""Half-width of the interval ``|z| <= R`` (normalised units, gauge ``w_0 = 1``, ``V_b = 0``) on
-which a fitted ``g`` is strictly monotone."""
 
 # Bounds in optimiser coordinates: the cells' are the mPL's; |w| <= 100 mirrors the document's
 # weight-sum constraint (sec. 5.3.3); g_0 only needs to stay finite; the Bernstein slopes of g
@@ -54,58 +56,6 @@ _LOG_G_MIN = np.log(1e-4)
 _G0_BOUND = 1e3
 _LOG_SLOPE_BOUNDS = (np.log(1e-6), np.log(1e3))
 _W_BOUND = 100.0
-
-
-def _slope_matrix(r: float) -> np.ndarray:
-    """``M`` with ``(g_1, g_2, g_3) = M b`` for ``g' = b_0 (1-t)^2 + 2 b_1 t (1-t) + b_2 t^2``,
-    ``t = (z + r) / (2 r)`` (expanded in ``z``, then integrated)."""
-    s = 1.0 / (2.0 * r)
-    return np.array([[0.25, 0.5, 0.25],
-                     [-0.5 * s, 0.0, 0.5 * s],
-                     [s * s / 3.0, -2.0 * s * s / 3.0, s * s / 3.0]])
-
-
-def output_from_slopes(g0: float, b: np.ndarray, r: float = MONOTONE_RANGE) -> np.ndarray:
-    """``g_0..g_3`` of the cubic with ``g(0) = g0`` whose slope has Bernstein coefficients
-    ``b`` on ``|z| <= r``; ``g`` is strictly monotone there when all ``b`` share a sign.
-
-    Parameters
-    ----------
-    g0 : float
-        ``g(0)``.
-    b : array, shape (3,)
-        Bernstein coefficients of ``g'`` on ``[-r, r]``.
-    r : float, default MONOTONE_RANGE
-        Half-width of the interval.
-
-    Returns
-    -------
-    numpy.ndarray, shape (4,)
-        ``g_0..g_3``.
-    """
-    return np.r_[g0, _slope_matrix(r) @ np.asarray(b, dtype=float)]
-
-
-def bernstein_slopes(g: np.ndarray, r: float = MONOTONE_RANGE) -> np.ndarray:
-    """Inverse of :func:`output_from_slopes` (without ``g_0``): ``b_0 = g'(-r)``,
-    ``b_2 = g'(r)``, ``b_1 = 2 g'(0) - (b_0 + b_2) / 2``.
-
-    Parameters
-    ----------
-    g : array, shape (4,)
-        ``g_0..g_3``.
-    r : float, default MONOTONE_RANGE
-        Half-width of the interval.
-
-    Returns
-    -------
-    numpy.ndarray, shape (3,)
-        ``b_0, b_1, b_2``.
-    """
-    g = np.asarray(g, dtype=float)
-    lo, mid, hi = (mpl_g.output_slope(mpl_g.MplGParams(i_s=[1.0], v_t=[1.0], g=g, w=[1.0, 0.0]),
-                                      z) for z in (-r, 0.0, r))
-    return np.array([lo, 2.0 * mid - 0.5 * (lo + hi), hi])
 
 
 def theta_names(n_cells: int) -> list[str]:
@@ -223,7 +173,7 @@ class _Coordinates:
 
     def __init__(self, n_cells: int, sign: float) -> None:
         self.n, self.sign = n_cells, sign
-        self.matrix = _slope_matrix(MONOTONE_RANGE)
+        self.matrix = slope_matrix(MONOTONE_RANGE)
 
     def to_params(self, theta: np.ndarray) -> mpl_g.MplGParams:
         n = self.n
