@@ -9,8 +9,8 @@ import math
 
 from ..errors import FitDivergedError, InputError
 from ..live import Adaptation, AdaptiveStream, Refit, RefittingStream
+from ._stream_defaults import DEFAULT_FORGETTING, DEFAULT_REFIT_EVERY, DEFAULT_WINDOW
 from ._stream_lines import Reading, Tally, reference_of
-from .cmd_stream import DEFAULT_FORGETTING, DEFAULT_REFIT_EVERY, DEFAULT_WINDOW
 
 __all__ = ["Learning", "adaptive_stream", "check_adapt_options", "run_line"]
 

@@ -17,17 +17,16 @@ import sys
 from collections.abc import Callable, Iterator
 
 from ..errors import InputError
+from ._stream_defaults import DEFAULT_BAUD, SERIAL_HINT
 
-__all__ = ["CHUNK_BYTES", "DEFAULT_BAUD", "MAX_LINE", "SERIAL_HINT", "TOO_LONG", "Input",
+__all__ = ["CHUNK_BYTES", "MAX_LINE", "TOO_LONG", "Input",
            "bounded", "decoded", "line_chunks", "lines_of", "open_input"]
 
-DEFAULT_BAUD = 115200
 # A longer line is no "time,sensor" pair: skipped without holding it in memory.
 MAX_LINE = 4096
 # At most this many bytes per read: what a pipe holds at once, a few thousand lines.
 CHUNK_BYTES = 1 << 16
 TOO_LONG = "\0 line too long"
-SERIAL_HINT = 'pip install "hystkit[serial]"'
 
 
 class Input:

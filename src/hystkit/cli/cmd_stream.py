@@ -53,15 +53,16 @@ from pathlib import Path
 
 from ._common import add_read_options, number, positive_int
 from ._own_layout import add_trained_note
-from ._stream_read import SERIAL_HINT
+from ._stream_defaults import (
+    ADAPT_CHOICES,
+    DEFAULT_FORGETTING,
+    DEFAULT_REFIT_EVERY,
+    DEFAULT_WINDOW,
+    SERIAL_HINT,
+)
 
-__all__ = ["register", "stream_options"]
-
-# As hystkit.live._adaptive and ._refit (not imported here: the parser stays light).
-ADAPT_CHOICES = ("gain", "weights", "full")
-DEFAULT_FORGETTING = 0.9
-DEFAULT_WINDOW = 60.0
-DEFAULT_REFIT_EVERY = 10
+__all__ = ["ADAPT_CHOICES", "DEFAULT_FORGETTING", "DEFAULT_REFIT_EVERY", "DEFAULT_WINDOW",
+           "register", "stream_options"]
 
 
 def _run(args: argparse.Namespace) -> int:
