@@ -21,10 +21,11 @@ from ._blocks import (
     DisturbanceObserver,
     Plant,
 )
-from ._loop import ControlLoop, LoopResponse, simulate_loop, tare
+from ._loop import ControlLoop, tare
 from ._names import EXPERIMENTS
 from ._noise import NoiseSpec
 from ._sensor_blocks import SensorModels
+from ._simulate import LoopResponse, simulate_loop
 
 __all__ = [
     "AMPLITUDES_MM",

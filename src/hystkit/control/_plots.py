@@ -10,8 +10,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ._experiments import ExperimentResult
-from ._loop import LoopResponse
 from ._loop_margins import LoopMargins
+from ._simulate import LoopResponse
 
 __all__ = ["plot_bode", "plot_cases", "plot_response"]
 

@@ -36,127 +36,13 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ._blocks import extended_input, extended_matrices, plant_matrices
-from ._experiments import run_experiment, sine_reference
+from ._experiments import run_experiment
 from ._linearise import _ss, classify_poles
 from ._loop import ControlLoop
+from ._sectors import Sector, chord_sector, hull, interval, measure_sector
 
-__all__ = ["CircleResult", "Sector", "StabilityReport", "chord_sector", "circle_criterion",
-           "global_stability", "measure_sector", "sector_channel"]
-
-RELATIVE_STEP = 1e-2
-"""Chord slopes are taken where ``|du| > RELATIVE_STEP * max |du|`` (the input moves)."""
-
-
-@dataclass(frozen=True)
-class Sector:
-    """Measured slope sector ``[k_min, k_max]`` of a block's increments.
-
-    Parameters
-    ----------
-    k_min, k_max : float
-        Smallest and largest chord slope ``dv / du`` [output units per input unit].
-    n_used, n_samples : int
-        Increments the slopes come from, of all.
-    unexplained_step : float
-        How far the left-out increments (input nearly still) fall outside the sector: the
-        largest distance of ``dv`` from ``[k_min du, k_max du]``, relative to the largest
-        ``|dv|`` of all. 0 (to rounding) for a memoryless block.
-    units : str, default ""
-        Units of the slopes, e.g. ``"m / m"``.
-    """
-
-    k_min: float
-    k_max: float
-    n_used: int
-    n_samples: int
-    unexplained_step: float
-    units: str = ""
-
-    def to_dict(self) -> dict:
-        """The fields as a JSON-safe dict."""
-        return dict(vars(self))
-
-
-def chord_sector(u: np.ndarray, v: np.ndarray, *, relative_step: float = RELATIVE_STEP,
-                 units: str = "") -> Sector:
-    """Sector of the chord slopes ``(v[n+1] - v[n]) / (u[n+1] - u[n])`` of a block's run.
-
-    Parameters
-    ----------
-    u, v : arrays, shape (n,)
-        Input and output of one run.
-    relative_step : float
-        Increments with ``|du| <= relative_step * max |du|`` are left out (see :class:`Sector`).
-    units : str, default ""
-        Units of the slopes, stored in the result.
-
-    Returns
-    -------
-    Sector
-        Slopes of the used increments and how far the others fall outside.
-
-    Raises
-    ------
-    ValueError
-        If the input does not move (no increment to take a slope of).
-    """
-    du, dv = np.diff(np.asarray(u, dtype=float)), np.diff(np.asarray(v, dtype=float))
-    if du.size == 0 or not np.any(du):
-        raise ValueError("the input does not move: no slope to measure")
-    used = np.abs(du) > relative_step * np.max(np.abs(du))
-    k = dv[used] / du[used]
-    k_min, k_max = float(k.min()), float(k.max())
-    lo = np.minimum(k_min * du[~used], k_max * du[~used])
-    hi = np.maximum(k_min * du[~used], k_max * du[~used])
-    outside = np.maximum(lo - dv[~used], dv[~used] - hi)
-    top = np.max(np.abs(dv))
-    unexplained = (float(max(np.max(outside, initial=0.0), 0.0) / top) if top > 0 else 0.0)
-    return Sector(k_min, k_max, int(used.sum()), int(du.size), unexplained, units)
-
-
-def _training_position(ts: float) -> np.ndarray:
-    """The trained sine (eq. 7.3, 0.5 Hz, 3 mm), 3 periods at ``ts`` [m]."""
-    return sine_reference(round(6.0 / ts), ts)
-
-
-def measure_sector(loop: ControlLoop, y: np.ndarray | None = None) -> dict[str, Sector]:
-    """Slope sectors of the loop's hysteretic blocks, driven by the position ``y`` [m].
-
-    ``y`` defaults to the trained sine (eq. 7.3, 3 periods at ``loop.ts``). Returns the sectors
-    of ``S_r`` (position -> sensor), of the compensator (sensor -> position, on ``S_r``'s
-    output) when present, and of the channel the circle criterion uses: ``y -> y_hat``
-    (compensator after ``S_r``) in scheme ``direct``, ``S_r`` itself in ``weighting``.
-
-    Parameters
-    ----------
-    loop : ControlLoop
-        The loop whose blocks are measured (run open loop, each from rest).
-    y : numpy.ndarray, shape (n,), optional
-        Plant position [m] driving ``S_r``; default the trained sine.
-
-    Returns
-    -------
-    dict of str to Sector
-        ``"sensor"``, ``"compensator"`` (with a compensator) and ``"channel"`` (scheme
-        ``direct`` with a compensator, or ``weighting``).
-
-    Raises
-    ------
-    ValueError
-        If `y` does not move.
-    """
-    y = _training_position(loop.ts) if y is None else np.asarray(y, dtype=float)
-    s, _ = loop.sensor.simulate(y, loop.ts)
-    out = {"sensor": chord_sector(y, s, units="sensor units / m")}
-    if loop.compensator is not None:
-        y_hat, _ = loop.compensator.simulate(s, loop.ts)
-        out["compensator"] = chord_sector(s, y_hat, units="m / sensor unit")
-        if loop.scheme == "direct":
-            out["channel"] = chord_sector(y, y_hat, units="m / m")
-    if loop.scheme == "weighting":
-        out["channel"] = out["sensor"]
-    return out
-
+__all__ = ["CircleResult", "StabilityReport", "circle_criterion", "global_stability",
+           "sector_channel"]
 
 def sector_channel(loop: ControlLoop) -> control.StateSpace:
     """The linear part ``G(z)`` the loop's nonlinearity closes: ``y = -G v``, ``v = phi(y)``.
@@ -351,17 +237,6 @@ class StabilityReport:
                 "stop_time": self.stop_time, "verdict": self.verdict, "reason": self.reason}
 
 
-def _hull(parts: list[Sector], units: str) -> Sector:
-    """The smallest sector holding every one of ``parts`` (their increments pooled)."""
-    return Sector(min(p.k_min for p in parts), max(p.k_max for p in parts),
-                  sum(p.n_used for p in parts), sum(p.n_samples for p in parts),
-                  max(p.unexplained_step for p in parts), units)
-
-
-def _interval(s: Sector) -> str:
-    return f"[{s.k_min:.4g}, {s.k_max:.4g}] {s.units}"
-
-
 def global_stability(loop: ControlLoop, experiment: str = "sine") -> StabilityReport:
     """Sectors, circle criterion and a simulation of ``experiment`` for one loop.
 
@@ -397,9 +272,9 @@ def global_stability(loop: ControlLoop, experiment: str = "sine") -> StabilityRe
     loop_sector, sources = None, ["trained sine (open loop)"]
     sector = channel
     if bounded:  # every case's increments, pooled
-        loop_sector = _hull([chord_sector(r.y, r.y_hat if loop.scheme == "direct" else r.s)
+        loop_sector = hull([chord_sector(r.y, r.y_hat if loop.scheme == "direct" else r.s)
                              for r in result.cases.values()], channel.units)
-        sector = _hull([channel, loop_sector], channel.units)
+        sector = hull([channel, loop_sector], channel.units)
         sources.append(f"{experiment} run (closed loop)")
     circle, why = None, ""
     try:
@@ -408,15 +283,15 @@ def global_stability(loop: ControlLoop, experiment: str = "sine") -> StabilityRe
         why = str(exc)
     left = (loop_sector is not None
             and (loop_sector.k_min < channel.k_min or loop_sector.k_max > channel.k_max))
-    note = (f"the {experiment} run's slopes {_interval(loop_sector)} leave the trained sine's "
-            f"{_interval(channel)}, so their hull is tested; " if left else "")
+    note = (f"the {experiment} run's slopes {interval(loop_sector)} leave the trained sine's "
+            f"{interval(channel)}, so their hull is tested; " if left else "")
     if not bounded:
         verdict = "unstable"
         reason = f"the {experiment} run diverged at t = {stop:.4g} s"
     elif circle is not None and circle.proved:
         verdict = "proved stable"
         reason = (f"{note}circle criterion: with a constant reference every increment decays "
-                  f"for slopes in {_interval(sector)} (measured on the "
+                  f"for slopes in {interval(sector)} (measured on the "
                   f"{' and the '.join(sources)}), inside the proved [{sector.k_min:.4g}, "
                   f"{circle.k_max_proved:.4g}); sufficient only while the slopes stay in that "
                   f"sector, which other trajectories may leave")
