@@ -49,15 +49,6 @@ def test_kernel_matches_readable_reference():
     assert_array_equal(x_end, x_ref)
 
 
-def test_split_run_equals_whole_run():
-    u = _walk(2000, 2)
-    y, x_end = G.simulate(STRUCT, PARAMS, u)
-    y1, x1 = G.simulate(STRUCT, PARAMS, u[:777])
-    y2, x2 = G.simulate(STRUCT, PARAMS, u[777:], x0=x1)
-    assert_allclose(np.concatenate([y1, y2]), y, rtol=0, atol=1e-13)
-    assert_array_equal(x2, x_end)
-
-
 def test_equal_weights_and_no_reversible_part_is_the_classical_model():
     e = _table(3, diagonal=True)
     params = G.GPreisachParams(everett_minus=e, everett_plus=e, nu=[0.0, 0.0, 0.0], offset=0.3)

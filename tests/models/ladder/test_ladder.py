@@ -33,15 +33,6 @@ def test_kernel_matches_readable_reference():
     assert_allclose(y, y_ref, rtol=0, atol=1e-15)  # read-out summed in another order
 
 
-def test_split_run_equals_whole_run():
-    u = _input()
-    y, x_end = ladder.simulate(STRUCT3, PARAMS3, u)
-    y1, x1 = ladder.simulate(STRUCT3, PARAMS3, u[:1500])
-    y2, x2 = ladder.simulate(STRUCT3, PARAMS3, u[1500:], x0=x1)
-    assert_array_equal(np.concatenate([y1, y2]), y)
-    assert_array_equal(x2, x_end)
-
-
 def test_linear_cell_step_response_closed_form():
     # no dead band: an RC cell, U_n = 1 - (1 - G dt)^n for a unit step from 0 (output first)
     g = 8.0

@@ -59,16 +59,6 @@ def test_kernel_matches_readable_reference_and_uses_the_limit():
     assert beyond > 50
 
 
-def test_split_run_equals_whole_run():
-    u = _input()
-    y, x_end = mp.simulate(STRUCT2, PARAMS2, u)
-    y1, x1 = mp.simulate(STRUCT2, PARAMS2, u[:1234])
-    y2, x2 = mp.simulate(STRUCT2, PARAMS2, u[1234:], x0=x1)
-    # Bit-identical: the state carries all the memory.
-    np.testing.assert_array_equal(np.concatenate([y1, y2]), y)
-    np.testing.assert_array_equal(x2, x_end)
-
-
 def test_inverse_split_run_equals_whole_run():
     y, _ = mp.simulate(STRUCT2, PARAMS2, _input())
     e, x_end = mp.invert(STRUCT2, PARAMS2, y)

@@ -85,15 +85,6 @@ def test_kernel_matches_readable_reference():
     assert_allclose(y, y_ref, rtol=0, atol=1e-13)  # f^-1 walks the segments in another order
 
 
-def test_split_run_equals_whole_run():
-    u = _input()
-    y, x_end = pl.simulate(STRUCT, PARAMS, u)
-    y1, x1 = pl.simulate(STRUCT, PARAMS, u[:1700])
-    y2, x2 = pl.simulate(STRUCT, PARAMS, u[1700:], x0=x1)
-    assert_array_equal(np.r_[y1, y2], y)
-    assert_array_equal(x2, x_end)
-
-
 def test_output_resistor_inverse_is_exact():
     i = np.linspace(-3, 3, 301)
     assert_allclose(pl.output_resistor_inverse(PARAMS, pl.output_resistor(PARAMS, i)), i,

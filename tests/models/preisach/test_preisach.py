@@ -60,17 +60,6 @@ def test_kernel_matches_readable_reference():
     assert_array_equal(x_end, x_ref)
 
 
-def test_split_run_equals_whole_run():
-    u = _walk(3000, 2)
-    y, x_end = P.simulate(STRUCT, PARAMS, u)
-    y1, x1 = P.simulate(STRUCT, PARAMS, u[:1234])
-    y2, x2 = P.simulate(STRUCT, PARAMS, u[1234:], x0=x1)
-    # the staircase carries all the memory; the running sums are rebuilt from it, which may
-    # round differently from the incremental ones
-    assert_allclose(np.concatenate([y1, y2]), y, rtol=0, atol=1e-13)
-    assert_array_equal(x2, x_end)
-
-
 def test_everett_nodes_are_cell_sums_and_interpolant_vanishes_on_the_diagonal():
     m = _masses(3)
     e = P.everett_from_masses(m)
