@@ -114,7 +114,9 @@ def fit_multistart(residual: Callable[[np.ndarray], np.ndarray],
 
     Every start first gets ``screen_nfev`` evaluations; the ``n_polish`` cheapest are then run
     to convergence (most starts fall into the same few basins, so polishing all of them would
-    repeat work). ``accept(params)`` can veto a candidate (e.g. an unstable inverse); vetoed
+    repeat work). With ``solver="tr"`` a polish continues its start's solve where the
+    screening stopped (radius and scaling go on, its point is not run again), and so does the
+    continuation of a best candidate that ran out of budget. ``accept(params)`` can veto a candidate (e.g. an unstable inverse); vetoed
     ones are skipped and counted.
 
     While a parallel executor is open in this process (`hystkit.parallel.open_executor`), a
