@@ -92,8 +92,8 @@ def test_the_fit_box_and_random_params_lie_inside_the_domain():
     """The domain holds everything the fit can return: its box corners at the extreme dts."""
     for dt in (1e-9, 0.025, 100.0):  # beyond ~1e4 s the fit box is empty (G floor 1e-4)
         structure = mpl.MplStructure(n_cells=2, dt=dt, slope_cap=1.99)
-        for log_g in (mpl.fit._LOG_G_MIN, np.log(structure.slope_cap / dt)):
-            for log_vt in mpl.fit._LOG_VT_BOUNDS:
+        for log_g in (mpl.box.LOG_G_MIN, np.log(structure.slope_cap / dt)):
+            for log_vt in mpl.box.LOG_VT_BOUNDS:
                 theta = np.r_[[log_g, log_vt] * 2, [100.0, -100.0, 100.0, -100.0]]
                 mpl.MplParams.from_vector(theta, 2)  # raises if outside
         rng = np.random.default_rng(0)

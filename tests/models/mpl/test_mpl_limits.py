@@ -34,12 +34,12 @@ def test_past_a_model_limit_the_model_does_not_change():
     at_cap = mpl.simulate(structure, _params(CAP, 0.3), u)[0]
     assert_array_equal(mpl.simulate(structure, _params(10 * CAP, 0.3), u)[0], at_cap)
     assert_array_equal(mpl.simulate(structure, _params(CAP, 0.01), u)[0], at_cap)
-    v_t_bound = np.exp(mpl.fit._LOG_VT_BOUNDS[1])
+    v_t_bound = np.exp(mpl.box.LOG_VT_BOUNDS[1])
     at_bound = mpl.simulate(structure, _params(0.5, v_t_bound), u)[0]
     far = mpl.simulate(structure, _params(0.5, 1e9), u)[0]
     assert np.max(np.abs(at_bound - far)) < 1e-6 * np.ptp(far)
     # the other bounds are a search box: past them the output changes
-    g_floor = np.exp(mpl.fit._LOG_G_MIN)
+    g_floor = np.exp(mpl.box.LOG_G_MIN)
     slower = mpl.simulate(structure, _params(g_floor / 100, 0.3), u)[0]
     assert np.max(np.abs(mpl.simulate(structure, _params(g_floor, 0.3), u)[0] - slower)) > 0
 

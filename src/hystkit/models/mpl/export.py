@@ -10,6 +10,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .._protocol import Translation
+from .cell_kernels import constants
 
 
 def extra(comp) -> dict:
@@ -21,8 +22,6 @@ def _cell_constants_c(plan, lit: Callable[[float], str], i_s_at: int) -> str:
     """The per-cell constants of ``kernels.cell_constants`` (1 / V_T, 2 I_S dt, the straight
     branch's offset c0) and cap dt, computed here by the kernel itself, so the exported step
     does per sample exactly what ``kernels.simulate`` does (bit for bit in double)."""
-    from .kernels import constants  # numba: loaded only when a C export is written
-
     n = int(plan.body[0])
     cap, dt = float(plan.body[2]), float(plan.body[3])
     i_s, v_t, knee = (np.ascontiguousarray(plan.body[i_s_at + j * n:i_s_at + (j + 1) * n])

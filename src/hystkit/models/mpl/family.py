@@ -11,6 +11,7 @@ from .._cells import Cells, cell_reductions, cell_report
 from .._protocol import Block, Family, FitStart
 from . import INFO, kernels
 from . import model as mpl
+from .box import fit_box, random_params, theta_names
 from .export import TRANSLATION
 from .presets import PRESETS, preset
 
@@ -56,8 +57,6 @@ class MplFamily(Family):
     def start_options(self, structure, params):
         """``init=params`` for :func:`.fit.fit_mpl` (a single start, no linear initialisation
         of the weights), with a note for every coordinate outside the fit's box."""
-        from .fit import fit_box, theta_names
-
         lower, upper = fit_box(structure)
         return FitStart.in_box({"init": params}, params.to_vector(), lower, upper,
                                theta_names(structure.n_cells))
@@ -66,8 +65,6 @@ class MplFamily(Family):
         """The fit's box (:func:`.fit.fit_mpl`), normalised data: ``G_k = 2 I_S / V_T`` log-uniform
         in ``[1e-4, slope_cap / dt]``, ``V_T`` log-uniform in ``[1e-3, 1e3]``, ``w`` and ``V_b``
         uniform in ``[-100, 100]``. Every draw is bounded: ``|y| <= sum |w| max|u| + |V_b|``."""
-        from .fit import random_params
-
         return random_params(structure, rng)
 
     def reductions(self, structure, params):

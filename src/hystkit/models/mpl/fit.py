@@ -26,19 +26,18 @@ from ...identification import FitResult, NormalEquations, check_fit_data, fit_mu
 from ...identification._constrained import constrain_fit
 from . import kernels
 from . import model as mpl
+from .box import (
+    LOG_G_MIN,
+    LOG_G_UNLIMITED,
+    LOG_VT_BOUNDS,
+    W_BOUND,
+    fit_box,
+    random_params,
+    theta_names,
+)
 
 __all__ = ["default_starts", "fit_box", "fit_mpl", "random_params", "theta_limits",
            "theta_names"]
-
-# Bounds in optimiser coordinates (see MplParams.to_vector). |w| <= 100 mirrors the document's
-# weight-sum constraint of 10^2 (sec. 5.3.3).
-_LOG_VT_BOUNDS = (np.log(1e-3), np.log(1e3))
-_LOG_G_MIN = np.log(1e-4)
-_W_BOUND = 100.0
-# Without the limit (limit=False) G has no Euler bound: a box wide enough for the document's
-# fitted G = 2 I_S / V_T = 1.1e-5 (table 5.2) and inside the domain (I_S = G V_T / 2 within
-# 1e-12 .. 1e12 for every V_T of the box).
-_LOG_G_UNLIMITED = (np.log(1e-8), np.log(1e8))
 
 
 def _linear_init(structure: mpl.MplStructure, i_s: np.ndarray, v_t: np.ndarray,
@@ -55,40 +54,9 @@ def _linear_init(structure: mpl.MplStructure, i_s: np.ndarray, v_t: np.ndarray,
                                            structure.slope_cap / structure.dt, structure.dt)
     lin = slice(2 * structure.n_cells, None)
     coef = -np.linalg.lstsq(jtj[lin, lin], jtr[lin], rcond=None)[0]
-    coef[:-1] = np.clip(coef[:-1], -0.9 * _W_BOUND, 0.9 * _W_BOUND)
+    coef[:-1] = np.clip(coef[:-1], -0.9 * W_BOUND, 0.9 * W_BOUND)
     return mpl.MplParams(i_s=i_s, v_t=v_t, w=coef[:-1], v_b=coef[-1])
 
-
-def theta_names(n_cells: int) -> list[str]:
-    """Names of the optimiser coordinates (:meth:`MplParams.to_vector`), cells from 1."""
-    cells = [f"{name}[{k}]" for k in range(1, n_cells + 1) for name in ("log_G", "log_v_t")]
-    return [*cells, *(f"w[{k}]" for k in range(n_cells + 1)), "v_b"]
-
-
-def fit_box(structure: mpl.MplStructure) -> tuple[np.ndarray, np.ndarray]:
-    """The fit's bounds in optimiser coordinates (:meth:`MplParams.to_vector`).
-
-    ``log G_k`` in ``[log 1e-4, log(slope_cap / dt)]`` (the Euler limit) or, without the
-    limit, ``[log 1e-8, log 1e8]``; ``log V_T,k`` in ``[log 1e-3, log 1e3]``; ``w_k`` and
-    ``V_b`` in ``[-100, 100]``.
-
-    Parameters
-    ----------
-    structure : MplStructure
-        The model's structure.
-
-    Returns
-    -------
-    lower, upper : numpy.ndarray, shape (3N + 2,)
-    """
-    n = structure.n_cells
-    if structure.limit:
-        log_g = (_LOG_G_MIN, np.log(structure.slope_cap / structure.dt))
-    else:
-        log_g = _LOG_G_UNLIMITED
-    lower = np.r_[np.tile([log_g[0], _LOG_VT_BOUNDS[0]], n), np.full(n + 2, -_W_BOUND)]
-    upper = np.r_[np.tile([log_g[1], _LOG_VT_BOUNDS[1]], n), np.full(n + 2, _W_BOUND)]
-    return lower, upper
 
 
 # A cell whose rate G at the floor moves it by less than this share of its drive over the whole
@@ -126,7 +94,7 @@ def theta_limits(n_cells: int, limit: bool = True,
     """
     lower: list[str | None] = [None] * (3 * n_cells + 2)
     upper = list(lower)
-    g_floor = float(np.exp(_LOG_G_MIN if limit else _LOG_G_UNLIMITED[0]))
+    g_floor = float(np.exp(LOG_G_MIN if limit else LOG_G_UNLIMITED[0]))
     for k in range(n_cells):
         if duration is not None and g_floor * duration <= _INTEGRATING:
             lower[2 * k] = (f"cell {k + 1} integrates over the record (time constant 1/G >= "
@@ -136,7 +104,7 @@ def theta_limits(n_cells: int, limit: bool = True,
             upper[2 * k] = (f"cell {k + 1} runs at the Euler slope cap (G dt = slope_cap, "
                             f"eq. 5.28-5.29)")
         upper[2 * k + 1] = (f"cell {k + 1} has a linear resistor (V_T at its bound "
-                            f"{np.exp(_LOG_VT_BOUNDS[1]):g} stands for V_T -> inf)")
+                            f"{np.exp(LOG_VT_BOUNDS[1]):g} stands for V_T -> inf)")
     return lower, upper
 
 
@@ -289,14 +257,3 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
         return result
     return constrain_fit(result, normal_equations, np.arange(2 * n, 3 * n + 1),
                          weight_sum_max, to_params, accept=accept, accept_reason=accept_reason)
-
-
-def random_params(structure: mpl.MplStructure, rng: np.random.Generator) -> mpl.MplParams:
-    """Parameters drawn from the fit's bounds (the family's documented domain): ``log G_k``
-    and ``log V_T,k`` uniform between their bounds, ``w_0..w_N`` and ``V_b`` uniform in
-    ``[-100, 100]`` (``V_b`` gets the weights' box; the fit leaves it free)."""
-    n = structure.n_cells
-    log_g = rng.uniform(_LOG_G_MIN, np.log(structure.slope_cap / structure.dt), n)
-    log_vt = rng.uniform(*_LOG_VT_BOUNDS, n)
-    lin = rng.uniform(-_W_BOUND, _W_BOUND, n + 2)
-    return mpl.MplParams.from_vector(np.r_[np.column_stack([log_g, log_vt]).reshape(-1), lin], n)

@@ -13,13 +13,12 @@ import numpy as np
 
 from .._cubic_output_code import C_SOLVE, M_CUBIC, M_SOLVE
 from .._protocol import Translation
+from .rest import rest_voltages
 
 
 def extra(comp) -> dict:
     """Rest voltages ``v*_k`` (the forward rest is ``e - v*``), ``sum(w)`` and ``w . v*`` of
     the inverse's rest input (``model.rest_state``)."""
-    from ...models.mpl_poly.model import rest_voltages
-
     p = comp.params
     v_rest = np.asarray(rest_voltages(comp.structure, p), float)
     return {"V_REST": v_rest, "W_SUM": float(p.w.sum()), "W_V": float(p.w[1:] @ v_rest)}

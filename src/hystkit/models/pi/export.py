@@ -13,13 +13,12 @@ from collections.abc import Callable
 import numpy as np
 
 from .._protocol import Translation
+from .operators import inverse_superposition
 
 
 def extra(comp) -> dict:
     """The inverse's rest input ``(S^-1(y0) - b) / (sum w_H + sum w_K)`` (``model.rest_input``)
     needs the unsigned ``S^-1`` weights, ``b`` and the static gain."""
-    from ...models.pi.model import inverse_superposition
-
     p = comp.params
     d_inv, ws_inv = inverse_superposition(p.d_s, p.w_s)
     return {"GAIN": float(p.w_h.sum() + p.w_k.sum()), "B": float(p.b),
