@@ -100,7 +100,7 @@ def test_the_fit_box_and_random_params_lie_inside_the_domain():
     rng = np.random.default_rng(0)
     for _ in range(50):
         pl.simulate(structure, FAMILY.random_params(structure, rng), U)
-    for i_t in np.exp(pl.fit._LOG_IT):
-        for v_t in np.exp(pl.fit._LOG_VT):
+    for i_t in np.exp(pl.box.LOG_IT):
+        for v_t in np.exp(pl.box.LOG_VT):
             pl.PlParams(i_t=i_t, v_t=v_t, w=[100.0, -100.0], v_b=-1e3,
-                        a=[pl.fit._A_MIN, 50 - pl.fit._A_MIN * 49] + [pl.fit._A_MIN] * 48)
+                        a=[pl.box.A_MIN, 50 - pl.box.A_MIN * 49] + [pl.box.A_MIN] * 48)

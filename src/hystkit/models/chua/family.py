@@ -8,7 +8,7 @@ import numpy as np
 
 from .._capabilities import ALL_LOSSES, Capabilities
 from .._protocol import Block, Family
-from . import INFO, kernels
+from . import INFO, box, kernels
 from . import model as chua
 from .export import TRANSLATION
 
@@ -44,12 +44,10 @@ class ChuaFamily(Family):
         return chua.ChuaStructure(n_elements=size, dt=dt, slope_cap=slope_cap)
 
     def random_params(self, structure, rng):
-        """The fit's bounds (:func:`.fit.random_params`): ``k_0``, ``k_inf``, ``y_s`` log-uniform in
+        """The fit's bounds (:func:`.box.random_params`): ``k_0``, ``k_inf``, ``y_s`` log-uniform in
         ``[1e-2, 1e2]``, ``G`` in ``[1e-3, 100 / dt]``, ``V_g`` in ``[1e-3, 1e3]``, ``delta`` in
         ``[0, 1]``. Bounded: ``|y| <= sum_k (max|u| + delta_k) / min(k_0, k_inf)_k``."""
-        from .fit import random_params as _random_params
-
-        return _random_params(structure, rng)
+        return box.random_params(structure, rng)
 
     def at(self, structure, dt):
         """The same ODE at ``dt``: the slope cap scales with ``dt``, so the limit on ``g'``

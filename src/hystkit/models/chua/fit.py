@@ -15,26 +15,14 @@ import numpy as np
 
 from ...identification import ChunkedDifferences, FitResult, check_fit_data, fit_multistart
 from . import model as chua
+from .box import (
+    fit_bounds,
+    random_params,
+)
 
 __all__ = ["default_starts", "fit_chua", "random_params"]
 
 _ELEMENT_NAMES = ("log_k0", "log_k_inf", "log_y_s", "log_g", "log_v_g", "delta")
-
-# Bounds per element in optimiser coordinates, for data normalised to max |.| = 1 (eq. 5.10):
-# slopes and scales over four decades around 1, bands up to the whole half-range.
-_LOG_SLOPE = (np.log(1e-2), np.log(1e2))
-_LOG_SCALE = (np.log(1e-2), np.log(1e2))
-_LOG_VG = (np.log(1e-3), np.log(1e3))
-_DELTA = (0.0, 1.0)
-
-
-def _bounds(structure: chua.ChuaStructure) -> tuple[np.ndarray, np.ndarray]:
-    # Beyond the Euler cap g is a straight line of the capped slope, so a larger G changes
-    # nothing: 100 / dt is above the cap for any restoring slope >= 1e-2.
-    log_g = (np.log(1e-3), np.log(min(100.0 / structure.dt, chua.DOMAIN["g"][1])))
-    per = [_LOG_SLOPE, _LOG_SLOPE, _LOG_SCALE, log_g, _LOG_VG, _DELTA]
-    lower, upper = (np.tile([b[i] for b in per], structure.n_elements) for i in (0, 1))
-    return lower, upper
 
 
 def _theta_names(n_elements: int) -> list[str]:
@@ -47,7 +35,7 @@ def _theta_limits(n_elements: int) -> tuple[list[str | None], list[str | None]]:
 
     * ``delta_k = 0``: the document's model (no dead band); a band cannot be narrower.
     * ``log g_k`` at its upper bound: beyond the Euler cap ``g`` is a straight line of the
-      capped slope, so a larger ``G`` changes nothing (see ``_bounds``).
+      capped slope, so a larger ``G`` changes nothing (see ``fit_bounds``).
 
     Every other bound is a search box: a fit there is reported as on bounds.
     """
@@ -145,7 +133,7 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
     def to_params(theta: np.ndarray) -> chua.ChuaParams:
         return chua.ChuaParams.from_vector(theta, n)
 
-    bounds = _bounds(structure)
+    bounds = fit_bounds(structure)
     chunked = ChunkedDifferences(
         lambda th, u_chunk, x: chua.simulate(structure, to_params(th), u_chunk, x), u, y,
         *bounds)
@@ -159,23 +147,3 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
                           weights=weights)
 
 
-
-def random_params(structure: chua.ChuaStructure, rng: np.random.Generator) -> chua.ChuaParams:
-    """Parameters drawn from the fit's bounds (the family's documented domain), per element:
-    ``k_0``, ``k_inf``, ``y_s`` log-uniform in ``[1e-2, 1e2]``, ``G`` log-uniform in
-    ``[1e-3, 100 / dt]``, ``V_g`` log-uniform in ``[1e-3, 1e3]``, ``delta`` uniform in ``[0, 1]``.
-
-    Parameters
-    ----------
-    structure : chua.ChuaStructure
-        The model's structure.
-    rng : numpy.random.Generator
-        Source of the draws.
-
-    Returns
-    -------
-    chua.ChuaParams
-        The drawn parameters.
-    """
-    lower, upper = _bounds(structure)
-    return chua.ChuaParams.from_vector(rng.uniform(lower, upper), structure.n_elements)

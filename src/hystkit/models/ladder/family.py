@@ -9,7 +9,7 @@ import numpy as np
 from ...errors import FitDivergedError
 from .._capabilities import ALL_LOSSES, Capabilities
 from .._protocol import Block, Family
-from . import INFO, kernels
+from . import INFO, box, kernels
 from . import model as ladder
 from .export import TRANSLATION
 
@@ -49,12 +49,10 @@ class LadderFamily(Family):
         return ladder.LadderStructure(n_cells=size, dt=dt, slope_cap=slope_cap)
 
     def random_params(self, structure, rng):
-        """The fit's bounds (:func:`.fit.random_params`): ``E_k`` in ``[0, 1.5]``, ``G_k``
+        """The fit's bounds (:func:`.box.random_params`): ``E_k`` in ``[0, 1.5]``, ``G_k``
         log-uniform in ``[1e-3, slope_cap / (2 dt)]``, ``w``, ``V_b`` in ``[-100, 100]``.
         Bounded: ``|y| <= sum |w| max|e| + |V_b|``."""
-        from .fit import random_params as _random_params
-
-        return _random_params(structure, rng)
+        return box.random_params(structure, rng)
 
     def at(self, structure, dt):
         """The same circuit at ``dt``: the slope cap scales with ``dt``, so the conductance

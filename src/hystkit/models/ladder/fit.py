@@ -24,12 +24,14 @@ from ...identification import (
     robust_linear_fit,
 )
 from . import model as ladder
+from .box import (
+    BAND,
+    LOG_G_MIN,
+    W_BOUND,
+    random_params,
+)
 
 __all__ = ["default_starts", "fit_ladder", "random_params"]
-
-_BAND = (0.0, 1.5)  # normalised data (eq. 5.10): a band beyond the range never conducts
-_LOG_G_MIN = np.log(1e-3)
-_W_BOUND = 100.0  # as the mPL's |w| <= 100 (sec. 5.3.3)
 
 
 def _theta_names(n_cells: int) -> list[str]:
@@ -136,8 +138,8 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
     check_cost(loss, f_scale)
     if weights is not None:
         weights = check_weights(weights, y.size)
-    lower = np.tile([_BAND[0], _LOG_G_MIN], n)
-    upper = np.tile([_BAND[1], np.log(ladder.conductance_limit(structure))], n)
+    lower = np.tile([BAND[0], LOG_G_MIN], n)
+    upper = np.tile([BAND[1], np.log(ladder.conductance_limit(structure))], n)
     cache: dict = {}
 
     def project(theta: np.ndarray) -> tuple[ladder.LadderParams, np.ndarray]:
@@ -150,7 +152,7 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
             states, _ = ladder.states(structure, probe, u)
             design = np.column_stack([u, states, -np.ones_like(u)])
             coef = robust_linear_fit(design, y, loss, f_scale, weights)
-            coef[:-1] = np.clip(coef[:-1], -_W_BOUND, _W_BOUND)
+            coef[:-1] = np.clip(coef[:-1], -W_BOUND, W_BOUND)
             # V_b is free, but within the domain where runs stay bounded
             coef[-1] = np.clip(coef[-1], -ladder.MAX_VALUE, ladder.MAX_VALUE)
             params = ladder.LadderParams(band=probe.band, conductance=probe.conductance,
@@ -168,27 +170,3 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
                           loss=loss, f_scale=f_scale, weights=weights)
 
 
-
-def random_params(structure: ladder.LadderStructure,
-                  rng: np.random.Generator) -> ladder.LadderParams:
-    """Parameters drawn from the fit's bounds (the family's documented domain): bands ``E_k``
-    uniform in ``[0, 1.5]``, ``G_k`` log-uniform in ``[1e-3, slope_cap / (2 dt)]``, ``w_0..w_N``
-    uniform in ``[-100, 100]``, ``V_b`` too (the fit leaves it free).
-
-    Parameters
-    ----------
-    structure : ladder.LadderStructure
-        The model's structure.
-    rng : numpy.random.Generator
-        Source of the draws.
-
-    Returns
-    -------
-    ladder.LadderParams
-        The drawn parameters.
-    """
-    n = structure.n_cells
-    band = rng.uniform(*_BAND, n)
-    g = np.exp(rng.uniform(_LOG_G_MIN, np.log(ladder.conductance_limit(structure)), n))
-    return ladder.LadderParams(band=band, conductance=g, w=rng.uniform(-_W_BOUND, _W_BOUND, n + 1),
-                               v_b=float(rng.uniform(-_W_BOUND, _W_BOUND)))

@@ -7,7 +7,7 @@ import numpy as np
 from ...errors import FitDivergedError
 from .._capabilities import ALL_LOSSES, Capabilities
 from .._protocol import Block, Family
-from . import INFO, kernels
+from . import INFO, box, kernels
 from . import model as pl
 from .export import TRANSLATION
 
@@ -49,12 +49,10 @@ class PlFamily(Family):
                               dt=dt, slope_cap=slope_cap)
 
     def random_params(self, structure, rng):
-        """The fit's bounds (:func:`.fit.random_params`): ``I_T`` log-uniform in ``[1e-6, 1e4]``,
+        """The fit's bounds (:func:`.box.random_params`): ``I_T`` log-uniform in ``[1e-6, 1e4]``,
         ``V_T`` in ``[1e-3, 2]``, ``w``, ``V_b`` in ``[-100, 100]``, ``a_j >= 0.05`` with
         ``sum a_j = M``. Bounded: ``|y| <= (sum |w| max|e| + |V_b|) / min a_j``."""
-        from .fit import random_params as _random_params
-
-        return _random_params(structure, rng)
+        return box.random_params(structure, rng)
 
     def at(self, structure, dt):
         """Same N, p, M, S and slope cap at ``dt``. ``I_T``, ``V_T`` are rates and voltages of

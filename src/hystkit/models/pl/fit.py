@@ -28,13 +28,16 @@ from scipy.optimize import lsq_linear
 
 from ...identification import FitResult, check_fit_data, check_weights, fit_multistart
 from . import model as pl
+from .box import (
+    A_MIN,
+    LOG_IT,
+    LOG_VT,
+    W_BOUND,
+    random_params,
+)
 
 __all__ = ["THETA_NAMES", "default_starts", "fit_pl", "random_params", "solve_weights"]
 
-_W_BOUND = 100.0
-_A_MIN = 0.05
-_LOG_VT = (np.log(1e-3), np.log(2.0))  # thresholds beyond N * 2 never matter on [-1, 1] data
-_LOG_IT = (np.log(1e-6), np.log(1e4))
 # The optimiser coordinates. Both bounds are search boxes (the Euler slope cap acts through the
 # straight branches of the characteristic, not through a bound), so no model limits are passed.
 THETA_NAMES = ("log_i_t", "log_v_t")
@@ -86,8 +89,8 @@ def solve_weights(structure: pl.PlStructure, x: np.ndarray, u: np.ndarray,
     constraint[0, :m] = heavy
     rows.append(constraint)
     rhs.append(np.array([heavy * m]))
-    lower = np.r_[np.full(m, _A_MIN), np.full(structure.n_cells + 1, -_W_BOUND), -np.inf]
-    upper = np.r_[np.full(m, np.inf), np.full(structure.n_cells + 1, _W_BOUND), np.inf]
+    lower = np.r_[np.full(m, A_MIN), np.full(structure.n_cells + 1, -W_BOUND), -np.inf]
+    upper = np.r_[np.full(m, np.inf), np.full(structure.n_cells + 1, W_BOUND), np.inf]
     sol = lsq_linear(np.vstack(rows), np.concatenate(rhs), bounds=(lower, upper),
                      method="bvls", lsmr_tol=None)
     coef = np.clip(sol.x, lower, upper)
@@ -174,8 +177,8 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
             cache[key] = params, pl.simulate(structure, params, u)[0] - y
         return cache[key]
 
-    lower = np.array([_LOG_IT[0], _LOG_VT[0]])
-    upper = np.array([_LOG_IT[1], _LOG_VT[1]])
+    lower = np.array([LOG_IT[0], LOG_VT[0]])
+    upper = np.array([LOG_IT[1], LOG_VT[1]])
     return fit_multistart(lambda th: project(th)[1],
                           default_starts(structure) if starts is None else starts,
                           (lower, upper), lambda th: project(th)[0], structure,
@@ -184,13 +187,3 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
                           solver=solver, loss=loss, f_scale=f_scale, weights=weights)
 
 
-def random_params(structure: pl.PlStructure, rng: np.random.Generator) -> pl.PlParams:
-    """Parameters drawn from the fit's bounds (the family's documented domain): ``log I_T``,
-    ``log V_T`` uniform between their bounds (``I_T`` in ``[1e-6, 1e4]``, ``V_T`` in
-    ``[1e-3, 2]``), ``w_0..w_N`` uniform in ``[-100, 100]``, ``V_b`` too (the fit leaves it
-    free), and slopes ``a_j >= 0.05`` with the fit's scale ``sum a_j = M``."""
-    n, m = structure.n_cells, structure.n_basis
-    i_t, v_t = np.exp(rng.uniform(*_LOG_IT)), np.exp(rng.uniform(*_LOG_VT))
-    a = _A_MIN + (m - m * _A_MIN) * rng.dirichlet(np.ones(m))
-    return pl.PlParams(i_t=float(i_t), v_t=float(v_t), w=rng.uniform(-_W_BOUND, _W_BOUND, n + 1),
-                       v_b=float(rng.uniform(-_W_BOUND, _W_BOUND)), a=a)
