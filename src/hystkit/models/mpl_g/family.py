@@ -12,9 +12,10 @@ from .._protocol import Block, Family, FitStart
 from ..mpl.family import FAMILY as MPL
 from ..mpl.kernels import current
 from ..mpl_poly.presets import PAPER_9_2_TABLE_II
-from . import INFO, kernels
+from . import INFO, fit, kernels
 from . import model as mpl_g
 from .export import TRANSLATION
+from .presets import ch7_compensator
 
 __all__ = ["FAMILY", "MplGFamily"]
 
@@ -33,14 +34,7 @@ class MplGFamily(Family):
     capabilities = Capabilities(losses=ALL_LOSSES, weight_sum_floor=mpl_g.WEIGHT_SUM_FLOOR,
                                 start_from_params=True)
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_mpl_g`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_mpl_g
-
-        return fit_mpl_g(u, y, structure, **options)
+    fit_function = fit.fit_mpl_g
 
     def invert(self, structure, params, y, x0=None):
         return self.model.invert(structure, params, y, x0)
@@ -69,25 +63,19 @@ class MplGFamily(Family):
         (``|y| <= sum_j |g_j| Z^j``, ``Z = sum |w| max|u| + |V_b|``), and with
         ``slope_cap <= 1`` the inverse exists for every output and contracts."""
 
-        from .fit import random_params
-
-        return random_params(structure, rng)
+        return fit.random_params(structure, rng)
 
     def start_options(self, structure, params):
         """``init=params`` for :func:`.fit.fit_mpl_g` (a single start, in its gauge ``w_0 = 1``,
         ``V_b = 0``), with a note for every coordinate outside the fit's box."""
-        from .fit import fit_box, start_theta, theta_names
-
-        lower, upper = fit_box(structure)
-        return FitStart.in_box({"init": params}, start_theta(params), lower, upper,
-                               theta_names(structure.n_cells))
+        lower, upper = fit.fit_box(structure)
+        return FitStart.in_box({"init": params}, fit.start_theta(params), lower, upper,
+                               fit.theta_names(structure.n_cells))
 
     def presets(self):
         """The sec. 7.2 compensators of paper 9.2's table II sensors, ``ch7-table-ii-COLUMN``,
         fitted on first use (about 1-3 s each; :mod:`.presets` says why table II's own weights
         cannot be presets of this family)."""
-        from .presets import ch7_compensator
-
         return {f"ch7-table-ii-{column}": ch7_compensator(column)
                 for column in PAPER_9_2_TABLE_II}
 

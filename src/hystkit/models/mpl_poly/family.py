@@ -8,7 +8,7 @@ from ...errors import FitDivergedError
 from .._capabilities import ALL_LOSSES, Capabilities
 from .._cells import Cells, cell_report
 from .._protocol import Block, Family, FitStart
-from . import INFO, kernels
+from . import INFO, fit, kernels
 from . import model as mpl_poly
 from .export import TRANSLATION
 from .presets import PAPER_9_2_TABLE_I, PAPER_9_2_TABLE_II, paper_9_2_params
@@ -28,14 +28,7 @@ class MplPolyFamily(Family):
     # model an equivalent one with sum |w| below any bound, so the constraint restricts nothing
     capabilities = Capabilities(losses=ALL_LOSSES, start_from_params=True)
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_mpl_poly`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_mpl_poly
-
-        return fit_mpl_poly(u, y, structure, **options)
+    fit_function = fit.fit_mpl_poly
 
     def n_params(self, structure, params) -> int:
         """``4N + 4``: of the ``5N + 6`` stored numbers, ``c_k0``, ``w_0`` and ``V_b`` are the
@@ -65,9 +58,7 @@ class MplPolyFamily(Family):
         """Paper 9.2's published range with margin (:func:`.fit.random_params`): ``c_k0..c_k2``
         in ``[-5, 5]``, ``c_k3`` log-uniform in ``[0.1, 100]``, ``g``, ``w`` in ``[-2, 2]``,
         ``V_b`` in ``[-1, 1]``. Bounded with ``structure.limit``: ``|u_k| <= max|e| + max|v*_k|``."""
-        from .fit import random_params as _random_params
-
-        return _random_params(structure, rng)
+        return fit.random_params(structure, rng)
 
     def presets(self):
         """Paper 9.2's table II columns: direct compensators (sensor -> position) fitted on
@@ -88,11 +79,9 @@ class MplPolyFamily(Family):
     def start_options(self, structure, params):
         """``init=params`` for :func:`.fit.fit_mpl_poly` (a single start), with a note for
         every coordinate outside the fit's box."""
-        from .fit import fit_box, theta_names
-
-        lower, upper = fit_box(structure)
+        lower, upper = fit.fit_box(structure)
         return FitStart.in_box({"init": params}, params.to_vector(), lower, upper,
-                               theta_names(structure.n_cells))
+                               fit.theta_names(structure.n_cells))
 
     def invert_step(self, structure, params, x, y):
         """As :func:`model.invert_step`; NaN input estimate and state when ``y`` is outside
