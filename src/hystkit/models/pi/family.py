@@ -9,7 +9,7 @@ import numpy as np
 
 from ...errors import FitDivergedError
 from .._protocol import Block, Family
-from . import INFO, kernels
+from . import INFO, box, kernels
 from . import model as pi
 from .export import TRANSLATION
 
@@ -41,9 +41,7 @@ class PiFamily(Family):
         return self.model.invert_step(structure, params, x, y)
 
     def make_structure(self, dt, size, **options):
-        from .fit import make_structure
-
-        return make_structure(dt, size, **options)
+        return box.make_structure(dt, size, **options)
 
     def random_params(self, structure, rng):
         """Drawn in the fit's coordinates (``fit.py``), which keep Kuhnen's invertibility
@@ -51,14 +49,7 @@ class PiFamily(Family):
         1 / MIN_SLOPE] = [0.01, 100]``, split creep weights ``w+, w-`` uniform in ``[0, 1]``,
         offset ``b`` in ``[-1, 1]``, ``S^-1`` thresholds of an output range ``[-1, 1]``, either
         polarity. Bounded: ``|y| <= sum |w_S| (sum |w_H| + sum |w_K| + |b|) max(1, |u|)``."""
-        from .fit import MIN_SLOPE, _to_params
-
-        n, n_k, m = structure.n_play, structure.n_creep, structure.n_deadzone
-        log_slope = np.log(MIN_SLOPE), -np.log(MIN_SLOPE)
-        theta = np.concatenate([np.exp(rng.uniform(*log_slope, n)), rng.uniform(0.0, 1.0, 2 * n_k),
-                                [rng.uniform(-1.0, 1.0)], np.exp(rng.uniform(*log_slope, 2 * m))])
-        d_inv = np.concatenate([-np.arange(m, 0, -1), [0.0], np.arange(1, m + 1)]) / (m + 1)
-        return _to_params(structure, theta, d_inv, float(rng.choice([-1.0, 1.0])))
+        return box.random_params(structure, rng)
 
     def at(self, structure, dt):
         """The same continuous-time model sampled every ``dt``.
