@@ -2,20 +2,22 @@
 against an earlier revision, paired in one run.
 
 Run:  python benchmarks/bench_stream.py [--before REV] [--after REV] [--rounds N] [--quick]
-      [--out FILE]        (~5 min with the defaults on 2 cores)
+      [--samples N ...] [--out FILE]        (~10 min with the defaults on 2 shared cores)
 
 Variants: ``after`` is this tree's ``src`` as it is at the start (or revision ``--after``),
-``before`` revision ``--before`` (``git archive``; 'none' skips it). Every measurement runs in
-a child process with ``PYTHONPATH`` on the variant's ``src``, its own numba cache and bytecode
-folders (filled by an untimed warm-up run). Model files are written once by the ``before``
-variant (the older code: both read its files) and shared.
+``before`` revision ``--before`` (default 2bff934, checked out once with ``git worktree add
+/tmp/stream_ref REV``; 'none' skips it). Every measurement runs in a child process with
+``PYTHONPATH`` on the variant's ``src``, its own numba cache and bytecode folders (filled by an
+untimed warm-up run). Model files are written once by the ``before`` variant (the older code:
+both read its files) and shared.
 
-1. **Command**: ``hystkit stream MODEL --in big.csv`` on ``--samples`` lines (default 100 000,
-   the virtual sensor's decay run repeated, time continued) and on 10 lines (start-up: the
-   interpreter, the imports, the model file, the kernel's cache); and the same 100 000 lines
-   through stdin, written by this process into a pipe. Wall time per run; samples/s whole
-   (N / wall) and after start-up ((N - 10) / (wall_N - wall_10)); ``same``: the outputs of the
-   variants are the same text (the estimates printed with repr: bit for bit).
+1. **Command**: ``hystkit stream MODEL --in big.csv`` on each ``--samples`` count of lines
+   (default 100 000 and 1 000 000: a realistic sensor file; the virtual sensor's decay run
+   repeated, time continued) and on 10 lines (start-up: the interpreter, the imports, the model
+   file, the kernel's cache); and the first count's lines through stdin, written by this
+   process into a pipe. Wall and cpu (user + system) time per run; samples/s whole (N / wall)
+   and after start-up ((N - 10) / (wall_N - wall_10)); ``same``: the outputs of the variants
+   are the same text (the estimates printed with repr: bit for bit).
 2. **Live**: one line written into the pipe at a time, the next only once its answer is read:
    the round trip per line (write, the command's read, parse, compensate, format, write, our
    read), median and p99 over ``--live`` lines after the first 20.
@@ -35,6 +37,7 @@ import argparse
 import json
 import os
 import platform
+import resource
 import shutil
 import statistics
 import subprocess
@@ -59,8 +62,7 @@ def python_latency(comp, sensor, *, repeats: int = 5, chunk: int = CHUNK) -> dic
     (compiles) first. (``benchmarks/bench_export.py`` adds its C and MATLAB rows to these.)"""
     import numpy as np
 
-    from hystkit.live import Stream
-
+    Stream = _stream_class()
     Stream(comp).process(sensor[:2])
     Stream(comp).step(float(sensor[0]))
     clock = time.perf_counter
@@ -96,8 +98,9 @@ def _latency(models: Path, n_samples: int) -> dict:
     """`python_latency` (one repeat) of every model file in `models`, on `n_samples` of the
     virtual sensor's decay run (seed 2); and whether the stream ran compiled."""
     from hystkit.compensation import load_compensator
-    from hystkit.live import Stream
     from hystkit.sensors import simulate_experiment
+
+    Stream = _stream_class()
 
     sensor = simulate_experiment("decay", 2).sensor[:n_samples]
     found = {}
@@ -106,6 +109,16 @@ def _latency(models: Path, n_samples: int) -> dict:
         found[path.stem] = {**python_latency(comp, sensor, repeats=1),
                             "compiled": getattr(Stream(comp), "compiled", None)}
     return found
+
+
+def _stream_class():
+    """``Stream`` from ``hystkit.live``, or (revisions before the live package) from
+    ``hystkit.compensation``."""
+    try:
+        from hystkit.live import Stream
+    except ImportError:
+        from hystkit.compensation import Stream
+    return Stream
 
 
 def _make_models(folder: Path) -> None:
@@ -129,17 +142,22 @@ def _make_models(folder: Path) -> None:
 
 # -- the parent's side -------------------------------------------------------------------------
 
+WORKTREE = Path("/tmp/stream_ref")
+
+
 def _source(rev: str, folder: Path) -> Path:
-    """The ``src`` of revision `rev` (or of this tree, 'tree') copied into `folder`."""
+    """The ``src`` of this tree ('tree', copied into `folder` as it is now) or of revision
+    `rev` (a git worktree at ``WORKTREE``, added once and kept at `rev`)."""
     if rev == "tree":
         shutil.copytree(REPO / "src", folder / "src",
                         ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
-    else:
-        folder.mkdir(parents=True, exist_ok=True)
-        archive = subprocess.run(["git", "-C", str(REPO), "archive", rev, "src"],
-                                 capture_output=True, check=True).stdout
-        subprocess.run(["tar", "-x", "-C", str(folder)], input=archive, check=True)
-    return folder / "src"
+        return folder / "src"
+    if not WORKTREE.exists():
+        subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(WORKTREE),
+                        rev], capture_output=True, check=True)
+    subprocess.run(["git", "-C", str(WORKTREE), "checkout", "--quiet", "--detach", rev],
+                   check=True)
+    return WORKTREE / "src"
 
 
 class Variant:
@@ -158,13 +176,18 @@ class Variant:
         return subprocess.run([sys.executable, *args], env=self.env, check=True, **run)
 
     def stream(self, model: Path, data: Path | None, text: bytes | None = None
-               ) -> tuple[float, bytes]:
-        """Wall seconds of ``hystkit stream`` on a file (or stdin fed `text`), its stdout."""
+               ) -> tuple[float, bytes, float]:
+        """Wall seconds of ``hystkit stream`` on a file (or stdin fed `text`), its stdout,
+        its cpu seconds (user + system)."""
         args = ["-m", "hystkit", "stream", str(model)] + ([] if data is None
                                                           else ["--in", str(data)])
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         done = self.python(args, input=text, capture_output=True)
-        return time.perf_counter() - t0, done.stdout
+        wall = time.perf_counter() - t0
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+        return wall, done.stdout, cpu
 
     def live(self, model: Path, lines: list[bytes]) -> list[float]:
         """Round trip [s] of each line written alone, its answer read before the next."""
@@ -195,20 +218,25 @@ def _read_line(stream) -> bytes:
     return line
 
 
-def _data(folder: Path, n: int) -> tuple[Path, Path]:
-    """`n` and SMALL lines of the decay run (seed 2) repeated, time continued, as CSV."""
+def _data(folder: Path, counts: list[int]) -> tuple[dict[int, Path], Path]:
+    """Files of each count and of SMALL lines of the decay run (seed 2) repeated, time
+    continued, as CSV."""
     import numpy as np
 
     from hystkit.sensors import simulate_experiment
 
     rec = simulate_experiment("decay", 2)
+    n = max(counts)
     sensor = np.tile(rec.sensor, -(-n // rec.n_samples))[:n]
     time_s = np.arange(n) * rec.dt
     rows = [f"{t!r},{s!r}\n" for t, s in zip(time_s.tolist(), sensor.tolist(), strict=True)]
-    big, small = folder / "big.csv", folder / "small.csv"
-    big.write_text("time,sensor\n" + "".join(rows))
+    files = {}
+    for count in counts:
+        files[count] = folder / f"big_{count}.csv"
+        files[count].write_text("time,sensor\n" + "".join(rows[:count]))
+    small = folder / "small.csv"
     small.write_text("time,sensor\n" + "".join(rows[:SMALL]))
-    return big, small
+    return files, small
 
 
 def _median(values: list[float]) -> float:
@@ -221,14 +249,14 @@ def _ratio(pairs: list[tuple[float, float]]) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--before", default="none", metavar="REV",
+    parser.add_argument("--before", default="2bff934", metavar="REV",
                         help="git revision to compare with ('none': this tree alone)")
     parser.add_argument("--after", default="tree", metavar="REV",
                         help="git revision to measure (default: this tree as it is)")
-    parser.add_argument("--rounds", type=int, default=5)
-    parser.add_argument("--samples", type=int, default=100_000)
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--samples", type=int, nargs="+", default=[100_000, 1_000_000])
     parser.add_argument("--live", type=int, default=2000, help="lines of the live table")
-    parser.add_argument("--quick", action="store_true", help="20 000 samples, 3 rounds")
+    parser.add_argument("--quick", action="store_true", help="20 000 samples, 2 rounds")
     parser.add_argument("--out", type=Path, help="also write the report here")
     parser.add_argument("--latency-child", nargs=2, metavar=("MODELS", "N"),
                         help=argparse.SUPPRESS)
@@ -241,7 +269,7 @@ def main() -> None:
         _make_models(Path(args.models_child))
         return
     if args.quick:
-        args.samples, args.rounds, args.live = 20_000, 3, 500
+        args.samples, args.rounds, args.live = [20_000], 2, 500
     report = _run(args)
     print(report)
     if args.out:
@@ -264,24 +292,28 @@ def _run(args: argparse.Namespace) -> str:
         variants[0].python([__file__, "--models-child", str(tmp)], capture_output=True)
         models = tmp / "models"
         model = models / "command_mpl_1_band.json"
-        big, small = _data(tmp, args.samples)
-        text = big.read_bytes()
+        files, small = _data(tmp, args.samples)
+        text = files[args.samples[0]].read_bytes()
         live_lines = [line + b"\n" for line in
                       text.splitlines()[1:args.live + 21]]
         for v in variants:  # warm-up: compile or load every kernel once, untimed
             v.stream(model, small)
             v.python([__file__, "--latency-child", str(models), "50"], capture_output=True)
         runs: dict[str, dict[str, list]] = {v.name: {} for v in variants}
-        outputs: dict[str, set[bytes]] = {v.name: set() for v in variants}
+        outputs: dict[str, dict[int, set[bytes]]] = {v.name: {} for v in variants}
         for r in range(args.rounds):
             for v in (variants if r % 2 == 0 else variants[::-1]):
                 row = runs[v.name]
-                seconds, out = v.stream(model, big)
-                outputs[v.name].add(out)
-                row.setdefault("file", []).append(seconds)
-                row.setdefault("small", []).append(v.stream(model, small)[0])
-                seconds, out = v.stream(model, None, text)
-                outputs[v.name].add(out)
+                for count, big in files.items():
+                    seconds, out, cpu = v.stream(model, big)
+                    outputs[v.name].setdefault(count, set()).add(out)
+                    row.setdefault(("file", count), []).append(seconds)
+                    row.setdefault(("cpu", count), []).append(cpu)
+                seconds, _, cpu = v.stream(model, small)
+                row.setdefault("small", []).append(seconds)
+                row.setdefault("small cpu", []).append(cpu)
+                seconds, out, _ = v.stream(model, None, text)
+                outputs[v.name].setdefault(args.samples[0], set()).add(out)
                 row.setdefault("stdin", []).append(seconds)
                 if r < 3:
                     row.setdefault("live", []).append(v.live(model, live_lines)[20:])
@@ -297,24 +329,34 @@ def _run(args: argparse.Namespace) -> str:
 def _tables(args, variants, runs, outputs) -> list[str]:
     import numpy as np
 
-    n = args.samples
     names = [v.name for v in variants]
-    same = len(set().union(*outputs.values())) == 1 and all(len(o) == 1 for o in outputs.values())
-    lines = ["", (f"Table 1. hystkit stream, mPL 1 cell with its band: {n} samples (and "
-                 f"{SMALL}: start-up); wall seconds, samples/s; outputs the same text in "
-                 f"every run and variant: {same}"),
-             (f"  {'variant':<8} {'--in s':>8} {'start-up s':>10} {'stdin s':>8} "
-             f"{'whole /s':>10} {'after start /s':>15} {'stdin whole /s':>15}")]
-    for name in names:
-        row = runs[name]
-        file_s, small_s, stdin_s = (_median(row[k]) for k in ("file", "small", "stdin"))
-        steady = [(n - SMALL) / (f - s) for f, s in zip(row["file"], row["small"], strict=True)]
-        lines.append(f"  {name:<8} {file_s:>8.2f} {small_s:>10.2f} {stdin_s:>8.2f} "
-                     f"{n / file_s:>10.0f} {_median(steady):>15.0f} {n / stdin_s:>15.0f}")
-    if len(names) == 2:
-        pairs = list(zip(runs["after"]["file"], runs["before"]["file"], strict=True))
-        lines.append(f"  before / after, --in whole command (median of rounds): "
-                     f"{_ratio(pairs)}")
+    same = all(len(set().union(*(o[n] for o in outputs.values()))) == 1 for n in args.samples)
+    lines = ["", (f"Table 1. hystkit stream, mPL 1 cell with its band, --in FILE of N samples "
+                 f"(and {SMALL}: start-up), stdin: the first N through a pipe; wall seconds, "
+                 f"cpu seconds (user + system), samples/s; outputs the same text in every run "
+                 f"and variant: {same}"),
+             (f"  {'N':>8} {'variant':<7} {'wall s':>7} {'cpu s':>6} {'start-up s':>10} "
+              f"{'whole /s':>9} {'after start /s':>14} {'cpu /s':>9} {'stdin whole /s':>14}")]
+    for n in args.samples:
+        for name in names:
+            row = runs[name]
+            file_s, cpu_s = _median(row[("file", n)]), _median(row[("cpu", n)])
+            small_s = _median(row["small"])
+            steady = [(n - SMALL) / (f - s) for f, s in zip(row[("file", n)], row["small"],
+                                                            strict=True)]
+            stdin = f"{args.samples[0] / _median(row['stdin']):>14.0f}" \
+                if n == args.samples[0] else f"{'':>14}"
+            lines.append(f"  {n:>8} {name:<7} {file_s:>7.2f} {cpu_s:>6.2f} {small_s:>10.2f} "
+                         f"{n / file_s:>9.0f} {_median(steady):>14.0f} {n / cpu_s:>9.0f} "
+                         f"{stdin}")
+        if len(names) == 2:
+            wall = list(zip(runs["after"][("file", n)], runs["before"][("file", n)],
+                            strict=True))
+            cpu = list(zip(runs["after"][("cpu", n)], runs["before"][("cpu", n)], strict=True))
+            lines.append(f"  {n:>8} before / after (median of paired rounds): wall "
+                         f"{_ratio(wall)}, cpu {_ratio(cpu)}")
+    lines.append("  start-up cpu s (10 lines): " + ", ".join(
+        f"{name} {_median(runs[name]['small cpu']):.2f}" for name in names))
     lines += ["", (f"Table 2. live: one line at a time through a pipe, its answer read before "
                   f"the next; round trip per line [µs] over {args.live} lines"),
               f"  {'variant':<8} {'median':>8} {'p99':>8}"]
