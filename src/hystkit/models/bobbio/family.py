@@ -21,14 +21,7 @@ class BobbioFamily(Family):
     Params = bobbio.BobbioParams
     model = bobbio
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_bobbio`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_bobbio
-
-        return fit_bobbio(u, y, structure, **options)
+    fit_function = "fit.fit_bobbio"  # fit.py, imported on the first fit (optimisers)
 
     def invert(self, structure, params, y, x0=None):
         return self.model.invert(structure, params, y, x0)

@@ -23,14 +23,7 @@ class BoucWenFamily(Family):
     model = boucwen
     capabilities = Capabilities(losses=ALL_LOSSES)
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_family`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_family
-
-        return fit_family(u, y, structure, **options)
+    fit_function = "fit.fit_family"  # fit.py, imported on the first fit (optimisers)
 
     def make_structure(self, dt: float, size: int, input_hold: str = "linear",
                        start: str = "equilibrium") -> boucwen.BoucWenStructure:

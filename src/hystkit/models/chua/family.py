@@ -25,14 +25,7 @@ class ChuaFamily(Family):
     model = chua
     capabilities = Capabilities(losses=ALL_LOSSES)
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_chua`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_chua
-
-        return fit_chua(u, y, structure, **options)
+    fit_function = "fit.fit_chua"  # fit.py, imported on the first fit (optimisers)
 
     def invert(self, structure, params, y, x0=None):
         return self.model.invert(structure, params, y, x0)

@@ -27,14 +27,7 @@ class GPreisachFamily(StaircaseFamily):
     Params = gpreisach.GPreisachParams
     stairs = gpreisach
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_gpreisach`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_gpreisach
-
-        return fit_gpreisach(u, y, structure, **options)
+    fit_function = "fit.fit_gpreisach"  # fit.py, imported on the first fit (optimisers)
 
     def make_structure(self, dt: float, size: int,
                        **options: Any) -> gpreisach.GPreisachStructure:

@@ -29,14 +29,7 @@ class LadderFamily(Family):
         losses=ALL_LOSSES, linear_output=True,
         sync_amplitude=lambda structure, params: float(np.sum(params.band)))
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_ladder`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_ladder
-
-        return fit_ladder(u, y, structure, **options)
+    fit_function = "fit.fit_ladder"  # fit.py, imported on the first fit (optimisers)
 
     def invert(self, structure, params, y, x0=None):
         return self.model.invert(structure, params, y, x0)

@@ -29,14 +29,7 @@ class MplFamily(Family):
     capabilities = Capabilities(losses=ALL_LOSSES, weight_sum_floor=0.0, linear_output=True,
                                 start_from_params=True)
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_mpl`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_mpl
-
-        return fit_mpl(u, y, structure, **options)
+    fit_function = "fit.fit_mpl"  # fit.py, imported on the first fit (optimisers)
 
     def invert(self, structure, params, y, x0=None):
         return self.model.invert(structure, params, y, x0)

@@ -25,14 +25,7 @@ class PiFamily(Family):
     Params = pi.PiParams
     model = pi  # rest_state, step, simulate, invert, invert_step: the module's functions
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_pi`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_pi
-
-        return fit_pi(u, y, structure, **options)
+    fit_function = "fit.fit_pi"  # fit.py, imported on the first fit (optimisers)
 
     def invert(self, structure, params, y, x0=None):
         return self.model.invert(structure, params, y, x0)

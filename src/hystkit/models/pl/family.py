@@ -28,14 +28,7 @@ class PlFamily(Family):
         losses=ALL_LOSSES, linear_output=lambda structure: structure.n_basis == 1,
         sync_amplitude=lambda structure, params: structure.n_cells * params.v_t)
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_pl`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_pl
-
-        return fit_pl(u, y, structure, **options)
+    fit_function = "fit.fit_pl"  # fit.py, imported on the first fit (optimisers)
 
     def invert(self, structure, params, y, x0=None):
         return self.model.invert(structure, params, y, x0)

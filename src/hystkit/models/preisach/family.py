@@ -156,14 +156,7 @@ class PreisachFamily(StaircaseFamily):
     Params = preisach.PreisachParams
     stairs = preisach
 
-    @staticmethod
-    def fit_function(u, y, structure, **options):
-        """:func:`.fit.fit_preisach`."""
-        # fit.py loads the optimisers (pl, pi, preisach, bobbio: scipy.optimize, +0.35 s),
-        # so only what fits imports it; running a model does not.
-        from .fit import fit_preisach
-
-        return fit_preisach(u, y, structure, **options)
+    fit_function = "fit.fit_preisach"  # fit.py, imported on the first fit (optimisers)
 
     def make_structure(self, dt: float, size: int, **options: Any) -> preisach.PreisachStructure:
         return preisach.PreisachStructure(levels=size, dt=dt, **options)
