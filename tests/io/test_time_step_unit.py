@@ -15,7 +15,8 @@ import hystkit as hk
 from hystkit.cli import main
 from hystkit.errors import InputError
 from hystkit.io import ReadOptions, read_recording
-from hystkit.io._recording import _Where, time_step_warning
+from hystkit.io._cells import Where as _Where
+from hystkit.io._time_column import time_step_warning
 from hystkit.sensors import simulate_experiment
 
 

@@ -21,7 +21,7 @@ from hystkit.io import (
     write_json,
     write_recording,
 )
-from hystkit.io._atomic import TEMP_MARK
+from hystkit.io._output_checks import TEMP_MARK
 
 
 def _names(folder: Path) -> list[str]:

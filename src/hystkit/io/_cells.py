@@ -88,7 +88,7 @@ def text_problems(text: pd.Series, decimal: str = ".") -> tuple[np.ndarray, np.n
     stripped : Series of str
         The cells without surrounding whitespace, for the error message.
     """
-    import pandas as pd
+    import pandas as pd  # here: a clean CSV never needs pandas (about 1 s to import)
 
     missing = text.isna().to_numpy()
     stripped = text.where(~missing, "").astype(str).str.strip()

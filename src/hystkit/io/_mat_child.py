@@ -23,25 +23,28 @@ import json
 import os
 import sys
 
+import numpy as np
+from scipy import sparse
+from scipy.io import loadmat
+from scipy.io.matlab import MatlabOpaque, MatReadError
+
+try:
+    import resource
+except ImportError:  # not POSIX: no memory limit
+    resource = None
+
 _MAX_TEXT = 16 << 20  # characters of a requested text (a model file is at most 16 MB)
 _DESCRIBED_ONLY = ("sparse", "object", "struct", "char", "cell")
 
 
 def _limit_memory(limit: int) -> None:
     # A flipped size field can ask for terabytes; fail with MemoryError instead of swapping.
-    try:
-        import resource
-    except ImportError:  # not POSIX: no limit
-        return
-    if limit > 0:
+    # RLIMIT_AS caps the whole address space, the modules imported above included.
+    if resource is not None and limit > 0:
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
 
 def _kind(value: object) -> str:
-    import numpy as np
-    from scipy import sparse
-    from scipy.io.matlab import MatlabOpaque
-
     if sparse.issparse(value):
         return "sparse"
     if isinstance(value, MatlabOpaque):
@@ -57,16 +60,12 @@ def _kind(value: object) -> str:
 
 
 def _describe(value: object) -> list:
-    import numpy as np
-
     dtype = "sparse" if _kind(value) == "sparse" else str(np.asarray(value).dtype)
     return [_kind(value), list(np.shape(value)), dtype]
 
 
 def _scalar_struct_fields(value: object) -> dict | None:
     """Field name -> value of a 1x1 struct, None for anything else."""
-    import numpy as np
-
     array = np.asarray(value)
     if not array.dtype.names or array.size != 1:
         return None
@@ -86,8 +85,6 @@ def _lookup(contents: dict, name: str) -> object | None:
 def _requested(contents: dict, names: list[str]):
     """(name, value) of each requested array: ``v``, ``v.f``, ``v.*`` (every field of v),
     ``*.f`` (field f of every 1x1 struct) and ``*`` (every 2-D variable with more rows than columns, at least 2 columns)."""
-    import numpy as np
-
     for name in names:
         if name == "*":
             for variable, value in contents.items():
@@ -110,10 +107,6 @@ def _requested(contents: dict, names: list[str]):
 
 def main(path: str, outdir: str, request: dict) -> dict:
     """Load `path`; save the requested real-valued arrays to `outdir`; return the report."""
-    import numpy as np
-    from scipy.io import loadmat
-    from scipy.io.matlab import MatReadError
-
     try:
         contents = loadmat(path)
     except NotImplementedError as exc:  # scipy's answer to HDF5-based (v7.3) files

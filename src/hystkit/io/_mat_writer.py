@@ -19,7 +19,8 @@ import numpy as np
 
 from hystkit.errors import NonFiniteError
 
-from ._atomic import atomic_output, check_output_format
+from ._atomic import atomic_output
+from ._output_checks import check_output_format
 
 __all__ = ["matlab_name", "to_matlab", "write_mat"]
 
@@ -175,7 +176,7 @@ def write_mat(path: str | os.PathLike[str], mapping: Mapping[str, Any], *,
     ValueError
         Two names that become the same MATLAB name.
     """
-    from scipy.io import savemat
+    from scipy.io import savemat  # here: scipy.io loads only for .mat outputs
 
     path = Path(path)
     check_output_format(path, (".mat",), "a MATLAB file")

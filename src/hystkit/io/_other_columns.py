@@ -20,6 +20,9 @@ from hystkit.errors import InputError
 from .._read_options import DEFAULT_OPTIONS, FIELDS, ReadOptions
 from ._cells import COLUMNS, Where
 from ._csv_layout import csv_layout
+from ._mat_reader import load_mat
+from ._recording import _validate, read_unvalidated
+from ._resample import resample_arrays
 
 __all__ = ["dropped_by_resampling", "read_other_columns"]
 
@@ -63,9 +66,6 @@ def read_other_columns(path: str | os.PathLike[str], n_samples: int,
         return _as_read(path, n_samples, options)
     else:
         as_read = _as_read(path, None, options)
-    from ._recording import _validate, read_unvalidated
-    from ._resample import resample_arrays
-
     numeric = {name: values for name, values in as_read.items() if name not in
                dropped_by_resampling(as_read)}
     if not numeric:
@@ -82,8 +82,6 @@ def read_other_columns(path: str | os.PathLike[str], n_samples: int,
 
 def _kept_rows(path: Path, options: ReadOptions) -> dict[str, np.ndarray]:
     """The other columns at the rows `read_recording` keeps under ``options.missing``."""
-    from ._recording import read_unvalidated
-
     _, where, _ = read_unvalidated(path, False, options, notices=False)
     as_read = _as_read(path, None, options)
     rows = where.rows
@@ -115,19 +113,17 @@ def _as_read(path: Path, n_samples: int | None, options: ReadOptions) -> dict[st
         return _mat_others(path, n_samples, options)
     if suffix not in (".csv", ".parquet"):
         return {}
-    import pandas as pd
+    import pandas as pd  # here: only outputs that keep other columns need pandas
 
     ours = {options.name(field) for field in FIELDS}
     clean: dict[object, str] = {}  # the file's name -> the column's name (a comment header's
     # first without its '#')
     if suffix == ".parquet":
-        import pyarrow.parquet as pq
+        import pyarrow.parquet as pq  # here: pyarrow loads only for Parquet files
 
         names = [n for n in pq.ParquetFile(path).schema_arrow.names if n not in ours]
         frame = pd.read_parquet(path, columns=names) if names else pd.DataFrame()
     else:
-        from ._cells import Where
-
         layout = csv_layout(path, options, Where(str(path), names=options.columns))
         header = pd.read_csv(path, nrows=0, sep=layout.sep, skiprows=layout.preamble,
                              encoding="utf-8-sig").columns
@@ -161,8 +157,6 @@ def _as_read(path: Path, n_samples: int | None, options: ReadOptions) -> dict[st
 def _mat_others(path: Path, n_samples: int | None, options: ReadOptions) -> dict[str, np.ndarray]:
     """The real vectors beside the recording in a ``.mat`` file (see the module notes);
     only those as long as the recording (`n_samples`; None: as long as its time)."""
-    from ._mat_reader import load_mat
-
     source = str(path)
     where = Where(source, names=options.columns)
     ours = {where.name(name) for name in COLUMNS}
@@ -193,8 +187,6 @@ def _mat_others(path: Path, n_samples: int | None, options: ReadOptions) -> dict
 
 def _matrix_others(path: Path, var: str, shape: tuple[int, ...], options: ReadOptions,
                    n_samples: int | None) -> dict[str, np.ndarray]:
-    from ._mat_reader import load_mat
-
     n_rows, n_cols = shape
     used = {int(v) for v in dict(options.columns).values() if v.isdigit()} or \
         set(range(1, min(n_cols, 3) + 1))

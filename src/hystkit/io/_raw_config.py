@@ -18,8 +18,8 @@ import numpy as np
 from hystkit.errors import InputError
 
 from ._atomic import atomic_output
-from ._raw import MAX_SKIP_ROWS
-from ._toml import load_toml
+from ._raw_format import MAX_SKIP_ROWS
+from ._toml import check_type, load_toml, settings_beside
 
 __all__ = ["CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_config"]
 
@@ -85,8 +85,7 @@ def find_raw_config(data_path: str | os.PathLike[str]) -> Path | None:
     pathlib.Path or None
         ``<stem>.toml`` beside it, None if there is none.
     """
-    candidate = Path(data_path).with_suffix(".toml")
-    return candidate if candidate.is_file() else None
+    return settings_beside(data_path)
 
 
 def read_raw_config(path: str | os.PathLike[str]) -> dict[str, Any]:
@@ -124,11 +123,7 @@ def read_raw_config(path: str | os.PathLike[str]) -> dict[str, Any]:
         if key not in CONFIG_KEYS:
             raise InputError(f"{path}: unknown key {key!r}; known keys: "
                              f"{', '.join(CONFIG_KEYS)}")
-        types = CONFIG_KEYS[key][0]
-        ok = isinstance(value, types) and not (isinstance(value, bool) and bool not in types)
-        if not ok:
-            raise InputError(f"{path}: key {key!r} must be "
-                             f"{' or '.join(t.__name__ for t in types)}, got {value!r}")
+        check_type(path, key, value, CONFIG_KEYS[key][0])
         _check_value(path, key, value)
     return values
 

@@ -7,7 +7,6 @@ the column and the row, so the CLI can print it verbatim.
 from __future__ import annotations
 
 import os
-import re
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -16,16 +15,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from hystkit._read_options import TIME_UNITS, ReadOptions
+from hystkit._read_options import ReadOptions
 from hystkit.errors import InputError
 
 from ._cells import COLUMNS as _COLUMNS  # also imported by _writing
-from ._cells import Where as _Where  # also imported by _raw
+from ._cells import Where as _Where
 from ._cells import as_vector
 from ._csv_reader import read_csv
 from ._mat_reader import read_mat
 from ._missing import fill_missing
 from ._resample import MAX_GAP_STEPS, resample_arrays, time_gaps
+from ._time_column import check_time_name, check_time_unit, time_step_warning
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -122,7 +122,7 @@ class Recording(Sampled):
         1   0.1       1.0     2.0
         2   0.2       2.0     3.0
         """
-        import pandas as pd
+        import pandas as pd  # here: reading a CSV needs no pandas (about 1 s to import)
 
         frame = pd.DataFrame({name: getattr(self, name) for name in _COLUMNS
                               if getattr(self, name) is not None})
@@ -178,7 +178,7 @@ class Recording(Sampled):
 
 def _numbers(values: pd.Series, what: str) -> np.ndarray:
     """A DataFrame column as float64; InputError naming the first row that is not a number."""
-    import pandas as pd
+    import pandas as pd  # here: as in to_frame
 
     numbers = pd.to_numeric(values, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
     bad = np.flatnonzero(np.isnan(numbers) & values.notna().to_numpy())
@@ -285,8 +285,8 @@ def read_unvalidated(path: Path, need_position: bool, options: ReadOptions, *,
     except OSError as exc:  # also a disk failing halfway (EIO)
         raise InputError(f"{source}: cannot read the file ({exc.strerror or exc})") from exc
     units = {**dict(options.units), **dict(where.units)}  # the file's own units first
-    _check_time_unit(units.get("time"), options, where)
-    _check_time_name(dict(options.columns).get("time", "time"), options, where)
+    check_time_unit(units.get("time"), options, where)
+    check_time_name(dict(options.columns).get("time", "time"), options, where)
     if options.time_scale != 1.0:  # to seconds before the checks, whose messages say "s"
         arrays["time"] = arrays["time"] * options.time_scale
     arrays, where, notice = fill_missing(arrays, where, options.missing)
@@ -301,68 +301,6 @@ def say(line: str) -> None:
     """Tell the user what reading a file did or suggests, on stderr (a command's stdout may
     carry its product: ``stream``'s estimates, ``datasets list``)."""
     print(f"hystkit: {line}", file=sys.stderr, flush=True)
-
-
-# Words that name a time unit in a column name (``time_sec``, ``t [ms]``); a name with none
-# says nothing, and then the step is all there is to go by
-_UNIT_WORDS = {"s", "sec", "secs", "second", "seconds", "ms", "msec", "millis", "us", "usec",
-               "micros", "ns", "nsec", "min", "mins", "minute", "minutes"}
-MIN_PLAUSIBLE_HZ = 1.0
-"""A rate at or below which a time column whose name states no unit is probably not in the
-unit read: a logger in ms writes integer steps of 1 to 1000 (1 kHz to 1 Hz), read as seconds
-a rate of 1 Hz down to 1 mHz."""
-
-
-def time_step_warning(time: np.ndarray, options: ReadOptions, where: _Where) -> str:
-    """The one-line warning for a time column (in seconds) whose median step makes the
-    rate `MIN_PLAUSIBLE_HZ` or lower when its name states no unit, with the unit that would
-    make it plausible; "" otherwise. Never a guess that changes the numbers: the time stays
-    as read, in the unit the options say (``min`` is taken as meant).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> print(time_step_warning(np.arange(5) * 20.0, ReadOptions(), _Where("my.csv")))
-    my.csv: column 'time': one sample every 20 s (0.05 Hz) read in s; if the time is in ms, ...
-    """
-    name = where.name("time")
-    words = {w.lower().replace("µ", "u") for w in re.split(r"[^0-9A-Za-zµ]+", name) if w}
-    finite = time[np.isfinite(time)]
-    if options.time_unit == "min" or words & _UNIT_WORDS or finite.size < 2:
-        return ""
-    step = float(np.median(np.diff(finite)))
-    if not step >= 1 / MIN_PLAUSIBLE_HZ:  # also NaN: the checks report a bad time column
-        return ""
-    raw = step / options.time_scale  # as written in the file
-    smaller = [u for u, scale in TIME_UNITS.items() if scale < options.time_scale]
-    fits = [u for u in sorted(smaller, key=TIME_UNITS.__getitem__, reverse=True)
-            if raw * TIME_UNITS[u] < 1 / MIN_PLAUSIBLE_HZ]
-    hint = (f"; if the time is in {fits[0]}, pass --time-unit {fits[0]} (or time_unit = "
-            f"\"{fits[0]}\" in the settings file)" if fits else "")
-    return where.fail(f"one sample every {step:.6g} s ({1 / step:.6g} Hz) read in "
-                      f"{options.time_unit}{hint}", "time").args[0]
-
-
-def _check_time_unit(unit: str | None, options: ReadOptions, where: _Where) -> None:
-    """A units row naming a time unit other than the one read would mean reading ms as s."""
-    if unit is None:
-        return
-    named = unit.strip().strip("[]()").strip()
-    if named in TIME_UNITS and named != options.time_unit:
-        raise where.fail(f"the file gives the time unit {unit!r} but time is read in "
-                         f"{options.time_unit}; pass --time-unit {named} (or time_unit = "
-                         f"\"{named}\" in the settings file)", "time")
-
-
-def _check_time_name(name: str, options: ReadOptions, where: _Where) -> None:
-    """A time column named for a unit (``t_ms``, ``time [us]``) other than the one read would
-    mean reading ms as s: 12000 samples at 0.05 Hz instead of 20 Hz, fitted without a word."""
-    words = {w.replace("µ", "u") for w in re.split(r"[^0-9A-Za-zµ]+", name) if w}
-    named = sorted(words & set(TIME_UNITS) - {options.time_unit})
-    if named and options.time_unit not in words:
-        raise where.fail(f"the time column {name!r} is named for {named[0]} but time is read "
-                         f"in {options.time_unit}; pass --time-unit {named[0]} (or time_unit = "
-                         f"\"{named[0]}\" in the settings file)", "time")
 
 
 def _adopt(arrays: dict[str, np.ndarray], source: str,

@@ -44,7 +44,9 @@ from typing import Any
 from hystkit.errors import InputError
 
 from .._read_options import FIELDS, ReadOptions
-from ._toml import load_toml
+from ._raw_config import _COLUMN_NAMES as RAW_COLUMNS
+from ._raw_config import CONFIG_KEYS as RAW_KEYS
+from ._toml import check_type, load_toml, settings_beside
 
 __all__ = ["RECORDING_KEYS", "find_recording_config", "is_raw_settings", "options_for",
            "read_recording_config", "settings_for"]
@@ -80,8 +82,7 @@ def find_recording_config(data_path: str | os.PathLike[str]) -> Path | None:
     pathlib.Path or None
         ``<stem>.toml`` beside it, None if there is none.
     """
-    candidate = Path(data_path).with_suffix(".toml")
-    return candidate if candidate.is_file() else None
+    return settings_beside(data_path)
 
 
 def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
@@ -103,8 +104,6 @@ def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
         Unreadable or invalid TOML, an unknown key (or one of raw files only), a value of the
         wrong type or one `ReadOptions` refuses; one line naming the file and the key.
     """
-    from ._raw_config import CONFIG_KEYS as RAW_KEYS
-
     path = Path(path)
     values = _load(path)
     for key, value in values.items():
@@ -113,10 +112,7 @@ def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
                 if key in RAW_KEYS else ""
             raise InputError(f"{path}: unknown key {key!r}{raw}; a recording's settings file "
                              f"knows {', '.join(RECORDING_KEYS)}")
-        types = RECORDING_KEYS[key][0]
-        if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
-            raise InputError(f"{path}: key {key!r} must be "
-                             f"{' or '.join(t.__name__ for t in types)}, got {value!r}")
+        check_type(path, key, value, RECORDING_KEYS[key][0])
     for name, item in values.get("columns", {}).items():
         if name not in FIELDS or not isinstance(item, str):
             raise InputError(f"{path}: key 'columns.{name}' = {item!r}: names must be among "
@@ -217,9 +213,6 @@ def is_raw_settings(values: dict[str, Any]) -> bool:
     only raw files have (``r_bridge``, ``fs_out``, ...) or a raw column name (``v1``,
     ``encoder``, ...) in ``[columns]``. ``run.parquet`` (raw) and ``preprocess``'s ``run.csv``
     share the stem, so ``run.toml`` beside ``run.csv`` may be the raw file's."""
-    from ._raw_config import _COLUMN_NAMES as RAW_COLUMNS
-    from ._raw_config import CONFIG_KEYS as RAW_KEYS
-
     raw_only = set(RAW_KEYS) - set(RECORDING_KEYS)
     columns = values.get("columns")
     return bool(raw_only & set(values)) or (

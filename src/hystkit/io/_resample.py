@@ -111,7 +111,7 @@ def resample_arrays(arrays: dict[str, np.ndarray], rate_hz: float,
 def _low_pass(time: np.ndarray, signals: dict[str, np.ndarray], own_rate: float,
               rate_hz: float) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Signals on a uniform grid at the file's mean rate, low-passed for `rate_hz`."""
-    from scipy.signal import butter, sosfiltfilt
+    from scipy.signal import butter, sosfiltfilt  # here: only resampling needs scipy.signal
 
     n = int(np.floor((time[-1] - time[0]) * own_rate * (1 + _SAME_RATE))) + 1
     uniform = time[0] + np.arange(n) / own_rate

@@ -1,13 +1,29 @@
-"""Reading TOML settings files, as Windows editors save them too."""
+"""Reading TOML settings files (as Windows editors save them too), found beside their data."""
 
 from __future__ import annotations
 
 import codecs
+import os
 import tomllib
 from pathlib import Path
 from typing import Any
 
-__all__ = ["load_toml"]
+from hystkit.errors import InputError
+
+__all__ = ["check_type", "load_toml", "settings_beside"]
+
+
+def settings_beside(data_path: str | os.PathLike[str]) -> Path | None:
+    """``<stem>.toml`` beside a data file (raw or recording), None if there is none."""
+    candidate = Path(data_path).with_suffix(".toml")
+    return candidate if candidate.is_file() else None
+
+
+def check_type(path: Path, key: str, value: Any, types: tuple[type, ...]) -> None:
+    """Refuse a setting of the wrong type (a TOML ``true`` is no number), naming file and key."""
+    if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
+        raise InputError(f"{path}: key {key!r} must be "
+                         f"{' or '.join(t.__name__ for t in types)}, got {value!r}")
 
 
 def load_toml(path: Path) -> dict[str, Any]:

@@ -14,7 +14,9 @@ import numpy as np
 from hystkit.errors import NonFiniteError
 
 from .._read_options import TIME_UNITS
-from ._atomic import atomic_output, atomic_outputs, check_output_format, check_output_path
+from ._atomic import atomic_output, atomic_outputs
+from ._mat_writer import recording_variables, write_mat
+from ._output_checks import check_output_format, check_output_path
 from ._recording import _COLUMNS, Recording
 
 if TYPE_CHECKING:  # pandas loads when a recording is written, not for a model file
@@ -122,11 +124,9 @@ def write_recording(
     # the time's unit labels it in .mat and Parquet; a settings file says time_unit instead
     labels = {written["time"]: time_unit, **all_units} if time_unit != "s" else all_units
     if suffix == ".mat":
-        from ._mat_writer import recording_variables, write_mat
-
         return write_mat(path, {}, force=force,
                          verbatim=recording_variables(columns, labels))
-    import pandas as pd
+    import pandas as pd  # here: see TYPE_CHECKING above
 
     # flags (bool) as 0/1 in text and Parquet files, as the files hystkit always wrote
     frame = pd.DataFrame({name: values.astype(int) if np.asarray(values).dtype.kind == "b"
@@ -229,7 +229,7 @@ def time_in_unit(seconds: np.ndarray, unit: str) -> np.ndarray:
 
 
 def _write_parquet(frame: pd.DataFrame, path: Path, units: dict[str, str]) -> None:
-    import pyarrow as pa
+    import pyarrow as pa  # here: pyarrow loads only for Parquet files
     import pyarrow.parquet as pq
 
     table = pa.Table.from_pandas(frame, preserve_index=False)

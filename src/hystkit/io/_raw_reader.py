@@ -1,4 +1,4 @@
-"""Raw scope recordings (time, v1, v2, encoder or enc_a/enc_b), read and written in chunks.
+"""Reading raw scope recordings (time, v1, v2, encoder or enc_a/enc_b) in chunks.
 
 A raw recording is what the oscilloscope saved (sec. 4.2.1, 4.3): the two half-bridge voltages
 ``v1``, ``v2`` [V] of gauges R1 (top) and R2 (bottom), measured across the bridge resistor
@@ -16,119 +16,24 @@ Settings can sit beside the data in a TOML file with the data file's stem
 from __future__ import annotations
 
 import os
-import sys
 from collections.abc import Iterator
-from contextlib import ExitStack
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Self
 
 import numpy as np
 import pandas as pd
 import pyarrow as pa
-import pyarrow.csv as pa_csv
 import pyarrow.parquet as pq
-from numba import njit
 
 from hystkit.errors import InputError
 
-from ._atomic import atomic_output, check_output_path
+from ._cells import Where
 from ._mat_reader import load_mat
-from ._recording import _Where
+from ._raw_checks import MAX_STEP_DEVIATION, check_time_steps, check_values
+from ._raw_format import OPTIONAL_COLUMNS, RAW_COLUMNS, TIME_UNITS, RawChunk, RawFormat
 
-__all__ = ["RAW_COLUMNS", "RawChunk", "RawFormat", "RawReader", "RawWriter", "open_raw"]
+__all__ = ["RawReader", "open_raw"]
 
-RAW_COLUMNS = ("time", "v1", "v2", "encoder", "enc_a", "enc_b", "v0")
-# Columns read only when the caller asks for them.
-OPTIONAL_COLUMNS = ("v0",)
-_TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
-_MAX_STEP_DEVIATION = 0.01  # as for recordings: relative to 1/fs
 _FS_HEAD = 4096  # samples whose mean step gives fs
-# No scope channel reads more; beyond it a histogram of the levels would overflow.
-MAX_VOLTAGE = 1e6
-# CSV lines skipped after the header (a units line or a few): pandas holds them as a set.
-MAX_SKIP_ROWS = 1_000_000
-
-@dataclass(frozen=True)
-class RawFormat:
-    """How to find the raw channels in a file.
-
-    Parameters
-    ----------
-    columns : tuple of (str, str)
-        (hystkit name, file column name) pairs for columns named differently in the file.
-    time_unit : {"s", "ms", "us", "ns"}
-        Unit of the time column.
-    skip_rows : int
-        CSV lines to skip after the header row.
-    fs : float, optional
-        Sample rate [Hz]: needed without a time column, checked against one.
-    n_samples : int, optional
-        Expected samples per channel; fewer means the file was truncated.
-    """
-
-    columns: tuple[tuple[str, str], ...] = ()
-    time_unit: str = "s"
-    skip_rows: int = 0
-    fs: float | None = None
-    n_samples: int | None = None
-
-    def __post_init__(self) -> None:
-        unknown = [k for k, _ in self.columns if k not in RAW_COLUMNS]
-        if unknown:
-            raise ValueError(f"unknown raw column(s) {unknown}; known: {', '.join(RAW_COLUMNS)}")
-        if self.time_unit not in _TIME_UNITS:
-            raise ValueError(f"time_unit must be one of {', '.join(_TIME_UNITS)}, "
-                             f"got {self.time_unit!r}")
-        if not 0 <= self.skip_rows <= MAX_SKIP_ROWS or (
-                self.fs is not None and not 0 < self.fs < np.inf) or (
-                self.n_samples is not None and self.n_samples < 1):
-            raise ValueError(f"skip_rows must lie in [0, {MAX_SKIP_ROWS}], fs be finite and "
-                             f"> 0 and n_samples >= 1")
-
-    def name(self, column: str) -> str:
-        """The file's name for hystkit column `column`."""
-        return dict(self.columns).get(column, column)
-
-
-@dataclass(frozen=True, eq=False)
-class RawChunk:
-    """Consecutive samples of a raw recording, from sample ``start`` (0-based) on.
-
-    Arrays are float32 or float64 as stored (other numbers become float64), shape (n,). A
-    column not read, or absent (``time`` without a time column, ``encoder`` when the file has
-    ``enc_a``/``enc_b`` and vice versa, ``v0`` unless asked for), is None.
-
-    Parameters
-    ----------
-    start : int
-        Index of the chunk's first sample in the recording (0-based).
-    time : numpy.ndarray, optional
-        Time [s].
-    v1, v2 : numpy.ndarray, optional
-        Bridge voltages [V].
-    encoder : numpy.ndarray, optional
-        Merged encoder signal [V].
-    enc_a, enc_b : numpy.ndarray, optional
-        Encoder channels A and B [V].
-    v0 : numpy.ndarray, optional
-        Measured supply voltage [V].
-    """
-
-    start: int
-    time: np.ndarray | None = None
-    v1: np.ndarray | None = None
-    v2: np.ndarray | None = None
-    encoder: np.ndarray | None = None
-    enc_a: np.ndarray | None = None
-    enc_b: np.ndarray | None = None
-    v0: np.ndarray | None = None
-
-    @property
-    def n(self) -> int:
-        """Samples in the chunk."""
-        return next(int(a.size) for a in (self.time, self.v1, self.v2, self.encoder,
-                                          self.enc_a, self.enc_b, self.v0) if a is not None)
 
 
 class RawReader:
@@ -179,10 +84,10 @@ class RawReader:
                                                    else "file not found"))
         if self.path.stat().st_size == 0:
             raise InputError(f"{self.source}: file is empty (0 bytes)")
-        self._where = _Where(self.source, noun="variable" if self.suffix == ".mat" else "column",
-                             item="sample" if self.suffix == ".mat" else "row",
-                             header_lines=1 + self.fmt.skip_rows if self.suffix == ".csv"
-                             else None)
+        self._where = Where(self.source, noun="variable" if self.suffix == ".mat" else "column",
+                            item="sample" if self.suffix == ".mat" else "row",
+                            header_lines=1 + self.fmt.skip_rows if self.suffix == ".csv"
+                            else None)
         self._mat: dict[str, np.ndarray] | None = None
         self.n_samples: int | None = None
         found = self._open()
@@ -198,6 +103,10 @@ class RawReader:
         """An InputError naming the file, the column (hystkit name) and the 0-based sample."""
         return self._where.fail(message, None if column is None else self.fmt.name(column),
                                 index)
+
+    def _check_values(self, values: np.ndarray, column: str, start: int) -> None:
+        check_values(values, column, start, self.fail, n_samples=self.n_samples,
+                     from_csv=self.suffix == ".csv")
 
     # ------------------------------------------------------------------ opening
 
@@ -265,12 +174,12 @@ class RawReader:
         if head is None or head[1]["time"].size < 2:
             raise self.fail("fewer than 2 samples; a raw recording needs more")
         t = head[1]["time"]
-        self._check_finite(t, "time", 0)
+        self._check_values(t, "time", 0)
         step = float((t[-1] - t[0]) / (t.size - 1))  # the mean step: jitter averages out
         if not step > 0:
             raise self.fail("time is not increasing", "time", 1)
         fs = 1.0 / step
-        if self.fmt.fs is not None and abs(fs / self.fmt.fs - 1) > _MAX_STEP_DEVIATION:
+        if self.fmt.fs is not None and abs(fs / self.fmt.fs - 1) > MAX_STEP_DEVIATION:
             raise self.fail(f"the time column is sampled at {fs:.6g} Hz but the settings say "
                             f"fs = {self.fmt.fs:.6g} Hz; fix the fs setting (or time_unit, "
                             f"now {self.fmt.time_unit!r})", "time")
@@ -291,9 +200,9 @@ class RawReader:
         n = 0
         for start, arrays in self._raw_chunks(self.chunk_size, wanted):
             for name, values in arrays.items():
-                self._check_finite(values, name, start)
+                self._check_values(values, name, start)
             if "time" in arrays:
-                t_prev = self._check_time(arrays["time"], t_prev, start)
+                t_prev = check_time_steps(arrays["time"], t_prev, start, self.fs, self.fail)
             n = start + next(iter(arrays.values())).size
             yield RawChunk(start=start, **arrays)
         if n < 2:
@@ -310,7 +219,7 @@ class RawReader:
 
     def _raw_chunks(self, size: int, wanted: tuple[str, ...]
                     ) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
-        scale = _TIME_UNITS[self.fmt.time_unit]
+        scale = TIME_UNITS[self.fmt.time_unit]
         start = 0
         for arrays in self._read(size, wanted):
             if "time" in arrays and scale != 1.0:
@@ -413,69 +322,10 @@ class RawReader:
             raise self.fail(f"must be a row or column vector, got shape {values.shape}", column)
         return _as_float(values)
 
-    # ------------------------------------------------------------------ checks
-
-    def _check_finite(self, values: np.ndarray, column: str, start: int) -> None:
-        i = _first_nonfinite(values)
-        if i < 0 and column != "time":
-            j = _first_beyond(values, MAX_VOLTAGE)
-            if j >= 0:
-                raise self.fail(f"value {values[j]:.6g} V is not a scope reading (hystkit "
-                                f"accepts voltages up to {MAX_VOLTAGE:g} V in magnitude)",
-                                column, start + j)
-        if i >= 0:
-            last = start + i + 1 == self.n_samples if self.n_samples else False
-            problem = "missing or NaN value" if np.isnan(values[i]) else "infinite value"
-            if self.suffix == ".csv" and np.isnan(values[i]):
-                problem += " (a short line: if it is the last one, the file is truncated)"
-            elif last:
-                problem += " in the last sample (truncated?)"
-            raise self.fail(problem, column, start + i)
-
-    def _check_time(self, t: np.ndarray, t_prev: float | None, start: int) -> float:
-        i = _first_bad_step(t, np.nan if t_prev is None else t_prev, self.fs,
-                            _MAX_STEP_DEVIATION)
-        if i >= 0:
-            previous = float(t[i - 1] if i else t_prev)
-            step = float(t[i]) - previous  # Python floats: a huge step is inf, not a warning
-            kind = ("time goes backwards or repeats" if step <= 0 else
-                    f"a gap of {step * self.fs - 1:.6g} samples (dropped data?)"
-                    if step * self.fs > 1.5 else "non-uniform sampling")
-            raise self.fail(f"{kind}: {t[i]:.12g} s follows {previous:.12g} s, but "
-                            f"1/fs = {1 / self.fs:.6g} s", "time", start + i)
-        return float(t[-1])
-
 
 def _as_float(values: np.ndarray) -> np.ndarray:
     """float32 stays float32 (a scope's samples fit, and it halves the memory); others float64."""
     return values if values.dtype in (np.float32, np.float64) else values.astype(np.float64)
-
-
-@njit(cache=True, nogil=True)
-def _first_nonfinite(x):
-    for i in range(x.size):
-        if not np.isfinite(x[i]):
-            return i
-    return -1
-
-
-@njit(cache=True, nogil=True)
-def _first_beyond(x, limit):
-    for i in range(x.size):
-        if abs(x[i]) > limit:
-            return i
-    return -1
-
-
-@njit(cache=True, nogil=True)
-def _first_bad_step(t, t_prev, fs, tol):
-    """First index whose step from the previous time deviates from 1/fs by more than `tol`."""
-    prev = t[0] - 1.0 / fs if np.isnan(t_prev) else t_prev
-    for i in range(t.size):
-        if abs((t[i] - prev) * fs - 1.0) > tol:
-            return i
-        prev = t[i]
-    return -1
 
 
 def open_raw(path: str | os.PathLike[str], fmt: RawFormat | None = None,
@@ -508,87 +358,3 @@ def open_raw(path: str | os.PathLike[str], fmt: RawFormat | None = None,
         with the ``fs`` setting. Further problems are raised while iterating chunks.
     """
     return RawReader(path, fmt, chunk_size, extra=extra)
-
-
-# --------------------------------------------------------------------------- writing
-
-
-class RawWriter:
-    """Write a raw recording chunk by chunk to ``.csv`` or ``.parquet`` (one row group a chunk).
-
-    Columns ``time`` (float64) and the voltages (float32: a scope's 8-16 bit samples fit its
-    24-bit mantissa, and the file is half the size). Use as a context manager. The rows go to
-    a hidden temporary beside `path` (:func:`atomic_output`), renamed into place when the block
-    ends normally: an exception, Ctrl-C or SIGTERM in between leaves no partial file, and
-    without `force` a file that appeared meanwhile is not overwritten.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        Output ``.csv`` or ``.parquet`` file.
-    columns : tuple of str
-        Columns to write, among :data:`RAW_COLUMNS`.
-    force : bool, default False
-        Replace an existing file.
-
-    Raises
-    ------
-    InputError
-        Another file type than ``.csv`` / ``.parquet``.
-    ValueError
-        A column not among :data:`RAW_COLUMNS`.
-    OutputExistsError
-        `path` exists and `force` is False.
-    """
-
-    def __init__(self, path: str | os.PathLike[str], columns: tuple[str, ...], *,
-                 force: bool = False) -> None:
-        self.path = Path(path)
-        suffix = self.path.suffix.lower()
-        if suffix not in (".csv", ".parquet"):
-            raise InputError(f"{self.path}: cannot write raw file type "
-                             f"{suffix or '(no suffix)'!r}; accepted: .csv, .parquet")
-        unknown = [c for c in columns if c not in RAW_COLUMNS]
-        if unknown:
-            raise ValueError(f"unknown raw column(s) {unknown}")
-        check_output_path(self.path, force)
-        self.columns = columns
-        self.schema = pa.schema([(c, pa.float64() if c == "time" else pa.float32())
-                                 for c in columns])
-        self.n_rows = 0
-        self._writer: Any = None
-        self._suffix = suffix
-        self._force = force
-        self._stack = ExitStack()
-
-    def __enter__(self) -> Self:
-        tmp = self._stack.enter_context(atomic_output(self.path, self._force))
-        try:
-            if self._suffix == ".csv":
-                self._writer = pa_csv.CSVWriter(
-                    tmp, self.schema, write_options=pa_csv.WriteOptions(quoting_header="none"))
-            else:
-                # Noisy samples neither dictionary-encode nor compress: both only cost time
-                # (5x slower writing, 2x slower reading for 1 % smaller files).
-                self._writer = pq.ParquetWriter(tmp, self.schema, use_dictionary=False,
-                                                compression="none")
-        except BaseException:
-            self._stack.__exit__(*sys.exc_info())  # removes the temporary
-            raise
-        return self
-
-    def write(self, **arrays: np.ndarray) -> None:
-        """Append rows; every column of the writer, equal lengths."""
-        table = pa.table({c: np.asarray(arrays[c], dtype=self.schema.field(c).type.to_pandas_dtype())
-                          for c in self.columns}, schema=self.schema)
-        self._writer.write_table(table)
-        self.n_rows += table.num_rows
-
-    def __exit__(self, *exc: object) -> None:
-        try:
-            if self._writer is not None:
-                self._writer.close()  # a Parquet footer: written before the file is published
-        except BaseException:
-            self._stack.__exit__(*sys.exc_info())
-            raise
-        self._stack.__exit__(*exc)  # publishes on success, removes the temporary otherwise
