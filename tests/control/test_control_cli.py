@@ -11,7 +11,6 @@ import pytest
 from numpy.testing import assert_allclose
 
 from hystkit import control as hc
-from hystkit.cli.cmd_control import _models
 from hystkit.compensation import fit_compensator, save_compensator
 from hystkit.sensors import simulate_experiment
 
@@ -25,9 +24,9 @@ METRIC_KEYS = {"e_p_max", "e_p_mean", "e_p_rms", "tracking_rms", "bounded", "sec
 
 @pytest.fixture(scope="module")
 def models() -> hc.SensorModels:
-    # the CLI's in-memory memo of fit_sensor_models() with the CLI defaults: the CLI tests
-    # below then reuse this fit instead of repeating it (about 2 s each)
-    return _models("recording", "sine", 3, None)
+    # the CLI's default models (kept on disk): the CLI tests below read this fit instead of
+    # repeating it (about 2 s each)
+    return hc.setup_loop(hc.LoopSetup("direct")).models
 
 
 def _one_error_line(err: str, *fragments: str) -> None:

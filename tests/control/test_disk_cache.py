@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from hystkit import control as hc
-from hystkit.control import _analysis, _disk_cache
+from hystkit.control import _disk_cache
 from hystkit.sensors import simulate_experiment
 
 
@@ -134,7 +134,7 @@ def test_stored_margins_are_the_computed_ones(tmp_path, monkeypatch):
     stored = _disk_cache.cached_loop_margins(loop, tmp_path)
     fresh = hc.loop_margins(loop)
     calls = []
-    monkeypatch.setattr(_analysis, "loop_margins", lambda loop: calls.append(loop))
+    monkeypatch.setattr(hc, "loop_margins", lambda loop: calls.append(loop))
     read = _disk_cache.cached_loop_margins(_linear_loop(), tmp_path)  # an equal loop
     assert calls == []
     assert read == stored == fresh

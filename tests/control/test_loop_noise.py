@@ -11,14 +11,13 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from hystkit import control as hc
 from hystkit.cli import main
-from hystkit.cli.cmd_control import _models
 
 SIGNALS = ("y", "s", "y_hat", "s_hat", "e", "u", "y_hat_plant")
 
 
 @pytest.fixture(scope="module")
 def models() -> hc.SensorModels:
-    return _models("recording", "sine", 3, None)  # the CLI's memo: shared with its tests
+    return hc.setup_loop(hc.LoopSetup("direct")).models  # the CLI's default, kept on disk
 
 
 @pytest.fixture(scope="module")

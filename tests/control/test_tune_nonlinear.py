@@ -11,14 +11,13 @@ from numpy.testing import assert_allclose
 
 from hystkit import control as hc
 from hystkit.cli import main
-from hystkit.cli.cmd_control import _models
 
 GAIN = 40.0
 
 
 @pytest.fixture(scope="module")
 def models() -> hc.SensorModels:
-    return _models("recording", "sine", 3, None)  # the CLI's memo: shared with its tests
+    return hc.setup_loop(hc.LoopSetup("direct")).models  # the CLI's default, kept on disk
 
 
 def _ideal(scheme: str) -> hc.ControlLoop:

@@ -1,36 +1,19 @@
-"""The reporting side of ``hystkit control``: the experiment table, the linearised verdict, the
-non-linear tuning (its options, with the held-out check) and the noise study. Kept apart from
-the command so each module stays small."""
+"""The printed side of ``hystkit control``: the loop and its linearised verdict, the non-linear
+tuning (with the held-out check), the experiment table and the noise study, from the records
+:func:`hystkit.control.run_control` returns."""
 
 from __future__ import annotations
 
-import argparse
 import math
 
 from ..control import SLOW_GROWTH_S, TYPICAL_RUN_S, slow_cell_words
-from ._common import UsageError
 
-__all__ = ["closed_loop", "fmt", "noise_study", "print_table", "resolve_tune_options", "tune"]
-
-# defaults of the --tune-nonlinear options (None in the parser: given or not is seen)
-TUNE_DEFAULTS = {"tune_objective": "rms", "tune_budget": 300, "min_phase_margin": 30.0,
-                 "min_gain_margin": 6.0}
+__all__ = ["closed_loop", "duration", "fmt", "print_noise_study", "print_run", "print_table"]
 
 
 def fmt(x: float | None, none: str = "n/a") -> str:
     """``x`` to 3 significant digits; ``none`` for a missing value."""
     return none if x is None else f"{x:.3g}"
-
-
-def resolve_tune_options(args: argparse.Namespace) -> None:
-    """Refuse the ``--tune-nonlinear`` options without it (one line); fill in defaults."""
-    given = [f"--{k.replace('_', '-')}" for k in TUNE_DEFAULTS if getattr(args, k) is not None]
-    if given and not args.tune_nonlinear:
-        verb = "applies" if len(given) == 1 else "apply"
-        raise UsageError(f"{', '.join(given)} only {verb} with --tune-nonlinear")
-    for key, value in TUNE_DEFAULTS.items():
-        if getattr(args, key) is None:
-            setattr(args, key, value)
 
 
 def closed_loop(margins) -> str:
@@ -83,19 +66,29 @@ def _change(before: float | None, after: float | None) -> str:
     return f"{100 * (after / before - 1):+.1f} %"
 
 
-def tune(args: argparse.Namespace, loop):
-    """``--tune-nonlinear``: the PID tuned on the non-linear loop; before/after printed, and
-    the held-out experiments (never seen by the search) beside them."""
-    from ..control import tune_nonlinear
+def print_run(options, run) -> None:
+    """The tuning (when asked), the loop and its linearised verdict."""
+    if run.tuned is not None:
+        _print_tuning(run.tuned, options.experiment)
+    loop, models, margins = run.loop, run.setup.models, run.margins
+    dob = f"{loop.dob.f_q:.3g} Hz" if loop.dob else "off"
+    print(f"hystkit control: scheme {options.loop.scheme}"
+          + (f", experiment {options.experiment}" if options.experiment else "")
+          + f", DOB {dob}; sensor models in "
+          f"{run.setup.fit_seconds:.1f} s (S_r: {models.info['sensor_source']}; compensator "
+          f"and S_m: {models.info['training_source']})")
+    p = loop.pid
+    print(f"PID Kp = {p.kp:.4g}, Ti = {p.ti:.4g} s, Td = {p.td:.4g} s, Tf = {p.tf:.3g} s; "
+          f"linearised at rest: crossover {fmt(margins.crossover_hz)} Hz, phase margin "
+          f"{fmt(margins.phase_margin_deg)} deg, gain margin "
+          f"{fmt(margins.gain_margin_db, 'inf')} dB")
+    print(f"  closed loop {closed_loop(margins)}")  # the verdict on a line of its own
 
-    try:
-        res = tune_nonlinear(loop, args.experiment, objective=args.tune_objective,
-                             min_phase_margin=args.min_phase_margin,
-                             min_gain_margin_db=args.min_gain_margin, noise=args.noise,
-                             max_evaluations=args.tune_budget)
-    except ValueError as exc:
-        raise UsageError(f"--tune-nonlinear: {exc}") from None
-    print(f"non-linear tuning ({args.experiment}, e_p {res.objective}, phase margin >= "
+
+def _print_tuning(res, experiment: str) -> None:
+    """``--tune-nonlinear``: before/after, and the held-out experiments (never seen by the
+    search) beside them."""
+    print(f"non-linear tuning ({experiment}, e_p {res.objective}, phase margin >= "
           f"{res.min_phase_margin:g} deg, gain margin >= {res.min_gain_margin_db:g} dB on the "
           f"loop linearised at rest, the only stability check): {res.n_evaluations} runs, "
           f"{res.n_margin_checks} linearisations, {res.seconds:.1f} s")
@@ -108,7 +101,6 @@ def tune(args: argparse.Namespace, loop):
     if not res.improved:
         print("  nothing better within the constraints: the start gains are kept")
     _print_held_out(res)
-    return res
 
 
 def _print_held_out(res) -> None:
@@ -123,28 +115,18 @@ def _print_held_out(res) -> None:
               + ("  (the tuned run itself)" if r["repeats_tuned_run"] else ""))
 
 
-def noise_study(args: argparse.Namespace, loop) -> dict:
-    """``--noise``: the experiment without and with the noise, each without and with the DOB
-    (the loop's own, else one from ``design_dob``); the table printed, the rows returned."""
-    from ..control import design_dob
-    from ..control import noise_study as study
-
-    try:
-        dob = loop.dob or design_dob(loop)
-    except ValueError as exc:
-        raise UsageError(f"--noise: the DOB comparison needs a DOB: {exc}") from None
-    rows = study(args.experiment, loop, args.noise, dob)
-    n = args.noise
+def print_noise_study(run, n) -> None:
+    """``--noise``: the experiment without and with the noise, each without and with the DOB."""
+    loop, dob = run.loop, run.noise_dob
     print(f"noise study: sensor SD {n.sensor:g} sensor units (= {n.sensor * loop.sensor_gain:.3g}"
           f" m through g_s), process SD {n.process:g} N, seed {n.seed}; DOB {dob.f_q:.3g} Hz")
     print(f"{'noise':<7}{'DOB':<5}{'case':<14}{'e_p,rms [m]':>13}{'e_p,max [m]':>13}"
           f"{'u rms [N]':>11}{'sensor noise SD':>17}")
-    for r in rows:
+    for r in run.noise_study["rows"]:
         print(f"{'yes' if r['noise'] else 'no':<7}{'on' if r['dob'] else 'off':<5}"
               f"{r['case']:<14}{fmt(r['e_p_rms']):>13}{fmt(r['e_p_max']):>13}"
               f"{fmt(r['u_rms']):>11}{fmt(r['sensor_noise_sd']):>17}"
               + ("" if r["bounded"] else "  UNBOUNDED"))
-    return {"dob_f_q": dob.f_q, "noise": n.to_dict(), "rows": rows}
 
 
 def print_table(metrics: dict) -> None:

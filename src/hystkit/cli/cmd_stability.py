@@ -15,17 +15,20 @@ with a simulation that shows divergence when there is.
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from .. import compensation
+from .. import control as hc
+from .. import io as hio
 from ..errors import InputError
 from ._common import UsageError, add_read_options, deferred, read_recording_args
-from .cmd_control import add_setup_options, setup_inputs, setup_loop
+from ._control_options import LoopOptions, add_setup_options
+from .cmd_control import loop_error, loop_setup
 
-if TYPE_CHECKING:  # the library loads when the command runs
+if TYPE_CHECKING:
     import numpy as np
-
-    from ..compensation import Compensator
 
 __all__ = ["register"]
 
@@ -33,14 +36,14 @@ __all__ = ["register"]
 def _probe_input(dt: float) -> np.ndarray:
     """The paper's chirp (0.1 -> 3 Hz over 100 s) at unit amplitude: the normalised training
     range [-1, 1] at every rate the experiments use."""
-    import numpy as np
+    import numpy as np  # this module is imported to build the parser: --help loads no numpy
 
     from ..signals import exponential_chirp
 
     return exponential_chirp(np.arange(round(100.0 / dt)) * dt, amplitude=1.0)
 
 
-def _model_input(comp: Compensator, path: Path, args: argparse.Namespace) -> np.ndarray:
+def _model_input(comp: compensation.Compensator, path: Path, args: argparse.Namespace) -> np.ndarray:
     """The fitted model's input on a recording, normalised as at fit time (eq. 5.10): the
     sensor signal for a direct compensator, the position for an inverse one's forward model."""
     rec = read_recording_args(args, path, need_position=comp.mode == "inverse")
@@ -80,23 +83,50 @@ def _sector_line(name: str, sector) -> str:
             f"step)")
 
 
-def _control_stability(args: argparse.Namespace) -> int:
-    from ..control import global_stability, loop_margins
-    from ..io import check_output_path, write_json
+@dataclass(frozen=True)
+class StabilityOptions:
+    """``hystkit stability``'s options: a model file's local stability, or with ``control`` a
+    loop's global stability."""
 
-    if args.model_json is not None or args.data is not None:
-        raise UsageError("--control examines a loop: give no MODEL.json and no --data")
-    if args.scheme is None:
-        raise UsageError("--control needs --scheme direct|weighting")
-    if args.json is not None:
-        check_output_path(args.json, args.force, inputs=setup_inputs(args))
-    loop, models, _ = setup_loop(args)
-    report = global_stability(loop, args.experiment)
-    margins = loop_margins(loop)
+    model_json: Path | None
+    data: Path | None
+    json: Path | None
+    force: bool
+    control: bool
+    experiment: str
+    loop: LoopOptions
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> StabilityOptions:
+        """The options of a parsed command line; a combination that does not fit is one line."""
+        options = cls(args.model_json, args.data, args.json, args.force, args.control,
+                      args.experiment, LoopOptions.from_args(args))
+        if options.control:
+            if options.model_json is not None or options.data is not None:
+                raise UsageError("--control examines a loop: give no MODEL.json and no --data")
+            if options.loop.scheme is None:
+                raise UsageError("--control needs --scheme direct|weighting")
+        elif options.loop.scheme is not None:
+            raise UsageError("--scheme and the other loop options need --control")
+        elif options.model_json is None:
+            raise UsageError("give MODEL.json (a model's local stability) or --control (a "
+                             "loop's)")
+        return options
+
+
+def _control_stability(options: StabilityOptions, args: argparse.Namespace) -> int:
+    if options.json is not None:
+        hio.check_output_path(options.json, options.force, inputs=options.loop.inputs())
+    try:
+        study = hc.examine_loop(loop_setup(options.loop, args), options.experiment)
+    except hc.LoopError as exc:
+        raise loop_error(exc, options.loop) from None
+    loop, models_, report, margins = (study.setup.loop, study.setup.models, study.report,
+                                      study.margins)
     p = loop.pid
     print(f"loop: scheme {loop.scheme}, PID Kp = {p.kp:.4g}, Ti = {p.ti:.4g} s, Td = "
           f"{p.td:.4g} s, DOB {f'{loop.dob.f_q:.3g} Hz' if loop.dob else 'off'}; S_r "
-          f"{models.info['sensor_model']}, compensator and S_m {models.info['model']}")
+          f"{models_.info['sensor_model']}, compensator and S_m {models_.info['model']}")
     print("slope sectors (chord slopes of consecutive samples where the input moves by more "
           "than 1 % of its largest step; the trained sine 0.5 Hz, 3 mm, 6 s at Ts):")
     for name, sector in report.sectors.items():
@@ -118,34 +148,29 @@ def _control_stability(args: argparse.Namespace) -> int:
     scope = (" (constant reference, slopes inside the tested sector)"
              if report.verdict == "proved stable" else "")
     print(f"global stability: {report.verdict.upper()}{scope}: {report.reason}")
-    if args.json is not None:
-        write_json({"scheme": loop.scheme, **report.to_dict(), "linear": margins.to_dict()},
-                   args.json, force=args.force)
-        print(f"wrote {args.json}")
+    if options.json is not None:
+        hio.write_json({"scheme": loop.scheme, **report.to_dict(), "linear": margins.to_dict()},
+                       options.json, force=options.force)
+        print(f"wrote {options.json}")
     return 0
 
 
 def _stability(args: argparse.Namespace) -> int:
-    from ..compensation import load_compensator
-    from ..io import check_output_path, write_json
-    from ..models import stability_report
+    from .. import models  # its registry loads numpy: not when the parser is built
 
-    if args.control:
-        return _control_stability(args)
-    if args.scheme is not None:
-        raise UsageError("--scheme and the other loop options need --control")
-    if args.model_json is None:
-        raise UsageError("give MODEL.json (a model's local stability) or --control (a loop's)")
+    options = StabilityOptions.from_args(args)
+    if options.control:
+        return _control_stability(options, args)
     if args.json is not None:
-        check_output_path(args.json, args.force,
-                          inputs=[args.model_json] + ([args.data] if args.data else []))
-    comp = load_compensator(args.model_json)
+        hio.check_output_path(args.json, args.force,
+                              inputs=[args.model_json] + ([args.data] if args.data else []))
+    comp = compensation.load_compensator(args.model_json)
     family, structure = comp.family, comp.structure
     u = (_probe_input(structure.dt) if args.data is None else _model_input(comp, args.data, args))
     probe = ("a unit chirp 0.1 -> 3 Hz" if args.data is None else str(args.data))
     try:
-        report = stability_report(family, structure, comp.params, u)
-        inverse = (stability_report(family, structure, comp.params,
+        report = models.stability_report(family, structure, comp.params, u)
+        inverse = (models.stability_report(family, structure, comp.params,
                                     _probe_input(structure.dt), inverse=True)
                    if comp.mode == "inverse" else None)
     except ValueError as exc:
@@ -168,17 +193,11 @@ def _stability(args: argparse.Namespace) -> int:
     if inverse is not None:
         print(f"inverse (the compensator as it runs, driven by a unit chirp): {_verdict(inverse)}")
     if args.json is not None:
-        write_json({"model_file": str(args.model_json), "model": comp.model, "mode": comp.mode,
+        hio.write_json({"model_file": str(args.model_json), "model": comp.model, "mode": comp.mode,
                     "probe": probe, **report, "inverse_report": inverse}, args.json,
                    force=args.force)
         print(f"wrote {args.json}")
     return 0
-
-
-def _experiments() -> tuple[str, ...]:
-    from ..control import EXPERIMENTS
-
-    return EXPERIMENTS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -199,7 +218,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                             help="with --control: the experiment simulated (default sine); its "
                                  "closed-loop slopes join the trained sine's in the sector "
                                  "tested, and a divergence shows instability"),
-             choices=_experiments)
+             choices=lambda: hc.EXPERIMENTS)
     add_setup_options(p, scheme_required=False)
     add_read_options(p)
     p.set_defaults(run=_stability)

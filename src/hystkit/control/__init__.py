@@ -27,6 +27,8 @@ __getattr__, __dir__ = lazy_exports(
      "_simulate": ("LoopResponse", "simulate_loop", "simulate_loop_reference"),
      "_nlsys": ("as_nlsys", "loop_initial_state", "loop_nlsys"),
      "_disk_cache": ("cached_loop_margins", "cached_sensor_models"),
+     "_setup": ("LoopError", "LoopSetup", "SetupResult", "sensor_from", "setup_loop"),
+     "_study": ("ControlRun", "LoopStudy", "Tuning", "examine_loop", "run_control"),
      "_plots": ("plot_bode", "plot_cases", "plot_response"),
      "_sensor_blocks": ("SensorBlock", "SensorModels", "compensator_block", "forward_block",
                         "linear_block", "sensor_block"),

@@ -155,12 +155,9 @@ def cached_loop_margins(loop: ControlLoop, folder: Path | None = None) -> LoopMa
         The margins, bit for bit those computed afresh.
     """
 
-    def compute() -> LoopMargins:
-        from ._analysis import loop_margins  # python-control: only when not stored
-
-        return loop_margins(loop)
-
-    return _memo("loop-margins", {"loop": loop}, compute, LoopMargins, folder)
+    # looked up in the package when not stored: python-control loads only then
+    return _memo("loop-margins", {"loop": loop}, lambda: package.loop_margins(loop),
+                 LoopMargins, folder)
 
 
 def _memo(kind: str, inputs: dict[str, Any], compute: Callable[[], T], expected: type,

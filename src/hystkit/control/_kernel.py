@@ -26,7 +26,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from numba import njit
+from numba import njit, typeof
 
 from .._closure_cache import compile_closure
 
@@ -92,8 +92,6 @@ def compile_run(r, d_out, d_in, noise, x0, direct, plant, pid, dob, y_limit, siz
     seconds it took (0.0 when already compiled). Called before a timed :func:`run`, so that the
     run's time is the simulation's alone (the first run of a combination of block steps would
     otherwise count about a second of JIT compilation)."""
-    from numba import typeof
-
     kernel = _kernel(step_r, step_c, step_m)
     args = (r, d_out, d_in, noise, x0, direct, plant, pid, dob, y_limit, sizes, aff_r, body_r,
             aff_c, body_c, aff_m, body_m)
