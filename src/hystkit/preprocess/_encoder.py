@@ -31,46 +31,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numba import njit
 
-__all__ = ["DEFAULT_STATES", "EncoderSettings", "EncoderState", "ab_to_code",
-           "code_to_ab", "count_to_code", "decode", "decode_flush", "decode_reference",
-           "decode_step", "encoder_init", "parse_states"]
+from ._quadrature import DEFAULT_STATES, PHASE, parse_states
 
-# A/B state code q = 2 A + B of the merged levels in ascending voltage: with the divider, A
-# (1 kOhm) weighs twice as much as B (2 kOhm), so the levels are (2A + B)/3 of the logic swing.
-DEFAULT_STATES = (0b00, 0b01, 0b10, 0b11)
-# Position in the quadrature cycle of each code, for A leading B counting up: 00, 10, 11, 01.
-_PHASE = np.array([0, 3, 1, 2], dtype=np.int64)
-_CODE_OF_PHASE = np.array([0b00, 0b10, 0b11, 0b01], dtype=np.int64)
+__all__ = ["EncoderSettings", "EncoderState", "decode", "decode_flush", "decode_reference",
+           "decode_step", "encoder_init"]
+
 _POLICIES = ("continue", "hold")
-
-
-def parse_states(text: str | list[str] | tuple) -> tuple[int, int, int, int]:
-    """A/B states of the four levels in ascending order from text like ``"00,01,10,11"``.
-
-    Each item is ``AB`` with A and B in {0, 1}; the four items must be the four states.
-
-    Parameters
-    ----------
-    text : str or sequence of str
-        Comma-separated ``AB`` pairs, or the pairs themselves.
-
-    Returns
-    -------
-    tuple of 4 int
-        The A/B code ``2 A + B`` of each level, in ascending voltage.
-
-    Raises
-    ------
-    ValueError
-        If there are not four ``AB`` pairs of 0/1, or a state is missing or repeated.
-    """
-    items = [s.strip() for s in text.split(",")] if isinstance(text, str) else list(text)
-    if len(items) != 4 or any(len(str(s)) != 2 or set(str(s)) - {"0", "1"} for s in items):
-        raise ValueError(f"encoder states must be four A/B pairs like 00,01,10,11; got {text!r}")
-    codes = tuple(int(str(s), 2) for s in items)
-    if sorted(codes) != [0, 1, 2, 3]:
-        raise ValueError(f"encoder states must name each of 00, 01, 10, 11 once; got {text!r}")
-    return codes  # type: ignore[return-value]
 
 
 @dataclass(frozen=True)
@@ -217,7 +183,7 @@ def decode_step(settings: EncoderSettings, state: EncoderState,
     floats = np.concatenate([state.levels, state.sums, state.n_firm])
     counts, ints, floats = _decode_kernel(
         np.ascontiguousarray(x, dtype=np.float64), np.asarray(settings.states, dtype=np.int64),
-        _PHASE, ints, floats, settings.dwell, settings.track_block, settings.track_gain,
+        PHASE, ints, floats, settings.dwell, settings.track_block, settings.track_gain,
         settings.illegal == "continue")
     new = replace(state, levels=floats[0:4].copy(), sums=floats[4:8].copy(),
                   n_firm=floats[8:12].copy(), **{f: int(v) for f, v in zip(_INT_FIELDS, ints)})
@@ -263,59 +229,6 @@ def decode(x: np.ndarray, levels: np.ndarray | list[float],
     settings = EncoderSettings() if settings is None else settings
     counts, state = decode_step(settings, encoder_init(levels), x)
     return np.concatenate([counts, decode_flush(state)]), state
-
-
-def ab_to_code(a: np.ndarray, b: np.ndarray, threshold_a: float,
-               threshold_b: float) -> np.ndarray:
-    """A/B codes ``2 A + B`` from logic channels; a channel is 1 above its threshold.
-
-    Parameters
-    ----------
-    a, b : numpy.ndarray
-        Channels A and B [V].
-    threshold_a, threshold_b : float
-        Logic thresholds of A and B [V].
-
-    Returns
-    -------
-    numpy.ndarray of float
-        The codes (as float, for :func:`decode` with levels 0, 1, 2, 3), the shape of `a`
-        and `b` broadcast.
-    """
-    return 2.0 * (np.asarray(a) > threshold_a) + (np.asarray(b) > threshold_b)
-
-
-def count_to_code(counts: np.ndarray) -> np.ndarray:
-    """A/B code ``2 A + B`` an encoder shows at position `counts` (count 0 shows A = B = 0).
-
-    Parameters
-    ----------
-    counts : numpy.ndarray of int
-        Positions [counts].
-
-    Returns
-    -------
-    numpy.ndarray of int64
-        The codes, the shape of `counts`.
-    """
-    return _CODE_OF_PHASE[np.mod(np.asarray(counts, dtype=np.int64), 4)]
-
-
-def code_to_ab(codes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Logic levels A and B (0 or 1) of A/B codes.
-
-    Parameters
-    ----------
-    codes : numpy.ndarray of int
-        A/B codes ``2 A + B``.
-
-    Returns
-    -------
-    a, b : numpy.ndarray of int64
-        Levels of A and B, the shape of `codes`.
-    """
-    codes = np.asarray(codes, dtype=np.int64)
-    return codes >> 1, codes & 1
 
 
 # --------------------------------------------------------------------------- kernels
@@ -464,7 +377,7 @@ def decode_reference(x: np.ndarray, levels: np.ndarray | list[float],
             report["n_rejected"] += excursion
             excursion = False
         elif length >= settings.dwell:
-            step = (int(_PHASE[q]) - int(_PHASE[stable])) % 4
+            step = (int(PHASE[q]) - int(PHASE[stable])) % 4
             if step == 2:
                 report["n_illegal"] += 1
                 if report["first_illegal"] < 0:

@@ -18,7 +18,7 @@ from ._encoder import EncoderSettings
 from ._levels import LevelSurvey
 
 if TYPE_CHECKING:
-    from ._raw import PreprocessSettings
+    from ._raw_records import PreprocessSettings
 
 __all__ = ["SURVEY_BLOCK", "encoder_setup"]
 

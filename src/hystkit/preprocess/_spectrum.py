@@ -30,20 +30,13 @@ second-order sections; the zero-phase (forward-backward) filter's amplitude resp
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from scipy import ndimage, signal, stats
 
-from ..io import RawFormat, open_raw
-from ._bridge import relative_change
-from ._chain import bridge_resistances, flush_chain, run_chain
-from ._decimate import decimator_init, design_chain
-from ._raw import PreprocessSettings
-
-__all__ = ["CutoffRule", "Spectrum", "butterworth_response", "noise_floor", "raw_gauge_changes",
-           "spectrum", "welch_psd"]
+__all__ = ["CutoffRule", "Spectrum", "butterworth_response", "noise_floor", "spectrum",
+           "welch_psd"]
 
 # Welch with a Hann window and 50 % overlap: adjacent segments correlate with c = 0.167, so
 # the estimate has nu = 2 K / (1 + 2 c^2) = 2 K / 1.056 degrees of freedom (Welch 1967).
@@ -132,44 +125,9 @@ class Spectrum:
     def plot(self, title: str = ""):
         """PSDs, floor and threshold on log axes; the filters' zero-phase response (dB) on a
         second axis; f_signal and the cut-offs marked. Returns the Figure."""
-        from matplotlib.figure import Figure
+        from ._spectrum_plot import plot_spectrum  # matplotlib: only when a figure is asked for
 
-        fig = Figure(figsize=(8, 5), layout="constrained")
-        ax = fig.add_subplot()
-        keep = self.freq > 0
-        f = self.freq[keep]
-        labels = {"dr1": "gauge 1 dR/R", "dr2": "gauge 2 dR/R",
-                  "differential": "dR1/R1 - dR2/R2"}
-        for name, values in self.psd.items():
-            ax.loglog(f, values[keep], lw=0.8 if name != "differential" else 1.1,
-                      label=labels[name], alpha=0.6 if name != "differential" else 1.0)
-        ax.loglog(f, self.floor[keep], "k--", lw=0.8, label="noise floor (differential)")
-        ax.loglog(f, self.floor[keep] * 10 ** (self.rule.margin_db / 10), "k:", lw=0.8,
-                  label=f"floor + {self.rule.margin_db:g} dB")
-        if math.isfinite(self.f_signal):
-            ax.axvline(self.f_signal, color="tab:red", lw=0.8)
-            ax.text(self.f_signal, 0.02, f" f_signal {self.f_signal:.3g} Hz", color="tab:red",
-                    transform=ax.get_xaxis_transform(), rotation=90, va="bottom")
-        # Far below the floor of the flat band only the decimation filter's edge remains.
-        flat = keep & (self.freq <= 0.4 * self.fs)
-        ax.set_ylim(bottom=max(ax.get_ylim()[0], 1e-3 * float(np.min(self.floor[flat]))))
-        ax.set_xlabel("frequency [Hz]")
-        ax.set_ylabel("PSD [1/Hz]")
-        lines, more = ax.get_legend_handles_labels(), ([], [])
-        if self.response:  # no filter to draw when no line gave a cut-off and none is compared
-            twin = ax.twinx()
-            for (label, h), style in zip(self.response.items(), ("-", "-."), strict=False):
-                twin.semilogx(f, 20 * np.log10(np.maximum(h[keep], 1e-12)), style,
-                              color="tab:purple", lw=1.0,
-                              label=f"zero-phase Butterworth {label}")
-            twin.set_ylim(-120, 5)
-            twin.set_ylabel("filter |H|² [dB]")
-            more = twin.get_legend_handles_labels()
-        ax.legend(lines[0] + more[0], lines[1] + more[1], fontsize=7, loc="lower left")
-        ax.set_title(title or (f"Welch PSD; suggested cut-off {self.cutoff:.3g} Hz"
-                               if math.isfinite(self.cutoff)
-                               else "Welch PSD; no spectral line above the margin, no cut-off"))
-        return fig
+        return plot_spectrum(self, title)
 
 
 def welch_psd(x: np.ndarray, fs: float, segment_s: float) -> tuple[np.ndarray, np.ndarray, int]:
@@ -390,51 +348,3 @@ def _filter_summary(freq: np.ndarray, fs: float, cutoff: float, order: int, f_si
             "noise_rms_above_f_signal_passed": passed,
             "noise_rms_above_f_signal_unfiltered":
                 math.sqrt(float(np.trapezoid(floor[band], freq[band])))}
-
-
-def raw_gauge_changes(path: str | os.PathLike[str], settings: PreprocessSettings,
-                      fmt: RawFormat | None = None, fs_analysis: float = 1000.0
-                      ) -> tuple[dict[str, np.ndarray], float]:
-    """dR/R of each gauge and the differential from a raw recording, at about `fs_analysis`.
-
-    Eq. 4.3 per sample (with the measured ``v0`` when ``settings.supply_channel``), then the
-    preprocessing's streaming FIR decimation, flat to 0.4 of the output rate; no Butterworth.
-    Only ``r_bridge``, ``v_supply``, ``supply_channel`` and ``chunk_size`` of `settings` are used.
-
-    Parameters
-    ----------
-    path : str or path-like
-        Raw recording (``.csv``, ``.parquet``, ``.mat``); see :mod:`hystkit.io`.
-    settings : PreprocessSettings
-        Bridge and supply settings.
-    fmt : RawFormat, optional
-        Column names, time unit and metadata of the file.
-    fs_analysis : float
-        Wanted output rate [Hz].
-
-    Returns
-    -------
-    rows : dict
-        ``dr1``, ``dr2``, ``differential`` [-] (eq. 4.4-4.5).
-    fs : float
-        Their sample rate [Hz] (the scope rate over a whole factor).
-
-    Raises
-    ------
-    InputError
-        As :func:`preprocess_raw` for the bridge and supply channels.
-    """
-    reader = open_raw(path, fmt, settings.chunk_size,
-                      extra=("v0",) if settings.supply_channel else ())
-    factor = max(1, round(reader.fs / fs_analysis))
-    fs_a = reader.fs / factor
-    chain = design_chain(reader.fs, factor, 0.4 * fs_a)
-    states = [decimator_init(stage, 2) for stage in chain]
-    ext = np.array([-np.inf, 0, np.inf, 0] * 2, dtype=float)
-    parts = []
-    for chunk in reader.chunks(columns=("v1", "v2", "v0")):
-        r, ext = bridge_resistances(reader, chunk, settings.r_bridge, settings.v_supply, ext)
-        parts.append(run_chain(chain, states, r))
-    parts.append(flush_chain(chain, states, 2))
-    dr1, dr2 = relative_change(np.concatenate(parts, axis=1), axis=1)
-    return {"dr1": dr1, "dr2": dr2, "differential": dr1 - dr2}, fs_a
