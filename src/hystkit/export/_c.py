@@ -19,6 +19,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ._c_band import BAND_RESET, BAND_STEP, band_fields, band_header, band_readme, band_source
 from ._comments import c_comment_text, comment_text
 from ._plan import ExportPlan
 
@@ -102,85 +103,6 @@ def _comment(plan: ExportPlan, what: str, double: bool) -> str:
 """
 
 
-_BAND_RESET = "\n    reset_band(st);"
-_BAND_STEP = """
-    {
-        const real half = band_half(st, s);
-        st->lower = estimate - half;
-        st->upper = estimate + half;
-    }"""
-
-
-def _band_header(plan: ExportPlan) -> str:
-    up = plan.name.upper()
-    if plan.band is None:
-        return (f"/* No prediction band: the model file has none, so no lower/upper outputs. */\n"
-                f"#define {up}_HAS_BAND 0\n")
-    return f"""/* The prediction band: after a step, st->lower and st->upper [mm] bound the estimate it
- * returned at this nominal level (hystkit's Compensator.estimate_with_band). */
-#define {up}_HAS_BAND 1
-#define {up}_BAND_LEVEL {plan.band['LEVEL']!r}
-"""
-
-
-def _band_fields(plan: ExportPlan) -> str:
-    if plan.band is None:
-        return ""
-    n = plan.name
-    return f"""
-    {n}_real lower;      /* band of the last estimate [mm]: lower bound */
-    {n}_real upper;      /* band of the last estimate [mm]: upper bound */
-    int band_started;    /* band: a sample has been seen (the first has no rate) */
-    {n}_real band_previous;  /* band: the last normalised sensor sample */
-    {n}_real band_rate;  /* band: running mean of |ds/dt| of the normalised sensor [1/s] */
-    {n}_real band_outside;  /* band: remembered distance outside the training range */"""
-
-
-def _band_source(plan: ExportPlan, lit: Callable[[float], str]) -> str:
-    """The band's feature state (``_band.BandState``) and its half-width per sample:
-    ``_band._features_kernel`` then ``_band.half_width``, in their order of operations."""
-    if plan.band is None:
-        return ""
-    n = plan.name
-    consts = "\n".join(f"#define BAND_{k} {lit(v)}" for k, v in plan.band.items()
-                       if k != "LEVEL")
-    return f"""
-/* The prediction band (hystkit.compensation._band): its constants at the exported level. */
-{consts}
-
-static void reset_band({n}_state *st)
-{{
-    st->lower = R(0.0);
-    st->upper = R(0.0);
-    st->band_started = 0;
-    st->band_previous = R(0.0);
-    st->band_rate = R(0.0);
-    st->band_outside = R(0.0);
-}}
-
-/* The band's half-width [mm] at normalised sensor sample s: the rate's running mean and the
- * remembered excursion beyond the training range (causal), then q * sigma + w * o. */
-static real band_half({n}_state *st, real s)
-{{
-    const real d = st->band_started ? FABS(s - st->band_previous) / BAND_DT : R(0.0);
-    real beyond = BAND_LOW - s;
-    real kept, over;
-    if (s - BAND_HIGH > beyond) beyond = s - BAND_HIGH;
-    if (R(0.0) > beyond) beyond = R(0.0);
-    beyond = beyond / BAND_WIDTH;
-    st->band_rate = BAND_DECAY * st->band_rate + BAND_GAIN * d;
-    kept = BAND_DECAY * st->band_outside;
-    st->band_outside = kept > beyond ? kept : beyond;  /* max(beyond, kept) */
-    st->band_previous = s;
-    st->band_started = 1;
-    over = st->band_rate / BAND_RATE_HIGH - R(1.0);
-    if (R(0.0) > over) over = R(0.0);
-    return BAND_Q * ((BAND_BASE + BAND_SHARE * st->band_rate / BAND_RATE_REFERENCE) + over)
-           + BAND_POSITION_WIDTH * st->band_outside;
-}}
-"""
-
-
 def _header(plan: ExportPlan, double: bool) -> str:
     n, up = plan.name, plan.name.upper()
     sync = "" if plan.sync_state is None else f"""
@@ -199,14 +121,14 @@ typedef {'double' if double else 'float'} {n}_real;
 #define {up}_SENSOR_OUTSIDE 1u  /* sensor beyond the training range (+-5 % of its width) */
 #define {up}_ESTIMATE_OUTSIDE 2u  /* estimate beyond the training positions (+-10 %) */
 #define {up}_RAN_AWAY 4u  /* model output not finite or beyond 1e6 x the training range */
-{_band_header(plan)}
+{band_header(plan)}
 typedef struct {{
     {n}_real x[{up}_N_STATE];  /* model state, normalised units */
     {n}_real level;      /* sensor level removed (tare / track centring) */
     {n}_real sum_z;      /* tare: running sum; track: delay of the weighted sum */
     {n}_real weight_z;   /* track: delay of the weight sum */
     long n_seen;         /* tare: samples in the running mean so far */
-    unsigned flags;      /* guard bits of the last step */{_band_fields(plan)}
+    unsigned flags;      /* guard bits of the last step */{band_fields(plan)}
 }} {n}_state;
 
 /* Start at rest at the first sensor sample (then pass that sample to {n}_step too). */
@@ -257,7 +179,7 @@ void {n}_sync({n}_state *st)
 {{
     int k;
     for (k = 0; k < {up}_N_STATE; k++) st->x[k] = SYNC_STATE[k];
-    reset_centring(st);{_BAND_RESET if plan.band else ''}
+    reset_centring(st);{BAND_RESET if plan.band else ''}
 }}
 """
     model = plan.translation.c_model(plan, lit)
@@ -283,7 +205,7 @@ static void reset_centring({n}_state *st)
     st->n_seen = 0L;
     st->flags = 0u;
 }}
-{_band_source(plan, lit)}
+{band_source(plan, lit)}
 /* The model's input: offset removed, flipped by the polarity, scaled (eq. 5.10). */
 static real normalised({n}_state *st, real sensor)
 {{
@@ -292,7 +214,7 @@ static real normalised({n}_state *st, real sensor)
 void {n}_init({n}_state *st, real first_sensor)
 {{
     {n}_state probe;
-    reset_centring(st);{_BAND_RESET if plan.band else ''}
+    reset_centring(st);{BAND_RESET if plan.band else ''}
     probe = *st;  /* the first sample's level, without counting it twice */
     model_rest(st->x, normalised(&probe, first_sensor));
 }}
@@ -306,7 +228,7 @@ real {n}_step({n}_state *st, real sensor)
     if (s < SENSOR_LOW || s > SENSOR_HIGH) flags |= {up}_SENSOR_OUTSIDE;
     if (estimate < ESTIMATE_LOW || estimate > ESTIMATE_HIGH) flags |= {up}_ESTIMATE_OUTSIDE;
     if (!(FABS(p) <= MAX_NORMALISED) || !isfinite(estimate)) flags |= {up}_RAN_AWAY;
-    st->flags = flags;{_BAND_STEP if plan.band else ''}
+    st->flags = flags;{BAND_STEP if plan.band else ''}
     return estimate;
 }}
 """
@@ -385,7 +307,7 @@ Build and run the example (one sensor value per line in, one estimate [mm] per l
 
     {COMPILE_LINE}
     ./estimate < sensor.txt > estimate.txt
-{_band_readme(plan)}
+{band_readme(plan)}
 In your own program: add {n}.c and {n}.h (they need only math.h, no allocation), then
 
 - `{n}_state st; {n}_init(&st, first_sensor);` at rest at the first sample, then
@@ -394,19 +316,6 @@ In your own program: add {n}.c and {n}.h (they need only math.h, no allocation),
   {n.upper()}_RAN_AWAY (the guards of `hystkit evaluate`).
 
 Feed samples at the model's sample time, dt = {plan.constants['DT']:g} s.
-"""
-
-
-def _band_readme(plan: ExportPlan) -> str:
-    n = plan.name
-    if plan.band is None:
-        return ("\nNo prediction band: the model file has none (fitted with --no-band, or by a "
-                "hystkit\nbefore bands), so the export has no lower/upper outputs.\n")
-    return f"""    ./estimate --band < sensor.txt > band.txt   # estimate lower upper [mm] per line
-
-Prediction band at nominal level {plan.band['LEVEL']:g}: after each `{n}_step`, `st.lower` and
-`st.upper` [mm] bound its estimate, as Compensator.estimate_with_band in hystkit; the band's
-features (rate, range excursion) are carried in the state and start afresh with `{n}_init`.
 """
 
 

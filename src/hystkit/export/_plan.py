@@ -26,7 +26,9 @@ from .. import __version__
 from ..compensation import Compensator
 from ..compensation._compensator import MAX_NORMALISED, POSITION_MARGIN, SENSOR_MARGIN
 from ..errors import InputError
+from ..models import get_family
 from ..models._protocol import Translation
+from ..signals import exponential_chirp
 
 __all__ = ["C_KEYWORDS", "FLOAT_SENSITIVITY_LIMIT", "ExportPlan", "band_constants",
            "float_sensitivity", "identifier", "make_plan"]
@@ -110,8 +112,6 @@ class ExportPlan:
     @property
     def translation(self) -> Translation:
         """The family's C and MATLAB translation (``Family.export``)."""
-        from ..models import get_family
-
         return get_family(self.model).export
 
     @property
@@ -274,8 +274,6 @@ def float_sensitivity(comp: Compensator) -> float:
     range; NaN when the double run does too (the model is unstable on the probe itself, so the
     probe says nothing).
     """
-    from ..signals import exponential_chirp
-
     t = np.arange(round(100.0 / comp.structure.dt)) * comp.structure.dt
     probe = exponential_chirp(t, amplitude=1.0)
     inverse = comp.mode == "inverse"

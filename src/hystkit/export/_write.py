@@ -13,6 +13,7 @@ import numpy as np
 from ..compensation import Compensator
 from ..errors import InputError, OutputError, OutputExistsError
 from ..io import atomic_folder, check_output_folder
+from ..live import sync_excitation
 from ._c import c_files
 from ._matlab import matlab_files
 from ._plan import ExportPlan, make_plan
@@ -25,8 +26,6 @@ LANGUAGES = ("c", "matlab")
 def sync_state_of(comp: Compensator) -> tuple[np.ndarray | None, str]:
     """The model state after the synchronisation excitation (eq. 2.21-2.22) and a note; the
     state is None, and the note says why, when the model does not forget its history."""
-    from ..live import sync_excitation
-
     try:
         sync = sync_excitation(comp)
     except InputError as exc:
