@@ -10,16 +10,8 @@ trace's resistance log (:func:`fit_settling`), the rest time before it is usable
 from ._cycles import DEFAULT_DEADBAND, cycle_bounds, input_minima, split_cycles
 from ._figures import plot_cycles, plot_settling
 from ._per_cycle import CycleTable, DriftRate, cycle_table, drift_rate, enclosed_area
-from ._settling import (
-    MODELS,
-    REST_RULE,
-    RestTime,
-    SettlingFit,
-    SettlingFitError,
-    fit_settling,
-    rest_time,
-    settling_curve,
-)
+from ._rest_time import REST_RULE, RestTime, rest_time
+from ._settling import MODELS, SettlingFit, SettlingFitError, fit_settling, settling_curve
 
 __all__ = ["DEFAULT_DEADBAND", "MODELS", "REST_RULE", "CycleTable", "DriftRate", "RestTime",
            "SettlingFit", "SettlingFitError", "cycle_bounds", "cycle_table", "drift_rate",

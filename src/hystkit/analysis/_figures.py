@@ -15,7 +15,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ._per_cycle import CycleTable
-from ._settling import RestTime, SettlingFit, settling_curve
+from ._rest_time import RestTime
+from ._settling import SettlingFit, settling_curve
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -51,7 +52,7 @@ def plot_cycles(x: np.ndarray, signals: Mapping[str, np.ndarray], table: CycleTa
     matplotlib.figure.Figure
         The loops, one panel per signal, and every cycle's offset over time.
     """
-    from matplotlib import colormaps
+    from matplotlib import colormaps  # here: the tables need no matplotlib
     from matplotlib.figure import Figure
 
     names = list(signals)
@@ -103,7 +104,7 @@ def plot_settling(logs: Mapping[str, tuple[np.ndarray, np.ndarray, SettlingFit |
     matplotlib.figure.Figure
         One panel per log.
     """
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # here: as in plot_cycles
 
     fig = Figure(figsize=(7.5, 2.6 * len(logs)), layout="constrained")
     axes = fig.subplots(len(logs), 1, squeeze=False)[:, 0]
