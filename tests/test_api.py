@@ -20,8 +20,8 @@ from hystkit.io import ReadOptions, Recording, read_recording
 from hystkit.sensors import simulate_experiment
 
 HEAVY = ("numpy", "pandas", "scipy", "numba", "matplotlib")
-DOCTESTED = ("hystkit._api", "hystkit.io._recording", "hystkit.compensation._estimator",
-             "hystkit.cli._inputs")
+DOCTESTED = ("hystkit._api", "hystkit._api_reading", "hystkit.io._recording",
+             "hystkit.io._time_column", "hystkit.compensation._estimator", "hystkit.cli._inputs")
 
 
 def _loaded_after(code: str) -> list[str]:

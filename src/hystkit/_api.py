@@ -13,8 +13,9 @@ import os
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Union
+from typing import TYPE_CHECKING, Any
 
+from ._api_reading import Data, as_recording, as_recordings, read, reading_options
 from .compensation import (
     DEFAULT_CENTER,
     DEFAULT_LEVEL,
@@ -27,95 +28,14 @@ from .compensation import (
 )
 from .compensation import evaluate as _evaluate
 from .compensation import use_flags as _use_flags
-from .io import (
-    ReadOptions,
-    Recording,
-    options_for,
-    read_pieces,
-    read_recording,
-    remember_reading,
-    settings_for,
-    training_units,
-)
+from .io import remember_reading, training_units
 from .models import get_family
+from .studies import compare_models
 
 if TYPE_CHECKING:
     import pandas as pd
 
 __all__ = ["compare", "compensate", "evaluate", "fit", "load", "read", "save"]
-
-Data = Union[Recording, "pd.DataFrame", str, os.PathLike]
-"""What every function here accepts as a recording: a `Recording`, a DataFrame with columns
-``time`` [s], ``position`` [mm] (needed to fit and to score) and ``sensor``, or a file path
-(CSV, Parquet, MATLAB) with those columns."""
-
-
-def read(path: str | os.PathLike, *, columns: Mapping[str, str] | None = None,
-         time_unit: str | None = None, **options: Any) -> Recording:
-    """Read a recording from a CSV, Parquet or MATLAB file, with its own column names.
-
-    A settings file beside it (``my.toml`` for ``my.csv``: columns, time unit, ..., see
-    ``docs/own_data.md``) is read first, as the command line does, and one line on stderr
-    says so (``hystkit: reading my.csv with the settings in my.toml``; or that one beside it
-    is for another file and was not applied); what is given here overrides it (``columns``
-    name by name). So do the other functions here given a file path.
-
-    Parameters
-    ----------
-    path : str or path-like
-        The file.
-    columns : mapping, optional
-        hystkit name (``time``, ``position``, ``sensor``) -> the file's column (or MATLAB
-        variable) name; names not given are read as hystkit's.
-    time_unit : {"s", "ms", "us", "ns", "min"}, optional
-        Unit of the time column, converted to seconds; default: the settings file's, else
-        seconds.
-    **options
-        The other fields of `hystkit.io.ReadOptions` (``skip_rows``, ``sep``, ``units_row``,
-        ...).
-
-    Returns
-    -------
-    Recording
-        ``time`` [s], ``sensor``, ``position`` [mm] when the file has one; ``to_frame()`` gives
-        a DataFrame.
-
-    Raises
-    ------
-    InputError
-        A missing file or column, or bad data; the message names file, column and row.
-
-    Examples
-    --------
-    >>> import hystkit as hk
-    >>> path = "own.csv"
-    >>> with open(path, "w") as f:
-    ...     _ = f.write("t_ms,x_mm,r_ohm\\n0,0.0,100.0\\n25,0.5,100.2\\n50,1.0,100.5\\n")
-    >>> rec = hk.read(path, columns={"time": "t_ms", "position": "x_mm", "sensor": "r_ohm"},
-    ...               time_unit="ms")
-    >>> rec.fs
-    40.0
-    >>> rec.to_frame().columns.tolist()
-    ['time', 'position', 'sensor']
-    """
-    given = dict(options)
-    if columns is not None:
-        given["columns"] = tuple(columns.items())
-    if time_unit is not None:
-        given["time_unit"] = time_unit
-    return read_recording(path, need_position=False, options=_reading(path, given))
-
-
-def _reading(path: str | os.PathLike, given: dict | None = None) -> ReadOptions:
-    """The options to read `path` with (its settings file, then `given`); says on stderr
-    which settings file was applied, or that one beside it is for another file."""
-    reading, settings = options_for(path, given)  # an unknown option is a TypeError there
-    note = settings_for(path)[1] if settings is None else ""
-    if settings is not None:
-        print(f"hystkit: reading {path} with the settings in {settings}", file=sys.stderr)
-    elif note:
-        print(f"hystkit: reading {path} without its settings: {note}", file=sys.stderr)
-    return reading
 
 
 def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None, *,
@@ -175,9 +95,9 @@ def fit(data: Data | Sequence[Data], model: str = "mpl", size: int | None = None
     """
     items = list(data) if isinstance(data, list | tuple) else [data]
     files = all(isinstance(item, str | os.PathLike) for item in items)
-    reading = [_reading(item) if isinstance(item, str | os.PathLike) else None
+    reading = [reading_options(item) if isinstance(item, str | os.PathLike) else None
                for item in items]
-    recordings = [rec for item, how in zip(items, reading) for rec in _as_recordings(item, how)]
+    recordings = [rec for item, how in zip(items, reading) for rec in as_recordings(item, how)]
     units = training_units(recordings)  # recordings in different units are refused first
     comp = fit_compensator(recordings, size, model=model, mode=mode, center=center, **options)
     if band:
@@ -233,7 +153,7 @@ def evaluate(compensator: Compensator, data: Data, *,
     >>> 0.8 < scores["band_coverage"] <= 1.0
     True
     """
-    scores = _evaluate(compensator, _as_recording(data), rest_position=rest_position,
+    scores = _evaluate(compensator, as_recording(data), rest_position=rest_position,
                        level=level)
     return dict(sorted(scores.items(), key=lambda item: _score_rank(item[0])))
 
@@ -279,7 +199,7 @@ def compensate(compensator: Compensator, data: Data, *,
     ['time', 'position', 'sensor', 'position_estimate', 'position_lower', 'position_upper', \
 'sensor_outside', 'estimate_outside']
     """
-    recording = _as_recording(data)
+    recording = as_recording(data)
     estimate = compensator.estimate(recording, rest_position=rest_position)
     frame = recording.to_frame()
     frame["position_estimate"] = estimate
@@ -324,11 +244,9 @@ def compare(fit_data: Data, val_data: Data, models: Sequence[str] | None = None,
     >>> bool((table["r2_direct"] > table["linear_r2"]).all())
     True
     """
-    import pandas as pd
+    import pandas as pd  # here: fitting and scoring need no pandas (about 1 s to import)
 
-    from .studies import compare_models
-
-    table = compare_models(_as_recording(fit_data), _as_recording(val_data), models, sizes)
+    table = compare_models(as_recording(fit_data), as_recording(val_data), models, sizes)
     return pd.DataFrame.from_dict(table, orient="index")
 
 
@@ -383,31 +301,3 @@ def save(compensator: Compensator, path: str | os.PathLike, *, force: bool = Fal
     return save_compensator(compensator, path, force=force)
 
 
-def _as_recordings(data: Data, options: ReadOptions | None = None) -> list[Recording]:
-    """`data` as recordings to fit jointly: a file whose settings say ``gaps = "split"`` as
-    its pieces between time gaps (`hystkit.io.read_pieces`), anything else as one. A file is
-    read with `options` (default: `_reading`'s)."""
-    if isinstance(data, str | os.PathLike):
-        options = _reading(data) if options is None else options
-        if options.gaps == "split":
-            return read_pieces(data, need_position=False, options=options)
-        return [read_recording(data, need_position=False, options=options)]
-    return [_as_recording(data)]
-
-
-def _as_recording(data: Data) -> Recording:
-    """`data` as a `Recording`: kept, converted from a DataFrame, or read from a file path.
-
-    Raises
-    ------
-    TypeError
-        `data` is none of those.
-    """
-    if isinstance(data, Recording):
-        return data
-    if isinstance(data, str | os.PathLike):
-        return read_recording(data, need_position=False, options=_reading(data))
-    if hasattr(data, "columns") and hasattr(data, "to_numpy"):  # a DataFrame, without pandas
-        return Recording.from_frame(data)
-    raise TypeError(f"expected a Recording, a DataFrame or a file path, got "
-                    f"{type(data).__name__}")

@@ -98,7 +98,7 @@ def _fir_lowpass(fs: float, cutoff_3db: float, numtaps: int) -> np.ndarray:
     ``firwin``'s cut-off is the -6 dB point, so the design cut-off is solved for the stated
     -3 dB point, as the document specifies its filter by it.
     """
-    from scipy import optimize, signal
+    from scipy import optimize, signal  # here: as in exponential_chirp
 
     def gain_error(fc: float) -> float:
         taps = signal.firwin(numtaps, fc, fs=fs)
@@ -134,7 +134,7 @@ def filtered_noise(t: np.ndarray, seed: int, cutoff: float = 4.0, order: int = 5
     numpy.ndarray
         Position [mm], same shape as `t`.
     """
-    from scipy import signal
+    from scipy import signal  # here: as in exponential_chirp
 
     t = np.asarray(t, dtype=float)
     fs = 1.0 / np.median(np.diff(t))
