@@ -17,7 +17,7 @@ repeats and the median of the paired ratios are reported.
 
 Table 3 (whole command). Wall time of a warm ``hystkit control --scheme direct --experiment sine``
 (a fresh process each: interpreter, imports, sensor models, loop kernel from numba's cache, the
-run, metrics and figure written), this tree against ``REFERENCE`` (extracted with ``git archive``
+run, metrics and figure written), this tree (or ``--src DIR``) against ``REFERENCE`` (extracted with ``git archive``
 into a temporary folder and run with ``PYTHONPATH``); one untimed run of each first fills the
 caches (numba's, and this tree's sensor models in a temporary ``HYSTKIT_CACHE_DIR``), then
 ``COMMAND_REPEATS`` pairs A B A B, medians and the median of the paired ratios.
@@ -190,11 +190,12 @@ def reference_source(folder: Path) -> Path:
     return folder / "src"
 
 
-def whole_command(folder: Path) -> tuple[float, float, float]:
-    """Medians of the warm command's wall time [s], this tree and the reference, and the median
-    of the paired ratios."""
+def whole_command(folder: Path, src: Path) -> tuple[float, float, float]:
+    """Medians of the warm command's wall time [s], the tree `src` and the reference, and the
+    median of the paired ratios."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "OPENBLAS_NUM_THREADS")}
-    variants = {"hystkit": {**env, "HYSTKIT_CACHE_DIR": str(folder / "cache")},
+    variants = {"hystkit": {**env, "HYSTKIT_CACHE_DIR": str(folder / "cache"),
+                            "PYTHONPATH": str(src)},
                 "before": {**env, "PYTHONPATH": str(reference_source(folder / "ref"))}}
     times: dict[str, list[float]] = {name: [] for name in variants}
     for k in range(COMMAND_REPEATS + 1):
@@ -214,14 +215,17 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tables", default="loop,command",
                         help="loop (tables 1 and 2), command (table 3), or both (default)")
-    tables = parser.parse_args().tables.split(",")
+    parser.add_argument("--src", type=Path, default=REPO / "src",
+                        help="source tree of table 3's hystkit (default: this checkout's)")
+    args = parser.parse_args()
+    tables = args.tables.split(",")
     t_total = time.perf_counter()
     machine()
     if "loop" in tables:
         loop_tables()
     if "command" in tables:
         with tempfile.TemporaryDirectory() as folder:
-            new, before, ratio = whole_command(Path(folder))
+            new, before, ratio = whole_command(Path(folder), args.src)
         print(f"Table 3. whole command, warm: hystkit {' '.join(COMMAND)}; medians of "
               f"{COMMAND_REPEATS} A/B pairs of fresh processes")
         print(f"  {'before (' + REFERENCE + ') s':>20}{'hystkit s':>11}"
