@@ -6,7 +6,8 @@ from numpy.testing import assert_allclose
 
 from hystkit.identification import ChunkedDifferences, dense_normal_equations
 from hystkit.models import chua
-from hystkit.models.chua.fit import _bounds, default_starts
+from hystkit.models.chua.box import fit_bounds
+from hystkit.models.chua.fit import default_starts
 
 STRUCTURE = chua.ChuaStructure(n_elements=2, dt=0.025)
 
@@ -21,7 +22,7 @@ def _data(n=3000, seed=4):
 def _chunked(u, y, chunk):
     def run(theta, u_chunk, x):
         return chua.simulate(STRUCTURE, chua.ChuaParams.from_vector(theta, 2), u_chunk, x)
-    return ChunkedDifferences(run, u, y, *_bounds(STRUCTURE), chunk=chunk)
+    return ChunkedDifferences(run, u, y, *fit_bounds(STRUCTURE), chunk=chunk)
 
 
 @pytest.fixture(scope="module")
@@ -48,7 +49,7 @@ def test_chunked_equals_the_dense_difference_jacobian(theta):
     def residual(th):
         return chua.simulate(STRUCTURE, chua.ChuaParams.from_vector(th, 2), u)[0] - y
 
-    dense = dense_normal_equations(residual, "2-point", *_bounds(STRUCTURE))(theta)
+    dense = dense_normal_equations(residual, "2-point", *fit_bounds(STRUCTURE))(theta)
     chunked = _chunked(u, y, 1000).normal_equations(theta)
     assert_allclose(chunked.cost, dense.cost, rtol=1e-12)
     assert_allclose(chunked.jtj, dense.jtj, rtol=1e-10, atol=1e-10 * np.max(np.abs(dense.jtj)))
