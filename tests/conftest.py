@@ -4,9 +4,11 @@
 Sphinx, a Dask cluster), in its own code, a fixture it uses or a helper of ``tests/`` it calls.
 ``python -m pytest -m "not slow"`` is the quick local loop; CI runs everything.
 
-``xdist_group``: under ``pytest -n N --dist loadgroup`` the tests of a file that share a fixture
-of module or class scope run on one worker, so that the fixture (a site build, a demo run, a
-set of fits) is made once; the other tests are spread one by one.
+Under ``pytest -n N`` (pytest-xdist) the tests are spread a file at a time (``--dist loadfile``
+in pyproject.toml), so that a file's module fixtures (the site build, the demo run, a set of
+fits) are made once. ``--dist loadgroup`` with per-file groups for just those files would
+spread the rest finer, but pytest-xdist 3.8 does not group under pytest 9 (it renames
+``item._nodeid``, which pytest 9 no longer reads): every test of a group ran apart.
 """
 
 from __future__ import annotations
@@ -76,12 +78,8 @@ def _fixture_defs(item: pytest.Item):
             yield from defs
 
 
-@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
-        defs = list(_fixture_defs(item))
-        funcs = [getattr(item, "function", None), *(d.func for d in defs)]
+        funcs = [getattr(item, "function", None), *(d.func for d in _fixture_defs(item))]
         if any(f is not None and _starts_process(f) for f in funcs):
             item.add_marker(pytest.mark.slow)
-        if any(d.scope in ("module", "class", "package") for d in defs):
-            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
