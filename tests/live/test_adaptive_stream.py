@@ -188,7 +188,7 @@ def test_bad_settings_and_references_are_refused():
         AdaptiveStream(comp).process(np.full(5, 1200.0), [0.0, 1.0])
     with pytest.raises(InputError, match="inverse"):
         AdaptiveStream(drawn("mpl", "inverse"), Adaptation("weights"))
-    with pytest.raises(InputError, match="no output weights"):
+    with pytest.raises(InputError, match="preisach model's output is not linear in w and v_b"):
         AdaptiveStream(drawn("preisach"), Adaptation("weights"))
     with pytest.raises(InputError, match="not linear in w and v_b"):
         AdaptiveStream(drawn("mpl-poly"), Adaptation("weights"))

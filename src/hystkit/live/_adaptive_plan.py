@@ -147,8 +147,9 @@ def _unit_weight_params(comp: Compensator) -> list[Any]:
     why = ""
     if comp.mode != "direct":
         why = "an inverse compensator's output is not linear in its weights"
-    elif not (hasattr(params, "w") and hasattr(params, "v_b")):
-        why = f"the {comp.model} model has no output weights w and bias v_b"
+    elif not comp.family.capabilities.output_is_linear(comp.structure):
+        why = (f"the {comp.model} model's output is not linear in w and v_b (its family "
+               f"does not declare a linear output)")
     if why:
         raise InputError(f"{comp.source or 'compensator'}: adaptation 'weights': {why}; "
                          f"use 'gain'")

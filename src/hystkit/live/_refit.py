@@ -155,8 +155,9 @@ class RefittingStream:
                              f"only at the references; use a direct one, or 'gain'")
         family = compensator.family
         where = f"{compensator.source or 'compensator'}: adaptation 'full'"
-        if "init" not in family.fit_options:
-            starts = sorted(name for name, f in FAMILIES.items() if "init" in f.fit_options)
+        if not family.capabilities.start_from_params:
+            starts = sorted(name for name, f in FAMILIES.items()
+                            if f.capabilities.start_from_params)
             raise InputError(f"{where}: the {family.name} fit cannot start from the present "
                              f"parameters (it would re-run its whole multi-start at every "
                              f"refit); it applies to {', '.join(starts)}; use 'gain'")

@@ -29,7 +29,6 @@ since after it the state no longer depends on where the stream started).
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,14 +41,6 @@ __all__ = ["SyncExcitation", "sync_excitation"]
 DEFAULT_TOLERANCE = 1e-6
 DEFAULT_MAX_SECONDS = 600.0
 DEFAULT_MIN_HOLD_SECONDS = 0.5
-
-# The largest play threshold of the families built from play operators (eq. 2.21's N V_T).
-# A family may instead define ``sync_amplitude(structure, params) -> float`` itself.
-_PLAY_THRESHOLD: dict[str, Callable] = {
-    "pl": lambda structure, params: structure.n_cells * params.v_t,
-    "ladder": lambda structure, params: float(np.sum(params.band)),
-}
-
 
 @dataclass(frozen=True, eq=False)
 class SyncExcitation:
@@ -163,13 +154,9 @@ def sync_excitation(comp: Compensator, *, tolerance: float = DEFAULT_TOLERANCE,
 
 
 def _amplitude(comp: Compensator) -> tuple[float, str]:
-    family = comp.family
-    own = getattr(family, "sync_amplitude", None)
-    if own is not None:
-        return float(own(comp.structure, comp.params)), f"{family.name}.sync_amplitude"
-    threshold = _PLAY_THRESHOLD.get(family.name)
-    if threshold is not None:
-        return float(threshold(comp.structure, comp.params)), (
+    amplitude = comp.family.capabilities.sync_amplitude
+    if amplitude is not None:  # families of play operators: their largest threshold
+        return float(amplitude(comp.structure, comp.params)), (
             "eq. 2.21 with E_0 = N V_T (largest play threshold), then back to rest")
     return 1.0, "swing to both ends of the training range (max |.| = 1), then back to rest"
 
