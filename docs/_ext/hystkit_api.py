@@ -190,7 +190,7 @@ def _ancestors(node: nodes.Node) -> list[nodes.Node]:
 
 
 def _docstring_of(node: nodes.Node) -> str:
-    """``hystkit.io._raw.RawReader`` for a node from autodoc's "docstring of ..."."""
+    """``hystkit.io._raw_reader.RawReader`` for a node from autodoc's "docstring of ..."."""
     try:
         source = get_node_source(node)
     except ValueError:  # a node with no source
