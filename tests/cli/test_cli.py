@@ -512,7 +512,7 @@ CAPPED = ["mpl", "mpl-poly", "mpl-g", "pl", "ladder", "chua"]
 
 
 def test_capped_families_are_the_registry_s():
-    from hystkit.cli.cmd_core import has_slope_cap
+    from hystkit.cli.cmd_fit import has_slope_cap
     from hystkit.models import FAMILIES, get_family
 
     assert sorted(CAPPED) == sorted(n for n in FAMILIES if has_slope_cap(get_family(n)))

@@ -12,7 +12,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from hystkit.cli import main
-from hystkit.cli._fit_start_options import parse_init
+from hystkit.cli._fit_checks import parse_init
 from hystkit.errors import InputError
 from hystkit.models import get_family
 

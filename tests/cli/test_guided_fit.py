@@ -9,19 +9,11 @@ import json
 
 import pytest
 
-from hystkit.cli._common import GUARD_EXIT, next_step
-from hystkit.cli._guided_fit import (
-    SHORT_LIST,
-    SKIPPED,
-    _Budgeted,
-    guided_candidates,
-    guided_select,
-    selection_status,
-)
-from hystkit.compensation import folds, load_compensator, protocol
+from hystkit.cli._common import GUARD_EXIT
+from hystkit.compensation import load_compensator
 from hystkit.datasets import load_excerpt
 from hystkit.io import write_recording
-from hystkit.parallel import SerialExecutor
+from hystkit.studies._guided import SHORT_LIST
 
 from ..cli_support import run_cli
 from ..compensation.test_verdict_corpus import data  # noqa: F401 (the labelled corpus)
@@ -87,56 +79,15 @@ def test_budget_belongs_to_the_guided_fit(data, tmp_path, capsys):  # noqa: F811
     assert code == 2 and "--budget applies to --model auto" in err
 
 
-def test_the_candidates_are_the_short_list_cheapest_first(data):  # noqa: F811
-    from hystkit.io import read_recording
-    from hystkit.parallel import fit_cost
-
-    rec = read_recording(data["sine1"])
-    cands = guided_candidates([rec])
-    assert {(c.model, c.size) for c in cands} == set(SHORT_LIST)
-    n = min(f.n_train for f in folds([rec]))
-    costs = [fit_cost(c.model, c.size, n) for c in cands]
-    assert costs == sorted(costs) and {c.mode for c in cands} == {"direct"}
-
-
-def test_a_budget_too_small_for_any_candidate_says_so_and_what_to_try(data):  # noqa: F811
-    from hystkit.io import read_recording
-
-    rec = read_recording(data["sine1"])
-    # 0.1 s for validation, serially: below every candidate's a-priori floor on 5333 samples
-    result = guided_select([rec], budget=0.2, executor=SerialExecutor())
-    assert result["winner"] is None and result["ranking"] == []
-    assert [label for label, _ in result["skipped"]] == [c.label for c in
-                                                          guided_candidates([rec])]
-    assert result["protocol"] == protocol([rec])
-    assert selection_status(result) == "skipped"
-    assert next_step("skipped", command="guided").startswith("--budget with more seconds")
-
-
-def test_pieces_after_the_deadline_are_skipped_not_run():
-    from hystkit.compensation import Candidate
-
-    def must_not_run(item):
-        raise AssertionError(f"piece {item} ran after the deadline")
-
-    cand = Candidate("mpl", 1, "direct", "fit")
-    done = []
-    budgeted = _Budgeted(SerialExecutor(), deadline=0.0)
-    results = budgeted.map(must_not_run, [(cand, k, {}) for k in range(3)],
-                           on_done=lambda i, r: done.append(i))
-    assert results == [{"error": SKIPPED}] * 3 and done == [0, 1, 2]
-    assert budgeted.late == {cand.label}
-
-
 def test_without_model_the_guided_fit_and_an_option_of_a_named_model_means_mpl(
         data, tmp_path, capsys):  # noqa: F811
-    """fit without --model is the guided fit (cmd_core.DEFAULT_MODEL, issue 27.5); --cells 3
-    alone is still the 3-cell mpl (as the issue's user typed it)."""
-    from hystkit.cli import cmd_core
+    """fit without --model is the guided fit (_core_options.DEFAULT_MODEL, issue 27.5); --cells
+    3 alone is still the 3-cell mpl (as the issue's user typed it)."""
+    from hystkit.cli import cmd_fit
     from hystkit.cli._main import _parser
 
     def chosen(*argv):
-        return cmd_core._chosen_model(_parser().parse_args(["fit", "x.csv", "--out", "m.json",
+        return cmd_fit._chosen_model(_parser().parse_args(["fit", "x.csv", "--out", "m.json",
                                                             *argv]))
 
     assert chosen() == "auto" and chosen("--model", "pi") == "pi"

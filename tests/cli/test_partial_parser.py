@@ -1,5 +1,6 @@
-"""A command line that names its subcommand builds the parser only up to the module that
-registers it (`hystkit.cli._main._parser`); what that subcommand accepts and shows is the same."""
+"""A command line that names its subcommand builds that subcommand's options only
+(`hystkit.cli._main._parser`, from the table `hystkit.cli._commands`); what it accepts and
+shows is the same as in the whole parser."""
 
 from __future__ import annotations
 
@@ -28,8 +29,28 @@ def test_a_named_subcommand_gets_the_same_parser_as_in_the_whole_one(command):
     assert partial[command].format_help() == _subcommands(_parser())[command].format_help()
 
 
-def test_fit_skips_the_modules_after_its_own():
-    assert "fit" in _subcommands(_parser("fit")) and len(_subcommands(_parser("fit"))) < len(FULL)
+def test_fit_builds_its_own_options_only():
+    partial = _subcommands(_parser("fit"))
+    with_options = [name for name, p in partial.items() if len(p._actions) > 2]  # -h, --force
+    assert with_options == ["fit"] and set(partial) == set(FULL)
+
+
+def test_only_the_chosen_commands_modules_are_imported():
+    """``hystkit fit --help`` imports fit's options module, no other command's (checked in a
+    fresh interpreter: this session has imported them all)."""
+    import subprocess
+    import sys
+
+    probe = ("import contextlib, io, sys\nfrom hystkit.cli import main\n"
+             "with contextlib.redirect_stdout(io.StringIO()):\n"
+             "    try:\n        main(['fit', '--help'])\n    except SystemExit:\n        pass\n"
+             "print(','.join(sorted(m.rpartition('.')[2] for m in sys.modules\n"
+             "                      if m.startswith('hystkit.cli.'))))")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         check=True, timeout=120).stdout.strip().split(",")
+    assert "_core_options" in out
+    assert not [m for m in out if m.startswith("cmd_") or m in ("_study_options",
+                                                                "_lab_options")], out
 
 
 @pytest.mark.parametrize("argv", [["no-such-command"], ["--version"], [], ["-h"]])

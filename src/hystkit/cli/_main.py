@@ -1,7 +1,7 @@
 """``hystkit`` command line: each subcommand parses, calls the library, writes, returns a code.
 
-Subcommands live in ``cmd_*.py`` modules beside this one, each with a ``register(sub)``
-function; they are found here so that adding a capability does not edit a shared file.
+Subcommands are the rows of `hystkit.cli._commands.COMMANDS` (name, help, options function,
+run function); only the chosen command's modules are imported.
 
 Exit codes: 0 success; 2 an error the user can fix (one ``hystkit: error:`` line); 3 work ran
 but failed its guards (`GUARD_EXIT`); 70 an internal error (a bug: one line, the traceback with
@@ -13,9 +13,7 @@ from __future__ import annotations
 
 import errno
 import gc
-import importlib
 import os
-import pkgutil
 import signal
 import sys
 import traceback
@@ -25,6 +23,7 @@ from typing import NoReturn
 from .. import __version__
 from .._compilation import announce
 from ..errors import HystkitError, Terminated
+from . import _commands
 from ._common import INTERNAL_EXIT, Parser
 from ._signals import forked_workers, received_signal, signals_as_exceptions
 
@@ -51,29 +50,51 @@ COMPILING_NOTICE = ("hystkit: compiling numba kernels, once per installation: th
                     "compiles them ahead)")
 
 
-def _parser(command: str | None = None) -> Parser:
-    """The ``hystkit`` parser; given `command`, only up to the module that registers it.
+def _parser(command: str | None = None, *, options: bool = True) -> Parser:
+    """The ``hystkit`` parser: every subcommand of the table (`hystkit.cli._commands`) by name
+    and help; given `command`, the options of that one only, else (`options`) of all.
 
-    The subcommand modules register in name order; a command line naming its subcommand needs
-    no parser of the modules after the one that registers it (a shorter start: ``fit`` skips
-    two thirds of them). A name no module registers gets the whole parser, whose error lists
-    every subcommand.
+    A command line naming its subcommand imports that command's options function only (a
+    shorter start); ``--help``, ``--version`` and an unknown name need no options at all
+    (``options=False``: the error of an unknown name still lists every subcommand).
     """
     parser = Parser(prog="hystkit", description="Hysteresis compensation for lousy "
                     "(3D-printed, soft) sensors.")
     parser.add_argument("--version", action="version", version=f"hystkit {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    package = __name__.rpartition(".")[0]
-    for info in sorted(pkgutil.iter_modules(sys.modules[package].__path__), key=lambda m: m.name):
-        if info.name.startswith("cmd_"):
-            importlib.import_module(f"{package}.{info.name}").register(sub)
-            if command in sub.choices:
-                break
-    for p in sub.choices.values():
-        if not any("--force" in a.option_strings for a in p._actions):
-            p.add_argument("--force", action="store_true",
-                           help="overwrite existing output files")
+    chosen = command if _commands.command(command) is not None else None
+    for row in _commands.COMMANDS:
+        p = sub.add_parser(row.name, help=row.help)
+        if row.name == chosen or (chosen is None and options):
+            _add_options(row, p)
     return parser
+
+
+def _add_options(row: _commands.Command, p: Parser) -> None:
+    """Add `row`'s options (and ``--force`` unless it has one) and its run function to `p`."""
+    if row.registers:
+        _commands.resolve(row.options)(_OneParser(row.name, p))
+    else:
+        _commands.resolve(row.options)(p)
+        if row.run is not None:
+            p.set_defaults(run=row.run)
+    if not any("--force" in a.option_strings for a in p._actions):
+        p.add_argument("--force", action="store_true", help="overwrite existing output files")
+
+
+class _OneParser:
+    """What a module's ``register(sub)`` is handed: `parser` for `name`, a throwaway parser
+    for the module's other subcommands (their own rows add them when chosen)."""
+
+    def __init__(self, name: str, parser: Parser):
+        self.name, self.parser = name, parser
+
+    def add_parser(self, name: str, **kwargs) -> Parser:
+        if name != self.name:
+            return Parser(prog=name)
+        if kwargs.get("description"):
+            self.parser.description = kwargs["description"]
+        return self.parser
 
 
 def _named_command(argv: Sequence[str]) -> str | None:
@@ -158,9 +179,10 @@ def program() -> NoReturn:
 def _main(argv: Sequence[str] | None) -> int:
     try:
         with signals_as_exceptions():
-            args = _parser(_named_command(sys.argv[1:] if argv is None else argv)
-                           ).parse_args(argv)
-            return args.run(args)
+            named = _named_command(sys.argv[1:] if argv is None else argv)
+            args = _parser(named, options=False).parse_args(argv)
+            run = _commands.resolve(args.run) if isinstance(args.run, str) else args.run
+            return run(args)
     except HystkitError as exc:
         if received_signal() is not None:  # e.g. a reader child killed by the same Ctrl-C
             return _stopped(received_signal())

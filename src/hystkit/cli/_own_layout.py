@@ -28,19 +28,20 @@ from pathlib import Path
 
 from .._read_options import FIELDS, ReadOptions
 from ..errors import InputError
-from ._common import given_read_options, read_options
+from ._read_args import given_read_options
 
-__all__ = ["TRAINED_NOTE", "add_trained_note", "estimate_names", "options_as_trained",
-           "output_names", "remembered_options", "stream_args"]
+__all__ = ["TRAINED_NOTE", "add_trained_note", "estimate_names", "output_names",
+           "remembered_options", "stream_args"]
 
 _HEAD_BYTES = 1 << 16  # as io._csv_layout: the header must end within it
 
 
-def remembered_options(args: argparse.Namespace, path: Path, reading: ReadOptions | None,
+def remembered_options(given: dict, path: Path, reading: ReadOptions | None,
                        ) -> tuple[ReadOptions, str] | None:
     """The options to read `path` with as the model's training data were read, and the line
     that says so; None when they do not apply (see the module: nothing remembered, a settings
-    file of its own, ``--columns`` given, or not the training files' column names).
+    file of its own, ``--columns`` in the reading options `given` on the command line, or
+    not the training files' column names).
 
     Raises
     ------
@@ -53,7 +54,6 @@ def remembered_options(args: argparse.Namespace, path: Path, reading: ReadOption
     if reading is None or not (reading.columns or reading.time_unit != "s"
                                or reading.units_row):
         return None
-    given = given_read_options(args)
     if "columns" in given or settings_for(path)[0] is not None:
         return None
     try:
@@ -77,23 +77,6 @@ def remembered_options(args: argparse.Namespace, path: Path, reading: ReadOption
     return options, f"reading {path} as the model's training data were read: {', '.join(parts)}"
 
 
-def options_as_trained(args: argparse.Namespace, path: Path,
-                       reading: ReadOptions | None) -> ReadOptions:
-    """`read_options` for a command that applies a model: the model's `reading` when it
-    applies to `path` (`remembered_options`, said once per file and command), else the
-    command line and the settings file as for any command."""
-    options = read_options(args, path)
-    found = remembered_options(args, path, reading)
-    if found is None:
-        return options
-    options, line = found
-    shown = args.__dict__.setdefault("_trained_shown", set())
-    if line not in shown:
-        shown.add(line)
-        print(line, flush=True)
-    return options
-
-
 TRAINED_NOTE = ("a file with the training files' column names and no settings file of its own "
                 "is read as the model's training data were read, said in one line (an option "
                 "given here wins; --columns replaces it)")
@@ -113,7 +96,7 @@ def stream_args(args: argparse.Namespace, reading: ReadOptions | None) -> None:
     if given on the command line, and say so on stderr (stdout carries the estimates)."""
     if args.input is None or not Path(args.input).is_file():
         return
-    found = remembered_options(args, Path(args.input), reading)
+    found = remembered_options(given_read_options(args), Path(args.input), reading)
     if found is None:
         return
     options, line = found

@@ -12,23 +12,36 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING
 
+import numpy as np
+import pandas as pd
+
+from ..analysis import cycle_table, plot_cycles
 from ..errors import InputError
-from ._common import (
-    UsageError,
-    add_read_options,
-    given_read_options,
-    number,
-    read_options,
-    read_recording_args,
+from ..io import (
+    RawFormat,
+    atomic_folder,
+    check_output_folder,
+    find_raw_config,
+    read_other_columns,
+    read_raw_config,
+    write_json,
 )
+from ..preprocess import (
+    PreprocessSettings,
+    RawDataWarning,
+    gauge_symmetry,
+    parse_states,
+    preprocess_raw,
+    relative_change,
+)
+from ._common import UsageError
+from ._read_args import given_read_options
+from ._reading import read_options, read_recording_args
 
-if TYPE_CHECKING:
-    import numpy as np
-
-__all__ = ["CYCLES_FILES", "register"]
+__all__ = ["CYCLES_FILES", "TABLE_3_1", "run_cycles"]
 
 CYCLES_FILES = ("cycles.csv", "cycles.json", "cycles.png", "cycles.svg")
 # Table 3.1 of the document (R1 top, R2 bottom [kOhm], symmetry 2 (R1 - R2) / (R1 + R2) [%]);
@@ -40,22 +53,9 @@ TABLE_3_1 = {"sample 0": (1.58, 2.78, -55.0), "sample 1": (15.0, 16.82, -11.0),
 _DEFAULT_DRAWN = 5
 
 
-def _cycle_list(text: str) -> tuple[int, ...] | str:
-    if text.strip() == "all":
-        return "all"
-    parts = [p.strip() for p in text.split(",")]
-    if not parts or not all(p.isascii() and p.isdigit() and int(p) >= 1 for p in parts):
-        raise argparse.ArgumentTypeError(f"expected 'all' or cycle numbers 1, 2, ... "
-                                         f"separated by commas, e.g. 1,5,20; got {text!r}")
-    return tuple(sorted({int(p) for p in parts}))
-
-
 def _gauges_from_raw(args: argparse.Namespace) -> tuple[np.ndarray, ...]:
     """Preprocess the raw file with its settings file: t, x, r1, r2 (or None), sensor."""
-    import warnings
 
-    from ..io import RawFormat, find_raw_config, read_raw_config
-    from ..preprocess import PreprocessSettings, RawDataWarning, preprocess_raw
 
     config = find_raw_config(args.input)
     if config is None:
@@ -76,8 +76,6 @@ def _gauges_from_raw(args: argparse.Namespace) -> tuple[np.ndarray, ...]:
         if "encoder_levels" in values:
             values["encoder_levels"] = tuple(values["encoder_levels"])
         if isinstance(values.get("encoder_states"), str | list):
-            from ..preprocess import parse_states
-
             values["encoder_states"] = parse_states(values["encoder_states"])
         settings = PreprocessSettings(**values)
     except (TypeError, ValueError) as exc:
@@ -94,9 +92,7 @@ def _gauges_from_raw(args: argparse.Namespace) -> tuple[np.ndarray, ...]:
 
 def _gauges_from_recording(args: argparse.Namespace) -> tuple:
     """Read a recording and its gauge columns r1, r2 (Ohm) when present."""
-    import numpy as np
 
-    from ..io import read_other_columns
 
     rec = read_recording_args(args, args.input)
     other = read_other_columns(args.input, rec.n_samples, read_options(args, args.input))
@@ -115,15 +111,12 @@ def _signals(r1, r2, sensor) -> dict:
     """dR/R per gauge about its mean (eq. 4.4-4.5) and their difference, else the sensor."""
     if r1 is None:
         return {"sensor": sensor}
-    from ..preprocess import relative_change
 
     dr1, dr2 = relative_change(r1), relative_change(r2)
     return {"dR1/R1": dr1, "dR2/R2": dr2, "dR1/R1 - dR2/R2": dr1 - dr2}
 
 
 def _drawn(requested: tuple[int, ...] | str | None, n_cycles: int, source: Path) -> list[int]:
-    import numpy as np
-
     if requested == "all":
         return list(range(1, n_cycles + 1))
     if requested is None:
@@ -138,7 +131,6 @@ def _drawn(requested: tuple[int, ...] | str | None, n_cycles: int, source: Path)
 def _gauge_summary(r1, r2) -> dict | None:
     if r1 is None:
         return None
-    from ..preprocess import gauge_symmetry
 
     return {"r1_mean_kohm": float(r1.mean()) / 1e3, "r2_mean_kohm": float(r2.mean()) / 1e3,
             "symmetry_pct": 100.0 * gauge_symmetry(r1, r2),
@@ -204,11 +196,9 @@ def _print(table, summary: dict, gauges: dict | None) -> None:
               f"R2 = {doc[1]:g} kOhm, {doc[2]:g} %)")
 
 
-def _cycles(args: argparse.Namespace) -> int:
-    import pandas as pd
+def run_cycles(args: argparse.Namespace) -> int:
+    """``hystkit cycles``: per-gauge loops and the per-cycle table of one recording."""
 
-    from ..analysis import cycle_table, plot_cycles
-    from ..io import atomic_folder, check_output_folder, write_json
 
     if args.raw and given_read_options(args):
         raise UsageError("--raw reads the raw file with its .toml settings; the options for "
@@ -241,25 +231,3 @@ def _cycles(args: argparse.Namespace) -> int:
              else f"{len(drawn)} cycles, {drawn[0]} to {drawn[-1]}")
     print(f"wrote {args.out}/: {', '.join(CYCLES_FILES)} (cycles drawn: {shown})")
     return 0
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``cycles`` to the ``hystkit`` parser."""
-    p = sub.add_parser("cycles", help="per-gauge loops of chosen cycles; loop area, offset and "
-                       "drift per cycle and per hour (figs. 4.16-4.17, table 3.1)")
-    p.add_argument("input", type=Path, help="recording (time, position, sensor; with r1, r2 "
-                   "from 'hystkit preprocess' per gauge) or, with --raw, a raw scope recording")
-    p.add_argument("--out", type=Path, required=True,
-                   help="folder for cycles.csv, cycles.json, cycles.png, cycles.svg")
-    p.add_argument("--raw", action="store_true",
-                   help="INPUT is a raw scope recording (v1, v2, encoder) with its .toml "
-                        "settings: preprocess it first, as 'hystkit preprocess' would")
-    p.add_argument("--cycles", type=_cycle_list, metavar="K,K,...",
-                   help="cycles to draw, numbered 1.. over the complete cycles, or 'all' "
-                        "(fig. 4.13: every cycle, coloured by time; default: 5 spread over the "
-                        "recording)")
-    p.add_argument("--deadband", type=number(0, 0.5, high_open=True), default=0.01,
-                   metavar="F", help="a position reversal counts after the position came back "
-                   "by this fraction of its range (default 0.01)")
-    add_read_options(p)
-    p.set_defaults(run=_cycles)

@@ -6,9 +6,28 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import deferred, stdout_for
+from ..datasets import (
+    DATASETS,
+    ENV_VAR,
+    Dataset,
+    dataset_info,
+    list_excerpts,
+    load,
+    load_excerpt,
+    shared_data_status,
+)
+from ..io import (
+    RECORDING_SUFFIXES,
+    atomic_outputs,
+    check_output_path,
+    sidecar_path,
+    units_settings_text,
+    write_json,
+    write_recording,
+)
+from ._common import stdout_for
 
-__all__ = ["register"]
+__all__ = ["run_export", "run_list", "run_show"]
 
 
 def _samples(counts: list[int]) -> str:
@@ -23,9 +42,7 @@ def _rates(rates: list[float | None]) -> str:
     return "/".join(f"{r:g}" for r in known) + " Hz"
 
 
-def _list(args: argparse.Namespace) -> int:
-    from ..datasets import DATASETS, list_excerpts, shared_data_status
-
+def run_list(args: argparse.Namespace) -> int:
     stdout_for("the list")
     root, how = shared_data_status(args.root)
     print(f"shared data: {root} ({how})" if root is not None else how)
@@ -56,8 +73,6 @@ def _list(args: argparse.Namespace) -> int:
 
 
 def _list_variants(name: str, root: Path | None) -> int:
-    from ..datasets import dataset_info
-
     info = dataset_info(name)
     print(f"{info.name}: {info.what}")
     print(f"  input {info.input_name} [{info.input_unit}] -> output {info.output_name} "
@@ -73,9 +88,7 @@ def _list_variants(name: str, root: Path | None) -> int:
     return 0
 
 
-def _show(args: argparse.Namespace) -> int:
-    from ..datasets import dataset_info, shared_data_status
-
+def run_show(args: argparse.Namespace) -> int:
     stdout_for("the description")
     info = dataset_info(args.name)
     root, how = shared_data_status(args.root)
@@ -109,23 +122,10 @@ def _show(args: argparse.Namespace) -> int:
 
 
 def _env_var() -> str:
-    from ..datasets import ENV_VAR
-
     return ENV_VAR
 
 
-def _export(args: argparse.Namespace) -> int:
-    from ..datasets import Dataset, load, load_excerpt
-    from ..io import (
-        RECORDING_SUFFIXES,
-        atomic_outputs,
-        check_output_path,
-        sidecar_path,
-        units_settings_text,
-        write_json,
-        write_recording,
-    )
-
+def run_export(args: argparse.Namespace) -> int:
     out = Path(args.out)
     sidecar = out.with_name(out.name + ".json")
     # CSV keeps its units in the settings file beside it, which reading it picks up
@@ -166,64 +166,3 @@ def _units(ds, role: str) -> dict[str, str]:
     position, sensor = ((ds.input_unit, ds.output_unit) if role == "inverse"
                         else (ds.output_unit, ds.input_unit))
     return {"position": position, "sensor": sensor, **dict(ds.channel_units)}
-
-
-def _dataset_names() -> list[str]:
-    from ..datasets import DATASETS
-
-    return list(DATASETS)
-
-
-def _roles() -> tuple[str, ...]:
-    from ..datasets import ROLES
-
-    return ROLES
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``datasets list``, ``datasets show`` and ``datasets export`` to the ``hystkit``
-    parser."""
-    p = sub.add_parser("datasets", help="public hysteresis data sets: list, export as a "
-                                        "recording")
-    # The parent gets a --force too (the CLI adds one to every top-level command); the child's
-    # default is SUPPRESS so that 'datasets --force export' is not reset to False by it.
-    p.add_argument("--force", action="store_true", help="overwrite existing output files")
-    actions = p.add_subparsers(dest="datasets_command", required=True)
-
-    q = actions.add_parser("list", help="the data sets (or the runs of one) and whether the "
-                                        "shared data are here")
-    deferred(q.add_argument("name", nargs="?", help="list this data set's runs"),
-             choices=_dataset_names)
-    q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
-                                             "or a shared/data folder found above)")
-    q.set_defaults(run=_list)
-
-    q = actions.add_parser("show", help="where a data set's files come from (repository, "
-                                        "commit, licence, credit) and where to put them")
-    deferred(q.add_argument("name", help="the data set (see 'hystkit datasets list')"),
-             choices=_dataset_names)
-    q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
-                                             "or a shared/data folder found above)")
-    q.set_defaults(run=_show)
-
-    q = actions.add_parser("export", help="write one run as a time, position, sensor "
-                                          "recording (CSV, Parquet or .mat) plus a .json sidecar")
-    deferred(q.add_argument("name", help="the data set to export (see 'hystkit datasets list')"),
-             choices=_dataset_names)
-    q.add_argument("--variant", help="the run (default: the data set's default; see "
-                                     "'hystkit datasets list NAME')")
-    q.add_argument("--segment", help="only this named segment of the run")
-    deferred(q.add_argument("--role", default="inverse",
-                   help="inverse (default): position = system input, sensor = output, so "
-                        "'hystkit fit' learns output -> input; forward: the other way round"),
-             choices=_roles)
-    q.add_argument("--excerpt", action="store_true",
-                   help="use the excerpt shipped with hystkit instead of the shared data")
-    q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
-                                             "or a shared/data folder found above)")
-    q.add_argument("--out", type=Path, required=True,
-                   help="file to write, by its extension: .csv, .parquet or .mat (MATLAB: one "
-                        "variable per column, with units)")
-    q.add_argument("--force", action="store_true", default=argparse.SUPPRESS,
-                   help="overwrite existing output files")
-    q.set_defaults(run=_export)

@@ -11,15 +11,15 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
-__all__ = ["register"]
+from ..compensation import load_compensator
+from ..export import COMPILE_LINE, export_compensator, float_warning
+
+__all__ = ["run_export"]
 
 
-def _export(args: argparse.Namespace) -> int:
-    from ..compensation import load_compensator
-    from ..export import COMPILE_LINE, export_compensator, float_warning
-
+def run_export(args: argparse.Namespace) -> int:
+    """``hystkit export``: the compensator as a C or MATLAB folder."""
     comp = load_compensator(args.model)
     plan, files = export_compensator(comp, args.out, args.lang, double=args.double, name=args.name,
                                      force=args.force, level=args.level)
@@ -35,26 +35,3 @@ def _export(args: argparse.Namespace) -> int:
     if plan.sync_note:
         print(plan.sync_note)
     return 0
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add the ``export`` subcommand to the ``hystkit`` parser."""
-    from ._common import number
-
-    p = sub.add_parser("export", help="write a fitted compensator as dependency-free C99 or "
-                                      "as MATLAB/Octave code")
-    p.add_argument("model", type=Path, help="model JSON file written by 'hystkit fit'")
-    p.add_argument("--lang", choices=("c", "matlab"), default="c",
-                   help="target language (default: c)")
-    p.add_argument("--out", type=Path, required=True,
-                   help="folder to write (refused if it exists, unless --force)")
-    p.add_argument("--double", action="store_true",
-                   help="C only: double arithmetic (default float, for single-precision FPUs); "
-                        "refused with --lang matlab, whose code is always double")
-    p.add_argument("--name", help="name of the generated functions (default: from the model "
-                                  "file name)")
-    p.add_argument("--level", type=number(0, 1, low_open=True, high_open=True), default=None,
-                   help="nominal coverage of the exported prediction band, in (0, 1) (default: "
-                        "the model's own, 0.90 unless fitted otherwise); refused for a model "
-                        "without a band")
-    p.set_defaults(run=_export)

@@ -11,50 +11,29 @@ import sys
 import time
 import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import HystkitError
-from ._common import integer, number
+from ..io import (
+    CONFIG_KEYS,
+    RawFormat,
+    atomic_outputs,
+    check_output_path,
+    find_raw_config,
+    read_raw_config,
+    write_json,
+    write_recording,
+)
+from ..preprocess import PreprocessSettings, RawDataWarning, parse_states, preprocess_raw
+from ..sensors import ScopeSettings, VirtualSensor, simulate_raw, with_asymmetry
+from ..signals import EXPERIMENTS
 
-if TYPE_CHECKING:  # the library loads when a command runs, not when the parser is built
-    from ..io import RawFormat
-    from ..preprocess import PreprocessSettings
-    from ..sensors import VirtualSensor
-
-__all__ = ["SettingsError", "add_simulation_options", "raw_settings", "register",
-           "run_raw_simulation", "sensor_from_args"]
+__all__ = ["SettingsError", "raw_settings", "run_preprocess", "run_raw_simulation",
+           "sensor_from_args"]
 
 
 class SettingsError(HystkitError, ValueError):
     """Options or a settings file with values preprocessing cannot use."""
-
-
-_positive = number(0, low_open=True)
-_non_negative = number(0)
-_count = integer(0, 10**6)
-# Samples per chunk: below ~1000 the filters' edge handling dominates a chunk; above 2^27 a
-# chunk of float64 channels alone passes a gigabyte.
-_chunk_size = integer(1024, 2**27)
-
-
-def _levels(text: str) -> tuple[float, ...]:
-    try:
-        values = tuple(number()(v) for v in text.split(","))
-    except argparse.ArgumentTypeError:
-        raise argparse.ArgumentTypeError(f"must be four comma-separated voltages, got {text!r}")
-    if len(values) != 4:
-        raise argparse.ArgumentTypeError(f"must be four comma-separated voltages, got {text!r}")
-    return values
-
-
-def _states(text: str) -> str:
-    from ..preprocess import parse_states
-
-    try:
-        parse_states(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-    return text
 
 
 # Option dest -> settings key (the same names as the TOML keys).
@@ -68,8 +47,6 @@ def raw_settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawForma
 
     Reads ``args.raw``, ``args.config``, ``args.supply_channel`` and any of the preprocess
     options present on `args` (``hystkit spectrum`` shares the bridge ones)."""
-    from ..io import CONFIG_KEYS, RawFormat, find_raw_config, read_raw_config
-    from ..preprocess import PreprocessSettings, parse_states
 
     config_path = args.config if args.config is not None else find_raw_config(args.raw)
     if config_path is not None and not Path(config_path).is_file():
@@ -105,9 +82,8 @@ def raw_settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawForma
     return settings, fmt, config_path
 
 
-def _preprocess(args: argparse.Namespace) -> int:
-    from ..io import atomic_outputs, check_output_path, write_json, write_recording
-    from ..preprocess import RawDataWarning, preprocess_raw
+def run_preprocess(args: argparse.Namespace) -> int:
+    """``hystkit preprocess``: a raw scope recording to a 40 Hz recording and its report."""
 
     report_path = args.report if args.report is not None else args.out.with_suffix(".json")
     if report_path == args.out:
@@ -169,101 +145,12 @@ def _plain(value: Any) -> Any:
     return list(value) if isinstance(value, tuple) else value
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``preprocess`` to the ``hystkit`` parser."""
-    p = sub.add_parser("preprocess", help="raw scope recording (v1, v2, encoder) -> position "
-                       "and dR/R at 40 Hz")
-    p.add_argument("raw", type=Path, help="raw recording: time, v1, v2 and encoder or "
-                   "enc_a/enc_b (CSV, Parquet or .mat)")
-    p.add_argument("--out", type=Path, required=True, help="CSV or Parquet file to write")
-    p.add_argument("--report", type=Path, help="JSON report (default: --out with .json)")
-    p.add_argument("--config", type=Path, help="TOML settings (default: the raw file's stem "
-                   "with .toml, if it exists)")
-    p.add_argument("--r-bridge", type=_positive, metavar="OHM", help="bridge resistor (eq. 4.2)")
-    p.add_argument("--v-supply", type=_positive, metavar="V", help="bridge supply V0 (eq. 4.2)")
-    p.add_argument("--supply-channel", action=argparse.BooleanOptionalAction, default=None,
-                   help="use the measured supply column v0 in eq. 4.3 instead of --v-supply "
-                        "(sec. 4.2.1's reference channel; removes supply drift); "
-                        "--no-supply-channel uses the nominal V0 even if the settings file "
-                        "asks for the column (default: the settings file, else nominal)")
-    p.add_argument("--um-per-count", type=_positive, metavar="UM",
-                   help="encoder resolution (default 5; eq. 9.16 calibrates 5.1)")
-    p.add_argument("--position-offset", dest="position_offset_mm", type=number(), metavar="MM",
-                   help="added to the position, which counts from the first sample (default 0)")
-    p.add_argument("--fs-out", type=_positive, metavar="HZ", help="output rate (default 40)")
-    p.add_argument("--cutoff", type=_positive, metavar="HZ",
-                   help="zero-phase Butterworth cut-off (default 20, eq. 4.1)")
-    p.add_argument("--order", type=integer(1, 10), metavar="N",
-                   help="Butterworth order, 1 to 10 (default 2)")
-    p.add_argument("--fs", type=_positive, metavar="HZ",
-                   help="scope sample rate: needed without a time column, checked against one")
-    p.add_argument("--time-unit", choices=["s", "ms", "us", "ns"],
-                   help="unit of the time column (default s)")
-    p.add_argument("--encoder-states", type=_states, metavar="AB,AB,AB,AB",
-                   help="A/B states of the merged levels, ascending (default 00,01,10,11)")
-    p.add_argument("--encoder-levels", type=_levels, metavar="V,V,V,V",
-                   help="the four merged levels (default: found in the data)")
-    p.add_argument("--encoder-dwell", dest="encoder_dwell_us", type=_positive, metavar="US",
-                   help="a new encoder level must last this long (default 4 us, >= 2 samples)")
-    p.add_argument("--illegal", choices=["continue", "hold"],
-                   help="a double transition adds 2 counts in the direction of travel "
-                        "(continue, default) or nothing (hold); both are counted and reported")
-    p.add_argument("--remove-mean", action="store_true", help="subtract the mean of position "
-                   "and sensor")
-    p.add_argument("--normalise", action="store_true",
-                   help="divide position and sensor by their max |.| (eq. 5.10)")
-    p.add_argument("--chunk-size", type=_chunk_size, metavar="N",
-                   help="samples per chunk, 1024 to 2^27 (default 262144); memory grows with "
-                        "it, the result does not depend on it")
-    p.set_defaults(run=_preprocess)
-
-
-# --------------------------------------------------------------------------- simulate-sensor
-
-
-def add_simulation_options(p: argparse.ArgumentParser) -> None:
-    """simulate-sensor options for the sensor (both modes) and the raw mode."""
-    p.add_argument("--age-hours", type=_non_negative, metavar="H",
-                   help="hours since printing: the resistance still settles (sec. 3.5.1; "
-                        "default 48)")
-    p.add_argument("--asymmetry", type=number(), metavar="S",
-                   help="gauge symmetry 2(R1-R2)/(R1+R2) of the base resistances "
-                        "(default 0.35: 22.4 / 15.7 kOhm)")
-    p.add_argument("--raw", action="store_true",
-                   help="write the raw scope recording (time, v1, v2, encoder) and its .toml "
-                        "settings instead of the 40 Hz recording")
-    p.add_argument("--scope-rate", type=number(0, 1e8, low_open=True), metavar="HZ",
-                   help="raw: scope sample rate (default 1e6; the document: 1.98e6, 6.25e6)")
-    p.add_argument("--duration", type=_positive, metavar="S",
-                   help="raw: only the first S seconds of the experiment")
-    p.add_argument("--encoder", choices=["merged", "ab"],
-                   help="raw: one merged 4-level channel (default) or enc_a, enc_b")
-    p.add_argument("--r-bridge", type=_positive, metavar="OHM",
-                   help="raw: bridge resistor (default 10000)")
-    p.add_argument("--v-supply", type=_positive, metavar="V", help="raw: bridge supply "
-                   "(default 2)")
-    p.add_argument("--glitches", type=_count, metavar="N",
-                   help="raw: hide N encoder states (each an illegal double transition)")
-    p.add_argument("--supply-drift", type=number(0, 1, high_open=True), metavar="FRACTION",
-                   help="raw: the bridge supply drifts as V0 (1 + FRACTION sin(2 pi t / P)) "
-                        "(default 0: a steady supply; 0.01 is a 1 %% drift)")
-    p.add_argument("--supply-drift-period", type=_positive, metavar="S",
-                   help="raw: period P of the bridge supply drift (default 30)")
-    p.add_argument("--supply-channel", action="store_true", default=None,
-                   help="raw: also record the bridge supply as a column v0 (sec. 4.2.1's "
-                        "reference channel); the .toml then sets supply_channel = true")
-    p.add_argument("--truth", type=Path, metavar="FILE",
-                   help="raw: also write the exact position and dR/R (differential and per gauge, "
-                        "dr1, dr2) at 40 Hz here")
-
-
 _RAW_ONLY = ("scope_rate", "duration", "encoder", "r_bridge", "v_supply", "glitches", "truth",
              "supply_drift", "supply_drift_period", "supply_channel")
 
 
 def sensor_from_args(args: argparse.Namespace) -> VirtualSensor:
     """The virtual sensor with the --age-hours / --asymmetry options applied."""
-    from ..sensors import VirtualSensor, with_asymmetry
 
     if not args.raw:
         used = [f"--{k.replace('_', '-')}" for k in _RAW_ONLY if getattr(args, k) is not None]
@@ -277,9 +164,6 @@ def sensor_from_args(args: argparse.Namespace) -> VirtualSensor:
 
 def run_raw_simulation(args: argparse.Namespace) -> int:
     """simulate-sensor --raw: write the raw file, its settings and optionally the truth."""
-    from ..io import check_output_path, write_recording
-    from ..sensors import ScopeSettings, simulate_raw
-    from ..signals import EXPERIMENTS
 
     config = args.out.with_suffix(".toml")
     for path in (args.out, config) + ((args.truth,) if args.truth else ()):

@@ -6,19 +6,18 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import UsageError, add_read_options
-from ._own_layout import add_trained_note, options_as_trained
+from ..compensation import MODEL_SUFFIXES, load_compensator
+from ..io import check_output_path
+from ..io._atomic import check_folder_writable
+from ..studies import build_report, write_report
+from ._common import UsageError
+from ._reading import options_as_trained
 
-__all__ = ["register"]
-
-FORMATS = ("png", "svg", "pdf")  # as reports.FIGURE_FORMATS, without loading the library
+__all__ = ["run_report"]
 
 
-def _report(args: argparse.Namespace) -> int:
-    from ..io import check_output_path
-    from ..io._atomic import check_folder_writable
-    from ..studies import build_report, write_report
-
+def run_report(args: argparse.Namespace) -> int:
+    """``hystkit report``: one HTML page of a fit on recordings, or of result folders."""
     if args.format != "png" and args.figures is None:
         raise UsageError("--format chooses the figure files' format; give --figures DIR too")
     check_output_path(args.out, args.force, inputs=args.inputs, formats=(".html", ".htm"),
@@ -47,35 +46,7 @@ def _report(args: argparse.Namespace) -> int:
 def _model_reading(inputs: list[Path]):
     """How the training data of the model file among `inputs` (the first, before
     recordings) were read; None for result folders (the page's builder names a wrong mix)."""
-    from ..compensation import MODEL_SUFFIXES, load_compensator
-
     first = inputs[0]
     if len(inputs) < 2 or first.suffix.lower() not in MODEL_SUFFIXES or not first.is_file():
         return None
     return load_compensator(first).reading
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``hystkit report``."""
-    p = sub.add_parser(
-        "report", help="one self-contained HTML page of a fit on your recordings, or of "
-                       "compare / generalize / select / control output folders",
-        description="MODEL.json RECORDING... : the model file's provenance, fit (parameters "
-                    "with standard errors, bound hits, status), deployable and oracle scores, "
-                    "loops with the error against the position, whole time series with the "
-                    "error. FOLDER... : the tables and figures of compare, generalize, "
-                    "select --report or control output folders. Figures are embedded; the "
-                    "page loads nothing from outside.")
-    p.add_argument("inputs", type=Path, nargs="+", metavar="INPUT",
-                   help="a model file (from 'hystkit fit') followed by one or more recordings "
-                        "(CSV/Parquet/.mat with a position column), or one or more result "
-                        "folders")
-    p.add_argument("--out", type=Path, required=True, help="HTML file to write (.html)")
-    p.add_argument("--figures", type=Path, metavar="DIR",
-                   help="also write every figure as PNG (and --format) files into DIR")
-    p.add_argument("--format", choices=FORMATS, default="png",
-                   help="format of the figure files beside PNG: svg or pdf (default png only; "
-                        "needs --figures)")
-    add_read_options(p)
-    add_trained_note(p)
-    p.set_defaults(run=_report)

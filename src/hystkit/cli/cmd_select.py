@@ -6,29 +6,38 @@ import argparse
 import sys
 import time
 from dataclasses import replace
-from pathlib import Path
 
-from ._common import (
-    GUARD_EXIT,
-    UsageError,
-    add_read_options,
-    deferred,
-    next_step,
-    positive_int,
-    read_options,
-    say_next,
+import pandas as pd
+
+from ..compensation import CENTERS, MODEL_SUFFIXES, folds, protocol, save_compensator
+from ..io import (
+    atomic_folder,
+    check_output_folder,
+    check_output_path,
+    read_recording,
+    training_reading,
+    write_json,
 )
-from ._guided_fit import selection_status
-from .cmd_compare import _models, add_parallel_options, executor_for
+from ..parallel import loading_meanwhile
+from ..studies import (
+    FIGURE_MODULES,
+    candidates,
+    plot_selection,
+    select_model,
+    selection_status,
+    text_table,
+)
+from ._common import GUARD_EXIT, UsageError, say_next
+from ._many_models import ParallelOptions, models_from, open_executor_for
+from ._next_step import next_step
+from ._reading import read_options
 
-__all__ = ["register"]
+__all__ = ["run_select"]
 
 SELECTION_FILES = ("selection.json", "selection.csv", "selection.png")
 
 
 def _centers(text: str) -> list[str]:
-    from ..compensation import CENTERS
-
     names = [n.strip() for n in text.split(",") if n.strip()]
     unknown = [n for n in names if n not in CENTERS]
     if unknown or not names:
@@ -37,21 +46,9 @@ def _centers(text: str) -> list[str]:
     return names
 
 
-def _select(args: argparse.Namespace) -> int:
-    import pandas as pd  # only this command needs it and matplotlib
-
-    from ..compensation import MODEL_SUFFIXES, folds, protocol, save_compensator
-    from ..io import (
-        atomic_folder,
-        check_output_folder,
-        check_output_path,
-        read_recording,
-        training_reading,
-        write_json,
-    )
-    from ..parallel import loading_meanwhile
-    from ..studies import FIGURE_MODULES, candidates, plot_selection, select_model, text_table
-
+def run_select(args: argparse.Namespace) -> int:
+    """``hystkit select``: family, size, mode and centring chosen on held-out data."""
+    parallel = ParallelOptions.from_args(args)
     check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
                       what="a model file")
     report = args.report or args.out.with_name(args.out.stem + "-selection")
@@ -64,14 +61,14 @@ def _select(args: argparse.Namespace) -> int:
     remembered, not_remembered = training_reading(reading, args.data, units)
     fold_list = folds(recs)
     fit_samples = min((f.n_train for f in fold_list), default=0)
-    cands = candidates(_models(args.models), _centers(args.centers), fit_samples=fit_samples,
+    cands = candidates(models_from(args.models), _centers(args.centers), fit_samples=fit_samples,
                        dt=recs[0].dt)
     t0 = time.perf_counter()
     print(f"selecting among {len(cands)} candidates on {', '.join(map(str, args.data))} "
           f"(deployable R² on held-out data: {protocol(recs)})")
     # while the workers run the map, this process loads the figure's matplotlib and numba for
     # the winner's refit
-    with executor_for(args, len(cands) * len(fold_list)) as executor, \
+    with open_executor_for(parallel, len(cands) * len(fold_list)) as executor, \
             loading_meanwhile(executor, FIGURE_MODULES, numba_ready=True):
         result = select_model(recs, cands, executor=executor, progress=print)
     rows = result["ranking"]
@@ -124,32 +121,3 @@ def _select(args: argparse.Namespace) -> int:
           f"{result['protocol']}; straight line {w['cv_linear_r2']:.4f}{oracle}); "
           f"wrote {args.out}")
     return 0
-
-
-def _default_center() -> str:
-    from ..compensation import DEPLOYABLE_CENTERS
-
-    # every deployable centring: the validation judges each the way it is used (a tare
-    # candidate on recordings that do not start at rest simply scores badly)
-    return ",".join(DEPLOYABLE_CENTERS)
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``select``."""
-    p = sub.add_parser("select", help="choose model family, size, mode and centring, each "
-                                      "validated on held-out data as it will be used")
-    p.add_argument("data", type=Path, nargs="+",
-                   help="training recording(s), one rate; give one per run: each is then held "
-                        "out in turn (left-out recording), the only check of offsets that "
-                        "change between runs")
-    p.add_argument("--out", type=Path, required=True, help="model JSON file of the winner")
-    p.add_argument("--report", type=Path,
-                   help="folder for selection.json/.csv/.png (default: OUT's name + -selection)")
-    p.add_argument("--models", help="comma-separated families (default: all)")
-    deferred(p.add_argument("--centers"), default=_default_center,
-             help=lambda: f"comma-separated centrings to try (default {_default_center()})")
-    add_read_options(p)
-    add_parallel_options(p)
-    # the option's name before issue 13; --workers N does the same
-    p.add_argument("--jobs", type=positive_int, dest="workers", help=argparse.SUPPRESS)
-    p.set_defaults(run=_select)

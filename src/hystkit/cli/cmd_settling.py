@@ -12,33 +12,25 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
 
+import numpy as np
+import pandas as pd
+
+from ..analysis import SettlingFitError, fit_settling, plot_settling, rest_time
 from ..errors import InputError
-from ._common import failures_exit, integer, number
+from ..io import atomic_folder, atomic_output, check_output_folder, check_output_path, write_json
+from ..sensors import simulate_settling_log
+from ._common import failures_exit
+from ._lab_options import HOURS_PER
 
-if TYPE_CHECKING:
-    import numpy as np
-
-__all__ = ["SETTLING_FILES", "register"]
+__all__ = ["SETTLING_FILES", "read_log", "run_settling", "run_simulate_settling"]
 
 SETTLING_FILES = ("settling.json", "settling.png", "settling.svg")
-_HOURS_PER = {"s": 1 / 3600, "min": 1 / 60, "h": 1.0, "d": 24.0}
-
-
-def _names(text: str) -> tuple[str, ...]:
-    names = tuple(n.strip() for n in text.split(",") if n.strip())
-    if not names:
-        raise argparse.ArgumentTypeError(f"expected column names separated by commas, "
-                                         f"got {text!r}")
-    return names
 
 
 def read_log(path: Path, time_column: str | None, time_unit: str,
              traces: tuple[str, ...] | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Hours and the resistance columns [Ohm] of a CSV log; bad cells named by column and row."""
-    import numpy as np
-    import pandas as pd
 
     if path.suffix.lower() != ".csv":
         raise InputError(f"{path}: a settling log is read as CSV (.csv), not "
@@ -70,22 +62,21 @@ def read_log(path: Path, time_column: str | None, time_unit: str,
                              f"number, got {frame[name].iloc[bad[0]]!r}")
         columns[name] = values
     _warn_unit_suffix(time_column, time_unit)
-    t_h = columns.pop(time_column) * _HOURS_PER[time_unit]
+    t_h = columns.pop(time_column) * HOURS_PER[time_unit]
     return t_h, columns
 
 
 def _warn_unit_suffix(time_column: str, time_unit: str) -> None:
     """One warning line when the time column's suffix (``_h``, ``_s``...) names another unit."""
     suffix = time_column.rsplit("_", 1)[-1] if "_" in time_column else ""
-    if suffix in _HOURS_PER and suffix != time_unit:
+    if suffix in HOURS_PER and suffix != time_unit:
         print(f"hystkit: warning: column {time_column!r} looks like {suffix!r} but "
               f"--time-unit is {time_unit!r}; times are read as {time_unit!r} (give "
               f"--time-unit {suffix} if the column's name is right)", file=sys.stderr)
 
 
-def _settling(args: argparse.Namespace) -> int:
-    from ..analysis import SettlingFitError, fit_settling, plot_settling, rest_time
-    from ..io import atomic_folder, check_output_folder, write_json
+def run_settling(args: argparse.Namespace) -> int:
+    """``hystkit settling``: the settling law fitted to each trace of a log."""
 
     check_output_folder(args.out, SETTLING_FILES, args.force, inputs=[args.log])
     t_h, columns = read_log(args.log, args.time_column, args.time_unit, args.traces)
@@ -134,11 +125,9 @@ def _print_fit(name: str, fit, rest) -> None:
           f"(drift |dR/dt| / R_final < {rest.threshold_pct_per_hour:g} %/h) {rest_text}")
 
 
-def _simulate_settling(args: argparse.Namespace) -> int:
-    import pandas as pd
+def run_simulate_settling(args: argparse.Namespace) -> int:
+    """``hystkit simulate-settling``: the virtual sensor's settling log, written."""
 
-    from ..io import atomic_output, check_output_path
-    from ..sensors import simulate_settling_log
 
     check_output_path(args.out, args.force, formats=(".csv",), what="a settling log")
     log = simulate_settling_log(args.hours, args.interval, args.seed)
@@ -148,37 +137,3 @@ def _simulate_settling(args: argparse.Namespace) -> int:
           f"{args.interval:g} min: time_h, r1, r2 (virtual sensor at rest from printing), "
           "block, block_annealed [Ohm]")
     return 0
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``settling`` and ``simulate-settling`` to the ``hystkit`` parser."""
-    p = sub.add_parser("settling", help="fit the resistance settling of freshly printed traces "
-                       "and the rest time before use (sec. 3.5.1)")
-    p.add_argument("log", type=Path, help="CSV log: a time column and one resistance column "
-                   "[Ohm] per trace, t = 0 at the end of printing")
-    p.add_argument("--out", type=Path, required=True,
-                   help="folder for settling.json, settling.png, settling.svg")
-    p.add_argument("--time-column", metavar="NAME",
-                   help="the time column (default: time_h if present, else time)")
-    p.add_argument("--time-unit", choices=list(_HOURS_PER), default="h",
-                   help="unit of the time column (default h)")
-    p.add_argument("--traces", type=_names, metavar="NAME,...",
-                   help="resistance columns to fit (default: every column but time)")
-    p.add_argument("--model", choices=["auto", "rise-drop", "drop"], default="auto",
-                   help="rise then drop (5 parameters), drop only (3), or auto: both, the "
-                        "lower BIC kept (default)")
-    p.add_argument("--threshold", type=number(0, 100, low_open=True), default=0.1,
-                   metavar="PCT_PER_H", help="rest time: the fitted drift |dR/dt| / R_final "
-                   "stays below this for good (default 0.1 %%/h)")
-    p.set_defaults(run=_settling)
-
-    s = sub.add_parser("simulate-settling", help="write a resistance log from printing on: the "
-                       "virtual sensor's gauges at rest and printed/annealed blocks")
-    s.add_argument("--out", type=Path, required=True, help="CSV file to write")
-    s.add_argument("--hours", type=number(0.2, 24 * 365, low_open=False), default=96.0,
-                   metavar="H", help="length of the log (default 96)")
-    s.add_argument("--interval", type=number(0.01, 1440), default=1.0, metavar="MIN",
-                   help="minutes between readings (default 1, as in sec. 3.5.1)")
-    s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0, help="noise seed "
-                   "(default 0)")
-    s.set_defaults(run=_simulate_settling)

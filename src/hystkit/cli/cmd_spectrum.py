@@ -13,22 +13,25 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ._common import integer, number
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from ..io import atomic_folder, check_output_folder, find_raw_config, read_recording, write_json
+from ..preprocess import CutoffRule, raw_gauge_changes, spectrum
 from .cmd_preprocess import SettingsError, raw_settings
 
 if TYPE_CHECKING:  # the library loads when the command runs
     import numpy as np
 
-__all__ = ["register"]
+__all__ = ["run_spectrum"]
 
 SPECTRUM_FILES = ("spectrum.json", "spectrum.png")
-_positive = number(0, low_open=True)
 
 
 def _is_raw(args: argparse.Namespace) -> bool:
     """Raw when asked, when bridge settings are given or stored beside the file, or when the
     file has v1 and v2 columns (variables)."""
-    from ..io import find_raw_config
 
     if args.kind != "auto":
         return args.kind == "raw"
@@ -38,9 +41,6 @@ def _is_raw(args: argparse.Namespace) -> bool:
 
 
 def _column_names(path: Path) -> set[str]:
-    import pandas as pd
-    import pyarrow as pa
-    import pyarrow.parquet as pq
     from scipy.io import whosmat
 
     suffix = path.suffix.lower()
@@ -58,9 +58,7 @@ def _column_names(path: Path) -> set[str]:
 
 def _recording_rows(path: Path) -> tuple[dict[str, np.ndarray], float]:
     """The differential sensor signal and, when the file has them, dr1 and dr2."""
-    import pandas as pd
 
-    from ..io import read_recording
 
     rec = read_recording(path, need_position=False)
     rows = {"differential": rec.sensor}
@@ -73,9 +71,8 @@ def _recording_rows(path: Path) -> tuple[dict[str, np.ndarray], float]:
     return rows, rec.fs
 
 
-def _spectrum(args: argparse.Namespace) -> int:
-    from ..io import atomic_folder, check_output_folder, write_json
-    from ..preprocess import CutoffRule, raw_gauge_changes, spectrum
+def run_spectrum(args: argparse.Namespace) -> int:
+    """``hystkit spectrum``: Welch PSDs and a suggested cut-off."""
 
     check_output_folder(args.out, SPECTRUM_FILES, args.force, inputs=[args.input])
     try:
@@ -137,47 +134,3 @@ def _spectrum(args: argparse.Namespace) -> int:
     print(f"wrote {args.out / 'spectrum.json'} and spectrum.png "
           f"({time.perf_counter() - t0:.1f} s)")
     return 0
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``spectrum``."""
-    p = sub.add_parser("spectrum", help="Welch PSD of each gauge and the differential signal "
-                       "with a suggested Butterworth cut-off (fig. 4.10)")
-    p.add_argument("input", type=Path, help="raw scope recording (v1, v2, encoder) or a "
-                   "recording (time, sensor; dr1, dr2 used when present)")
-    p.add_argument("--out", type=Path, required=True,
-                   help="folder for spectrum.json and spectrum.png")
-    p.add_argument("--kind", choices=["auto", "raw", "data"], default="auto",
-                   help="raw or recording (default auto: raw when bridge settings are given "
-                        "or stored beside the file, or the file has v1 and v2)")
-    p.add_argument("--segment", type=_positive, metavar="S",
-                   help="Welch segment length (default 20 s, bins 0.05 Hz apart, or half the "
-                        "recording when shorter; at least 3 segments are needed)")
-    p.add_argument("--margin", type=_positive, default=10.0, metavar="DB",
-                   help="a line is signal when this far above the local noise floor "
-                        "(default 10 dB)")
-    p.add_argument("--safety", type=number(1), default=2.5, metavar="X",
-                   help="suggested cut-off = X * f_signal (default 2.5, the document's "
-                        "20 Hz / 8 Hz)")
-    p.add_argument("--floor-width", type=_positive, default=4.0, metavar="HZ",
-                   help="running-median width of the local noise floor (default 4 Hz)")
-    p.add_argument("--order", type=integer(1, 10), metavar="N",
-                   help="one-way Butterworth order of the proposed filter (default 2, eq. 4.1)")
-    p.add_argument("--compare", type=_positive, metavar="HZ",
-                   help="also overlay this cut-off (default: the settings' cutoff, else 20 Hz, "
-                        "the document's)")
-    p.add_argument("--fs-analysis", type=_positive, default=1000.0, metavar="HZ",
-                   help="raw: decimate to about this rate before the Welch PSD (default 1000)")
-    p.add_argument("--config", type=Path, help="raw: TOML settings (default: the raw file's "
-                   "stem with .toml, if it exists)")
-    p.add_argument("--r-bridge", type=_positive, metavar="OHM", help="raw: bridge resistor "
-                   "(eq. 4.2)")
-    p.add_argument("--v-supply", type=_positive, metavar="V", help="raw: bridge supply V0")
-    p.add_argument("--supply-channel", action=argparse.BooleanOptionalAction, default=None,
-                   help="raw: use the measured supply column v0 in eq. 4.3 (default: the "
-                        "settings file, else the nominal V0)")
-    p.add_argument("--fs", type=_positive, metavar="HZ",
-                   help="raw: scope sample rate, needed without a time column")
-    p.add_argument("--time-unit", choices=["s", "ms", "us", "ns"],
-                   help="raw: unit of the time column (default s)")
-    p.set_defaults(run=_spectrum)

@@ -21,9 +21,19 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from ._common import UsageError
+from numba import config
 
-__all__ = ["register"]
+from .. import _compilation
+from .._compilation import compiler_seconds, listen
+from ..control import _kernel
+from ..io import Recording, write_recording
+from ..models import FAMILIES
+from ..parallel._contract import make_numba_ready
+from ..sensors import simulate_experiment
+from ._common import UsageError
+from ._main import main
+
+__all__ = ["run_steps", "run_warm", "warm_steps"]
 
 # Seconds of each step on the 2-core machine (2026-11-28, load ~1.5): its work with the
 # kernels cached, and what compiling them adds with an empty cache (34 s in all). The estimate
@@ -68,9 +78,6 @@ def warm_steps(folder: Path, models: Sequence[str], control: bool) -> list[WarmS
 def run_steps(steps: Sequence[WarmStep], progress: Callable[[str], None]) -> float:
     """Run `steps`, one line each to `progress` (seconds, note, estimate of the rest); the
     wall seconds of all."""
-    from .._compilation import compiler_seconds, listen
-    from ..parallel._contract import make_numba_ready
-
     listen()
     make_numba_ready()  # numba's one-off start (~0.2 s), not a kernel: outside the estimate
     t_start, compiling_start, expected = time.perf_counter(), compiler_seconds(), 0.0
@@ -88,9 +95,6 @@ def run_steps(steps: Sequence[WarmStep], progress: Callable[[str], None]) -> flo
 
 def _write_recordings(folder: Path) -> None:
     """The fitting and validation recordings (noise seed 1, sine seed 2), cut short."""
-    from ..io import Recording, write_recording
-    from ..sensors import simulate_experiment
-
     for name, excitation, seed in (("fit.csv", "noise", 1), ("val.csv", "sine", 2)):
         rec = simulate_experiment(excitation, seed)
         short = Recording(rec.time[:N_SAMPLES], rec.sensor[:N_SAMPLES],
@@ -101,8 +105,6 @@ def _write_recordings(folder: Path) -> None:
 def _command(*argv: str, ran: Sequence[int] = (0, 3)) -> str | None:
     """Run ``hystkit ARGV`` here with its output dropped; None, or why it failed. An exit code
     in `ran` counts as run (a fit that fails its guards, exit 3, has compiled all the same)."""
-    from ._main import main
-
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         code = main(list(argv))
@@ -141,18 +143,12 @@ def _kernel_cache() -> str:
     """Where numba caches hystkit's kernels: ``NUMBA_CACHE_DIR`` if set, else one kernel's
     folder (``__pycache__`` beside the sources, or numba's user-wide cache where that is not
     writable)."""
-    from numba import config
-
-    from ..control import _kernel
-
     if config.CACHE_DIR:
         return config.CACHE_DIR
     return f"e.g. {_kernel.identity_step.stats.cache_path}"
 
 
 def _models(text: str | None) -> list[str]:
-    from ..models import FAMILIES
-
     if text is None:
         return list(FAMILIES)
     names = [name.strip() for name in text.split(",") if name.strip()]
@@ -161,9 +157,8 @@ def _models(text: str | None) -> list[str]:
     return names
 
 
-def _warm(args: argparse.Namespace) -> int:
-    from .. import _compilation
-
+def run_warm(args: argparse.Namespace) -> int:
+    """``hystkit warm``: the common commands run once, their kernels compiled and cached."""
     _compilation.announce(None)  # the progress lines say it
     models, control = _models(args.models), not args.no_control
     commands = ("fit, evaluate, stream, compare and control" if control
@@ -177,13 +172,3 @@ def _warm(args: argparse.Namespace) -> int:
         seconds = run_steps(steps, lambda line: print(f"  {line}", flush=True))
     print(f"done in {seconds:.1f} s: later runs load these kernels from the cache")
     return 0
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add the ``warm`` subcommand to the ``hystkit`` parser."""
-    p = sub.add_parser("warm", help="compile the numba kernels of fit, stream, compare and "
-                                    "control ahead, once per installation")
-    p.add_argument("--models", metavar="NAME,...",
-                   help="only these model families (default: all)")
-    p.add_argument("--no-control", action="store_true", help="skip the control loop")
-    p.set_defaults(run=_warm)

@@ -24,6 +24,7 @@ __getattr__, __dir__ = lazy_exports(
      "_generalization_plot": ("plot_generalization",),
      "_demo": ("DEMO_FILES", "DOCUMENT_TABLE_5_5", "format_table", "run_demo"),
      "_figures": ("plot_loops", "plot_time_series"),
+     "_guided": ("explain_choice", "guided_candidates", "guided_select", "selection_status"),
      "_report_model": ("ReportContent", "model_report"),
      "_report_page": ("FIGURE_FORMATS", "build_report", "write_report"),
      "_select": ("Candidate", "candidates", "plot_selection", "select_model"),
