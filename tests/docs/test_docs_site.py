@@ -1,7 +1,7 @@
 """The documentation site builds with warnings as errors (issue 30).
 
 One build, as ``docs/index.md`` documents it (``python -m sphinx -W --keep-going -b html docs
-OUT``, here into a temporary folder), then what it must show: the API pages of
+OUT``, here from a copy of ``docs/`` into a temporary folder), then what it must show: the API pages of
 ``fit_compensator``, ``Stream`` and ``CompensatorEstimator``, a section per subcommand that
 ``hystkit --help`` lists, the tutorial and every example script run by sphinx-gallery with
 their output and figures (an example that raises fails the build), and no link to a missing
@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -36,13 +37,35 @@ _LINK = re.compile(r'(?:href|src)="([^"]+)"')
 _ID = re.compile(r'\bid="([^"]+)"')
 
 
+# What a build writes into its source folder (the API pages, sphinx-gallery's pages): left out
+# of the copy the test builds from, so a build never sees an earlier one's pages.
+GENERATED = frozenset({"_build", "gallery", "tutorial", "reference/api", "sg_execution_times.rst"})
+
+
+def _generated(folder: str, names: list[str]) -> list[str]:
+    return [n for n in names if (Path(folder) / n).relative_to(DOCS).as_posix() in GENERATED]
+
+
+def source_copy(root: Path) -> Path:
+    """``docs/`` copied into `root`, the repository's other entries linked beside it (the pages
+    link to ``../examples`` and ``../benchmarks``): the build writes into the copy, never into
+    the checkout, so two test runs at once (``pytest -n``, two checkouts) cannot collide."""
+    root.mkdir()
+    for entry in ROOT.iterdir():
+        if entry.name != "docs" and not entry.name.startswith("."):
+            (root / entry.name).symlink_to(entry)
+    shutil.copytree(DOCS, root / "docs", ignore=_generated)
+    return root / "docs"
+
+
 @pytest.fixture(scope="module")
 def site(tmp_path_factory) -> Path:
     """The built site's HTML folder; the build's output is in the failure message."""
     out = tmp_path_factory.mktemp("site")
+    docs = source_copy(out / "source")
     proc = subprocess.run(
         [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-b", "html",
-         "-d", str(out / "doctrees"), str(DOCS), str(out / "html")],
+         "-d", str(out / "doctrees"), str(docs), str(out / "html")],
         capture_output=True, text=True, timeout=900, check=False, cwd=ROOT)
     problems = [line for line in (proc.stdout + proc.stderr).splitlines()
                 if "WARNING" in line or "ERROR" in line]
