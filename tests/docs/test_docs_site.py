@@ -1,8 +1,8 @@
 """The documentation site builds with warnings as errors (issue 30).
 
 One build, as ``docs/index.md`` documents it (``python -m sphinx -W --keep-going -b html docs
-OUT``, here from a copy of ``docs/`` into a temporary folder), then what it must show: the API pages of
-``fit_compensator``, ``Stream`` and ``CompensatorEstimator``, a section per subcommand that
+OUT``, here from a copy of ``docs/`` into a temporary folder), then what it must show: the API
+pages of ``fit_compensator``, ``Stream`` and ``CompensatorEstimator``, a section per subcommand that
 ``hystkit --help`` lists, the tutorial and every example script run by sphinx-gallery with
 their output and figures (an example that raises fails the build), and no link to a missing
 page. A Sphinx
