@@ -24,6 +24,7 @@ __getattr__, __dir__ = lazy_exports(
      "_estimator": ("CompensatorEstimator",),
      "_evaluate": ("evaluate", "use_flags"),
      "_fitting": ("fit_compensator",),
+     "_fit_info": ("FitInfo",),
      "_fit_costs": ("check_loss_available", "fit_module_constant", "supported_losses",
                     "weight_column"),
      "_runaway": ("MAX_NORMALISED", "runaway_kind", "runaway_samples"),

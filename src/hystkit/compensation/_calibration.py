@@ -56,7 +56,7 @@ def with_band(comp, recordings: Sequence[Recording], size: int, options: dict | 
         A copy with ``band`` set (None if it could not be calibrated).
     """
     band, note = calibrate_band(comp, recordings, size, options, level=level)
-    return replace(comp, band=band, fit_info={**comp.fit_info, "band": note})
+    return replace(comp, band=band, fit_info=comp.fit_info.with_entries(band=note))
 
 
 def calibrate_band(comp, recordings: Sequence[Recording], size: int,

@@ -34,6 +34,7 @@ from ._centring import (
     sensor_level,
 )
 from ._conventions import LinearBaseline, Scaling
+from ._fit_info import FitInfo
 from ._modes import MODES
 from ._runaway import MAX_NORMALISED, runaway_kind, runaway_samples
 
@@ -93,8 +94,8 @@ class Compensator:
         Offsets and scales of the fitting data (eq. 5.10).
     baseline : LinearBaseline
         Straight line position(sensor) in normalised units.
-    fit_info : dict, optional
-        What the fit reported (status, scores, settings).
+    fit_info : FitInfo or mapping, optional
+        What the fit reported (status, scores, settings); a mapping becomes a `FitInfo`.
     model : str, default "mpl"
         Family name in the registry.
     training_range : tuple of float, optional
@@ -135,7 +136,7 @@ class Compensator:
     center: str
     scaling: Scaling
     baseline: LinearBaseline
-    fit_info: dict = field(default_factory=dict)
+    fit_info: FitInfo = field(default_factory=FitInfo)
     model: str = "mpl"
     training_range: tuple[float, float] | None = None
     polarity: float = 1.0
@@ -180,6 +181,8 @@ class Compensator:
                     raise ValueError(f"{name} must be two finite numbers, low <= high, got "
                                      f"{value!r}")
                 object.__setattr__(self, name, (lo, hi))
+        if not isinstance(self.fit_info, FitInfo):  # a model file's "fit" section, a dict
+            object.__setattr__(self, "fit_info", FitInfo(self.fit_info))
         if self.band is not None and (self.training_range is None
                                       or self.position_range is None):
             raise ValueError("a band needs the training_range and position_range it was "

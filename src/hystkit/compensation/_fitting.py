@@ -14,6 +14,7 @@ R² and AIC/BIC stay on the plain SSE.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -41,6 +42,7 @@ from ._fit_costs import (
     standard_error_caveat,
     weight_column,
 )
+from ._fit_info import FitInfo
 from ._param_vector import flatten_params, simulate_segments
 from ._redundancy import redundancy_notes
 from ._training_checks import MIN_SAMPLES, check_fitting_data, check_training_data
@@ -216,8 +218,7 @@ def fit_compensator(recordings: Recording | Sequence[Recording], size: int | Non
     caveat = standard_error_caveat(info, result)
     if info.get("standard_errors") and caveat:
         info["standard_errors"]["caveat"] = caveat
-    object.__setattr__(comp, "fit_info", info)
-    return comp
+    return replace(comp, fit_info=FitInfo(info))
 
 
 def _fit_family(family: Family, structure: Any, mode: str, s: np.ndarray,

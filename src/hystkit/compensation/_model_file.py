@@ -87,7 +87,7 @@ def compensator_to_dict(comp: Compensator) -> dict:
         "normalisation": asdict(comp.scaling),
         "baseline": asdict(comp.baseline),
         "fit_seconds": comp.fit_info.get("fit_seconds"),
-        "fit": comp.fit_info,
+        "fit": comp.fit_info.to_dict(),
         "training_range": (None if comp.training_range is None
                            else list(comp.training_range)),
         "position_range": (None if comp.position_range is None
