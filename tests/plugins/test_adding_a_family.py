@@ -164,3 +164,12 @@ def test_exported_matlab_runs_in_octave_like_the_compensator(hystkit, work, offl
                    check=True, capture_output=True, timeout=600)
     got = np.loadtxt(work / "m" / "out.txt")
     np.testing.assert_allclose(got, offline[:N_CHECK], rtol=0, atol=1e-9)
+
+
+def test_a_family_that_declares_nothing_fits_the_plain_sse_only(hystkit, work):
+    """Capabilities default to the safe ones: a robust loss is refused in one line, nothing
+    written, instead of being recorded in the model file and ignored."""
+    done = hystkit("fit", "train.csv", "--model", "toy-lag", "--loss", "huber", "--f-scale",
+                   "0.1", "--out", "huber.json", expect=2)
+    assert len(done.stderr.strip().splitlines()) <= 2 and "huber" in done.stderr
+    assert not (work / "huber.json").exists()

@@ -17,8 +17,8 @@ from ._own_layout import add_trained_note
 from ._read_args import add_read_options
 
 __all__ = ["COMPENSATE_NAMES_NOTE", "DEFAULT_MODEL", "GUIDED_HELP", "GUIDED_MODEL",
-           "compensate_options", "demo_options", "evaluate_options", "fit_options",
-           "add_simulation_options", "model_options_given", "simulate_sensor_options"]
+           "add_simulation_options", "compensate_options", "demo_options", "evaluate_options",
+           "fit_options", "model_options_given", "simulate_sensor_options"]
 
 # fit's --model value for the guided fit (issue 27.5)
 GUIDED_MODEL = "auto"

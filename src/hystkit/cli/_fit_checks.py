@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..compensation._fitting import check_loss_available, fit_module_constant
+from ..compensation import check_loss_available
 from ..errors import InputError
 from ..io import read_other_columns
 from ..models import FAMILIES, get_family
@@ -157,7 +157,7 @@ def weight_sum_options(opts: FitOptions, family: Any) -> dict:
                          "polish of several is unconstrained)")
     if opts.loss not in (None, "linear"):
         raise UsageError("--weight-sum-max is solved on the SSE (eq. 5.9), not with --loss")
-    floor = fit_module_constant(family.name, "WEIGHT_SUM_FLOOR", 0.0)
+    floor = family.capabilities.weight_sum_floor
     if not opts.weight_sum_max > floor:
         raise UsageError(f"--weight-sum-max for {family.name} must be above {floor:g} (its "
                          f"fit's gauge fixes w_0 = 1), got {opts.weight_sum_max:g}")

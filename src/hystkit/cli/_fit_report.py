@@ -98,17 +98,17 @@ def _band_lines(comp) -> tuple[str, ...]:
     if comp.band is None:
         return (f"  {note}",) if note else ()
     unit = (comp.fit_info.get("units") or {}).get("position", "")
-    return (f"  prediction band {comp.band.level:.0%}: ±{comp.band.quantile():.4g}"
+    return ((f"  prediction band {comp.band.level:.0%}: ±{comp.band.quantile():.4g}"
             f"{' ' + unit if unit else ''} at the training rate, wider when faster or outside "
-            f"the training range ({note})",)
+            f"the training range ({note})"),)
 
 
 def _cost_lines(info: dict) -> tuple[str, ...]:
     """What a fit minimised when that was not the plain SSE (whose value ``fit`` says)."""
     if info.get("criteria_note") is None:
         return ()
-    return (f"  minimised the {info['objective_label']}: {info['objective']:.4g} "
-            f"(normalised); R², AIC and BIC are on the plain SSE",)
+    return ((f"  minimised the {info['objective_label']}: {info['objective']:.4g} "
+            f"(normalised); R², AIC and BIC are on the plain SSE"),)
 
 
 def units_label(rec) -> str:

@@ -25,7 +25,7 @@ __getattr__, __dir__ = lazy_exports(
      "_evaluate": ("evaluate", "use_flags"),
      "_fitting": ("fit_compensator",),
      "_fit_info": ("FitInfo",),
-     "_fit_costs": ("check_loss_available", "fit_module_constant", "supported_losses",
+     "_fit_costs": ("check_loss_available", "supported_losses",
                     "weight_column"),
      "_runaway": ("MAX_NORMALISED", "runaway_kind", "runaway_samples"),
      "_folds": ("EXTRAPOLATION_NOTE", "ONE_RUN_CAVEAT", "Candidate", "PROTOCOLS", "Fold", "admissible_size",

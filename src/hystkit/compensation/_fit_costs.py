@@ -8,7 +8,6 @@ AIC/BIC stay on the plain SSE, and these notes say so.
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -16,7 +15,6 @@ import numpy as np
 
 from ..errors import InputError
 from ..identification import (
-    LOSSES,
     MAX_WEIGHT,
     FitResult,
     check_cost,
@@ -26,41 +24,14 @@ from ..identification import (
 from ..io import Recording, read_other_columns
 from ..models import get_family
 
-__all__ = ["check_loss_available", "cost_info", "cost_options", "fit_module_constant",
-           "standard_error_caveat", "supported_losses", "weight_column"]
-
-
-def fit_module_constant(model: str, name: str, default: Any) -> Any:
-    """A constant the fit module of family `model` declares (``hystkit.models.<family>.fit``),
-    or `default` where it declares none.
-
-    Parameters
-    ----------
-    model : str
-        A registered family name.
-    name : str
-        The constant's name, e.g. ``SUPPORTED_LOSSES`` or ``WEIGHT_SUM_FLOOR``.
-    default : object
-        The value for a family without it (or without a fit module of its own).
-
-    Returns
-    -------
-    object
-    """
-    package = type(get_family(model)).__module__.rpartition(".")[0]
-    if not package:  # a family object outside a package of its own (a test's stand-in)
-        return default
-    try:
-        fit_module = importlib.import_module(f"{package}.fit")
-    except ModuleNotFoundError:
-        return default
-    return getattr(fit_module, name, default)
+__all__ = ["check_loss_available", "cost_info", "cost_options", "standard_error_caveat",
+           "supported_losses", "weight_column"]
 
 
 def supported_losses(model: str) -> tuple[str, ...]:
-    """The losses model family `model` can fit with (all of
-    :data:`hystkit.identification.LOSSES` unless its ``fit`` module says otherwise in
-    ``SUPPORTED_LOSSES``: the linear-least-squares families fit the SSE only).
+    """The losses model family `model` can fit with: what its capabilities declare
+    (:class:`hystkit.models.Capabilities`; the plain SSE only for a family that declares none,
+    and for the linear-least-squares families).
 
     Parameters
     ----------
@@ -71,7 +42,7 @@ def supported_losses(model: str) -> tuple[str, ...]:
     -------
     tuple of str
     """
-    return tuple(fit_module_constant(model, "SUPPORTED_LOSSES", LOSSES))
+    return tuple(get_family(model).capabilities.losses)
 
 
 def weight_column(recordings: Sequence[Recording], column: str,

@@ -35,10 +35,8 @@ from ._compensator import MODES, Compensator
 from ._conventions import LinearBaseline, prepare_training_data
 from ._diagnostics import MIN_SAMPLES_PER_PARAM, bound_flags, fit_status, fixed_mask
 from ._fit_costs import (
-    check_loss_available,
     cost_info,
     cost_options,
-    fit_module_constant,
     standard_error_caveat,
     weight_column,
 )
@@ -47,9 +45,7 @@ from ._param_vector import flatten_params, simulate_segments
 from ._redundancy import redundancy_notes
 from ._training_checks import MIN_SAMPLES, check_fitting_data, check_training_data
 
-# check_loss_available and fit_module_constant live in ._fit_costs (exported by the package);
-# named here too for the CLI modules that still import them from this module.
-__all__ = ["MIN_SAMPLES", "check_loss_available", "fit_compensator", "fit_module_constant"]
+__all__ = ["MIN_SAMPLES", "fit_compensator"]
 
 # The joint polish differentiates numerically, one model run per parameter: above this many
 # parameters (Preisach grids) it is skipped and the concatenated fit is kept.

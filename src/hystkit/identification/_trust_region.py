@@ -44,8 +44,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._normal_equations import NormalEquations, RunCounter, SolveResult
-from ._trust_region_steps import (coleman_li, gradient_norm, propose, scaled_problem,
-                                  strictly_feasible)
+from ._trust_region_steps import (
+    coleman_li,
+    gradient_norm,
+    propose,
+    scaled_problem,
+    strictly_feasible,
+)
 
 __all__ = ["TrustRegionState", "solve_trust_region"]
 
