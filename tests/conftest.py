@@ -83,3 +83,7 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         funcs = [getattr(item, "function", None), *(d.func for d in _fixture_defs(item))]
         if any(f is not None and _starts_process(f) for f in funcs):
             item.add_marker(pytest.mark.slow)
+    # Files that start processes first (the site build, Octave, cc): under -n they would
+    # otherwise start last and run alone at the end (--no-loadscope-reorder keeps this order).
+    slow_files = {i.path for i in items if i.get_closest_marker("slow")}
+    items.sort(key=lambda i: i.path not in slow_files)  # stable: the files keep their order
