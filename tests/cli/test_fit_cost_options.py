@@ -129,7 +129,8 @@ def test_all_zero_weights(recording, tmp_path, capsys):
 @pytest.mark.parametrize(("argv", "message"), [
     (["--loss", "l1"], "argument --loss: invalid choice: 'l1'"),
     (["--loss", "huber", "--model", "preisach"],
-     "model 'preisach' fits by linear least squares; the huber loss is not available"),
+     ("model 'preisach' fits the plain SSE only (the losses its family declares); "
+     "the huber loss is not available")),
     (["--f-scale", "0.1"], "--f-scale applies to a robust --loss"),
     (["--loss", "cauchy", "--f-scale", "0"], "argument --f-scale"),
     (["--weights", "w", "--weight-sum-max", "100"], "--weight-sum-max is solved on the SSE"),

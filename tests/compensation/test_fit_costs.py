@@ -83,8 +83,8 @@ def test_text_weights_that_are_numbers_are_read(recordings):
 
 
 def test_a_robust_loss_is_refused_before_any_work_for_a_linear_model(recordings):
-    with pytest.raises(InputError, match="model 'pi' fits by linear least squares; the "
-                                         "cauchy loss is not available"):
+    with pytest.raises(InputError, match=r"model 'pi' fits the plain SSE only \(the losses its family "
+                                         r"declares\); the cauchy loss is not available"):
         fit_compensator(recordings[0], model="pi", loss="cauchy")
 
 

@@ -19,7 +19,6 @@ from ..identification import (
     FitResult,
     check_cost,
     cost_label,
-    require_linear_loss,
 )
 from ..io import Recording, read_other_columns
 from ..models import get_family
@@ -143,15 +142,19 @@ def check_loss_available(model: str, loss: str, f_scale: float) -> None:
     Raises
     ------
     InputError
-        If the cost is not valid, or the family fits by linear least squares and `loss` is
-        a robust loss (:func:`hystkit.identification.require_linear_loss`, one line).
+        If the cost is not valid, or `loss` is not one the family's capabilities declare
+        (one line naming the losses it takes).
     """
     try:
         check_cost(loss, f_scale)
     except ValueError as exc:
         raise InputError(str(exc)) from None
-    if loss not in supported_losses(model):
-        require_linear_loss(loss, f_scale, model, "linear least squares")
+    losses = supported_losses(model)
+    if loss not in losses:
+        takes = "the plain SSE only" if losses == ("linear",) else "the losses " + ", ".join(
+            losses)
+        raise InputError(f"model {model!r} fits {takes} (the losses its family declares); "
+                         f"the {loss} loss is not available for it")
 
 
 def cost_options(model: str, loss: str, f_scale: float,
