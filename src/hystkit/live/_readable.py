@@ -218,8 +218,8 @@ def advance_scaled(path: _Path, state: StreamState, sensor: np.ndarray,
 def _half_width(path: _Path, s: np.ndarray,
                 state: BandState) -> tuple[np.ndarray | None, BandState]:
     """The band's half-width [mm] over a chunk of scaled sensor samples, continuing the
-    features from `state` (:func:`._band.band_features`; the same operations as
-    :func:`._band.interval`, so chunked == whole); None without a band."""
+    features from `state` (``compensation._band.band_features``; the same operations as
+    ``compensation._band.interval``, so chunked == whole); None without a band."""
     comp = path.comp
     if comp.band is None:
         return None, state

@@ -32,7 +32,8 @@ class StreamState:
     track_weight : float, default 0.0
         Last output of the same low-pass run on ones: its weight sum (``track``).
     band : BandState, default BandState()
-        What the prediction band's local scale remembers (:mod:`._band`).
+        What the prediction band's local scale remembers
+        (:class:`hystkit.compensation.BandState`).
     """
 
     x: np.ndarray | None
