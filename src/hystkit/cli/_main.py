@@ -42,12 +42,12 @@ _PROGRAM_GC_THRESHOLDS = (700, 10, 100)
 # library, plus its threads' spinning on a busy machine (benchmarks/README.md, start-up).
 _BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")
 # The program's line at its first numba compilation (`hystkit._compilation.announce`): the first
-# run after installing compiles the kernels it needs (2026-11-28, 2 cores: `fit` 10-12 s,
-# `control` 13-15 s, `compare` 40-60 s, against about 1, 1.6 and 6 s with the kernels in
-# numba's cache; benchmarks/bench_first_run.py).
+# run after installing compiles the kernels it needs (2026-11-28, 2 cores, load 3, a fresh
+# numba cache: `fit --model mpl` 5.5 s wall / 3.2 s user, `compare` of every family 30 s wall /
+# 24 s user, against about 1 and 6 s with the kernels in numba's cache).
 COMPILING_NOTICE = ("hystkit: compiling numba kernels, once per installation: this run takes "
-                    "10-60 s longer, later runs load them from numba's cache ('hystkit warm' "
-                    "compiles them ahead)")
+                    "a few seconds (fit) to half a minute (compare) longer, later runs load "
+                    "them from numba's cache ('hystkit warm' compiles them ahead)")
 
 
 def _parser(command: str | None = None, *, options: bool = True) -> Parser:
