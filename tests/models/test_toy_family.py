@@ -1,110 +1,23 @@
-"""A family written in one module, registered at run time, works in fit, compare, control and
-stability with no edit anywhere else: the point of the family protocol."""
+"""A family written outside hystkit (the toy plugin folder, tests/plugins/toy_lag), registered
+at run time in this process, works in fit, compare, control and stability with no edit anywhere
+else: the point of the family protocol. tests/plugins/test_adding_a_family.py runs the same
+folder through the entry point in fresh processes."""
 
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
 
-import numpy as np
 import pytest
-from numba import njit
 from numpy.testing import assert_allclose
 
 from hystkit import control as hc
 from hystkit.compensation import load_compensator
-from hystkit.identification import FitResult, check_fit_data
 from hystkit.io import write_recording
-from hystkit.models import Block, Family, Record, register, unregister
+from hystkit.models import register, unregister
 from hystkit.sensors import simulate_experiment
 
 from ..cli_support import run_cli
-
-RATES = np.geomspace(0.05, 20.0, 25)  # candidate lag rates [1/s] for the grid search
-
-
-@dataclass(frozen=True)
-class LagStructure(Record):
-    dt: float = 0.025
-
-
-@dataclass(frozen=True, eq=False)
-class LagParams(Record):
-    rate: float
-    w0: float
-    w1: float
-    bias: float = 0.0
-
-
-@njit
-def _lag_forward(body, x, xn, off, u):
-    xn[off] = x[off] + body[0] * body[4] * (u - x[off])
-    return body[1] * u + body[2] * x[off] + body[3]
-
-
-@njit
-def _lag_inverse(body, x, xn, off, y):
-    u = (y - body[2] * x[off] - body[3]) / body[1]
-    xn[off] = x[off] + body[0] * body[4] * (u - x[off])
-    return u
-
-
-class LagFamily(Family):
-    """y = w0 u + w1 x + bias with a first-order lag x' = rate (u - x): a toy, not hysteresis."""
-
-    name = "toy-lag"
-    title = "first-order lag (a toy family defined in a test)"
-    size_help = "ignored"
-    Structure = LagStructure
-    Params = LagParams
-
-    def make_structure(self, dt, size, **options):
-        return LagStructure(dt)
-
-    def rest_state(self, structure, params, value, inverse=False):
-        if inverse:
-            value = (value - params.bias) / (params.w0 + params.w1)
-        return np.array([float(value)])
-
-    def step(self, structure, params, x, u):
-        y = params.w0 * u + params.w1 * x[0] + params.bias
-        return float(y), np.array([x[0] + params.rate * structure.dt * (u - x[0])])
-
-    def invert_step(self, structure, params, x, y):
-        u = (y - params.w1 * x[0] - params.bias) / params.w0
-        return float(u), np.array([x[0] + params.rate * structure.dt * (u - x[0])])
-
-    def run_cli(self, step, structure, params, u, x0, inverse):
-        u = np.asarray(u, dtype=float)
-        x = self.rest_state(structure, params, float(u[0]), inverse) if x0 is None else x0
-        y = np.empty_like(u)
-        for k, u_k in enumerate(u):
-            y[k], x = step(structure, params, x, u_k)
-        return y, x
-
-    def simulate(self, structure, params, u, x0=None):
-        return self.run_cli(self.step, structure, params, u, x0, False)
-
-    def invert(self, structure, params, y, x0=None):
-        return self.run_cli(self.invert_step, structure, params, y, x0, True)
-
-    def fit(self, u, y, structure, *, accept=None, accept_reason="", **options):
-        u, y = check_fit_data(u, y)
-        best = None
-        for rate in RATES:
-            lag = self.simulate(structure, LagParams(rate, 0.0, 1.0), u)[0]
-            coef = np.linalg.lstsq(np.column_stack([u, lag, np.ones_like(u)]), y, rcond=None)[0]
-            x = LagParams(rate, *coef)
-            cost = float(np.sum((self.simulate(structure, x, u)[0] - y) ** 2))
-            if best is None or cost < best[0]:
-                best = (cost, x)
-        return FitResult(structure=structure, params=best[1], cost=best[0],
-                         n_evaluations=RATES.size, seconds=0.0, converged=True,
-                         message="grid search", n_starts=RATES.size)
-
-    def block(self, structure, params, inverse=False):
-        body = np.array([params.rate, params.w0, params.w1, params.bias, structure.dt])
-        return Block(_lag_inverse if inverse else _lag_forward, body, 1)
+from ..plugins.toy_lag.family import LagFamily, LagParams, LagStructure
 
 
 @pytest.fixture
