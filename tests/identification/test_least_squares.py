@@ -79,31 +79,3 @@ def test_every_solver_finds_the_box_optimum(solver):
     # cost of the clipped target: (5 - 1)^2 + (-4 + 1)^2 = 25, to the bounds' margin
     assert_allclose(result.cost, 25.0, rtol=1e-6)
     assert_allclose(result.sensitivity, np.ones(3), rtol=1e-6)  # J = I
-
-
-def _on_bound(sensitivity: float, cost: float):
-    """A fit whose coordinate 1 ends on its upper bound, with that coordinate's Jacobian
-    column norm `sensitivity` (coordinate 0's is 1) and SSE `cost`."""
-    from hystkit.identification import FitResult
-
-    return FitResult(structure=None, params=None, cost=cost, n_evaluations=1, seconds=0.0,
-                     converged=True, message="", n_starts=1, theta=np.array([0.0, 1.0]),
-                     bounds=(np.array([-1.0, -1.0]), np.array([1.0, 1.0])), names=["a", "b"],
-                     sensitivity=np.array([1.0, sensitivity]))
-
-
-def test_a_coordinate_the_data_cannot_place_is_a_note_in_both_directions():
-    """On a bound, a coordinate whose whole box moves the output by less than FLAT_SHARE of
-    the misfit (first order) constrains nothing: a note. One that moves it more is a failed
-    guard, however small its column next to the largest."""
-    from hystkit.identification._result import FLAT_SHARE
-
-    misfit = 0.5  # sqrt(SSE)
-    width = 2.0
-    flat = FLAT_SHARE * misfit / width
-    on_bounds, notes = bound_flags(_on_bound(0.5 * flat, misfit ** 2))
-    note = "b does not affect the model output at the optimum (its upper bound holds nothing)"
-    assert on_bounds == [] and notes == [note]
-    assert bound_flags(_on_bound(2.0 * flat, misfit ** 2))[0] == ["b (upper)"]
-    # a perfect fit (no misfit): only an exactly insensitive coordinate is excused
-    assert bound_flags(_on_bound(1e-6, 0.0))[0] == ["b (upper)"]

@@ -14,11 +14,6 @@ __all__ = ["INSENSITIVE", "BoundHit", "FitResult"]
 # A coordinate whose Jacobian column is below this share of the largest column does not affect
 # the model output at the optimum (e.g. V_T of an mPL cell at the Euler slope cap: exactly 0).
 INSENSITIVE = 1e-10
-# ... or moving it across its whole box would change the output, to first order, by less than
-# this share of the misfit's norm sqrt(SSE): the data cannot tell where in the box it lies
-# (the Chua element's saturated v_g at 2.8e-9 of the largest column, the fit's SSE unchanged
-# to 4 digits whether it ends at 960 or at its bound 1000), so its bound constrains nothing.
-FLAT_SHARE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -128,8 +123,7 @@ class FitResult:
 
         None when the fit did not record ``theta`` and ``bounds``. A coordinate on a model
         limit carries that limit's note (``BoundHit.limit``), and so does one that does not
-        affect the output at the optimum (Jacobian column below ``INSENSITIVE`` x the largest,
-        or column x box width below ``FLAT_SHARE`` x sqrt(cost)).
+        affect the output at the optimum (Jacobian column below ``INSENSITIVE`` x the largest).
         """
         if self.theta is None or self.bounds is None:
             return None
@@ -141,8 +135,6 @@ class FitResult:
         if self.sensitivity is not None:
             norms = np.asarray(self.sensitivity, dtype=float)
             free = norms <= INSENSITIVE * max(float(np.max(norms, initial=0.0)), 1e-300)
-            misfit = np.sqrt(max(float(self.cost), 0.0))
-            free |= np.isfinite(upper - lower) & (norms * width <= FLAT_SHARE * misfit)
         hits = []
         for side, on_side in (("lower", np.isfinite(lower) & (theta - lower <= tol)),
                               ("upper", np.isfinite(upper) & (upper - theta <= tol))):
