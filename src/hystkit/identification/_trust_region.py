@@ -44,13 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._normal_equations import NormalEquations, RunCounter, SolveResult
-from ._trust_region_steps import (
-    coleman_li,
-    gradient_norm,
-    propose,
-    scaled_problem,
-    strictly_feasible,
-)
+from ._trust_region_steps import coleman_li, propose, scaled_problem, strictly_feasible
 
 __all__ = ["TrustRegionState", "solve_trust_region"]
 
@@ -100,16 +94,12 @@ def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations]
         alpha = 0.0
     status = None
     while True:
-        if status is not None or runs.nfev >= max_nfev:
-            # no step follows: the gtol test alone, without the scaled problem's SVD
-            if gradient_norm(x, ne.jtr, lb, ub) < gtol:
-                status = 1
-            break
         # raises scale_inv to the column norms at x (once per accepted point, as scipy)
         d, diag_h, g_h, h_h, eig, vecs, sg, g_norm = scaled_problem(x, ne.jtj, ne.jtr, lb, ub,
                                                                     scale_inv)
         if g_norm < gtol:
             status = 1
+        if status is not None or runs.nfev >= max_nfev:
             break
         theta = max(0.995, 1.0 - g_norm)
         x_norm = _norm(x)

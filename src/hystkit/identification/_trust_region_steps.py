@@ -22,8 +22,7 @@ import math
 import numpy as np
 from scipy.linalg import lapack
 
-__all__ = ["coleman_li", "gradient_norm", "propose", "scaled_problem", "square_root",
-           "strictly_feasible"]
+__all__ = ["coleman_li", "propose", "scaled_problem", "square_root", "strictly_feasible"]
 
 _EPS = np.finfo(float).eps
 
@@ -97,7 +96,7 @@ def scaled_problem(x, jtj, g, lb, ub, scale_inv):
     root = square_root(jtj)
     np.maximum(scale_inv, np.sqrt(np.maximum(jtj.diagonal(), 0.0)), out=scale_inv)
     v, dv = coleman_li(x, g, lb, ub)
-    g_norm = _scaled_gradient_norm(g, v)
+    g_norm = float(np.abs(g * v).max())
     v = np.where(dv != 0, v * scale_inv, v)
     d = np.sqrt(v) / scale_inv
     diag_h = g * dv / scale_inv
@@ -114,16 +113,6 @@ def scaled_problem(x, jtj, g, lb, ub, scale_inv):
     if info != 0:
         raise np.linalg.LinAlgError("SVD did not converge")
     return d, diag_h, g_h, h_h, sv ** 2, vecs_t.T, vecs_t @ g_h, g_norm
-
-
-def gradient_norm(x: np.ndarray, g: np.ndarray, lb: np.ndarray, ub: np.ndarray) -> float:
-    """``||v g||_inf`` with ``v`` the Coleman-Li scaling at ``x``: :func:`scaled_problem`'s
-    ``g_norm`` alone (the gtol test where no step follows)."""
-    return _scaled_gradient_norm(g, coleman_li(x, g, lb, ub)[0])
-
-
-def _scaled_gradient_norm(g: np.ndarray, v: np.ndarray) -> float:
-    return float(np.abs(g * v).max())
 
 
 def _norm(v: np.ndarray) -> float:
