@@ -17,7 +17,7 @@ from scipy.optimize._lsq.common import (
 )
 from scipy.optimize._lsq.trf import select_step
 
-from hystkit.identification._trust_region_steps import coleman_li, propose, scaled_problem
+from hystkit.identification._trust_region_steps import propose, scaled_problem
 
 
 def _problem(seed: int, half_width: float):
@@ -103,17 +103,3 @@ def test_normal_equations_that_are_not_finite_are_refused(bad):
     jtj[0, 1] = jtj[1, 0] = bad
     with pytest.raises(np.linalg.LinAlgError, match="infs or NaNs"):
         scaled_problem(x, jtj, jtr, lb, ub, np.ones(x.size))
-
-
-@pytest.mark.parametrize("seed", range(5))
-def test_coleman_li_scaling_is_scipy_s(seed):
-    """Gradients of either sign, zero or NaN, against finite and infinite bounds."""
-    rng = np.random.default_rng(seed)
-    p = 40
-    x = rng.normal(size=p)
-    g = rng.choice([-1.0, 0.0, 1.0, np.nan], size=p) * rng.uniform(0.5, 2.0, p)
-    lb = np.where(rng.random(p) < 0.3, -np.inf, x - rng.uniform(0.0, 1.0, p))
-    ub = np.where(rng.random(p) < 0.3, np.inf, x + rng.uniform(0.0, 1.0, p))
-    v, dv = coleman_li(x, g, lb, ub)
-    want_v, want_dv = CL_scaling_vector(x, g, lb, ub)
-    assert np.array_equal(v, want_v) and np.array_equal(dv, want_dv)

@@ -112,7 +112,7 @@ def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations]
                 new_cost = trial.cost
             else:
                 trial, new_cost = None, runs.cost(cost, x_new)
-            if not math.isfinite(new_cost):
+            if not np.isfinite(new_cost):
                 delta = 0.25 * step_h_norm
                 continue
             actual = ne.cost - new_cost
@@ -149,7 +149,7 @@ def _result(x, cost, status, runs, column_norms, state=None) -> SolveResult:
 
 
 def _column_norms(jtj: np.ndarray) -> np.ndarray:
-    return np.sqrt(np.maximum(jtj.diagonal(), 0.0))
+    return np.sqrt(np.maximum(np.diag(jtj), 0.0))
 
 
 def _update_radius(delta, actual, predicted, step_norm, bound_hit):

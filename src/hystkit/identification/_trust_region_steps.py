@@ -31,12 +31,11 @@ def coleman_li(x: np.ndarray, g: np.ndarray, lb: np.ndarray,
                ub: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Coleman-Li scaling vector ``v`` and its derivative sign ``dv`` (scipy's
     ``CL_scaling_vector``)."""
-    # whole-vector operations: masked assignments cost ~1 us each on 10 entries
-    v = np.where(g < 0, ub - x, x - lb)
-    dv = np.sign(g)
-    free = (dv * dv != 1) | ~(np.abs(v) < np.inf)  # g = 0 or NaN, or the bound infinite
-    if free.any():
-        v[free], dv[free] = 1.0, 0.0
+    v, dv = np.ones(x.size), np.zeros(x.size)
+    upper = (g < 0) & np.isfinite(ub)
+    v[upper], dv[upper] = ub[upper] - x[upper], -1.0
+    lower = (g > 0) & np.isfinite(lb)
+    v[lower], dv[lower] = x[lower] - lb[lower], 1.0
     return v, dv
 
 
@@ -94,18 +93,18 @@ def scaled_problem(x, jtj, g, lb, ub, scale_inv):
     ||v g||_inf`` (the gtol measure).
     """
     root = square_root(jtj)
-    np.maximum(scale_inv, np.sqrt(np.maximum(jtj.diagonal(), 0.0)), out=scale_inv)
+    np.maximum(scale_inv, np.sqrt(np.maximum(np.diagonal(jtj), 0.0)), out=scale_inv)
     v, dv = coleman_li(x, g, lb, ub)
-    g_norm = float(np.abs(g * v).max())
-    v = np.where(dv != 0, v * scale_inv, v)
+    g_norm = float(np.max(np.abs(g * v)))
+    moving = dv != 0
+    v[moving] *= scale_inv[moving]
     d = np.sqrt(v) / scale_inv
     diag_h = g * dv / scale_inv
     g_h = d * g
-    h_h = jtj * (d[:, None] * d)
-    p = x.size
-    stacked = np.zeros((2 * p, p), order="F")
-    np.multiply(root, d, out=stacked[:p])
-    stacked[p:].flat[::p + 1] = np.sqrt(diag_h)
+    h_h = jtj * np.outer(d, d)
+    stacked = np.empty((2 * x.size, x.size), order="F")
+    stacked[:x.size] = root * d
+    stacked[x.size:] = np.diag(np.sqrt(diag_h))
     if not np.isfinite(stacked).all():
         _refuse_non_finite()
     _, sv, vecs_t, info = lapack.dgesdd(stacked, compute_uv=1, full_matrices=0,
@@ -119,11 +118,10 @@ def _norm(v: np.ndarray) -> float:
     return math.sqrt(float(v @ v))
 
 
-def _secular(sg: np.ndarray, eig: np.ndarray, alpha: float) -> tuple[float, float]:
-    """``||sg / (eig + alpha)||`` and ``sum(sg^2 / (eig + alpha)^3)``."""
-    denom = eig + alpha
-    q = sg / denom
-    return math.sqrt(float(q @ q)), float(q @ (q / denom))
+def _secular(sg2: np.ndarray, eig: np.ndarray, alpha: float) -> tuple[float, float]:
+    """``||sg / (eig + alpha)||`` and ``sum(sg^2 / (eig + alpha)^3)`` (``sg2 = sg^2``)."""
+    q = sg2 / (eig + alpha) ** 2
+    return math.sqrt(float(q.sum())), float((q / (eig + alpha)).sum())
 
 
 def _trust_region_step(eig, vecs, sg, delta, alpha):
@@ -135,17 +133,18 @@ def _trust_region_step(eig, vecs, sg, delta, alpha):
         p = -(vecs @ (sg / eig))
         if _norm(p) <= delta:
             return p, 0.0
-    alpha_upper = _norm(sg) / delta
+    sg2 = sg * sg
+    alpha_upper = math.sqrt(float(sg2.sum())) / delta
     alpha_lower = 0.0
     if full_rank:
-        p_norm, cubes = _secular(sg, eig, 0.0)
+        p_norm, cubes = _secular(sg2, eig, 0.0)
         alpha_lower = (p_norm - delta) * p_norm / cubes
     if not full_rank and alpha == 0:
         alpha = max(0.001 * alpha_upper, (alpha_lower * alpha_upper) ** 0.5)
     for _ in range(10):
         if alpha < alpha_lower or alpha > alpha_upper:
             alpha = max(0.001 * alpha_upper, (alpha_lower * alpha_upper) ** 0.5)
-        p_norm, cubes = _secular(sg, eig, alpha)
+        p_norm, cubes = _secular(sg2, eig, alpha)
         phi = p_norm - delta
         if phi < 0:
             alpha_upper = alpha
@@ -219,8 +218,6 @@ def propose(x, h_h, diag_h, g_h, eig, vecs, sg, d, delta, alpha, lb, ub, theta):
     p_h, alpha = _trust_region_step(eig, vecs, sg, delta, alpha)
     p = d * p_h
     x_p = x + p
-    if (lb < x_p).all() and (x_p < ub).all():  # the common case: x_p is the trial point
-        return x_p, _norm(p), _norm(p_h), -_model_value(h_h, g_h, p_h, diag_h), alpha
     if (lb <= x_p).all() and (x_p <= ub).all():
         step, step_h, predicted = p, p_h, -_model_value(h_h, g_h, p_h, diag_h)
     else:
