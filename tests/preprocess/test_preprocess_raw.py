@@ -395,7 +395,7 @@ def test_demo_raw_path_round_trip():
 
 
 def test_demo_raw_flag_prints_the_raw_path(tmp_path, capsys, monkeypatch):
-    import hystkit.studies
+    from hystkit.cli import cmd_simulate
 
     canned = {"metrics": {}, "noise_trained": {}, "config": {},
               "raw_path": {"excitation": "sine", "scope_rate_hz": 5e4,
@@ -406,7 +406,7 @@ def test_demo_raw_flag_prints_the_raw_path(tmp_path, capsys, monkeypatch):
                                "position_max_error_um": 0.4, "position_max_error_counts": 0.08,
                                "sensor_rms_error": 4e-5, "n_illegal": 0, "n_edges": 240000}}}}
     calls = []
-    monkeypatch.setattr(hystkit.studies, "run_demo",
+    monkeypatch.setattr(cmd_simulate, "demo_study",
                         lambda out, **kw: calls.append(kw) or canned)
     assert main(["demo", "--out", str(tmp_path), "--cells", "1", "--raw"]) == 0
     out = capsys.readouterr().out

@@ -34,8 +34,15 @@ TABLE_II = "table-ii-"
 
 
 class LoopError(ValueError):
-    """A part of the setup that cannot serve: ``part`` is ``"sensor"``, ``"compensator"``,
-    ``"model"`` (the model file of ``S_m``) or ``"loop"`` (the combination)."""
+    """A part of the setup that cannot serve.
+
+    Parameters
+    ----------
+    part : {"sensor", "compensator", "model", "loop"}
+        Which part: ``"model"`` is the model file of ``S_m``, ``"loop"`` the combination.
+    message : str
+        What is wrong, one line.
+    """
 
     def __init__(self, part: str, message: str) -> None:
         super().__init__(message)
@@ -109,7 +116,17 @@ class LoopSetup:
 
 @dataclass(frozen=True, eq=False)
 class SetupResult:
-    """The loop built, its sensor models and the seconds they took (fitted or read)."""
+    """The loop built, its sensor models and the seconds they took.
+
+    Parameters
+    ----------
+    loop : ControlLoop
+        The loop, every slot filled.
+    models : SensorModels
+        The sensor models of ch. 7 it was built from.
+    fit_seconds : float
+        Seconds the sensor models took, fitted or read from the disk cache.
+    """
 
     loop: ControlLoop
     models: SensorModels
@@ -118,6 +135,16 @@ class SetupResult:
 
 def sensor_from(setup: LoopSetup) -> SensorBlock | None:
     """``S_r`` as the setup names it; None for one fitted on the virtual sensor or a recording.
+
+    Parameters
+    ----------
+    setup : LoopSetup
+        The loop's definition.
+
+    Returns
+    -------
+    SensorBlock or None
+        The sensor's block, or None when it is fitted.
 
     Raises
     ------
@@ -148,6 +175,16 @@ def _block(make, compensator: Compensator, name: str, part: str) -> SensorBlock:
 def setup_loop(setup: LoopSetup) -> SetupResult:
     """The loop of `setup`: its sensor models fitted (or read from the disk cache), model
     files in their slots, the PID tuned and the DOB designed when asked.
+
+    Parameters
+    ----------
+    setup : LoopSetup
+        The loop's definition.
+
+    Returns
+    -------
+    SetupResult
+        The loop, its sensor models and the seconds they took.
 
     Raises
     ------

@@ -28,7 +28,19 @@ __all__ = ["ControlRun", "LoopStudy", "Tuning", "examine_loop", "run_control"]
 
 @dataclass(frozen=True)
 class Tuning:
-    """The options of :func:`~hystkit.control.tune_nonlinear` (its defaults)."""
+    """The options of :func:`~hystkit.control.tune_nonlinear` (its defaults).
+
+    Parameters
+    ----------
+    objective : {"rms", "max"}, default "rms"
+        ``e_p_rms`` or ``e_p_max`` is minimised.
+    budget : int, default 300
+        Budget of simulations (``max_evaluations``).
+    min_phase_margin : float, default 30.0
+        Phase margin the linearised loop keeps [deg].
+    min_gain_margin : float, default 6.0
+        Gain margin the linearised loop keeps [dB].
+    """
 
     objective: str = "rms"
     budget: int = 300
@@ -126,8 +138,17 @@ def run_control(setup: LoopSetup, *, experiment: str | None = None,
 
 @dataclass(frozen=True, eq=False)
 class LoopStudy:
-    """``hystkit stability --control``: the loop, its global stability report
-    (:func:`~hystkit.control.global_stability`) and its linearised margins."""
+    """``hystkit stability --control``: the loop, its global stability and its margins.
+
+    Parameters
+    ----------
+    setup : SetupResult
+        The loop as set up, its models and their seconds.
+    report : StabilityReport
+        Its global stability (:func:`~hystkit.control.global_stability`).
+    margins : LoopMargins
+        The linearised loop's margins.
+    """
 
     setup: SetupResult
     report: Any

@@ -55,8 +55,22 @@ SKIPPED = "not validated: its turn came after the time budget's validation share
 def guided_candidates(recordings: Sequence, mode: str = "direct", center: str = "fit"
                       ) -> list:
     """`SHORT_LIST` as `hystkit.compensation.Candidate`, cheapest first, without those the
-    smallest fold cannot fit (too few samples per parameter) or that have no inverse (`mode`
-    ``"inverse"``)."""
+    smallest fold cannot fit (too few samples per parameter) or that have no inverse.
+
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        The training recordings (their folds decide what fits).
+    mode : {"direct", "inverse"}, default "direct"
+        The compensator's mode; ``"inverse"`` keeps the families with an inverse.
+    center : str, default "fit"
+        The centring of every candidate.
+
+    Returns
+    -------
+    list of Candidate
+        The candidates, cheapest fit first.
+    """
     n_train = min((f.n_train for f in folds(recordings)), default=0)
     dt = recordings[0].dt
     kept = [Candidate(name, size, mode, center) for name, size in SHORT_LIST
@@ -161,10 +175,21 @@ def guided_select(recordings: Sequence, *, budget: float = DEFAULT_BUDGET, mode:
 
 
 def selection_status(result: dict) -> str:
-    """Why a selection has no winner, as a `next_step` status: ``no_signal`` (no candidate
-    explains the position), ``worse_than_line``, ``refit`` (the best ones' fits on all the data
-    failed their guards), ``skipped`` (nothing validated within the budget), ``failed``
-    (every candidate failed); ``ok`` when it has one."""
+    """Why a selection has no winner, as a `next_step` status.
+
+    Parameters
+    ----------
+    result : dict
+        What the selection returned (``winner``, ``ranking``, ``skipped``).
+
+    Returns
+    -------
+    str
+        ``no_signal`` (no candidate explains the position), ``worse_than_line``, ``refit``
+        (the best ones' fits on all the data failed their guards), ``skipped`` (nothing
+        validated within the budget), ``failed`` (every candidate failed); ``ok`` when it has
+        a winner.
+    """
     if result["winner"] is not None:
         return "ok"
     scored = [r for r in result["ranking"] if "error" not in r]
@@ -179,7 +204,20 @@ def selection_status(result: dict) -> str:
 
 def explain_choice(result: dict, n_folds: int) -> list[str]:
     """The guided fit's three lines: what won and why, its held-out score with the protocol
-    named, the runner-up and why not the others."""
+    named, the runner-up and why not the others.
+
+    Parameters
+    ----------
+    result : dict
+        What the selection returned, with a winner.
+    n_folds : int
+        How many folds the held-out score is the mean of.
+
+    Returns
+    -------
+    list of str
+        The three lines.
+    """
     w = result["winner"]
     usable = [r for r in result["ranking"] if "error" not in r and not r["guard_failed"]
               and r["verdict"] == "ok" and r is not w]
