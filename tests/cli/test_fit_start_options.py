@@ -106,12 +106,14 @@ def test_init_list_prints_the_presets_of_the_model_wherever_it_stands(capsys, mo
 
 def test_mpl_g_weight_sum_floor_is_refused_before_the_data_are_read(recordings, tmp_path,
                                                                     capsys, monkeypatch):
-    import hystkit.io
+    from hystkit.cli import _reading
 
     def unread(*args, **kwargs):
         raise AssertionError("the data were read")
 
-    monkeypatch.setattr(hystkit.io, "read_recording", unread)
+    # the names the CLI reads with (imported at the top of cli._reading)
+    monkeypatch.setattr(_reading, "read_recording", unread)
+    monkeypatch.setattr(_reading, "read_pieces", unread)
     code, _, err = run_cli(capsys, "fit", recordings["sine"], "--model", "mpl-g",
                         "--weight-sum-max", "1", "--out", tmp_path / "g.json")
     assert code == 2

@@ -16,8 +16,7 @@ import numpy as np
 import pytest
 from matplotlib.image import imread
 
-import hystkit.studies
-from hystkit.cli import main
+from hystkit.cli import cmd_select, main
 from hystkit.errors import InputError
 from hystkit.io import Recording, write_recording
 from hystkit.sensors import simulate_experiment
@@ -77,7 +76,9 @@ def folders(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     assert main(["generalize", str(fit), str(val), "--models", "mpl", "--out",
                  str(out["gen"])]) == 0
     with pytest.MonkeyPatch.context() as patch:  # two candidates instead of every family
-        patch.setattr(hystkit.studies, "candidates", lambda *a, **k: [
+        # the name select calls (imported at the top of cmd_select): patching the package's
+        # would leave this process's select with two candidates for every later test
+        patch.setattr(cmd_select, "candidates", lambda *a, **k: [
             Candidate("mpl", 1, "direct", "fit"), Candidate("mpl", 2, "direct", "fit")])
         assert main(["select", str(fit), "--out", str(root / "sel.json"), "--report",
                      str(out["sel"]), "--workers", "1"]) == 0  # serial: no cluster to start
