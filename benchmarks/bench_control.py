@@ -15,12 +15,15 @@ temporary folder and fed the same blocks in its own packing. Both are called wit
 arguments; A and B alternate (A B A B ...) so bursts of load hit both alike; medians of the
 repeats and the median of the paired ratios are reported.
 
-Table 3 (whole command). Wall time of a warm ``hystkit control --scheme direct --experiment sine``
-(a fresh process each: interpreter, imports, sensor models, loop kernel from numba's cache, the
-run, metrics and figure written), this tree (or ``--src DIR``) against ``REFERENCE`` (extracted with ``git archive``
-into a temporary folder and run with ``PYTHONPATH``); one untimed run of each first fills the
-caches (numba's, and this tree's sensor models in a temporary ``HYSTKIT_CACHE_DIR``), then
-``COMMAND_REPEATS`` pairs A B A B, medians and the median of the paired ratios.
+Table 3 (whole command). Wall and CPU time (user + system of the child, from ``getrusage``) of a
+warm ``hystkit control --scheme direct --experiment sine`` (a fresh process each: interpreter,
+imports, sensor models and margins from the disk cache, loop kernel from numba's cache, the run,
+metrics and figure written), this tree (or ``--src DIR``) against ``--reference`` (default
+``REFERENCE``; extracted with ``git archive`` into a temporary folder and run with
+``PYTHONPATH``); one untimed run of each first fills the caches (numba's, and the sensor models
+and margins in a temporary ``HYSTKIT_CACHE_DIR`` shared by both: its keys name the code), then
+``COMMAND_REPEATS`` pairs A B A B, medians and the medians of the paired ratios. CPU is quoted
+beside wall because the machine is shared: wall moves with the load, CPU far less.
 
 Table 2 (families and references). ``simulate_loop`` with a 3-cell mPL, a 10-operator PI and a
 20-level Preisach compensator (S_r stays the mPL; ``first call`` includes compiling the loop for
@@ -37,6 +40,7 @@ import importlib
 import io
 import os
 import platform
+import resource
 import statistics
 import subprocess
 import sys
@@ -63,7 +67,7 @@ SECONDS = 5.0
 REPEATS = 21
 PY_REPEATS = 3
 BEFORE = "411a485"  # the last commit before the family protocol
-REFERENCE = "2bff934"  # before the sensor models were cached on disk (issue 29)
+REFERENCE = "7ec2408"  # before pandas left the loop run (issue 29.3); 2bff934: before the disk cache
 COMMAND = ["control", "--scheme", "direct", "--experiment", "sine"]
 COMMAND_REPEATS = 9
 REPO = Path(__file__).resolve().parents[1]
@@ -180,35 +184,43 @@ def family_rows(r: np.ndarray, models: hc.SensorModels) -> list[tuple]:
     return rows
 
 
-def reference_source(folder: Path) -> Path:
-    """``REFERENCE``'s ``src`` extracted into `folder` (a checkout shared with others stays
+def reference_source(folder: Path, reference: str) -> Path:
+    """`reference`'s ``src`` extracted into `folder` (a checkout shared with others stays
     untouched)."""
-    archive = subprocess.run(["git", "archive", REFERENCE, "src"], cwd=REPO, check=True,
+    archive = subprocess.run(["git", "archive", reference, "src"], cwd=REPO, check=True,
                              capture_output=True).stdout
     with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
         tar.extractall(folder, filter="data")
     return folder / "src"
 
 
-def whole_command(folder: Path, src: Path) -> tuple[float, float, float]:
-    """Medians of the warm command's wall time [s], the tree `src` and the reference, and the
-    median of the paired ratios."""
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def whole_command(folder: Path, src: Path, reference: str) -> dict[str, tuple[float, float]]:
+    """Medians of the warm command's wall and CPU time [s]: ``hystkit`` (the tree `src`),
+    ``before`` (`reference`) and ``ratio`` (the medians of the paired ratios)."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "OPENBLAS_NUM_THREADS")}
-    variants = {"hystkit": {**env, "HYSTKIT_CACHE_DIR": str(folder / "cache"),
-                            "PYTHONPATH": str(src)},
-                "before": {**env, "PYTHONPATH": str(reference_source(folder / "ref"))}}
-    times: dict[str, list[float]] = {name: [] for name in variants}
+    env["HYSTKIT_CACHE_DIR"] = str(folder / "cache")
+    variants = {"hystkit": {**env, "PYTHONPATH": str(src)},
+                "before": {**env, "PYTHONPATH": str(reference_source(folder / "ref", reference))}}
+    times: dict[str, list[tuple[float, float]]] = {name: [] for name in variants}
     for k in range(COMMAND_REPEATS + 1):
         for name, variant_env in variants.items():
             out = folder / f"run-{name}-{k}"
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), _children_cpu()
             subprocess.run([sys.executable, "-m", "hystkit", *COMMAND, "--out", str(out)],
                            env=variant_env, cwd=folder, check=True, capture_output=True)
             if k:  # the first pair fills the caches
-                times[name].append(time.perf_counter() - t0)
-    ratios = [a / b for a, b in zip(times["hystkit"], times["before"], strict=True)]
-    return (statistics.median(times["hystkit"]), statistics.median(times["before"]),
-            statistics.median(ratios))
+                times[name].append((time.perf_counter() - t0, _children_cpu() - c0))
+    medians = {name: tuple(statistics.median(run[i] for run in runs) for i in (0, 1))
+               for name, runs in times.items()}
+    medians["ratio"] = tuple(statistics.median(a[i] / b[i] for a, b in
+                                               zip(times["hystkit"], times["before"], strict=True))
+                             for i in (0, 1))
+    return medians
 
 
 def main() -> None:
@@ -217,6 +229,8 @@ def main() -> None:
                         help="loop (tables 1 and 2), command (table 3), or both (default)")
     parser.add_argument("--src", type=Path, default=REPO / "src",
                         help="source tree of table 3's hystkit (default: this checkout's)")
+    parser.add_argument("--reference", default=REFERENCE,
+                        help=f"git revision table 3 pairs it with (default {REFERENCE})")
     args = parser.parse_args()
     tables = args.tables.split(",")
     t_total = time.perf_counter()
@@ -225,12 +239,15 @@ def main() -> None:
         loop_tables()
     if "command" in tables:
         with tempfile.TemporaryDirectory() as folder:
-            new, before, ratio = whole_command(Path(folder), args.src)
+            medians = whole_command(Path(folder), args.src, args.reference)
+        load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
         print(f"Table 3. whole command, warm: hystkit {' '.join(COMMAND)}; medians of "
-              f"{COMMAND_REPEATS} A/B pairs of fresh processes")
-        print(f"  {'before (' + REFERENCE + ') s':>20}{'hystkit s':>11}"
+              f"{COMMAND_REPEATS} A/B pairs of fresh processes (load {load} at the end)")
+        print(f"  {'':<6}{'before (' + args.reference + ') s':>20}{'hystkit s':>11}"
               f"{'ratio (median of pairs)':>25}")
-        print(f"  {before:>20.3f}{new:>11.3f}{ratio:>25.3f}")
+        for i, what in enumerate(("wall", "cpu")):
+            print(f"  {what:<6}{medians['before'][i]:>20.3f}{medians['hystkit'][i]:>11.3f}"
+                  f"{medians['ratio'][i]:>25.3f}")
         print()
     print(f"Total benchmark time {time.perf_counter() - t_total:.1f} s")
 
