@@ -37,6 +37,13 @@ def fleet(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return folder
 
 
+@pytest.fixture(scope="module")
+def whole(fleet: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[list, Path]:
+    """The fleet's manifest run once, uninterrupted: its table and output folder (read only)."""
+    out = tmp_path_factory.mktemp("whole") / "out"
+    return run_batch(read_manifest(fleet / "manifest.csv", {}), out), out
+
+
 def _untimed(table: list[dict]) -> list[dict]:
     return [{k: v for k, v in row.items() if k not in TIMES} for row in table]
 
@@ -94,13 +101,13 @@ def test_a_split_recording_fits_its_first_half_and_scores_its_second(tmp_path, f
     assert row["r2_deployable"] == evaluate(comp, second)["r2"]
 
 
-def test_batch_writes_models_and_a_table_of_their_scores(tmp_path, fleet):
+def test_batch_writes_models_and_a_table_of_their_scores(fleet, whole):
     jobs = read_manifest(fleet / "manifest.csv", {})
-    table = run_batch(jobs, tmp_path / "out")
+    table, out = whole
     assert [r["sensor"] for r in table] == ["s0", "s1", "s2"]
     for row, job in zip(table, jobs):
         # the row's scores are those of the written model file on the validation recording
-        scores = evaluate(load_compensator(tmp_path / "out" / row["model_file"]),
+        scores = evaluate(load_compensator(out / row["model_file"]),
                           read_recording(job.validate[0]))
         assert row["status"] == "ok" and row["error"] is None
         assert (row["r2_deployable"], row["r2_oracle"], row["e_rms_pct_deployable"]) == \
@@ -110,16 +117,16 @@ def test_batch_writes_models_and_a_table_of_their_scores(tmp_path, fleet):
             (scores["band_coverage"], scores["band_width_median"])
         assert 0.5 < row["band_coverage"] <= 1.0
     for name in ("results.parquet", "results.csv"):
-        read = getattr(pd, f"read_{name.split('.')[1]}")(tmp_path / "out" / name)
+        read = getattr(pd, f"read_{name.split('.')[1]}")(out / name)
         assert list(read.columns) == list(RESULT_COLUMNS)
         # empty cells read back as NaN (CSV) or None (Parquet): compare them as None
         assert read.astype(object).where(read.notna(), None).to_dict("records") == table
 
 
-def test_an_interrupted_batch_resumed_gives_the_uninterrupted_table(tmp_path, fleet,
+def test_an_interrupted_batch_resumed_gives_the_uninterrupted_table(tmp_path, fleet, whole,
                                                                     monkeypatch):
     jobs = read_manifest(fleet / "manifest.csv", {})
-    whole = run_batch(jobs, tmp_path / "whole")
+    whole_table, whole_out = whole
 
     real_fit = batch_run.fit_compensator
 
@@ -143,9 +150,9 @@ def test_an_interrupted_batch_resumed_gives_the_uninterrupted_table(tmp_path, fl
     assert said[0].startswith("3 sensors: 1 finished before, 2 to fit")
     assert resumed[0] == first  # s0 not refitted: its row (and time) from the first run
     assert (out / "models" / "s0.json").stat().st_mtime_ns == s0_model
-    assert _untimed(resumed) == _untimed(whole)
+    assert _untimed(resumed) == _untimed(whole_table)
     assert pd.read_csv(out / "results.csv").drop(columns=list(TIMES)).equals(
-        pd.read_csv(tmp_path / "whole" / "results.csv").drop(columns=list(TIMES)))
+        pd.read_csv(whole_out / "results.csv").drop(columns=list(TIMES)))
 
 
 def test_a_changed_recording_is_fitted_again(tmp_path, fleet):
