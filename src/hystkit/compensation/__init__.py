@@ -16,8 +16,10 @@ __getattr__, __dir__ = lazy_exports(
      "_centring": ("CENTERS", "DEFAULT_CENTER", "DEFAULT_TARE_SECONDS", "DEFAULT_TRACK_SECONDS",
                    "DEPLOYABLE_CENTERS", "ORACLE_CENTER", "center_label"),
      "_modes": ("MODES",),
-     "_band": ("BAND_SCORE_KEYS", "DEFAULT_LEVEL", "Band", "BandState", "interval",
-               "interval_scores"),
+     # with the band's per-sample pieces the live stream and its compiled kernel share
+     "_band": ("BAND_SCORE_KEYS", "DEFAULT_LEVEL", "Band", "BandState", "band_features",
+               "feature_decay", "feature_range", "feature_step", "half_width", "interval",
+               "interval_scores", "position_width"),
      "_calibration": ("calibrate_band", "with_band"),
      "_compensator": ("POSITION_MARGIN", "SENSOR_MARGIN", "BandedEstimate", "Compensator"),
      "_conventions": ("LinearBaseline", "Scaling", "centre_and_scale", "prepare_training_data"),

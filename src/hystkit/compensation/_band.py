@@ -45,7 +45,8 @@ from ..errors import InputError
 from ..io import Recording
 
 __all__ = ["BAND_SCORE_KEYS", "DEFAULT_LEVEL", "Band", "BandState", "band_features",
-           "interval", "interval_scores"]
+           "feature_decay", "feature_range", "feature_step", "half_width", "interval",
+           "interval_scores", "position_width"]
 
 DEFAULT_LEVEL = 0.90
 # Probabilities at which the model file keeps the calibration scores' quantiles.
@@ -168,7 +169,32 @@ class BandState:
 @njit(cache=True, inline="always")
 def feature_step(v, started, previous, r, o, dt, decay, low, high, width):  # pragma: no cover
     """One sample of :func:`band_features`: the rate and range memory after normalised sensor
-    sample `v` (the compiled stream runs the same arithmetic, `._stream_kernel`)."""
+    sample `v` (compiled, inlined by the live stream's kernel, so both give the same bits).
+
+    Parameters
+    ----------
+    v : float
+        The normalised sensor sample.
+    started : float
+        1.0 once a sample has been seen (the first has no rate), else 0.0.
+    previous : float
+        The previous normalised sample.
+    r, o : float
+        The rate's running mean [1/s] and the remembered excursion [range widths] before `v`.
+    dt : float
+        Sample time [s].
+    decay : float
+        The memory's factor per sample (:func:`feature_decay`).
+    low, high : float
+        The range the excursion is measured from (:func:`feature_range`).
+    width : float
+        ``high - low``.
+
+    Returns
+    -------
+    r, o : float
+        The rate's running mean and the remembered excursion after `v`.
+    """
     d = abs(v - previous) / dt if started > 0.0 else 0.0
     r = decay * r + (1.0 - decay) * d
     beyond = max(low - v, v - high, 0.0) / width
@@ -229,13 +255,37 @@ def band_features(s: np.ndarray, dt: float, tau: float, training_range: tuple[fl
 
 def feature_range(training_range: tuple[float, float]) -> tuple[float, float]:
     """The range the excursion is measured from: the training range, or for a range of one
-    value the unit range above it (distances in its units)."""
+    value the unit range above it (distances in its units).
+
+    Parameters
+    ----------
+    training_range : tuple of float
+        The normalised sensor range seen in training.
+
+    Returns
+    -------
+    low, high : float
+        The range, ``high > low``.
+    """
     low, high = training_range
     return float(low), float(high if high > low else low + 1.0)
 
 
 def feature_decay(dt: float, tau: float) -> float:
-    """The memory's factor per sample."""
+    """The memory's factor per sample.
+
+    Parameters
+    ----------
+    dt : float
+        Sample time [s].
+    tau : float
+        Time constant [s] of the memory.
+
+    Returns
+    -------
+    float
+        ``exp(-dt / tau)``.
+    """
     return math.exp(-dt / tau)
 
 
@@ -252,13 +302,40 @@ def rate_scale(rate: np.ndarray, share: float, reference: float, high: float) ->
 
 def half_width(band: Band, quantile: float, rate: np.ndarray, outside: np.ndarray,
                position_width: float) -> np.ndarray:
-    """The band's half-width [position units] per sample, ``quantile`` being
-    ``band.quantile(level)`` (a stream computes it once)."""
+    """The band's half-width [position units] per sample.
+
+    Parameters
+    ----------
+    band : Band
+        The calibrated band.
+    quantile : float
+        ``band.quantile(level)`` (a stream computes it once).
+    rate, outside : numpy.ndarray, shape (n,)
+        The features of :func:`band_features`.
+    position_width : float
+        The training position range's width (:func:`position_width`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        ``quantile * sigma(rate) + position_width * outside``.
+    """
     return quantile * local_scale(band, rate) + position_width * outside
 
 
 def position_width(comp) -> float:
-    """The training position range's width [mm] (the extrapolation term's unit)."""
+    """The training position range's width [mm] (the extrapolation term's unit).
+
+    Parameters
+    ----------
+    comp : Compensator
+        Whose ``position_range`` (the training positions' ``(low, high)`` [mm]) is read.
+
+    Returns
+    -------
+    float
+        ``high - low``.
+    """
     lo, hi = comp.position_range
     return float(hi - lo)
 

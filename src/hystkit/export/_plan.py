@@ -23,11 +23,9 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
-from ..compensation import Compensator
-from ..compensation._compensator import MAX_NORMALISED, POSITION_MARGIN, SENSOR_MARGIN
+from ..compensation import MAX_NORMALISED, POSITION_MARGIN, SENSOR_MARGIN, Compensator
 from ..errors import InputError
-from ..models import get_family
-from ..models._protocol import Translation
+from ..models import Translation, get_family
 from ..signals import exponential_chirp
 
 __all__ = ["C_KEYWORDS", "FLOAT_SENSITIVITY_LIMIT", "ExportPlan", "band_constants",

@@ -47,7 +47,7 @@ import dataclasses
 
 import numpy as np
 
-from ..compensation._compensator import Compensator
+from ..compensation import Compensator
 from ..errors import InputError
 from ._adaptive_plan import _Plan
 from ._adaptive_records import (
@@ -59,6 +59,7 @@ from ._adaptive_records import (
     Adaptation,
     AdaptiveState,
     Plausible,
+    reference_column,
 )
 from ._readable import StartUp, _advance, _advance_one, _Previous, initial_state
 from ._stream import Stream
@@ -68,24 +69,11 @@ __all__ = ["ADAPT_PARAMETERS", "BAND_STEP", "MAX_INNOVATION", "MAX_MULTIPLIER", 
            "Adaptation", "AdaptiveState", "AdaptiveStream", "Plausible", "advance_adaptive"]
 
 
-def _references(reference: np.ndarray | None, n: int, first: int, label: str) -> np.ndarray:
-    if reference is None:
-        return np.full(n, np.nan)
-    r = np.asarray(reference, dtype=np.float64).reshape(-1)
-    if r.size != n:
-        raise InputError(f"{label}: {r.size} references for {n} sensor samples")
-    bad = np.flatnonzero(np.isinf(r))
-    if bad.size:
-        raise InputError(f"{label}: sample {first + bad[0]}: reference is infinite "
-                         f"(NaN marks an unknown one)")
-    return r
-
-
 def _advance_plan(plan: _Plan, state: AdaptiveState, sensor: np.ndarray,
                   reference: np.ndarray | None,
                   label: str) -> tuple[StreamOutput, AdaptiveState]:
     s_raw = np.ascontiguousarray(sensor, dtype=np.float64).reshape(-1)
-    r = _references(reference, s_raw.size, state.stream.n_samples, label)
+    r = reference_column(reference, s_raw.size, state.stream.n_samples, label)
     plain, stream_next = _advance(plan.path, state.stream, s_raw, label)
     if s_raw.size == 0:
         return plain, state
@@ -242,7 +230,7 @@ class AdaptiveStream:
                               *(None if b is None else float(b[0]) for b in out[3:]))
         # gain: the plain stream's fast one-sample path (the same bits as its chunks), then
         # the same prediction and update as a chunk's
-        r = _references(np.array([reference]), 1, self._state.stream.n_samples, self.label)[0]
+        r = reference_column(np.array([reference]), 1, self._state.stream.n_samples, self.label)[0]
         plain, stream_next, self._previous = _advance_one(
             self._plan.path, self._state.stream, sensor, self.label, self._previous)
         phi = np.array([[plain.estimate, 1.0]])

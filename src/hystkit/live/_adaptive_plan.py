@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ..compensation._compensator import Compensator
+from ..compensation import Compensator
 from ..errors import InputError
 from ._adaptive_records import (
     BAND_STEP,

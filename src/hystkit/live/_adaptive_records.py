@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ..compensation._compensator import Compensator
+from ..compensation import Compensator
 from ..errors import InputError
 from ._rls import RlsState
 from ._stream_state import StreamState
@@ -187,3 +187,18 @@ class Plausible:
             if not abs(reference - estimate) <= self.innovation * self.extent:
                 return "innovation"
         return None
+
+
+def reference_column(reference: np.ndarray | None, n: int, first: int, label: str) -> np.ndarray:
+    """`reference` [mm] as one float per sensor sample of a chunk (all NaN, unknown, when None);
+    InputError for another count or an infinite one (`first`: the chunk's first sample)."""
+    if reference is None:
+        return np.full(n, np.nan)
+    r = np.asarray(reference, dtype=np.float64).reshape(-1)
+    if r.size != n:
+        raise InputError(f"{label}: {r.size} references for {n} sensor samples")
+    bad = np.flatnonzero(np.isinf(r))
+    if bad.size:
+        raise InputError(f"{label}: sample {first + bad[0]}: reference is infinite "
+                         f"(NaN marks an unknown one)")
+    return r

@@ -15,13 +15,16 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..compensation import ORACLE_CENTER
-from ..compensation._band import BandState, band_features, half_width, position_width
-from ..compensation._compensator import (
+from ..compensation import (
     MAX_NORMALISED,
+    ORACLE_CENTER,
     POSITION_MARGIN,
     SENSOR_MARGIN,
+    BandState,
     Compensator,
+    band_features,
+    half_width,
+    position_width,
     runaway_kind,
     runaway_samples,
 )
@@ -218,8 +221,8 @@ def advance_scaled(path: _Path, state: StreamState, sensor: np.ndarray,
 def _half_width(path: _Path, s: np.ndarray,
                 state: BandState) -> tuple[np.ndarray | None, BandState]:
     """The band's half-width [mm] over a chunk of scaled sensor samples, continuing the
-    features from `state` (``compensation._band.band_features``; the same operations as
-    ``compensation._band.interval``, so chunked == whole); None without a band."""
+    features from `state` (``compensation.band_features``; the same operations as
+    ``compensation.interval``, so chunked == whole); None without a band."""
     comp = path.comp
     if comp.band is None:
         return None, state

@@ -41,7 +41,7 @@ import numpy as np
 from ..compensation import Compensator
 from ..errors import FitDivergedError, InputError
 from ..models import FAMILIES
-from ._adaptive_records import MAX_INNOVATION, REFERENCE_MARGIN, Plausible
+from ._adaptive_records import MAX_INNOVATION, REFERENCE_MARGIN, Plausible, reference_column
 from ._readable import StartUp, _advance, _Path, advance_scaled, initial_state
 from ._stream_output import StepOutput, StreamOutput
 from ._stream_state import StreamState
@@ -236,15 +236,7 @@ class RefittingStream:
         """Estimates and use-time flags for a chunk; refits at the references that
         complete an ``every``."""
         s_raw = np.ascontiguousarray(sensor, dtype=np.float64).reshape(-1)
-        r = (np.full(s_raw.size, np.nan) if reference is None
-             else np.asarray(reference, dtype=np.float64).reshape(-1))
-        if r.size != s_raw.size:
-            raise InputError(f"{self.label}: {r.size} references for {s_raw.size} sensor "
-                             f"samples")
-        if np.isinf(r).any():
-            raise InputError(f"{self.label}: sample "
-                             f"{self._state.n_samples + int(np.flatnonzero(np.isinf(r))[0])}: "
-                             f"reference is infinite (NaN marks an unknown one)")
+        r = reference_column(reference, s_raw.size, self._state.n_samples, self.label)
         if s_raw.size == 0:
             return _advance(self._path, self._state, s_raw, self.label)[0]
         # split after each reference that completes an `every`: the refit happens there

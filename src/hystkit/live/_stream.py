@@ -33,8 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..compensation import load_compensator
-from ..compensation._compensator import Compensator
+from ..compensation import Compensator, load_compensator
 from ..errors import FitDivergedError, InputError
 from ._readable import (
     StartUp,

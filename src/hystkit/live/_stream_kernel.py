@@ -18,14 +18,14 @@ from __future__ import annotations
 import numpy as np
 
 from .._closure_cache import compile_closure
-from ..compensation._band import (
+from ..compensation import (
+    MAX_NORMALISED,
     BandState,
     feature_decay,
     feature_range,
     feature_step,
     position_width,
 )
-from ..compensation._compensator import MAX_NORMALISED
 from ..io import MAX_MAGNITUDE
 from ._stream_state import StreamState
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..compensation._compensator import Compensator
+from ..compensation import Compensator
 from ..errors import FitDivergedError
 from ._readable import _advance, _Path
 from ._stream_kernel import Engine
