@@ -133,6 +133,18 @@ def test_butterworth_overlay_is_the_zero_phase_response(cutoff, order):
     assert butterworth_response(np.array([cutoff]), FS, cutoff, order)[0] == pytest.approx(0.5)
 
 
+@pytest.mark.parametrize("cutoff", [0.0, -5.0, FS / 2, 2 * FS])
+def test_the_filter_and_its_overlay_refuse_the_same_cut_offs(cutoff):
+    """One design (eq. 4.1) behind both: the same refusal, in the same words."""
+    from hystkit.preprocess import lowpass_zero_phase
+
+    with pytest.raises(ValueError, match="must lie between 0 and fs/2 = 500 Hz") as filtering:
+        lowpass_zero_phase(np.zeros(64), FS, cutoff, 2)
+    with pytest.raises(ValueError) as overlay:
+        butterworth_response(np.array([1.0]), FS, cutoff, 2)
+    assert str(filtering.value) == str(overlay.value)
+
+
 def test_zero_phase_filter_shapes_white_noise_as_the_overlay_says():
     """PSD after lowpass_zero_phase / PSD before = |H|^4 (the power response of forward-
     backward filtering), checked where the noise is well above rounding."""

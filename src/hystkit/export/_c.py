@@ -62,7 +62,7 @@ def float_warning(plan: ExportPlan) -> str:
     Parameters
     ----------
     plan : ExportPlan
-        The export plan.
+        The export plan; its float sensitivity is read (:func:`make_plan` measures it).
 
     Returns
     -------

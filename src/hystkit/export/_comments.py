@@ -22,35 +22,14 @@ _TRIGRAPH_START = re.compile(r"\?(?=\?)")
 def comment_text(text: object) -> str:
     """`text` as one printable line: every character `str.isprintable` refuses (newline,
     carriage return, tab, other control characters, Unicode line and paragraph separators) is
-    written as its Python escape (``\\n``, ``\\x1b``, ``\\u2028``).
-
-    Parameters
-    ----------
-    text : object
-        The value (its `str`).
-
-    Returns
-    -------
-    str
-        The text with no line break and no control character.
-    """
+    written as its Python escape (``\\n``, ``\\x1b``, ``\\u2028``)."""
     return "".join(ch if ch.isprintable() else repr(ch)[1:-1] for ch in str(text))
 
 
 def c_comment_text(text: object) -> str:
     """`comment_text` for a C ``/* ... */`` comment: also ``*/`` (which would end it) as
     ``*\\/``, ``/*`` (a warning with ``-Wall``) as ``/\\*``, and no trigraph (``??/`` is a
-    backslash in C99).
-
-    Parameters
-    ----------
-    text : object
-        The value (its `str`).
-
-    Returns
-    -------
-    str
-        Text that stays inside the comment, on one line, and compiles without a warning.
-    """
+    backslash in C99): text that stays inside the comment, on one line, and compiles without
+    a warning."""
     line = _TRIGRAPH_START.sub("?\\\\", comment_text(text))
     return line.replace("*/", "*\\/").replace("/*", "/\\*")

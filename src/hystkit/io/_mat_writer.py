@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -104,13 +104,21 @@ def _is_number(value: Any) -> bool:
 
 def _struct(mapping: Mapping, where: str) -> dict[str, Any]:
     fields: dict[str, Any] = {}
-    for key, item in mapping.items():
-        name = matlab_name(key)
-        if name in fields:
-            raise ValueError(f"{where or 'value'}: keys {key!r} and another both become "
-                             f"MATLAB field {name!r}")
-        fields[name] = to_matlab(item, f"{where}.{key}" if where else str(key))
+    for key, name in _matlab_keys(mapping, f"{where or 'value'}: keys", "field"):
+        fields[name] = to_matlab(mapping[key], f"{where}.{key}" if where else str(key))
     return fields
+
+
+def _matlab_keys(keys: Iterable[str], what: str, kind: str) -> Iterator[tuple[str, str]]:
+    """Each key with its `matlab_name`, in order; a ValueError (``<what> 'a-b' and another both
+    become MATLAB <kind> 'a_b'``) at the first key whose name an earlier key took."""
+    taken: set[str] = set()
+    for key in keys:
+        name = matlab_name(key)
+        if name in taken:
+            raise ValueError(f"{what} {key!r} and another both become MATLAB {kind} {name!r}")
+        taken.add(name)
+        yield key, name
 
 
 def _check_finite(values: Any, where: str) -> None:
@@ -126,11 +134,8 @@ def recording_variables(columns: Mapping[str, np.ndarray],
     """The variables of a recording written to ``.mat``: one column vector per column
     (boolean flags as logical, text as a cell array), ``column_names`` and ``units``."""
     variables: dict[str, Any] = {}
-    for name, values in columns.items():
-        key = matlab_name(name)
-        if key in variables:
-            raise ValueError(f"columns {name!r} and another both become MATLAB variable {key!r}")
-        values = np.asarray(values)
+    for name, key in _matlab_keys(columns, "columns", "variable"):
+        values = np.asarray(columns[name])
         if values.dtype.kind not in "biuf":
             import pandas as pd  # here: a model file written as .mat needs no pandas
 
@@ -181,13 +186,9 @@ def write_mat(path: str | os.PathLike[str], mapping: Mapping[str, Any], *,
     path = Path(path)
     check_output_format(path, (".mat",), "a MATLAB file")
     variables: dict[str, Any] = {}
-    for name, value in mapping.items():
-        key = matlab_name(name)
-        if key in variables:
-            raise ValueError(f"{path}: names {name!r} and another both become MATLAB "
-                             f"variable {key!r}")
+    for name, key in _matlab_keys(mapping, f"{path}: names", "variable"):
         try:
-            variables[key] = to_matlab(value, key)
+            variables[key] = to_matlab(mapping[name], key)
         except NonFiniteError as exc:
             raise NonFiniteError(f"{path}: {exc}; refusing to write NaN or infinity") from None
     for name, value in (verbatim or {}).items():

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import os
-import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +18,7 @@ from hystkit.errors import InputError
 
 from ._atomic import atomic_output
 from ._raw_format import MAX_SKIP_ROWS
-from ._toml import check_type, load_toml, settings_beside
+from ._toml import check_type, load_settings, settings_beside
 
 __all__ = ["CONFIG_KEYS", "find_raw_config", "read_raw_config", "write_raw_config"]
 
@@ -72,20 +71,7 @@ _CHOICES = {"illegal": ("continue", "hold"), "time_unit": ("s", "ms", "us", "ns"
 _COLUMN_NAMES = ("time", "v1", "v2", "encoder", "enc_a", "enc_b", "v0")
 
 
-def find_raw_config(data_path: str | os.PathLike[str]) -> Path | None:
-    """The settings file stored next to a raw recording (same stem, ``.toml``), if present.
-
-    Parameters
-    ----------
-    data_path : str or os.PathLike
-        The raw recording.
-
-    Returns
-    -------
-    pathlib.Path or None
-        ``<stem>.toml`` beside it, None if there is none.
-    """
-    return settings_beside(data_path)
+find_raw_config = settings_beside  # the same rule as a recording's settings
 
 
 def read_raw_config(path: str | os.PathLike[str]) -> dict[str, Any]:
@@ -109,16 +95,7 @@ def read_raw_config(path: str | os.PathLike[str]) -> dict[str, Any]:
         choice or column name; one line naming the file and the key.
     """
     path = Path(path)
-    try:
-        if path.is_dir():
-            raise InputError(f"{path}: is a folder, not a TOML settings file")
-        values = load_toml(path)
-    except FileNotFoundError as exc:
-        raise InputError(f"{path}: config file not found") from exc
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot read config file ({exc})") from exc
-    except (tomllib.TOMLDecodeError, RecursionError) as exc:
-        raise InputError(f"{path}: invalid TOML ({exc})") from exc
+    values = load_settings(path, "config file")
     for key, value in values.items():
         if key not in CONFIG_KEYS:
             raise InputError(f"{path}: unknown key {key!r}; known keys: "

@@ -36,7 +36,6 @@ recognised by its raw-only keys or raw column names and left alone (`is_raw_sett
 from __future__ import annotations
 
 import os
-import tomllib
 from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
@@ -46,7 +45,7 @@ from hystkit.errors import InputError
 from .._read_options import FIELDS, ReadOptions
 from ._raw_config import _COLUMN_NAMES as RAW_COLUMNS
 from ._raw_config import CONFIG_KEYS as RAW_KEYS
-from ._toml import check_type, load_toml, settings_beside
+from ._toml import check_type, load_settings, settings_beside
 
 __all__ = ["RECORDING_KEYS", "find_recording_config", "is_raw_settings", "options_for",
            "read_recording_config", "settings_for"]
@@ -69,20 +68,7 @@ RECORDING_KEYS: dict[str, tuple[tuple[type, ...], str]] = {
 }
 
 
-def find_recording_config(data_path: str | os.PathLike[str]) -> Path | None:
-    """The settings file of a recording: same folder, same stem, ``.toml``; None if absent.
-
-    Parameters
-    ----------
-    data_path : str or os.PathLike
-        The recording.
-
-    Returns
-    -------
-    pathlib.Path or None
-        ``<stem>.toml`` beside it, None if there is none.
-    """
-    return settings_beside(data_path)
+find_recording_config = settings_beside  # the same rule as a raw recording's
 
 
 def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
@@ -105,7 +91,7 @@ def read_recording_config(path: str | os.PathLike[str]) -> dict[str, Any]:
         wrong type or one `ReadOptions` refuses; one line naming the file and the key.
     """
     path = Path(path)
-    values = _load(path)
+    values = load_settings(path, "settings file")
     for key, value in values.items():
         if key not in RECORDING_KEYS:
             raw = " (a setting of raw scope files, for 'hystkit preprocess')" \
@@ -180,7 +166,7 @@ def settings_for(data_path: str | os.PathLike[str]) -> tuple[Path | None, str]:
     settings = find_recording_config(data)
     if settings is None:
         return None, ""
-    values = _load(settings)
+    values = load_settings(settings, "settings file")
     if is_raw_settings(values):
         return None, ""  # the raw recording's settings (for preprocess), not this file's
     target = values.get("file")
@@ -197,15 +183,6 @@ def settings_for(data_path: str | os.PathLike[str]) -> tuple[Path | None, str]:
                          f"are for with file = \"{data.name}\" in it (the other is then read "
                          "with options given on the command line)")
     return settings, ""
-
-
-def _load(path: Path) -> dict[str, Any]:
-    try:
-        return load_toml(path)
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot read settings file ({exc})") from exc
-    except (tomllib.TOMLDecodeError, RecursionError) as exc:
-        raise InputError(f"{path}: invalid TOML ({exc})") from exc
 
 
 def is_raw_settings(values: dict[str, Any]) -> bool:

@@ -35,10 +35,15 @@ def lowpass_zero_phase(x: np.ndarray, fs: float, cutoff: float = 20.0, order: in
     ValueError
         If `cutoff` is not between 0 and ``fs / 2``.
     """
+    return signal.sosfiltfilt(butterworth_sections(fs, cutoff, order), x, axis=axis)
+
+
+def butterworth_sections(fs: float, cutoff: float, order: int) -> np.ndarray:
+    """The one-way Butterworth low-pass of eq. 4.1 as second-order sections; ValueError unless
+    0 < `cutoff` < `fs` / 2 (the spectrum's response is of the same design)."""
     if not 0 < cutoff < fs / 2:
-        raise ValueError(f"cutoff {cutoff} Hz must lie between 0 and fs/2 = {fs / 2} Hz")
-    sos = signal.butter(order, cutoff, fs=fs, output="sos")
-    return signal.sosfiltfilt(sos, x, axis=axis)
+        raise ValueError(f"cutoff {cutoff:g} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
+    return signal.butter(order, cutoff, fs=fs, output="sos")
 
 
 def downsample(x: np.ndarray, fs: float, fs_out: float, axis: int = -1) -> np.ndarray:

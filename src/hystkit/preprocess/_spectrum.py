@@ -35,6 +35,8 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy import ndimage, signal, stats
 
+from ._filters import butterworth_sections
+
 __all__ = ["CutoffRule", "Spectrum", "butterworth_response", "noise_floor", "spectrum",
            "welch_psd"]
 
@@ -213,9 +215,7 @@ def butterworth_response(freq: np.ndarray, fs: float, cutoff: float, order: int 
     ValueError
         If `cutoff` is not between 0 and ``fs / 2``.
     """
-    if not 0 < cutoff < fs / 2:
-        raise ValueError(f"cutoff {cutoff:g} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
-    sos = signal.butter(order, cutoff, fs=fs, output="sos")
+    sos = butterworth_sections(fs, cutoff, order)
     _, h = signal.sosfreqz(sos, worN=np.asarray(freq, dtype=float), fs=fs)
     return np.abs(h) ** 2
 
