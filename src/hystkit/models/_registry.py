@@ -213,7 +213,11 @@ def family_of(structure: object) -> Family:
     TypeError
         `structure` belongs to no registered family.
     """
-    for entry in list(_entries().values()):
+    module = type(structure).__module__
+    # the family whose folder defines the class first: the other families stay unloaded
+    entries = sorted(_entries().values(),
+                     key=lambda e: not module.startswith(e.source.rpartition(".")[0] + "."))
+    for entry in entries:
         family = entry.load()
         if isinstance(structure, family.Structure):
             return family
