@@ -13,6 +13,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from .. import __version__
+from ..compensation import MODEL_SUFFIXES
 from ..errors import InputError
 from ..io import ReadOptions, Recording, atomic_outputs, options_for, read_recording
 from ._figures import DEFAULT_SENSOR_LABEL
@@ -24,7 +25,6 @@ from ._report_model import ReportContent, model_report
 __all__ = ["FIGURE_FORMATS", "build_report", "figure_paths", "sensor_label", "write_report"]
 
 FIGURE_FORMATS = ("png", "svg", "pdf")
-MODEL_SUFFIXES = (".json", ".mat")  # what save_compensator writes
 
 
 def sensor_label(options: ReadOptions | None, recordings: Sequence[Recording] = ()) -> str:
