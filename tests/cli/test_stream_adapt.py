@@ -125,13 +125,13 @@ def test_weights_on_an_inverse_model_is_one_error_line(tmp_path, capsys):
 
 def test_the_parser_constants_are_the_library_s():
     # the parser keeps its own copies so that building it imports no numpy
-    from hystkit.cli import cmd_stream
+    from hystkit.cli import _stream_defaults
     from hystkit.live import ADAPT_PARAMETERS, Refit
 
-    assert cmd_stream.ADAPT_CHOICES == (*ADAPT_PARAMETERS, "full")
-    assert cmd_stream.DEFAULT_FORGETTING == Adaptation().forgetting
-    assert cmd_stream.DEFAULT_WINDOW == Refit().window_seconds
-    assert cmd_stream.DEFAULT_REFIT_EVERY == Refit().every
+    assert _stream_defaults.ADAPT_CHOICES == (*ADAPT_PARAMETERS, "full")
+    assert _stream_defaults.DEFAULT_FORGETTING == Adaptation().forgetting
+    assert _stream_defaults.DEFAULT_WINDOW == Refit().window_seconds
+    assert _stream_defaults.DEFAULT_REFIT_EVERY == Refit().every
 
 
 def test_adapt_full_gives_the_library_refitting_stream(model, tmp_path, capsys):

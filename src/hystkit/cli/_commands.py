@@ -8,9 +8,7 @@ run function's module is imported after the command line parsed, so a ``cmd_*`` 
 what it uses at its top.
 
 A command with subcommands of its own (``table 5.4``, ``datasets list``) has no run function in
-its row: its options function sets each one's (``set_defaults(run="module:function")``). An
-options function named ``register`` is a module's ``register(sub)``, the older form some
-commands still use: it adds the parser and sets ``run`` itself.
+its row: its options function sets each one's (``set_defaults(run="module:function")``).
 """
 
 from __future__ import annotations
@@ -28,12 +26,13 @@ class Command:
 
     name: str
     help: str
-    options: str  # "module:function": add_options(parser), or a module's register(sub)
+    options: str  # "module:function": add_options(parser)
     run: str | None = None  # "module:function" taking the parsed namespace
 
     @property
     def registers(self) -> bool:
-        """Whether `options` is a module's ``register(sub)`` (the older form)."""
+        """Whether `options` is a module's ``register(sub)``: no row is any more (kept while
+        `hystkit.cli._main` still asks)."""
         return self.options.endswith(":register")
 
 
@@ -52,7 +51,8 @@ COMMANDS = (
             "virtual-sensor excitations)", "_study_options:generalize_options",
             "cmd_compare:run_generalize"),
     Command("control", "closed-loop position control with a hysteretic sensor: the "
-            "document's ch. 7 experiments", "cmd_control:register"),
+            "document's ch. 7 experiments", "_control_options:control_options",
+            "cmd_control:run_control_command"),
     Command("simulate-sensor", "record an experiment on the virtual sensor",
             "_core_options:simulate_sensor_options", "cmd_simulate:run_simulate_sensor"),
     Command("fit", "fit a compensator to a recording", "_core_options:fit_options",
@@ -94,9 +94,10 @@ COMMANDS = (
             "cmd_spectrum:run_spectrum"),
     Command("stability", "local stability of a fitted model of any family (linearised step; "
             "eq. 5.18-5.28 for the mPL), or with --control a loop's global stability",
-            "cmd_stability:register"),
+            "_control_options:stability_options", "cmd_stability:run_stability"),
     Command("stream", "compensate live: time,sensor lines in (stdin, a file or a serial "
-            "port), time,position_estimate,flags lines out", "cmd_stream:register"),
+            "port), time,position_estimate,flags lines out", "_stream_options:stream_options",
+            "cmd_stream:run_stream"),
     Command("table", "the reference document's tables 5.4 and 2.2 measured on the virtual "
             "sensor, the document's numbers beside them", "_study_options:table_options"),
     Command("warm", "compile the numba kernels of fit, stream, compare and control ahead, "

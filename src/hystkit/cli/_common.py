@@ -16,8 +16,8 @@ from ._read_args import add_read_options, given_read_options
 
 __all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Deferred", "Parser", "UsageError", "add_read_options",
            "check_size", "deferred", "failures_exit", "given_read_options", "integer",
-           "number", "positive_float", "positive_int", "read_options", "read_recording_args",
-           "read_recordings_args", "say_next", "size_limit", "slope_cap", "stdout_for"]
+           "number", "positive_float", "positive_int", "read_recordings_args", "say_next",
+           "size_limit", "slope_cap", "stdout_for"]
 
 # Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
 # bounds, not converged; a family failed in compare/select); 2 is kept for errors that stop a
@@ -142,22 +142,8 @@ def say_next(step: str) -> None:
     print(f"next: try {step}", flush=True)
 
 
-# Kept here for the modules that still read recordings through this one (cmd_control,
-# cmd_stability, tests/io): the readers live in `hystkit.cli._reading`, which loads hystkit.io.
-def read_options(args: argparse.Namespace, path=None):
-    """`hystkit.cli._reading.read_options`."""
-    from . import _reading
-
-    return _reading.read_options(args, path)
-
-
-def read_recording_args(args: argparse.Namespace, path, *, need_position: bool = True):
-    """`hystkit.cli._reading.read_recording_args`."""
-    from . import _reading
-
-    return _reading.read_recording_args(args, path, need_position=need_position)
-
-
+# Kept for tests/io/test_gap_pieces.py only (not a CLI file): the readers live in
+# `hystkit.cli._reading`, which loads hystkit.io; that test can import it from there.
 def read_recordings_args(args: argparse.Namespace, paths, *, need_position: bool = True
                          ) -> list:
     """`hystkit.cli._reading.read_recordings_args`."""

@@ -1,7 +1,8 @@
-"""The options of ``hystkit control`` and ``hystkit stability --control``: the parser's options
-(:func:`add_setup_options`, :func:`add_control_options`) and the frozen records they parse into
-(:class:`LoopOptions`, :class:`ControlOptions`). Nothing here loads the library: option values
-that need it (schemes, families, experiments) are computed when shown or checked.
+"""The options of ``hystkit control`` and ``hystkit stability``: the parser's options
+(:func:`control_options`, :func:`stability_options`, from the shared :func:`add_setup_options`)
+and the frozen records they parse into (:class:`LoopOptions`, :class:`ControlOptions`,
+:class:`StabilityOptions`). Nothing here loads the library: option values that need it
+(schemes, families, experiments) are computed when shown or checked.
 """
 
 from __future__ import annotations
@@ -13,9 +14,11 @@ from pathlib import Path
 
 from .. import control as hc
 from ._common import UsageError, deferred, number, positive_int
+from ._read_args import add_read_options
 
 __all__ = ["PID_TYPES", "TUNE_DEFAULTS", "TUNE_TYPES", "Checked", "ControlOptions",
-           "LoopOptions", "add_control_options", "add_setup_options"]
+           "LoopOptions", "StabilityOptions", "add_control_options", "add_setup_options",
+           "control_options", "stability_options"]
 
 
 # PID gains (eq. 7.2): 0 < Kp <= 1e9, 1 us <= Ti <= 1e6 s (inf: no integral action),
@@ -119,6 +122,8 @@ class ControlOptions:
     @classmethod
     def from_args(cls, args: argparse.Namespace) -> ControlOptions:
         """The options of a parsed command line; an option that needs another is one line."""
+        if not (args.experiment or args.bode):
+            raise UsageError("give --experiment NAME and/or --bode (see 'hystkit control --help')")
         given = [f"--{k.replace('_', '-')}" for k in TUNE_DEFAULTS if getattr(args, k) is not None]
         if given and not args.tune_nonlinear:
             verb = "applies" if len(given) == 1 else "apply"
@@ -129,8 +134,44 @@ class ControlOptions:
                      for k, d in TUNE_DEFAULTS.items()}
             tuning = hc.Tuning(value["tune_objective"], value["tune_budget"],
                                value["min_phase_margin"], value["min_gain_margin"])
-        return cls(LoopOptions.from_args(args), args.experiment, args.bode, args.noise, tuning,
-                   args.out, args.force)
+        options = cls(LoopOptions.from_args(args), args.experiment, args.bode, args.noise,
+                      tuning, args.out, args.force)
+        if options.tuning is not None and not options.experiment:
+            raise UsageError("--tune-nonlinear tunes on an experiment: give --experiment NAME")
+        if options.noise is not None and not options.experiment:
+            raise UsageError("--noise runs an experiment with noise: give --experiment NAME")
+        return options
+
+
+@dataclass(frozen=True)
+class StabilityOptions:
+    """``hystkit stability``'s options: a model file's local stability, or with ``control`` a
+    loop's global stability."""
+
+    model_json: Path | None
+    data: Path | None
+    json: Path | None
+    force: bool
+    control: bool
+    experiment: str
+    loop: LoopOptions
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> StabilityOptions:
+        """The options of a parsed command line; a combination that does not fit is one line."""
+        options = cls(args.model_json, args.data, args.json, args.force, args.control,
+                      args.experiment, LoopOptions.from_args(args))
+        if options.control:
+            if options.model_json is not None or options.data is not None:
+                raise UsageError("--control examines a loop: give no MODEL.json and no --data")
+            if options.loop.scheme is None:
+                raise UsageError("--control needs --scheme direct|weighting")
+        elif options.loop.scheme is not None:
+            raise UsageError("--scheme and the other loop options need --control")
+        elif options.model_json is None:
+            raise UsageError("give MODEL.json (a model's local stability) or --control (a "
+                             "loop's)")
+        return options
 
 
 def _noise_option(text: str):
@@ -255,3 +296,30 @@ def add_control_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--min-gain-margin", type=number(0, 60),
                    help="--tune-nonlinear constraint on the linearised loop [dB] (default 6)")
     p.add_argument("--out", type=Path, help="output folder (default: a new timestamped one)")
+
+
+def control_options(p: argparse.ArgumentParser) -> None:
+    """``hystkit control``'s arguments and options."""
+    add_setup_options(p)
+    add_read_options(p)  # for --sensor-data and --training-data
+    add_control_options(p)
+
+
+def stability_options(p: argparse.ArgumentParser) -> None:
+    """``hystkit stability``'s arguments and options: a model file, or a loop (as ``control``'s)."""
+    p.add_argument("model_json", type=Path, nargs="?", metavar="MODEL.json",
+                   help="model JSON file written by 'hystkit fit' (not with --control)")
+    p.add_argument("--data", type=Path,
+                   help="recording whose model input (normalised as at fit time) drives the "
+                        "model; default: a unit chirp 0.1 -> 3 Hz")
+    p.add_argument("--json", type=Path, help="also write the analysis to this JSON file")
+    p.add_argument("--control", action="store_true",
+                   help="examine the control loop set up by the options below (as 'hystkit "
+                        "control'): slope sectors, circle criterion, a simulation")
+    deferred(p.add_argument("--experiment", default="sine",
+                            help="with --control: the experiment simulated (default sine); its "
+                                 "closed-loop slopes join the trained sine's in the sector "
+                                 "tested, and a divergence shows instability"),
+             choices=lambda: hc.EXPERIMENTS)
+    add_setup_options(p, scheme_required=False)
+    add_read_options(p)

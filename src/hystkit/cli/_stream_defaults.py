@@ -1,6 +1,6 @@
-"""``hystkit stream``'s option defaults, shared by its parser (:mod:`.cmd_stream`, which must
-stay light) and its run (:mod:`._stream_run`): as ``hystkit.live``'s own (tested), not imported
-from there, since that loads numba."""
+"""``hystkit stream``'s option defaults, shared by its parser (:mod:`._stream_options`, which
+must stay light) and its run (:mod:`.cmd_stream`): as ``hystkit.live``'s own (tested), not
+imported from there, since that loads numba."""
 
 from __future__ import annotations
 

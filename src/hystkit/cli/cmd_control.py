@@ -17,10 +17,11 @@ from .. import __version__, compensation
 from .. import control as hc
 from .. import io as hio
 from . import _control_report as report
-from ._common import UsageError, add_read_options, check_size, read_options
-from ._control_options import ControlOptions, LoopOptions, add_control_options, add_setup_options
+from ._common import UsageError, check_size
+from ._control_options import ControlOptions, LoopOptions
+from ._reading import Reader, reader_of
 
-__all__ = ["add_setup_options", "loop_error", "loop_setup", "register"]
+__all__ = ["loop_error", "loop_setup", "run_control_command"]
 
 # eq. 7.6 (scheme a) and eq. 7.8 (scheme b): the document's plant errors on the eq. 7.3 sine
 DOCUMENT_SINE = {"direct": {"e_p_max": 6.94e-4, "e_p_mean": -1.543e-4, "source": "eq. 7.6"},
@@ -37,14 +38,15 @@ def _model_file(path: Path | None, option: str):
         raise UsageError(f"{option} {path}: {exc}") from None
 
 
-def loop_setup(options: LoopOptions, args: argparse.Namespace) -> hc.LoopSetup:
-    """The library's loop description from the options: sizes checked, files read."""
+def loop_setup(options: LoopOptions, reader: Reader) -> hc.LoopSetup:
+    """The library's loop description from the options: sizes checked, files read (with the
+    command line's reading options, `reader`)."""
     check_size(options.sensor_model, options.sensor_size, "--sensor-size")
     check_size(options.model, options.model_size, "--model-size")
     if options.sensor != "virtual" and options.sensor_data is not None:
         raise UsageError("--sensor-data fits S_r on a recording; it cannot be combined with "
                          f"--sensor {options.sensor}")
-    reading = {path: read_options(args, path)
+    reading = {path: reader.options(path)
                for path in (options.sensor_data, options.training_data) if path is not None}
     sensor_file = _model_file(options.sensor_path, "--sensor")
     recordings = [None if path is None else hio.read_recording(path, options=reading[path])
@@ -88,18 +90,6 @@ def _outputs(options: ControlOptions, out: Path) -> list[Path]:
     if options.bode:
         names.append("bode.png")
     return [out / n for n in names]
-
-
-def _options(args: argparse.Namespace) -> ControlOptions:
-    """The options, with what needs another option refused in one line."""
-    if not (args.experiment or args.bode):
-        raise UsageError("give --experiment NAME and/or --bode (see 'hystkit control --help')")
-    options = ControlOptions.from_args(args)
-    if options.tuning is not None and not options.experiment:
-        raise UsageError("--tune-nonlinear tunes on an experiment: give --experiment NAME")
-    if options.noise is not None and not options.experiment:
-        raise UsageError("--noise runs an experiment with noise: give --experiment NAME")
-    return options
 
 
 def _config(options: ControlOptions, run: hc.ControlRun) -> dict:
@@ -150,8 +140,9 @@ def _write(options: ControlOptions, run: hc.ControlRun, folder: Path, metrics: d
                      f"rest, cut at the plant input").savefig(folder / "bode.png", dpi=110)
 
 
-def _control(args: argparse.Namespace) -> int:
-    options = _options(args)
+def run_control_command(args: argparse.Namespace) -> int:
+    """``hystkit control``: the loop set up, run, printed and written."""
+    options = ControlOptions.from_args(args)
     stamp = time.strftime("%Y%m%d-%H%M%S")
     out = options.out or Path(f"hystkit-control-{options.loop.scheme}-"
                               f"{options.experiment or 'bode'}-{stamp}")
@@ -161,8 +152,9 @@ def _control(args: argparse.Namespace) -> int:
                             inputs=options.loop.inputs())
     t_start = time.perf_counter()
     try:
-        run = hc.run_control(loop_setup(options.loop, args), experiment=options.experiment,
-                             noise=options.noise, tuning=options.tuning, bode=options.bode)
+        run = hc.run_control(loop_setup(options.loop, reader_of(args)),
+                             experiment=options.experiment, noise=options.noise,
+                             tuning=options.tuning, bode=options.bode)
     except hc.LoopError as exc:
         raise loop_error(exc, options.loop) from None
     report.print_run(options, run)
@@ -183,12 +175,3 @@ def _control(args: argparse.Namespace) -> int:
           f"({config['seconds']:.1f} s)")
     return 0
 
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``hystkit control`` to the ``hystkit`` parser."""
-    p = sub.add_parser("control", help="closed-loop position control with a hysteretic "
-                       "sensor: the document's ch. 7 experiments")
-    add_setup_options(p)
-    add_read_options(p)  # for --sensor-data and --training-data
-    add_control_options(p)
-    p.set_defaults(run=_control)

@@ -15,38 +15,32 @@ with a simulation that shows divergence when there is.
 from __future__ import annotations
 
 import argparse
-from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-from .. import compensation
+import numpy as np
+
+from .. import compensation, models
 from .. import control as hc
 from .. import io as hio
 from ..errors import InputError
-from ._common import UsageError, add_read_options, deferred, read_recording_args
-from ._control_options import LoopOptions, add_setup_options
+from ..signals import exponential_chirp
+from ._control_options import StabilityOptions
+from ._reading import Reader, reader_of
 from .cmd_control import loop_error, loop_setup
 
-if TYPE_CHECKING:
-    import numpy as np
-
-__all__ = ["register"]
+__all__ = ["run_stability"]
 
 
 def _probe_input(dt: float) -> np.ndarray:
     """The paper's chirp (0.1 -> 3 Hz over 100 s) at unit amplitude: the normalised training
     range [-1, 1] at every rate the experiments use."""
-    import numpy as np  # this module is imported to build the parser: --help loads no numpy
-
-    from ..signals import exponential_chirp
-
     return exponential_chirp(np.arange(round(100.0 / dt)) * dt, amplitude=1.0)
 
 
-def _model_input(comp: compensation.Compensator, path: Path, args: argparse.Namespace) -> np.ndarray:
+def _model_input(comp: compensation.Compensator, path: Path, reader: Reader) -> np.ndarray:
     """The fitted model's input on a recording, normalised as at fit time (eq. 5.10): the
     sensor signal for a direct compensator, the position for an inverse one's forward model."""
-    rec = read_recording_args(args, path, need_position=comp.mode == "inverse")
+    rec = reader.recording(path, need_position=comp.mode == "inverse")
     comp.check_sampling(rec)
     if comp.mode == "direct":
         return comp.normalised_sensor(rec.sensor)
@@ -83,42 +77,11 @@ def _sector_line(name: str, sector) -> str:
             f"step)")
 
 
-@dataclass(frozen=True)
-class StabilityOptions:
-    """``hystkit stability``'s options: a model file's local stability, or with ``control`` a
-    loop's global stability."""
-
-    model_json: Path | None
-    data: Path | None
-    json: Path | None
-    force: bool
-    control: bool
-    experiment: str
-    loop: LoopOptions
-
-    @classmethod
-    def from_args(cls, args: argparse.Namespace) -> StabilityOptions:
-        """The options of a parsed command line; a combination that does not fit is one line."""
-        options = cls(args.model_json, args.data, args.json, args.force, args.control,
-                      args.experiment, LoopOptions.from_args(args))
-        if options.control:
-            if options.model_json is not None or options.data is not None:
-                raise UsageError("--control examines a loop: give no MODEL.json and no --data")
-            if options.loop.scheme is None:
-                raise UsageError("--control needs --scheme direct|weighting")
-        elif options.loop.scheme is not None:
-            raise UsageError("--scheme and the other loop options need --control")
-        elif options.model_json is None:
-            raise UsageError("give MODEL.json (a model's local stability) or --control (a "
-                             "loop's)")
-        return options
-
-
-def _control_stability(options: StabilityOptions, args: argparse.Namespace) -> int:
+def _control_stability(options: StabilityOptions, reader: Reader) -> int:
     if options.json is not None:
         hio.check_output_path(options.json, options.force, inputs=options.loop.inputs())
     try:
-        study = hc.examine_loop(loop_setup(options.loop, args), options.experiment)
+        study = hc.examine_loop(loop_setup(options.loop, reader), options.experiment)
     except hc.LoopError as exc:
         raise loop_error(exc, options.loop) from None
     loop, models_, report, margins = (study.setup.loop, study.setup.models, study.report,
@@ -155,27 +118,28 @@ def _control_stability(options: StabilityOptions, args: argparse.Namespace) -> i
     return 0
 
 
-def _stability(args: argparse.Namespace) -> int:
-    from .. import models  # its registry loads numpy: not when the parser is built
-
+def run_stability(args: argparse.Namespace) -> int:
+    """``hystkit stability``: a model file's local stability, or a loop's (``--control``)."""
     options = StabilityOptions.from_args(args)
+    reader = reader_of(args)
     if options.control:
-        return _control_stability(options, args)
-    if args.json is not None:
-        hio.check_output_path(args.json, args.force,
-                              inputs=[args.model_json] + ([args.data] if args.data else []))
-    comp = compensation.load_compensator(args.model_json)
+        return _control_stability(options, reader)
+    model_json, data = options.model_json, options.data
+    if options.json is not None:
+        hio.check_output_path(options.json, options.force,
+                              inputs=[model_json] + ([data] if data else []))
+    comp = compensation.load_compensator(model_json)
     family, structure = comp.family, comp.structure
-    u = (_probe_input(structure.dt) if args.data is None else _model_input(comp, args.data, args))
-    probe = ("a unit chirp 0.1 -> 3 Hz" if args.data is None else str(args.data))
+    u = _probe_input(structure.dt) if data is None else _model_input(comp, data, reader)
+    probe = "a unit chirp 0.1 -> 3 Hz" if data is None else str(data)
     try:
         report = models.stability_report(family, structure, comp.params, u)
         inverse = (models.stability_report(family, structure, comp.params,
                                     _probe_input(structure.dt), inverse=True)
                    if comp.mode == "inverse" else None)
     except ValueError as exc:
-        raise InputError(f"{args.model_json}: {exc}") from None
-    print(f"{args.model_json}: {family.name} ({family.title}), dt = {structure.dt:g} s, "
+        raise InputError(f"{model_json}: {exc}") from None
+    print(f"{model_json}: {family.name} ({family.title}), dt = {structure.dt:g} s, "
           f"{report['n_state']} state(s)")
     details = report["details"]
     if details is not None:
@@ -192,33 +156,10 @@ def _stability(args: argparse.Namespace) -> int:
     print(f"linearised step, eigenvalues of A: {_verdict(report)}")
     if inverse is not None:
         print(f"inverse (the compensator as it runs, driven by a unit chirp): {_verdict(inverse)}")
-    if args.json is not None:
-        hio.write_json({"model_file": str(args.model_json), "model": comp.model, "mode": comp.mode,
-                    "probe": probe, **report, "inverse_report": inverse}, args.json,
-                   force=args.force)
-        print(f"wrote {args.json}")
+    if options.json is not None:
+        hio.write_json({"model_file": str(model_json), "model": comp.model, "mode": comp.mode,
+                        "probe": probe, **report, "inverse_report": inverse}, options.json,
+                       force=options.force)
+        print(f"wrote {options.json}")
     return 0
 
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add the ``stability`` subcommand to the ``hystkit`` parser."""
-    p = sub.add_parser("stability", help="local stability of a fitted model of any family "
-                                         "(linearised step; eq. 5.18-5.28 for the mPL), or "
-                                         "with --control a loop's global stability")
-    p.add_argument("model_json", type=Path, nargs="?", metavar="MODEL.json",
-                   help="model JSON file written by 'hystkit fit' (not with --control)")
-    p.add_argument("--data", type=Path,
-                   help="recording whose model input (normalised as at fit time) drives the "
-                        "model; default: a unit chirp 0.1 -> 3 Hz")
-    p.add_argument("--json", type=Path, help="also write the analysis to this JSON file")
-    p.add_argument("--control", action="store_true",
-                   help="examine the control loop set up by the options below (as 'hystkit "
-                        "control'): slope sectors, circle criterion, a simulation")
-    deferred(p.add_argument("--experiment", default="sine",
-                            help="with --control: the experiment simulated (default sine); its "
-                                 "closed-loop slopes join the trained sine's in the sector "
-                                 "tested, and a divergence shows instability"),
-             choices=lambda: hc.EXPERIMENTS)
-    add_setup_options(p, scheme_required=False)
-    add_read_options(p)
-    p.set_defaults(run=_stability)

@@ -49,74 +49,151 @@ adapted parameters. Adapting streams run sample by sample in Python (their updat
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
+import contextlib
+import itertools
+import sys
+import time
+from collections import deque
+from collections.abc import Iterator
 
-from ._common import add_read_options, number, positive_int
-from ._own_layout import add_trained_note
-from ._stream_defaults import (
-    ADAPT_CHOICES,
-    DEFAULT_FORGETTING,
-    DEFAULT_REFIT_EVERY,
-    DEFAULT_WINDOW,
-    SERIAL_HINT,
+import numpy as np
+
+from ..compensation import load_compensator
+from ..errors import InputError, OutputError
+from ..live import AdaptiveStream, RefittingStream, Stream, SyncExcitation, sync_excitation
+from ..live._stream import check_streamable
+from ._common import stdout_for
+from ._own_layout import stream_args
+from ._stream_adapt import Learning, adaptive_stream, check_adapt_options, run_line
+from ._stream_chunks import run_chunk
+from ._stream_input import (
+    Rewriter,
+    live_as_trained,
+    nothing_compensated,
+    output_header,
+    stream_format,
 )
+from ._stream_lines import Reading, Tally
+from ._stream_read import TOO_LONG, Input, lines_of, open_input
 
-__all__ = ["ADAPT_CHOICES", "DEFAULT_FORGETTING", "DEFAULT_REFIT_EVERY", "DEFAULT_WINDOW",
-           "register", "stream_options"]
+__all__ = ["run_stream"]
 
-
-def _run(args: argparse.Namespace) -> int:
-    # the run's module loads numba: imported once the command line parsed, not for --help
-    from ._stream_run import run_stream
-
-    return run_stream(args)
+# Latency percentiles are over the most recent samples (memory stays bounded on a long run).
+LATENCY_WINDOW = 100_000
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add the ``stream`` subcommand to the ``hystkit`` parser."""
-    p = sub.add_parser("stream", help="compensate live: time,sensor lines in (stdin, a file or "
-                                      "a serial port), time,position_estimate,flags lines out")
-    stream_options(p)
-    p.set_defaults(run=_run)
+class Latency:
+    """Per-sample latencies [s]: the most recent ``LATENCY_WINDOW`` ones, the count, the max."""
+
+    def __init__(self) -> None:
+        self.recent: deque[float] = deque(maxlen=LATENCY_WINDOW)
+        self.n = 0
+        self.max = 0.0
+
+    def add(self, seconds: float, n: int = 1) -> None:
+        """`n` samples that took `seconds` each (a chunk's: each waited for the whole)."""
+        self.recent.extend(itertools.repeat(seconds, n))
+        self.n += n
+        self.max = max(self.max, seconds)
+
+    def summary(self) -> str:
+        if not self.n:
+            return "hystkit stream: no sample compensated"
+        us = np.asarray(self.recent) * 1e6
+        window = ("" if self.n <= LATENCY_WINDOW
+                  else f" (median and p99 over the last {LATENCY_WINDOW})")
+        return (f"hystkit stream: {self.n} samples; latency per sample median "
+                f"{np.median(us):.1f} µs, p99 {np.percentile(us, 99):.1f} µs, max "
+                f"{self.max * 1e6:.1f} µs{window}")
 
 
-def stream_options(p: argparse.ArgumentParser) -> None:
-    """``stream``'s arguments and options."""
-    p.add_argument("model", type=Path, help="model JSON file written by 'hystkit fit' "
-                                            "(centring fit, tare, track or none)")
-    source = p.add_mutually_exclusive_group()
-    source.add_argument("--in", dest="input", type=Path, metavar="FILE",
-                        help="read this file instead of stdin")
-    source.add_argument("--serial", metavar="PORT",
-                        help=f"read a serial port (needs pyserial: {SERIAL_HINT})")
-    p.add_argument("--baud", type=positive_int, help="serial baud rate (default 115200)")
-    p.add_argument("--start", choices=("rest", "sync"), default="rest",
-                   help="rest: model at rest at the first sample (default); sync: after the "
-                        "synchronisation excitation e_sync (eq. 2.21-2.22), printed to stderr")
-    add_read_options(p)  # --in FILE, stdin or a port laid out as the user's files
-    add_trained_note(p)
-    p.add_argument("--level", type=number(0, 1, low_open=True, high_open=True), default=None,
-                   help="nominal coverage of the prediction band columns, in (0, 1) (default: "
-                        "the model's own, 0.90 unless fitted otherwise)")
-    adapt = p.add_argument_group("online adaptation (a reference column: the true position "
-                                 "[mm] now and then, empty when unknown)")
-    adapt.add_argument("--adapt", choices=ADAPT_CHOICES,
-                       help="re-fit from the references: gain (gain and offset of the "
-                            "estimate, any model) or weights (cell output weights and offset; "
-                            "direct mpl, pl, ladder) by recursive least squares; full (every "
-                            "parameter, re-fitted on a sliding window; direct compensators)")
-    adapt.add_argument("--forgetting", type=number(0, 1, low_open=True), metavar="LAMBDA",
-                       help=f"forgetting factor per reference, in (0, 1]: remembers about "
-                            f"1/(1-LAMBDA) references (default {DEFAULT_FORGETTING:g})")
-    adapt.add_argument("--prior-gain", type=number(0, 1e6, low_open=True), metavar="STD",
-                       help="prior standard deviation of each gain / weight multiplier "
-                            "(default 0.1: 10 %%)")
-    adapt.add_argument("--prior-offset", type=number(0, 1e9, low_open=True), metavar="MM",
-                       help="prior standard deviation of the offset [mm] (default 10 %% of "
-                            "the training positions' span)")
-    adapt.add_argument("--window", type=number(0, 1e6, low_open=True), metavar="SECONDS",
-                       help=f"--adapt full: length of the sliding window re-fitted [s] (default "
-                            f"{DEFAULT_WINDOW:g}); it must hold 4 references per parameter")
-    adapt.add_argument("--refit-every", type=positive_int, metavar="N",
-                       help=f"--adapt full: re-fit after every N new references (default "
-                            f"{DEFAULT_REFIT_EVERY})")
+def run_stream(args: argparse.Namespace) -> int:
+    """Run ``hystkit stream`` on the parsed command line (see the module)."""
+    if args.serial is None and args.baud is not None:
+        raise InputError("--baud is for --serial")
+    check_adapt_options(args)
+    comp = load_compensator(args.model)
+    stream_args(args, comp.reading)  # --in FILE of the training files' names: read as they were
+    live_as_trained(args, comp.reading)  # stdin or a port: so too, unless told otherwise
+    fmt = stream_format(args)  # --in FILE: its settings file and layout, as fit reads it
+    stdout_for("the estimates")
+    if args.level is not None and comp.band is None:
+        raise InputError(f"--level: {args.model} has no prediction band (fitted without one or "
+                         f"by a hystkit before bands); fit it again")
+    check_streamable(comp)  # the oracle centring, --no-limit: before anything is said
+    start = "rest"
+    if args.start == "sync":
+        sync = sync_excitation(comp)
+        _print_sync(sync)
+        start = sync.state_after
+    learning = None
+    if args.adapt is None:
+        stream = Stream(comp, start, label=str(args.model), level=args.level)
+    else:
+        stream, learning = adaptive_stream(args, comp, start), Learning()
+    source, chunks = open_input(args)
+    if not fmt.plain:
+        rewrite = Rewriter(fmt, source, TOO_LONG)
+        chunks = Input((rewrite.chunk(chunk) for chunk in chunks), chunks)
+    with contextlib.closing(chunks):
+        _write(output_header(fmt, comp.band is not None and args.adapt != "full"))
+        tally, latency = Tally(), Latency()
+        try:
+            _run(stream, chunks, tally, latency, fmt.time_scale, learning)
+            if not latency.n:  # a stream that compensates nothing is no success
+                raise InputError(nothing_compensated(source, tally.count, tally.first))
+        finally:  # also on Ctrl-C / SIGTERM: the summary, then main's exit 130 / 143
+            tally.report(source, comp.structure.dt)
+            print(latency.summary(), file=sys.stderr)
+            if learning is not None:
+                print(learning.summary(stream, args.adapt, args.forgetting), file=sys.stderr)
+    return 0
+
+
+def _run(stream: Stream | AdaptiveStream | RefittingStream, chunks: Iterator[str],
+         tally: Tally, latency: Latency, time_scale: float,
+         learning: Learning | None = None) -> None:
+    """Compensate every line, writing each chunk's results at once
+    (:func:`._stream_chunks.run_chunk`); an adapting stream (``learning`` given) runs line by
+    line and also gets each line's reference."""
+    reading = Reading(time_scale)
+    banded = stream.compensator.band is not None
+    for chunk in chunks:
+        arrived = time.perf_counter()
+        if learning is None:
+            rows = run_chunk(stream, chunk, reading, tally, banded)
+        else:
+            rows = [row for line in lines_of(chunk)
+                    if (row := run_line(stream, line, reading, tally, learning)) is not None]
+        if rows:
+            # counted before the lines leave: a reader that got them finds them in the summary
+            latency.add(time.perf_counter() - arrived, len(rows))
+            _write("".join(rows))
+
+
+def _write(text: str) -> None:
+    """Write and flush `text` to stdout at once; a full disk or a failing device is one error
+    line (a reader that left stays a BrokenPipeError: exit 1, as for every command)."""
+    out = stdout_for("the estimates")
+    try:
+        out.write(text)
+        out.flush()
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        raise OutputError(f"standard output: cannot write the estimates "
+                          f"({exc.strerror or exc})") from None
+
+
+def _print_sync(sync: SyncExcitation) -> None:
+    levels = ", ".join(f"{v:.6g}" for v in _user_levels(sync))
+    where = " (at the training data's offsets)" if sync.quantity == "sensor" else ""
+    print(f"hystkit stream: start-up e_sync ({sync.rule}): drive the {sync.quantity} to "
+          f"{levels} {sync.unit}{where}, holding each {sync.hold_seconds:g} s "
+          f"({sync.duration:g} s in all); the stream starts from the state it leaves",
+          file=sys.stderr)
+
+
+def _user_levels(sync: SyncExcitation) -> list[float]:
+    n_hold = round(sync.hold_seconds / sync.dt)
+    return [float(sync.signal[k * n_hold]) for k in range(len(sync.levels))]
