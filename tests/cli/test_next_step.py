@@ -160,3 +160,51 @@ def test_data_far_outside_the_training_range_ask_for_a_refit_whatever_the_score(
     assert json.loads(scores.read_text())["verdict"] in ("worse_than_line", "no_signal",
                                                           "extrapolated")
     assert _next(out).startswith("next: try refitting on recordings that cover this range")
+
+
+def test_a_poor_compensator_asks_for_recordings_like_the_one_judged(tmp_path, capsys):
+    """Ferrite loops: fitted on the 80 A/m loop, judged on the 16 A/m one inside it, R² 0.19
+    above a line at -0.31 (it was 'ok'): poor, and the next step is data like these."""
+    from hystkit.datasets import load
+    from hystkit.errors import InputError
+
+    try:
+        train, test = (load("bh_loops", f"MnZn_ferrite_H{h}").to_recording() for h in (80, 16))
+    except InputError as exc:
+        pytest.skip(f"shared data absent: {exc}")
+    paths = [write_recording(rec, tmp_path / f"{name}.csv")
+             for rec, name in ((train, "h80"), (test, "h16"))]
+    model = tmp_path / "m.json"
+    assert run_cli(capsys, "fit", paths[0], "--model", "mpl-poly", "--out", model)[0] == 0
+    code, out, err = run_cli(capsys, "evaluate", model, paths[1])
+    assert code == GUARD_EXIT and "hystkit: evaluate: poor: " in err
+    assert _next(out).startswith("next: try refitting on recordings like these")
+    assert "holds only in part here" in _next(out)
+
+
+def test_a_fit_that_explains_too_little_is_sent_to_other_models_then_the_sensor(tmp_path,
+                                                                                capsys):
+    """A sensor whose noise is as large as its signal: one mPL cell explains ~60 % of the
+    position in training (poor)."""
+    from hystkit.io import Recording
+    from hystkit.sensors import simulate_experiment
+
+    rec = simulate_experiment("sine", 1)
+    noise = np.std(rec.sensor) * np.random.default_rng(5).normal(size=rec.n_samples)
+    noisy = write_recording(Recording(time=rec.time, position=rec.position, source="noisy",
+                                      sensor=rec.sensor + noise), tmp_path / "noisy.csv")
+    code, out, err = run_cli(capsys, "fit", noisy, "--model", "mpl", "--out", tmp_path / "m.json")
+    assert code == GUARD_EXIT and "hystkit: fit poor" in err
+    step = _next(out)
+    assert step.startswith("next: try --model auto") and "explains too little" in step
+    assert step.endswith("check the columns (--columns position=NAME,sensor=NAME)")
+
+
+@pytest.mark.parametrize(("command", "start"), [
+    ("select", "more recordings of the device (one per run) or --models with more families"),
+    ("guided", "more recordings of the device (one per run) or 'hystkit select DATA --models"),
+])
+def test_a_selection_with_only_poor_candidates_asks_for_data_or_more_families(command, start):
+    from hystkit.cli._next_step import next_step
+
+    assert next_step("poor", command=command, model="mpl", size=1).startswith(start)

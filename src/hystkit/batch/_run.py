@@ -24,13 +24,12 @@ import pandas as pd
 from .. import __version__
 from ..compensation import (
     DEFAULT_CENTER,
-    FAR_MARGIN,
     evaluate,
     fit_compensator,
     save_compensator,
-    verdict,
     with_band,
 )
+from ..compensation._verdict import pooled_verdict
 from ..errors import InputError, OutputError
 from ..io import (
     ReadOptions,
@@ -109,11 +108,7 @@ def fit_sensor(job: SensorJob, *, read_options: Reading = None) -> dict:
     status, message = info["status"], info["status_message"]
     if status == "ok" and scores:
         # a fit that passed its guards is judged, as `evaluate` would, on the validation runs
-        far = [comp.sensor_outside(rec, margin=FAR_MARGIN) for rec in val_recs]
-        outside = None if any(m is None for m in far) else float(
-            sum(m.sum() for m in far) / sum(m.size for m in far))
-        status, message = verdict(_mean(scores, "r2"), _mean(scores, "linear_r2"),
-                                  "validation (deployable)", outside)
+        status, message = pooled_verdict(scores, "validation (deployable)")
         status = "ok" if status == "undetermined" else status
     row.update(status=status,
                r2_deployable=_mean(scores, "r2"), e_rms_pct_deployable=_mean(scores, "e_rms_pct"),

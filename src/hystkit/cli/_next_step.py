@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..compensation import MAX_OUTSIDE, MIN_EXPLAINED
+from ..compensation._verdict import MAX_OUTSIDE, MIN_EXPLAINED
 
 __all__ = ["next_step"]
 
@@ -10,6 +10,11 @@ _AUTO = ("--model auto (mpl with 1-3 cells, mpl-poly, pi and pl, each scored on 
          "data)")
 _EVALUATE_COLUMNS = ("checking that this file's columns are the training files' "
                      "(--columns position=NAME,sensor=NAME)")
+_MORE_MODELS = {"select": "--models with more families (e.g. mpl,mpl-poly,pi,preisach)",
+                "guided": "'hystkit select DATA --models mpl,mpl-poly,pi,preisach' (more "
+                          "families than the guided list)"}
+_TOO_LITTLE = ("the sensor may carry too little of the position: check the columns "
+               "(--columns position=NAME,sensor=NAME)")
 _COLUMNS = ("checking the columns: the sensor column may not carry the position "
             "(--columns position=NAME,sensor=NAME); no model recovers a signal that is not there")
 
@@ -23,7 +28,8 @@ def next_step(status: str, *, command: str = "fit", model: str | None = None,
     ----------
     status : str
         A fit's status (``on_bounds``, ``not_converged``, ``collapsed``, ``no_signal``,
-        ``worse_than_line``, ``no_limit``), a use verdict (``extrapolated``), or a selection's
+        ``poor``, ``worse_than_line``, ``no_limit``), a use verdict (``extrapolated``,
+        ``poor``), or a selection's
         (``failed``: every candidate failed; ``refit``: the best ones' fits on all the data
         failed their guards; ``skipped``: candidates left out for the time budget).
     command : {"fit", "evaluate", "select", "guided"}
@@ -54,6 +60,9 @@ def next_step(status: str, *, command: str = "fit", model: str | None = None,
                          f"wired differently, carries nothing the model learnt",
             "extrapolated": "refitting on recordings that cover this range, e.g. 'hystkit fit "
                             "TRAIN.csv THIS.csv' (fitted jointly)",
+            "poor": "refitting on recordings like these, e.g. 'hystkit fit TRAIN.csv THIS.csv' "
+                    "(fitted jointly): what the model learnt holds only in part here (another "
+                    "rate, amplitude or operating point than in training)",
         }.get(status, "refitting on recordings like these, e.g. 'hystkit fit TRAIN.csv "
                       "THIS.csv' (fitted jointly; without --model it chooses among small "
                       "models on held-out data)")
@@ -68,6 +77,8 @@ def next_step(status: str, *, command: str = "fit", model: str | None = None,
             "failed": "'hystkit fit DATA --model mpl --out m.json': one fit's own error says "
                       "what stops them",
             "skipped": "--budget with more seconds, or fewer samples (--resample HZ)",
+            "poor": f"more recordings of the device (one per run) or {_MORE_MODELS[command]}; "
+                    f"if no model explains more of the position held out, {_TOO_LITTLE}",
         }.get(status, f"'hystkit fit DATA --model {model or 'NAME'}"
                       f"{'' if size is None else f' --size {size}'}' (the best candidate): "
                       f"its refusal names what failed and what to try")
@@ -88,6 +99,9 @@ def next_step(status: str, *, command: str = "fit", model: str | None = None,
     if status == "worse_than_line":
         return (f"{_AUTO}: {model or 'this model'} does no better than a straight line on "
                 f"these data")
+    if status == "poor":
+        return (f"{_AUTO}: {model or 'this model'} explains too little of the position on its "
+                f"own training data; if no model explains more, {_TOO_LITTLE}")
     if status == "no_limit":
         return "the fit without --no-limit (the stability limit keeps its Euler step bounded)"
     return _AUTO

@@ -181,8 +181,10 @@ def fit_status(estimate: np.ndarray, target: np.ndarray, line: np.ndarray,
                limited: bool = True) -> tuple[str, str]:
     """``(status, message)`` of a fit from its training estimate and the straight line's.
 
-    Status is the first that applies: ``collapsed`` (estimate constant), ``no_signal`` or
-    ``worse_than_line`` (the shared verdict on the training data, :func:`~._verdict.verdict`),
+    Status is the first that applies: ``collapsed`` (estimate constant), ``no_signal``,
+    ``worse_than_line`` or ``poor`` (the shared verdict on the training data,
+    :func:`~._verdict.verdict`: a model that cannot follow its own training data well enough
+    to be used),
     ``on_bounds`` (search box hits, by name: see :func:`bound_flags`; a model at its own limit
     is not on bounds), ``not_converged``, ``no_limit`` (a model without the stability limit,
     ``limited`` False: fitted for study, it may diverge on other data), else ``ok``.

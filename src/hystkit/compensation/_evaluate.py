@@ -17,6 +17,7 @@ from ._band import BAND_SCORE_KEYS, interval, interval_scores
 from ._centring import ORACLE_CENTER, center_label
 from ._compensator import POSITION_MARGIN, SENSOR_MARGIN, Compensator
 from ._training_checks import MIN_SAMPLES
+from ._verdict import FAR_MARGIN
 
 __all__ = ["MIN_SCORED_SAMPLES", "SCORE_KEYS", "evaluate", "use_flags"]
 
@@ -90,7 +91,9 @@ def evaluate(compensator: Compensator, recording: Recording, *,
         with a ``linear_`` prefix for the straight line; the same with an ``_oracle`` suffix
         under the paper's protocol (``center_oracle``); ``sensor_loop_area``, ``n_samples``,
         ``extrapolated_fraction``, ``n_sensor_outside`` / ``n_estimate_outside`` (use-time
-        guards, None if the model file predates them) with their margins. Every number is
+        guards, None if the model file predates them) with their margins, and
+        ``n_sensor_far_outside`` / ``n_estimate_far_outside`` beyond ``far_margin`` of the
+        ranges' widths (what :func:`~._verdict.verdict` judges as extrapolation). Every number is
         finite; a score that is undefined or overflowed is None. ``notes``: why a score is
         None, by its key, where there is a reason to give (e.g. ``sinad_db``: the recording
         is too short for its fundamental, and how many samples it needs); empty otherwise.
@@ -128,9 +131,13 @@ def evaluate(compensator: Compensator, recording: Recording, *,
     scores["sensor_loop_area"] = _loop_area_or_none(position, recording.sensor)
     flags = use_flags(compensator, recording, estimate)
     scores["extrapolated_fraction"] = compensator.extrapolated_fraction(recording)
+    # what the verdict judges: samples beyond the training ranges by FAR_MARGIN of their width
+    flags["sensor_far_outside"] = compensator.sensor_outside(recording, margin=FAR_MARGIN)
+    flags["estimate_far_outside"] = compensator.estimate_outside(estimate, margin=FAR_MARGIN)
     for name, mask in flags.items():
         scores[f"n_{name}"] = None if mask is None else int(np.sum(mask))
     scores["sensor_margin"], scores["position_margin"] = SENSOR_MARGIN, POSITION_MARGIN
+    scores["far_margin"] = FAR_MARGIN
     scores.update(_band_scores(compensator, recording, estimate, level))
     scores["notes"] = notes
     return {key: _finite_or_none(value) for key, value in scores.items()}

@@ -28,13 +28,13 @@ from collections.abc import Callable, Sequence
 from functools import partial
 
 from ..compensation import (
-    MIN_EXPLAINED,
     Candidate,
     check_fitting_data,
     fits_in,
     folds,
     protocol,
 )
+from ..compensation._verdict import MIN_EXPLAINED, MIN_USABLE
 from ..models import get_family
 from ..parallel import SerialExecutor, fit_cost
 from ._select import select_model
@@ -185,7 +185,8 @@ def selection_status(result: dict) -> str:
     Returns
     -------
     str
-        ``no_signal`` (no candidate explains the position), ``worse_than_line``, ``refit``
+        ``no_signal`` (no candidate explains the position), ``poor`` (none, and not the
+        straight line either, explains ``MIN_USABLE`` of it), ``worse_than_line``, ``refit``
         (the best ones' fits on all the data failed their guards), ``skipped`` (nothing
         validated within the budget), ``failed`` (every candidate failed); ``ok`` when it has
         a winner.
@@ -199,6 +200,8 @@ def selection_status(result: dict) -> str:
         return "no_signal"  # nothing explains the position, not even the straight line
     if any(r["verdict"] == "ok" and not r["guard_failed"] for r in scored):
         return "refit"
+    if all(max(r["cv_r2"], r["cv_linear_r2"]) < MIN_USABLE for r in scored):
+        return "poor"  # some signal, but no candidate (nor the line) is usable held out
     return "worse_than_line"
 
 
