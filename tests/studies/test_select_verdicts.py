@@ -80,12 +80,15 @@ def test_select_refuses_a_noise_only_sensor(tmp_path, capsys):
     assert result["winner"] is None and result["compensator"] is None
     assert "no candidate" in result["refusal"]
     assert all(r["verdict"] != "ok" for r in result["ranking"] if "error" not in r)
-    # on the command line: exit 3, one line, no model file
+    # on the command line: exit 3, one line, no model file (the fit centring only: every
+    # centring of mpl and pi on a noise-only sensor is refused in test_verdict_corpus.py's
+    # test_bad_select_on_a_noise_only_sensor)
     data = tmp_path / "noise_only.csv"
     np.savetxt(data, np.column_stack([rec.time, rec.position, rec.sensor]), delimiter=",",
                header="time,position,sensor", comments="")
     out = tmp_path / "best.json"
-    assert main(["select", str(data), "--models", "mpl", "--out", str(out)]) == 3
+    assert main(["select", str(data), "--models", "mpl", "--centers", "fit", "--out",
+                 str(out)]) == 3
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("hystkit: select: no usable model")
     assert not out.exists()
