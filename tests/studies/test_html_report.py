@@ -97,19 +97,20 @@ def render(page: Path, shot: Path, *flags: str) -> np.ndarray:
     return imread(shot)[..., :3]
 
 
-def page_requests(page: Path, tmp_path: Path) -> list[str]:
-    """URLs the page itself asked for while Chromium rendered it, from Chromium's net log.
+def render_logged(page: Path, tmp_path: Path) -> tuple[np.ndarray, list[str]]:
+    """One Chromium run of `page`: its screenshot (as :func:`render`) and the URLs the page
+    itself asked for meanwhile, from Chromium's net log.
 
     The page's requests carry its (opaque, file://) origin as initiator, "null"; the browser's
     own background requests say "not an origin". Data URIs never reach the network stack.
     """
     log = tmp_path / f"{page.stem}-net.json"
-    render(page, tmp_path / f"{page.stem}-shot.png", f"--log-net-log={log}")
+    shot = render(page, tmp_path / f"{page.stem}-shot.png", f"--log-net-log={log}")
     events = json.loads(log.read_text(encoding="utf-8"))
     names = {v: k for k, v in events["constants"]["logEventTypes"].items()}
-    return [e["params"]["url"] for e in events["events"]
-            if names[e["type"]] == "URL_REQUEST_START_JOB" and "url" in e.get("params", {})
-            and e["params"].get("initiator") != "not an origin"]
+    return shot, [e["params"]["url"] for e in events["events"]
+                  if names[e["type"]] == "URL_REQUEST_START_JOB" and "url" in e.get("params", {})
+                  and e["params"].get("initiator") != "not an origin"]
 
 
 @pytest.fixture(scope="module")
@@ -131,6 +132,12 @@ def page(fitted: dict) -> Path:
     folder = fitted["folder"]
     content = build_report([fitted["model"], *(folder / n for n in fitted["recordings"])])
     return write_report(content, folder / "report.html")[0]
+
+
+@pytest.fixture(scope="module")
+def rendered(page: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[np.ndarray, list]:
+    """The report rendered once by Chromium (a start costs seconds): screenshot, requests."""
+    return render_logged(page, tmp_path_factory.mktemp("rendered"))
 
 
 def _rows(tables: list, header_start: tuple[str, ...]) -> list[list[list[str]]]:
@@ -215,8 +222,8 @@ def test_tables_escape_their_text() -> None:
 
 
 @needs_chromium
-def test_chromium_renders_the_page_with_its_figures(page: Path, tmp_path: Path) -> None:
-    shot = render(page, tmp_path / "shot.png")
+def test_chromium_renders_the_page_with_its_figures(rendered: tuple) -> None:
+    shot, _ = rendered
     pixels = np.round(shot * 255).astype(np.uint8).reshape(-1, 3)
     n_colours = np.unique(pixels, axis=0).shape[0]
     assert n_colours > 2000, n_colours  # text alone gives a few hundred grey levels
@@ -230,10 +237,10 @@ def test_chromium_renders_the_page_with_its_figures(page: Path, tmp_path: Path) 
 
 
 @needs_chromium
-def test_chromium_requests_nothing_for_the_page(page: Path, tmp_path: Path) -> None:
-    assert page_requests(page, tmp_path) == []
+def test_chromium_requests_nothing_for_the_page(rendered: tuple, tmp_path: Path) -> None:
+    assert rendered[1] == []
     # the check sees a page's request when there is one
     canary = tmp_path / "canary.html"
     canary.write_text('<html><body><img src="http://example.invalid/a.png"></body></html>',
                       encoding="utf-8")
-    assert page_requests(canary, tmp_path) == ["http://example.invalid/a.png"]
+    assert render_logged(canary, tmp_path)[1] == ["http://example.invalid/a.png"]
