@@ -25,7 +25,7 @@ from .._compilation import announce
 from ..errors import HystkitError, Terminated
 from . import _commands
 from ._common import INTERNAL_EXIT, Parser
-from ._signals import forked_workers, received_signal, signals_as_exceptions
+from ._signals import end_workers, quiet_finalisers, received_signal, signals_as_exceptions
 
 __all__ = ["main", "program"]
 
@@ -122,9 +122,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     life (`_PROGRAM_GC_THRESHOLDS`, and a frozen heap at the end, which the interpreter's
     shutdown does not walk again), has OpenBLAS start one thread unless the environment says
     otherwise (`_BLAS_THREAD_VARIABLES`), and a run that has to compile numba kernels says
-    so on stderr (`COMPILING_NOTICE`); stopped by a signal after
-    forking workers, it ends the process itself: multiprocessing's exit handlers would otherwise
-    wait forever to flush queues to the workers it stopped.
+    so on stderr (`COMPILING_NOTICE`); stopped by a signal, it terminates and joins the
+    workers the command forked (`hystkit.cli._signals.end_workers`) before returning 130 or
+    143, so that the interpreter's exit has none to wait for, nor reports the finalisers the
+    signal cut short; and it flushes stdout itself, so that a reader that left is exit 1 (or
+    the signal's code), not a traceback.
 
     Parameters
     ----------
@@ -146,25 +148,30 @@ def main(argv: Sequence[str] | None = None) -> int:
             os.environ["OPENBLAS_NUM_THREADS"] = "1"  # before numpy is imported
         announce(COMPILING_NOTICE)
     code = _main(argv)
+    if argv is None and received_signal() is not None:
+        end_workers()  # the interpreter's exit would join them
+        quiet_finalisers()
     if argv is None:
-        gc.freeze()  # the shutdown's collections skip the frozen heap
-    if argv is None and code in (130, 143) and forked_workers():
         code = _flush_streams(code)
-        os._exit(code)
+        gc.freeze()  # the shutdown's collections skip the frozen heap
     return code
 
 
 def _flush_streams(code: int) -> int:
-    """Flush stdout and stderr before an ``os._exit``; either may be closed (``>&-``: None)
-    or gone (a reader that left: exit 1 unless the code already says something)."""
+    """Flush stdout and stderr before the interpreter's exit does: its flush into a pipe whose
+    reader left (output still buffered) prints 'Exception ignored' and exits 120. Such a
+    stream is pointed at devnull, its unread output dropped; a stdout gone makes the exit 1
+    unless the code already says something. Either may be closed (``>&-``: None); any other
+    error (a full disk) is left for the interpreter's flush to report."""
     for stream in (sys.stdout, sys.stderr):
         try:
             if stream is not None:
                 stream.flush()
-        except BrokenPipeError:
+        except BrokenPipeError:  # the reader left (`hystkit ... | head`): not our error
+            os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
             if stream is sys.stdout:
                 code = code or 1
-        except OSError:  # nothing left to tell
+        except OSError:
             pass
     return code
 

@@ -7,8 +7,10 @@ prints one line and exits 143. Both handlers first terminate this process's mult
 workers (the processes of a local Dask cluster, `hystkit.parallel`), so a cluster being shut
 down does not wait for their work. Forked workers get the default actions back: on Ctrl-C (the
 terminal signals the whole process group) or when terminated they end without a traceback, and
-the parent reports once; a worker a cluster forks after the signal (a nanny restarting the one
-just stopped) ends at once.
+the parent reports once; a worker a pool forks after the signal (one still starting) ends at
+once, by that signal's default action. Before the stopped program exits, `end_workers` joins
+every worker, so multiprocessing's exit handlers have none left to wait for, and
+`quiet_finalisers` keeps the interpreter's exit from reporting what the signal cut short.
 """
 
 from __future__ import annotations
@@ -29,7 +31,6 @@ _received: int | None = None  # the last signal the running command got
 _owner = os.getpid()  # the process running the command (not a forked worker)
 _forking = False  # between this process's at-fork hooks
 _PR_SET_PDEATHSIG = 1  # prctl(2) option
-_forks = 0  # worker processes forked by the running command
 _previous_excepthook = threading.excepthook
 
 
@@ -42,15 +43,54 @@ def received_signal() -> int | None:
     return _received
 
 
+def _terminate_workers() -> list:
+    """SIGTERM to this process's live multiprocessing children; returns them."""
+    multiprocessing = sys.modules.get("multiprocessing")
+    if multiprocessing is None:  # never imported: no workers
+        return []
+    children = multiprocessing.active_children()
+    for child in children:
+        child.terminate()
+    return children
+
+
 def _stop_workers() -> None:
     # What the stopped workers' connections log from a cluster's event loop (closed streams,
     # futures whose exception nobody reads) is the signal's consequence: not shown.
     logging.disable(logging.CRITICAL)
-    multiprocessing = sys.modules.get("multiprocessing")
-    if multiprocessing is None:  # never imported: no workers
-        return
-    for child in multiprocessing.active_children():
-        child.terminate()
+    _terminate_workers()
+
+
+def end_workers(timeout: float = 5.0) -> None:
+    """Terminate and join this process's multiprocessing children, the workers of a command
+    stopped by a signal: the interpreter's exit (multiprocessing's handler joins every live
+    child) then has nothing to wait for. One still alive after `timeout` seconds is killed."""
+    for child in _terminate_workers():
+        child.join(timeout)
+        if child.is_alive():
+            child.kill()
+            child.join()
+
+
+def quiet_finalisers() -> None:
+    """After a signal, finalisers that fail at the interpreter's exit are not shown: they belong
+    to objects the signal left half-built (a multiprocessing ``Finalize`` interrupted before
+    its key, an LLVM handle of a compilation cut short). ``HYSTKIT_DEBUG=1`` shows them."""
+    if os.environ.get("HYSTKIT_DEBUG", "") in ("", "0"):
+        sys.unraisablehook = _ignore_unraisable
+
+
+def _ignore_unraisable(unraisable: object) -> None:
+    """Refers to no global: it may run while the interpreter clears this module."""
+
+
+def _die_by(signum: int) -> None:
+    """End this forked worker by `signum`'s default action: no handler, no Python cleanup
+    (what it copied from its parent is not its to flush); its parent sees it killed by the
+    signal, a shell reports 128 + `signum`."""
+    signal.signal(signum, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signum})
+    os.kill(os.getpid(), signum)  # delivered before kill returns (unblocked, to itself)
 
 
 def _stopping(signum: int) -> bool:
@@ -58,8 +98,7 @@ def _stopping(signum: int) -> bool:
     now (a forked worker that is about to reset its handlers, or a fork in progress)."""
     global _received
     if os.getpid() != _owner:  # a worker forked a moment ago, before `_quiet_child` ran
-        signal.signal(signum, signal.SIG_DFL)
-        os.kill(os.getpid(), signum)
+        _die_by(signum)
         return False
     _received = signum
     if _forking:
@@ -97,15 +136,8 @@ def _fork_starts() -> None:
 
 
 def _fork_done() -> None:
-    global _forking, _forks
+    global _forking
     _forking = False
-    if _active:
-        _forks += 1
-
-
-def forked_workers() -> bool:
-    """Whether the current or last command forked worker processes."""
-    return _forks > 0
 
 
 def _quiet_thread_errors(args: threading.ExceptHookArgs) -> None:
@@ -126,7 +158,7 @@ def _die_with_parent() -> None:
     except (OSError, AttributeError):  # not Linux: the parent's terminate has to do
         return
     if os.getppid() != _owner:  # the parent ended before the request took effect
-        os._exit(128 + signal.SIGTERM)
+        _die_by(signal.SIGTERM)
 
 
 def _quiet_child() -> None:
@@ -134,7 +166,7 @@ def _quiet_child() -> None:
     _forking = False
     if _active:
         if _received is not None:  # forked by a pool still starting after the signal
-            os._exit(128 + _received)
+            _die_by(_received)
         if sys.platform.startswith("linux"):
             _die_with_parent()
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
@@ -152,8 +184,8 @@ os.register_at_fork(before=_fork_starts, after_in_parent=_fork_done,
 def signals_as_exceptions() -> Iterator[None]:
     """Within the block, SIGTERM raises `Terminated` and SIGINT KeyboardInterrupt, each after
     stopping worker processes (main thread only; the previous handlers are restored)."""
-    global _active, _received, _owner, _forks, _previous_excepthook
-    _received, _owner, _forks = None, os.getpid(), 0
+    global _active, _received, _owner, _previous_excepthook
+    _received, _owner = None, os.getpid()
     if threading.current_thread() is not threading.main_thread():
         yield  # signal handlers can only be set from the main thread
         return
