@@ -161,10 +161,10 @@ def fit_options(p: argparse.ArgumentParser) -> None:
     deferred(p._actions[-1], choices=lambda: compensation_value("MODES"))
     _add_centring_options(p)
     p.add_argument("--slope-cap", type=slope_cap, default=None,
-                   help="models with an Euler slope cap (mpl, mpl-poly, mpl-g, pl, ladder, "
-                        "chua): cap on the step gain f'·dt of their non-linear elements, in "
-                        "[0.001, 2), default 1 (eq. 5.28-5.29; the ladder allows at most 1; "
-                        "each model's docs page says what it caps)")
+                   help="families whose structure takes an Euler slope cap (given for another, "
+                        "the error names them): cap on the step gain f'·dt of their non-linear "
+                        "elements, in [0.001, 2), default 1 (eq. 5.28-5.29; a family may allow "
+                        "less, and its docs page says what it caps)")
     p.add_argument("--p", type=number(1, low_open=True), default=None, metavar="P",
                    help="pl only: power p of the cells, > 1 (default 21; 'hystkit pl-search' "
                         "searches it)")

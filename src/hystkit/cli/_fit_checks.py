@@ -24,7 +24,8 @@ from ._option_types import UsageError
 from ._reading import Reader, reader_of
 
 __all__ = ["CostOptions", "FitOptions", "cost_options", "list_presets", "parse_init",
-           "start_options", "structure_options", "weight_sum_options"]
+           "start_options", "structure_options", "structure_takers", "structure_takes",
+           "weight_sum_options"]
 
 
 
@@ -98,6 +99,18 @@ def list_presets(opts: FitOptions) -> int:
     return 0
 
 
+def structure_takes(family: Any, *keywords: str) -> bool:
+    """Whether `family`'s structure takes every one of `keywords` (``make_structure(...,
+    slope_cap=...)``): the knobs the family declares."""
+    return set(keywords) <= set(inspect.signature(family.make_structure).parameters)
+
+
+def structure_takers(*keywords: str) -> list[str]:
+    """The registered families whose structure takes every one of `keywords` (for the error
+    that refuses an option: every family loads)."""
+    return [name for name, family in FAMILIES.items() if structure_takes(family, *keywords)]
+
+
 def structure_options(opts: FitOptions, family: Any) -> dict:
     """The structure options of ``--no-limit``, its warning printed on stderr.
 
@@ -120,9 +133,9 @@ def structure_options(opts: FitOptions, family: Any) -> dict:
     """
     if not opts.no_limit:
         return {}
-    if "limit" not in inspect.signature(family.make_structure).parameters:
+    if not structure_takes(family, "limit"):
         raise UsageError(f"--no-limit applies to models with the stability limit eq. 5.29 "
-                         f"(mpl, mpl-poly), not {family.name!r}")
+                         f"({', '.join(structure_takers('limit'))}), not {family.name!r}")
     print(_NO_LIMIT_WARNING.format(model=family.name), file=sys.stderr)
     return {"limit": False}
 

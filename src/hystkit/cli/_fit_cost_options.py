@@ -3,8 +3,9 @@
 By default a fit minimises the SSE (eq. 5.9). ``--loss`` picks one of scipy's robust losses
 instead, ``--f-scale`` its residual scale (normalised units: the data are scaled to max |.| = 1
 before the fit, eq. 5.10) and ``--weights`` a column of the recordings with one weight per
-sample. A model whose fit is a linear least-squares solve takes weights but no robust loss:
-it is refused here, before any data are read, with the library's message.
+sample. A family takes the losses its capabilities declare (a linear least-squares fit takes
+weights but no robust loss): another is refused before any data are read, with the library's
+message.
 """
 
 from __future__ import annotations
@@ -32,8 +33,8 @@ def add_cost_options(parser: argparse.ArgumentParser) -> None:
         "--loss", default="linear", choices=LOSSES,
         help="cost the fit minimises: linear = the SSE (eq. 5.9, default); soft_l1, huber, "
              "cauchy = scipy's robust losses, which count residuals beyond --f-scale less "
-             "(outliers, spikes); models fitted by linear least squares (preisach, gpreisach, "
-             "bobbio, pi) take linear only")
+             "(outliers, spikes); a family takes the losses it declares, linear only unless "
+             "it declares more (the error names the ones it takes)")
     parser.add_argument(
         "--f-scale", type=number(0, low_open=True), default=None, metavar="F",
         help="residual scale of a robust --loss, > 0, in normalised units: the data are "

@@ -50,15 +50,16 @@ def add_start_options(parser: argparse.ArgumentParser) -> None:
         help="start the fit from these parameters only (the document's single fmincon start, "
              "normalised units): JSON '{\"i_s\": 0.1, \"v_t\": 0.2, \"w\": [1, 0.4], \"v_b\": "
              "-0.6}', a list i_s=0.1,v_t=0.2,w=1:0.4,v_b=-0.6 (one value is repeated over the "
-             "cells) or a preset name (mpl: table-5.2, table-5.2-fitted, paper-9.1; mpl-poly: "
-             "paper-9.2-table-i; mpl-g: ch7-table-ii-sine, -chirp, -decay, -noise); "
-             "'--init list' lists the presets of --model; mpl, mpl-poly, mpl-g")
+             "cells) or the name of one of --model's presets ('--init list' lists them); for "
+             "the families that declare a start from given parameters (given for another, "
+             "the error names them)")
     parser.add_argument(
         "--no-limit", action="store_true",
-        help="mpl, mpl-poly: drop the stability limit eq. 5.29 (the unbounded sinh or cubic "
-             "of sec. 5.3.3), to reproduce the document's diverging fits; not for use")
+        help="families whose structure has the stability limit eq. 5.29 (given for another, "
+             "the error names them): drop it (the unbounded model of sec. 5.3.3), to "
+             "reproduce the document's diverging fits; not for use")
     parser.add_argument(
         "--weight-sum-max", type=number(0, low_open=True), default=None, metavar="B",
-        help="mpl, mpl-g: constrain sum |w_k| <= B as the document's fmincon fit (B = 100; "
-             "default: no constraint beyond the box |w_k| <= 100); mpl-g counts w_0 = 1 of its "
-             "gauge")
+        help="families that declare a weight-sum floor (given for another, the error names "
+             "them): constrain sum |w_k| <= B, B above the family's floor, as the document's "
+             "fmincon fit (B = 100; default: no constraint beyond the box |w_k| <= 100)")

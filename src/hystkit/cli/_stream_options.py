@@ -42,7 +42,8 @@ def stream_options(p: argparse.ArgumentParser) -> None:
     adapt.add_argument("--adapt", choices=ADAPT_CHOICES,
                        help="re-fit from the references: gain (gain and offset of the "
                             "estimate, any model) or weights (cell output weights and offset; "
-                            "direct mpl, pl, ladder) by recursive least squares; full (every "
+                            "direct compensators of the families that declare an output "
+                            "linear in them) by recursive least squares; full (every "
                             "parameter, re-fitted on a sliding window; direct compensators)")
     adapt.add_argument("--forgetting", type=number(0, 1, low_open=True), metavar="LAMBDA",
                        help=f"forgetting factor per reference, in (0, 1]: remembers about "

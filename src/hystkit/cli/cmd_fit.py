@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import argparse
-import inspect
 import sys
 from dataclasses import replace
 
@@ -16,7 +15,7 @@ from ..compensation import (
     with_band,
 )
 from ..io import check_output_path, training_reading, training_units
-from ..models import FAMILIES, get_family
+from ..models import get_family
 from ._commands import resolve
 from ._common import GUARD_EXIT, UsageError, check_size, say_next
 from ._core_options import DEFAULT_MODEL, GUIDED_MODEL, model_options_given
@@ -26,6 +25,8 @@ from ._fit_checks import (
     list_presets,
     start_options,
     structure_options,
+    structure_takers,
+    structure_takes,
     weight_sum_options,
 )
 from ._fit_report import FitReport, units_label
@@ -59,7 +60,7 @@ def fit_named(opts: FitOptions) -> int:
     options = {} if opts.slope_cap is None else {"slope_cap": opts.slope_cap}
     if options and not has_slope_cap(family):
         raise UsageError(f"--slope-cap applies to the models with an Euler slope cap "
-                         f"({', '.join(_slope_cap_models())}), not {opts.model!r}")
+                         f"({', '.join(structure_takers('slope_cap'))}), not {opts.model!r}")
     options.update(_pl_options(opts, family))
     options.update(structure_options(opts, family))
     check_size(opts.model, opts.cells, "--cells")
@@ -113,17 +114,8 @@ def _chosen_model(args: argparse.Namespace) -> str:
 
 def has_slope_cap(family) -> bool:
     """Whether the family's structure takes an Euler slope cap (``make_structure(...,
-    slope_cap=...)``): the mPL families, PL, the ladder and Chua's model."""
-    return "slope_cap" in inspect.signature(family.make_structure).parameters
-
-
-def _takes(family, keywords) -> bool:
-    """Whether the family's structure takes every one of `keywords` (its declared knobs)."""
-    return set(keywords) <= set(inspect.signature(family.make_structure).parameters)
-
-
-def _slope_cap_models() -> list[str]:
-    return [name for name, family in FAMILIES.items() if has_slope_cap(family)]
+    slope_cap=...)``)."""
+    return structure_takes(family, "slope_cap")
 
 
 def _pl_options(opts: FitOptions, family) -> dict:
@@ -133,8 +125,8 @@ def _pl_options(opts: FitOptions, family) -> dict:
                                              ("smoothing", opts.s)) if value is not None}
     if not given:
         return {}
-    if not _takes(family, given):
-        takers = [name for name, other in FAMILIES.items() if _takes(other, given)]
+    if not structure_takes(family, *given):
+        takers = structure_takers(*given)
         raise UsageError(f"--p, --m and --s apply to the {', '.join(takers)} model"
                          f"{'s' if len(takers) > 1 else ''} only, not {opts.model!r}")
     size = family.default_size if opts.cells is None else opts.cells

@@ -44,9 +44,8 @@ def run_table_5_4(args: argparse.Namespace) -> int:
                          f"and {args.model} has none ({family.no_inverse_reason})")
     check_size(args.model, args.size)
     _check_out(args, "table_5_4")
-    # the document's mPL has one cell; another family gets its own default size
-    size = args.size if args.size is not None else 1 if args.model == "mpl" \
-        else family.default_size
+    # the family's default size (the document's mPL: one cell, mpl's default)
+    size = args.size if args.size is not None else family.default_size
     print(f"model {args.model}, size {size}: {family.size_help}"
           f"{'' if args.size is not None else ' (default)'}")
     settings = Table54Settings(fit_seed=args.fit_seed, val_seed=args.val_seed, model=args.model,
