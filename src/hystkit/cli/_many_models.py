@@ -4,6 +4,7 @@ the sizes of ``--size MODEL=N``, and the executor of ``--workers`` / ``--schedul
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from ..models import FAMILIES, warm_kernels
@@ -55,7 +56,7 @@ def models_from(text: str | None) -> list[str]:
     return names
 
 
-def sizes_from(pairs: list[str]) -> dict[str, int]:
+def sizes_from(pairs: Iterable[str]) -> dict[str, int]:
     """``--size MODEL=N`` options; each size checked against its family's limits."""
     out = {}
     for pair in pairs:

@@ -3,41 +3,66 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
+from pathlib import Path
 
 from ..batch import jobs_from_folder, pending, read_manifest, run_batch
 from ._common import UsageError, failures_exit
 from ._many_models import ParallelOptions, open_executor_for
-from ._reading import read_options
+from ._reading import Reader, reader_of
 
-__all__ = ["run_batch_command"]
+__all__ = ["BatchOptions", "run_batch_command"]
+
+
+@dataclass(frozen=True)
+class BatchOptions:
+    """``hystkit batch``'s options, as parsed: `defaults` are the fit's where the manifest
+    gives none (``model``, ``size``, ``mode``, ``center``)."""
+
+    source: Path
+    out: Path
+    defaults: dict
+    force: bool
+    parallel: ParallelOptions
+    reader: Reader  # the recordings' reading options
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> BatchOptions:
+        """The options of a parsed ``batch`` command line."""
+        defaults = {"model": args.model, "size": args.size, "mode": args.mode,
+                    "center": args.center}
+        return cls(args.source, args.out, defaults, args.force, ParallelOptions.from_args(args),
+                   reader_of(args))
 
 
 def run_batch_command(args: argparse.Namespace) -> int:
     """``hystkit batch``: one model file per sensor and one results table."""
-    parallel = ParallelOptions.from_args(args)
-    defaults = {"model": args.model, "size": args.size, "mode": args.mode,
-                "center": args.center}
-    if args.source.is_dir():
-        jobs = jobs_from_folder(args.source, defaults)
-    elif args.source.exists():
-        jobs = read_manifest(args.source, defaults)
+    return batch(BatchOptions.from_args(args))
+
+
+def batch(opts: BatchOptions) -> int:
+    """Fit every sensor of the manifest or folder not finished yet; write the table."""
+    if opts.source.is_dir():
+        jobs = jobs_from_folder(opts.source, opts.defaults)
+    elif opts.source.exists():
+        jobs = read_manifest(opts.source, opts.defaults)
     else:
-        raise UsageError(f"{args.source}: no such manifest or folder")
-    print(f"batch of {len(jobs)} sensors from {args.source} into {args.out} (scores on the "
+        raise UsageError(f"{opts.source}: no such manifest or folder")
+    print(f"batch of {len(jobs)} sensors from {opts.source} into {opts.out} (scores on the "
           f"validation recordings: deployable; oracle: each recording's own means, the "
           f"paper's protocol)", flush=True)
     # Every recording as fit reads it: its settings file, then the command line; settled (and
     # said) here, so a settings file that is refused stops the batch before any fit.
-    reading = {str(path): read_options(args, path)
+    reading = {str(path): opts.reader.options(path)
                for job in jobs for path in (*job.fit, *job.validate)}
     # a rerun with everything finished starts no cluster
-    n_pieces = len(pending(jobs, args.out, args.force, reading))
-    with open_executor_for(parallel, n_pieces) as executor:
-        table = run_batch(jobs, args.out, executor=executor, read_options=reading,
-                          refit=args.force, source=str(args.source), progress=_say)
-    print(f"wrote {args.out / 'results.parquet'}, {args.out / 'results.csv'} and "
+    n_pieces = len(pending(jobs, opts.out, opts.force, reading))
+    with open_executor_for(opts.parallel, n_pieces) as executor:
+        table = run_batch(jobs, opts.out, executor=executor, read_options=reading,
+                          refit=opts.force, source=str(opts.source), progress=_say)
+    print(f"wrote {opts.out / 'results.parquet'}, {opts.out / 'results.csv'} and "
           f"{sum(r['status'] != 'failed' for r in table)} model file(s) in "
-          f"{args.out / 'models'}")
+          f"{opts.out / 'models'}")
     return failures_exit([r["sensor"] for r in table if r["status"] != "ok"], "sensor(s)")
 
 

@@ -38,8 +38,7 @@ from ..preprocess import (
     relative_change,
 )
 from ._common import UsageError
-from ._read_args import given_read_options
-from ._reading import read_options, read_recording_args
+from ._reading import Reader, reader_of
 
 __all__ = ["CYCLES_FILES", "TABLE_3_1", "run_cycles"]
 
@@ -53,14 +52,12 @@ TABLE_3_1 = {"sample 0": (1.58, 2.78, -55.0), "sample 1": (15.0, 16.82, -11.0),
 _DEFAULT_DRAWN = 5
 
 
-def _gauges_from_raw(args: argparse.Namespace) -> tuple[np.ndarray, ...]:
+def _gauges_from_raw(path: Path) -> tuple[np.ndarray, ...]:
     """Preprocess the raw file with its settings file: t, x, r1, r2 (or None), sensor."""
-
-
-    config = find_raw_config(args.input)
+    config = find_raw_config(path)
     if config is None:
-        raise InputError(f"{args.input}: --raw needs the settings file "
-                         f"{Path(args.input).with_suffix('.toml')} (bridge resistor and "
+        raise InputError(f"{path}: --raw needs the settings file "
+                         f"{Path(path).with_suffix('.toml')} (bridge resistor and "
                          "supply; 'hystkit simulate-sensor --raw' writes it), or run "
                          "'hystkit preprocess' with --r-bridge/--v-supply and analyse its output")
     values = read_raw_config(config)
@@ -80,29 +77,27 @@ def _gauges_from_raw(args: argparse.Namespace) -> tuple[np.ndarray, ...]:
         settings = PreprocessSettings(**values)
     except (TypeError, ValueError) as exc:
         raise InputError(f"{config}: {exc}") from None
-    print(f"preprocessing {args.input} with the settings in {config} ...", flush=True)
+    print(f"preprocessing {path} with the settings in {config} ...", flush=True)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RawDataWarning)
-        result = preprocess_raw(args.input, settings, fmt)
+        result = preprocess_raw(path, settings, fmt)
     for warning in caught:
         print(f"hystkit: warning: {warning.message}", file=sys.stderr)
     rec = result.recording
     return rec.time, rec.position, result.extra["r1"], result.extra["r2"], rec.sensor
 
 
-def _gauges_from_recording(args: argparse.Namespace) -> tuple:
+def _gauges_from_recording(path: Path, reader: Reader) -> tuple:
     """Read a recording and its gauge columns r1, r2 (Ohm) when present."""
-
-
-    rec = read_recording_args(args, args.input)
-    other = read_other_columns(args.input, rec.n_samples, read_options(args, args.input))
+    rec = reader.recording(path)
+    other = read_other_columns(path, rec.n_samples, reader.options(path))
     r1, r2 = other.get("r1"), other.get("r2")
     if r1 is None or r2 is None or r1.dtype.kind != "f" or r2.dtype.kind != "f":
         return rec.time, rec.position, None, None, rec.sensor
     for name, r in (("r1", r1), ("r2", r2)):
         bad = np.flatnonzero(~(np.isfinite(r) & (r > 0)))
         if bad.size:
-            raise InputError(f"{args.input}: column {name!r} row {bad[0] + 1}: a gauge "
+            raise InputError(f"{path}: column {name!r} row {bad[0] + 1}: a gauge "
                              f"resistance must be a positive number, got {r[bad[0]]}")
     return rec.time, rec.position, r1, r2, rec.sensor
 
@@ -198,14 +193,13 @@ def _print(table, summary: dict, gauges: dict | None) -> None:
 
 def run_cycles(args: argparse.Namespace) -> int:
     """``hystkit cycles``: per-gauge loops and the per-cycle table of one recording."""
-
-
-    if args.raw and given_read_options(args):
+    reader = reader_of(args)
+    if args.raw and reader.given:
         raise UsageError("--raw reads the raw file with its .toml settings; the options for "
                          "reading recordings (--columns, --time-unit, ...) do not apply")
     check_output_folder(args.out, CYCLES_FILES, args.force, inputs=[args.input])
-    t, x, r1, r2, sensor = (_gauges_from_raw(args) if args.raw
-                            else _gauges_from_recording(args))
+    t, x, r1, r2, sensor = (_gauges_from_raw(args.input) if args.raw
+                            else _gauges_from_recording(args.input, reader))
     signals = _signals(r1, r2, sensor)
     try:
         table = cycle_table(t, x, signals, args.deadband)

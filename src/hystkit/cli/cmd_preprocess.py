@@ -1,4 +1,5 @@
-"""``hystkit preprocess``: raw scope recording -> 40 Hz recording; raw mode of simulate-sensor.
+"""``hystkit preprocess``: raw scope recording -> 40 Hz recording (simulate-sensor's raw mode
+writes such recordings: `hystkit.cli.cmd_simulate`).
 
 Settings come from, in increasing priority: the defaults, the TOML file stored next to the raw
 file (same stem, ``.toml``) or given with ``--config``, and the command-line options.
@@ -10,6 +11,7 @@ import argparse
 import sys
 import time
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -25,11 +27,8 @@ from ..io import (
     write_recording,
 )
 from ..preprocess import PreprocessSettings, RawDataWarning, parse_states, preprocess_raw
-from ..sensors import ScopeSettings, VirtualSensor, simulate_raw, with_asymmetry
-from ..signals import EXPERIMENTS
 
-__all__ = ["SettingsError", "raw_settings", "run_preprocess", "run_raw_simulation",
-           "sensor_from_args"]
+__all__ = ["RawOptions", "SettingsError", "raw_settings", "run_preprocess"]
 
 
 class SettingsError(HystkitError, ValueError):
@@ -42,31 +41,46 @@ _OPTIONS = ("r_bridge", "v_supply", "um_per_count", "position_offset_mm", "fs_ou
             "illegal", "remove_mean", "normalise", "chunk_size", "time_unit")
 
 
-def raw_settings(args: argparse.Namespace) -> tuple[PreprocessSettings, RawFormat, Path | None]:
-    """Merge defaults, the settings file and the options; return what preprocessing needs.
+@dataclass(frozen=True)
+class RawOptions:
+    """How a raw scope file is to be read: the file, ``--config`` and the preprocess options
+    given (by their settings keys; ``hystkit spectrum`` shares the bridge ones)."""
 
-    Reads ``args.raw``, ``args.config``, ``args.supply_channel`` and any of the preprocess
-    options present on `args` (``hystkit spectrum`` shares the bridge ones)."""
+    raw: Path
+    config: Path | None
+    given: dict[str, Any]
+    supply_channel: bool | None  # --supply-channel / --no-supply-channel, None: not given
 
-    config_path = args.config if args.config is not None else find_raw_config(args.raw)
+    @classmethod
+    def from_args(cls, args: argparse.Namespace, raw: Path) -> RawOptions:
+        """The raw-reading options of a parsed command line, for the raw file `raw`."""
+        given = {}
+        for key in _OPTIONS:
+            option = getattr(args, key, None)
+            if option is not None and option is not False:
+                given[key] = option
+        return cls(raw, args.config, given, getattr(args, "supply_channel", None))
+
+
+def raw_settings(options: RawOptions) -> tuple[PreprocessSettings, RawFormat, Path | None]:
+    """Merge defaults, the settings file and the options; return what preprocessing needs."""
+    config_path = (options.config if options.config is not None
+                   else find_raw_config(options.raw))
     if config_path is not None and not Path(config_path).is_file():
         problem = "is a folder" if Path(config_path).is_dir() else "does not exist"
         raise SettingsError(f"--config {config_path} {problem}; expected a TOML settings file")
     values: dict[str, Any] = read_raw_config(config_path) if config_path is not None else {}
     values.pop("simulation", None)
-    for key in _OPTIONS:
-        option = getattr(args, key, None)
-        if option is not None and option is not False:
-            values[key] = option
-    if getattr(args, "supply_channel", None) is not None:  # --no-supply-channel overrides it
-        values["supply_channel"] = args.supply_channel
+    values.update(options.given)
+    if options.supply_channel is not None:  # --no-supply-channel overrides it
+        values["supply_channel"] = options.supply_channel
     where = f"settings from {config_path} and the options" if config_path else "options"
     for key in ("r_bridge", "v_supply"):
         if key not in values:
             flag = "--" + key.replace("_", "-")
-            raise SettingsError(f"{args.raw}: the bridge {CONFIG_KEYS[key][1]} is not known: "
-                                f"pass {flag} or set {key} in a settings file "
-                                f"({Path(args.raw).with_suffix('.toml')})")
+            raise SettingsError(f"{options.raw}: the bridge {CONFIG_KEYS[key][1]} is not "
+                                f"known: pass {flag} or set {key} in a settings file "
+                                f"({Path(options.raw).with_suffix('.toml')})")
     fmt_keys = {"fs", "n_samples", "time_unit", "skip_rows", "columns"}
     try:
         fmt = RawFormat(columns=tuple(values.get("columns", {}).items()),
@@ -91,7 +105,7 @@ def run_preprocess(args: argparse.Namespace) -> int:
     inputs = [args.raw] + ([args.config] if args.config is not None else [])
     check_output_path(args.out, args.force, inputs=inputs)
     check_output_path(report_path, args.force, inputs=inputs)
-    settings, fmt, config_path = raw_settings(args)
+    settings, fmt, config_path = raw_settings(RawOptions.from_args(args, args.raw))
     print(f"preprocessing {args.raw}" + (f" with settings from {config_path}" if config_path
                                           else "") + " ...", flush=True)
     t0 = time.perf_counter()
@@ -143,62 +157,3 @@ def run_preprocess(args: argparse.Namespace) -> int:
 
 def _plain(value: Any) -> Any:
     return list(value) if isinstance(value, tuple) else value
-
-
-_RAW_ONLY = ("scope_rate", "duration", "encoder", "r_bridge", "v_supply", "glitches", "truth",
-             "supply_drift", "supply_drift_period", "supply_channel")
-
-
-def sensor_from_args(args: argparse.Namespace) -> VirtualSensor:
-    """The virtual sensor with the --age-hours / --asymmetry options applied."""
-
-    if not args.raw:
-        used = [f"--{k.replace('_', '-')}" for k in _RAW_ONLY if getattr(args, k) is not None]
-        if used:
-            raise SettingsError(f"{', '.join(used)} only apply with --raw")
-    try:
-        return with_asymmetry(VirtualSensor(), args.asymmetry, args.age_hours)
-    except ValueError as exc:
-        raise SettingsError(str(exc)) from None
-
-
-def run_raw_simulation(args: argparse.Namespace) -> int:
-    """simulate-sensor --raw: write the raw file, its settings and optionally the truth."""
-
-    config = args.out.with_suffix(".toml")
-    for path in (args.out, config) + ((args.truth,) if args.truth else ()):
-        check_output_path(path, args.force)
-    sensor = sensor_from_args(args)
-    defaults = ScopeSettings()
-    scope = ScopeSettings(
-        fs=args.scope_rate or defaults.fs, r_bridge=args.r_bridge or defaults.r_bridge,
-        v_supply=args.v_supply or defaults.v_supply, encoder_mode=args.encoder or "merged",
-        n_missed_states=args.glitches or 0,
-        bridge_supply_drift=args.supply_drift or 0.0,
-        bridge_drift_period=args.supply_drift_period or defaults.bridge_drift_period,
-        supply_channel=bool(args.supply_channel))
-    t0 = time.perf_counter()
-    try:
-        truth = simulate_raw(args.out, args.excitation, args.seed, sensor=sensor, scope=scope,
-                             duration=args.duration, force=args.force)
-    except ValueError as exc:
-        if isinstance(exc, HystkitError):
-            raise
-        raise SettingsError(str(exc)) from None
-    print(f"wrote {args.out}: raw scope recording of the virtual sensor, "
-          f"{EXPERIMENTS[args.excitation].description}, seed {args.seed}, {truth.n_samples} "
-          f"samples at {scope.fs:.6g} Hz ({truth.n_samples / scope.fs:.6g} s), "
-          f"{scope.encoder_mode} encoder, {len(truth.missed)} hidden encoder state(s) "
-          f"({time.perf_counter() - t0:.1f} s)")
-    supply = (f", bridge supply drift {100 * scope.bridge_supply_drift:g} % (period "
-              f"{scope.bridge_drift_period:g} s)" if scope.bridge_supply_drift else "")
-    supply += ", measured supply in column v0" if scope.supply_channel else ""
-    print(f"wrote {config}: R_br = {scope.r_bridge:g} Ohm, V0 = {scope.v_supply:g} V, "
-          f"fs = {scope.fs:.6g} Hz{supply}; 'hystkit preprocess {args.out}' reads it")
-    if args.truth:
-        write_recording(truth.recording(), args.truth, extra=truth.gauge_changes(),
-                        force=args.force)
-        print(f"wrote {args.truth}: the exact position [mm], dR1/R1 - dR2/R2 and each gauge's "
-              "dR/R (dr1, dr2) at 40 Hz")
-    return 0
-

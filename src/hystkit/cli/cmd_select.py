@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from pathlib import Path
 
 import pandas as pd
 
@@ -30,9 +31,9 @@ from ..studies import (
 from ._common import GUARD_EXIT, UsageError, say_next
 from ._many_models import ParallelOptions, models_from, open_executor_for
 from ._next_step import next_step
-from ._reading import read_options
+from ._reading import Reader, reader_of
 
-__all__ = ["run_select"]
+__all__ = ["SelectOptions", "run_select"]
 
 SELECTION_FILES = ("selection.json", "selection.csv", "selection.png")
 
@@ -46,29 +47,53 @@ def _centers(text: str) -> list[str]:
     return names
 
 
+@dataclass(frozen=True)
+class SelectOptions:
+    """``hystkit select``'s options, as parsed."""
+
+    data: tuple[Path, ...]
+    out: Path
+    report: Path | None
+    models: str | None
+    centers: str
+    force: bool
+    parallel: ParallelOptions
+    reader: Reader  # the recordings' reading options
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> SelectOptions:
+        """The options of a parsed ``select`` command line."""
+        return cls(tuple(args.data), args.out, args.report, args.models, args.centers,
+                   args.force, ParallelOptions.from_args(args), reader_of(args))
+
+
 def run_select(args: argparse.Namespace) -> int:
     """``hystkit select``: family, size, mode and centring chosen on held-out data."""
-    parallel = ParallelOptions.from_args(args)
-    check_output_path(args.out, args.force, inputs=args.data, formats=MODEL_SUFFIXES,
+    return select(SelectOptions.from_args(args))
+
+
+def select(opts: SelectOptions) -> int:
+    """Choose on held-out data, write the winner's model file and the selection report."""
+    check_output_path(opts.out, opts.force, inputs=opts.data, formats=MODEL_SUFFIXES,
                       what="a model file")
-    report = args.report or args.out.with_name(args.out.stem + "-selection")
-    check_output_folder(report, SELECTION_FILES, args.force, inputs=args.data)
+    report = opts.report or opts.out.with_name(opts.out.stem + "-selection")
+    check_output_folder(report, SELECTION_FILES, opts.force, inputs=opts.data)
     reading, recs = [], []
-    for path in args.data:
-        reading.append(read_options(args, path))
+    for path in opts.data:
+        reading.append(opts.reader.options(path))
         recs.append(read_recording(path, options=reading[-1]))
     units = {name: unit for name, unit in recs[0].units if all(r.unit(name) == unit for r in recs)}
-    remembered, not_remembered = training_reading(reading, args.data, units)
+    remembered, not_remembered = training_reading(reading, opts.data, units)
     fold_list = folds(recs)
     fit_samples = min((f.n_train for f in fold_list), default=0)
-    cands = candidates(models_from(args.models), _centers(args.centers), fit_samples=fit_samples,
+    cands = candidates(models_from(opts.models), _centers(opts.centers), fit_samples=fit_samples,
                        dt=recs[0].dt)
     t0 = time.perf_counter()
-    print(f"selecting among {len(cands)} candidates on {', '.join(map(str, args.data))} "
+    print(f"selecting among {len(cands)} candidates on {', '.join(map(str, opts.data))} "
           f"(deployable R² on held-out data: {protocol(recs)})")
     # while the workers run the map, this process loads the figure's matplotlib and numba for
     # the winner's refit
-    with open_executor_for(parallel, len(cands) * len(fold_list)) as executor, \
+    with open_executor_for(opts.parallel, len(cands) * len(fold_list)) as executor, \
             loading_meanwhile(executor, FIGURE_MODULES, numba_ready=True):
         result = select_model(recs, cands, executor=executor, progress=print)
     rows = result["ranking"]
@@ -92,18 +117,18 @@ def run_select(args: argparse.Namespace) -> int:
     summary = {"winner": result["winner"], "protocol": result["protocol"],
                "caveats": result["caveats"], "refusal": result["refusal"],
                "folds": result["folds"], "ranking": rows,
-               "seconds": time.perf_counter() - t0, "model_file": str(args.out)}
+               "seconds": time.perf_counter() - t0, "model_file": str(opts.out)}
     # The report folder is published only after the winner's model file was: a failure on the
     # way leaves neither (the model file alone only if the folder's rename itself fails).
-    with atomic_folder(report, args.force, SELECTION_FILES) as tmp:
+    with atomic_folder(report, opts.force, SELECTION_FILES) as tmp:
         write_json(summary, tmp / "selection.json")
         pd.DataFrame([{k: v for k, v in r.items() if k != "fold_status"}
                       for r in rows]).to_csv(tmp / "selection.csv", index=False)
         plot_selection(rows).savefig(tmp / "selection.png", dpi=110)
         if result["winner"] is not None:
             # later commands read files of the training files' layout as these were read
-            save_compensator(replace(result["compensator"], reading=remembered), args.out,
-                             force=args.force)
+            save_compensator(replace(result["compensator"], reading=remembered), opts.out,
+                             force=opts.force)
     print(f"wrote {report / 'selection.json'}, .csv, .png ({summary['seconds']:.1f} s)")
     if result["winner"] is None:
         sys.stdout.flush()  # the table before the refusal
@@ -119,5 +144,5 @@ def run_select(args: argparse.Namespace) -> int:
     oracle = "" if w["cv_r2_oracle"] is None else f", oracle {w['cv_r2_oracle']:.4f}"
     print(f"winner: {w['candidate']} (deployable R² {w['cv_r2']:.4f} on held-out data, "
           f"{result['protocol']}; straight line {w['cv_linear_r2']:.4f}{oracle}); "
-          f"wrote {args.out}")
+          f"wrote {opts.out}")
     return 0

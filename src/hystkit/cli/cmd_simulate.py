@@ -8,13 +8,22 @@ import time
 from pathlib import Path
 
 from ..compensation import DEFAULT_CENTER
+from ..errors import HystkitError
 from ..io import check_output_path, write_recording
-from ..sensors import occasional_references, simulate_experiment, with_gain_drift
+from ..sensors import (
+    ScopeSettings,
+    VirtualSensor,
+    occasional_references,
+    simulate_experiment,
+    simulate_raw,
+    with_asymmetry,
+    with_gain_drift,
+)
 from ..signals import EXPERIMENTS
 from ..studies import DOCUMENT_TABLE_5_5, format_table
 from ..studies import run_demo as demo_study
 from ._common import UsageError, check_size
-from .cmd_preprocess import run_raw_simulation, sensor_from_args
+from .cmd_preprocess import SettingsError
 
 __all__ = ["run_demo", "run_simulate_sensor"]
 
@@ -25,9 +34,9 @@ def run_simulate_sensor(args: argparse.Namespace) -> int:
         if args.gain_drift is not None or args.references_every is not None:
             raise UsageError("--gain-drift and --references-every apply to the 40 Hz "
                              "recording, not to --raw")
-        return run_raw_simulation(args)
+        return _raw_simulation(args)
     check_output_path(args.out, args.force)
-    rec = simulate_experiment(args.excitation, seed=args.seed, sensor=sensor_from_args(args))
+    rec = simulate_experiment(args.excitation, seed=args.seed, sensor=_sensor(args))
     if args.gain_drift is not None:
         rec = with_gain_drift(rec, args.gain_drift)
     kept, note = {}, ""
@@ -38,6 +47,64 @@ def run_simulate_sensor(args: argparse.Namespace) -> int:
     drift = "" if args.gain_drift is None else f", sensor gain drift {args.gain_drift:+.1%}"
     print(f"wrote {args.out}: {EXPERIMENTS[args.excitation].description}, seed {args.seed}, "
           f"{rec.n_samples} samples at {rec.fs:g} Hz{drift}{note}")
+    return 0
+
+
+_RAW_ONLY = ("scope_rate", "duration", "encoder", "r_bridge", "v_supply", "glitches", "truth",
+             "supply_drift", "supply_drift_period", "supply_channel")
+
+
+def _sensor(args: argparse.Namespace) -> VirtualSensor:
+    """The virtual sensor with the --age-hours / --asymmetry options applied."""
+
+    if not args.raw:
+        used = [f"--{k.replace('_', '-')}" for k in _RAW_ONLY if getattr(args, k) is not None]
+        if used:
+            raise SettingsError(f"{', '.join(used)} only apply with --raw")
+    try:
+        return with_asymmetry(VirtualSensor(), args.asymmetry, args.age_hours)
+    except ValueError as exc:
+        raise SettingsError(str(exc)) from None
+
+
+def _raw_simulation(args: argparse.Namespace) -> int:
+    """simulate-sensor --raw: write the raw file, its settings and optionally the truth."""
+
+    config = args.out.with_suffix(".toml")
+    for path in (args.out, config) + ((args.truth,) if args.truth else ()):
+        check_output_path(path, args.force)
+    sensor = _sensor(args)
+    defaults = ScopeSettings()
+    scope = ScopeSettings(
+        fs=args.scope_rate or defaults.fs, r_bridge=args.r_bridge or defaults.r_bridge,
+        v_supply=args.v_supply or defaults.v_supply, encoder_mode=args.encoder or "merged",
+        n_missed_states=args.glitches or 0,
+        bridge_supply_drift=args.supply_drift or 0.0,
+        bridge_drift_period=args.supply_drift_period or defaults.bridge_drift_period,
+        supply_channel=bool(args.supply_channel))
+    t0 = time.perf_counter()
+    try:
+        truth = simulate_raw(args.out, args.excitation, args.seed, sensor=sensor, scope=scope,
+                             duration=args.duration, force=args.force)
+    except ValueError as exc:
+        if isinstance(exc, HystkitError):
+            raise
+        raise SettingsError(str(exc)) from None
+    print(f"wrote {args.out}: raw scope recording of the virtual sensor, "
+          f"{EXPERIMENTS[args.excitation].description}, seed {args.seed}, {truth.n_samples} "
+          f"samples at {scope.fs:.6g} Hz ({truth.n_samples / scope.fs:.6g} s), "
+          f"{scope.encoder_mode} encoder, {len(truth.missed)} hidden encoder state(s) "
+          f"({time.perf_counter() - t0:.1f} s)")
+    supply = (f", bridge supply drift {100 * scope.bridge_supply_drift:g} % (period "
+              f"{scope.bridge_drift_period:g} s)" if scope.bridge_supply_drift else "")
+    supply += ", measured supply in column v0" if scope.supply_channel else ""
+    print(f"wrote {config}: R_br = {scope.r_bridge:g} Ohm, V0 = {scope.v_supply:g} V, "
+          f"fs = {scope.fs:.6g} Hz{supply}; 'hystkit preprocess {args.out}' reads it")
+    if args.truth:
+        write_recording(truth.recording(), args.truth, extra=truth.gauge_changes(),
+                        force=args.force)
+        print(f"wrote {args.truth}: the exact position [mm], dR1/R1 - dR2/R2 and each gauge's "
+              "dR/R (dr1, dr2) at 40 Hz")
     return 0
 
 

@@ -19,7 +19,7 @@ import pyarrow.parquet as pq
 
 from ..io import atomic_folder, check_output_folder, find_raw_config, read_recording, write_json
 from ..preprocess import CutoffRule, raw_gauge_changes, spectrum
-from .cmd_preprocess import SettingsError, raw_settings
+from .cmd_preprocess import RawOptions, SettingsError, raw_settings
 
 if TYPE_CHECKING:  # the library loads when the command runs
     import numpy as np
@@ -83,8 +83,7 @@ def run_spectrum(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     compare = args.compare
     if _is_raw(args):
-        args.raw = args.input
-        settings, fmt, config_path = raw_settings(args)
+        settings, fmt, config_path = raw_settings(RawOptions.from_args(args, args.input))
         compare = settings.cutoff if compare is None else compare
         supply = "measured v0" if settings.supply_channel else f"V0 = {settings.v_supply:g} V"
         print(f"spectrum of raw {args.input}" + (f" (settings from {config_path})"
