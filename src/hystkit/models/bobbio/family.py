@@ -23,12 +23,6 @@ class BobbioFamily(Family):
 
     fit_function = "fit.fit_bobbio"  # fit.py, imported on the first fit (optimisers)
 
-    def invert(self, structure, params, y, x0=None):
-        return self.model.invert(structure, params, y, x0)
-
-    def invert_step(self, structure, params, x, y):
-        return self.model.invert_step(structure, params, x, y)
-
     def make_structure(self, dt: float, size: int) -> bobbio.BobbioStructure:
         return bobbio.BobbioStructure(n_springs=size, dt=dt)
 

@@ -6,21 +6,13 @@ loop state and protocol methods it reuses. ``model`` holds the equations and the
 reference, ``fit`` the identification, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
-from ..._lazy import lazy_exports
+from .._package import family_exports
 from .._protocol import FamilyInfo
 
 INFO = FamilyInfo(
-    name="gpreisach",
+    name="gpreisach", docs="docs/models/preisach.md", default_size=16, max_size=64,
     title="generalised (non-linear) Preisach, input-dependent weight and reversible part (sec. "
           "2.1.2, eq. 2.2)",
-    size_help="grid levels L of the two Preisach weights ((L - 1) (L - 2) relay cells)",
-    default_size=16,
-    max_size=64,
-    docs="docs/models/preisach.md")
+    size_help="grid levels L of the two Preisach weights ((L - 1) (L - 2) relay cells)")
 
-# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
-# equations, fit and numba kernels load when one of their names is first used.
-__getattr__, __dir__ = lazy_exports(
-    __name__, globals(),
-    {"family": ("FAMILY", "GPreisachFamily"), "model": ("*",), "fit": ("*",)},
-    first=("INFO",))
+__getattr__, __dir__ = family_exports(__name__, globals(), "GPreisachFamily")

@@ -5,21 +5,14 @@
 ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
-from ..._lazy import lazy_exports
+from .._package import family_exports
 from .._protocol import FamilyInfo
 
 INFO = FamilyInfo(
-    name="mpl",
+    name="mpl", docs="docs/models/mpl.md", default_size=1, max_size=50,
     title="modified Power-Law, sinh resistors (sec. 5.3.1, eq. 5.1-5.6)",
-    size_help="cells N (3N + 2 params)",
-    default_size=1,
-    max_size=50,
-    docs="docs/models/mpl.md")
+    size_help="cells N (3N + 2 params)")
 
-# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
-# equations, fit and numba kernels load when one of their names is first used.
-__getattr__, __dir__ = lazy_exports(
-    __name__, globals(),
-    {"family": ("FAMILY", "MplFamily"), "model": ("*",),
-     "fit": ("default_starts", "fit_box", "fit_mpl"), "presets": ("PRESETS", "preset")},
-    first=("INFO",))
+__getattr__, __dir__ = family_exports(
+    __name__, globals(), "MplFamily",
+    fit=("default_starts", "fit_box", "fit_mpl"), presets=("PRESETS", "preset"))

@@ -31,12 +31,6 @@ class MplFamily(Family):
 
     fit_function = "fit.fit_mpl"  # fit.py, imported on the first fit (optimisers)
 
-    def invert(self, structure, params, y, x0=None):
-        return self.model.invert(structure, params, y, x0)
-
-    def invert_step(self, structure, params, x, y):
-        return self.model.invert_step(structure, params, x, y)
-
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0,
                        limit: bool = True) -> mpl.MplStructure:
         return self.Structure(n_cells=size, dt=dt, slope_cap=slope_cap, limit=limit)

@@ -6,22 +6,15 @@ docs/models/mpl_g.md).
 paper 9.2's table II sensors, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
-from ..._lazy import lazy_exports
+from .._package import family_exports
 from .._protocol import FamilyInfo
 
 INFO = FamilyInfo(
-    name="mpl-g",
+    name="mpl-g", docs="docs/models/mpl_g.md", default_size=1, max_size=50,
     title="ch. 7 compensator: sinh cells with a cubic output resistor g (sec. 7.2, eq. 5.1-5.6, "
           "5.16-5.17)",
-    size_help="cells N (3N + 4 fitted params)",
-    default_size=1,
-    max_size=50,
-    docs="docs/models/mpl_g.md")
+    size_help="cells N (3N + 4 fitted params)")
 
-# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
-# equations, fit and numba kernels load when one of their names is first used.
-__getattr__, __dir__ = lazy_exports(
-    __name__, globals(),
-    {"family": ("FAMILY", "MplGFamily"), "model": ("*",), "fit": ("canonical", "fit_mpl_g"),
-     "presets": ("ch7_compensator", "table_ii_response")},
-    first=("INFO",))
+__getattr__, __dir__ = family_exports(
+    __name__, globals(), "MplGFamily",
+    fit=("canonical", "fit_mpl_g"), presets=("ch7_compensator", "table_ii_response"))

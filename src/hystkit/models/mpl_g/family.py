@@ -36,9 +36,6 @@ class MplGFamily(Family):
 
     fit_function = fit.fit_mpl_g
 
-    def invert(self, structure, params, y, x0=None):
-        return self.model.invert(structure, params, y, x0)
-
     def invert_step(self, structure, params, x, y):
         """As :func:`model.invert_step`; NaN input estimate and state when ``y`` is outside
         the range of ``g``'s branch (no input gives it), as the compiled block."""

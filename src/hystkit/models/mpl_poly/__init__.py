@@ -5,22 +5,15 @@ the compiled loops (with the loop blocks), ``fit`` the identification, ``presets
 tables, ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
-from ..._lazy import lazy_exports
+from .._package import family_exports
 from .._protocol import FamilyInfo
 
 INFO = FamilyInfo(
-    name="mpl-poly",
+    name="mpl-poly", docs="docs/models/mpl_poly.md", default_size=1, max_size=30,
     title="polynomial modified Power-Law, cubic resistors (sec. 5.3.5, eq. 5.16-5.17, 5.29)",
-    size_help="cells N (5N + 6 params)",
-    default_size=1,
-    max_size=30,
-    docs="docs/models/mpl_poly.md")
+    size_help="cells N (5N + 6 params)")
 
-# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
-# equations, fit and numba kernels load when one of their names is first used.
-__getattr__, __dir__ = lazy_exports(
-    __name__, globals(),
-    {"family": ("FAMILY", "MplPolyFamily"), "model": ("*",),
-     "fit": ("canonical", "default_starts", "fit_box", "fit_mpl_poly"),
-     "presets": ("PAPER_9_2_TABLE_I", "PAPER_9_2_TABLE_II", "paper_9_2_params")},
-    first=("INFO",))
+__getattr__, __dir__ = family_exports(
+    __name__, globals(), "MplPolyFamily",
+    fit=("canonical", "default_starts", "fit_box", "fit_mpl_poly"),
+    presets=("PAPER_9_2_TABLE_I", "PAPER_9_2_TABLE_II", "paper_9_2_params"))

@@ -41,9 +41,6 @@ class MplPolyFamily(Family):
         ``V_b = 0`` (:func:`.fit.canonical`); the data determine none of them."""
         return (*(f"f[{k}][0]" for k in range(structure.n_cells)), "w[0]", "v_b")
 
-    def invert(self, structure, params, y, x0=None):
-        return self.model.invert(structure, params, y, x0)
-
     def make_structure(self, dt: float, size: int, slope_cap: float = 1.0,
                        limit: bool = True) -> mpl_poly.MplPolyStructure:
         return mpl_poly.MplPolyStructure(n_cells=size, dt=dt, slope_cap=slope_cap, limit=limit)

@@ -27,12 +27,6 @@ class PiFamily(Family):
 
     fit_function = "fit.fit_pi"  # fit.py, imported on the first fit (optimisers)
 
-    def invert(self, structure, params, y, x0=None):
-        return self.model.invert(structure, params, y, x0)
-
-    def invert_step(self, structure, params, x, y):
-        return self.model.invert_step(structure, params, x, y)
-
     def make_structure(self, dt, size, **options):
         return box.make_structure(dt, size, **options)
 

@@ -5,22 +5,15 @@ the loop blocks), ``fit`` the weight fit for a fixed structure, ``search`` the e
 structural search behind ``hystkit pl-search``, ``family`` the protocol adapter (``FAMILY``).
 """
 
-from ..._lazy import lazy_exports
+from .._package import family_exports
 from .._protocol import FamilyInfo
 
 INFO = FamilyInfo(
-    name="pl",
+    name="pl", docs="docs/models/pl.md", default_size=1, max_size=50,
     title="Power-Law model as published, Biggio et al. (sec. 2.1.7, eq. 2.16-2.18)",
-    size_help="cells N (N + M + 4 params; p, M, S via options or 'hystkit pl-search')",
-    default_size=1,
-    max_size=50,
-    docs="docs/models/pl.md")
+    size_help="cells N (N + M + 4 params; p, M, S via options or 'hystkit pl-search')")
 
-# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
-# equations, fit and numba kernels load when one of their names is first used.
-__getattr__, __dir__ = lazy_exports(
-    __name__, globals(),
-    {"family": ("FAMILY", "PlFamily"), "model": ("*",),
-     "fit": ("default_starts", "fit_pl", "solve_weights"), "grid": ("DEFAULT_GRID",),
-     "search": ("format_search_table", "structural_search")},
-    first=("INFO",))
+__getattr__, __dir__ = family_exports(
+    __name__, globals(), "PlFamily",
+    fit=("default_starts", "fit_pl", "solve_weights"), grid=("DEFAULT_GRID",),
+    search=("format_search_table", "structural_search"))

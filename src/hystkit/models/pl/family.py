@@ -30,12 +30,6 @@ class PlFamily(Family):
 
     fit_function = "fit.fit_pl"  # fit.py, imported on the first fit (optimisers)
 
-    def invert(self, structure, params, y, x0=None):
-        return self.model.invert(structure, params, y, x0)
-
-    def invert_step(self, structure, params, x, y):
-        return self.model.invert_step(structure, params, x, y)
-
     def make_structure(self, dt: float, size: int, power: float = 21.0, n_basis: int = 1,
                        smoothing: float = 0.001, slope_cap: float = 1.0) -> pl.PlStructure:
         return pl.PlStructure(n_cells=size, power=power, n_basis=n_basis, smoothing=smoothing,

@@ -5,21 +5,14 @@
 squares and FORCs), ``family`` the protocol adapter exported as ``FAMILY``.
 """
 
-from ..._lazy import lazy_exports
+from .._package import family_exports
 from .._protocol import FamilyInfo
 
 INFO = FamilyInfo(
-    name="preisach",
+    name="preisach", docs="docs/models/preisach.md", default_size=20, max_size=100,
     title="classical Preisach, Everett function on a grid (sec. 2.1.1, eq. 2.1, 9.4-9.13)",
-    size_help="grid levels L over the normalised input (L (L - 1) / 2 Preisach cells)",
-    default_size=20,
-    max_size=100,
-    docs="docs/models/preisach.md")
+    size_help="grid levels L over the normalised input (L (L - 1) / 2 Preisach cells)")
 
-# The registry reads INFO (hystkit fit --help loads no model); the family object (FAMILY), its
-# equations, fit and numba kernels load when one of their names is first used.
-__getattr__, __dir__ = lazy_exports(
-    __name__, globals(),
-    {"family": ("FAMILY", "PreisachFamily", "StaircaseFamily"), "model": ("*", "INVERT_TOL"),
-     "fit": ("*",)},
-    first=("INFO", "kernels"))
+__getattr__, __dir__ = family_exports(
+    __name__, globals(), "PreisachFamily", "StaircaseFamily",
+    first=("kernels",), model=("*", "INVERT_TOL"))
