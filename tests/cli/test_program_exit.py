@@ -1,11 +1,11 @@
-"""The ``hystkit`` program ends its process without the interpreter's teardown, losing nothing.
+"""The ``hystkit`` program ends with the interpreter's normal exit, its heap frozen, losing nothing.
 
-`hystkit.cli.program` (the console script, ``python -m hystkit``) runs the command, then the
-exit handlers, flushes the standard streams and ends the process: the teardown that would
-release every module's objects one by one is skipped (a shorter ``fit``: benchmarks/README.md,
-start-up). Checked in fresh interpreters: what a normal exit guarantees still happens, the
-teardown does not, and a running non-daemon thread gets the normal exit, which waits for it
-(the thread's last line comes before the exit handler's).
+`hystkit.cli.program` (the console script, ``python -m hystkit``) runs the command, flushes
+the standard streams, freezes the heap (``gc.freeze``: the shutdown's collections do not walk
+the objects numba built again, `hystkit.cli._main`) and exits with the command's code through
+``sys.exit``. Checked in fresh interpreters: what a normal exit guarantees happens (exit
+handlers, the whole output), the frozen objects' finalisers do not run at teardown, and a
+running non-daemon thread is waited for (its last line comes before the exit handler's).
 """
 
 from __future__ import annotations
@@ -75,6 +75,6 @@ def test_a_running_non_daemon_thread_gets_the_normal_exit_which_waits_for_it():
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     assert "piezo_micromanipulator" in done.stdout
-    # the normal exit waited for the thread (os._exit would have ended it mid-sleep), then ran
-    # the exit handlers
+    # the normal exit waited for the thread (ending the process at once would have ended it
+    # mid-sleep), then ran the exit handlers
     assert lines[-2:] == ["thread finished", "exit handler ran"]
