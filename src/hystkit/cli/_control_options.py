@@ -193,6 +193,18 @@ def _excitation_names() -> list[str]:
     return sorted(EXPERIMENTS)
 
 
+# The files a loop may be given, each instead of what it is fitted or run on by default
+_LOOP_FILES = {
+    "--sensor-data": ("recording (time, position, sensor) to fit S_r on instead of the virtual "
+                      "sensor's noise run"),
+    "--training-data": ("recording to fit the compensator and S_m on instead of the virtual "
+                        "sensor's"),
+    "--compensator": ("use this model file (from 'hystkit fit', any family, direct or inverse "
+                      "mode) as the compensator"),
+    "--model-file": ("use this model file as S_m of scheme (b), run position -> sensor like "
+                     "--sensor MODEL.json")}
+
+
 def add_setup_options(p: argparse.ArgumentParser, *, scheme_required: bool = True) -> None:
     """The options that define a loop (scheme, PID, DOB, plant, sensor models), shared by
     ``hystkit control`` and ``hystkit stability --control``."""
@@ -246,18 +258,8 @@ def add_setup_options(p: argparse.ArgumentParser, *, scheme_required: bool = Tru
                             help="excitation of the training recording (default sine, 0.5 Hz "
                                  "3 mm)"),
              choices=_excitation_names)
-    p.add_argument("--sensor-data", type=Path,
-                   help="recording (time, position, sensor) to fit S_r on instead of the "
-                        "virtual sensor's noise run")
-    p.add_argument("--training-data", type=Path,
-                   help="recording to fit the compensator and S_m on instead of the virtual "
-                        "sensor's")
-    p.add_argument("--compensator", type=Path,
-                   help="use this model file (from 'hystkit fit', any family, direct or "
-                        "inverse mode) as the compensator")
-    p.add_argument("--model-file", type=Path,
-                   help="use this model file as S_m of scheme (b), run position -> sensor "
-                        "like --sensor MODEL.json")
+    for option, text in _LOOP_FILES.items():
+        p.add_argument(option, type=Path, help=text)
     p.add_argument("--sensor-size", "--sensor-cells", type=positive_int, dest="sensor_size",
                    help="size of the fitted S_r (mPL cells; default 3 for mpl, else the "
                         "family's default)")

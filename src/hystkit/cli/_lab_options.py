@@ -105,10 +105,9 @@ def preprocess_options(p: argparse.ArgumentParser) -> None:
                         "it, the result does not depend on it")
 
 def cycles_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("input", type=Path, help="recording (time, position, sensor; with r1, r2 "
-                   "from 'hystkit preprocess' per gauge) or, with --raw, a raw scope recording")
-    p.add_argument("--out", type=Path, required=True,
-                   help="folder for cycles.csv, cycles.json, cycles.png, cycles.svg")
+    _input_and_folder(p, "input", "recording (time, position, sensor; with r1, r2 from 'hystkit "
+                      "preprocess' per gauge) or, with --raw, a raw scope recording",
+                      "cycles.csv, cycles.json, cycles.png, cycles.svg")
     p.add_argument("--raw", action="store_true",
                    help="INPUT is a raw scope recording (v1, v2, encoder) with its .toml "
                         "settings: preprocess it first, as 'hystkit preprocess' would")
@@ -122,10 +121,9 @@ def cycles_options(p: argparse.ArgumentParser) -> None:
     add_read_options(p)
 
 def settling_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("log", type=Path, help="CSV log: a time column and one resistance column "
-                   "[Ohm] per trace, t = 0 at the end of printing")
-    p.add_argument("--out", type=Path, required=True,
-                   help="folder for settling.json, settling.png, settling.svg")
+    _input_and_folder(p, "log", "CSV log: a time column and one resistance column [Ohm] per "
+                      "trace, t = 0 at the end of printing",
+                      "settling.json, settling.png, settling.svg")
     p.add_argument("--time-column", metavar="NAME",
                    help="the time column (default: time_h if present, else time)")
     p.add_argument("--time-unit", choices=list(HOURS_PER), default="h",
@@ -151,10 +149,8 @@ def simulate_settling_options(s: argparse.ArgumentParser) -> None:
                    "(default 0)")
 
 def spectrum_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("input", type=Path, help="raw scope recording (v1, v2, encoder) or a "
-                   "recording (time, sensor; dr1, dr2 used when present)")
-    p.add_argument("--out", type=Path, required=True,
-                   help="folder for spectrum.json and spectrum.png")
+    _input_and_folder(p, "input", "raw scope recording (v1, v2, encoder) or a recording (time, "
+                      "sensor; dr1, dr2 used when present)", "spectrum.json and spectrum.png")
     p.add_argument("--kind", choices=["auto", "raw", "data"], default="auto",
                    help="raw or recording (default auto: raw when bridge settings are given "
                         "or stored beside the file, or the file has v1 and v2)")
@@ -189,33 +185,27 @@ def spectrum_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--time-unit", choices=["s", "ms", "us", "ns"],
                    help="raw: unit of the time column (default s)")
 
+def _input_and_folder(p: argparse.ArgumentParser, name: str, input_help: str,
+                      files: str) -> None:
+    """A lab command's input file `name` and its ``--out`` folder of `files`."""
+    p.add_argument(name, type=Path, help=input_help)
+    p.add_argument("--out", type=Path, required=True, help=f"folder for {files}")
+
+
 def datasets_options(p: argparse.ArgumentParser) -> None:
     # The parent gets a --force too (the CLI adds one to every top-level command); the child's
     # default is SUPPRESS so that 'datasets --force export' is not reset to False by it.
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
     actions = p.add_subparsers(dest="datasets_command", required=True)
 
-    q = actions.add_parser("list", help="the data sets (or the runs of one) and whether the "
-                                        "shared data are here")
-    q.set_defaults(run="cmd_datasets:run_list")
-    deferred(q.add_argument("name", nargs="?", help="list this data set's runs"),
-             choices=dataset_names)
-    q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
-                                             "or a shared/data folder found above)")
-
-    q = actions.add_parser("show", help="where a data set's files come from (repository, "
-                                        "commit, licence, credit) and where to put them")
-    q.set_defaults(run="cmd_datasets:run_show")
-    deferred(q.add_argument("name", help="the data set (see 'hystkit datasets list')"),
-             choices=dataset_names)
-    q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
-                                             "or a shared/data folder found above)")
-
-    q = actions.add_parser("export", help="write one run as a time, position, sensor "
-                                          "recording (CSV, Parquet or .mat) plus a .json sidecar")
-    q.set_defaults(run="cmd_datasets:run_export")
-    deferred(q.add_argument("name", help="the data set to export (see 'hystkit datasets list')"),
-             choices=dataset_names)
+    _dataset_command(actions, "list", "the data sets (or the runs of one) and whether the "
+                         "shared data are here", "list this data set's runs", nargs="?")
+    _dataset_command(actions, "show", "where a data set's files come from (repository, "
+                         "commit, licence, credit) and where to put them",
+                         "the data set (see 'hystkit datasets list')")
+    q = _dataset_command(actions, "export", "write one run as a time, position, sensor "
+                         "recording (CSV, Parquet or .mat) plus a .json sidecar",
+                         "the data set to export (see 'hystkit datasets list')", root=False)
     q.add_argument("--variant", help="the run (default: the data set's default; see "
                                      "'hystkit datasets list NAME')")
     q.add_argument("--segment", help="only this named segment of the run")
@@ -225,10 +215,26 @@ def datasets_options(p: argparse.ArgumentParser) -> None:
              choices=roles)
     q.add_argument("--excerpt", action="store_true",
                    help="use the excerpt shipped with hystkit instead of the shared data")
-    q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
-                                             "or a shared/data folder found above)")
+    _add_root(q)
     q.add_argument("--out", type=Path, required=True,
                    help="file to write, by its extension: .csv, .parquet or .mat (MATLAB: one "
                         "variable per column, with units)")
     q.add_argument("--force", action="store_true", default=argparse.SUPPRESS,
                    help="overwrite existing output files")
+
+
+def _dataset_command(actions, name: str, help_text: str, name_help: str, *,
+                     nargs: str | None = None, root: bool = True) -> argparse.ArgumentParser:
+    """``datasets NAME``'s parser: its run function (``cmd_datasets:run_NAME``), the data
+    set's name and (`root`) ``--root``."""
+    q = actions.add_parser(name, help=help_text)
+    q.set_defaults(run=f"cmd_datasets:run_{name}")
+    deferred(q.add_argument("name", nargs=nargs, help=name_help), choices=dataset_names)
+    if root:
+        _add_root(q)
+    return q
+
+
+def _add_root(q: argparse.ArgumentParser) -> None:
+    q.add_argument("--root", type=Path, help="shared data root (default: $HYSTKIT_SHARED_DATA "
+                                             "or a shared/data folder found above)")

@@ -6,15 +6,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from . import _stream_defaults as defaults
 from ._common import add_read_options, number, positive_int
 from ._own_layout import add_trained_note
-from ._stream_defaults import (
-    ADAPT_CHOICES,
-    DEFAULT_FORGETTING,
-    DEFAULT_REFIT_EVERY,
-    DEFAULT_WINDOW,
-    SERIAL_HINT,
-)
 
 __all__ = ["stream_options"]
 
@@ -27,7 +21,7 @@ def stream_options(p: argparse.ArgumentParser) -> None:
     source.add_argument("--in", dest="input", type=Path, metavar="FILE",
                         help="read this file instead of stdin")
     source.add_argument("--serial", metavar="PORT",
-                        help=f"read a serial port (needs pyserial: {SERIAL_HINT})")
+                        help=f"read a serial port (needs pyserial: {defaults.SERIAL_HINT})")
     p.add_argument("--baud", type=positive_int, help="serial baud rate (default 115200)")
     p.add_argument("--start", choices=("rest", "sync"), default="rest",
                    help="rest: model at rest at the first sample (default); sync: after the "
@@ -39,7 +33,7 @@ def stream_options(p: argparse.ArgumentParser) -> None:
                         "the model's own, 0.90 unless fitted otherwise)")
     adapt = p.add_argument_group("online adaptation (a reference column: the true position "
                                  "[mm] now and then, empty when unknown)")
-    adapt.add_argument("--adapt", choices=ADAPT_CHOICES,
+    adapt.add_argument("--adapt", choices=defaults.ADAPT_CHOICES,
                        help="re-fit from the references: gain (gain and offset of the "
                             "estimate, any model) or weights (cell output weights and offset; "
                             "direct compensators of the families that declare an output "
@@ -47,7 +41,7 @@ def stream_options(p: argparse.ArgumentParser) -> None:
                             "parameter, re-fitted on a sliding window; direct compensators)")
     adapt.add_argument("--forgetting", type=number(0, 1, low_open=True), metavar="LAMBDA",
                        help=f"forgetting factor per reference, in (0, 1]: remembers about "
-                            f"1/(1-LAMBDA) references (default {DEFAULT_FORGETTING:g})")
+                            f"1/(1-LAMBDA) references (default {defaults.DEFAULT_FORGETTING:g})")
     adapt.add_argument("--prior-gain", type=number(0, 1e6, low_open=True), metavar="STD",
                        help="prior standard deviation of each gain / weight multiplier "
                             "(default 0.1: 10 %%)")
@@ -56,7 +50,7 @@ def stream_options(p: argparse.ArgumentParser) -> None:
                             "the training positions' span)")
     adapt.add_argument("--window", type=number(0, 1e6, low_open=True), metavar="SECONDS",
                        help=f"--adapt full: length of the sliding window re-fitted [s] (default "
-                            f"{DEFAULT_WINDOW:g}); it must hold 4 references per parameter")
+                            f"{defaults.DEFAULT_WINDOW:g}); it must hold 4 references per parameter")
     adapt.add_argument("--refit-every", type=positive_int, metavar="N",
                        help=f"--adapt full: re-fit after every N new references (default "
-                            f"{DEFAULT_REFIT_EVERY})")
+                            f"{defaults.DEFAULT_REFIT_EVERY})")

@@ -53,23 +53,23 @@ def compare_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("data_fit", type=Path, help="recording to fit every model on")
     p.add_argument("data_val", type=Path, help="recording to score them on (not seen by the "
                    "fits)")
-    deferred(p.add_argument("--models"), help=_models_help)
-    p.add_argument("--size", action="append", default=[], metavar="MODEL=N",
-                   help="model size, e.g. --size mpl=3 (repeatable)")
-    p.add_argument("--out", type=Path, help="folder for compare.json and compare.mat (the same "
-                   "table for MATLAB)")
-    add_read_options(p)
-    add_parallel_options(p)
+    _every_model_options(p, "", "folder for compare.json and compare.mat (the same table for "
+                         "MATLAB)")
 
 
 def generalize_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("data", type=Path, nargs="*",
                    help="your recordings (at least two, one rate); default: the virtual sensor")
+    _every_model_options(p, "; default: each family's own", "output folder (default "
+                         "hystkit-generalize): generalize.json, generalize.mat, generalize.png")
+
+
+def _every_model_options(p: argparse.ArgumentParser, size_default: str, out_help: str) -> None:
+    """The options of a command that fits every family (compare, generalize) after its data."""
     deferred(p.add_argument("--models"), help=_models_help)
     p.add_argument("--size", action="append", default=[], metavar="MODEL=N",
-                   help="model size, e.g. --size mpl=3 (repeatable; default: each family's own)")
-    p.add_argument("--out", type=Path, help="output folder (default hystkit-generalize): "
-                   "generalize.json, generalize.mat, generalize.png")
+                   help=f"model size, e.g. --size mpl=3 (repeatable{size_default})")
+    p.add_argument("--out", type=Path, help=out_help)
     add_read_options(p)
     add_parallel_options(p)
 

@@ -21,7 +21,7 @@ class BatchOptions:
 
     source: Path
     out: Path
-    defaults: dict
+    defaults: dict[str, object]
     force: bool
     parallel: ParallelOptions
     reader: Reader  # the recordings' reading options

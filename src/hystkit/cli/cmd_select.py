@@ -52,19 +52,19 @@ class SelectOptions:
     """``hystkit select``'s options, as parsed."""
 
     data: tuple[Path, ...]
+    reader: Reader  # how each of `data` is read
+    parallel: ParallelOptions
     out: Path
     report: Path | None
     models: str | None
     centers: str
     force: bool
-    parallel: ParallelOptions
-    reader: Reader  # the recordings' reading options
 
     @classmethod
     def from_args(cls, args: argparse.Namespace) -> SelectOptions:
         """The options of a parsed ``select`` command line."""
-        return cls(tuple(args.data), args.out, args.report, args.models, args.centers,
-                   args.force, ParallelOptions.from_args(args), reader_of(args))
+        return cls(tuple(args.data), reader_of(args), ParallelOptions.from_args(args), args.out,
+                   args.report, args.models, args.centers, args.force)
 
 
 def run_select(args: argparse.Namespace) -> int:
