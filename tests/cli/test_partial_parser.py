@@ -35,22 +35,27 @@ def test_fit_builds_its_own_options_only():
     assert with_options == ["fit"] and set(partial) == set(FULL)
 
 
-def test_only_the_chosen_commands_modules_are_imported():
-    """``hystkit fit --help`` imports fit's options module, no other command's (checked in a
-    fresh interpreter: this session has imported them all)."""
+@pytest.mark.parametrize("command, options", [
+    ("fit", "_core_options"), ("control", "_control_options"),
+    ("stability", "_control_options"), ("stream", "_stream_options")])
+def test_only_the_chosen_commands_options_module_is_imported(command, options):
+    """``hystkit COMMAND --help`` imports that command's options module and no run module
+    (checked in a fresh interpreter: this session has imported them all)."""
     import subprocess
     import sys
 
     probe = ("import contextlib, io, sys\nfrom hystkit.cli import main\n"
              "with contextlib.redirect_stdout(io.StringIO()):\n"
-             "    try:\n        main(['fit', '--help'])\n    except SystemExit:\n        pass\n"
+             f"    try:\n        main([{command!r}, '--help'])\n    except SystemExit:\n"
+             "        pass\n"
              "print(','.join(sorted(m.rpartition('.')[2] for m in sys.modules\n"
              "                      if m.startswith('hystkit.cli.'))))")
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                          check=True, timeout=120).stdout.strip().split(",")
-    assert "_core_options" in out
-    assert not [m for m in out if m.startswith("cmd_") or m in ("_study_options",
-                                                                "_lab_options")], out
+    assert options in out
+    others = {"_core_options", "_control_options", "_stream_options", "_study_options",
+              "_lab_options"} - {options}
+    assert not [m for m in out if m.startswith("cmd_") or m in others], out
 
 
 @pytest.mark.parametrize("argv", [["no-such-command"], ["--version"], [], ["-h"]])
