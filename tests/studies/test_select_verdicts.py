@@ -10,6 +10,7 @@ import pytest
 from hystkit.cli import main
 from hystkit.compensation import MIN_EXPLAINED, fit_compensator, verdict
 from hystkit.compensation._folds import Fold, fits_in, fold_scores, folds
+from hystkit.compensation._verdict import MIN_USABLE
 from hystkit.io import Recording
 from hystkit.models import get_family
 from hystkit.sensors import simulate_experiment
@@ -32,8 +33,8 @@ def _noise_only(rec: Recording, seed: int = 0) -> Recording:
 
 @pytest.mark.parametrize(("r2_model", "r2_line", "status"), [
     (0.99, 0.9, "ok"), (0.9, 0.99, "worse_than_line"), (0.05, 0.0, "no_signal"),
-    (-46.0, -0.5, "worse_than_line"), (None, 0.5, "undetermined"), (0.5, None, "ok"),
-    (MIN_EXPLAINED, 0.0, "ok")])
+    (-46.0, -0.5, "worse_than_line"), (None, 0.5, "undetermined"), (0.5, None, "poor"),
+    (0.8, None, "ok"), (MIN_EXPLAINED, 0.0, "poor"), (MIN_USABLE, 0.0, "ok")])
 def test_the_shared_verdict(r2_model, r2_line, status):
     found, message = verdict(r2_model, r2_line, "held-out")
     assert found == status and message.startswith("held-out")
