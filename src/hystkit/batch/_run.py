@@ -26,10 +26,10 @@ from ..compensation import (
     DEFAULT_CENTER,
     evaluate,
     fit_compensator,
+    pooled_verdict,
     save_compensator,
     with_band,
 )
-from ..compensation._verdict import pooled_verdict
 from ..errors import InputError, OutputError
 from ..io import (
     ReadOptions,

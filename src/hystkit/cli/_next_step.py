@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..compensation._verdict import MAX_OUTSIDE, MIN_EXPLAINED
+from ..compensation import MAX_OUTSIDE, MIN_EXPLAINED
 
 __all__ = ["next_step"]
 

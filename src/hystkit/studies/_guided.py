@@ -28,13 +28,14 @@ from collections.abc import Callable, Sequence
 from functools import partial
 
 from ..compensation import (
+    MIN_EXPLAINED,
+    MIN_USABLE,
     Candidate,
     check_fitting_data,
     fits_in,
     folds,
     protocol,
 )
-from ..compensation._verdict import MIN_EXPLAINED, MIN_USABLE
 from ..models import get_family
 from ..parallel import SerialExecutor, fit_cost
 from ._select import select_model
