@@ -15,7 +15,8 @@ from numpy.testing import assert_array_equal
 
 import hystkit as hk
 from hystkit.cli import main
-from hystkit.cli._common import Parser, add_read_options, read_recordings_args
+from hystkit.cli._common import Parser, add_read_options
+from hystkit.cli._reading import read_recordings_args
 from hystkit.compensation import fit_compensator
 from hystkit.errors import InputError
 from hystkit.io import ReadOptions, read_pieces, read_recording, read_recording_config, time_gaps

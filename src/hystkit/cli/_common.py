@@ -16,7 +16,7 @@ from ._read_args import add_read_options, given_read_options
 
 __all__ = ["GUARD_EXIT", "INTERNAL_EXIT", "Deferred", "Parser", "UsageError", "add_read_options",
            "check_size", "deferred", "failures_exit", "given_read_options", "integer",
-           "number", "positive_float", "positive_int", "read_recordings_args", "say_next",
+           "number", "positive_float", "positive_int", "say_next",
            "size_limit", "slope_cap", "stdout_for"]
 
 # Exit code of work that ran but failed its guards (a fit collapsed, worse than the line, on
@@ -141,12 +141,3 @@ def say_next(step: str) -> None:
     after the refusal's line on stderr: the guard tests read that line as stderr's last."""
     print(f"next: try {step}", flush=True)
 
-
-# Kept for tests/io/test_gap_pieces.py only (not a CLI file): the readers live in
-# `hystkit.cli._reading`, which loads hystkit.io; that test can import it from there.
-def read_recordings_args(args: argparse.Namespace, paths, *, need_position: bool = True
-                         ) -> list:
-    """`hystkit.cli._reading.read_recordings_args`."""
-    from . import _reading
-
-    return _reading.read_recordings_args(args, paths, need_position=need_position)
