@@ -1,8 +1,9 @@
 """Speed of hystkit's mPL forward model and of its fit, against references run in the same process.
 
-Run:  python benchmarks/bench_mpl.py [--fit-only] [--quick]   (several minutes on 2 cores: the
-      128k-sample trf fits take up to a minute each; --fit-only skips table 1 and the compile
-      costs; --quick keeps only N = 1 of the 128k-sample rows, for a loaded machine)
+Run:  python benchmarks/bench_mpl.py [--fit-only] [--quick] [--pair DIR [--rounds K]]
+      (several minutes on 2 cores: the 128k-sample trf fits take up to a minute each;
+      --fit-only skips table 1 and the compile costs; --quick keeps only N = 1 of the
+      128k-sample rows, for a loaded machine; --pair: see below)
 
 Table 1 -- forward model cost in ns per sample per cell, for N = 1, 3, 10 cells on a
 100 000-sample normalised input (0.5 Hz sine plus white noise, max |u| = 1, dt = 0.025 s):
@@ -31,6 +32,13 @@ The same fits are also given in simulations' worth of the fast C reference
 (``_c_fast_reference.c``'s ``mpl_fast`` at ``-O3 -march=native``, built by ``_c_build.py`` as
 ``bench_kernels.py`` builds it), timed interleaved with every ``mpl.simulate`` call (issue 29.5).
 
+Paired mode (``--pair DIR``, DIR another checkout, e.g. a ``git worktree`` of the commit to
+compare against): only the default solver's fits at 8000 samples (1, 3, 5 cells), each round
+run in a fresh process of DIR/src and then of this checkout's src (A B A B, ``--rounds`` pairs,
+3 by default), every process timing its own fast C reference after each fit; printed are the
+model runs and SSE of each side, the median fit cost in fast-C simulations by CPU time and the
+paired ratios (after / before, each round's pair) with their median and range.
+
 BLAS: unless OPENBLAS_NUM_THREADS is already set, this script sets it to 1 before numpy loads.
 The trf path's linear algebra (scipy's SVD in least_squares) is on n x <= 17 matrices, too small
 for threads to pay; on a 2-core machine with another process busy, OpenBLAS's two spinning
@@ -42,6 +50,7 @@ setting.
 from __future__ import annotations
 
 import ctypes
+import json
 import os
 import platform
 import shutil
@@ -80,6 +89,15 @@ FIT_REPEATS = {8000: 3, 128_000: 2}  # interleaved pairs (tr, trf) per row
 SIM_TIMING_REPEATS = 7
 FIT_ONLY = "--fit-only" in sys.argv
 QUICK = "--quick" in sys.argv
+PAIR_WORKER = "--pair-worker" in sys.argv  # one side of one round of --pair (internal)
+
+
+def _option(name: str, default: str | None = None) -> str | None:
+    return sys.argv[sys.argv.index(name) + 1] if name in sys.argv else default
+
+
+PAIR = _option("--pair")
+ROUNDS = int(_option("--rounds", "3"))
 FIT_SEED = 1  # the demo report's fitting seed (hystkit.studies._demo.FIT_SEED)
 C_FLAGS = SLOW_FLAGS
 C_SOURCE = SLOW_SOURCE
@@ -327,13 +345,7 @@ def fit_data(n_samples: int = 8000) -> tuple[np.ndarray, np.ndarray, float]:
 
 def fit_bounds(structure: mpl.MplStructure) -> tuple[np.ndarray, np.ndarray]:
     """The bounds ``fit_mpl`` builds internally (optimiser coordinates of MplParams)."""
-    n = structure.n_cells
-    cap = structure.slope_cap / structure.dt
-    lower = np.r_[np.tile([_fit._LOG_G_MIN, _fit._LOG_VT_BOUNDS[0]], n),
-                  np.full(n + 2, -_fit._W_BOUND)]
-    upper = np.r_[np.tile([np.log(cap), _fit._LOG_VT_BOUNDS[1]], n),
-                  np.full(n + 2, _fit._W_BOUND)]
-    return lower, upper
+    return _fit.fit_box(structure)
 
 
 def fd_reference_fit(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure) -> dict:
@@ -500,6 +512,60 @@ def print_fit_table(fast_c=None) -> None:
     print()
 
 
+# ----------------------------------------------------------------------------- paired
+
+def pair_worker(fast_c) -> None:
+    """One side of a --pair round: tr fits at 8000 samples, one JSON line on stdout."""
+    u, y, dt = fit_data()
+    hystkit_fit(u[:500], y[:500], mpl.MplStructure(n_cells=1, dt=dt))  # kernel load
+    rows = {}
+    for n in FIT_CELLS:
+        structure = mpl.MplStructure(n_cells=n, dt=dt)
+        fits, fast = [], []
+        for _ in range(FIT_REPEATS[8000]):
+            fits.append(hystkit_fit(u, y, structure))
+            fast += simulate_seconds(structure, fits[-1]["params"], u, fast_c)["fast"]
+        fast_cpu = statistics.median(c for _, c in fast)
+        cpu = statistics.median(f["cpu"] for f in fits)
+        rows[n] = {"runs": fits[-1]["runs"], "cost": fits[-1]["cost"], "cpu": cpu,
+                   "converged": fits[-1]["converged"], "ccpu": cpu / fast_cpu}
+    print(json.dumps(rows))
+
+
+def print_pair_table(before_root: Path) -> None:
+    trees = {"before": before_root / "src", "after": Path(__file__).resolve().parents[1] / "src"}
+    rounds: dict[str, list[dict]] = {name: [] for name in trees}
+    for _ in range(ROUNDS):
+        for name, src in trees.items():  # A B A B
+            env = {**os.environ, "PYTHONPATH": str(src)}
+            out = subprocess.run([sys.executable, __file__, "--pair-worker"], env=env,
+                                 capture_output=True, text=True, check=True)
+            rounds[name].append(json.loads(out.stdout.strip().splitlines()[-1]))
+    print(f"Paired fit cost, tr solver, 8000 samples (seed {FIT_SEED} sine): before = "
+          f"{trees['before']}, after = {trees['after']}, {ROUNDS} rounds A B")
+    print("  Ccpu = fit CPU / fast C simulate CPU (median of the round's 3 fits and their "
+          "simulate calls); ratio = after / before per round")
+    head = (f"  {'N':>2} | {'runs':>9} | {'SSE before':>17} {'SSE after':>17} {'rel':>9} | "
+            f"{'conv':>7} | {'Ccpu before':>11} {'after':>6} | {'ratio med':>9} {'range':>11}")
+    print(head)
+    print("  " + "-" * (len(head) - 2))
+    for n in map(str, FIT_CELLS):
+        b, a = ([r[n] for r in rounds[name]] for name in ("before", "after"))
+        ratios = [ra["ccpu"] / rb["ccpu"] for ra, rb in zip(a, b)]
+        cb, ca = b[-1]["cost"], a[-1]["cost"]
+        conv = f"{'y' if b[-1]['converged'] else 'n'}->{'y' if a[-1]['converged'] else 'n'}"
+        print(f"  {n:>2} | {b[-1]['runs']:>4}->{a[-1]['runs']:<4} | {cb:17.12f} {ca:17.12f} "
+              f"{(ca - cb) / cb:+9.1e} | {conv:>7} | "
+              f"{statistics.median(r['ccpu'] for r in b):11.0f} "
+              f"{statistics.median(r['ccpu'] for r in a):6.0f} | "
+              f"{statistics.median(ratios):9.2f} {min(ratios):5.2f}-{max(ratios):<5.2f}")
+    print("  rounds (Ccpu before -> after): " + "; ".join(
+        f"N={n}: " + " ".join(f"{rb[n]['ccpu']:.0f}->{ra[n]['ccpu']:.0f}"
+                              for rb, ra in zip(rounds["before"], rounds["after"]))
+        for n in map(str, FIT_CELLS)))
+    print()
+
+
 # ----------------------------------------------------------------------------- main
 
 def find_compiler() -> str | None:
@@ -512,7 +578,15 @@ def find_compiler() -> str | None:
 def main() -> int:
     t_total = time.perf_counter()
     cc = find_compiler()
+    if PAIR_WORKER:
+        with tempfile.TemporaryDirectory(prefix="hystkit-bench-") as workdir:
+            pair_worker(fast_mpl(cc, Path(workdir)))
+        return 0
     print_machine(cc)
+    if PAIR:
+        print_pair_table(Path(PAIR))
+        print(f"Total benchmark time {time.perf_counter() - t_total:.1f} s")
+        return 0
     with tempfile.TemporaryDirectory(prefix="hystkit-bench-") as workdir:
         c_func, c_seconds = build_c_reference(cc, workdir) if cc else (None, None)
         # Compile costs first: the tables' warm-ups would otherwise hide the first call.

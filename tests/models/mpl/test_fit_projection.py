@@ -1,6 +1,6 @@
-"""The mPL fit with the weights projected out (fit.Projection, issue 29.5): its normal equations
-are the full problem's at the best weights, and the 1-cell fit it drives reaches the full
-search's minimum."""
+"""The mPL fit with the weights projected out (projection.Projection, issue 29.5): its normal
+equations are the full problem's at the best weights, and the 1-cell fit it drives reaches the
+full search's minimum."""
 
 import numpy as np
 import pytest
@@ -11,6 +11,7 @@ from hystkit.identification import NormalEquations
 from hystkit.models import mpl
 from hystkit.models.mpl import fit as mpl_fit
 from hystkit.models.mpl import kernels
+from hystkit.models.mpl.projection import COST_SCALE, Projection
 from hystkit.sensors._virtual import simulate_experiment
 
 DT = 0.025
@@ -28,7 +29,7 @@ def _data(n_cells, n=3000):
 
 
 def _unscaled(ne):
-    return NormalEquations(*(part / mpl_fit.COST_SCALE for part in (ne.cost, ne.jtj, ne.jtr)))
+    return NormalEquations(*(part / COST_SCALE for part in (ne.cost, ne.jtj, ne.jtr)))
 
 
 def _full_problem(structure, u, y):
@@ -45,7 +46,7 @@ def test_projected_normal_equations_are_the_full_ones_at_the_best_weights(n_cell
     full = _full_problem(structure, u, y)
     lower, upper = mpl_fit.fit_box(structure)
     m = 2 * n_cells
-    projected = mpl_fit.Projection(full, n_cells, lower[m:], upper[m:])
+    projected = Projection(full, n_cells, lower[m:], upper[m:])
     cells = np.log([0.4, 0.5, 0.9, 0.3][:m])  # (log G, log V_T) per cell, away from the truth
     reduced = _unscaled(projected(cells))
     at = full(projected.full(cells))
@@ -67,7 +68,7 @@ def test_weights_held_in_their_box_keep_the_cost_and_free_gradient_consistent():
     full = _full_problem(structure, u, y)
     # a box the unconstrained best weights leave (w_1 near 0.4 there): |w| <= 0.2
     low, high = np.full(3, -0.2), np.full(3, 0.2)
-    projected = mpl_fit.Projection(full, 1, low, high)
+    projected = Projection(full, 1, low, high)
     cells = np.log([0.4, 0.3])
     reduced = _unscaled(projected(cells))
     theta = projected.full(cells)
@@ -103,7 +104,7 @@ def test_a_near_exact_fit_gets_its_cost_from_a_pass_at_its_own_weights():
     y = mpl.simulate(structure, truth, u)[0]
     full = _full_problem(structure, u, y)
     lower, upper = mpl_fit.fit_box(structure)
-    projected = mpl_fit.Projection(full, 1, lower[2:], upper[2:])
+    projected = Projection(full, 1, lower[2:], upper[2:])
     cells = truth.to_vector()[:2] + 1e-5
     reduced = _unscaled(projected(cells))
     assert projected.extra == 1  # the second pass
