@@ -3,8 +3,11 @@ and MATLAB, shared by the mpl-poly and mpl-g translations (``<family>/export.py`
 kernels share ``mpl_poly.kernels.solve_output``: both bodies start with the same head
 ``[n, v_b, cap, dt, limit, lo, hi, sign, centre, g0..g3, ...]``.
 
-Plain text, no format fields; the C needs ``cubic(g, z, &slope)``, ``IG`` and ``BODY`` from the
-family's code.
+Plain text, no format fields; the C needs ``cubic(g, z, &slope)``, ``IG``, ``IW``, ``N_CELLS``,
+``cells(x, drive)`` and ``BODY`` from the family's code, the MATLAB ``cells(B, x, drive)``. The
+block's step reads the output through ``g`` from ``z = w_0 u + sum w_k x_k - V_b`` (forward) or
+solves it for ``z`` and then ``u`` (inverse), then drives the cells: the same in both families
+but for how many body values each cell takes (:func:`m_step`).
 """
 
 C_SOLVE = """
@@ -104,3 +107,62 @@ end
 ok = true;
 end
 """
+
+
+C_FORWARD = """
+/* block_forward: y = g(w_0 u + sum w_k x_k - V_b) (eq. 5.17), then the cells driven by u */
+static real model_step(real *x, real u)
+{
+    int k;
+    real z = BODY[IW] * u - BODY[1], y;
+    for (k = 0; k < N_CELLS; k++) z += BODY[IW + 1 + k] * x[k];
+    y = cubic(BODY + IG, z, 0);
+    cells(x, u);
+    return y;
+}
+"""
+
+C_INVERSE = """
+/* block_inverse: z = g^-1(y) on the rest branch, u_hat = (z - sum w_k x_k + V_b) / w_0, the
+   cells driven by u_hat; NaN when y is outside the branch's range (no input gives it) */
+static real model_step(real *x, real y)
+{
+    int k, ok;
+    const real z = solve_output(y, &ok);
+    real acc = z + BODY[1], u_hat;
+    for (k = 0; k < N_CELLS; k++) acc -= BODY[IW + 1 + k] * x[k];
+    u_hat = ok ? acc / BODY[IW] : (real)NAN;
+    cells(x, u_hat);
+    return u_hat;
+}
+"""
+
+_M_FORWARD = """
+function [y, x] = model_step(B, x, u)
+n = round(B(1)); iw = 14 + @PER_CELL@ * n;
+z = B(iw) * u - B(2);
+for k = 1:n
+    z = z + B(iw + k) * x(k);
+end
+y = cubic(B(10:13), z);
+x = cells(B, x, u);
+end
+"""
+
+_M_INVERSE = """
+function [u_hat, x] = model_step(B, x, y)
+n = round(B(1)); iw = 14 + @PER_CELL@ * n;
+[z, ok] = solve_output(B, y);
+acc = z + B(2);
+for k = 1:n
+    acc = acc - B(iw + k) * x(k);
+end
+if ok, u_hat = acc / B(iw); else, u_hat = NaN; end
+x = cells(B, x, u_hat);
+end
+"""
+
+
+def m_step(inverse: bool, per_cell: int) -> str:
+    """The MATLAB ``model_step`` of a body with `per_cell` values per cell before ``w``."""
+    return (_M_INVERSE if inverse else _M_FORWARD).replace("@PER_CELL@", str(per_cell))

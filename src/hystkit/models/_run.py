@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ._docs import filled
 from ._validation import broadcast_state, check_finite_run, check_signal, run_steps
 
 __all__ = ["Runs", "family_runs"]
@@ -85,10 +86,7 @@ _SIMULATE = """Run {title} over an input sequence (compiled kernel).
 
     Parameters
     ----------
-    structure : Structure
-        The model's structure.
-    params : Params
-        Its parameters.
+    %(structure)s
     u : array, shape (n,)
         Model input, one value per sample (every ``structure.dt``).
     x0 : array, float or None
@@ -116,10 +114,7 @@ _REFERENCE = """Same as ``simulate``, as a plain loop over ``step`` (the readabl
 
     Parameters
     ----------
-    structure : Structure
-        The model's structure.
-    params : Params
-        Its parameters.
+    %(structure)s
     u : array, shape (n,)
         Model input, one value per sample.
     x0 : array, float or None
@@ -142,10 +137,7 @@ _INVERT = """Run the inverse of {title} (the compensator) over an output sequenc
 
     Parameters
     ----------
-    structure : Structure
-        The model's structure.
-    params : Params
-        Its parameters.
+    %(structure)s
     y : array, shape (n,)
         Measured model output (e.g. the sensor signal), one value per sample.
     x0 : array, float or None
@@ -173,7 +165,7 @@ _INVERT = """Run the inverse of {title} (the compensator) over an output sequenc
 def _named(function: Callable, name: str, module: str, doc: str, notes: str) -> Callable:
     function.__name__ = function.__qualname__ = name
     function.__module__ = module
-    function.__doc__ = doc + (f"\n    Notes\n    -----\n    {notes}\n" if notes else "")
+    function.__doc__ = filled(doc) + (f"\n    Notes\n    -----\n    {notes}\n" if notes else "")
     return function
 
 
@@ -200,26 +192,27 @@ def family_runs(runs: Runs, module: str, title: str, notes: str = "",
         ``(simulate, simulate_reference, invert)``.
     """
 
+    def checked(structure: Any, params: Any, signal: np.ndarray, x0: Any,
+                inverse: bool) -> tuple[np.ndarray, np.ndarray]:
+        """The checked signal (``u``, or ``y`` for the inverse) and the start state."""
+        runs.check(structure, params, inverse)
+        signal = check_signal(signal, "y" if inverse else "u")
+        return signal, runs.initial(structure, params, x0, signal[0], inverse)
+
     def simulate(structure: Any, params: Any, u: np.ndarray,
                  x0: np.ndarray | float | None = None) -> Run:
-        runs.check(structure, params, False)
-        u = check_signal(u, "u")
-        x = runs.initial(structure, params, x0, u[0], False)
+        u, x = checked(structure, params, u, x0, False)
         y, x_end = runs.forward(structure, params, u, x)
         return check_finite_run(y, runs.label), x_end
 
     def simulate_reference(structure: Any, params: Any, u: np.ndarray,
                            x0: np.ndarray | float | None = None) -> Run:
-        runs.check(structure, params, False)
-        u = check_signal(u, "u")
-        x = runs.initial(structure, params, x0, u[0], False)
+        u, x = checked(structure, params, u, x0, False)
         return run_steps(runs.step, structure, params, u, x)
 
     def invert(structure: Any, params: Any, y: np.ndarray,
                x0: np.ndarray | float | None = None) -> Run:
-        runs.check(structure, params, True)
-        y = check_signal(y, "y")
-        x = runs.initial(structure, params, x0, y[0], True)
+        y, x = checked(structure, params, y, x0, True)
         u_hat, x_end = runs.inverse(structure, params, y, x)
         return check_finite_run(u_hat, runs.label, "inverse"), x_end
 

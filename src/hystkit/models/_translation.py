@@ -8,6 +8,8 @@ import dataclasses
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 
 def _no_extra(comp: Any) -> dict:
     return {}
@@ -59,3 +61,42 @@ class Translation:
     state_size: Callable[[Any], int] = _block_state
     inverse: bool = True
     m_load: str | None = None
+
+
+# The linear readout y = w_0 u + sum w_k x_k - V_b (mPL eq. 5.2, the ladder's output) with w at
+# BODY[IW] (C) / B(iw + 1) (MATLAB) and V_b at BODY[1]: the forward block's output, or solved
+# for the input (eq. 5.13) by the inverse block. The code sets ``drive``, what drives the cells.
+
+def linear_readout_rest(comp: Any) -> dict:
+    """``W_SUM``: ``sum(w)``, the divisor of the inverse's rest input ``(y + V_b) / sum(w)``."""
+    return {"W_SUM": float(np.sum(comp.params.w))}
+
+
+def c_linear_readout(inverse: bool) -> str:
+    """C declaring ``acc`` and setting ``drive``: ``acc`` the output (forward), ``drive`` the
+    input ``(y + V_b - sum w_k x_k) / w_0`` (inverse); needs ``k``, ``drive``, ``N_CELLS``, ``IW``."""
+    if inverse:
+        return """    real acc = u + BODY[1];
+    for (k = 0; k < N_CELLS; k++) acc -= BODY[IW + 1 + k] * x[k];
+    drive = acc / BODY[IW];"""
+    return """    real acc = BODY[IW] * u - BODY[1];
+    for (k = 0; k < N_CELLS; k++) acc += BODY[IW + 1 + k] * x[k];
+    drive = u;"""
+
+
+def m_linear_readout(inverse: bool) -> str:
+    """MATLAB setting ``drive`` and the block's output ``out``, as :func:`c_linear_readout`;
+    needs ``n`` and ``iw``."""
+    if inverse:
+        return """acc = u + B(2);
+for k = 1:n
+    acc = acc - B(iw + k) * x(k);
+end
+drive = acc / B(iw);
+out = drive;"""
+    return """acc = B(iw) * u - B(2);
+for k = 1:n
+    acc = acc + B(iw + k) * x(k);
+end
+drive = u;
+out = acc;"""

@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._docs import docfiller
 from .._protocol import Record
 from .._run import Runs, family_runs
 from .._validation import (
@@ -46,6 +47,8 @@ from .._validation import (
     freeze_arrays,
 )
 from . import kernels
+
+fill_doc = docfiller("BobbioStructure", "BobbioParams")
 
 __all__ = [
     "MAX_SPRINGS",
@@ -166,16 +169,14 @@ def output_bound(params: BobbioParams, u_max: float) -> float:
     return float(params.compliance.sum() * u_max + abs(params.offset))
 
 
+@fill_doc
 def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
     """Apply force ``u``: project the spring forces onto eq. 2.5, then read the deformation.
 
     Parameters
     ----------
-    structure : BobbioStructure
-        The model's structure.
-    params : BobbioParams
-        Its parameters.
+    %(structure)s
     x : numpy.ndarray
         State before the sample.
     u : float
@@ -185,8 +186,7 @@ def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
     -------
     y : float
         Deformation with the projected forces.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(x_next)s
     """
     x_next = np.array(x, dtype=float)
     prev = u
@@ -197,6 +197,7 @@ def step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
     return float(y), x_next
 
 
+@fill_doc
 def invert_step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of :func:`invert`: the force that gives ``y`` from the forces ``x``, and the
@@ -204,21 +205,16 @@ def invert_step(structure: BobbioStructure, params: BobbioParams, x: np.ndarray,
 
     Parameters
     ----------
-    structure : BobbioStructure
-        The model's structure.
-    params : BobbioParams
-        Its parameters.
+    %(structure)s
     x : numpy.ndarray
         State before the sample.
-    y : float
-        Output to reach at this sample.
+    %(y_step)s
 
     Returns
     -------
     u : float
         Force that gives `y` from the present forces; NaN where none does.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(x_next)s
     """
     x = np.array(x, dtype=float)
     x_next = x.copy()
@@ -232,27 +228,14 @@ def _rest_force(params: BobbioParams, y: float) -> float:
     return (y - params.offset) / total if total > 0 else 0.0
 
 
+@fill_doc
 def rest_state(structure: BobbioStructure, params: BobbioParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """Every spring carrying the force ``value`` (``inverse``: the force ``(value - b) / sum(c)``
     that gives the deformation ``value``), no piston loaded: the start of ``simulate`` /
     ``invert`` with ``x0=None``.
 
-    Parameters
-    ----------
-    structure : BobbioStructure
-        The model's structure.
-    params : BobbioParams
-        Its parameters.
-    value : float
-        Constant input (with `inverse`: output) the model rests at.
-    inverse : bool, default False
-        Rest state of the inverse: `value` is an output.
-
-    Returns
-    -------
-    numpy.ndarray
-        The state at rest.
+    %(rest_state)s
     """
     force = _rest_force(params, value) if inverse else float(value)
     return np.full(params.n_springs - 1, force)
@@ -262,6 +245,7 @@ def _check(structure: BobbioStructure, params: BobbioParams, inverse: bool) -> N
     check_size(params.n_springs, structure.n_springs, "springs")
 
 
+@fill_doc
 def forces(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
            x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Spring forces ``F_2 .. F_N`` after each sample, shape (n, N - 1), and the final state.
@@ -270,10 +254,7 @@ def forces(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
 
     Parameters
     ----------
-    structure : BobbioStructure
-        The model's structure.
-    params : BobbioParams
-        Its parameters.
+    %(structure)s
     u : numpy.ndarray, shape (n,)
         Applied force, one value per sample.
     x0 : numpy.ndarray, float or None, optional

@@ -7,20 +7,23 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._docs import docfiller
 from .records import (
     RK4_LIMIT,
     BoucWenParams,
     BoucWenStructure,
 )
 
+fill_doc = docfiller("BoucWenStructure", "BoucWenParams")
 
+
+@fill_doc
 def bounded_class(params: BoucWenParams) -> bool:
     """``beta + gamma >= 0`` and ``beta - gamma >= 0``: ``z`` stays bounded, loops dissipate.
 
     Parameters
     ----------
-    params : BoucWenParams
-        The model's parameters.
+    %(params)s
 
     Returns
     -------
@@ -30,6 +33,7 @@ def bounded_class(params: BoucWenParams) -> bool:
     return params.beta + params.gamma >= 0 and params.beta - params.gamma >= 0
 
 
+@fill_doc
 def divergence_bound(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
                      u: np.ndarray) -> float:
     """A bound on ``|y|`` that the exact solution cannot exceed over a run of ``u`` from ``x``.
@@ -43,10 +47,7 @@ def divergence_bound(structure: BoucWenStructure, params: BoucWenParams, x: np.n
 
     Parameters
     ----------
-    structure : BoucWenStructure
-        The model's structure.
-    params : BoucWenParams
-        Its parameters.
+    %(structure)s
     x : numpy.ndarray, shape (4,)
         State ``(y, y', z, u_prev)`` at the start of the run.
     u : numpy.ndarray, shape (n,)
@@ -67,16 +68,14 @@ def divergence_bound(structure: BoucWenStructure, params: BoucWenParams, x: np.n
         return float(2.0 * np.sqrt(2.0 * energy / params.k))
 
 
+@fill_doc
 def divergence_message(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
                         n_bad: int, n: int, bound: float) -> str:
     """What happened (the state at the sample it diverged) and the likely cause.
 
     Parameters
     ----------
-    structure : BoucWenStructure
-        The model's structure.
-    params : BoucWenParams
-        Its parameters.
+    %(structure)s
     x : numpy.ndarray
         State at the sample where the run diverged.
     n_bad : int

@@ -50,6 +50,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._docs import docfiller
 from .._validation import check_signal
 from . import kernels
 from .divergence import (
@@ -66,6 +67,8 @@ from .records import (
     BoucWenParams,
     BoucWenStructure,
 )
+
+fill_doc = docfiller("BoucWenStructure", "BoucWenParams")
 
 __all__ = [
     "BENCHMARK_PARAMS",
@@ -94,16 +97,14 @@ def _rhs(params: BoucWenParams, y: float, v: float, z: float, u: float):
     return np.array([v, (u - params.c * v - params.k * y - z) / params.m, dz])
 
 
+@fill_doc
 def step(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
     """One sample of the model (readable reference): integrate to the next force sample.
 
     Parameters
     ----------
-    structure : BoucWenStructure
-        The model's structure.
-    params : BoucWenParams
-        Its parameters.
+    %(structure)s
     x : array, shape (4,)
         ``(y, y', z, u_prev)`` at the previous sample.
     u : float
@@ -130,16 +131,14 @@ def step(structure: BoucWenStructure, params: BoucWenParams, x: np.ndarray,
     return float(s[0]), np.append(s, u)
 
 
+@fill_doc
 def initial_state(structure: BoucWenStructure, params: BoucWenParams,
                   u0: float) -> np.ndarray:
     """``(y, y', z, u0)`` at the first sample of a run without ``x0`` (``structure.start``).
 
     Parameters
     ----------
-    structure : BoucWenStructure
-        The model's structure.
-    params : BoucWenParams
-        Its parameters.
+    %(structure)s
     u0 : float
         Force at the first sample.
 
@@ -156,6 +155,7 @@ def initial_state(structure: BoucWenStructure, params: BoucWenParams,
     return np.array([y0, 0.0, params.alpha * y0, u0])
 
 
+@fill_doc
 def rest_state(structure: BoucWenStructure, params: BoucWenParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """The start of :func:`simulate` with ``x0=None`` (:func:`initial_state`) for the force
@@ -164,10 +164,7 @@ def rest_state(structure: BoucWenStructure, params: BoucWenParams, value: float,
 
     Parameters
     ----------
-    structure : BoucWenStructure
-        The model's structure.
-    params : BoucWenParams
-        Its parameters.
+    %(structure)s
     value : float
         Constant force.
     inverse : bool, default False
@@ -175,8 +172,7 @@ def rest_state(structure: BoucWenStructure, params: BoucWenParams, value: float,
 
     Returns
     -------
-    numpy.ndarray
-        The state at rest.
+    %(rest_returns)s
 
     Raises
     ------
@@ -200,16 +196,14 @@ def _initial_state(structure: BoucWenStructure, params: BoucWenParams, x0: np.nd
     return x0.copy(), False
 
 
+@fill_doc
 def simulate_states(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
                     x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Run the model and return every sample's mechanical state (compiled kernel).
 
     Parameters
     ----------
-    structure : BoucWenStructure
-        The model's structure.
-    params : BoucWenParams
-        Its parameters.
+    %(structure)s
     u : array, shape (n,)
         Force sampled every ``structure.dt``.
     x0 : array, shape (4,), or None
@@ -244,16 +238,14 @@ def simulate_states(structure: BoucWenStructure, params: BoucWenParams, u: np.nd
     return states, x_end
 
 
+@fill_doc
 def simulate(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
              x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Displacement response to a force sequence (see :func:`simulate_states`).
 
     Parameters
     ----------
-    structure : BoucWenStructure
-        The model's structure.
-    params : BoucWenParams
-        Its parameters.
+    %(structure)s
     u : numpy.ndarray, shape (n,)
         Force sampled every ``structure.dt``.
     x0 : numpy.ndarray, shape (4,), optional
@@ -270,16 +262,14 @@ def simulate(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
     return states[:, 0].copy(), x_end
 
 
+@fill_doc
 def simulate_reference(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
                        x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
 
     Parameters
     ----------
-    structure : BoucWenStructure
-        The model's structure.
-    params : BoucWenParams
-        Its parameters.
+    %(structure)s
     u : numpy.ndarray, shape (n,)
         Force sampled every ``structure.dt``.
     x0 : numpy.ndarray, shape (4,), optional

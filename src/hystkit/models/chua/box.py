@@ -7,7 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._docs import docfiller
 from . import model as chua
+
+fill_doc = docfiller()
 
 __all__ = ["DELTA", "LOG_SCALE", "LOG_SLOPE", "LOG_VG", "fit_bounds", "random_params"]
 
@@ -30,6 +33,7 @@ def fit_bounds(structure: chua.ChuaStructure) -> tuple[np.ndarray, np.ndarray]:
     return lower, upper
 
 
+@fill_doc
 def random_params(structure: chua.ChuaStructure, rng: np.random.Generator) -> chua.ChuaParams:
     """Parameters drawn from the fit's bounds (the family's documented domain), per element:
     ``k_0``, ``k_inf``, ``y_s`` log-uniform in ``[1e-2, 1e2]``, ``G`` log-uniform in
@@ -39,8 +43,7 @@ def random_params(structure: chua.ChuaStructure, rng: np.random.Generator) -> ch
     ----------
     structure : chua.ChuaStructure
         The model's structure.
-    rng : numpy.random.Generator
-        Source of the draws.
+    %(rng)s
 
     Returns
     -------

@@ -14,11 +14,14 @@ from collections.abc import Callable
 import numpy as np
 
 from ...identification import ChunkedDifferences, FitResult, check_fit_data, fit_multistart
+from .._docs import docfiller
 from . import model as chua
 from .box import (
     fit_bounds,
     random_params,
 )
+
+fill_doc = docfiller()
 
 __all__ = ["default_starts", "fit_chua", "random_params"]
 
@@ -80,6 +83,7 @@ def default_starts(structure: chua.ChuaStructure, gain: float) -> list[chua.Chua
     return starts
 
 
+@fill_doc
 def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
              starts: list[chua.ChuaParams] | None = None, max_nfev: int = 100,
              screen_nfev: int = 10, n_polish: int = 2,
@@ -110,8 +114,7 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
 
     Returns
     -------
-    FitResult
-        The best start's fit.
+    %(best_start)s
 
     Raises
     ------

@@ -38,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._docs import docfiller
 from .._run import Runs, family_runs
 from .._validation import check_size
 from . import kernels
@@ -48,6 +49,10 @@ from .records import (
     ChuaStructure,
     output_bound,
 )
+
+fill_doc = docfiller("ChuaStructure", "ChuaParams", state="""\
+x : numpy.ndarray, shape (N,)
+    Element outputs ``y_k`` before the step.""")
 
 __all__ = [
     "DOMAIN",
@@ -69,15 +74,13 @@ __all__ = [
     "step",
 ]
 
+@fill_doc
 def limits(structure: ChuaStructure, params: ChuaParams) -> tuple[np.ndarray, np.ndarray]:
     """Per element: the cap on ``g'`` and the knee ``|v|`` beyond which ``g`` is straight.
 
     Parameters
     ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
@@ -93,13 +96,13 @@ def limits(structure: ChuaStructure, params: ChuaParams) -> tuple[np.ndarray, np
     return cap, knee
 
 
+@fill_doc
 def restoring(params: ChuaParams, y: np.ndarray) -> np.ndarray:
     """``f_k(y_k)``; ``y`` of shape (..., N).
 
     Parameters
     ----------
-    params : ChuaParams
-        The model's parameters.
+    %(params)s
     y : numpy.ndarray, shape (..., N)
         Element outputs.
 
@@ -112,6 +115,7 @@ def restoring(params: ChuaParams, y: np.ndarray) -> np.ndarray:
     return params.k_inf * y + (params.k0 - params.k_inf) * params.y_s * np.tanh(y / params.y_s)
 
 
+@fill_doc
 def restoring_inverse(params: ChuaParams, u: float) -> np.ndarray:
     """``f_k^-1(u)`` for every element, shape (N,), by bisection to float resolution.
 
@@ -119,8 +123,7 @@ def restoring_inverse(params: ChuaParams, u: float) -> np.ndarray:
 
     Parameters
     ----------
-    params : ChuaParams
-        The model's parameters.
+    %(params)s
     u : float
         Input.
 
@@ -132,15 +135,13 @@ def restoring_inverse(params: ChuaParams, u: float) -> np.ndarray:
     return kernels.restoring_inverse(float(u), params.k0, params.k_inf, params.y_s)
 
 
+@fill_doc
 def dissipation(structure: ChuaStructure, params: ChuaParams, v: np.ndarray) -> np.ndarray:
     """Limited ``g_k(v_k)`` (dead band, sinh, straight line beyond the knee); shape (..., N).
 
     Parameters
     ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
+    %(structure)s
     v : numpy.ndarray, shape (..., N)
         Argument ``u - f_k(y_k)`` per element.
 
@@ -157,6 +158,7 @@ def dissipation(structure: ChuaStructure, params: ChuaParams, v: np.ndarray) -> 
     return np.sign(v) * mag
 
 
+@fill_doc
 def dissipation_slope(structure: ChuaStructure, params: ChuaParams,
                       v: np.ndarray) -> np.ndarray:
     """``g_k'(v_k)`` of the limited dissipation function: 0 in the dead band, the sinh's slope
@@ -164,10 +166,7 @@ def dissipation_slope(structure: ChuaStructure, params: ChuaParams,
 
     Parameters
     ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
+    %(structure)s
     v : numpy.ndarray, shape (..., N)
         Argument per element.
 
@@ -183,33 +182,20 @@ def dissipation_slope(structure: ChuaStructure, params: ChuaParams,
     return np.where(a <= params.delta, 0.0, np.where(a <= knee, inner, cap))
 
 
+@fill_doc
 def step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """One Euler step with input ``u``; the output is the sum of the updated element states.
+    """One Euler step with input ``u``; the output ``y`` is the sum of the updated element
+    states.
 
-    Parameters
-    ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
-    x : numpy.ndarray, shape (N,)
-        Element outputs ``y_k`` before the step.
-    u : float
-        Input of the sample.
-
-    Returns
-    -------
-    y : float
-        Output: the sum of the updated element states.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(step)s
     """
     x = np.asarray(x, dtype=float)
     x_next = x + structure.dt * dissipation(structure, params, u - restoring(params, x))
     return float(np.sum(x_next)), x_next
 
 
+@fill_doc
 def invert_step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """The input that makes :func:`step` return ``y``, and the state it leaves.
@@ -220,23 +206,7 @@ def invert_step(structure: ChuaStructure, params: ChuaParams, x: np.ndarray,
     ``sum x_k`` is that output (``r = 0``): rounding must not decide which edge of a dead band
     the input jumps to.
 
-    Parameters
-    ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
-    x : numpy.ndarray, shape (N,)
-        Element outputs ``y_k`` before the step.
-    y : float
-        Output to reach at this sample.
-
-    Returns
-    -------
-    u : float
-        Input that gives `y` from the present state.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(invert_step)s
     """
     x = np.asarray(x, dtype=float)
     fx = restoring(params, x)
@@ -277,6 +247,7 @@ def _check(structure: ChuaStructure, params: ChuaParams, inverse: bool) -> None:
     check_size(params.n_elements, structure.n_elements, "elements")
 
 
+@fill_doc
 def rest_state(structure: ChuaStructure, params: ChuaParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """Element outputs at rest (``g = 0``) under a constant input ``value``, ``f_k^-1(value)``;
@@ -284,36 +255,20 @@ def rest_state(structure: ChuaStructure, params: ChuaParams, value: float,
     ``sum_k f_k^-1(u) = value`` first. These are the starts of ``simulate`` / ``invert`` with
     ``x0=None``.
 
-    Parameters
-    ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
-    value : float
-        Constant input (with `inverse`: output) the model rests at.
-    inverse : bool, default False
-        Rest state of the inverse: `value` is an output.
-
-    Returns
-    -------
-    numpy.ndarray
-        The state at rest.
+    %(rest_state)s
     """
     if inverse:
         value = kernels.rest_input(float(value), params.k0, params.k_inf, params.y_s)
     return restoring_inverse(params, value)
 
 
+@fill_doc
 def kernel_args(structure: ChuaStructure, params: ChuaParams) -> tuple:
     """The compiled kernels' parameter arguments, in their order.
 
     Parameters
     ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------

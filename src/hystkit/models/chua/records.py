@@ -8,11 +8,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._docs import docfiller
 from .._protocol import Record
 from .._validation import (
     check_cells,
     freeze_arrays,
 )
+
+fill_doc = docfiller("ChuaStructure", "ChuaParams")
 
 _FIELDS = ("k0", "k_inf", "y_s", "g", "v_g", "delta")
 MAX_ELEMENTS = 100  # O(N) a sample; the fit's Jacobian holds 6 N columns: 4.8 kB a sample
@@ -119,6 +122,7 @@ class ChuaParams(Record):
         return cls(*np.exp(t[:, :5]).T, delta=t[:, 5])
 
 
+@fill_doc
 def output_bound(structure: ChuaStructure, params: ChuaParams, u_max: float) -> float:
     """``q sum_k (u_max + delta_k) / min(k_0, k_inf)_k`` with ``q = max(1, s / (2 - s))``,
     ``s`` the slope cap: no output of a run whose inputs, and the restoring forces
@@ -132,10 +136,7 @@ def output_bound(structure: ChuaStructure, params: ChuaParams, u_max: float) -> 
 
     Parameters
     ----------
-    structure : ChuaStructure
-        The model's structure.
-    params : ChuaParams
-        Its parameters.
+    %(structure)s
     u_max : float
         Bound on the magnitude of the inputs and of the start's restoring forces.
 

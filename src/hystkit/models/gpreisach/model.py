@@ -37,6 +37,7 @@ from math import comb
 import numpy as np
 from numpy.polynomial import Polynomial
 
+from .._docs import docfiller
 from .._protocol import Record
 from .._run import Runs, family_runs
 from .._validation import check_magnitude
@@ -52,6 +53,8 @@ from ..preisach import (
     start_staircase,
     update_staircase,
 )
+
+fill_doc = docfiller("GPreisachStructure", "GPreisachParams", state="x_staircase")
 
 __all__ = [
     "GPreisachParams",
@@ -192,13 +195,13 @@ class GPreisachParams(Record):
                    offset=d["offset"])
 
 
+@fill_doc
 def major_slope(params: GPreisachParams) -> float:
     """Mean slope of the major loop, ``(y(+sat) - y(-sat)) / 2``: the extension beyond +-1.
 
     Parameters
     ----------
-    params : GPreisachParams
-        The model's parameters.
+    %(params)s
 
     Returns
     -------
@@ -217,16 +220,15 @@ def _mass(params: GPreisachParams) -> float:
     return float(relay + 2.0 * np.abs(params.nu).sum() / params.nu.size)
 
 
+@fill_doc
 def output_bound(params: GPreisachParams, u_max: float) -> float:
     """``|y_0| + B max(1, u_max)`` (class Notes): no output of a run with ``|u| <= u_max``
     exceeds it.
 
     Parameters
     ----------
-    params : GPreisachParams
-        The model's parameters.
-    u_max : float
-        Largest input magnitude.
+    %(params)s
+    %(u_max)s
 
     Returns
     -------
@@ -257,26 +259,13 @@ def _combine(params: GPreisachParams, relay: np.ndarray, u: np.ndarray) -> np.nd
             + params.offset + major_slope(params) * (u - u_clip))
 
 
+@fill_doc
 def step(structure: GPreisachStructure, params: GPreisachParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """One sample: update the staircase with ``u``, then the output of eq. 2.2.
+    """One sample: update the staircase with the normalised input ``u``, then the output of eq.
+    2.2 (``x_next``: the staircase after the sample).
 
-    Parameters
-    ----------
-    structure : GPreisachStructure
-        The model's structure.
-    params : GPreisachParams
-        Its parameters.
-    x : numpy.ndarray, shape (k,)
-        Staircase before the sample.
-    u : float
-        Normalised input of the sample.
-
-    Returns
-    -------
-    y : float
-    x_next : array, shape (k,)
-        Staircase after the sample.
+    %(step)s
     """
     x_next = update_staircase(x, u, structure.capacity)
     relay = np.array([staircase_terms(params.everett_minus, x_next),
@@ -290,14 +279,14 @@ def _check(structure: GPreisachStructure, params: GPreisachParams, inverse: bool
                          f"the structure (levels {structure.levels}, degree {structure.degree})")
 
 
+@fill_doc
 def kernel_parts(params: GPreisachParams) -> tuple[np.ndarray, bool, np.ndarray, float]:
     """What the compiled kernels run on: the two tables, weighted (True), the monomial
     coefficients of ``R(u) + y_0`` and the slope of the straight-line extension.
 
     Parameters
     ----------
-    params : GPreisachParams
-        The model's parameters.
+    %(params)s
 
     Returns
     -------
@@ -343,27 +332,12 @@ simulate, simulate_reference, invert = family_runs(
                   "<= 0): no inverse exists.")
 
 
+@fill_doc
 def invert_step(structure: GPreisachStructure, params: GPreisachParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of :func:`invert` from the staircase ``x``: ``(u_hat, x_next)``.
 
-    Parameters
-    ----------
-    structure : GPreisachStructure
-        The model's structure.
-    params : GPreisachParams
-        Its parameters.
-    x : numpy.ndarray, shape (k,)
-        Staircase before the sample.
-    y : float
-        Output to reach at this sample.
-
-    Returns
-    -------
-    u : float
-        Input that gives `y` from the present state.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(invert_step)s
     """
     u_hat, x_next = invert(structure, params, np.array([float(y)]), x0=x)
     return float(u_hat[0]), x_next

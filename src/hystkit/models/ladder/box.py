@@ -6,7 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._docs import docfiller
 from . import model as ladder
+
+fill_doc = docfiller()
 
 __all__ = ["BAND", "LOG_G_MIN", "W_BOUND", "random_params"]
 
@@ -16,6 +19,7 @@ LOG_G_MIN = np.log(1e-3)
 W_BOUND = 100.0  # as the mPL's |w| <= 100 (sec. 5.3.3)
 
 
+@fill_doc
 def random_params(structure: ladder.LadderStructure,
                   rng: np.random.Generator) -> ladder.LadderParams:
     """Parameters drawn from the fit's bounds (the family's documented domain): bands ``E_k``
@@ -26,8 +30,7 @@ def random_params(structure: ladder.LadderStructure,
     ----------
     structure : ladder.LadderStructure
         The model's structure.
-    rng : numpy.random.Generator
-        Source of the draws.
+    %(rng)s
 
     Returns
     -------

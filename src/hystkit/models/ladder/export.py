@@ -7,14 +7,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import numpy as np
-
 from .._protocol import Translation
-
-
-def extra(comp) -> dict:
-    """``W_SUM``: ``sum(w)``, the divisor of the inverse's rest input ``(y + V_b) / sum(w)``."""
-    return {"W_SUM": float(np.sum(comp.params.w))}
+from .._translation import c_linear_readout, linear_readout_rest, m_linear_readout
 
 
 def c_model(plan, lit: Callable[[float], str]) -> str:
@@ -22,16 +16,7 @@ def c_model(plan, lit: Callable[[float], str]) -> str:
     w_sum = plan.extra["W_SUM"]
     rest = ("value" if not plan.inverse else
             f"(value + BODY[1]) / {lit(w_sum)}" if w_sum != 0 else "R(0.0)")
-    if plan.inverse:  # solve_input: (y + V_b - sum w_k U_k) / w_0
-        head = """    real acc = u + BODY[1];
-    for (k = 0; k < N_CELLS; k++) acc -= BODY[IW + 1 + k] * x[k];
-    drive = acc / BODY[IW];
-    out = drive;"""
-    else:  # output: w_0 e + sum w_k U_k - V_b
-        head = """    real acc = BODY[IW] * u - BODY[1];
-    for (k = 0; k < N_CELLS; k++) acc += BODY[IW + 1 + k] * x[k];
-    drive = u;
-    out = acc;"""
+    head = c_linear_readout(plan.inverse) + f"\n    out = {'drive' if plan.inverse else 'acc'};"
     return f"""#define N_CELLS {n}
 #define IW (3 + 2 * N_CELLS)
 
@@ -73,20 +58,6 @@ def m_model(plan, lit: Callable[[float], str]) -> str:
     w_sum = plan.extra["W_SUM"]
     rest = ("value" if not plan.inverse else
             f"(value + B(2)) / {lit(w_sum)}" if w_sum != 0 else "0.0")
-    if plan.inverse:
-        head = """acc = u + B(2);
-for k = 1:n
-    acc = acc - B(iw + k) * x(k);
-end
-drive = acc / B(iw);
-out = drive;"""
-    else:
-        head = """acc = B(iw) * u - B(2);
-for k = 1:n
-    acc = acc + B(iw + k) * x(k);
-end
-drive = u;
-out = acc;"""
     return f"""function x = model_rest(B, value)
 x = ({rest}) * ones(round(B(1)), 1);
 end
@@ -94,7 +65,7 @@ end
 function [out, x] = model_step(B, x, u)
 n = round(B(1));
 iw = 4 + 2 * n;
-{head}
+{m_linear_readout(plan.inverse)}
 i_in = dead_zone(B, drive - x(1), 1, n);
 for k = 1:n
     i_out = 0.0;
@@ -124,4 +95,4 @@ TRANSLATION = Translation(
     c_model=c_model,
     m_model=m_model,
     m_functions=("dead_zone",),
-    extra=extra)
+    extra=linear_readout_rest)

@@ -23,6 +23,7 @@ from ...identification import (
     fit_multistart,
     robust_linear_fit,
 )
+from .._docs import docfiller
 from . import model as ladder
 from .box import (
     BAND,
@@ -30,6 +31,8 @@ from .box import (
     W_BOUND,
     random_params,
 )
+
+fill_doc = docfiller()
 
 __all__ = ["default_starts", "fit_ladder", "random_params"]
 
@@ -84,6 +87,7 @@ def default_starts(structure: ladder.LadderStructure) -> list[np.ndarray]:
     return starts
 
 
+@fill_doc
 def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, *,
                starts: list[np.ndarray] | None = None, max_nfev: int = 100,
                screen_nfev: int = 10, n_polish: int = 2,
@@ -102,10 +106,7 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
     starts : list of arrays, optional
         Resistor parameters ``[E_1, log G_1, .., E_N, log G_N]``; default
         :func:`default_starts` (9 starts).
-    max_nfev, screen_nfev, n_polish : int
-        Passed to ``fit_multistart``.
-    accept, accept_reason
-        Candidates with ``accept(params)`` false are skipped.
+    %(multistart)s
     solver : {"trf", "tr", "lm"}
         See :func:`~hystkit.identification.fit_multistart`. scipy's trf stays the default here:
         "tr" reaches the same SSE (to 1e-15 on the virtual sensor), but the inverse 1-cell
@@ -120,8 +121,7 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
 
     Returns
     -------
-    FitResult
-        The best start's fit.
+    %(best_start)s
 
     Raises
     ------

@@ -36,6 +36,7 @@ import numpy as np
 
 from ...errors import FitDivergedError
 from .._cells import CellStructure
+from .._docs import docfiller
 from .._protocol import Record
 from .._run import Runs, family_runs
 from .._validation import (
@@ -45,6 +46,8 @@ from .._validation import (
     freeze_arrays,
 )
 from . import kernels
+
+fill_doc = docfiller("LadderStructure", "LadderParams", state="x_capacitors")
 
 __all__ = [
     "MAX_CELLS",
@@ -192,15 +195,13 @@ def conductance_limit(structure: LadderStructure) -> float:
     return structure.slope_cap / (2.0 * structure.dt)
 
 
+@fill_doc
 def effective_conductance(structure: LadderStructure, params: LadderParams) -> np.ndarray:
     """``G_k`` limited to :func:`conductance_limit`, what the Euler step uses.
 
     Parameters
     ----------
-    structure : LadderStructure
-        The model's structure.
-    params : LadderParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
@@ -210,27 +211,13 @@ def effective_conductance(structure: LadderStructure, params: LadderParams) -> n
     return np.minimum(params.conductance, conductance_limit(structure))
 
 
+@fill_doc
 def step(structure: LadderStructure, params: LadderParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """Output from the present capacitor voltages, then one Euler step with source ``u``.
+    """Output from the present capacitor voltages, then one Euler step with the source voltage
+    ``u``.
 
-    Parameters
-    ----------
-    structure : LadderStructure
-        The model's structure.
-    params : LadderParams
-        Its parameters.
-    x : numpy.ndarray, shape (N,)
-        Capacitor voltages before the sample.
-    u : float
-        Source voltage of the sample.
-
-    Returns
-    -------
-    y : float
-        Output from the present state.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(step)s
     """
     x = np.asarray(x, dtype=float)
     y = params.w[0] * u + params.w[1:] @ x - params.v_b
@@ -240,28 +227,13 @@ def step(structure: LadderStructure, params: LadderParams, x: np.ndarray,
     return float(y), x + structure.dt * (i - np.append(i[1:], 0.0))
 
 
+@fill_doc
 def invert_step(structure: LadderStructure, params: LadderParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of :func:`invert`: ``e = (y + V_b - sum_k w_k U_k) / w_0`` from the present
     voltages, then the Euler step with ``e``.
 
-    Parameters
-    ----------
-    structure : LadderStructure
-        The model's structure.
-    params : LadderParams
-        Its parameters.
-    x : numpy.ndarray, shape (N,)
-        Capacitor voltages before the sample.
-    y : float
-        Output to reach at this sample.
-
-    Returns
-    -------
-    u : float
-        Input that gives `y` from the present state.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(invert_step)s
     """
     x = np.asarray(x, dtype=float)
     e = (y + params.v_b - params.w[1:] @ x) / params.w[0]
@@ -273,27 +245,14 @@ def _rest_input(params: LadderParams, y: float) -> float:
     return (y + params.v_b) / w_sum if w_sum != 0 else 0.0
 
 
+@fill_doc
 def rest_state(structure: LadderStructure, params: LadderParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """Every capacitor at the source voltage ``value``, no current (``inverse``: at the source
     ``(value + V_b) / sum(w)`` that gives the output ``value``): the start of ``simulate`` /
     ``invert`` with ``x0=None``.
 
-    Parameters
-    ----------
-    structure : LadderStructure
-        The model's structure.
-    params : LadderParams
-        Its parameters.
-    value : float
-        Constant input (with `inverse`: output) the model rests at.
-    inverse : bool, default False
-        Rest state of the inverse: `value` is an output.
-
-    Returns
-    -------
-    numpy.ndarray
-        The state at rest.
+    %(rest_state)s
     """
     return np.full(params.n_cells, _rest_input(params, value) if inverse else float(value))
 
@@ -304,6 +263,7 @@ def _check(structure: LadderStructure, params: LadderParams, inverse: bool) -> N
         raise FitDivergedError("the ladder model has w_0 = 0, so it has no inverse")
 
 
+@fill_doc
 def states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
            x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Capacitor voltages seen by each sample's output, shape (n, N), and the final state.
@@ -312,21 +272,15 @@ def states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
 
     Parameters
     ----------
-    structure : LadderStructure
-        The model's structure.
-    params : LadderParams
-        Its parameters.
-    u : numpy.ndarray, shape (n,)
-        Source voltage sampled every ``structure.dt``.
-    x0 : numpy.ndarray, float or None, optional
-        Initial capacitor voltages, as for :func:`simulate`.
+    %(structure)s
+    %(u_source)s
+    %(x0_capacitors)s
 
     Returns
     -------
     states : numpy.ndarray, shape (n, N)
         Capacitor voltages each sample's output is computed from.
-    x_end : numpy.ndarray, shape (N,)
-        Capacitor voltages after the last sample.
+    %(x_end_capacitors)s
     """
     _check(structure, params, False)
     u = check_signal(u, "u")

@@ -10,12 +10,8 @@ from collections.abc import Callable
 import numpy as np
 
 from .._protocol import Translation
+from .._translation import c_linear_readout, linear_readout_rest, m_linear_readout
 from .cell_kernels import constants
-
-
-def extra(comp) -> dict:
-    """``W_SUM``: ``sum(w)``, the divisor of the inverse's rest input ``(y + V_b) / sum(w)``."""
-    return {"W_SUM": float(np.sum(comp.params.w))}
 
 
 def _cell_constants_c(plan, lit: Callable[[float], str], i_s_at: int) -> str:
@@ -81,14 +77,6 @@ def c_model(plan, lit: Callable[[float], str]) -> str:
     w_sum = plan.extra["W_SUM"]
     rest = ("x[k] = value;" if not plan.inverse else  # mpl.invert's start
             f"x[k] = (value + BODY[1]) / {lit(w_sum)};" if w_sum != 0 else "x[k] = R(0.0);")
-    if plan.inverse:
-        head = """    real acc = u + BODY[1];
-    for (k = 0; k < N_CELLS; k++) acc -= BODY[IW + 1 + k] * x[k];
-    drive = acc / BODY[IW];"""
-    else:
-        head = """    real acc = BODY[IW] * u - BODY[1];
-    for (k = 0; k < N_CELLS; k++) acc += BODY[IW + 1 + k] * x[k];
-    drive = u;"""
     out = "drive" if plan.inverse else "acc"
     return f"""#define N_CELLS {n}
 #define IW (4 + 3 * N_CELLS)
@@ -106,7 +94,7 @@ static real model_step(real *x, real u)
 {{
     int k;
     real drive;
-{head}
+{c_linear_readout(plan.inverse)}
     for (k = 0; k < N_CELLS; k++) x[k] = x[k] + cell_increment(drive - x[k], k);
     return {out};
 }}
@@ -117,20 +105,6 @@ def m_model(plan, lit: Callable[[float], str]) -> str:
     w_sum = plan.extra["W_SUM"]
     rest = ("v = value;" if not plan.inverse else
             f"v = (value + B(2)) / {lit(w_sum)};" if w_sum != 0 else "v = 0.0;")
-    if plan.inverse:
-        head = """acc = u + B(2);
-for k = 1:n
-    acc = acc - B(iw + k) * x(k);
-end
-drive = acc / B(iw);
-out = drive;"""
-    else:
-        head = """acc = B(iw) * u - B(2);
-for k = 1:n
-    acc = acc + B(iw + k) * x(k);
-end
-drive = u;
-out = acc;"""
     return f"""function x = model_rest(B, value)
 {rest}
 x = v * ones(round(B(1)), 1);
@@ -139,7 +113,7 @@ end
 function [out, x] = model_step(B, x, u)
 n = round(B(1));
 iw = 5 + 3 * n;
-{head}
+{m_linear_readout(plan.inverse)}
 for k = 1:n
     x(k) = x(k) + mpl_current(B, drive - x(k), k, n) * B(4);
 end
@@ -162,4 +136,4 @@ TRANSLATION = Translation(
     c_model=c_model,
     m_model=m_model,
     m_functions=("mpl_current",),
-    extra=extra)
+    extra=linear_readout_rest)

@@ -24,10 +24,31 @@ from .cell_kernels import (
     straight_offset,
 )
 
+
+@njit(cache=True, inline="always")
+def readout(w, v_b, x, u):
+    """``w_0 u + sum w_k x_k - V_b`` (eq. 5.2; with mpl-poly's and mpl-g's ``g`` outside, eq.
+    5.17), summed in this order by every run and block of the three families."""
+    acc = w[0] * u - v_b
+    for k in range(x.size):
+        acc += w[k + 1] * x[k]
+    return acc
+
+
+@njit(cache=True, inline="always")
+def input_for(w, v_b, x, z):
+    """``(z + V_b - sum w_k x_k) / w_0``: the input whose :func:`readout` is ``z`` (eq. 5.13)."""
+    acc = z + v_b
+    for k in range(x.size):
+        acc -= w[k + 1] * x[k]
+    return acc / w[0]
+
+
 # the cell's arithmetic lives in cell_kernels.py; its names stay importable from here
 __all__ = ["NORMAL_BLOCK", "block_forward", "block_inverse", "cell_constants",
            "cell_increment", "cell_sensitivity_step", "constants", "current", "fold_block",
-           "invert", "knee_constants", "mirror_upper", "normal_equations", "simulate",
+           "input_for", "invert", "knee_constants", "mirror_upper", "normal_equations", "readout",
+           "simulate",
            "simulate_with_jacobian", "sinh_cosh", "sinh_series", "straight_offset",
            "theta_cells", "theta_normal_equations"]
 
@@ -41,10 +62,7 @@ def simulate(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
     cap_dt = cap * dt
     for n in range(u.size):
         u_n = u[n]
-        acc = w[0] * u_n - v_b
-        for k in range(n_cells):
-            acc += w[k + 1] * x[k]
-        y[n] = acc
+        y[n] = readout(w, v_b, x, u_n)
         for k in range(n_cells):
             x[k] += cell_increment(u_n - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
     return y, x
@@ -63,10 +81,7 @@ def invert(y, x0, i_s, v_t, w, v_b, knee, cap, dt):
     inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
     cap_dt = cap * dt
     for n in range(y.size):
-        acc = y[n] + v_b
-        for k in range(n_cells):
-            acc -= w[k + 1] * x[k]
-        e = acc / w[0]
+        e = input_for(w, v_b, x, y[n])
         if not abs(e) < bound:
             return u_hat, x, n
         u_hat[n] = e
@@ -302,16 +317,17 @@ def theta_normal_equations(u, y_target, x0, theta, slope_cap, dt):
 # i_s (n), v_t (n), knee (n), w (n + 1)].
 
 @njit(cache=True, inline="always")
-def _block_cells(body, x, xn, off, drive):
+def block_cells(body, x, xn, off, drive, ic):
     """The cells driven by ``drive`` (eq. 5.6), in :func:`simulate`'s arithmetic: the per-cell
     constants are recomputed per call in the same arithmetic (:func:`cell_constants`; the
     straight branch's offset only where it is taken), so a stream or a loop advances the state
-    bit for bit as the offline run does."""
+    bit for bit as the offline run does. ``i_s``, ``v_t`` and ``knee`` follow each other from
+    ``body[ic]`` (4 here, 13 in mpl-g's body)."""
     n = int(body[0])
     cap, dt = body[2], body[3]
     cap_dt = cap * dt
     for k in range(n):
-        i_s, v_t, knee = body[4 + k], body[4 + n + k], body[4 + 2 * n + k]
+        i_s, v_t, knee = body[ic + k], body[ic + n + k], body[ic + 2 * n + k]
         v = drive - x[off + k]
         c0 = 0.0 if abs(v) <= knee else straight_offset(i_s, v_t, knee, cap, dt)
         xn[off + k] = x[off + k] + cell_increment(v, 1.0 / v_t, 2.0 * i_s * dt, knee, c0, cap_dt)
@@ -322,11 +338,9 @@ def block_forward(body, x, xn, off, u):
     """``y = w_0 u + sum w_k x_k - V_b`` (eq. 5.2), then the cells driven by ``u`` (eq. 5.6)."""
     n = int(body[0])
     iw = 4 + 3 * n
-    acc = body[iw] * u - body[1]
-    for k in range(n):
-        acc += body[iw + 1 + k] * x[off + k]
-    _block_cells(body, x, xn, off, u)
-    return acc
+    y = readout(body[iw:iw + n + 1], body[1], x[off:off + n], u)
+    block_cells(body, x, xn, off, u, 4)
+    return y
 
 
 @njit(cache=True)
@@ -334,9 +348,6 @@ def block_inverse(body, x, xn, off, y):
     """``u_hat = (y + V_b - sum w_k x_k) / w_0`` (eq. 5.13), cells driven by ``u_hat``."""
     n = int(body[0])
     iw = 4 + 3 * n
-    acc = y + body[1]
-    for k in range(n):
-        acc -= body[iw + 1 + k] * x[off + k]
-    u_hat = acc / body[iw]
-    _block_cells(body, x, xn, off, u_hat)
+    u_hat = input_for(body[iw:iw + n + 1], body[1], x[off:off + n], y)
+    block_cells(body, x, xn, off, u_hat, 4)
     return u_hat

@@ -25,11 +25,13 @@ Everything here is pure: memory is the explicit state ``x`` passed in and return
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from ...errors import FitDivergedError
 from .._cells import MAX_CELLS, CellStructure, state_bound
+from .._docs import docfiller
 from .._protocol import Record
 from .._run import Runs, family_runs
 from .._validation import (
@@ -41,6 +43,8 @@ from .._validation import (
     freeze_arrays,
 )
 from . import kernels
+
+fill_doc = docfiller("MplStructure", "MplParams", state="x_cells")
 
 __all__ = [
     "I_S_RANGE",
@@ -101,6 +105,28 @@ class MplStructure(CellStructure):
         return 3 * self.n_cells + 2
 
 
+# The sinh cells' parameters, shared with the ch. 7 compensator (mpl_g.MplGParams).
+
+def freeze_sinh_cells(params: Any) -> None:
+    """Set ``n_cells`` and freeze ``i_s``, ``v_t`` (N each) and ``w`` (N + 1) of a record."""
+    n = np.size(params.i_s)
+    check_structure_size(n, "the number of cells (size of i_s)", MAX_CELLS)  # before copying
+    object.__setattr__(params, "n_cells", int(n))
+    freeze_arrays(params, i_s=n, v_t=n, w=n + 1)
+
+
+def sinh_coordinates(params: Any) -> np.ndarray:
+    """The optimiser's cell coordinates ``[log G_1, log V_T1, ..., log G_N, log V_TN]``."""
+    return np.column_stack([np.log(2 * params.i_s / params.v_t), np.log(params.v_t)]).reshape(-1)
+
+
+def sinh_from_coordinates(theta: np.ndarray, n_cells: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(i_s, v_t)`` from the first ``2 N`` coordinates of :func:`sinh_coordinates`."""
+    cells = theta[: 2 * n_cells].reshape(n_cells, 2)
+    v_t = np.exp(cells[:, 1])
+    return 0.5 * np.exp(cells[:, 0]) * v_t, v_t
+
+
 @dataclass(frozen=True, eq=False)
 class MplParams(Record):
     """Fitted quantities of an mPL model.
@@ -138,10 +164,7 @@ class MplParams(Record):
     n_cells: int = field(init=False)
 
     def __post_init__(self) -> None:
-        n = np.size(self.i_s)
-        check_structure_size(n, "the number of cells (size of i_s)", MAX_CELLS)  # before copying
-        object.__setattr__(self, "n_cells", int(n))
-        freeze_arrays(self, i_s=n, v_t=n, w=n + 1)
+        freeze_sinh_cells(self)
         finite_floats(self, "v_b")
         check_range(self.i_s, "i_s", *I_S_RANGE, " (eq. 5.1)")
         check_range(self.v_t, "v_t", *V_T_RANGE, " (eq. 5.1)")
@@ -150,20 +173,18 @@ class MplParams(Record):
 
     def to_vector(self) -> np.ndarray:
         """Optimiser coordinates (see Notes of the class)."""
-        cells = np.column_stack([np.log(2 * self.i_s / self.v_t), np.log(self.v_t)]).reshape(-1)
-        return np.concatenate([cells, self.w, [self.v_b]])
+        return np.concatenate([sinh_coordinates(self), self.w, [self.v_b]])
 
     @classmethod
     def from_vector(cls, theta: np.ndarray, n_cells: int) -> MplParams:
         """Inverse of :meth:`to_vector`."""
         theta = np.asarray(theta, dtype=float)
-        cells = theta[: 2 * n_cells].reshape(n_cells, 2)
-        v_t = np.exp(cells[:, 1])
-        i_s = 0.5 * np.exp(cells[:, 0]) * v_t
+        i_s, v_t = sinh_from_coordinates(theta, n_cells)
         return cls(i_s=i_s, v_t=v_t, w=theta[2 * n_cells: 3 * n_cells + 1],
                    v_b=theta[3 * n_cells + 1])
 
 
+@fill_doc
 def output_bound(structure: MplStructure, params: MplParams, u_max: float,
                  x0_max: float | None = None) -> float:
     """Largest ``|y|`` of a forward run with ``|u| <= u_max`` from ``|x0| <= x0_max``
@@ -171,10 +192,7 @@ def output_bound(structure: MplStructure, params: MplParams, u_max: float,
 
     Parameters
     ----------
-    structure : MplStructure
-        The model's structure.
-    params : MplParams
-        Its parameters.
+    %(structure)s
     u_max : float
         Bound on ``|u|`` over the run.
     x0_max : float or None, optional
@@ -189,6 +207,7 @@ def output_bound(structure: MplStructure, params: MplParams, u_max: float,
     return float(abs(params.w[0]) * u_max + np.abs(params.w[1:]).sum() * b + abs(params.v_b))
 
 
+@fill_doc
 def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:
     """Voltage ``x+`` (= ``-x-``) beyond which each cell's resistor is a straight line.
 
@@ -199,10 +218,7 @@ def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:
 
     Parameters
     ----------
-    structure : MplStructure
-        The model's structure.
-    params : MplParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
@@ -216,17 +232,14 @@ def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:
     return np.where(ratio > 1, params.v_t * np.arccosh(np.maximum(ratio, 1.0)), 0.0)
 
 
+@fill_doc
 def resistor_current(structure: MplStructure, params: MplParams, v: np.ndarray) -> np.ndarray:
     """Limited cell-resistor currents ``f_k,lim(v)`` (eq. 5.1 with eq. 5.29, corrected).
 
     Parameters
     ----------
-    structure : MplStructure
-        The model's structure.
-    params : MplParams
-        Its parameters.
-    v : array, shape (..., N)
-        Voltage across each cell's resistor.
+    %(structure)s
+    %(v_cells)s
 
     Returns
     -------
@@ -243,27 +256,14 @@ def resistor_current(structure: MplStructure, params: MplParams, v: np.ndarray) 
     return np.where(inside, f_in, f_in + cap * (v - v_in))
 
 
+@fill_doc
 def step(structure: MplStructure, params: MplParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """One sample of the forward model: output from the present state, then the Euler update.
+    """One sample of the forward model: output ``y = w_0 u + sum w_k x_k - V_b`` (eq. 5.2) from
+    the present state and the model input ``u = e``, then the Euler update of the cell voltages
+    over ``dt`` (eq. 5.6).
 
-    Parameters
-    ----------
-    structure : MplStructure
-        The model's structure.
-    params : MplParams
-        Its parameters.
-    x : array, shape (N,)
-        Cell voltages before the sample.
-    u : float
-        Model input ``e`` of the sample.
-
-    Returns
-    -------
-    y : float
-        Model output ``w_0 u + sum w_k x_k - V_b`` (eq. 5.2).
-    x_next : array, shape (N,)
-        Cell voltages after ``dt`` (eq. 5.6).
+    %(step)s
     """
     x = np.asarray(x, dtype=float)
     y = params.w[0] * u + params.w[1:] @ x - params.v_b
@@ -271,6 +271,7 @@ def step(structure: MplStructure, params: MplParams, x: np.ndarray,
     return float(y), x_next
 
 
+@fill_doc
 def invert_step(structure: MplStructure, params: MplParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of the analytical inverse (eq. 5.13-5.14, order of fig. 5.12).
@@ -280,14 +281,9 @@ def invert_step(structure: MplStructure, params: MplParams, x: np.ndarray,
 
     Parameters
     ----------
-    structure : MplStructure
-        The model's structure.
-    params : MplParams
-        Its parameters.
-    x : array, shape (N,)
-        Cell voltages before the sample.
-    y : float
-        Output to reach at this sample.
+    %(structure)s
+    %(state)s
+    %(y_step)s
 
     Returns
     -------
@@ -302,6 +298,7 @@ def invert_step(structure: MplStructure, params: MplParams, x: np.ndarray,
     return float(u_hat), x_next
 
 
+@fill_doc
 def rest_state(structure: MplStructure, params: MplParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """Cell voltages at rest under a constant input ``value``: each cell equals its drive.
@@ -310,10 +307,7 @@ def rest_state(structure: MplStructure, params: MplParams, value: float,
 
     Parameters
     ----------
-    structure : MplStructure
-        The model's structure.
-    params : MplParams
-        Its parameters.
+    %(structure)s
     value : float
         Constant input (with `inverse`: output).
     inverse : bool, default False

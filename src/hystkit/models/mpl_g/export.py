@@ -12,18 +12,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import numpy as np
-
-from .._cubic_output_code import C_SOLVE, M_CUBIC, M_SOLVE
+from .._cubic_output_code import C_FORWARD, C_INVERSE, C_SOLVE, M_CUBIC, M_SOLVE, m_step
 from .._protocol import Translation
+from .._translation import linear_readout_rest
 from ..mpl.export import c_cells
 
 _IC = 13  # body index of i_s (the C's IC, the MATLAB's ic)
-
-
-def extra(comp) -> dict:
-    """``W_SUM``: ``sum(w)``, the divisor of the inverse's rest input ``(z_0 + V_b) / sum(w)``."""
-    return {"W_SUM": float(np.sum(comp.params.w))}
 
 
 def c_model(plan, lit: Callable[[float], str]) -> str:
@@ -61,36 +55,8 @@ static void model_rest(real *x, real value)
     int k;
 {rest}    for (k = 0; k < N_CELLS; k++) x[k] = e0;
 }}
-{_C_INVERSE if plan.inverse else _C_FORWARD}"""
+{C_INVERSE if plan.inverse else C_FORWARD}"""
 
-
-_C_FORWARD = """
-/* block_forward: y = g(w_0 u + sum w_k x_k - V_b) (eq. 5.17), then the cells driven by u */
-static real model_step(real *x, real u)
-{
-    int k;
-    real z = BODY[IW] * u - BODY[1], y;
-    for (k = 0; k < N_CELLS; k++) z += BODY[IW + 1 + k] * x[k];
-    y = cubic(BODY + IG, z, 0);
-    cells(x, u);
-    return y;
-}
-"""
-
-_C_INVERSE = """
-/* block_inverse: z = g^-1(y) on the rest branch, u_hat = (z - sum w_k x_k + V_b) / w_0, the
-   cells driven by u_hat; NaN when y is outside the branch's range (no input gives it) */
-static real model_step(real *x, real y)
-{
-    int k, ok;
-    const real z = solve_output(y, &ok);
-    real acc = z + BODY[1], u_hat;
-    for (k = 0; k < N_CELLS; k++) acc -= BODY[IW + 1 + k] * x[k];
-    u_hat = ok ? acc / BODY[IW] : (real)NAN;
-    cells(x, u_hat);
-    return u_hat;
-}
-"""
 
 
 def m_model(plan, lit: Callable[[float], str]) -> str:
@@ -122,33 +88,7 @@ for k = 1:n
 end
 end
 
-{M_SOLVE if plan.inverse else ""}{_M_INVERSE if plan.inverse else _M_FORWARD}"""
-
-
-_M_FORWARD = """
-function [y, x] = model_step(B, x, u)
-n = round(B(1)); iw = 14 + 3 * n;
-z = B(iw) * u - B(2);
-for k = 1:n
-    z = z + B(iw + k) * x(k);
-end
-y = cubic(B(10:13), z);
-x = cells(B, x, u);
-end
-"""
-
-_M_INVERSE = """
-function [u_hat, x] = model_step(B, x, y)
-n = round(B(1)); iw = 14 + 3 * n;
-[z, ok] = solve_output(B, y);
-acc = z + B(2);
-for k = 1:n
-    acc = acc - B(iw + k) * x(k);
-end
-if ok, u_hat = acc / B(iw); else, u_hat = NaN; end
-x = cells(B, x, u_hat);
-end
-"""
+{M_SOLVE if plan.inverse else ""}{m_step(plan.inverse, 3)}"""
 
 
 # The family's block in C and MATLAB: FAMILY.export (family.py).
@@ -156,4 +96,4 @@ TRANSLATION = Translation(
     c_model=c_model,
     m_model=m_model,
     m_functions=("cells", "cubic", "solve_output"),
-    extra=extra)
+    extra=linear_readout_rest)

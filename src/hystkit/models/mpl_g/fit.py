@@ -34,6 +34,7 @@ from ...errors import FitDivergedError
 from ...identification import FitResult, check_fit_data, fit_multistart
 from ...identification._constrained import constrain_fit
 from ...identification._normal_equations import dense_normal_equations
+from .._docs import docfiller
 from ..mpl import model as mpl
 from ..mpl.fit import fit_mpl, theta_limits
 from . import model as mpl_g
@@ -44,6 +45,8 @@ from .slopes import (
     output_from_slopes,
     slope_matrix,
 )
+
+fill_doc = docfiller()
 
 __all__ = ["MONOTONE_RANGE", "WEIGHT_SUM_FLOOR", "bernstein_slopes", "canonical", "fit_box",
            "fit_mpl_g", "output_from_slopes", "random_params", "start_theta", "theta_names"]
@@ -197,6 +200,7 @@ class _Coordinates:
         return np.column_stack([jac[:, :2 * n + 1], slopes, jac[:, 2 * n + 5:3 * n + 5]])
 
 
+@fill_doc
 def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
               max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
               accept: Callable[[mpl_g.MplGParams], bool] | None = None,
@@ -213,12 +217,7 @@ def fit_mpl_g(u: np.ndarray, y: np.ndarray, structure: mpl_g.MplGStructure, *,
         Model input and target, sampled every ``structure.dt``, centred and normalised
         (eq. 5.10) by the caller.
     structure : MplGStructure
-    max_nfev, screen_nfev, n_polish : int
-        As :func:`hystkit.identification.fit_multistart`.
-    accept : callable, optional
-        A candidate counts only if ``accept(params)``; ``accept_reason`` says why others failed.
-    accept_reason : str, optional
-        Why candidates were rejected, for the message.
+    %(multistart)s
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart`.
     loss, f_scale, weights
@@ -336,6 +335,7 @@ _RANDOM_CELL_SHARE = 0.9
 _RANDOM_VB = 1.0
 
 
+@fill_doc
 def random_params(structure: mpl_g.MplGStructure, rng: np.random.Generator) -> mpl_g.MplGParams:
     """Parameters from the family's documented domain for normalised data: ``log G_k`` and
     ``log V_T,k`` uniform between the fit's bounds (``G`` in ``[1e-4, slope_cap / dt]``,
@@ -352,8 +352,7 @@ def random_params(structure: mpl_g.MplGStructure, rng: np.random.Generator) -> m
     ----------
     structure : MplGStructure
         The model's structure (its ``N``, ``dt`` and ``slope_cap`` set the cells' range).
-    rng : numpy.random.Generator
-        Source of the draws.
+    %(rng)s
 
     Returns
     -------

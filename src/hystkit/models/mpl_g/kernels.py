@@ -12,13 +12,15 @@ import numpy as np
 from numba import njit
 
 from ..mpl.kernels import (
+    block_cells,
     cell_increment,
     cell_sensitivity_step,
     constants,
+    input_for,
     knee_constants,
-    straight_offset,
+    readout,
 )
-from ..mpl_poly.kernels import solve_output
+from ..mpl_poly.kernels import branch_input, solve_output
 
 
 @njit(cache=True, inline="always")
@@ -37,10 +39,7 @@ def simulate(u, x0, gc, w, v_b, i_s, v_t, knee, cap, dt):
     inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
     cap_dt = cap * dt
     for n in range(u.size):
-        z = w[0] * u[n] - v_b
-        for k in range(n_cells):
-            z += w[k + 1] * x[k]
-        y[n], _ = _output(gc, z)
+        y[n], _ = _output(gc, readout(w, v_b, x, u[n]))
         for k in range(n_cells):
             x[k] += cell_increment(u[n] - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
     return y, x
@@ -64,9 +63,7 @@ def simulate_with_jacobian(u, x0, gc, w, v_b, i_s, v_t, knee, cap, dt):
     two_i_s, g, f_knee, dvt_knee = knee_constants(i_s, v_t, knee, cap)
     cap_dt = cap * dt
     for n in range(u.size):
-        z = w[0] * u[n] - v_b
-        for k in range(n_cells):
-            z += w[k + 1] * x[k]
+        z = readout(w, v_b, x, u[n])
         y[n], dg = _output(gc, z)
         zj = 1.0
         for j in range(4):
@@ -100,15 +97,9 @@ def invert(y, x0, gc, lo, hi, sign, centre, w, v_b, i_s, v_t, knee, cap, dt, bou
     inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
     cap_dt = cap * dt
     for n in range(y.size):
-        z, ok = solve_output(y[n], gc, lo, hi, sign, centre)
-        if not ok:
-            return e_hat, x, n, 1
-        acc = z + v_b
-        for k in range(n_cells):
-            acc -= w[k + 1] * x[k]
-        e = acc / w[0]
-        if not abs(e) < bound:
-            return e_hat, x, n, 2
+        e, why = branch_input(y[n], gc, lo, hi, sign, centre, w, v_b, x, bound)
+        if why:
+            return e_hat, x, n, why
         e_hat[n] = e
         for k in range(n_cells):
             x[k] += cell_increment(e - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
@@ -123,31 +114,14 @@ _IG = 9  # first output-resistor coefficient
 _IC = 13  # first cell parameter
 
 
-@njit(cache=True, inline="always")
-def _block_cells(body, x, xn, off, drive):
-    """The cells' Euler update (eq. 5.6, sinh resistors limited by eq. 5.29) driven by
-    ``drive``, in :func:`simulate`'s arithmetic: the constants per call as ``mpl.kernels``'
-    blocks compute them (the straight branch's offset only where it is taken)."""
-    n = int(body[0])
-    cap, dt = body[2], body[3]
-    cap_dt = cap * dt
-    for k in range(n):
-        i_s, v_t, knee = body[_IC + k], body[_IC + n + k], body[_IC + 2 * n + k]
-        v = drive - x[off + k]
-        c0 = 0.0 if abs(v) <= knee else straight_offset(i_s, v_t, knee, cap, dt)
-        xn[off + k] = x[off + k] + cell_increment(v, 1.0 / v_t, 2.0 * i_s * dt, knee, c0, cap_dt)
-
-
 @njit(cache=True)
 def block_forward(body, x, xn, off, u):
-    """``y = g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17), then the cells driven by ``u``."""
+    """``y = g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17), then the cells driven by ``u`` (eq. 5.6,
+    sinh resistors limited by eq. 5.29, as ``mpl.kernels``' blocks advance them)."""
     n = int(body[0])
     iw = _IC + 3 * n
-    z = body[iw] * u - body[1]
-    for k in range(n):
-        z += body[iw + 1 + k] * x[off + k]
-    y, _ = _output(body[_IG:_IG + 4], z)
-    _block_cells(body, x, xn, off, u)
+    y, _ = _output(body[_IG:_IG + 4], readout(body[iw:iw + n + 1], body[1], x[off:off + n], u))
+    block_cells(body, x, xn, off, u, _IC)
     return y
 
 
@@ -159,9 +133,6 @@ def block_inverse(body, x, xn, off, y):
     n = int(body[0])
     iw = _IC + 3 * n
     z, ok = solve_output(y, body[_IG:_IG + 4], body[5], body[6], body[7], body[8])
-    acc = z + body[1]
-    for k in range(n):
-        acc -= body[iw + 1 + k] * x[off + k]
-    u_hat = acc / body[iw] if ok else np.nan
-    _block_cells(body, x, xn, off, u_hat)
+    u_hat = input_for(body[iw:iw + n + 1], body[1], x[off:off + n], z) if ok else np.nan
+    block_cells(body, x, xn, off, u_hat, _IC)
     return u_hat

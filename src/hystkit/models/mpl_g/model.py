@@ -29,10 +29,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ...errors import FitDivergedError
-from .._cells import MAX_CELLS, CellStructure
+from .._cells import CellStructure
+from .._docs import docfiller
 from .._protocol import Record
 from .._run import Runs, family_runs
 from .._validation import (
@@ -40,17 +40,25 @@ from .._validation import (
     check_range,
     check_signal,
     check_size,
-    check_structure_size,
     finite_floats,
-    freeze_arrays,
     frozen_shaped,
 )
-from ..mpl.model import I_S_RANGE, V_T_RANGE, knee_voltage, resistor_current
+from ..mpl.model import (
+    I_S_RANGE,
+    V_T_RANGE,
+    freeze_sinh_cells,
+    knee_voltage,
+    resistor_current,
+    sinh_coordinates,
+    sinh_from_coordinates,
+)
 from ..mpl_poly.kernels import solve_output
 from ..mpl_poly.records import G_MIN, POLY_MAX
-from ..mpl_poly.resistors import output_current, output_slope
+from ..mpl_poly.resistors import output_current, output_root, output_slope
 from ..mpl_poly.rest import branch_around, check_branch_inverse
 from . import kernels
+
+fill_doc = docfiller("MplGStructure", "MplGParams", state="x_cells")
 
 __all__ = [
     "WEIGHT_SUM_FLOOR",
@@ -133,10 +141,7 @@ class MplGParams(Record):
     n_cells: int = field(init=False)
 
     def __post_init__(self) -> None:
-        n = np.size(self.i_s)
-        check_structure_size(n, "the number of cells (size of i_s)", MAX_CELLS)  # before copying
-        object.__setattr__(self, "n_cells", int(n))
-        freeze_arrays(self, i_s=n, v_t=n, w=n + 1)
+        freeze_sinh_cells(self)
         object.__setattr__(self, "g", frozen_shaped(self.g, (4,), "g"))
         finite_floats(self, "v_b")
         check_range(self.i_s, "i_s", *I_S_RANGE, " (eq. 5.1)")
@@ -151,20 +156,18 @@ class MplGParams(Record):
 
     def to_vector(self) -> np.ndarray:
         """Optimiser coordinates (see Notes of the class)."""
-        cells = np.column_stack([np.log(2 * self.i_s / self.v_t), np.log(self.v_t)]).reshape(-1)
-        return np.concatenate([cells, self.g, self.w, [self.v_b]])
+        return np.concatenate([sinh_coordinates(self), self.g, self.w, [self.v_b]])
 
     @classmethod
     def from_vector(cls, theta: np.ndarray, n_cells: int) -> MplGParams:
         """Inverse of :meth:`to_vector`."""
         theta = np.asarray(theta, dtype=float)
-        cells = theta[: 2 * n_cells].reshape(n_cells, 2)
-        v_t = np.exp(cells[:, 1])
+        i_s, v_t = sinh_from_coordinates(theta, n_cells)
         rest = theta[2 * n_cells:]
-        return cls(i_s=0.5 * np.exp(cells[:, 0]) * v_t, v_t=v_t, g=rest[:4],
-                   w=rest[4:n_cells + 5], v_b=rest[n_cells + 5])
+        return cls(i_s=i_s, v_t=v_t, g=rest[:4], w=rest[4:n_cells + 5], v_b=rest[n_cells + 5])
 
 
+@fill_doc
 def output_branch(params: MplGParams) -> tuple[float, float, float]:
     """The monotone branch of ``g`` the inverse uses: ``(lo, hi, sign)``.
 
@@ -179,10 +182,7 @@ def output_branch(params: MplGParams) -> tuple[float, float, float]:
 
     Returns
     -------
-    lo, hi : float
-        The branch's bounds (``+-inf`` where unbounded).
-    sign : float
-        Sign of ``g'`` on it.
+    %(branch)s
 
     Raises
     ------
@@ -220,6 +220,7 @@ def _solve(params: MplGParams, y: float) -> tuple[float, bool]:
     return solve_output(float(y), np.ascontiguousarray(params.g), *inverse_branch(params))
 
 
+@fill_doc
 def rest_state(structure: MplGStructure, params: MplGParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """Cells at rest, ``u_k = e_0``, shape (N,).
@@ -231,14 +232,8 @@ def rest_state(structure: MplGStructure, params: MplGParams, value: float,
 
     Parameters
     ----------
-    structure : MplGStructure
-        The model's structure.
-    params : MplGParams
-        Its parameters.
-    value : float
-        Constant input (with `inverse`: output) the model rests at.
-    inverse : bool, default False
-        Rest state of the inverse: `value` is an output.
+    %(structure)s
+    %(rest_value)s
 
     Returns
     -------
@@ -252,33 +247,21 @@ def rest_state(structure: MplGStructure, params: MplGParams, value: float,
     return np.full(structure.n_cells, float(value))
 
 
+@fill_doc
 def step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """One sample of the forward model: output from the present state, then the Euler update.
+    """One sample of the forward model: output ``y = g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17)
+    from the present state and the model input ``u = e``, then the Euler update of the cell
+    voltages over ``dt`` (eq. 5.6, sinh resistors limited by eq. 5.29).
 
-    Parameters
-    ----------
-    structure : MplGStructure
-        The model's structure.
-    params : MplGParams
-        Its parameters.
-    x : numpy.ndarray, shape (N,)
-        Cell voltages before the sample.
-    u : float
-        Model input ``e`` of the sample.
-
-    Returns
-    -------
-    y : float
-        ``g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17).
-    x_next : array, shape (N,)
-        Cell voltages after ``dt`` (eq. 5.6, sinh resistors limited by eq. 5.29).
+    %(step)s
     """
     x = np.asarray(x, dtype=float)
     y = output_current(params, params.w[0] * u + params.w[1:] @ x - params.v_b)
     return float(y), x + resistor_current(structure, params, u - x) * structure.dt
 
 
+@fill_doc
 def invert_step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of the inverse (readable reference): ``z = g^-1(y)`` on
@@ -287,19 +270,13 @@ def invert_step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
 
     Parameters
     ----------
-    structure : MplGStructure
-        The model's structure.
-    params : MplGParams
-        Its parameters.
-    x : numpy.ndarray, shape (N,)
-        Cell voltages before the sample.
-    y : float
-        Output to reach at this sample.
+    %(structure)s
+    %(state)s
+    %(y_step)s
 
     Returns
     -------
-    u : float
-        Input that gives `y` from the present state.
+    %(u_step)s
     x_next : numpy.ndarray, shape (N,)
         Cell voltages after the sample.
 
@@ -310,11 +287,7 @@ def invert_step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
     """
     x = np.asarray(x, dtype=float)
     lo, hi, _ = output_branch(params)
-    a = lo if np.isfinite(lo) else -1e15
-    b = hi if np.isfinite(hi) else 1e15
-    # a +-1e15 bracket down to 1e-15 takes ~101 halvings: above brentq's default 100
-    z = brentq(lambda z: output_current(params, z) - y, a, b, xtol=1e-15, rtol=1e-15,
-               maxiter=200)
+    z = output_root(params, y, lo, hi)
     e = (z - params.w[1:] @ x + params.v_b) / params.w[0]
     return float(e), x + resistor_current(structure, params, e - x) * structure.dt
 
@@ -359,16 +332,14 @@ simulate, simulate_reference, invert = family_runs(
                   "(the inverse's cells see ``-(1 + w_k / w_0)`` times their own voltage).")
 
 
+@fill_doc
 def simulate_with_jacobian(structure: MplGStructure, params: MplGParams,
                            u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Forward output from rest and its exact Jacobian ``dy/dtheta`` (forward sensitivities).
 
     Parameters
     ----------
-    structure : MplGStructure
-        The model's structure.
-    params : MplGParams
-        Its parameters.
+    %(structure)s
     u : numpy.ndarray, shape (n,)
         Model input ``e`` sampled every ``structure.dt``; the run starts at rest at ``u[0]``.
 

@@ -11,7 +11,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .._cubic_output_code import C_SOLVE, M_CUBIC, M_SOLVE
+from .._cubic_output_code import C_FORWARD, C_INVERSE, C_SOLVE, M_CUBIC, M_SOLVE, m_step
 from .._protocol import Translation
 from .rest import rest_voltages
 
@@ -37,7 +37,7 @@ def c_model(plan, lit: Callable[[float], str]) -> str:
     rest_z = ("    int ok;\n    const real z0 = solve_output(value, &ok);\n"
               if plan.inverse and e["W_SUM"] != 0 else
               "    (void)value;\n" if plan.inverse else "")
-    step = _C_INVERSE if plan.inverse else _C_FORWARD
+    step = C_INVERSE if plan.inverse else C_FORWARD
     solver = C_SOLVE if plan.inverse else ""
     return f"""#define N_CELLS {n}
 #define IG 9
@@ -82,34 +82,6 @@ static void model_rest(real *x, real value)
 {step}"""
 
 
-_C_FORWARD = """
-/* block_forward: y = g(w_0 u + sum w_k x_k - V_b) (eq. 5.17), then the cells driven by u */
-static real model_step(real *x, real u)
-{
-    int k;
-    real z = BODY[IW] * u - BODY[1], y;
-    for (k = 0; k < N_CELLS; k++) z += BODY[IW + 1 + k] * x[k];
-    y = cubic(BODY + IG, z, 0);
-    cells(x, u);
-    return y;
-}
-"""
-
-_C_INVERSE = """
-/* block_inverse: z = g^-1(y) on the rest branch, u_hat = (z - sum w_k x_k + V_b) / w_0, the
-   cells driven by u_hat; NaN when y is outside the branch's range (no input gives it) */
-static real model_step(real *x, real y)
-{
-    int k, ok;
-    const real z = solve_output(y, &ok);
-    real acc = z + BODY[1], u_hat;
-    for (k = 0; k < N_CELLS; k++) acc -= BODY[IW + 1 + k] * x[k];
-    u_hat = ok ? acc / BODY[IW] : (real)NAN;
-    cells(x, u_hat);
-    return u_hat;
-}
-"""
-
 
 def m_model(plan, lit: Callable[[float], str]) -> str:
     e = plan.extra
@@ -121,7 +93,7 @@ def m_model(plan, lit: Callable[[float], str]) -> str:
                 f"+ B(2)) / {lit(e['W_SUM'])};\nelse\n    e0 = 0.0;\nend")
     else:
         rest = "e0 = 0.0;"
-    step = _M_INVERSE if plan.inverse else _M_FORWARD
+    step = m_step(plan.inverse, 6)
     return f"""function x = model_rest(B, value)
 {rest}
 x = e0 - {v_rest};
@@ -144,33 +116,6 @@ end
 end
 
 {M_SOLVE}{step}"""
-
-
-_M_FORWARD = """
-function [y, x] = model_step(B, x, u)
-n = round(B(1)); iw = 14 + 6 * n;
-z = B(iw) * u - B(2);
-for k = 1:n
-    z = z + B(iw + k) * x(k);
-end
-y = cubic(B(10:13), z);
-x = cells(B, x, u);
-end
-"""
-
-_M_INVERSE = """
-function [u_hat, x] = model_step(B, x, y)
-n = round(B(1)); iw = 14 + 6 * n;
-[z, ok] = solve_output(B, y);
-acc = z + B(2);
-for k = 1:n
-    acc = acc - B(iw + k) * x(k);
-end
-if ok, u_hat = acc / B(iw); else, u_hat = NaN; end
-x = cells(B, x, u_hat);
-end
-"""
-
 
 
 # The family's block in C and MATLAB: FAMILY.export (family.py).

@@ -26,9 +26,12 @@ import numpy as np
 
 from ...errors import FitDivergedError
 from ...identification import FitResult, NormalEquations, check_fit_data, fit_multistart
+from .._docs import docfiller
 from . import kernels
 from . import model as mpl_poly
 from .presets import PAPER_9_2_TABLE_I, paper_9_2_params
+
+fill_doc = docfiller()
 
 __all__ = ["canonical", "default_starts", "fit_box", "fit_mpl_poly", "random_params",
            "theta_names"]
@@ -209,6 +212,7 @@ def normal_equations(structure: mpl_poly.MplPolyStructure, params: mpl_poly.MplP
     return NormalEquations(0.5 * sse, jtj, jtr)
 
 
+@fill_doc
 def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStructure, *,
                  max_nfev: int = 200, screen_nfev: int = 12, n_polish: int = 2,
                  accept: Callable[[mpl_poly.MplPolyParams], bool] | None = None,
@@ -225,12 +229,7 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
         (eq. 5.10) by the caller.
     structure : MplPolyStructure
         With ``limit=False`` trial points whose run diverges are rejected by the solver.
-    max_nfev, screen_nfev, n_polish : int
-        As :func:`hystkit.identification.fit_multistart`.
-    accept : callable, optional
-        A candidate counts only if ``accept(params)``; ``accept_reason`` says why others failed.
-    accept_reason : str, optional
-        Why candidates were rejected, for the message.
+    %(multistart)s
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart` ("trf" works on the dense Jacobian).
     loss, f_scale, weights
@@ -243,8 +242,7 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
 
     Returns
     -------
-    FitResult
-        The best start's fit.
+    %(best_start)s
 
     Raises
     ------

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..mpl.kernels import NORMAL_BLOCK, fold_block, mirror_upper
+from ..mpl.kernels import NORMAL_BLOCK, fold_block, input_for, mirror_upper, readout
 
 
 @njit(cache=True, inline="always")
@@ -62,16 +62,30 @@ def simulate(u, x0, fc, knees, s, limit, gc, w, v_b, dt, bound):
     x = x0.copy()
     y = np.empty(u.size)
     for n in range(u.size):
-        z = w[0] * u[n] - v_b
-        for k in range(n_cells):
-            z += w[k + 1] * x[k]
-        y[n], _ = _cubic(gc[0], gc[1], gc[2], gc[3], z)
+        y[n], _ = _cubic(gc[0], gc[1], gc[2], gc[3], readout(w, v_b, x, u[n]))
         for k in range(n_cells):
             f, _ = _cell(u[n] - x[k], fc[k], knees[k, 0], knees[k, 1], s, limit)
             x[k] += f * dt
             if not abs(x[k]) < bound:
                 return y, x, n
     return y, x, -1
+
+
+@njit(cache=True, inline="always")
+def _advance_with_sensitivities(u_n, x, sens, fc, knees, s, limit, dt, bound):
+    """The cells' Euler update driven by ``u_n`` with their parameter sensitivities (rows of
+    ``sens``, the order of :func:`cell_gradient`); False as soon as a cell leaves
+    ``|u_k| < bound``, the later cells then left as they were."""
+    for k in range(x.size):
+        v = u_n - x[k]
+        f, slope = _cell(v, fc[k], knees[k, 0], knees[k, 1], s, limit)
+        grad = cell_gradient(v, fc[k], knees[k, 0], knees[k, 1], s, limit)
+        for j in range(4):
+            sens[k, j] += (grad[j] - slope * sens[k, j]) * dt
+        x[k] += f * dt
+        if not abs(x[k]) < bound:
+            return False
+    return True
 
 
 @njit(cache=True)
@@ -90,9 +104,7 @@ def simulate_with_jacobian(u, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt, bo
     jac = np.zeros((u.size, 5 * n_cells + 6))
     col_g, col_w, col_vb = 4 * n_cells, 4 * n_cells + 4, 5 * n_cells + 5
     for n in range(u.size):
-        z = w[0] * u[n] - v_b
-        for k in range(n_cells):
-            z += w[k + 1] * x[k]
+        z = readout(w, v_b, x, u[n])
         y[n], dg = _cubic(gc[0], gc[1], gc[2], gc[3], z)
         zj = 1.0
         for j in range(4):
@@ -104,15 +116,8 @@ def simulate_with_jacobian(u, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt, bo
             jac[n, col_w + 1 + k] = dg * x[k]
             for j in range(4):
                 jac[n, 4 * k + j] = dg * w[k + 1] * sens[k, j]
-        for k in range(n_cells):
-            v = u[n] - x[k]
-            f, slope = _cell(v, fc[k], knees[k, 0], knees[k, 1], s, limit)
-            grad = cell_gradient(v, fc[k], knees[k, 0], knees[k, 1], s, limit)
-            for j in range(4):
-                sens[k, j] += (grad[j] - slope * sens[k, j]) * dt
-            x[k] += f * dt
-            if not abs(x[k]) < bound:
-                return y, jac, n
+        if not _advance_with_sensitivities(u[n], x, sens, fc, knees, s, limit, dt, bound):
+            return y, jac, n
     return y, jac, -1
 
 
@@ -137,9 +142,7 @@ def normal_equations(u, y_target, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt
     m = 0
     col_g, col_w, col_vb = 4 * n_cells, 4 * n_cells + 4, 5 * n_cells + 5
     for n in range(u.size):
-        z = w[0] * u[n] - v_b
-        for k in range(n_cells):
-            z += w[k + 1] * x[k]
+        z = readout(w, v_b, x, u[n])
         y, dg = _cubic(gc[0], gc[1], gc[2], gc[3], z)
         zj = 1.0
         for j in range(4):
@@ -158,15 +161,8 @@ def normal_equations(u, y_target, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt
         if m == NORMAL_BLOCK or n == u.size - 1:
             fold_block(cols, res, m, jtj, jtr)
             m = 0
-        for k in range(n_cells):
-            v = u[n] - x[k]
-            f, slope = _cell(v, fc[k], knees[k, 0], knees[k, 1], s, limit)
-            grad = cell_gradient(v, fc[k], knees[k, 0], knees[k, 1], s, limit)
-            for j in range(4):
-                sens[k, j] += (grad[j] - slope * sens[k, j]) * dt
-            x[k] += f * dt
-            if not abs(x[k]) < bound:
-                return sse, mirror_upper(jtj), jtr, n
+        if not _advance_with_sensitivities(u[n], x, sens, fc, knees, s, limit, dt, bound):
+            return sse, mirror_upper(jtj), jtr, n
     return sse, mirror_upper(jtj), jtr, -1
 
 
@@ -216,6 +212,20 @@ def solve_output(i, gc, lo, hi, sign, centre):
     return z, True
 
 
+@njit(cache=True, inline="always")
+def branch_input(y, gc, lo, hi, sign, centre, w, v_b, x, bound):
+    """One sample of the inverse's input: ``z = g^-1(y)`` on the branch (:func:`solve_output`),
+    then ``e = (z + V_b - sum w_k x_k) / w_0`` from the present state. Returns ``(e, why)``,
+    ``why`` 1 when ``y`` is outside the branch's range, 2 when ``|e| >= bound``, else 0."""
+    z, ok = solve_output(y, gc, lo, hi, sign, centre)
+    if not ok:
+        return 0.0, 1
+    e = input_for(w, v_b, x, z)
+    if not abs(e) < bound:
+        return e, 2
+    return e, 0
+
+
 @njit(cache=True)
 def invert(y, x0, fc, knees, s, limit, gc, lo, hi, sign, centre, w, v_b, dt, bound):
     """Inverse model: solve ``g(z) = i``, then ``e`` from the output equation with the present
@@ -226,15 +236,9 @@ def invert(y, x0, fc, knees, s, limit, gc, lo, hi, sign, centre, w, v_b, dt, bou
     x = x0.copy()
     e_hat = np.empty(y.size)
     for n in range(y.size):
-        z, ok = solve_output(y[n], gc, lo, hi, sign, centre)
-        if not ok:
-            return e_hat, x, n, 1
-        acc = z + v_b
-        for k in range(n_cells):
-            acc -= w[k + 1] * x[k]
-        e = acc / w[0]
-        if not abs(e) < bound:
-            return e_hat, x, n, 2
+        e, why = branch_input(y[n], gc, lo, hi, sign, centre, w, v_b, x, bound)
+        if why:
+            return e_hat, x, n, why
         e_hat[n] = e
         for k in range(n_cells):
             f, _ = _cell(e - x[k], fc[k], knees[k, 0], knees[k, 1], s, limit)
@@ -266,9 +270,7 @@ def block_forward(body, x, xn, off, u):
     """``y = g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17), then the cells driven by ``u``."""
     n = int(body[0])
     iw = _IF + 6 * n
-    z = body[iw] * u - body[1]
-    for k in range(n):
-        z += body[iw + 1 + k] * x[off + k]
+    z = readout(body[iw:iw + n + 1], body[1], x[off:off + n], u)
     y, _ = _cubic(body[_IG], body[_IG + 1], body[_IG + 2], body[_IG + 3], z)
     _block_cells(body, x, xn, off, u)
     return y
@@ -282,9 +284,6 @@ def block_inverse(body, x, xn, off, y):
     n = int(body[0])
     iw = _IF + 6 * n
     z, ok = solve_output(y, body[_IG:_IG + 4], body[5], body[6], body[7], body[8])
-    acc = z + body[1]
-    for k in range(n):
-        acc -= body[iw + 1 + k] * x[off + k]
-    u_hat = acc / body[iw] if ok else np.nan
+    u_hat = input_for(body[iw:iw + n + 1], body[1], x[off:off + n], z) if ok else np.nan
     _block_cells(body, x, xn, off, u_hat)
     return u_hat

@@ -31,9 +31,9 @@ name importable from here).
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ...errors import FitDivergedError
+from .._docs import docfiller
 from .._run import Runs, family_runs
 from .._validation import (
     broadcast_state,
@@ -52,6 +52,7 @@ from .records import (
 from .resistors import (
     knee_points,
     output_current,
+    output_root,
     output_slope,
     resistor_current,
     resistor_slope,
@@ -66,6 +67,8 @@ from .rest import (
     rest_state,
     rest_voltages,
 )
+
+fill_doc = docfiller("MplPolyStructure", "MplPolyParams", state="x_cells")
 
 __all__ = [
     "C3_RANGE",
@@ -95,64 +98,31 @@ __all__ = [
 ]
 
 
+@fill_doc
 def step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """One sample of the forward model: output from the present state, then the Euler update.
+    """One sample of the forward model: output ``y = g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17)
+    from the present state and the model input ``u = e``, then the Euler update of the cell
+    voltages over ``dt`` (eq. 5.6 with eq. 5.16).
 
-    Parameters
-    ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
-    x : numpy.ndarray, shape (N,)
-        Cell voltages before the sample.
-    u : float
-        Model input ``e`` of the sample.
-
-    Returns
-    -------
-    y : float
-        ``g(w_0 u + sum w_k x_k - V_b)`` (eq. 5.17).
-    x_next : array, shape (N,)
-        Cell voltages after ``dt`` (eq. 5.6 with eq. 5.16).
+    %(step)s
     """
     x = np.asarray(x, dtype=float)
     y = output_current(params, params.w[0] * u + params.w[1:] @ x - params.v_b)
     return float(y), x + resistor_current(structure, params, u - x) * structure.dt
 
 
+@fill_doc
 def invert_step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of the inverse: ``z = g^-1(y)`` on :func:`output_branch`, the input from the
     output equation with the present state (as eq. 5.13), then the state update (fig. 5.12).
 
-    Parameters
-    ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
-    x : numpy.ndarray, shape (N,)
-        Cell voltages before the sample.
-    y : float
-        Output to reach at this sample.
-
-    Returns
-    -------
-    u : float
-        Input that gives `y` from the present state.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(invert_step)s
     """
     x = np.asarray(x, dtype=float)
     lo, hi, _ = output_branch(structure, params)
-    a = lo if np.isfinite(lo) else -1e15
-    b = hi if np.isfinite(hi) else 1e15
-    # from a +-1e15 bracket to a 1e-15 tolerance takes ~101 halvings: more than brentq's
-    # default 100 iterations in the worst case (found by tests/models/test_invert_step_fuzz.py)
-    z = brentq(lambda z: output_current(params, z) - y, a, b, xtol=1e-15, rtol=1e-15,
-               maxiter=200)
+    z = output_root(params, y, lo, hi)
     e = (z - params.w[1:] @ x + params.v_b) / params.w[0]
     return float(e), x + resistor_current(structure, params, e - x) * structure.dt
 
@@ -234,6 +204,7 @@ simulate, simulate_reference, invert = family_runs(
                   "finite range.")
 
 
+@fill_doc
 def simulate_with_jacobian(structure: MplPolyStructure, params: MplPolyParams, u: np.ndarray,
                            x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Forward output and its exact Jacobian ``dy/dtheta``, shape (n, 5N + 6), columns in the
@@ -242,10 +213,7 @@ def simulate_with_jacobian(structure: MplPolyStructure, params: MplPolyParams, u
 
     Parameters
     ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
+    %(structure)s
     u : numpy.ndarray, shape (n,)
         Model input ``e`` sampled every ``structure.dt``.
     x0 : numpy.ndarray, float or None, optional

@@ -6,13 +6,18 @@ with their slopes.
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import brentq
 
+from .._docs import docfiller
 from .records import (
     MplPolyParams,
     MplPolyStructure,
 )
 
+fill_doc = docfiller("MplPolyStructure", "MplPolyParams")
 
+
+@fill_doc
 def knee_points(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarray:
     """Knees ``x-, x+`` of each cell, shape (N, 2): the extreme solutions of ``f'(x) = s``.
 
@@ -21,10 +26,7 @@ def knee_points(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarra
 
     Parameters
     ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
@@ -57,18 +59,15 @@ def _resistor(structure: MplPolyStructure, params: MplPolyParams,
             np.where(outside, s, df))
 
 
+@fill_doc
 def resistor_current(structure: MplPolyStructure, params: MplPolyParams,
                      v: np.ndarray) -> np.ndarray:
     """Cell currents ``f_k,lim(v)`` (eq. 5.16 with 5.29 when ``structure.limit``).
 
     Parameters
     ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
-    v : array, shape (..., N)
-        Voltage across each cell's resistor.
+    %(structure)s
+    %(v_cells)s
 
     Returns
     -------
@@ -78,18 +77,15 @@ def resistor_current(structure: MplPolyStructure, params: MplPolyParams,
     return _resistor(structure, params, v)[0]
 
 
+@fill_doc
 def resistor_slope(structure: MplPolyStructure, params: MplPolyParams,
                    v: np.ndarray) -> np.ndarray:
     """Slopes ``f'_k,lim(v)``, shape (..., N): the cells' rates in eq. 5.20 and 5.26.
 
     Parameters
     ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
-    v : numpy.ndarray, shape (..., N)
-        Voltage across each cell's resistor.
+    %(structure)s
+    %(v_cells)s
 
     Returns
     -------
@@ -99,13 +95,13 @@ def resistor_slope(structure: MplPolyStructure, params: MplPolyParams,
     return _resistor(structure, params, v)[1]
 
 
+@fill_doc
 def output_current(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
     """Output resistor current ``g(z)`` (eq. 5.17).
 
     Parameters
     ----------
-    params : MplPolyParams
-        The model's parameters.
+    %(params)s
     z : numpy.ndarray
         Voltage across the output resistor.
 
@@ -117,13 +113,13 @@ def output_current(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
     return _cubic(params.g, np.asarray(z, dtype=float))[0]
 
 
+@fill_doc
 def output_slope(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
     """Output resistor slope ``g'(z)`` (``g'_0`` of eq. 5.19).
 
     Parameters
     ----------
-    params : MplPolyParams
-        The model's parameters.
+    %(params)s
     z : numpy.ndarray
         Voltage across the output resistor.
 
@@ -133,3 +129,15 @@ def output_slope(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
         ``g'(z)``, same shape as `z`.
     """
     return _cubic(params.g, np.asarray(z, dtype=float))[1]
+
+
+def output_root(params: MplPolyParams, y: float, lo: float, hi: float) -> float:
+    """The ``z`` with ``g(z) = y`` on the branch ``[lo, hi]`` (``+-inf``: unbounded) by bracketed
+    root finding, the readable reference of ``kernels.solve_output``; brentq's ValueError when
+    ``y`` is outside the branch's range."""
+    a = lo if np.isfinite(lo) else -1e15
+    b = hi if np.isfinite(hi) else 1e15
+    # from a +-1e15 bracket to a 1e-15 tolerance takes ~101 halvings: more than brentq's
+    # default 100 iterations in the worst case (found by tests/models/test_invert_step_fuzz.py)
+    return brentq(lambda z: output_current(params, z) - y, a, b, xtol=1e-15, rtol=1e-15,
+                  maxiter=200)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._docs import docfiller
 from . import kernels
 from .records import (
     REST_MAX,
@@ -21,7 +22,10 @@ from .resistors import (
     resistor_slope,
 )
 
+fill_doc = docfiller("MplPolyStructure", "MplPolyParams")
 
+
+@fill_doc
 def equilibria(structure: MplPolyStructure, params: MplPolyParams) -> list[np.ndarray]:
     """Every rest voltage ``v*`` with ``f_k,lim(v*) = 0`` of each cell, ascending.
 
@@ -29,10 +33,7 @@ def equilibria(structure: MplPolyStructure, params: MplPolyParams) -> list[np.nd
 
     Parameters
     ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
@@ -56,6 +57,7 @@ def equilibria(structure: MplPolyStructure, params: MplPolyParams) -> list[np.nd
     return out
 
 
+@fill_doc
 def check_rest(structure: MplPolyStructure, params: MplPolyParams) -> None:
     """Raise FitDivergedError unless every rest voltage of the limited resistors at this
     ``dt`` (:func:`equilibria`) lies within ``REST_MAX``: the straight continuations can move
@@ -63,10 +65,7 @@ def check_rest(structure: MplPolyStructure, params: MplPolyParams) -> None:
 
     Parameters
     ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
+    %(structure)s
 
     Raises
     ------
@@ -81,6 +80,7 @@ def check_rest(structure: MplPolyStructure, params: MplPolyParams) -> None:
                 f"domain |v| <= {REST_MAX:g} where runs stay bounded")
 
 
+@fill_doc
 def output_bound(structure: MplPolyStructure, params: MplPolyParams, u_max: float) -> float:
     """Largest ``|y|`` of a forward run from rest with ``|u| <= u_max`` and
     ``slope_cap <= 1``.
@@ -93,12 +93,8 @@ def output_bound(structure: MplPolyStructure, params: MplPolyParams, u_max: floa
 
     Parameters
     ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
-    u_max : float
-        Largest input magnitude.
+    %(structure)s
+    %(u_max)s
 
     Returns
     -------
@@ -110,6 +106,7 @@ def output_bound(structure: MplPolyStructure, params: MplPolyParams, u_max: floa
     return float(np.abs(params.g) @ z ** np.arange(4))
 
 
+@fill_doc
 def rest_voltages(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarray:
     """Default start: each cell at a stable rest voltage (``f' > 0``), shape (N,).
 
@@ -120,10 +117,7 @@ def rest_voltages(structure: MplPolyStructure, params: MplPolyParams) -> np.ndar
 
     Parameters
     ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
@@ -141,6 +135,7 @@ def rest_voltages(structure: MplPolyStructure, params: MplPolyParams) -> np.ndar
     return out
 
 
+@fill_doc
 def output_branch(structure: MplPolyStructure,
                   params: MplPolyParams) -> tuple[float, float, float]:
     """The monotone branch of ``g`` used by :func:`invert`: ``(lo, hi, sign)``.
@@ -153,17 +148,11 @@ def output_branch(structure: MplPolyStructure,
 
     Parameters
     ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
-    lo, hi : float
-        The branch's bounds (``+-inf`` where unbounded).
-    sign : float
-        Sign of ``g'`` on it.
+    %(branch)s
 
     Raises
     ------
@@ -208,6 +197,7 @@ def branch_around(params: MplPolyParams, z_rest: float) -> tuple[float, float, f
 
 
 
+@fill_doc
 def inverse_branch(structure: MplPolyStructure,
                    params: MplPolyParams) -> tuple[float, float, float, float]:
     """``(lo, hi, sign, centre)``: :func:`output_branch` and the rest point ``z_rest`` inside it,
@@ -216,17 +206,11 @@ def inverse_branch(structure: MplPolyStructure,
 
     Parameters
     ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
-    lo, hi : float
-        The branch's bounds (``+-inf`` where unbounded).
-    sign : float
-        Sign of ``g'`` on it.
+    %(branch)s
     centre : float
         ``z_rest``.
 
@@ -240,6 +224,7 @@ def inverse_branch(structure: MplPolyStructure,
     return lo, hi, sign, float(centre)
 
 
+@fill_doc
 def rest_state(structure: MplPolyStructure, params: MplPolyParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """Cells at rest, ``u_k = e - v*_k`` (:func:`rest_voltages`), shape (N,).
@@ -250,21 +235,7 @@ def rest_state(structure: MplPolyStructure, params: MplPolyParams, value: float,
     branch's range or ``sum w = 0``. :func:`simulate` / :func:`invert` start here for
     ``x0=None``.
 
-    Parameters
-    ----------
-    structure : MplPolyStructure
-        The model's structure.
-    params : MplPolyParams
-        Its parameters.
-    value : float
-        Constant input (with `inverse`: output) the model rests at.
-    inverse : bool, default False
-        Rest state of the inverse: `value` is an output.
-
-    Returns
-    -------
-    numpy.ndarray
-        The state at rest.
+    %(rest_state)s
     """
     v_rest = rest_voltages(structure, params)
     if not inverse:

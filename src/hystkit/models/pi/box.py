@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._docs import docfiller
 from . import model as pi
+
+fill_doc = docfiller()
 
 __all__ = ["MIN_SLOPE", "make_structure", "params_from_theta", "random_params"]
 
@@ -78,6 +81,7 @@ def make_structure(dt: float, size: int, *, n_deadzone: int = 2, n_creep: int = 
                           creep_rates=tuple(1.0 / (tau_min * 10.0 ** np.arange(n_creep))), dt=dt)
 
 
+@fill_doc
 def random_params(structure: pi.PiStructure, rng: np.random.Generator) -> pi.PiParams:
     """Parameters drawn in the fit's coordinates (the family's documented domain, see
     ``PiFamily.random_params``).
@@ -86,8 +90,7 @@ def random_params(structure: pi.PiStructure, rng: np.random.Generator) -> pi.PiP
     ----------
     structure : pi.PiStructure
         The model's structure.
-    rng : numpy.random.Generator
-        Source of the draws.
+    %(rng)s
 
     Returns
     -------

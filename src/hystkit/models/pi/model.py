@@ -42,6 +42,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._docs import docfiller
 from .._run import Runs, family_runs
 from .._validation import check_finite_run
 from . import kernels
@@ -64,21 +65,23 @@ from .records import (
     output_bound,
 )
 
+fill_doc = docfiller("PiStructure", "PiParams", state="""\
+x : numpy.ndarray, shape (n_play + n_creep,)
+    Play outputs then creep states before the sample.""")
+
 __all__ = ["MAX_CREEP", "MAX_DEADZONES", "MAX_PLAYS", "MAX_VALUE", "InverseParts", "PiParams", "PiStructure", "deadzone", "instantaneous_weights",
            "inverse_parts", "inverse_pi", "inverse_play_states", "inverse_superposition",
            "invert", "invert_step", "not_invertible_reason", "output_bound", "play", "rest_input", "rest_state",
            "simulate", "simulate_reference", "step"]
 
 
+@fill_doc
 def instantaneous_weights(structure: PiStructure, params: PiParams) -> np.ndarray:
     """Play weights of ``H~ = H + kappa x``, the operator one sample of ``H + K`` applies.
 
     Parameters
     ----------
-    structure : PiStructure
-        The model's structure.
-    params : PiParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
@@ -113,16 +116,14 @@ class InverseParts(NamedTuple):
     ws_inv: np.ndarray
 
 
+@fill_doc
 def inverse_parts(structure: PiStructure, params: PiParams) -> InverseParts:
     """The inverse operators: polarity ``sign`` of ``H~`` (the polarity lives in ``H``, ``S``
     increases), its weights ``w_inst``, the inverse plays of ``sign * H~`` and ``S^-1``.
 
     Parameters
     ----------
-    structure : PiStructure
-        The model's structure.
-    params : PiParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
@@ -136,13 +137,13 @@ def inverse_parts(structure: PiStructure, params: PiParams) -> InverseParts:
     return InverseParts(sign, w_inst, r_inv, w_inv, d_inv, ws_inv)
 
 
+@fill_doc
 def rest_input(params: PiParams, y0: float) -> float:
     """The input at rest at output ``y0``: ``(S^-1(y0) - b) / (sum w_H + sum w_K)``.
 
     Parameters
     ----------
-    params : PiParams
-        The model's parameters.
+    %(params)s
     y0 : float
         Output at rest.
 
@@ -164,27 +165,14 @@ def rest_input(params: PiParams, y0: float) -> float:
     return (float(ws_inv @ deadzone(y0, d_inv)) - params.b) / gain
 
 
+@fill_doc
 def rest_state(structure: PiStructure, params: PiParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """State at rest: every play and creep state at the input ``value`` (where :func:`simulate`
     starts), or for ``inverse`` at the input at rest at the output ``value`` (:func:`invert`'s
     start, :func:`rest_input`).
 
-    Parameters
-    ----------
-    structure : PiStructure
-        The model's structure.
-    params : PiParams
-        Its parameters.
-    value : float
-        Constant input (with `inverse`: output) the model rests at.
-    inverse : bool, default False
-        Rest state of the inverse: `value` is an output.
-
-    Returns
-    -------
-    numpy.ndarray
-        The state at rest.
+    %(rest_state)s
     """
     u = rest_input(params, float(value)) if inverse else float(value)
     return np.full(structure.n_play + structure.n_creep, u)
@@ -194,26 +182,13 @@ def _superposition(params: PiParams, v: float) -> float:
     return float(params.w_s @ deadzone(v, params.d_s))
 
 
+@fill_doc
 def step(structure: PiStructure, params: PiParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """One sample of the forward model (the readable reference of the kernel).
+    """One sample of the forward model (the readable reference of the kernel): output ``y =
+    S[H[u] + K[u] + b]`` with the states after this sample (eq. 2.12-2.15).
 
-    Parameters
-    ----------
-    structure : PiStructure
-        The model's structure.
-    params : PiParams
-        Its parameters.
-    x : numpy.ndarray, shape (n_play + n_creep,)
-        Play outputs then creep states before the sample.
-    u : float
-        Input of the sample.
-
-    Returns
-    -------
-    y : float
-        ``S[H[u] + K[u] + b]`` with the states after this sample (eq. 2.12-2.15).
-    x_next : array, shape (n_play + n_creep,)
+    %(step)s
     """
     x = np.asarray(x, dtype=float)
     p = play(u, x[: structure.n_play], np.asarray(structure.play_thresholds))
@@ -222,6 +197,7 @@ def step(structure: PiStructure, params: PiParams, x: np.ndarray,
     return y, np.concatenate([p, z])
 
 
+@fill_doc
 def invert_step(structure: PiStructure, params: PiParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of the inverse model on the forward state (the reference of the kernel).
@@ -230,23 +206,7 @@ def invert_step(structure: PiStructure, params: PiParams, x: np.ndarray,
     play states; the estimate then advances the forward state as :func:`step` would.
     Needs an invertible model (see :func:`invert`).
 
-    Parameters
-    ----------
-    structure : PiStructure
-        The model's structure.
-    params : PiParams
-        Its parameters.
-    x : numpy.ndarray, shape (n_play + n_creep,)
-        Play outputs then creep states before the sample. (the forward state)
-    y : float
-        Output to reach at this sample.
-
-    Returns
-    -------
-    u : float
-        Input that gives `y` from the present state.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(invert_step)s
     """
     x = np.asarray(x, dtype=float)
     n, c = structure.n_play, structure.creep_gains
@@ -301,6 +261,7 @@ def _inverse(structure: PiStructure, params: PiParams, y: np.ndarray,
     return check_finite_run(u_hat, "PI", "inverse"), check_finite_run(x_end, "PI", "state")
 
 
+@fill_doc
 def not_invertible_reason(structure: PiStructure, params: PiParams) -> str:
     """Why the model has no inverse, or ``""`` if it has one.
 
@@ -311,10 +272,7 @@ def not_invertible_reason(structure: PiStructure, params: PiParams) -> str:
 
     Parameters
     ----------
-    structure : PiStructure
-        The model's structure.
-    params : PiParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------

@@ -27,6 +27,7 @@ import numpy as np
 from scipy.optimize import lsq_linear
 
 from ...identification import FitResult, check_fit_data, check_weights, fit_multistart
+from .._docs import docfiller
 from . import model as pl
 from .box import (
     A_MIN,
@@ -35,6 +36,8 @@ from .box import (
     W_BOUND,
     random_params,
 )
+
+fill_doc = docfiller()
 
 __all__ = ["THETA_NAMES", "default_starts", "fit_pl", "random_params", "solve_weights"]
 
@@ -120,6 +123,7 @@ def default_starts(structure: pl.PlStructure) -> list[np.ndarray]:
     return starts
 
 
+@fill_doc
 def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
            starts: list[np.ndarray] | None = None, max_nfev: int = 40, screen_nfev: int = 4,
            n_polish: int = 2, accept: Callable[[pl.PlParams], bool] | None = None,
@@ -136,10 +140,7 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
         The fixed structure.
     starts : list of arrays ``[log I_T, log V_T]``, optional
         Default :func:`default_starts` (12 starts).
-    max_nfev, screen_nfev, n_polish : int
-        Passed to ``fit_multistart``.
-    accept, accept_reason
-        Candidates with ``accept(params)`` false are skipped.
+    %(multistart)s
     solver : {"tr", "lm", "trf"}
         See :func:`hystkit.identification.fit_multistart`. Variable projection leaves two
         coordinates, so their difference Jacobian (``n x 2``) is formed densely.
@@ -151,8 +152,7 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
 
     Returns
     -------
-    FitResult
-        The best start's fit.
+    %(best_start)s
 
     Raises
     ------

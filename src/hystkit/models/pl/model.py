@@ -41,6 +41,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._docs import docfiller
 from .._run import Runs, family_runs
 from .._validation import check_signal
 from . import kernels
@@ -55,6 +56,8 @@ from .records import (
     basis_breakpoints,
     output_bound,
 )
+
+fill_doc = docfiller("PlStructure", "PlParams", state="x_capacitors")
 
 __all__ = [
     "A_RANGE",
@@ -93,17 +96,14 @@ def _cells(structure: PlStructure, params: PlParams) -> tuple[np.ndarray, np.nda
     return thr, np.minimum(knee, thr), g_lin
 
 
+@fill_doc
 def resistor_current(structure: PlStructure, params: PlParams, v: np.ndarray) -> np.ndarray:
     """Cell-resistor currents ``d_k(v)`` (eq. 2.16 with the straight branches).
 
     Parameters
     ----------
-    structure : PlStructure
-        The model's structure.
-    params : PlParams
-        Its parameters.
-    v : array, shape (..., N)
-        Voltage across each cell's resistor.
+    %(structure)s
+    %(v_cells)s
 
     Returns
     -------
@@ -117,18 +117,15 @@ def resistor_current(structure: PlStructure, params: PlParams, v: np.ndarray) ->
     return np.sign(v) * (inside + g_lin * np.maximum(a - knee, 0.0))
 
 
+@fill_doc
 def resistor_slope(structure: PlStructure, params: PlParams, v: np.ndarray) -> np.ndarray:
     """Slopes ``d'_k(v)``, shape (..., N): ``p I_T / ((p - 1) k V_T) |v / k V_T|^(p - 1)``
     inside the knee, ``G`` on the straight branches (the cells' rates in a linearisation).
 
     Parameters
     ----------
-    structure : PlStructure
-        The model's structure.
-    params : PlParams
-        Its parameters.
-    v : numpy.ndarray, shape (..., N)
-        Voltage across each cell's resistor.
+    %(structure)s
+    %(v_cells)s
 
     Returns
     -------
@@ -141,13 +138,13 @@ def resistor_slope(structure: PlStructure, params: PlParams, v: np.ndarray) -> n
     inside = p * params.i_t / ((p - 1) * thr) * (np.abs(v) / thr) ** (p - 1)
     return np.where(np.abs(v) <= knee, inside, g_lin)
 
+@fill_doc
 def output_resistor(params: PlParams, i: np.ndarray) -> np.ndarray:
     """``u = f(i) = sum_j a_j phi_j(i)`` (eq. 2.17), shape of ``i``.
 
     Parameters
     ----------
-    params : PlParams
-        The model's parameters.
+    %(params)s
     i : numpy.ndarray
         Output current.
 
@@ -164,13 +161,13 @@ def output_resistor(params: PlParams, i: np.ndarray) -> np.ndarray:
     return phi @ params.a
 
 
+@fill_doc
 def output_resistor_inverse(params: PlParams, u: np.ndarray) -> np.ndarray:
     """``i = f^-1(u)`` (eq. 2.18), exact: ``f`` is PWL and strictly increasing.
 
     Parameters
     ----------
-    params : PlParams
-        The model's parameters.
+    %(params)s
     u : numpy.ndarray
         Voltage across the output resistor.
 
@@ -189,14 +186,14 @@ def output_resistor_inverse(params: PlParams, u: np.ndarray) -> np.ndarray:
     return knots[ref] + (u - f_knots[ref]) / params.a[seg]
 
 
+@fill_doc
 def output_resistor_slope(params: PlParams, i: np.ndarray) -> np.ndarray:
     """``f'(i)``: the slope ``a_j`` of the segment holding ``i`` (the left one at a breakpoint
     inside, as the outermost segments extend to infinity).
 
     Parameters
     ----------
-    params : PlParams
-        The model's parameters.
+    %(params)s
     i : numpy.ndarray
         Output current.
 
@@ -210,6 +207,7 @@ def output_resistor_slope(params: PlParams, i: np.ndarray) -> np.ndarray:
     return params.a[seg]
 
 
+@fill_doc
 def rest_state(structure: PlStructure, params: PlParams, value: float,
                inverse: bool = False) -> np.ndarray:
     """Cells at rest, each equal to the source (``d_k(0) = 0``), shape (N,).
@@ -218,21 +216,7 @@ def rest_state(structure: PlStructure, params: PlParams, value: float,
     current): ``e_0 = (f(value) + V_b) / sum w`` (0 if ``sum w = 0``), the source at which the
     model rests with that output. :func:`simulate` / :func:`invert` start here for ``x0=None``.
 
-    Parameters
-    ----------
-    structure : PlStructure
-        The model's structure.
-    params : PlParams
-        Its parameters.
-    value : float
-        Constant input (with `inverse`: output) the model rests at.
-    inverse : bool, default False
-        Rest state of the inverse: `value` is an output.
-
-    Returns
-    -------
-    numpy.ndarray
-        The state at rest.
+    %(rest_state)s
     """
     if inverse:
         w_sum = params.w.sum()
@@ -240,6 +224,7 @@ def rest_state(structure: PlStructure, params: PlParams, value: float,
         value = (u + params.v_b) / w_sum if w_sum != 0 else 0.0
     return np.full(structure.n_cells, float(value))
 
+@fill_doc
 def step(structure: PlStructure, params: PlParams, x: np.ndarray,
          e: float) -> tuple[float, np.ndarray]:
     """One sample: output ``i = f^-1(w_0 e + sum w_k u_k - V_b)`` from the present state
@@ -247,12 +232,8 @@ def step(structure: PlStructure, params: PlParams, x: np.ndarray,
 
     Parameters
     ----------
-    structure : PlStructure
-        The model's structure.
-    params : PlParams
-        Its parameters.
-    x : numpy.ndarray, shape (N,)
-        Capacitor voltages before the sample.
+    %(structure)s
+    %(state)s
     e : float
         Source voltage of the sample.
 
@@ -267,6 +248,7 @@ def step(structure: PlStructure, params: PlParams, x: np.ndarray,
     return y, x + resistor_current(structure, params, e - x) * structure.dt
 
 
+@fill_doc
 def invert_step(structure: PlStructure, params: PlParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of the inverse: ``u = f(i)`` (eq. 2.17), ``e = (u + V_b - sum w_k u_k) / w_0``
@@ -274,21 +256,15 @@ def invert_step(structure: PlStructure, params: PlParams, x: np.ndarray,
 
     Parameters
     ----------
-    structure : PlStructure
-        The model's structure.
-    params : PlParams
-        Its parameters.
-    x : numpy.ndarray, shape (N,)
-        Capacitor voltages before the sample.
+    %(structure)s
+    %(state)s
     y : float
         Output current to reach at this sample.
 
     Returns
     -------
-    u : float
-        Input that gives `y` from the present state.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(u_step)s
+    %(x_next)s
     """
     x = np.asarray(x, dtype=float)
     e = (float(output_resistor(params, y)) + params.v_b - params.w[1:] @ x) / params.w[0]
@@ -302,15 +278,13 @@ def _check(structure: PlStructure, params: PlParams, inverse: bool) -> None:
         raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 2.20)")
 
 
+@fill_doc
 def kernel_args(structure: PlStructure, params: PlParams) -> tuple:
     """``(I_T, thresholds, knees, p, G, dt)``: the cell arguments of the compiled kernels.
 
     Parameters
     ----------
-    structure : PlStructure
-        The model's structure.
-    params : PlParams
-        Its parameters.
+    %(structure)s
 
     Returns
     -------
@@ -350,27 +324,22 @@ simulate, simulate_reference, invert = family_runs(
                   "feedback through ``-w_k / w_0`` is not stable for every weight set.")
 
 
+@fill_doc
 def states(structure: PlStructure, params: PlParams, u: np.ndarray,
            x0: np.ndarray | float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Capacitor voltages at every sample, shape (n, N), and the final state (weights unused).
 
     Parameters
     ----------
-    structure : PlStructure
-        The model's structure.
-    params : PlParams
-        Its parameters.
-    u : numpy.ndarray, shape (n,)
-        Source voltage sampled every ``structure.dt``.
-    x0 : numpy.ndarray, float or None, optional
-        Initial capacitor voltages, as for :func:`simulate`.
+    %(structure)s
+    %(u_source)s
+    %(x0_capacitors)s
 
     Returns
     -------
     states : numpy.ndarray, shape (n, N)
         Capacitor voltages at every sample.
-    x_end : numpy.ndarray, shape (N,)
-        Capacitor voltages after the last sample.
+    %(x_end_capacitors)s
     """
     _check(structure, params, False)
     u = check_signal(u, "u")

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._cells import DT_RANGE, MAX_CELLS, SLOPE_CAP_MIN, state_bound
+from .._docs import docfiller
 from .._protocol import Record
 from .._validation import (
     check_dt,
@@ -20,6 +21,8 @@ from .._validation import (
     finite_floats,
     freeze_arrays,
 )
+
+fill_doc = docfiller("PlStructure", "PlParams")
 
 # Limits and the documented parameter domain (normalised units, eq. 5.10). The fit's box
 # (I_T in [1e-6, 1e4], V_T in [1e-3, 2], a_j >= 0.05 with sum a_j = M, |w| <= 100) lies
@@ -139,6 +142,7 @@ class PlParams(Record):
         check_magnitude(self.v_b, "v_b")
 
 
+@fill_doc
 def output_bound(structure: PlStructure, params: PlParams, u_max: float,
                  x0_max: float | None = None) -> float:
     """Largest ``|y|`` of a forward run with ``|u| <= u_max`` from ``|x0| <= x0_max``
@@ -146,12 +150,8 @@ def output_bound(structure: PlStructure, params: PlParams, u_max: float,
 
     Parameters
     ----------
-    structure : PlStructure
-        The model's structure.
-    params : PlParams
-        Its parameters.
-    u_max : float
-        Largest input magnitude.
+    %(structure)s
+    %(u_max)s
     x0_max : float, optional
         Largest initial state magnitude; default `u_max` (a start at rest).
 

@@ -51,6 +51,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._docs import docfiller
 from .._run import Runs, family_runs
 from .._validation import check_size
 from . import kernels
@@ -78,6 +79,8 @@ from .staircase import (
     unpack_state,
     update_staircase,
 )
+
+fill_doc = docfiller("PreisachStructure", "PreisachParams", state="x_staircase")
 
 __all__ = [
     "MAX_CAPACITY",
@@ -114,14 +117,14 @@ def _slope(params: PreisachParams) -> float:
     return float(params.everett[-1, 0])
 
 
+@fill_doc
 def kernel_parts(params: PreisachParams) -> tuple[np.ndarray, bool, np.ndarray, float]:
     """What the compiled kernels run on: tables (1, L, L), weighted (False), output polynomial
     (the offset) and the slope of the straight-line extension.
 
     Parameters
     ----------
-    params : PreisachParams
-        The model's parameters.
+    %(params)s
 
     Returns
     -------
@@ -138,26 +141,13 @@ def kernel_parts(params: PreisachParams) -> tuple[np.ndarray, bool, np.ndarray, 
             _slope(params))
 
 
+@fill_doc
 def step(structure: PreisachStructure, params: PreisachParams, x: np.ndarray,
          u: float) -> tuple[float, np.ndarray]:
-    """One sample: update the staircase with ``u``, then the output (eq. 9.13 + extension).
+    """One sample: update the staircase with the normalised input ``u``, then the output (eq. 9.13
+    + extension; ``x_next``: the staircase after the sample).
 
-    Parameters
-    ----------
-    structure : PreisachStructure
-        The model's structure.
-    params : PreisachParams
-        Its parameters.
-    x : numpy.ndarray, shape (k,)
-        Staircase before the sample.
-    u : float
-        Normalised input of the sample.
-
-    Returns
-    -------
-    y : float
-    x_next : array, shape (k,)
-        Staircase after the sample.
+    %(step)s
     """
     x_next = update_staircase(x, u, structure.capacity)
     u_clip = x_next[-1]
@@ -228,16 +218,15 @@ def check_rise(rise: float, mass: float, model: str) -> None:
                                f"needed); it has no inverse")
 
 
+@fill_doc
 def output_bound(params: PreisachParams, u_max: float) -> float:
     """``|y_0| + sum |m| max(1, u_max)``: no output of a run with ``|u| <= u_max`` exceeds it
     (each cell contributes at most ``|m|``; beyond [-1, 1] the line of slope ``F(1, -1)``).
 
     Parameters
     ----------
-    params : PreisachParams
-        The model's parameters.
-    u_max : float
-        Largest input magnitude.
+    %(params)s
+    %(u_max)s
 
     Returns
     -------
@@ -247,27 +236,12 @@ def output_bound(params: PreisachParams, u_max: float) -> float:
     return float(abs(params.offset) + np.abs(params.masses()).sum() * max(1.0, u_max))
 
 
+@fill_doc
 def invert_step(structure: PreisachStructure, params: PreisachParams, x: np.ndarray,
                 y: float) -> tuple[float, np.ndarray]:
     """One sample of :func:`invert` from the staircase ``x``: ``(u_hat, x_next)``.
 
-    Parameters
-    ----------
-    structure : PreisachStructure
-        The model's structure.
-    params : PreisachParams
-        Its parameters.
-    x : numpy.ndarray, shape (k,)
-        Staircase before the sample.
-    y : float
-        Output to reach at this sample.
-
-    Returns
-    -------
-    u : float
-        Input that gives `y` from the present state.
-    x_next : numpy.ndarray
-        State after the sample.
+    %(invert_step)s
     """
     u_hat, x_next = invert(structure, params, np.array([float(y)]), x0=x)
     return float(u_hat[0]), x_next

@@ -9,12 +9,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._docs import docfiller
 from .._protocol import Record
 from .._validation import (
     check_dt,
     check_magnitude,
     check_structure_size,
 )
+
+fill_doc = docfiller(params="PreisachParams")
 
 # Limits. The fit's design matrix holds n_samples x L (L - 1) / 2 floats: at L = 128 and 8000
 # samples 0.5 GB (measured: 1.5 GB peak, 2.5 min); L = 512 would need 8.4 GB. A run holds one
@@ -225,13 +228,13 @@ class PreisachParams(Record):
         return cls(everett=e, offset=d["offset"])
 
 
+@fill_doc
 def everett(params: PreisachParams, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     """Interpolated Everett function ``F(alpha, beta)`` (any shapes that broadcast, in [-1, 1]).
 
     Parameters
     ----------
-    params : PreisachParams
-        The model's parameters.
+    %(params)s
     alpha, beta : numpy.ndarray
         Switching-up and switching-down inputs in [-1, 1].
 
