@@ -58,9 +58,7 @@ inverse : bool, default False
     Initial capacitor voltages, as for :func:`simulate`.""",
     "x_end_capacitors": """x_end : numpy.ndarray, shape (N,)
     Capacitor voltages after the last sample.""",
-    # the cells' resistors and the output branch of the cubic-output families
-    "v_cells": """v : numpy.ndarray, shape (..., N)
-    Voltage across each cell's resistor.""",
+    # the output branch of the cubic-output families
     "branch": """lo, hi : float
     The branch's bounds (``+-inf`` where unbounded).
 sign : float
@@ -87,6 +85,27 @@ accept_reason : str, optional
     The best start's fit.""",
     "state": "{state}",
     # whole sections of the protocol functions whose signature means the same everywhere
+    "cell_voltages": """Parameters
+----------
+""" + _RECORDS + """
+v : numpy.ndarray, shape (..., N)
+    Voltage across each cell's resistor.
+
+Returns
+-------
+numpy.ndarray, shape (..., N)
+    One value per cell and voltage.""",
+    "params_bound": """Parameters
+----------
+params : {Params}
+    The model's parameters.
+u_max : float
+    Largest input magnitude.
+
+Returns
+-------
+float
+    The bound on ``|y|``.""",
     "rest_state": """Parameters
 ----------
 """ + _RECORDS + """

@@ -225,15 +225,7 @@ def output_bound(params: GPreisachParams, u_max: float) -> float:
     """``|y_0| + B max(1, u_max)`` (class Notes): no output of a run with ``|u| <= u_max``
     exceeds it.
 
-    Parameters
-    ----------
-    %(params)s
-    %(u_max)s
-
-    Returns
-    -------
-    float
-        The bound on ``|y|``.
+    %(params_bound)s
     """
     return float(abs(params.offset) + _mass(params) * max(1.0, u_max))
 

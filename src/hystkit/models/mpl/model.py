@@ -234,18 +234,11 @@ def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:
 
 @fill_doc
 def resistor_current(structure: MplStructure, params: MplParams, v: np.ndarray) -> np.ndarray:
-    """Limited cell-resistor currents ``f_k,lim(v)`` (eq. 5.1 with eq. 5.29, corrected).
+    """Limited cell-resistor currents ``f_k,lim(v)`` (eq. 5.1 with eq. 5.29, corrected):
+    ``2 I_S sinh(v / V_T)`` inside the knees, the straight line of slope ``slope_cap / dt``
+    beyond.
 
-    Parameters
-    ----------
-    %(structure)s
-    %(v_cells)s
-
-    Returns
-    -------
-    array, shape (..., N)
-        Current through each cell's resistor: ``2 I_S sinh(v / V_T)`` inside the knees, the
-        straight line of slope ``slope_cap / dt`` beyond.
+    %(cell_voltages)s
     """
     v = np.asarray(v, dtype=float)
     knee = knee_voltage(structure, params)

@@ -64,15 +64,7 @@ def resistor_current(structure: MplPolyStructure, params: MplPolyParams,
                      v: np.ndarray) -> np.ndarray:
     """Cell currents ``f_k,lim(v)`` (eq. 5.16 with 5.29 when ``structure.limit``).
 
-    Parameters
-    ----------
-    %(structure)s
-    %(v_cells)s
-
-    Returns
-    -------
-    numpy.ndarray, shape (..., N)
-        The cell currents.
+    %(cell_voltages)s
     """
     return _resistor(structure, params, v)[0]
 
@@ -82,15 +74,7 @@ def resistor_slope(structure: MplPolyStructure, params: MplPolyParams,
                    v: np.ndarray) -> np.ndarray:
     """Slopes ``f'_k,lim(v)``, shape (..., N): the cells' rates in eq. 5.20 and 5.26.
 
-    Parameters
-    ----------
-    %(structure)s
-    %(v_cells)s
-
-    Returns
-    -------
-    numpy.ndarray, shape (..., N)
-        The slopes.
+    %(cell_voltages)s
     """
     return _resistor(structure, params, v)[1]
 

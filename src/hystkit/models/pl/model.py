@@ -100,14 +100,7 @@ def _cells(structure: PlStructure, params: PlParams) -> tuple[np.ndarray, np.nda
 def resistor_current(structure: PlStructure, params: PlParams, v: np.ndarray) -> np.ndarray:
     """Cell-resistor currents ``d_k(v)`` (eq. 2.16 with the straight branches).
 
-    Parameters
-    ----------
-    %(structure)s
-    %(v_cells)s
-
-    Returns
-    -------
-    array, shape (..., N)
+    %(cell_voltages)s
     """
     v = np.asarray(v, dtype=float)
     thr, knee, g_lin = _cells(structure, params)
@@ -122,15 +115,7 @@ def resistor_slope(structure: PlStructure, params: PlParams, v: np.ndarray) -> n
     """Slopes ``d'_k(v)``, shape (..., N): ``p I_T / ((p - 1) k V_T) |v / k V_T|^(p - 1)``
     inside the knee, ``G`` on the straight branches (the cells' rates in a linearisation).
 
-    Parameters
-    ----------
-    %(structure)s
-    %(v_cells)s
-
-    Returns
-    -------
-    numpy.ndarray, shape (..., N)
-        The slopes.
+    %(cell_voltages)s
     """
     v = np.asarray(v, dtype=float)
     thr, knee, g_lin = _cells(structure, params)

@@ -223,15 +223,7 @@ def output_bound(params: PreisachParams, u_max: float) -> float:
     """``|y_0| + sum |m| max(1, u_max)``: no output of a run with ``|u| <= u_max`` exceeds it
     (each cell contributes at most ``|m|``; beyond [-1, 1] the line of slope ``F(1, -1)``).
 
-    Parameters
-    ----------
-    %(params)s
-    %(u_max)s
-
-    Returns
-    -------
-    float
-        The bound on ``|y|``.
+    %(params_bound)s
     """
     return float(abs(params.offset) + np.abs(params.masses()).sum() * max(1.0, u_max))
 
