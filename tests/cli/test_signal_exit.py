@@ -81,7 +81,8 @@ def test_end_workers_without_multiprocessing_does_nothing() -> None:
 
 # The program (`hystkit.cli.program`) around a stand-in command that leaves what a signal can
 # leave: an object whose finaliser fails at the interpreter's exit and a line still buffered
-# for a stdout pipe that has no reader. With SIGNAL set, a signal stops the command.
+# for a stdout pipe that has no reader. With SIGNAL set, a signal stops the command; with AGAIN,
+# Ctrl-C comes again during the exit.
 _PROGRAM = """\
 import atexit, os, signal, sys
 import hystkit.cli._main as _main
@@ -97,6 +98,9 @@ def command(argv):
         with signals_as_exceptions():
             atexit.register([HalfBuilt()].clear)  # released at the interpreter's exit
             print("a line still in the buffer")
+            if "AGAIN" in os.environ:  # a second Ctrl-C while the interpreter exits
+                atexit.register(lambda: (os.kill(os.getpid(), signal.SIGINT),
+                                         print("the exit went on", file=sys.stderr)))
             if "SIGNAL" in os.environ:
                 os.kill(os.getpid(), int(os.environ["SIGNAL"]))
             return 0
@@ -137,3 +141,9 @@ def test_without_a_signal_a_failing_finaliser_is_shown_and_a_gone_reader_is_exit
     assert code == 1  # the interpreter's own flush would have made it 120
     assert "BrokenPipeError" not in err
     assert "a finaliser of something the signal cut short" in err  # only a signal hides it
+
+
+def test_a_second_ctrl_c_during_the_exit_ends_the_process_by_sigint() -> None:
+    code, err = _program_into_a_closed_pipe(SIGNAL=str(int(signal.SIGINT)), AGAIN="1")
+    assert code == -signal.SIGINT  # at once, by the signal: a shell reports 130
+    assert err.splitlines() == ["hystkit: interrupted"]

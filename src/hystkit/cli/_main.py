@@ -25,7 +25,7 @@ from .._compilation import announce
 from ..errors import HystkitError, Terminated
 from . import _commands
 from ._common import INTERNAL_EXIT, Parser
-from ._signals import end_workers, quiet_finalisers, received_signal, signals_as_exceptions
+from ._signals import end_workers, quiet_exit, received_signal, signals_as_exceptions
 
 __all__ = ["main", "program"]
 
@@ -124,9 +124,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     otherwise (`_BLAS_THREAD_VARIABLES`), and a run that has to compile numba kernels says
     so on stderr (`COMPILING_NOTICE`); stopped by a signal, it terminates and joins the
     workers the command forked (`hystkit.cli._signals.end_workers`) before returning 130 or
-    143, so that the interpreter's exit has none to wait for, nor reports the finalisers the
-    signal cut short; and it flushes stdout itself, so that a reader that left is exit 1 (or
-    the signal's code), not a traceback.
+    143, so that the interpreter's exit has none to wait for, and that exit says nothing more
+    (`hystkit.cli._signals.quiet_exit`); and it flushes stdout itself, so that a reader that
+    left is exit 1 (or the signal's code), not a traceback.
 
     Parameters
     ----------
@@ -150,7 +150,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     code = _main(argv)
     if argv is None and received_signal() is not None:
         end_workers()  # the interpreter's exit would join them
-        quiet_finalisers()
+        quiet_exit()
     if argv is None:
         code = _flush_streams(code)
         gc.freeze()  # the shutdown's collections skip the frozen heap

@@ -10,7 +10,7 @@ terminal signals the whole process group) or when terminated they end without a 
 the parent reports once; a worker a pool forks after the signal (one still starting) ends at
 once, by that signal's default action. Before the stopped program exits, `end_workers` joins
 every worker, so multiprocessing's exit handlers have none left to wait for, and
-`quiet_finalisers` keeps the interpreter's exit from reporting what the signal cut short.
+`quiet_exit` keeps the interpreter's exit from reporting what the signal cut short.
 """
 
 from __future__ import annotations
@@ -72,12 +72,16 @@ def end_workers(timeout: float = 5.0) -> None:
             child.join()
 
 
-def quiet_finalisers() -> None:
-    """After a signal, finalisers that fail at the interpreter's exit are not shown: they belong
-    to objects the signal left half-built (a multiprocessing ``Finalize`` interrupted before
-    its key, an LLVM handle of a compilation cut short). ``HYSTKIT_DEBUG=1`` shows them."""
+def quiet_exit() -> None:
+    """The exit of a program a signal stopped says nothing more: finalisers that fail then are
+    not shown, as they belong to objects the signal left half-built (a multiprocessing
+    ``Finalize`` interrupted before its key, an LLVM handle of a compilation cut short;
+    ``HYSTKIT_DEBUG=1`` shows them), and a second Ctrl-C meanwhile ends the process at once by
+    SIGINT's default action (a shell's 130 still), not with a KeyboardInterrupt's traceback."""
     if os.environ.get("HYSTKIT_DEBUG", "") in ("", "0"):
         sys.unraisablehook = _ignore_unraisable
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not an ignored one
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def _ignore_unraisable(unraisable: object) -> None:
