@@ -20,6 +20,7 @@ from hystkit.errors import OutputError, OutputExistsError
 
 # check_folder_writable: re-exported for cli.cmd_report, which imports it from here.
 from ._output_checks import TEMP_MARK, check_folder_writable, check_output_folder, check_output_path
+from ._unfinished import forget, register
 
 __all__ = ["atomic_folder", "atomic_output", "atomic_outputs", "check_folder_writable"]
 
@@ -101,6 +102,7 @@ def _staged(target: Path, make: Callable[[Path], Path], publish: Callable[[Path]
             raise OutputError(f"{target}: cannot write ({exc.strerror or exc})") from None
     finally:
         discard(tmp)
+        forget(tmp)
         if not done:
             _remove_folders(created)
 
@@ -129,11 +131,13 @@ def _create_temporary(path: Path) -> Path:
     """Exclusively create an empty hidden file beside `path` (mode from the umask, unlike
     mkstemp's 0600, so the published file gets the usual permissions)."""
     while True:
-        tmp = path.with_name(f".{path.stem}{TEMP_MARK}{secrets.token_hex(4)}{path.suffix}")
+        tmp = register(path.with_name(f".{path.stem}{TEMP_MARK}{secrets.token_hex(4)}"
+                                      f"{path.suffix}"))
         try:
             os.close(os.open(tmp, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666))
             return tmp
-        except FileExistsError:
+        except FileExistsError:  # another writer's
+            forget(tmp)
             continue
 
 
@@ -208,11 +212,13 @@ def _create_temporary_folder(out: Path) -> Path:
     while True:
         name = f".{os.path.basename(os.path.abspath(out)) or 'out'}{TEMP_MARK}" \
                f"{secrets.token_hex(4)}"
-        tmp = out / name if out.is_dir() else Path(os.path.abspath(out)).with_name(name)
+        tmp = register(out / name if out.is_dir()
+                       else Path(os.path.abspath(out)).with_name(name))
         try:
             tmp.mkdir()
             return tmp
-        except FileExistsError:
+        except FileExistsError:  # another writer's
+            forget(tmp)
             continue
 
 

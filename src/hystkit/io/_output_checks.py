@@ -14,6 +14,8 @@ from pathlib import Path
 
 from hystkit.errors import OutputError, OutputExistsError
 
+from ._unfinished import forget, register
+
 __all__ = ["TEMP_MARK", "check_folder_writable", "check_output_folder", "check_output_format",
            "check_output_path"]
 
@@ -184,13 +186,15 @@ def check_folder_writable(folder: Path, *, what: str | os.PathLike[str] | None =
     if not os.access(existing, os.W_OK | os.X_OK):
         raise OutputError(f"{what}: cannot write into {existing} (permission denied)")
     # os.access says yes to root and knows nothing of read-only mounts or /proc: try it.
-    probe = existing / f".hystkit-probe{TEMP_MARK}{secrets.token_hex(4)}"
+    probe = register(existing / f".hystkit-probe{TEMP_MARK}{secrets.token_hex(4)}")
     try:
         os.close(os.open(probe, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o600))
     except OSError as exc:
+        forget(probe)
         raise OutputError(f"{what}: cannot write into {existing} "
                           f"({exc.strerror or exc})") from None
     probe.unlink(missing_ok=True)
+    forget(probe)
 
 
 def _same_file(a: Path, b: Path) -> bool:
