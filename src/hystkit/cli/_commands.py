@@ -29,12 +29,6 @@ class Command:
     options: str  # "module:function": add_options(parser)
     run: str | None = None  # "module:function" taking the parsed namespace
 
-    @property
-    def registers(self) -> bool:
-        """Whether `options` is a module's ``register(sub)``: no row is any more (kept while
-        `hystkit.cli._main` still asks)."""
-        return self.options.endswith(":register")
-
 
 def resolve(reference: str) -> Callable:
     """The function ``"module:function"`` names (a module of ``hystkit.cli``), imported now."""

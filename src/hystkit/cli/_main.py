@@ -72,29 +72,11 @@ def _parser(command: str | None = None, *, options: bool = True) -> Parser:
 
 def _add_options(row: _commands.Command, p: Parser) -> None:
     """Add `row`'s options (and ``--force`` unless it has one) and its run function to `p`."""
-    if row.registers:
-        _commands.resolve(row.options)(_OneParser(row.name, p))
-    else:
-        _commands.resolve(row.options)(p)
-        if row.run is not None:
-            p.set_defaults(run=row.run)
+    _commands.resolve(row.options)(p)
+    if row.run is not None:
+        p.set_defaults(run=row.run)
     if not any("--force" in a.option_strings for a in p._actions):
         p.add_argument("--force", action="store_true", help="overwrite existing output files")
-
-
-class _OneParser:
-    """What a module's ``register(sub)`` is handed: `parser` for `name`, a throwaway parser
-    for the module's other subcommands (their own rows add them when chosen)."""
-
-    def __init__(self, name: str, parser: Parser):
-        self.name, self.parser = name, parser
-
-    def add_parser(self, name: str, **kwargs) -> Parser:
-        if name != self.name:
-            return Parser(prog=name)
-        if kwargs.get("description"):
-            self.parser.description = kwargs["description"]
-        return self.parser
 
 
 def _named_command(argv: Sequence[str]) -> str | None:
