@@ -91,12 +91,16 @@ def test_a_robust_loss_is_refused_before_any_work_for_a_linear_model(recordings)
 # --- fits -----------------------------------------------------------------------------------
 
 def test_unit_weights_give_the_unweighted_compensator(recordings):
+    """The same minimum, compared where it is determined: the cost, and what the compensator
+    estimates. The two take different searches (a weighted fit runs on scipy's trf, a plain
+    1-cell mPL fit projects its weights out), which end at different points of a flat valley:
+    the parameters differ by up to 2e-4 relative at costs 1.2e-9 apart (the plain one lower)."""
     rec = recordings[0]
     plain = fit_compensator(rec, 1, diagnose=False)
     ones = fit_compensator(rec, 1, diagnose=False, weights="w",
                            other_columns=[{"w": np.ones(rec.n_samples)}])
-    np.testing.assert_allclose(flatten_params(ones.params)[0], flatten_params(plain.params)[0],
-                               rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(ones.estimate(rec.sensor), plain.estimate(rec.sensor), rtol=0,
+                               atol=1e-5 * np.ptp(rec.position))
     info = ones.fit_info
     assert info["cost"] == pytest.approx(plain.fit_info["cost"], rel=1e-8)
     assert (info["loss"], info["weights"]) == ("linear", "w")
