@@ -168,7 +168,7 @@ def test_evaluate_counts_what_the_verdict_judges():
     assert scores["n_sensor_far_outside"] == int(comp.sensor_outside(big, FAR_MARGIN).sum()) > 0
     assert scores["n_estimate_far_outside"] == int(
         comp.estimate_outside(estimate, FAR_MARGIN).sum()) > 0
-    assert use_verdict(comp, big, scores, "big") == verdict(
+    assert use_verdict(scores, "big") == verdict(
         scores["r2"], scores["linear_r2"], "big",
         scores["n_sensor_far_outside"] / scores["n_samples"],
         scores["n_estimate_far_outside"] / scores["n_samples"])

@@ -185,7 +185,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     print(f"outside training: {_count(scores['n_sensor_outside'])} sensor samples, "
           f"{_count(scores['n_estimate_outside'])} estimates")
     # the shared verdict, on the deployable scores: what a compensator in use would give
-    status, message = use_verdict(comp, rec, scores, f"{opts.data}: deployable")
+    status, message = use_verdict(scores, f"{opts.data}: deployable")
     scores["verdict"], scores["verdict_message"] = status, message
     if opts.json is not None:
         write_json(scores, opts.json, force=opts.force)

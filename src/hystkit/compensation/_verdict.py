@@ -113,21 +113,15 @@ def verdict(r2_model: float | None, r2_line: float | None, where: str,
     return "ok", f"{where} R² {r2_model:.4f} (straight line {line})"
 
 
-def use_verdict(compensator, recording, scores: dict, where: str) -> tuple[str, str]:
-    """:func:`verdict` of a compensator on a recording from :func:`~._evaluate.evaluate`'s
-    deployable scores, with the shares of its sensor samples and of its estimates far outside
-    the training ranges.
+def use_verdict(scores: dict, where: str) -> tuple[str, str]:
+    """:func:`verdict` of a compensator on one recording from :func:`~._evaluate.evaluate`'s
+    deployable scores, which carry the counts of sensor samples and estimates far outside
+    the training ranges (:func:`pooled_verdict` of one recording).
 
     Parameters
     ----------
-    compensator : Compensator
-        The fitted compensator.
-    recording : Recording
-        The scored recording.
     scores : dict
-        ``evaluate(compensator, recording)``: it carries the far-outside counts
-        (``n_sensor_far_outside``, ``n_estimate_far_outside``), so the verdict needs no second
-        run of the model.
+        ``evaluate(compensator, recording)``.
     where : str
         What the scores are of, for the message.
 

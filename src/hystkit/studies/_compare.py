@@ -171,7 +171,7 @@ def _compare_piece(piece: tuple[str, int | None, str], *, fit_rec: Recording,
             return _forward_scores(name, size, fit_rec, val_rec)
         comp = fit_compensator(fit_rec, size, model=name, diagnose=False)
         direct = evaluate(comp, val_rec)
-        use, why = use_verdict(comp, val_rec, direct, "validation (deployable)")
+        use, why = use_verdict(direct, "validation (deployable)")
         entry = {"center": direct["center"], "direct_status": comp.fit_info["status"],
                  "verdict": use, "verdict_message": why}
         for suffix in ("", "_oracle"):

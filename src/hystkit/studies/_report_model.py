@@ -255,7 +255,7 @@ def compensator_sections(comp: Compensator, recordings: Mapping[str, Recording],
     for name, rec in recordings.items():
         scores[name] = evaluate(comp, rec)
         scores[name]["verdict"], scores[name]["verdict_message"] = use_verdict(
-            comp, rec, scores[name], "deployable")
+            scores[name], "deployable")
         shown[name] = (rec, comp.estimate(rec), comp.estimate_linear(rec))
         if comp.band is not None:
             bands[name] = interval(comp, rec, shown[name][1])
