@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from hystkit.cli._common import GUARD_EXIT
+from hystkit.cli._next_step import next_step
 from hystkit.io import read_recording, write_recording
 
 from ..cli_support import run_cli
@@ -205,6 +206,18 @@ def test_a_fit_that_explains_too_little_is_sent_to_other_models_then_the_sensor(
     ("guided", "more recordings of the device (one per run) or 'hystkit select DATA --models"),
 ])
 def test_a_selection_with_only_poor_candidates_asks_for_data_or_more_families(command, start):
-    from hystkit.cli._next_step import next_step
-
     assert next_step("poor", command=command, model="mpl", size=1).startswith(start)
+
+
+@pytest.mark.parametrize(("training_line_r2", "start"), [
+    (0.94, "checking that this file's columns"),  # the line worked in training: wiring?
+    (None, "checking that this file's columns"),  # a model file without it: as before
+    # an MR damper: force against displacement is no line in training either (0.006), so a
+    # line at 0.005 on the judged run says nothing about its columns (25 mm, 1 A, fitted at
+    # 0.5 Hz, judged at 0.25 Hz: R² -20.4)
+    (0.006, "refitting on recordings like these"),
+])
+def test_columns_are_suspected_only_where_the_line_worked_in_training(training_line_r2, start):
+    step = next_step("worse_than_line", command="evaluate", line_r2=0.005,
+                     training_line_r2=training_line_r2)
+    assert step.startswith(start)

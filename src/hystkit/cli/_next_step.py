@@ -21,7 +21,7 @@ _COLUMNS = ("checking the columns: the sensor column may not carry the position 
 
 def next_step(status: str, *, command: str = "fit", model: str | None = None,
               size: int | None = None, mode: str = "direct", line_r2: float | None = None,
-              outside: float | None = None) -> str:
+              training_line_r2: float | None = None, outside: float | None = None) -> str:
     """What to try after a refusal whose reason is `status`, as the words after ``next: try``.
 
     Parameters
@@ -40,13 +40,19 @@ def next_step(status: str, *, command: str = "fit", model: str | None = None,
     line_r2 : float, optional
         R² of the straight line on the same data: a model below a line that explains nothing
         either (a noise-only sensor) is a sensor problem, not a model's.
+    training_line_r2 : float, optional
+        R² of the model's straight line on its training data (``evaluate``): where it explained
+        nothing there either (an MR damper's force against its displacement), a line that
+        explains nothing on the judged file says nothing about its columns.
     outside : float, optional
         Share of the judged sensor samples far outside the training range (``evaluate``): when
         it is above the verdict's limit, the data left the model's range, and a refit on data
         that cover it comes first, whatever the scores.
     """
     far_outside = command == "evaluate" and outside is not None and outside > MAX_OUTSIDE
-    if status == "worse_than_line" and line_r2 is not None and line_r2 < MIN_EXPLAINED:
+    line_carried_signal = training_line_r2 is None or training_line_r2 >= MIN_EXPLAINED
+    if (status == "worse_than_line" and line_r2 is not None and line_r2 < MIN_EXPLAINED
+            and line_carried_signal):
         status = "no_signal"
     if far_outside and status == "no_signal":  # swapped columns, or data beyond the range
         return (f"{_EVALUATE_COLUMNS}; if they are, refitting on recordings that cover this "

@@ -201,6 +201,7 @@ def _evaluate(args: argparse.Namespace) -> int:
               f"{comp.model} compensator on data like these", file=sys.stderr)
         far = comp.sensor_outside(rec, margin=FAR_MARGIN)
         say_next(next_step(status, command="evaluate", line_r2=scores["linear_r2"],
+                           training_line_r2=comp.fit_info.get("training_linear_r2"),
                            outside=None if far is None else float(far.mean())))
         return GUARD_EXIT
     print(f"verdict: {status} ({message})")
