@@ -4,18 +4,15 @@ their references, and the summary of what it learnt (:mod:`hystkit.live._adaptiv
 
 from __future__ import annotations
 
-import argparse
 import math
 
-from ..errors import FitDivergedError, InputError
+from ..errors import FitDivergedError
 from ..live import Adaptation, AdaptiveStream, Refit, RefittingStream
-from ._stream_defaults import DEFAULT_FORGETTING, DEFAULT_REFIT_EVERY, DEFAULT_WINDOW
+from ._stream_defaults import DEFAULT_REFIT_EVERY, DEFAULT_WINDOW
 from ._stream_lines import Reading, Tally, reference_of
+from ._stream_options import StreamOptions
 
-__all__ = ["Learning", "adaptive_stream", "check_adapt_options", "run_line"]
-
-ADAPT_OPTIONS = ("prior_gain", "prior_offset")
-REFIT_OPTIONS = ("window", "refit_every")
+__all__ = ["Learning", "adaptive_stream", "run_line"]
 
 
 class Learning:
@@ -99,39 +96,14 @@ def run_line(stream: AdaptiveStream | RefittingStream, line: str, reading: Readi
     return f"{text},{result.estimate!r},{flags}{band}\n"
 
 
-def check_adapt_options(args: argparse.Namespace) -> None:
-    """Refuse the adaptation options that the chosen ``--adapt`` (or none) does not take;
-    ``--forgetting``'s default for gain and weights."""
-    def given(names: tuple[str, ...]) -> list[str]:
-        return [f"--{k.replace('_', '-')}" for k in names if getattr(args, k) is not None]
-
-    if args.adapt is None:
-        if used := given(("forgetting", *ADAPT_OPTIONS)):
-            raise InputError(f"{', '.join(used)} only {_verb(used)} with --adapt")
-        if used := given(REFIT_OPTIONS):
-            raise InputError(f"{', '.join(used)} only {_verb(used)} with --adapt full")
-    elif args.adapt == "full":
-        if used := given(("forgetting", *ADAPT_OPTIONS)):
-            raise InputError(f"{', '.join(used)} {_verb(used)} to --adapt gain or weights, "
-                             f"not full")
-    else:
-        if used := given(REFIT_OPTIONS):
-            raise InputError(f"{', '.join(used)} only {_verb(used)} with --adapt full")
-        if args.forgetting is None:
-            args.forgetting = DEFAULT_FORGETTING
-
-
-def _verb(options: list[str]) -> str:
-    return "applies" if len(options) == 1 else "apply"
-
-
-def adaptive_stream(args: argparse.Namespace, comp,
-                    start) -> AdaptiveStream | RefittingStream:
+def adaptive_stream(options: StreamOptions, comp, start) -> AdaptiveStream | RefittingStream:
     """The adapting stream ``--adapt`` and its options ask for."""
-    if args.adapt == "full":
-        refit = Refit(DEFAULT_WINDOW if args.window is None else args.window,
-                      DEFAULT_REFIT_EVERY if args.refit_every is None else args.refit_every)
-        return RefittingStream(comp, refit, start, label=str(args.model))
-    options = {k: getattr(args, k) for k in ADAPT_OPTIONS if getattr(args, k) is not None}
-    adaptation = Adaptation(args.adapt, args.forgetting, **options)
-    return AdaptiveStream(comp, adaptation, start, label=str(args.model), level=args.level)
+    if options.adapt == "full":
+        refit = Refit(DEFAULT_WINDOW if options.window is None else options.window,
+                      DEFAULT_REFIT_EVERY if options.refit_every is None
+                      else options.refit_every)
+        return RefittingStream(comp, refit, start, label=str(options.model))
+    priors = {k: v for k, v in (("prior_gain", options.prior_gain),
+                                ("prior_offset", options.prior_offset)) if v is not None}
+    adaptation = Adaptation(options.adapt, options.forgetting, **priors)
+    return AdaptiveStream(comp, adaptation, start, label=str(options.model), level=options.level)

@@ -19,13 +19,12 @@ The output keeps the input's names as ``compensate`` does (`output_header`): the
 under the input's name and unit (echoed as received), the estimate and band named after the
 position column (``x_mm_estimate``, ...). A model that remembers how its training files were
 read (their ``reading``) reads stdin and a serial port that way too unless ``--columns`` or
-``--time-unit`` say otherwise (`live_as_trained`): a live input cannot be looked at before the
+``--time-unit`` say otherwise (`reading_options`): a live input cannot be looked at before the
 output's header is written.
 """
 
 from __future__ import annotations
 
-import argparse
 import re
 import sys
 from dataclasses import dataclass, replace
@@ -34,12 +33,12 @@ from pathlib import Path
 from .._read_options import FIELDS
 from ..errors import InputError
 from ..io import ReadOptions, csv_layout, options_for, settings_for
-from ._common import given_read_options
-from ._own_layout import estimate_names
+from ._own_layout import estimate_names, remembered_options
+from ._stream_options import StreamOptions
 from ._stream_read import lines_of
 
-__all__ = ["Rewriter", "StreamFormat", "live_as_trained", "nothing_compensated",
-           "output_header", "stream_format"]
+__all__ = ["Rewriter", "StreamFormat", "nothing_compensated", "output_header",
+           "reading_options", "stream_format"]
 
 _NUMBER = re.compile(r"\s*[+-]?(\d+[.,]?\d*|[.,]\d+)([eE][+-]?\d+)?\s*")
 
@@ -86,11 +85,12 @@ class StreamFormat:
         return replace(self, position="position", time_scale=1.0) == StreamFormat()
 
 
-def stream_format(args: argparse.Namespace) -> StreamFormat:
-    """The format of the stream's input: for ``--in FILE``, its settings file (``my.toml``),
-    then the command line, then what `hystkit.io.csv_layout` detects; for stdin and a serial
-    port, the command line (a comma and decimal points unless given). What was applied or
-    detected is said on stderr (stdout carries the estimates).
+def stream_format(path: Path | None, given: dict) -> StreamFormat:
+    """The format of the stream's input read with the reading options `given`
+    (`hystkit.io.ReadOptions` keyword arguments): for ``--in FILE`` (`path`), its settings
+    file (``my.toml``), then `given`, then what `hystkit.io.csv_layout` detects; for stdin and
+    a serial port (`path` None), `given` (a comma and decimal points unless given). What was
+    applied or detected is said on stderr (stdout carries the estimates).
 
     Raises
     ------
@@ -98,16 +98,16 @@ def stream_format(args: argparse.Namespace) -> StreamFormat:
         ``--resample`` or ``--mat-var`` (a stream takes samples as they come), or a settings
         file or layout that `hystkit.io` refuses.
     """
-    given = given_read_options(args)
-    refused = [f"--{k}" for k in ("resample", "mat_var") if getattr(args, k, None) is not None]
+    refused = [option for option, key in (("--resample", "resample_hz"), ("--mat-var", "mat_var"))
+               if key in given]
     missing = given.get("missing") == "interpolate"
     refused += ["--missing interpolate"] if missing else []
     if refused:
-        raise InputError(f"{', '.join(refused).replace('_', '-')}: stream compensates the "
+        raise InputError(f"{', '.join(refused)}: stream compensates the "
                          "samples of a text input as they come (resample the file, or read "
                          "it with compensate)" + ("; a line missing a value is skipped and "
                                                   "counted" if missing else ""))
-    if args.input is None:
+    if path is None:
         try:
             options = ReadOptions(**given)
         except ValueError as exc:
@@ -115,7 +115,7 @@ def stream_format(args: argparse.Namespace) -> StreamFormat:
         sep = "," if options.sep == "auto" else options.sep
         decimal = "." if options.decimal == "auto" else options.decimal
         return _format(options, sep, decimal)
-    path = Path(args.input)
+    path = Path(path)
     options, settings = options_for(path, given)
     note = settings_for(path)[1] if settings is None else ""
     if settings is not None:
@@ -153,23 +153,45 @@ def output_header(fmt: StreamFormat, banded: bool) -> str:
     return f"{fmt.time},{new['position_estimate']},flags{band}\n"
 
 
-def live_as_trained(args: argparse.Namespace, reading) -> None:
-    """stdin or a serial port read as the model's training files were (their columns and
-    time unit, `reading`), unless ``--columns`` or ``--time-unit`` is given: put it on `args`
-    as if given, and say so on stderr. No units line: a live input has none to look for."""
-    if args.input is not None or reading is None or not (reading.columns
-                                                         or reading.time_unit != "s"):
-        return
-    given = given_read_options(args)
+def reading_options(options: StreamOptions, reading: ReadOptions | None) -> dict:
+    """The reading options to read the input with (`hystkit.io.ReadOptions` keyword
+    arguments): those given on the command line, and how the model's training files were
+    read (`reading`) where that applies, as if given, said on stderr. ``--in FILE``: when the
+    file has the training files' column names (`hystkit.cli._own_layout.remembered_options`);
+    stdin or a serial port: their columns and time unit unless ``--columns`` or
+    ``--time-unit`` is given, no units line (a live input has none to look for)."""
+    given = options.given
+    if options.input is not None:
+        return _file_as_trained(Path(options.input), given, reading)
+    if reading is None or not (reading.columns or reading.time_unit != "s"):
+        return given
     if "columns" in given or "time_unit" in given:
-        return
-    args.columns, args.time_unit = reading.columns, reading.time_unit
+        return given
     parts = [f"columns {','.join(reading.name(field) for field in FIELDS)}"] \
         if reading.columns else []
     parts.append(f"time in {reading.time_unit}")
-    source = "<stdin>" if args.serial is None else str(args.serial)
-    _say(f"reading {source} as the model's training data were read: {', '.join(parts)} "
-         "(--columns and --time-unit read it otherwise)")
+    _say(f"reading {options.source} as the model's training data were read: "
+         f"{', '.join(parts)} (--columns and --time-unit read it otherwise)")
+    return _as_given(given, columns=reading.columns, time_unit=reading.time_unit)
+
+
+def _file_as_trained(path: Path, given: dict, reading: ReadOptions | None) -> dict:
+    """`given` with the model's reading of the file `path`, when it applies."""
+    if not path.is_file():
+        return given
+    found = remembered_options(given, path, reading)
+    if found is None:
+        return given
+    remembered, line = found
+    _say(line)
+    return _as_given(given, columns=remembered.columns, time_unit=remembered.time_unit,
+                     units_row=remembered.units_row)
+
+
+def _as_given(given: dict, **values) -> dict:
+    """`given` with `values` set as if given on the command line (an option left at its
+    default is no given option: `hystkit.cli._read_args.given_read_options`)."""
+    return {k: v for k, v in {**given, **values}.items() if v not in (None, (), False)}
 
 
 def _say(line: str) -> None:

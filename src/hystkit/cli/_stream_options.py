@@ -1,16 +1,104 @@
-"""``hystkit stream``'s arguments and options (what they do: :mod:`.cmd_stream`). Light:
-building the parser loads neither numba nor the live streams."""
+"""``hystkit stream``'s arguments and options (what they do: :mod:`.cmd_stream`) and the
+frozen record they parse into (:class:`StreamOptions`). Light: building the parser loads
+neither numba nor the live streams."""
 
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
+from ..errors import InputError
 from . import _stream_defaults as defaults
-from ._common import add_read_options, number, positive_int
+from ._common import add_read_options, given_read_options, number, positive_int
 from ._own_layout import add_trained_note
 
-__all__ = ["stream_options"]
+__all__ = ["StreamOptions", "stream_options"]
+
+# The options of --adapt gain and weights, and of --adapt full
+_ADAPT_OPTIONS = ("forgetting", "prior_gain", "prior_offset")
+_REFIT_OPTIONS = ("window", "refit_every")
+
+
+@dataclass(frozen=True)
+class StreamOptions:
+    """What ``hystkit stream`` was asked, as parsed and checked (``--baud`` only with
+    ``--serial``, each adaptation option only with the ``--adapt`` that takes it).
+
+    ``forgetting`` is the one used: ``--forgetting`` or its default for ``--adapt gain`` and
+    ``weights``, None otherwise. ``reading`` holds the reading options given on the command
+    line (`given`: as `hystkit.io.ReadOptions` keyword arguments).
+    """
+
+    model: Path
+    input: Path | None
+    serial: str | None
+    baud: int | None
+    start: str
+    level: float | None
+    adapt: str | None
+    forgetting: float | None
+    prior_gain: float | None
+    prior_offset: float | None
+    window: float | None
+    refit_every: int | None
+    reading: tuple[tuple[str, Any], ...]
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> StreamOptions:
+        """The options of a parsed ``stream`` command line.
+
+        Raises
+        ------
+        InputError
+            ``--baud`` without ``--serial``, or an adaptation option that the chosen
+            ``--adapt`` (or none) does not take.
+        """
+        if args.serial is None and args.baud is not None:
+            raise InputError("--baud is for --serial")
+        forgetting = _checked_adapt(args)
+        return cls(args.model, args.input, args.serial, args.baud, args.start, args.level,
+                   args.adapt, forgetting, args.prior_gain, args.prior_offset, args.window,
+                   args.refit_every, tuple(given_read_options(args).items()))
+
+    @property
+    def given(self) -> dict:
+        """The reading options given on the command line, as `hystkit.io.ReadOptions` keyword
+        arguments."""
+        return dict(self.reading)
+
+    @property
+    def source(self) -> str:
+        """The input's name in messages."""
+        return (str(self.serial) if self.serial is not None
+                else str(self.input) if self.input is not None else "<stdin>")
+
+
+def _checked_adapt(args: argparse.Namespace) -> float | None:
+    """Refuse the adaptation options that the chosen ``--adapt`` (or none) does not take;
+    the forgetting factor used (``--forgetting``'s default for gain and weights)."""
+    def given(names: tuple[str, ...]) -> list[str]:
+        return [f"--{k.replace('_', '-')}" for k in names if getattr(args, k) is not None]
+
+    if args.adapt is None:
+        if used := given(_ADAPT_OPTIONS):
+            raise InputError(f"{', '.join(used)} only {_verb(used)} with --adapt")
+        if used := given(_REFIT_OPTIONS):
+            raise InputError(f"{', '.join(used)} only {_verb(used)} with --adapt full")
+        return None
+    if args.adapt == "full":
+        if used := given(_ADAPT_OPTIONS):
+            raise InputError(f"{', '.join(used)} {_verb(used)} to --adapt gain or weights, "
+                             f"not full")
+        return None
+    if used := given(_REFIT_OPTIONS):
+        raise InputError(f"{', '.join(used)} only {_verb(used)} with --adapt full")
+    return defaults.DEFAULT_FORGETTING if args.forgetting is None else args.forgetting
+
+
+def _verb(options: list[str]) -> str:
+    return "applies" if len(options) == 1 else "apply"
 
 
 def stream_options(p: argparse.ArgumentParser) -> None:

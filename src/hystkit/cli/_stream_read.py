@@ -10,14 +10,17 @@ soon as it arrives. A serial port gives one line per chunk.
 
 from __future__ import annotations
 
-import argparse
 import codecs
 import io
 import sys
 from collections.abc import Callable, Iterator
+from typing import TYPE_CHECKING
 
 from ..errors import InputError
 from ._stream_defaults import DEFAULT_BAUD, SERIAL_HINT
+
+if TYPE_CHECKING:
+    from ._stream_options import StreamOptions
 
 __all__ = ["CHUNK_BYTES", "MAX_LINE", "TOO_LONG", "Input",
            "bounded", "decoded", "line_chunks", "lines_of", "open_input"]
@@ -44,21 +47,21 @@ class Input:
         self.handle.close()
 
 
-def open_input(args: argparse.Namespace) -> tuple[str, Input]:
+def open_input(options: StreamOptions) -> tuple[str, Input]:
     """Name of the input and its chunks (a serial port's until it closes)."""
-    if args.serial is not None:
-        return str(args.serial), _serial_lines(args.serial, args.baud or DEFAULT_BAUD)
-    if args.input is not None:
+    if options.serial is not None:
+        return options.source, _serial_lines(options.serial, options.baud or DEFAULT_BAUD)
+    if options.input is not None:
         try:
-            handle = open(args.input, "rb")  # noqa: SIM115
+            handle = open(options.input, "rb")  # noqa: SIM115
         except OSError as exc:
-            raise InputError(f"{args.input}: cannot read ({exc.strerror})") from None
-        return str(args.input), Input(line_chunks(decoded(handle.read1)), handle)
+            raise InputError(f"{options.input}: cannot read ({exc.strerror})") from None
+        return options.source, Input(line_chunks(decoded(handle.read1)), handle)
     binary = getattr(sys.stdin, "buffer", None)
     if binary is not None and hasattr(binary, "read1"):
-        return "<stdin>", Input(line_chunks(decoded(binary.read1)), sys.stdin)
+        return options.source, Input(line_chunks(decoded(binary.read1)), sys.stdin)
     # a text stream without bytes underneath (a StringIO put in place of stdin)
-    return "<stdin>", Input(line_chunks(lambda: sys.stdin.read(CHUNK_BYTES)), sys.stdin)
+    return options.source, Input(line_chunks(lambda: sys.stdin.read(CHUNK_BYTES)), sys.stdin)
 
 
 def decoded(read1: Callable[[int], bytes]) -> Callable[[], str]:

@@ -63,17 +63,17 @@ from ..errors import InputError, OutputError
 from ..live import AdaptiveStream, RefittingStream, Stream, SyncExcitation, sync_excitation
 from ..live._stream import check_streamable
 from ._common import stdout_for
-from ._own_layout import stream_args
-from ._stream_adapt import Learning, adaptive_stream, check_adapt_options, run_line
+from ._stream_adapt import Learning, adaptive_stream, run_line
 from ._stream_chunks import run_chunk
 from ._stream_input import (
     Rewriter,
-    live_as_trained,
     nothing_compensated,
     output_header,
+    reading_options,
     stream_format,
 )
 from ._stream_lines import Reading, Tally
+from ._stream_options import StreamOptions
 from ._stream_read import TOO_LONG, Input, lines_of, open_input
 
 __all__ = ["run_stream"]
@@ -109,34 +109,32 @@ class Latency:
 
 def run_stream(args: argparse.Namespace) -> int:
     """Run ``hystkit stream`` on the parsed command line (see the module)."""
-    if args.serial is None and args.baud is not None:
-        raise InputError("--baud is for --serial")
-    check_adapt_options(args)
-    comp = load_compensator(args.model)
-    stream_args(args, comp.reading)  # --in FILE of the training files' names: read as they were
-    live_as_trained(args, comp.reading)  # stdin or a port: so too, unless told otherwise
-    fmt = stream_format(args)  # --in FILE: its settings file and layout, as fit reads it
+    options = StreamOptions.from_args(args)
+    comp = load_compensator(options.model)
+    # --in FILE of the training files' names, stdin or a port: read as they were, unless told
+    # otherwise; --in FILE: its settings file and layout, as fit reads it
+    fmt = stream_format(options.input, reading_options(options, comp.reading))
     stdout_for("the estimates")
-    if args.level is not None and comp.band is None:
-        raise InputError(f"--level: {args.model} has no prediction band (fitted without one or "
-                         f"by a hystkit before bands); fit it again")
+    if options.level is not None and comp.band is None:
+        raise InputError(f"--level: {options.model} has no prediction band (fitted without one "
+                         f"or by a hystkit before bands); fit it again")
     check_streamable(comp)  # the oracle centring, --no-limit: before anything is said
     start = "rest"
-    if args.start == "sync":
+    if options.start == "sync":
         sync = sync_excitation(comp)
         _print_sync(sync)
         start = sync.state_after
     learning = None
-    if args.adapt is None:
-        stream = Stream(comp, start, label=str(args.model), level=args.level)
+    if options.adapt is None:
+        stream = Stream(comp, start, label=str(options.model), level=options.level)
     else:
-        stream, learning = adaptive_stream(args, comp, start), Learning()
-    source, chunks = open_input(args)
+        stream, learning = adaptive_stream(options, comp, start), Learning()
+    source, chunks = open_input(options)
     if not fmt.plain:
         rewrite = Rewriter(fmt, source, TOO_LONG)
         chunks = Input((rewrite.chunk(chunk) for chunk in chunks), chunks)
     with contextlib.closing(chunks):
-        _write(output_header(fmt, comp.band is not None and args.adapt != "full"))
+        _write(output_header(fmt, comp.band is not None and options.adapt != "full"))
         tally, latency = Tally(), Latency()
         try:
             _run(stream, chunks, tally, latency, fmt.time_scale, learning)
@@ -146,7 +144,8 @@ def run_stream(args: argparse.Namespace) -> int:
             tally.report(source, comp.structure.dt)
             print(latency.summary(), file=sys.stderr)
             if learning is not None:
-                print(learning.summary(stream, args.adapt, args.forgetting), file=sys.stderr)
+                print(learning.summary(stream, options.adapt, options.forgetting),
+                      file=sys.stderr)
     return 0
 
 
