@@ -22,16 +22,14 @@ from __future__ import annotations
 
 import argparse
 import csv
-import sys
 from dataclasses import replace
 from pathlib import Path
 
 from .._read_options import FIELDS, ReadOptions
 from ..errors import InputError
-from ._read_args import given_read_options
 
 __all__ = ["TRAINED_NOTE", "add_trained_note", "estimate_names", "output_names",
-           "remembered_options", "stream_args"]
+           "remembered_options"]
 
 _HEAD_BYTES = 1 << 16  # as io._csv_layout: the header must end within it
 
@@ -89,20 +87,6 @@ def add_trained_note(p: argparse.ArgumentParser, replace_note: str | None = None
         if (group.title or "").startswith("reading your own files"):
             first = replace_note if replace_note is not None else group.description
             group.description = f"{first}; {TRAINED_NOTE}" if first else TRAINED_NOTE
-
-
-def stream_args(args: argparse.Namespace, reading: ReadOptions | None) -> None:
-    """``stream --in FILE``: put the model's reading of FILE (when it applies) on `args`, as
-    if given on the command line, and say so on stderr (stdout carries the estimates)."""
-    if args.input is None or not Path(args.input).is_file():
-        return
-    found = remembered_options(given_read_options(args), Path(args.input), reading)
-    if found is None:
-        return
-    options, line = found
-    args.columns, args.time_unit = options.columns, options.time_unit
-    args.units_row = options.units_row
-    print(f"hystkit stream: {line}", file=sys.stderr, flush=True)
 
 
 def _file_names(path: Path, options: ReadOptions) -> tuple[set[str], bool] | None:
