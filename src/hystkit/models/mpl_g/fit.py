@@ -36,6 +36,7 @@ from ...identification._constrained import constrain_fit
 from ...identification._normal_equations import dense_normal_equations
 from .._docs import docfiller
 from ..mpl import model as mpl
+from ..mpl.box import LOG_G_MIN, LOG_VT_BOUNDS, W_BOUND
 from ..mpl.fit import fit_mpl, theta_limits
 from . import model as mpl_g
 from .model import WEIGHT_SUM_FLOOR
@@ -51,14 +52,11 @@ fill_doc = docfiller()
 __all__ = ["MONOTONE_RANGE", "WEIGHT_SUM_FLOOR", "bernstein_slopes", "canonical", "fit_box",
            "fit_mpl_g", "output_from_slopes", "random_params", "start_theta", "theta_names"]
 
-# Bounds in optimiser coordinates: the cells' are the mPL's; |w| <= 100 mirrors the document's
-# weight-sum constraint (sec. 5.3.3); g_0 only needs to stay finite; the Bernstein slopes of g
-# between 1e-6 (g' near 0 somewhere on |z| <= R: a model limit) and 1e3.
-_LOG_VT_BOUNDS = (np.log(1e-3), np.log(1e3))
-_LOG_G_MIN = np.log(1e-4)
+# Bounds in optimiser coordinates: the cells' and the weights' are the mPL's (mpl.box); g_0 only
+# needs to stay finite; the Bernstein slopes of g between 1e-6 (g' near 0 somewhere on
+# |z| <= R: a model limit) and 1e3.
 _G0_BOUND = 1e3
 _LOG_SLOPE_BOUNDS = (np.log(1e-6), np.log(1e3))
-_W_BOUND = 100.0
 
 
 def theta_names(n_cells: int) -> list[str]:
@@ -96,10 +94,10 @@ def fit_box(structure: mpl_g.MplGStructure) -> tuple[np.ndarray, np.ndarray]:
     """
     n = structure.n_cells
     cap = structure.slope_cap / structure.dt
-    lower = np.r_[np.tile([_LOG_G_MIN, _LOG_VT_BOUNDS[0]], n), -_G0_BOUND,
-                  np.full(3, _LOG_SLOPE_BOUNDS[0]), np.full(n, -_W_BOUND)]
-    upper = np.r_[np.tile([np.log(cap), _LOG_VT_BOUNDS[1]], n), _G0_BOUND,
-                  np.full(3, _LOG_SLOPE_BOUNDS[1]), np.full(n, _W_BOUND)]
+    lower = np.r_[np.tile([LOG_G_MIN, LOG_VT_BOUNDS[0]], n), -_G0_BOUND,
+                  np.full(3, _LOG_SLOPE_BOUNDS[0]), np.full(n, -W_BOUND)]
+    upper = np.r_[np.tile([np.log(cap), LOG_VT_BOUNDS[1]], n), _G0_BOUND,
+                  np.full(3, _LOG_SLOPE_BOUNDS[1]), np.full(n, W_BOUND)]
     return lower, upper
 
 
@@ -360,8 +358,8 @@ def random_params(structure: mpl_g.MplGStructure, rng: np.random.Generator) -> m
         One draw.
     """
     n = structure.n_cells
-    log_g = rng.uniform(_LOG_G_MIN, np.log(structure.slope_cap / structure.dt), n)
-    log_vt = rng.uniform(*_LOG_VT_BOUNDS, n)
+    log_g = rng.uniform(LOG_G_MIN, np.log(structure.slope_cap / structure.dt), n)
+    log_vt = rng.uniform(*LOG_VT_BOUNDS, n)
     g1, g3 = rng.uniform(*_RANDOM_G1), np.exp(rng.uniform(*_RANDOM_LOG_G3))
     g2 = 0.9 * np.sqrt(3 * g1 * g3) * rng.uniform(-1.0, 1.0)
     w0 = rng.uniform(*_RANDOM_W0) * rng.choice([-1.0, 1.0])

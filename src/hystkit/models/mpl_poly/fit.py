@@ -27,6 +27,7 @@ import numpy as np
 from ...errors import FitDivergedError
 from ...identification import FitResult, NormalEquations, check_fit_data, fit_multistart
 from .._docs import docfiller
+from ..mpl.box import W_BOUND
 from . import kernels
 from . import model as mpl_poly
 from .presets import PAPER_9_2_TABLE_I, paper_9_2_params
@@ -36,11 +37,10 @@ fill_doc = docfiller()
 __all__ = ["canonical", "default_starts", "fit_box", "fit_mpl_poly", "random_params",
            "theta_names"]
 
-# Bounds in optimiser coordinates (MplPolyParams.to_vector). |w| <= 100 mirrors the document's
-# weight-sum constraint (sec. 5.3.3); the polynomial coefficients only need to stay finite.
+# Bounds in optimiser coordinates (MplPolyParams.to_vector): the weights' are the mPL's
+# (mpl.box); the polynomial coefficients only need to stay finite.
 _COEF_BOUND = 1e3
 _LOG_C3_BOUNDS = (np.log(1e-6), np.log(1e4))
-_W_BOUND = 100.0
 
 
 def theta_names(n_cells: int) -> list[str]:
@@ -74,9 +74,9 @@ def fit_box(structure: mpl_poly.MplPolyStructure) -> tuple[np.ndarray, np.ndarra
     """
     n = structure.n_cells
     lower = np.r_[np.tile([-_COEF_BOUND] * 3 + [_LOG_C3_BOUNDS[0]], n),
-                  np.full(4, -_COEF_BOUND), np.full(n + 2, -_W_BOUND)]
+                  np.full(4, -_COEF_BOUND), np.full(n + 2, -W_BOUND)]
     upper = np.r_[np.tile([_COEF_BOUND] * 3 + [_LOG_C3_BOUNDS[1]], n),
-                  np.full(4, _COEF_BOUND), np.full(n + 2, _W_BOUND)]
+                  np.full(4, _COEF_BOUND), np.full(n + 2, W_BOUND)]
     return lower, upper
 
 
@@ -183,7 +183,7 @@ def _linear_output_start(structure: mpl_poly.MplPolyStructure, f: np.ndarray, u:
         return None
     lin = slice(4 * n + 4, None)
     coef = -np.linalg.lstsq(ne.jtj[lin, lin], ne.jtr[lin], rcond=None)[0]
-    coef[:-1] = np.clip(coef[:-1], -0.9 * _W_BOUND, 0.9 * _W_BOUND)
+    coef[:-1] = np.clip(coef[:-1], -0.9 * W_BOUND, 0.9 * W_BOUND)
     return mpl_poly.MplPolyParams(f=f, g=probe.g, w=coef[:-1], v_b=coef[-1])
 
 
