@@ -9,7 +9,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..compensation import (
-    FAR_MARGIN,
     ORACLE_CENTER,
     POSITION_MARGIN,
     SENSOR_MARGIN,
@@ -199,10 +198,10 @@ def _evaluate(args: argparse.Namespace) -> int:
     if status not in ("ok", "undetermined"):
         print(f"hystkit: evaluate: {status.replace('_', ' ')}: {message}; do not use the "
               f"{comp.model} compensator on data like these", file=sys.stderr)
-        far = comp.sensor_outside(rec, margin=FAR_MARGIN)
+        far = scores["n_sensor_far_outside"]  # counted by evaluate for the verdict
         say_next(next_step(status, command="evaluate", line_r2=scores["linear_r2"],
                            training_line_r2=comp.fit_info.get("training_linear_r2"),
-                           outside=None if far is None else float(far.mean())))
+                           outside=None if far is None else far / scores["n_samples"]))
         return GUARD_EXIT
     print(f"verdict: {status} ({message})")
     return 0
