@@ -221,3 +221,12 @@ def test_columns_are_suspected_only_where_the_line_worked_in_training(training_l
     step = next_step("worse_than_line", command="evaluate", line_r2=0.005,
                      training_line_r2=training_line_r2)
     assert step.startswith(start)
+
+
+def test_a_guided_refusal_whose_refit_failed_also_names_select_with_every_family():
+    # bh_loops MnZn_HP_ferrite_H80 (129 samples): the guided list's best (mpl:3) failed its
+    # refit, while select's full list found a usable inverse Preisach
+    step = next_step("refit", command="guided", model="mpl", size=3)
+    assert step.startswith("'hystkit fit DATA --model mpl --size 3' (the best candidate)")
+    assert step.endswith("or 'hystkit select DATA --out m.json' (every family, both modes)")
+    assert "hystkit select" not in next_step("refit", command="select", model="mpl", size=3)

@@ -87,7 +87,12 @@ def next_step(status: str, *, command: str = "fit", model: str | None = None,
                     f"if no model explains more of the position held out, {_TOO_LITTLE}",
         }.get(status, f"'hystkit fit DATA --model {model or 'NAME'}"
                       f"{'' if size is None else f' --size {size}'}' (the best candidate): "
-                      f"its refusal names what failed and what to try")
+                      f"its refusal names what failed and what to try"
+                      # the guided list is 6 direct-mode candidates; a B(H) loop of 129
+                      # samples had none, and select's every family, both modes found an
+                      # inverse Preisach at 0.98 held out
+                      + ("; or 'hystkit select DATA --out m.json' (every family, both modes)"
+                         if command == "guided" else ""))
     smaller = None if size is None or size <= 1 else size - 1
     if status == "on_bounds":
         if model == "mpl":
