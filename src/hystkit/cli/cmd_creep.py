@@ -4,6 +4,8 @@ creep error against the sensor's own creep term (issue 14.7)."""
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
+from pathlib import Path
 
 from ..io import check_output_folder
 from ..studies import (
@@ -17,18 +19,44 @@ from ..studies import (
 from ._common import GUARD_EXIT
 from ._many_models import models_from, sizes_from
 
-__all__ = ["run_creep"]
+__all__ = ["CreepOptions", "creep", "run_creep"]
+
+
+@dataclass(frozen=True)
+class CreepOptions:
+    """``hystkit creep``'s options, as parsed: ``hours`` of holds as given (``quick``: 0.2 h
+    whatever it says)."""
+
+    hours: float
+    amplitude: float  # mm
+    models: str | None
+    sizes: tuple[str, ...]  # --size MODEL=N, as given
+    seed: int
+    quick: bool
+    out: Path | None
+    force: bool
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> CreepOptions:
+        """The options of a parsed ``creep`` command line."""
+        return cls(args.hours, args.amplitude, args.models, tuple(args.size), args.seed,
+                   args.quick, args.out, args.force)
 
 
 def run_creep(args: argparse.Namespace) -> int:
     """``hystkit creep``: the step-and-hold experiment and each compensator's creep error."""
-    models = models_from(args.models) if args.models else ["mpl", "pl"]
-    sizes = sizes_from(args.size)
-    if args.out is not None:
-        check_output_folder(args.out, output_names("creep"), args.force)
-    hours = 0.2 if args.quick else args.hours
-    plan = CreepPlan(hold_seconds=hours * 3600.0 / 3, amplitude_mm=args.amplitude)
-    result = creep_experiment(plan, models=models, sizes=sizes, seed=args.seed,
+    return creep(CreepOptions.from_args(args))
+
+
+def creep(opts: CreepOptions) -> int:
+    """Run the step-and-hold experiment; print (and write) each compensator's creep error."""
+    models = models_from(opts.models) if opts.models else ["mpl", "pl"]
+    sizes = sizes_from(opts.sizes)
+    if opts.out is not None:
+        check_output_folder(opts.out, output_names("creep"), opts.force)
+    hours = 0.2 if opts.quick else opts.hours
+    plan = CreepPlan(hold_seconds=hours * 3600.0 / 3, amplitude_mm=opts.amplitude)
+    result = creep_experiment(plan, models=models, sizes=sizes, seed=opts.seed,
                               progress=print)
     columns = CREEP_COLUMNS + tuple((f"{m}_creep_error_pct", f"{m} creep error (%)")
                                     for m in models)
@@ -59,7 +87,7 @@ def run_creep(args: argparse.Namespace) -> int:
     for m in failed:
         print(f"hystkit: warning: {m}: fit {result['fits'][m]['status']}: "
               f"{result['fits'][m]['status_message']}")
-    if args.out is not None:
-        paths = write_table(args.out, "creep", result, result["rows"], force=args.force)
+    if opts.out is not None:
+        paths = write_table(opts.out, "creep", result, result["rows"], force=opts.force)
         print(f"wrote {', '.join(str(p) for p in paths)}")
     return GUARD_EXIT if failed else 0

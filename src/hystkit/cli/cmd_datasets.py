@@ -4,6 +4,7 @@ says where a data set's files come from and where they go (issue 27.8)."""
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
 from pathlib import Path
 
 from ..datasets import (
@@ -27,7 +28,43 @@ from ..io import (
 )
 from ._common import stdout_for
 
-__all__ = ["run_export", "run_list", "run_show"]
+__all__ = ["DatasetsExportOptions", "DatasetsOptions", "export_dataset", "list_datasets",
+           "run_export", "run_list", "run_show", "show_dataset"]
+
+
+@dataclass(frozen=True)
+class DatasetsOptions:
+    """``hystkit datasets list`` and ``show``'s options, as parsed: the data set (``list``:
+    None for all of them) and the shared data root (None: the environment's or one found)."""
+
+    name: str | None
+    root: Path | None
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> DatasetsOptions:
+        """The options of a parsed ``datasets list`` or ``datasets show`` command line."""
+        return cls(args.name, args.root)
+
+
+@dataclass(frozen=True)
+class DatasetsExportOptions:
+    """``hystkit datasets export``'s options, as parsed: ``variant`` None for the data set's
+    default; ``excerpt``: the excerpt shipped with hystkit instead of the shared data."""
+
+    name: str
+    variant: str | None
+    segment: str | None
+    role: str  # "inverse" or "forward"
+    excerpt: bool
+    root: Path | None
+    out: Path
+    force: bool
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> DatasetsExportOptions:
+        """The options of a parsed ``datasets export`` command line."""
+        return cls(args.name, args.variant, args.segment, args.role, args.excerpt, args.root,
+                   Path(args.out), args.force)
 
 
 def _samples(counts: list[int]) -> str:
@@ -43,11 +80,17 @@ def _rates(rates: list[float | None]) -> str:
 
 
 def run_list(args: argparse.Namespace) -> int:
+    """``hystkit datasets list [NAME]``."""
+    return list_datasets(DatasetsOptions.from_args(args))
+
+
+def list_datasets(opts: DatasetsOptions) -> int:
+    """The data sets (or the runs of ``opts.name``) and whether the shared data are here."""
     stdout_for("the list")
-    root, how = shared_data_status(args.root)
+    root, how = shared_data_status(opts.root)
     print(f"shared data: {root} ({how})" if root is not None else how)
-    if args.name is not None:
-        return _list_variants(args.name, root)
+    if opts.name is not None:
+        return _list_variants(opts.name, root)
     print(f"{'name':<24}{'runs':>5}  {'samples':<13}{'rate':<15}{'input -> output':<32}"
           f"{'here':<6}licence")
     for info in DATASETS.values():
@@ -89,9 +132,15 @@ def _list_variants(name: str, root: Path | None) -> int:
 
 
 def run_show(args: argparse.Namespace) -> int:
+    """``hystkit datasets show NAME``."""
+    return show_dataset(DatasetsOptions.from_args(args))
+
+
+def show_dataset(opts: DatasetsOptions) -> int:
+    """Where the files of data set ``opts.name`` come from and where they go."""
     stdout_for("the description")
-    info = dataset_info(args.name)
-    root, how = shared_data_status(args.root)
+    info = dataset_info(opts.name)
+    root, how = shared_data_status(opts.root)
     sources = [info.provenance(v.name) for v in info.variants]
     first = sources[0]
     print(f"{info.name}: {info.what}")
@@ -126,32 +175,38 @@ def _env_var() -> str:
 
 
 def run_export(args: argparse.Namespace) -> int:
-    out = Path(args.out)
+    """``hystkit datasets export NAME --out FILE``."""
+    return export_dataset(DatasetsExportOptions.from_args(args))
+
+
+def export_dataset(opts: DatasetsExportOptions) -> int:
+    """Write one run of a data set as a recording, with its sidecar (and settings file)."""
+    out = opts.out
     sidecar = out.with_name(out.name + ".json")
     # CSV keeps its units in the settings file beside it, which reading it picks up
     settings = sidecar_path(out) if out.suffix.lower() == ".csv" else None
-    check_output_path(out, args.force, formats=RECORDING_SUFFIXES, what="a recording")
+    check_output_path(out, opts.force, formats=RECORDING_SUFFIXES, what="a recording")
     for path in (sidecar, settings):  # refuse before reading anything
         if path is not None:
-            check_output_path(path, args.force)
-    ds: Dataset = (load_excerpt(args.name, args.variant) if args.excerpt
-                   else load(args.name, args.variant, root=args.root))
-    if args.segment is not None:
-        ds = ds.segment(args.segment)
-    rec = ds.to_recording(role=args.role)
-    units = _units(ds, args.role)
-    meta = {"exported_by": "hystkit datasets export", "role": args.role,
-            "segment": args.segment, "excerpt": args.excerpt, "columns": ds.columns(args.role),
+            check_output_path(path, opts.force)
+    ds: Dataset = (load_excerpt(opts.name, opts.variant) if opts.excerpt
+                   else load(opts.name, opts.variant, root=opts.root))
+    if opts.segment is not None:
+        ds = ds.segment(opts.segment)
+    rec = ds.to_recording(role=opts.role)
+    units = _units(ds, opts.role)
+    meta = {"exported_by": "hystkit datasets export", "role": opts.role,
+            "segment": opts.segment, "excerpt": opts.excerpt, "columns": ds.columns(opts.role),
             "units": units, "dataset": ds.metadata()}
     # The recording and its sidecars appear together or not at all.
     paths = [out, sidecar] + ([settings] if settings is not None else [])
-    with atomic_outputs(paths, args.force) as temps:
+    with atomic_outputs(paths, opts.force) as temps:
         write_recording(rec, temps[0], extra=dict(ds.channels), units=units, force=True)
         write_json(meta, temps[1], force=True)
         if settings is not None:
             temps[2].write_text(units_settings_text(units), encoding="utf-8")
-    cols = ds.columns(args.role)
-    print(f"wrote {out}: {ds.label}{f' segment {args.segment}' if args.segment else ''}, "
+    cols = ds.columns(opts.role)
+    print(f"wrote {out}: {ds.label}{f' segment {opts.segment}' if opts.segment else ''}, "
           f"{ds.n_samples} samples at {ds.fs:g} Hz")
     for column, meaning in cols.items():
         print(f"  {column:<22}{meaning}")

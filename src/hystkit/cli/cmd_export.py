@@ -11,27 +11,54 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
+from pathlib import Path
 
 from ..compensation import load_compensator
 from ..export import COMPILE_LINE, export_compensator, float_warning
 
-__all__ = ["run_export"]
+__all__ = ["ExportOptions", "export", "run_export"]
+
+
+@dataclass(frozen=True)
+class ExportOptions:
+    """``hystkit export``'s options, as parsed."""
+
+    model: Path
+    lang: str  # "c" or "matlab"
+    out: Path
+    double: bool
+    name: str | None
+    level: float | None
+    force: bool
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> ExportOptions:
+        """The options of a parsed ``export`` command line."""
+        return cls(args.model, args.lang, args.out, args.double, args.name, args.level,
+                   args.force)
 
 
 def run_export(args: argparse.Namespace) -> int:
     """``hystkit export``: the compensator as a C or MATLAB folder."""
-    comp = load_compensator(args.model)
-    plan, files = export_compensator(comp, args.out, args.lang, double=args.double, name=args.name,
-                                     force=args.force, level=args.level)
+    return export(ExportOptions.from_args(args))
+
+
+def export(opts: ExportOptions) -> int:
+    """Write the compensator of ``opts.model`` as a C or MATLAB folder."""
+    comp = load_compensator(opts.model)
+    plan, files = export_compensator(comp, opts.out, opts.lang, double=opts.double,
+                                     name=opts.name, force=opts.force, level=opts.level)
     band = ("" if comp.band is None else
-            f" (with the {comp.band.level if args.level is None else args.level:.0%} "
+            f" (with the {comp.band.level if opts.level is None else opts.level:.0%} "
             f"prediction band: lower, upper)")
-    print(f"wrote {args.out}: {', '.join(sorted(files))}{band}")
-    if args.lang == "c":
-        precision = "double" if args.double else "float"
-        print(f"{precision} arithmetic; build the example with: cd {args.out} && {COMPILE_LINE}")
-        if not args.double and float_warning(plan):
-            print(f"hystkit: warning: {float_warning(plan)}", file=sys.stderr)
+    print(f"wrote {opts.out}: {', '.join(sorted(files))}{band}")
+    if opts.lang == "c":
+        precision = "double" if opts.double else "float"
+        print(f"{precision} arithmetic; build the example with: cd {opts.out} && {COMPILE_LINE}")
+        warning = "" if opts.double else float_warning(plan)
+        if warning:
+            print(f"hystkit: warning: {warning}", file=sys.stderr)
     if plan.sync_note:
         print(plan.sync_note)
     return 0

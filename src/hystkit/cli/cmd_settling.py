@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -23,9 +24,47 @@ from ..sensors import simulate_settling_log
 from ._common import failures_exit
 from ._lab_options import HOURS_PER
 
-__all__ = ["SETTLING_FILES", "read_log", "run_settling", "run_simulate_settling"]
+__all__ = ["SETTLING_FILES", "SettlingOptions", "SimulateSettlingOptions", "read_log",
+           "run_settling", "run_simulate_settling", "settling", "simulate_settling"]
 
 SETTLING_FILES = ("settling.json", "settling.png", "settling.svg")
+
+
+@dataclass(frozen=True)
+class SettlingOptions:
+    """``hystkit settling``'s options, as parsed: ``time_column`` None for ``time_h`` if the
+    log has it, else ``time``; ``traces`` None for every column but the time."""
+
+    log: Path
+    out: Path
+    time_column: str | None
+    time_unit: str  # a key of HOURS_PER
+    traces: tuple[str, ...] | None
+    model: str  # "auto", "rise-drop" or "drop"
+    threshold: float  # %/h
+    force: bool
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> SettlingOptions:
+        """The options of a parsed ``settling`` command line."""
+        return cls(args.log, args.out, args.time_column, args.time_unit, args.traces,
+                   args.model, args.threshold, args.force)
+
+
+@dataclass(frozen=True)
+class SimulateSettlingOptions:
+    """``hystkit simulate-settling``'s options, as parsed."""
+
+    out: Path
+    hours: float
+    interval: float  # minutes
+    seed: int
+    force: bool
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> SimulateSettlingOptions:
+        """The options of a parsed ``simulate-settling`` command line."""
+        return cls(args.out, args.hours, args.interval, args.seed, args.force)
 
 
 def read_log(path: Path, time_column: str | None, time_unit: str,
@@ -77,14 +116,18 @@ def _warn_unit_suffix(time_column: str, time_unit: str) -> None:
 
 def run_settling(args: argparse.Namespace) -> int:
     """``hystkit settling``: the settling law fitted to each trace of a log."""
+    return settling(SettlingOptions.from_args(args))
 
-    check_output_folder(args.out, SETTLING_FILES, args.force, inputs=[args.log])
-    t_h, columns = read_log(args.log, args.time_column, args.time_unit, args.traces)
+
+def settling(opts: SettlingOptions) -> int:
+    """Fit the settling law to each trace of ``opts.log``; print and write the fits."""
+    check_output_folder(opts.out, SETTLING_FILES, opts.force, inputs=[opts.log])
+    t_h, columns = read_log(opts.log, opts.time_column, opts.time_unit, opts.traces)
     results, drawn, failed = {}, {}, []
     for name, r in columns.items():
         try:
-            fit = fit_settling(t_h, r, args.model)
-            rest = rest_time(fit, args.threshold)
+            fit = fit_settling(t_h, r, opts.model)
+            rest = rest_time(fit, opts.threshold)
         except SettlingFitError as exc:
             print(f"  {name}: NOT FITTED: {exc}")
             results[name] = {"fitted": False, "reason": str(exc)}
@@ -92,22 +135,22 @@ def run_settling(args: argparse.Namespace) -> int:
             failed.append(name)
             continue
         except ValueError as exc:
-            raise InputError(f"{args.log}: column {name!r}: {exc}") from None
+            raise InputError(f"{opts.log}: column {name!r}: {exc}") from None
         results[name] = {"fitted": True, "fit": fit.to_dict(), "rest_time": rest.to_dict()}
         drawn[name] = (t_h, r, fit, rest)
         _print_fit(name, fit, rest)
     fig = plot_settling(drawn)
-    report = {"log": str(args.log), "time_unit_read": args.time_unit, "model": args.model,
-              "threshold_pct_per_hour": args.threshold,
+    report = {"log": str(opts.log), "time_unit_read": opts.time_unit, "model": opts.model,
+              "threshold_pct_per_hour": opts.threshold,
               "law": "R(t) = r_final + drop exp(-t/tau_drop_h) - rise exp(-t/tau_rise_h), "
                      "t in hours since the log's t = 0",
               "document": "sec. 3.5.1: rest 2-3 days before measuring non-annealed traces",
               "traces": results}
-    with atomic_folder(args.out, args.force, SETTLING_FILES) as tmp:
+    with atomic_folder(opts.out, opts.force, SETTLING_FILES) as tmp:
         write_json(report, tmp / "settling.json")
         fig.savefig(tmp / "settling.png", dpi=120)
         fig.savefig(tmp / "settling.svg")
-    print(f"wrote {args.out}/: {', '.join(SETTLING_FILES)}")
+    print(f"wrote {opts.out}/: {', '.join(SETTLING_FILES)}")
     return failures_exit(failed, "trace(s)")
 
 
@@ -127,13 +170,16 @@ def _print_fit(name: str, fit, rest) -> None:
 
 def run_simulate_settling(args: argparse.Namespace) -> int:
     """``hystkit simulate-settling``: the virtual sensor's settling log, written."""
+    return simulate_settling(SimulateSettlingOptions.from_args(args))
 
 
-    check_output_path(args.out, args.force, formats=(".csv",), what="a settling log")
-    log = simulate_settling_log(args.hours, args.interval, args.seed)
-    with atomic_output(args.out, args.force) as tmp:
+def simulate_settling(opts: SimulateSettlingOptions) -> int:
+    """Write the virtual sensor's settling log to ``opts.out``."""
+    check_output_path(opts.out, opts.force, formats=(".csv",), what="a settling log")
+    log = simulate_settling_log(opts.hours, opts.interval, opts.seed)
+    with atomic_output(opts.out, opts.force) as tmp:
         pd.DataFrame(log).to_csv(tmp, index=False)
-    print(f"wrote {args.out}: {log['time_h'].size} readings over {args.hours:g} h, every "
-          f"{args.interval:g} min: time_h, r1, r2 (virtual sensor at rest from printing), "
+    print(f"wrote {opts.out}: {log['time_h'].size} readings over {opts.hours:g} h, every "
+          f"{opts.interval:g} min: time_h, r1, r2 (virtual sensor at rest from printing), "
           "block, block_annealed [Ohm]")
     return 0
