@@ -34,12 +34,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import FitDivergedError
 from ._protocol import Record, Reduction
-from ._validation import check_cells, check_range, check_structure_size
+from ._validation import check_cells, check_range, check_size, check_structure_size
 
 __all__ = ["DT_RANGE", "MAX_CELLS", "MAX_MERGED_CELLS", "SLOPE_CAP_MIN", "CellStructure", "Cells",
-           "LinearModel", "cell_reductions", "cell_report", "discrete_eigenvalues", "linearise",
-           "linearise_cells", "state_bound"]
+           "LimitedCellStructure", "LinearModel", "cell_reductions", "cell_report",
+           "check_weighted_cells", "discrete_eigenvalues", "linearise", "linearise_cells",
+           "state_bound"]
 
 # Limits shared by the cell models (mpl, mpl-poly, pl, ladder). Runs cost O(N) a sample and
 # fits hold an (n_samples x ~3N) Jacobian, so 1000 cells (24 kB of parameters, 24 MB of
@@ -95,6 +97,28 @@ class CellStructure(Record):
         check_cells(self.n_cells, self.dt, self.slope_cap)
         check_range(self.dt, "dt", *DT_RANGE, " s")
         check_range(self.slope_cap, "slope_cap", SLOPE_CAP_MIN, 2.0, " (below 2: eq. 5.28)")
+
+
+@dataclass(frozen=True)
+class LimitedCellStructure(CellStructure):
+    """A :class:`CellStructure` with the switch of the stability limit (eq. 5.29): ``limit``
+    (bool, default True) applies it; ``False`` runs the raw cell resistor, which may diverge.
+    """
+
+    limit: bool = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not isinstance(self.limit, bool):
+            raise TypeError(f"limit must be true or false, got {self.limit!r}")
+
+
+def check_weighted_cells(structure: CellStructure, params: Record, inverse: bool) -> None:
+    """The check before a run of an mPL family (``Runs.check``): the parameters have as many
+    cells as the structure, and the inverse needs ``w_0 != 0`` (eq. 5.13)."""
+    check_size(params.n_cells, structure.n_cells, "cells")
+    if inverse and params.w[0] == 0:
+        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
 
 
 @dataclass(frozen=True, eq=False)

@@ -30,14 +30,13 @@ from typing import Any
 import numpy as np
 
 from ...errors import FitDivergedError
-from .._cells import MAX_CELLS, CellStructure, state_bound
+from .._cells import MAX_CELLS, LimitedCellStructure, check_weighted_cells, state_bound
 from .._docs import docfiller
 from .._protocol import Record
 from .._run import Runs, family_runs
 from .._validation import (
     check_magnitude,
     check_range,
-    check_size,
     check_structure_size,
     finite_floats,
     freeze_arrays,
@@ -72,7 +71,7 @@ V_T_RANGE = (1e-6, 1e12)
 
 
 @dataclass(frozen=True)
-class MplStructure(CellStructure):
+class MplStructure(LimitedCellStructure):
     """What does not get fitted: cell count ``N``, sample time and the Euler slope cap
     (:class:`~hystkit.models._cells.CellStructure`; the cap bounds ``f'(v) dt``).
 
@@ -91,13 +90,6 @@ class MplStructure(CellStructure):
         (sec. 5.3.3); it exists to reproduce that, not for use. Model files written before
         this field load as limited.
     """
-
-    limit: bool = True
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if not isinstance(self.limit, bool):
-            raise TypeError(f"limit must be true or false, got {self.limit!r}")
 
     @property
     def n_params(self) -> int:
@@ -352,14 +344,8 @@ def _inverse(structure: MplStructure, params: MplParams, y: np.ndarray,
     return u_hat, x_end
 
 
-def _check(structure: MplStructure, params: MplParams, inverse: bool) -> None:
-    check_size(params.n_cells, structure.n_cells, "cells")
-    if inverse and params.w[0] == 0:
-        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
-
-
 RUNS = Runs(label="mpl", step=step, n_state=lambda structure, params: structure.n_cells,
-            rest_state=rest_state, forward=_forward, inverse=_inverse, check=_check)
+            rest_state=rest_state, forward=_forward, inverse=_inverse, check=check_weighted_cells)
 simulate, simulate_reference, invert = family_runs(
     RUNS, __name__, "the mPL model",
     notes="The input is the source voltage ``e`` and the state the cell voltages ``u_k``; the "

@@ -8,6 +8,7 @@ import numpy as np
 from ...errors import FitDivergedError
 from .._capabilities import ALL_LOSSES, Capabilities
 from .._cells import Cells, cell_reductions, cell_report
+from .._cubic_output import output_linearisation
 from .._protocol import Block, Family, FitStart
 from ..mpl.family import FAMILY as MPL
 from ..mpl.kernels import current
@@ -109,26 +110,16 @@ class MplGFamily(Family):
         ``dy = g'(z) (w_0 du + w . dx)``. Inverse: ``dz = dy / g'(z)``,
         ``de = (dz - w . dx) / w_0``, the cells driven by ``e``. ``f'`` is the slope of the
         limited sinh resistor (eq. 5.29) at the operating point."""
-        x = np.asarray(x, dtype=float)
-        w0, w = params.w[0], params.w[1:]
-        if inverse:
-            z, ok = mpl_g._solve(params, u)
-            if not ok:
-                raise ValueError(f"output {u:.4g} is outside the range of g's branch: the "
-                                 f"inverse is not defined there")
-            drive = (z - w @ x + params.v_b) / w0
-        else:
-            drive = u
-            z = w0 * u + w @ x - params.v_b
-        dg = float(mpl_g.output_slope(params, z))
         knee = mpl_g.knee_voltage(structure, params)
         cap = structure.slope_cap / structure.dt
-        g = np.array([current(drive - x[k], params.i_s[k], params.v_t[k], knee[k], cap)[1]
-                      for k in range(structure.n_cells)]) * structure.dt
-        if inverse:
-            return (np.diag(1.0 - g) - np.outer(g, w) / w0, g / (w0 * dg), -w / w0,
-                    float(1.0 / (w0 * dg)))
-        return np.diag(1.0 - g), g, dg * w, float(dg * w0)
+
+        def cell_slopes(v):
+            return np.array([current(v[k], params.i_s[k], params.v_t[k], knee[k], cap)[1]
+                             for k in range(structure.n_cells)])
+
+        return output_linearisation(structure, params, x, u, inverse,
+                                    lambda y: mpl_g._solve(params, y), mpl_g.output_slope,
+                                    cell_slopes)
 
     def cells(self, structure, params) -> Cells:
         """The model as the eq. 5.18-5.28 analysis sees it (sinh cells, cubic output ``g``)."""

@@ -30,8 +30,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...errors import FitDivergedError
-from .._cells import CellStructure
+from .._cells import CellStructure, check_weighted_cells
+from .._cubic_output import output_invert_step, output_step
 from .._docs import docfiller
 from .._protocol import Record
 from .._run import Runs, family_runs
@@ -256,9 +256,7 @@ def step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
 
     %(step)s
     """
-    x = np.asarray(x, dtype=float)
-    y = output_current(params, params.w[0] * u + params.w[1:] @ x - params.v_b)
-    return float(y), x + resistor_current(structure, params, u - x) * structure.dt
+    return output_step(structure, params, x, u, output_current, resistor_current)
 
 
 @fill_doc
@@ -285,17 +283,9 @@ def invert_step(structure: MplGStructure, params: MplGParams, x: np.ndarray,
     ValueError
         If ``y`` is outside the range of the branch (no input gives it).
     """
-    x = np.asarray(x, dtype=float)
     lo, hi, _ = output_branch(params)
-    z = output_root(params, y, lo, hi)
-    e = (z - params.w[1:] @ x + params.v_b) / params.w[0]
-    return float(e), x + resistor_current(structure, params, e - x) * structure.dt
-
-
-def _check(structure: MplGStructure, params: MplGParams, inverse: bool) -> None:
-    check_size(params.n_cells, structure.n_cells, "cells")
-    if inverse and params.w[0] == 0:
-        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
+    return output_invert_step(structure, params, x, output_root(params, y, lo, hi),
+                              resistor_current)
 
 
 def _cell_args(structure: MplGStructure, params: MplGParams) -> tuple:
@@ -321,7 +311,7 @@ def _inverse(structure: MplGStructure, params: MplGParams, y: np.ndarray,
 
 
 RUNS = Runs(label="mpl-g", step=step, n_state=lambda structure, params: structure.n_cells,
-            rest_state=rest_state, forward=_forward, inverse=_inverse, check=_check)
+            rest_state=rest_state, forward=_forward, inverse=_inverse, check=check_weighted_cells)
 simulate, simulate_reference, invert = family_runs(
     RUNS, __name__, "the mPL model with a general output resistor",
     notes="The input is ``e`` (normalised units), the state the cell voltages ``u_k`` (at rest: "

@@ -7,11 +7,13 @@ import numpy as np
 from ...errors import FitDivergedError
 from .._capabilities import ALL_LOSSES, Capabilities
 from .._cells import Cells, cell_report
+from .._cubic_output import output_linearisation
 from .._protocol import Block, Family, FitStart
 from . import INFO, fit, kernels
 from . import model as mpl_poly
 from .export import TRANSLATION
 from .presets import PAPER_9_2_TABLE_I, PAPER_9_2_TABLE_II, paper_9_2_params
+from .rest import solve_on_branch
 
 __all__ = ["FAMILY", "MplPolyFamily"]
 
@@ -83,9 +85,7 @@ class MplPolyFamily(Family):
     def invert_step(self, structure, params, x, y):
         """As :func:`model.invert_step`; NaN input estimate and state when ``y`` is outside
         the range of ``g``'s branch (no input gives it), as the compiled block."""
-        lo, hi, sign, centre = mpl_poly.inverse_branch(structure, params)
-        if not kernels.solve_output(float(y), np.ascontiguousarray(params.g), lo, hi, sign,
-                                    centre)[1]:
+        if not solve_on_branch(structure, params, y)[1]:
             return np.nan, np.full(np.size(x), np.nan)
         return mpl_poly.invert_step(structure, params, x, y)
 
@@ -109,25 +109,10 @@ class MplPolyFamily(Family):
         ``dy = g'(z) (w_0 du + w . dx)``. Inverse: ``dz = dy / g'(z)``,
         ``de = (dz - w . dx) / w_0``, the cells driven by ``e``. ``f'`` is the slope of the
         limited cubic (eq. 5.29) at the operating point."""
-        x = np.asarray(x, dtype=float)
-        w0, w = params.w[0], params.w[1:]
-        if inverse:
-            lo, hi, sign, centre = mpl_poly.inverse_branch(structure, params)
-            z, ok = kernels.solve_output(float(u), np.ascontiguousarray(params.g), lo, hi, sign,
-                                         centre)
-            if not ok:
-                raise ValueError(f"output {u:.4g} is outside the range of g's branch: the "
-                                 f"inverse is not defined there")
-            drive = (z - w @ x + params.v_b) / w0
-        else:
-            drive = u
-            z = w0 * u + w @ x - params.v_b
-        dg = float(mpl_poly.output_slope(params, z))
-        g = mpl_poly.resistor_slope(structure, params, drive - x) * structure.dt
-        if inverse:
-            return (np.diag(1.0 - g) - np.outer(g, w) / w0, g / (w0 * dg), -w / w0,
-                    float(1.0 / (w0 * dg)))
-        return np.diag(1.0 - g), g, dg * w, float(dg * w0)
+        return output_linearisation(structure, params, x, u, inverse,
+                                    lambda y: solve_on_branch(structure, params, y),
+                                    mpl_poly.output_slope,
+                                    lambda v: mpl_poly.resistor_slope(structure, params, v))
 
     def cells(self, structure, params) -> Cells:
         """The model as the eq. 5.18-5.28 analysis sees it (cubic output ``g``)."""

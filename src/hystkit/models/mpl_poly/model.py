@@ -33,6 +33,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
+from .._cells import check_weighted_cells
+from .._cubic_output import output_invert_step, output_step
 from .._docs import docfiller
 from .._run import Runs, family_runs
 from .._validation import (
@@ -107,9 +109,7 @@ def step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarray,
 
     %(step)s
     """
-    x = np.asarray(x, dtype=float)
-    y = output_current(params, params.w[0] * u + params.w[1:] @ x - params.v_b)
-    return float(y), x + resistor_current(structure, params, u - x) * structure.dt
+    return output_step(structure, params, x, u, output_current, resistor_current)
 
 
 @fill_doc
@@ -120,17 +120,13 @@ def invert_step(structure: MplPolyStructure, params: MplPolyParams, x: np.ndarra
 
     %(invert_step)s
     """
-    x = np.asarray(x, dtype=float)
     lo, hi, _ = output_branch(structure, params)
-    z = output_root(params, y, lo, hi)
-    e = (z - params.w[1:] @ x + params.v_b) / params.w[0]
-    return float(e), x + resistor_current(structure, params, e - x) * structure.dt
+    return output_invert_step(structure, params, x, output_root(params, y, lo, hi),
+                              resistor_current)
 
 
 def _check(structure: MplPolyStructure, params: MplPolyParams, inverse: bool) -> None:
-    check_size(params.n_cells, structure.n_cells, "cells")
-    if inverse and params.w[0] == 0:
-        raise FitDivergedError("the model has w_0 = 0, so it has no inverse (eq. 5.13)")
+    check_weighted_cells(structure, params, inverse)
     check_rest(structure, params)
 
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._cells import MAX_CELLS, CellStructure
+from .._cells import MAX_CELLS, LimitedCellStructure
 from .._protocol import Record
 from .._validation import (
     check_magnitude,
@@ -58,9 +58,9 @@ def _far_root(c: np.ndarray) -> float | None:
 
 
 @dataclass(frozen=True)
-class MplPolyStructure(CellStructure):
-    """What does not get fitted: cell count, sample time, Euler slope cap (outside the knees;
-    :class:`~hystkit.models._cells.CellStructure`) and the limit switch.
+class MplPolyStructure(LimitedCellStructure):
+    """What does not get fitted: cell count, sample time, Euler slope cap (outside the knees)
+    and the limit switch (:class:`~hystkit.models._cells.LimitedCellStructure`).
 
     Parameters
     ----------
@@ -73,13 +73,6 @@ class MplPolyStructure(CellStructure):
     limit : bool
         Apply the stability limit eq. 5.29; ``False`` runs the raw cubic (may diverge).
     """
-
-    limit: bool = True
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if not isinstance(self.limit, bool):
-            raise TypeError(f"limit must be true or false, got {self.limit!r}")
 
     @property
     def n_params(self) -> int:

@@ -224,6 +224,14 @@ def inverse_branch(structure: MplPolyStructure,
     return lo, hi, sign, float(centre)
 
 
+def solve_on_branch(structure: MplPolyStructure, params: MplPolyParams,
+                    y: float) -> tuple[float, bool]:
+    """``(z, ok)``: the ``z`` on :func:`inverse_branch` with ``g(z) = y``, as the compiled
+    inverse finds it (``kernels.solve_output``); ``ok`` false outside the branch's range."""
+    return kernels.solve_output(float(y), np.ascontiguousarray(params.g),
+                                *inverse_branch(structure, params))
+
+
 @fill_doc
 def rest_state(structure: MplPolyStructure, params: MplPolyParams, value: float,
                inverse: bool = False) -> np.ndarray:
@@ -240,9 +248,7 @@ def rest_state(structure: MplPolyStructure, params: MplPolyParams, value: float,
     v_rest = rest_voltages(structure, params)
     if not inverse:
         return float(value) - v_rest
-    lo, hi, sign, centre = inverse_branch(structure, params)
-    z0, ok = kernels.solve_output(float(value), np.ascontiguousarray(params.g), lo, hi, sign,
-                                  centre)
+    z0, ok = solve_on_branch(structure, params, value)
     w_sum = params.w.sum()
     e0 = (z0 + params.w[1:] @ v_rest + params.v_b) / w_sum if ok and w_sum != 0 else 0.0
     return e0 - v_rest
