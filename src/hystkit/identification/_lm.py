@@ -47,7 +47,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ._normal_equations import NormalEquations, RunCounter, SolveResult
+from ._normal_equations import STATUS_MESSAGES, NormalEquations, RunCounter, SolveResult
 
 __all__ = ["solve_lm"]
 
@@ -57,15 +57,6 @@ __all__ = ["solve_lm"]
 # fit ended at SSE 4e-3 instead of 1e-24), and 0.1 and 1 both needed half the evaluations.
 _TAU = 0.1
 _LAM_MAX = 1e16
-_MESSAGES = {
-    -3: "the cost is not finite at the start",
-    -2: "stalled: no step lowered the cost (damping exceeded 1e16) before xtol was met",
-    0: "budget exhausted: the maximum number of function evaluations was reached",
-    1: "gtol termination condition is satisfied",
-    2: "ftol termination condition is satisfied",
-    3: "xtol termination condition is satisfied",
-    4: "both ftol and xtol termination conditions are satisfied",
-}
 
 
 def solve_lm(normal_equations: Callable[[np.ndarray], NormalEquations],
@@ -165,7 +156,7 @@ def solve_lm(normal_equations: Callable[[np.ndarray], NormalEquations],
 
 
 def _result(x, cost, status, state, column_norms) -> SolveResult:
-    return SolveResult(x=x, cost=float(cost), status=status, message=_MESSAGES[status],
+    return SolveResult(x=x, cost=float(cost), status=status, message=STATUS_MESSAGES[status],
                        nfev=state.nfev, njev=state.njev, n_runs=state.n_runs,
                        column_norms=column_norms)
 

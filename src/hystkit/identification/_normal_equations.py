@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ChunkedDifferences", "NormalEquations", "RunCounter", "SolveResult",
-           "dense_normal_equations", "difference_steps"]
+__all__ = ["STATUS_MESSAGES", "ChunkedDifferences", "NormalEquations", "RunCounter",
+           "SolveResult", "dense_normal_equations", "difference_steps"]
 
 _REL_STEP = np.finfo(float).eps ** 0.5  # scipy's '2-point' relative step
 CHUNK = 65_536  # samples per chunk: (p + 1) runs of this many samples stay a few MB
@@ -42,6 +42,18 @@ class NormalEquations:
     cost: float
     jtj: np.ndarray
     jtr: np.ndarray
+
+
+# SolveResult.message of each status, as scipy words them (-2 only LM reaches)
+STATUS_MESSAGES = {
+    -3: "the cost is not finite at the start",
+    -2: "stalled: no step lowered the cost (damping exceeded 1e16) before xtol was met",
+    0: "budget exhausted: the maximum number of function evaluations was reached",
+    1: "gtol termination condition is satisfied",
+    2: "ftol termination condition is satisfied",
+    3: "xtol termination condition is satisfied",
+    4: "both ftol and xtol termination conditions are satisfied",
+}
 
 
 @dataclass(frozen=True)

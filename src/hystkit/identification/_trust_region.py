@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._normal_equations import NormalEquations, RunCounter, SolveResult
+from ._normal_equations import STATUS_MESSAGES, NormalEquations, RunCounter, SolveResult
 from ._trust_region_steps import coleman_li, propose, scaled_problem, strictly_feasible
 
 __all__ = ["TrustRegionState", "solve_trust_region"]
@@ -52,14 +52,6 @@ __all__ = ["TrustRegionState", "solve_trust_region"]
 def _norm(v: np.ndarray) -> float:
     """Euclidean norm of a short vector (np.linalg.norm's dispatch costs more than the sum)."""
     return math.sqrt(float(v @ v))
-_MESSAGES = {
-    -3: "the cost is not finite at the start",
-    0: "budget exhausted: the maximum number of function evaluations was reached",
-    1: "gtol termination condition is satisfied",
-    2: "ftol termination condition is satisfied",
-    3: "xtol termination condition is satisfied",
-    4: "both ftol and xtol termination conditions are satisfied",
-}
 
 
 def solve_trust_region(normal_equations: Callable[[np.ndarray], NormalEquations],
@@ -143,7 +135,7 @@ class TrustRegionState:
 
 
 def _result(x, cost, status, runs, column_norms, state=None) -> SolveResult:
-    return SolveResult(x=x, cost=float(cost), status=status, message=_MESSAGES[status],
+    return SolveResult(x=x, cost=float(cost), status=status, message=STATUS_MESSAGES[status],
                        nfev=runs.nfev, njev=runs.njev, n_runs=runs.n_runs,
                        column_norms=column_norms, state=state)
 
