@@ -101,6 +101,17 @@ static real model_step(real *x, real u)
 """
 
 
+# The limited sinh resistor (eq. 5.1 with eq. 5.29) in MATLAB: f from v, i_s, v_t, knee, cap
+# (mpl-g's cells use it too).
+M_SINH_CURRENT = """if abs(v) <= knee
+    f = 2.0 * i_s * sinh(v / v_t);
+else
+    s = -1.0; if v > 0, s = 1.0; end
+    f = s * 2.0 * i_s * sinh(knee / v_t) + cap * (v - s * knee);
+end
+"""
+
+
 def m_model(plan, lit: Callable[[float], str]) -> str:
     w_sum = plan.extra["W_SUM"]
     rest = ("v = value;" if not plan.inverse else
@@ -121,13 +132,7 @@ end
 
 function f = mpl_current(B, v, k, n)
 i_s = B(4 + k); v_t = B(4 + n + k); knee = B(4 + 2 * n + k); cap = B(3);
-if abs(v) <= knee
-    f = 2.0 * i_s * sinh(v / v_t);
-else
-    s = -1.0; if v > 0, s = 1.0; end
-    f = s * 2.0 * i_s * sinh(knee / v_t) + cap * (v - s * knee);
-end
-end
+{M_SINH_CURRENT}end
 """
 
 

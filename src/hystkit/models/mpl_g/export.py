@@ -11,11 +11,12 @@ w (n + 1)]``.
 from __future__ import annotations
 
 from collections.abc import Callable
+from textwrap import indent
 
 from .._cubic_output_code import C_FORWARD, C_INVERSE, C_SOLVE, M_CUBIC, M_SOLVE, m_step
 from .._protocol import Translation
 from .._translation import linear_readout_rest
-from ..mpl.export import c_cells
+from ..mpl.export import M_SINH_CURRENT, c_cells
 
 _IC = 13  # body index of i_s (the C's IC, the MATLAB's ic)
 
@@ -78,13 +79,7 @@ n = round(B(1)); ic = 13;
 for k = 1:n
     v = drive - x(k);
     i_s = B(ic + k); v_t = B(ic + n + k); knee = B(ic + 2 * n + k); cap = B(3);
-    if abs(v) <= knee
-        f = 2.0 * i_s * sinh(v / v_t);
-    else
-        s = -1.0; if v > 0, s = 1.0; end
-        f = s * 2.0 * i_s * sinh(knee / v_t) + cap * (v - s * knee);
-    end
-    x(k) = x(k) + f * B(4);
+{indent(M_SINH_CURRENT, "    ")}    x(k) = x(k) + f * B(4);
 end
 end
 
