@@ -53,7 +53,7 @@ from ..mpl.model import (
     sinh_from_coordinates,
 )
 from ..mpl_poly.kernels import solve_output
-from ..mpl_poly.records import G_MIN, POLY_MAX
+from ..mpl_poly.records import check_output_cubic
 from ..mpl_poly.resistors import output_current, output_root, output_slope
 from ..mpl_poly.rest import branch_around, check_branch_inverse
 from . import kernels
@@ -146,11 +146,7 @@ class MplGParams(Record):
         finite_floats(self, "v_b")
         check_range(self.i_s, "i_s", *I_S_RANGE, " (eq. 5.1)")
         check_range(self.v_t, "v_t", *V_T_RANGE, " (eq. 5.1)")
-        check_magnitude(self.g, "g", POLY_MAX)
-        tiny = (self.g != 0) & (np.abs(self.g) < G_MIN)
-        if np.any(tiny):
-            raise ValueError(f"g must be 0 or at least {G_MIN:g} in magnitude (its roots are "
-                             f"solved for), got {float(self.g[np.argmax(tiny)])!r}")
+        check_output_cubic(self.g)
         check_magnitude(self.w, "w")
         check_magnitude(self.v_b, "v_b")
 

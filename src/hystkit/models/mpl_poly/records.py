@@ -34,6 +34,16 @@ G_MIN = 1e-200
 REST_MAX = 2e9
 
 
+def check_output_cubic(g: np.ndarray) -> None:
+    """The output resistor's cubic (mpl-poly, mpl-g): ``|g_j| <= POLY_MAX`` and each ``g_j``
+    0 or at least ``G_MIN`` in magnitude; ValueError naming the first one that is not."""
+    check_magnitude(g, "g", POLY_MAX)
+    tiny = (g != 0) & (np.abs(g) < G_MIN)
+    if np.any(tiny):
+        raise ValueError(f"g must be 0 or at least {G_MIN:g} in magnitude (its roots are "
+                         f"solved for), got {float(g[np.argmax(tiny)])!r}")
+
+
 def _far_root(c: np.ndarray) -> float | None:
     """A real root of the cubic ``c`` (``c0..c3``) beyond ``REST_MAX``, or None.
 
@@ -128,11 +138,7 @@ class MplPolyParams(Record):
         check_range(self.f[:, 3], "the cubic coefficient f[k][3]", *C3_RANGE,
                     " (positive: stable for large |v|, sec. 5.3.5)")
         check_magnitude(self.f[:, :3], "f (c0..c2)", POLY_MAX)
-        check_magnitude(self.g, "g", POLY_MAX)
-        tiny = (self.g != 0) & (np.abs(self.g) < G_MIN)
-        if np.any(tiny):
-            raise ValueError(f"g must be 0 or at least {G_MIN:g} in magnitude (its roots are "
-                             f"solved for), got {float(self.g[np.argmax(tiny)])!r}")
+        check_output_cubic(self.g)
         check_magnitude(self.w, "w")
         check_magnitude(self.v_b, "v_b")
         for k, c in enumerate(self.f):
