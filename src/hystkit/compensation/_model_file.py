@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
+from .._docfill import fill_output_doc
 from .._read_options import ReadOptions
 from ..errors import InputError
 from ..io import check_output_format, load_mat, matlab_name, write_json, write_mat
@@ -242,6 +243,7 @@ MODEL_SUFFIXES = (".json", ".mat")
 MAT_JSON_KEY = "hystkit_json"  # the variable of a .mat model file that hystkit reads back
 
 
+@fill_output_doc
 def save_compensator(comp: Compensator, path: str | Path, *, force: bool = False) -> Path:
     """Write the model file, JSON or MATLAB by the extension of `path` (``.json``/``.mat``);
     refuses another extension, and to overwrite unless ``force``.
@@ -252,20 +254,11 @@ def save_compensator(comp: Compensator, path: str | Path, *, force: bool = False
         The compensator.
     path : str or pathlib.Path
         Output file, ``.json`` or ``.mat``.
-    force : bool, default False
-        Replace an existing file.
+    %(force)s
 
-    Returns
-    -------
-    pathlib.Path
-        `path`.
-
-    Raises
-    ------
+    %(written_path)s
     OutputError
         Another extension.
-    OutputExistsError
-        `path` exists and `force` is False.
     """
     path = Path(path)
     d = compensator_to_dict(comp)

@@ -18,6 +18,8 @@ from pathlib import Path
 
 from hystkit.errors import OutputError, OutputExistsError
 
+from .._docfill import fill_output_doc
+
 # check_folder_writable: re-exported for cli.cmd_report, which imports it from here.
 from ._output_checks import TEMP_MARK, check_folder_writable, check_output_folder, check_output_path
 from ._unfinished import forget, register
@@ -25,6 +27,7 @@ from ._unfinished import forget, register
 __all__ = ["atomic_folder", "atomic_output", "atomic_outputs", "check_folder_writable"]
 
 
+@fill_output_doc
 @contextmanager
 def atomic_output(path: str | os.PathLike[str], force: bool = False) -> Iterator[Path]:
     """Yield a temporary path to write `path`'s content to; publish it only on success.
@@ -43,8 +46,7 @@ def atomic_output(path: str | os.PathLike[str], force: bool = False) -> Iterator
     ----------
     path : str or os.PathLike
         The output file.
-    force : bool, default False
-        Replace an existing file.
+    %(force)s
 
     Yields
     ------

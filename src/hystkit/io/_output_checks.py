@@ -14,6 +14,7 @@ from pathlib import Path
 
 from hystkit.errors import OutputError, OutputExistsError
 
+from .._docfill import fill_output_doc
 from ._unfinished import forget, register
 
 __all__ = ["TEMP_MARK", "check_folder_writable", "check_output_folder", "check_output_format",
@@ -59,6 +60,7 @@ def check_output_format(path: str | os.PathLike[str], suffixes: Iterable[str],
     return suffix
 
 
+@fill_output_doc
 def check_output_path(path: str | os.PathLike[str], force: bool = False, *,
                       inputs: Iterable[str | os.PathLike[str]] = (),
                       formats: Iterable[str] | None = None, what: str = "this output") -> Path:
@@ -84,15 +86,7 @@ def check_output_path(path: str | os.PathLike[str], force: bool = False, *,
     what : str, default "this output"
         What the file holds, for the message about a wrong extension.
 
-    Returns
-    -------
-    pathlib.Path
-        `path`.
-
-    Raises
-    ------
-    OutputExistsError
-        `path` exists and `force` is False.
+    %(written_path)s
     OutputError
         Any other reason listed above.
     """

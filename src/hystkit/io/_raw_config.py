@@ -16,6 +16,7 @@ import numpy as np
 
 from hystkit.errors import InputError
 
+from .._docfill import fill_output_doc
 from ._atomic import atomic_output
 from ._raw_format import MAX_SKIP_ROWS
 from ._toml import check_type, load_settings, settings_beside
@@ -134,6 +135,7 @@ def _check_value(path: Path, key: str, value: Any) -> None:
                      f"{', '.join(_COLUMN_NAMES)} and map to column names (strings)")
 
 
+@fill_output_doc
 def write_raw_config(path: str | os.PathLike[str], values: dict[str, Any], *,
                      comment: str = "", force: bool = False) -> Path:
     """Write flat settings (numbers, strings, booleans, lists, one level of tables) as TOML,
@@ -147,18 +149,9 @@ def write_raw_config(path: str | os.PathLike[str], values: dict[str, Any], *,
         Settings; a dict value becomes a table.
     comment : str, optional
         Text written first, each line as a ``#`` comment.
-    force : bool, default False
-        Replace an existing file.
+    %(force)s
 
-    Returns
-    -------
-    pathlib.Path
-        `path`.
-
-    Raises
-    ------
-    OutputExistsError
-        `path` exists and `force` is False.
+    %(written_path)s
     """
     path = Path(path)
     lines = [f"# {line}" for line in comment.splitlines()]

@@ -15,6 +15,7 @@ import pyarrow.parquet as pq
 
 from hystkit.errors import InputError
 
+from .._docfill import fill_output_doc
 from ._atomic import atomic_output
 from ._output_checks import check_output_path
 from ._raw_format import RAW_COLUMNS
@@ -22,6 +23,7 @@ from ._raw_format import RAW_COLUMNS
 __all__ = ["RawWriter"]
 
 
+@fill_output_doc
 class RawWriter:
     """Write a raw recording chunk by chunk to ``.csv`` or ``.parquet`` (one row group a chunk).
 
@@ -37,8 +39,7 @@ class RawWriter:
         Output ``.csv`` or ``.parquet`` file.
     columns : tuple of str
         Columns to write, among :data:`RAW_COLUMNS`.
-    force : bool, default False
-        Replace an existing file.
+    %(force)s
 
     Raises
     ------

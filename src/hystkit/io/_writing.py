@@ -13,6 +13,7 @@ import numpy as np
 
 from hystkit.errors import NonFiniteError
 
+from .._docfill import fill_output_doc
 from .._read_options import TIME_UNITS
 from ._atomic import atomic_output, atomic_outputs
 from ._mat_writer import recording_variables, write_mat
@@ -249,6 +250,7 @@ def _refuse_non_finite(path: Path, name: str, values: np.ndarray) -> None:
                              f"({bad.size} non-finite value(s)); refusing to write it")
 
 
+@fill_output_doc
 def write_json(obj: Any, path: str | os.PathLike[str], *, force: bool = False) -> Path:
     """Write `obj` as indented JSON (metrics, model parameters), atomically.
 
@@ -261,18 +263,9 @@ def write_json(obj: Any, path: str | os.PathLike[str], *, force: bool = False) -
         JSON-serialisable data; numpy scalars and arrays allowed.
     path : str or os.PathLike
         Output ``.json`` file.
-    force : bool, default False
-        Replace an existing file.
+    %(force)s
 
-    Returns
-    -------
-    pathlib.Path
-        `path`.
-
-    Raises
-    ------
-    OutputExistsError
-        `path` exists and `force` is False.
+    %(written_path)s
     OutputError
         `path` does not end in ``.json`` (`check_output_format`).
     NonFiniteError

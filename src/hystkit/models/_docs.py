@@ -19,9 +19,10 @@ it) stays in the source::
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable
 from typing import TypeVar
+
+from .._docfill import fill
 
 __all__ = ["ENTRIES", "docfiller", "filled"]
 
@@ -146,9 +147,6 @@ x_next : numpy.ndarray
     State after the sample.""",
 }
 
-_LINE = re.compile(r"^( *)%\((\w+)\)s$", re.MULTILINE)
-
-
 def filled(doc: str, structure: type | str = "Structure", params: type | str = "Params",
            state: str = "") -> str:
     """`doc` with its ``%(name)s`` lines replaced by :data:`ENTRIES`.
@@ -170,13 +168,7 @@ def filled(doc: str, structure: type | str = "Structure", params: type | str = "
     names = {"Structure": getattr(structure, "__name__", structure),
              "Params": getattr(params, "__name__", params),
              "state": ENTRIES.get(state, state)}
-
-    def entry(match: re.Match) -> str:
-        indent, key = match.groups()
-        lines = ENTRIES[key].format(**names).split("\n")
-        return "\n".join(indent + line if line else line for line in lines)
-
-    return _LINE.sub(entry, doc)
+    return fill(doc, lambda key: ENTRIES[key].format(**names))
 
 
 def docfiller(structure: type | str = "Structure", params: type | str = "Params",
