@@ -84,6 +84,14 @@ accept_reason : str, optional
     Why candidates were rejected, for the message.""",
     "best_start": """FitResult
     The best start's fit.""",
+    # the fits that solve one linear least-squares problem (no robust loss)
+    "linear_loss": """loss, f_scale : str, float
+    Only ``"linear"`` (the SSE): a robust loss is refused with InputError.""",
+    # ... with a smoothness penalty (preisach, gpreisach)
+    "penalised_weights": """weights : array, shape (n,), optional
+    Per-sample weights (finite, >= 0, not all 0): the rows of the least-squares problem
+    are scaled by ``sqrt(w)`` and the smoothness penalty by ``sqrt(mean(w))`` (so weights
+    all equal to any ``c`` give the unweighted fit).""",
     "state": "{state}",
     # whole sections of the protocol functions whose signature means the same everywhere
     "cell_voltages": """Parameters

@@ -19,8 +19,11 @@ import numpy as np
 
 from ...identification import FitResult, require_linear_loss
 from .. import preisach
+from .._docs import docfiller
 from ..preisach import check_data, fit_oriented, smoothness_rows
 from . import model as gpreisach
+
+fill_doc = docfiller()
 
 __all__ = ["SUPPORTED_LOSSES", "fit_gpreisach"]
 
@@ -28,6 +31,7 @@ SUPPORTED_LOSSES = ("linear",)
 """Costs :func:`fit_gpreisach` minimises: the (weighted) SSE only (one linear solve)."""
 
 
+@fill_doc
 def fit_gpreisach(u: np.ndarray, y: np.ndarray, structure: gpreisach.GPreisachStructure, *,
                   accept: Callable[[gpreisach.GPreisachParams], bool] | None = None,
                   accept_reason: str = "rejected by the acceptance test", loss: str = "linear",
@@ -44,12 +48,8 @@ def fit_gpreisach(u: np.ndarray, y: np.ndarray, structure: gpreisach.GPreisachSt
         Checked on each solution (one per orientation tried), cheapest first.
     accept_reason : str, optional
         Why solutions were rejected, for the message.
-    loss, f_scale : str, float
-        Only ``"linear"`` (the SSE): a robust loss is refused with InputError.
-    weights : array, shape (n,), optional
-        Per-sample weights (finite, >= 0, not all 0): the rows of the least-squares problem
-        are scaled by ``sqrt(w)`` and the smoothness penalty by ``sqrt(mean(w))`` (so weights
-        all equal to any ``c`` give the unweighted fit).
+    %(linear_loss)s
+    %(penalised_weights)s
 
     Returns
     -------

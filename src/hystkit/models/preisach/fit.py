@@ -41,7 +41,10 @@ from ...identification import (
     check_weights,
     require_linear_loss,
 )
+from .._docs import docfiller
 from . import model as preisach
+
+fill_doc = docfiller()
 
 __all__ = ["ORIENTATIONS", "SUPPORTED_LOSSES", "check_data", "everett_from_forcs",
            "fit_oriented", "fit_preisach", "smoothness_rows", "solve_regularised"]
@@ -222,6 +225,7 @@ def fit_oriented(a: np.ndarray, y: np.ndarray, penalty: np.ndarray, hysteretic: 
                            f"rejected ({accept_reason})")
 
 
+@fill_doc
 def fit_preisach(u: np.ndarray, y: np.ndarray, structure: preisach.PreisachStructure, *,
                  accept: Callable[[preisach.PreisachParams], bool] | None = None,
                  accept_reason: str = "rejected by the acceptance test", loss: str = "linear",
@@ -241,12 +245,8 @@ def fit_preisach(u: np.ndarray, y: np.ndarray, structure: preisach.PreisachStruc
         skipped.
     accept_reason : str, optional
         The message when every solution is rejected.
-    loss, f_scale : str, float
-        Only ``"linear"`` (the SSE): a robust loss is refused with InputError.
-    weights : array, shape (n,), optional
-        Per-sample weights (finite, >= 0, not all 0): the rows of the least-squares problem
-        are scaled by ``sqrt(w)`` and the smoothness penalty by ``sqrt(mean(w))`` (so weights
-        all equal to any ``c`` give the unweighted fit).
+    %(linear_loss)s
+    %(penalised_weights)s
 
     Returns
     -------
