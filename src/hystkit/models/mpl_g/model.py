@@ -173,8 +173,7 @@ def output_branch(params: MplGParams) -> tuple[float, float, float]:
 
     Parameters
     ----------
-    params : MplGParams
-        Its parameters.
+    %(params)s
 
     Returns
     -------
@@ -188,14 +187,14 @@ def output_branch(params: MplGParams) -> tuple[float, float, float]:
     return branch_around(params, -params.v_b)
 
 
+@fill_doc
 def inverse_branch(params: MplGParams) -> tuple[float, float, float, float]:
     """``(lo, hi, sign, centre)``: :func:`output_branch` and ``z_rest = -V_b``, the
     arguments of ``mpl_poly.kernels.solve_output``.
 
     Parameters
     ----------
-    params : MplGParams
-        Its parameters.
+    %(params)s
 
     Returns
     -------
