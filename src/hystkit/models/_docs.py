@@ -24,18 +24,19 @@ from typing import TypeVar
 
 from .._docfill import fill
 
-__all__ = ["ENTRIES", "docfiller", "filled"]
+__all__ = ["ENTRIES", "RECORDS", "docfiller", "filled"]
 
 F = TypeVar("F", bound=Callable)
 
-_RECORDS = """structure : {Structure}
+# The records every model function takes first; modules start their own entries with it.
+RECORDS = """structure : {Structure}
     The model's structure.
 params : {Params}
     Its parameters."""
 
 ENTRIES = {
     # the records every model function takes first
-    "structure": _RECORDS,
+    "structure": RECORDS,
     "params": """params : {Params}
     The model's parameters.""",
     # rest_state(structure, params, value, inverse)
@@ -96,7 +97,7 @@ accept_reason : str, optional
     # whole sections of the protocol functions whose signature means the same everywhere
     "cell_voltages": """Parameters
 ----------
-""" + _RECORDS + """
+""" + RECORDS + """
 v : numpy.ndarray, shape (..., N)
     Voltage across each cell's resistor.
 
@@ -117,7 +118,7 @@ float
     The bound on ``|y|``.""",
     "rest_state": """Parameters
 ----------
-""" + _RECORDS + """
+""" + RECORDS + """
 value : float
     Constant input (with `inverse`: output) the model rests at.
 inverse : bool, default False
@@ -129,7 +130,7 @@ numpy.ndarray
     The state at rest.""",
     "step": """Parameters
 ----------
-""" + _RECORDS + """
+""" + RECORDS + """
 {state}
 u : float
     Input of the sample.
@@ -142,7 +143,7 @@ x_next : numpy.ndarray
     State after the sample.""",
     "invert_step": """Parameters
 ----------
-""" + _RECORDS + """
+""" + RECORDS + """
 {state}
 y : float
     Output to reach at this sample.
@@ -156,7 +157,7 @@ x_next : numpy.ndarray
 }
 
 def filled(doc: str, structure: type | str = "Structure", params: type | str = "Params",
-           state: str = "") -> str:
+           state: str = "", entries: dict[str, str] | None = None) -> str:
     """`doc` with its ``%(name)s`` lines replaced by :data:`ENTRIES`.
 
     Parameters
@@ -167,20 +168,23 @@ def filled(doc: str, structure: type | str = "Structure", params: type | str = "
         The family's record types (or their names).
     state : str
         The entry of the state ``x``: a key of :data:`ENTRIES` or the entry's text.
+    entries : dict, optional
+        The module's own entries, beside :data:`ENTRIES` (same form).
 
     Returns
     -------
     str
         The docstring filled in.
     """
+    table = {**ENTRIES, **entries} if entries else ENTRIES
     names = {"Structure": getattr(structure, "__name__", structure),
              "Params": getattr(params, "__name__", params),
-             "state": ENTRIES.get(state, state)}
-    return fill(doc, lambda key: ENTRIES[key].format(**names))
+             "state": table.get(state, state)}
+    return fill(doc, lambda key: table[key].format(**names))
 
 
 def docfiller(structure: type | str = "Structure", params: type | str = "Params",
-              state: str = "") -> Callable[[F], F]:
+              state: str = "", entries: dict[str, str] | None = None) -> Callable[[F], F]:
     """A decorator that fills a function's docstring in place (:func:`filled`).
 
     Parameters
@@ -189,6 +193,8 @@ def docfiller(structure: type | str = "Structure", params: type | str = "Params"
         The family's record types (or their names).
     state : str
         The entry of the state ``x`` (:func:`filled`).
+    entries : dict, optional
+        The module's own entries (:func:`filled`).
 
     Returns
     -------
@@ -197,7 +203,7 @@ def docfiller(structure: type | str = "Structure", params: type | str = "Params"
     """
 
     def fill_doc(function: F) -> F:
-        function.__doc__ = filled(function.__doc__, structure, params, state)
+        function.__doc__ = filled(function.__doc__, structure, params, state, entries)
         return function
 
     return fill_doc

@@ -50,7 +50,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
-from .._docs import docfiller
+from .._docs import RECORDS, docfiller
 from .._validation import check_signal
 from . import kernels
 from .divergence import (
@@ -68,7 +68,17 @@ from .records import (
     BoucWenStructure,
 )
 
-fill_doc = docfiller("BoucWenStructure", "BoucWenParams")
+# the arguments of the three runs (simulate_states, simulate, simulate_reference)
+_RUN_ARGUMENTS = """Parameters
+----------
+""" + RECORDS + """
+u : numpy.ndarray, shape (n,)
+    Force sampled every ``structure.dt``.
+x0 : numpy.ndarray, shape (4,), optional
+    State ``(y, y', z, u_prev)`` one sample before ``u[0]`` (the ``x_end`` of a previous
+    run); None starts at ``u[0]`` as ``structure.start`` says (:func:`initial_state`)."""
+
+fill_doc = docfiller("BoucWenStructure", "BoucWenParams", entries={"run": _RUN_ARGUMENTS})
 
 __all__ = [
     "BENCHMARK_PARAMS",
@@ -201,14 +211,7 @@ def simulate_states(structure: BoucWenStructure, params: BoucWenParams, u: np.nd
                     x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Run the model and return every sample's mechanical state (compiled kernel).
 
-    Parameters
-    ----------
-    %(structure)s
-    u : array, shape (n,)
-        Force sampled every ``structure.dt``.
-    x0 : array, shape (4,), or None
-        State ``(y, y', z, u_prev)`` one sample before ``u[0]`` (the ``x_end`` of a previous
-        run); ``None`` starts at ``u[0]`` as ``structure.start`` says (:func:`initial_state`).
+    %(run)s
 
     Returns
     -------
@@ -243,14 +246,7 @@ def simulate(structure: BoucWenStructure, params: BoucWenParams, u: np.ndarray,
              x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Displacement response to a force sequence (see :func:`simulate_states`).
 
-    Parameters
-    ----------
-    %(structure)s
-    u : numpy.ndarray, shape (n,)
-        Force sampled every ``structure.dt``.
-    x0 : numpy.ndarray, shape (4,), optional
-        State ``(y, y', z, u_prev)`` one sample before ``u[0]``; None starts as
-        ``structure.start`` says (:func:`initial_state`).
+    %(run)s
 
     Returns
     -------
@@ -267,14 +263,7 @@ def simulate_reference(structure: BoucWenStructure, params: BoucWenParams, u: np
                        x0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Same as :func:`simulate`, as a plain loop over :func:`step` (the readable reference).
 
-    Parameters
-    ----------
-    %(structure)s
-    u : numpy.ndarray, shape (n,)
-        Force sampled every ``structure.dt``.
-    x0 : numpy.ndarray, shape (4,), optional
-        State ``(y, y', z, u_prev)`` one sample before ``u[0]``; None starts as
-        ``structure.start`` says (:func:`initial_state`).
+    %(run)s
 
     Returns
     -------
