@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from .._docfill import docfiller
 from ..compensation import Compensator, Scaling
 from ..models import Family, family_of
 from . import _kernel
@@ -41,6 +42,13 @@ __all__ = ["MM", "SensorBlock", "SensorModels", "compensator_block", "forward_bl
            "linear_block", "sensor_block"]
 
 MM = 1e-3  # recordings hold position in mm; the loop works in metres
+
+# What every builder of a sensor block returns (the docstrings' %(sensor_block)s).
+SENSOR_BLOCK_ENTRIES = {"sensor_block": """Returns
+-------
+SensorBlock
+    Position [m] in, sensor signal out."""}
+fill_sensor_doc = docfiller(SENSOR_BLOCK_ENTRIES.__getitem__)
 
 
 @dataclass(frozen=True, eq=False)
@@ -187,6 +195,7 @@ class SensorBlock:
                 float(self.out_scale * d / self.in_scale))
 
 
+@fill_sensor_doc
 def forward_block(structure: Any, params: Any, scaling: Scaling, *, name: str = "sensor",
                   info: dict | None = None) -> SensorBlock:
     """Forward model position [m] -> sensor from a fit on normalised mm data.
@@ -203,10 +212,7 @@ def forward_block(structure: Any, params: Any, scaling: Scaling, *, name: str = 
     info : dict, optional
         Provenance, copied into the block.
 
-    Returns
-    -------
-    SensorBlock
-        Position [m] in, sensor signal out.
+    %(sensor_block)s
     """
     return SensorBlock(structure, params, False, scaling.position_offset * MM,
                        scaling.position_scale * MM, scaling.sensor_offset, scaling.sensor_scale,
@@ -260,6 +266,7 @@ def compensator_block(compensator: Compensator, *, name: str = "compensator") ->
                        info=_file_info(compensator, "sensor -> position"))
 
 
+@fill_sensor_doc
 def sensor_block(compensator: Compensator, *, name: str = "S_r") -> SensorBlock:
     """A model file run in the sensor's own direction: position [m] in, sensor signal out.
 
@@ -274,10 +281,7 @@ def sensor_block(compensator: Compensator, *, name: str = "S_r") -> SensorBlock:
     name : str, default "S_r"
         Block name.
 
-    Returns
-    -------
-    SensorBlock
-        Position [m] in, sensor signal out.
+    %(sensor_block)s
 
     Raises
     ------

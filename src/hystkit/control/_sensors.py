@@ -16,7 +16,14 @@ from ..io import Recording
 from ..models import get_family
 from ..sensors import VIRTUAL_PHYSICS, VirtualSensor, physics_of, simulate_experiment
 from ._names import TRAININGS
-from ._sensor_blocks import MM, SensorBlock, SensorModels, compensator_block, forward_block
+from ._sensor_blocks import (
+    MM,
+    SensorBlock,
+    SensorModels,
+    compensator_block,
+    fill_sensor_doc,
+    forward_block,
+)
 
 __all__ = ["TRAININGS", "fit_forward_sensor", "fit_sensor_models", "table_ii_sensor",
            "table_ii_sensors", "virtual_sensor_block"]
@@ -206,6 +213,7 @@ def table_ii_sensors() -> tuple[str, ...]:
     return tuple(k.removeprefix(TABLE_II_PREFIX) for k in presets if k.startswith(TABLE_II_PREFIX))
 
 
+@fill_sensor_doc
 def table_ii_sensor(column: str = "noise", *, sensor_scale: float = 1.0,
                     sensor_offset: float = 0.0) -> SensorBlock:
     """Paper 9.2's table II ``column`` as the forward "real" sensor ``S_r``: position -> sensor.
@@ -226,10 +234,7 @@ def table_ii_sensor(column: str = "noise", *, sensor_scale: float = 1.0,
     sensor_offset : float, default 0.0
         Sensor signal at normalised zero [sensor units].
 
-    Returns
-    -------
-    SensorBlock
-        Position [m] in, sensor signal out.
+    %(sensor_block)s
 
     Raises
     ------
@@ -250,6 +255,7 @@ def table_ii_sensor(column: str = "noise", *, sensor_scale: float = 1.0,
                              "sensor_scale": sensor_scale})
 
 
+@fill_sensor_doc
 def virtual_sensor_block(sensor: VirtualSensor | None = None, *,
                          name: str = "S_r") -> SensorBlock:
     """The virtual sensor's own causal physics as the "real" sensor ``S_r``.
@@ -269,10 +275,7 @@ def virtual_sensor_block(sensor: VirtualSensor | None = None, *,
     name : str, default "S_r"
         Block name.
 
-    Returns
-    -------
-    SensorBlock
-        Position [m] in, sensor signal out.
+    %(sensor_block)s
     """
     sensor = VirtualSensor() if sensor is None else sensor
     structure, params = physics_of(sensor)
