@@ -3,6 +3,7 @@ against an earlier revision, paired in one run.
 
 Run:  python benchmarks/bench_stream.py [--before REV] [--after REV] [--rounds N] [--quick]
       [--samples N ...] [--out FILE]        (~10 min with the defaults on 2 shared cores)
+      [--table3 [--models NAME ...]]        (table 3 alone, of these models, e.g. ladder_3)
 
 Variants: ``after`` is this tree's ``src`` as it is at the start (or revision ``--after``),
 ``before`` revision ``--before`` (default 2bff934, checked out once with ``git worktree add
@@ -121,8 +122,9 @@ def _stream_class():
     return Stream
 
 
-def _make_models(folder: Path) -> None:
-    """The in-process table's compensators (direct, no band) and the command's model."""
+def _make_models(folder: Path, names: list[str] | None = None, command: bool = True) -> None:
+    """The in-process table's compensators (direct, no band; of `names` only if given) and
+    the command's model (unless not `command`)."""
     from hystkit.cli import main as cli
     from hystkit.compensation import fit_compensator, save_compensator
     from hystkit.io import write_recording
@@ -132,8 +134,12 @@ def _make_models(folder: Path) -> None:
     models = folder / "models"
     models.mkdir()
     for name, size in FAMILIES:
+        if names and f"{name}_{size}" not in names:
+            continue
         comp = fit_compensator(train, size, model=name, diagnose=False)
         save_compensator(comp, models / f"{name}_{size}.json")
+    if not command:
+        return
     write_recording(train, folder / "train.csv")
     code = cli(["fit", str(folder / "train.csv"), "--cells", "1", "--out",
                 str(models / "command_mpl_1_band.json")])
@@ -261,12 +267,16 @@ def main() -> None:
     parser.add_argument("--latency-child", nargs=2, metavar=("MODELS", "N"),
                         help=argparse.SUPPRESS)
     parser.add_argument("--models-child", metavar="FOLDER", help=argparse.SUPPRESS)
+    parser.add_argument("--table3", action="store_true",
+                        help="only table 3 (in-process Stream.step), no command runs")
+    parser.add_argument("--models", nargs="+", metavar="NAME",
+                        help="table 3's models, e.g. ladder_3 mpl_3 (default: all)")
     args = parser.parse_args()
     if args.latency_child:
         print(json.dumps(_latency(Path(args.latency_child[0]), int(args.latency_child[1]))))
         return
     if args.models_child:
-        _make_models(Path(args.models_child))
+        _make_models(Path(args.models_child), args.models, command=not args.table3)
         return
     if args.quick:
         args.samples, args.rounds, args.live = [20_000], 2, 500
@@ -289,8 +299,16 @@ def _run(args: argparse.Namespace) -> str:
         if args.before != "none":
             variants.insert(0, Variant("before", args.before, tmp))
         lines.append("variants: " + "; ".join(f"{v.name} = {v.rev}" for v in variants))
-        variants[0].python([__file__, "--models-child", str(tmp)], capture_output=True)
+        selection = (["--models", *args.models] if args.models else []) + \
+            (["--table3"] if args.table3 else [])
+        variants[0].python([__file__, "--models-child", str(tmp), *selection],
+                           capture_output=True)
         models = tmp / "models"
+        if args.table3:
+            lines += _table3_only(args, variants, models)
+            lines.append(f"load at the end {', '.join(f'{x:.2f}' for x in os.getloadavg())}; "
+                         f"benchmark {time.perf_counter() - t_start:.0f} s")
+            return "\n".join(lines)
         model = models / "command_mpl_1_band.json"
         files, small = _data(tmp, args.samples)
         text = files[args.samples[0]].read_bytes()
@@ -363,7 +381,24 @@ def _tables(args, variants, runs, outputs) -> list[str]:
     for name in names:
         trips = np.concatenate(runs[name]["live"]) * 1e6
         lines.append(f"  {name:<8} {np.median(trips):>8.1f} {np.percentile(trips, 99):>8.1f}")
-    lines += ["", ("Table 3. in-process, µs per sample (2000 samples of the decay run; direct "
+    return lines + _latency_table(names, runs)
+
+
+def _table3_only(args, variants, models: Path) -> list[str]:
+    """Table 3 alone: the latency child of each variant, rounds alternating as in `_run`."""
+    for v in variants:  # warm-up: compile or load every kernel once, untimed
+        v.python([__file__, "--latency-child", str(models), "50"], capture_output=True)
+    runs: dict[str, dict[str, list]] = {v.name: {"latency": []} for v in variants}
+    for r in range(args.rounds):
+        for v in (variants if r % 2 == 0 else variants[::-1]):
+            found = json.loads(v.python([__file__, "--latency-child", str(models), "2000"],
+                                        capture_output=True, text=True).stdout)
+            runs[v.name]["latency"].append(found)
+    return _latency_table([v.name for v in variants], runs)
+
+
+def _latency_table(names: list[str], runs) -> list[str]:
+    lines = ["", ("Table 3. in-process, µs per sample (2000 samples of the decay run; direct "
                   "compensators fitted on the sine run): Stream.step p50 / p99, "
                   "Stream.process on chunks of 64, a plain-Python loop over the family's step"),
               (f"  {'model':<22} {'variant':<7} {'compiled':>8} {'step p50':>9} "

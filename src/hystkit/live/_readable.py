@@ -239,7 +239,7 @@ def _run_model(comp: Compensator, s: np.ndarray,
         return comp.family.invert(comp.structure, comp.params, s, x0)
     p, x_end = comp.family.simulate(comp.structure, comp.params, s, x0)
     if s.size == 1:
-        # A family whose output is ``states @ weights`` (ladder, bobbio) gets numpy's
+        # A family whose output is ``states @ weights`` (bobbio) gets numpy's
         # single-row matmul here, which sums in another order than the many-row one of a
         # whole run: take the output of a two-sample run (the sample repeated) instead.
         try:

@@ -53,6 +53,19 @@ def solve_input(y, x, off, w, v_b):
 
 
 @njit(cache=True)
+def simulate(u, x0, band, g, w, v_b, dt):
+    """Output from the present voltages (:func:`output`), then the Euler step, per sample: the
+    forward block's arithmetic, so a stream or a loop of blocks gives these bits (a matrix
+    product of :func:`states` would sum in BLAS's order, which depends on the machine)."""
+    x = x0.copy()
+    y = np.empty(u.size)
+    for n in range(u.size):
+        y[n] = output(u[n], x, 0, w, v_b)
+        euler(u[n], x, x, 0, band, g, dt)
+    return y, x
+
+
+@njit(cache=True)
 def states(u, x0, band, g, dt):
     """Capacitor voltages at each sample, before that sample's update (output first)."""
     x = x0.copy()

@@ -296,9 +296,8 @@ def _states(structure: LadderStructure, params: LadderParams, u: np.ndarray,
 
 def _forward(structure: LadderStructure, params: LadderParams, u: np.ndarray,
              x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    s, x_end = _states(structure, params, u, x)
-    with np.errstate(over="ignore", invalid="ignore"):  # inputs near the float range
-        return params.w[0] * u + s @ params.w[1:] - params.v_b, x_end
+    return kernels.simulate(u, x, params.band, effective_conductance(structure, params),
+                            params.w, params.v_b, structure.dt)
 
 
 def _inverse(structure: LadderStructure, params: LadderParams, y: np.ndarray,
