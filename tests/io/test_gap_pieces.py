@@ -1,7 +1,7 @@
 """A recording with time gaps (issue 27.1): refused by default naming the gap's row and the
 option; ``gaps = "split"`` (``--gaps split``, a settings-file key) reads the pieces between
 gaps, says how many and where in one line, and the pieces are fitted jointly as several
-recordings are (``hk.fit``; the CLI's ``read_recordings_args``)."""
+recordings are (``hk.fit``; the CLI's ``Reader.training_files``)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,8 @@ from numpy.testing import assert_array_equal
 import hystkit as hk
 from hystkit.cli import main
 from hystkit.cli._common import Parser, add_read_options
-from hystkit.cli._reading import read_recordings_args
+from hystkit.cli._read_args import given_read_options
+from hystkit.cli._reading import Reader
 from hystkit.compensation import fit_compensator
 from hystkit.errors import InputError
 from hystkit.io import ReadOptions, read_pieces, read_recording, read_recording_config, time_gaps
@@ -137,12 +138,13 @@ def test_the_cli_reads_pieces_for_a_joint_fit(tmp_path, capsys):
     parser = Parser(prog="hystkit fit")
     add_read_options(parser)
     args = parser.parse_args(["--gaps", "split"])
-    recordings = read_recordings_args(args, [path, plain])
+    reading, recordings = Reader(given_read_options(args)).training_files([path, plain])
+    assert [r.gaps for r in reading] == ["split", "split"]
     assert [r.n_samples for r in recordings] == [3000, 3000, 2000, 8000]
     joint = fit_compensator(recordings, 1, diagnose=False)
     assert joint.fit_info["joint_fit"].startswith("joint polish over 4 recordings")
     with pytest.raises(InputError, match="a time gap: split the recording there"):
-        read_recordings_args(parser.parse_args([]), [path])
+        Reader(given_read_options(parser.parse_args([]))).training_files([path])
 
 
 def test_hystkit_fit_gaps_split_fits_the_pieces_jointly(tmp_path, capsys):

@@ -21,7 +21,8 @@ from ..errors import InputError
 from ..io import read_other_columns
 from ..models import FAMILIES, get_family
 from ._option_types import UsageError
-from ._reading import Reader, reader_of
+from ._read_args import given_read_options
+from ._reading import Reader
 
 __all__ = ["CostOptions", "FitOptions", "cost_options", "list_presets", "parse_init",
            "start_options", "structure_options", "structure_takers", "structure_takes",
@@ -62,7 +63,8 @@ class FitOptions:
     def from_args(cls, args: argparse.Namespace, model: str) -> FitOptions:
         """The options of a parsed ``fit`` command line, fitting `model`."""
         named = {f.name for f in fields(cls)} - {"data", "model", "reader"}
-        return cls(data=tuple(args.data or ()), model=model, reader=reader_of(args),
+        return cls(data=tuple(args.data or ()), model=model,
+                   reader=Reader(given_read_options(args)),
                    **{name: getattr(args, name) for name in named})
 
 

@@ -2,23 +2,20 @@
 file beside each (`hystkit.io.options_for`): what every command that reads a recording calls.
 
 A `Reader` holds the reading options given on one command line and what it has said (the
-settings file used, a CSV layout it guessed), so each is said once per command; the functions
-taking the parsed namespace are the same for commands not yet parsed into options records.
+settings file used, a CSV layout it guessed), so each is said once per command: a command
+builds one, ``Reader(given_read_options(args))``, and keeps it in its options record or passes
+it along (nothing is written onto the parsed command line).
 """
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 from .._read_options import ReadOptions
 from ..io import csv_layout, options_for, read_pieces, read_recording, settings_for
-from ._option_types import UsageError
 from ._own_layout import remembered_options
-from ._read_args import given_read_options
 
-__all__ = ["Reader", "options_as_trained", "read_options", "read_recording_args",
-           "read_recordings_args", "read_training_files"]
+__all__ = ["Reader"]
 
 
 class Reader:
@@ -37,15 +34,10 @@ class Reader:
         self._layouts: set[str] = set()  # files whose CSV layout was said
         self._trained: set[str] = set()  # "as the model's training data" lines
 
-    def options(self, path=None) -> ReadOptions:
+    def options(self, path) -> ReadOptions:
         """The `hystkit.io.ReadOptions` of a recording `path`: the settings file next to it
         (``my.toml`` for ``my.csv``) first, the command line over it; the file used is printed
-        once per command. Without `path`, only the command line counts."""
-        if path is None:
-            try:
-                return ReadOptions(**self.given)
-            except ValueError as exc:  # already checked one by one while parsing: a guard
-                raise UsageError(str(exc)) from None
+        once per command."""
         options, settings = options_for(path, self.given)
         note = settings_for(path)[1] if settings is None else ""
         said = (f"reading {path} with the settings in {settings}" if settings is not None
@@ -89,12 +81,6 @@ class Reader:
         """Recording `path`, read with `options`."""
         return read_recording(path, need_position=need_position, options=self.options(path))
 
-    def recordings(self, paths, *, need_position: bool = True) -> list:
-        """The recordings of `paths` for a command that fits several jointly: a file read
-        with ``gaps = "split"`` (``--gaps split`` or its settings file) as its pieces between
-        time gaps (`hystkit.io.read_pieces`, which says how many and where)."""
-        return self.training_files(paths, need_position=need_position)[1]
-
     def training_files(self, paths, *, need_position: bool = True) -> tuple[list, list]:
         """How each file of `paths` is read and its recordings: one per file, or its pieces
         between time gaps (fitted jointly)."""
@@ -107,38 +93,3 @@ class Reader:
                 recs.append(read_recording(path, need_position=need_position,
                                            options=reading[-1]))
         return reading, recs
-
-
-def reader_of(args: argparse.Namespace) -> Reader:
-    """The `Reader` of a parsed command line: one per command (what it said is kept on the
-    namespace), with the reading options as they are on it now (``stream`` sets some)."""
-    reader = args.__dict__.setdefault("_reader", Reader({}))
-    reader.given = given_read_options(args)
-    return reader
-
-
-def read_training_files(args: argparse.Namespace) -> tuple[list, list]:
-    """`Reader.training_files` of ``args.data``."""
-    return reader_of(args).training_files(args.data)
-
-
-def read_options(args: argparse.Namespace, path=None) -> ReadOptions:
-    """`Reader.options` of `path` with the command line's reading options."""
-    return reader_of(args).options(path)
-
-
-def read_recordings_args(args: argparse.Namespace, paths, *, need_position: bool = True
-                         ) -> list:
-    """`Reader.recordings` of `paths` with the command line's reading options."""
-    return reader_of(args).recordings(paths, need_position=need_position)
-
-
-def options_as_trained(args: argparse.Namespace, path, reading: ReadOptions | None
-                       ) -> ReadOptions:
-    """`Reader.as_trained` of `path` with the command line's reading options."""
-    return reader_of(args).as_trained(path, reading)
-
-
-def read_recording_args(args: argparse.Namespace, path, *, need_position: bool = True):
-    """`Reader.recording` of `path` with the command line's reading options."""
-    return reader_of(args).recording(path, need_position=need_position)

@@ -9,7 +9,8 @@ from pathlib import Path
 from ..batch import jobs_from_folder, pending, read_manifest, run_batch
 from ._common import UsageError, failures_exit
 from ._many_models import ParallelOptions, open_executor_for
-from ._reading import Reader, reader_of
+from ._read_args import given_read_options
+from ._reading import Reader
 
 __all__ = ["BatchOptions", "run_batch_command"]
 
@@ -32,7 +33,7 @@ class BatchOptions:
         defaults = {"model": args.model, "size": args.size, "mode": args.mode,
                     "center": args.center}
         return cls(args.source, args.out, defaults, args.force, ParallelOptions.from_args(args),
-                   reader_of(args))
+                   Reader(given_read_options(args)))
 
 
 def run_batch_command(args: argparse.Namespace) -> int:

@@ -20,7 +20,8 @@ from ..studies import (
 )
 from ._common import UsageError, failures_exit
 from ._many_models import ParallelOptions, models_from, open_executor_for, say_where, sizes_from
-from ._reading import Reader, reader_of
+from ._read_args import given_read_options
+from ._reading import Reader
 
 __all__ = ["CompareOptions", "run_compare", "run_generalize"]
 
@@ -46,7 +47,7 @@ class CompareOptions:
     def from_args(cls, args: argparse.Namespace, data: list[Path]) -> CompareOptions:
         """The options of a parsed ``compare`` or ``generalize`` command line."""
         return cls(tuple(data), args.models, tuple(args.size), args.out, args.force,
-                   ParallelOptions.from_args(args), reader_of(args))
+                   ParallelOptions.from_args(args), Reader(given_read_options(args)))
 
 
 def run_compare(args: argparse.Namespace) -> int:

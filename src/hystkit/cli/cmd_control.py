@@ -19,7 +19,8 @@ from .. import io as hio
 from . import _control_report as report
 from ._common import UsageError, check_size
 from ._control_options import ControlOptions, LoopOptions
-from ._reading import Reader, reader_of
+from ._read_args import given_read_options
+from ._reading import Reader
 
 __all__ = ["loop_error", "loop_setup", "run_control_command"]
 
@@ -152,7 +153,7 @@ def run_control_command(args: argparse.Namespace) -> int:
                             inputs=options.loop.inputs())
     t_start = time.perf_counter()
     try:
-        run = hc.run_control(loop_setup(options.loop, reader_of(args)),
+        run = hc.run_control(loop_setup(options.loop, Reader(given_read_options(args))),
                              experiment=options.experiment, noise=options.noise,
                              tuning=options.tuning, bode=options.bode)
     except hc.LoopError as exc:

@@ -33,7 +33,8 @@ from ._common import GUARD_EXIT, UsageError, say_next
 from ._inputs import check_inputs_exist
 from ._next_step import next_step
 from ._own_layout import estimate_names, output_names
-from ._reading import Reader, reader_of
+from ._read_args import given_read_options
+from ._reading import Reader
 
 __all__ = ["UseOptions"]  # the commands run through the table (cli._commands)
 
@@ -54,7 +55,7 @@ class UseOptions:
     @classmethod
     def from_args(cls, args: argparse.Namespace) -> UseOptions:
         return cls(args.model, args.data, args.out, getattr(args, "json", None),
-                   args.rest_position, args.level, args.force, reader_of(args))
+                   args.rest_position, args.level, args.force, Reader(given_read_options(args)))
 
 
 def _compensate(args: argparse.Namespace) -> int:

@@ -38,7 +38,8 @@ from ..preprocess import (
     relative_change,
 )
 from ._common import UsageError
-from ._reading import Reader, reader_of
+from ._read_args import given_read_options
+from ._reading import Reader
 
 __all__ = ["CYCLES_FILES", "TABLE_3_1", "run_cycles"]
 
@@ -193,7 +194,7 @@ def _print(table, summary: dict, gauges: dict | None) -> None:
 
 def run_cycles(args: argparse.Namespace) -> int:
     """``hystkit cycles``: per-gauge loops and the per-cycle table of one recording."""
-    reader = reader_of(args)
+    reader = Reader(given_read_options(args))
     if args.raw and reader.given:
         raise UsageError("--raw reads the raw file with its .toml settings; the options for "
                          "reading recordings (--columns, --time-unit, ...) do not apply")

@@ -11,7 +11,8 @@ from ..io import check_output_path
 from ..io._atomic import check_folder_writable
 from ..studies import build_report, write_report
 from ._common import UsageError
-from ._reading import options_as_trained
+from ._read_args import given_read_options
+from ._reading import Reader
 
 __all__ = ["run_report"]
 
@@ -28,9 +29,8 @@ def run_report(args: argparse.Namespace) -> int:
         check_folder_writable(args.figures)
     # each recording with its settings file, the command line's reading options on top, or
     # as the model's training data were read
-    reading = _model_reading(args.inputs)
-    content = build_report(args.inputs,
-                           options=lambda path: options_as_trained(args, path, reading))
+    reading, reader = _model_reading(args.inputs), Reader(given_read_options(args))
+    content = build_report(args.inputs, options=lambda path: reader.as_trained(path, reading))
     paths = write_report(content, args.out, figures=args.figures, fmt=args.format,
                          force=args.force)
     size = paths[0].stat().st_size

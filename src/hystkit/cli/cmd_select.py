@@ -31,7 +31,8 @@ from ..studies import (
 from ._common import GUARD_EXIT, UsageError, say_next
 from ._many_models import ParallelOptions, models_from, open_executor_for
 from ._next_step import next_step
-from ._reading import Reader, reader_of
+from ._read_args import given_read_options
+from ._reading import Reader
 
 __all__ = ["SelectOptions", "run_select"]
 
@@ -63,8 +64,9 @@ class SelectOptions:
     @classmethod
     def from_args(cls, args: argparse.Namespace) -> SelectOptions:
         """The options of a parsed ``select`` command line."""
-        return cls(tuple(args.data), reader_of(args), ParallelOptions.from_args(args), args.out,
-                   args.report, args.models, args.centers, args.force)
+        return cls(tuple(args.data), Reader(given_read_options(args)),
+                   ParallelOptions.from_args(args), args.out, args.report, args.models,
+                   args.centers, args.force)
 
 
 def run_select(args: argparse.Namespace) -> int:

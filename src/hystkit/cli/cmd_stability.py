@@ -25,7 +25,8 @@ from .. import io as hio
 from ..errors import InputError
 from ..signals import exponential_chirp
 from ._control_options import StabilityOptions
-from ._reading import Reader, reader_of
+from ._read_args import given_read_options
+from ._reading import Reader
 from .cmd_control import loop_error, loop_setup
 
 __all__ = ["run_stability"]
@@ -121,7 +122,7 @@ def _control_stability(options: StabilityOptions, reader: Reader) -> int:
 def run_stability(args: argparse.Namespace) -> int:
     """``hystkit stability``: a model file's local stability, or a loop's (``--control``)."""
     options = StabilityOptions.from_args(args)
-    reader = reader_of(args)
+    reader = Reader(given_read_options(args))
     if options.control:
         return _control_stability(options, reader)
     model_json, data = options.model_json, options.data
