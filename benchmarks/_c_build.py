@@ -25,6 +25,12 @@ _I64, _DBL = ctypes.c_int64, ctypes.c_double
 MPL_ARGS = [ARR, _I64, ARR, _I64, ARR, ARR, ARR, _DBL, ARR, _DBL, _DBL, ARR]
 PL_ARGS = [ARR, _I64, ARR, _I64, _DBL, ARR, ARR, _DBL, _DBL, _DBL, ARR, _DBL, ARR, _I64, ARR,
            ARR]
+# pi_fast: (u, n, p, n_play, z, n_creep, r, w_h, d_s, w_s, n_dz, c, w_k, b, y)
+PI_ARGS = [ARR, _I64, ARR, _I64, ARR, _I64, ARR, ARR, ARR, ARR, _I64, ARR, ARR, _DBL, ARR]
+# preisach_fast: (u, n, s, &n_s, capacity, A (L x L), L, offset, slope, y)
+PREISACH_ARGS = [ARR, _I64, ARR, ctypes.POINTER(_I64), _I64, ARR, _I64, _DBL, _DBL, ARR]
+# boucwen_fast: (u, n, x (4), fresh, theta (7), dt, n_sub, linear, y)
+BOUCWEN_ARGS = [ARR, _I64, ARR, _I64, ARR, _DBL, _I64, _I64, ARR]
 
 
 def compile_shared(cc: str, flags, source: Path, out: Path,
@@ -44,7 +50,7 @@ def function(lib: ctypes.CDLL, name: str, argtypes) -> ctypes._CFuncPtr:
 
 def build_fast_reference(cc: str, workdir: Path) -> ctypes.CDLL:
     """``_c_fast_reference.c`` at ``FAST_FLAGS`` (functions mpl_fast, mpl_fast_unguarded,
-    pl_fast)."""
+    pl_fast, pi_fast, preisach_fast, boucwen_fast)."""
     return compile_shared(cc, FAST_FLAGS, FAST_SOURCE, Path(workdir) / "fast.so")
 
 

@@ -146,3 +146,171 @@ void pl_fast(const double *u, int64_t n, double *x, int64_t n_cells, double i_t,
         }
     }
 }
+
+/* pi_fast: the Prandtl-Ishlinskii model with creep of hystkit.models.pi.kernels.simulate
+ * (eq. 2.11-2.15): plays p_i = max(x - r_i, min(x + r_i, p_i)), creep z_j += c_j (x - z_j),
+ * v = b + w_H . p + w_K . z, y = sum_k w_Sk S_dk(v). No libm call; measured choices (10
+ * plays, 4 creep operators, 5 dead zones; ns/sample): max and min as compare and select, not
+ * fmax / fmin, whose IEEE NaN rules cost a blend sequence each (38 -> 14); the states moved in
+ * loops of their own before the sums, so the moves vectorise and the sums do not wait on each
+ * store (14 -> 7); the dead zones' sign test done once, out of the loop (three sums).
+ * p[n_play], z[n_creep] updated in place; d_s, w_s[n_dz]. */
+void pi_fast(const double *u, int64_t n, double *restrict p, int64_t n_play, double *restrict z,
+             int64_t n_creep, const double *restrict r, const double *restrict w_h,
+             const double *d_s, const double *w_s, int64_t n_dz, const double *restrict c,
+             const double *restrict w_k, double b, double *y)
+{
+    double d_pos[n_dz], w_pos[n_dz], d_neg[n_dz], w_neg[n_dz], w_zero = 0.0;
+    int64_t n_pos = 0, n_neg = 0;
+    for (int64_t k = 0; k < n_dz; ++k) {
+        if (d_s[k] > 0.0) {
+            d_pos[n_pos] = d_s[k];
+            w_pos[n_pos++] = w_s[k];
+        } else if (d_s[k] < 0.0) {
+            d_neg[n_neg] = d_s[k];
+            w_neg[n_neg++] = w_s[k];
+        } else {
+            w_zero += w_s[k];
+        }
+    }
+    for (int64_t t = 0; t < n; ++t) {
+        const double x = u[t];
+        for (int64_t i = 0; i < n_play; ++i) {
+            const double lo = x - r[i], hi = x + r[i];
+            const double q = p[i] < hi ? p[i] : hi;
+            p[i] = q > lo ? q : lo;
+        }
+        for (int64_t j = 0; j < n_creep; ++j)
+            z[j] += c[j] * (x - z[j]);
+        double v = b;
+        for (int64_t i = 0; i < n_play; ++i)
+            v += w_h[i] * p[i];
+        for (int64_t j = 0; j < n_creep; ++j)
+            v += w_k[j] * z[j];
+        double acc = w_zero * v;
+        for (int64_t k = 0; k < n_pos; ++k) {
+            const double e = v - d_pos[k];
+            acc += w_pos[k] * (e > 0.0 ? e : 0.0);  /* maxsd, no branch */
+        }
+        for (int64_t k = 0; k < n_neg; ++k) {
+            const double e = v - d_neg[k];
+            acc += w_neg[k] * (e < 0.0 ? e : 0.0);
+        }
+        y[t] = acc;
+    }
+}
+
+/* preisach_fast: the classical Preisach model of hystkit.models.preisach (kernels.run_tables
+ * with one Everett table, then the offset and the straight-line extension beyond [-1, 1]).
+ * The staircase of dominant extrema s[0 .. ns-1] with the running sums c[i] of the closed
+ * segments' terms (eq. 9.13), so a sample costs one bilinear interpolation of the table (two
+ * at a reversal) and the wiping-out is a pop; no libm call.
+ * A[L * L]: the antisymmetric Everett table (row-major); s[capacity] holds the start
+ * staircase of length *ns on entry and the final one on return. */
+static inline double preisach_everett(const double *A, int64_t L, double scale, double a,
+                                      double b)
+{
+    const double xa = (a + 1.0) * scale, xb = (b + 1.0) * scale;
+    int64_t ia = (int64_t)xa, ib = (int64_t)xb;
+    ia = ia < L - 2 ? ia : L - 2;
+    ib = ib < L - 2 ? ib : L - 2;
+    const double sa = xa - ia, sb = xb - ib;
+    const double *r0 = A + ia * L + ib, *r1 = r0 + L;
+    return (1.0 - sa) * ((1.0 - sb) * r0[0] + sb * r0[1])
+           + sa * ((1.0 - sb) * r1[0] + sb * r1[1]);
+}
+
+static inline double preisach_term(const double *A, int64_t L, double scale, double p, double q)
+{
+    return q >= p ? preisach_everett(A, L, scale, q, p) : -preisach_everett(A, L, scale, p, q);
+}
+
+void preisach_fast(const double *u, int64_t n, double *s, int64_t *ns, int64_t capacity,
+                   const double *A, int64_t L, double offset, double slope, double *y)
+{
+    const double scale = 0.5 * (L - 1), f0 = -A[(L - 1) * L];
+    double c[capacity];
+    int64_t m = *ns;
+    c[0] = 0.0;
+    for (int64_t i = 1; i < m - 1; ++i)
+        c[i] = c[i - 1] + preisach_term(A, L, scale, s[i - 1], s[i]);
+    for (int64_t t = 0; t < n; ++t) {
+        if (m >= capacity - 1) {  /* forget the innermost closed loop before a push */
+            s[m - 3] = s[m - 1];
+            m -= 2;
+        }
+        const double ut = u[t], uc = fmin(1.0, fmax(-1.0, ut));
+        const double last = s[m - 1];
+        if (uc != last) {
+            if (m == 1) {
+                s[1] = uc;
+                m = 2;
+            } else if ((uc > last) == (last > s[m - 2])) {
+                s[m - 1] = uc;
+            } else {  /* a reversal closes the last segment */
+                c[m - 1] = c[m - 2] + preisach_term(A, L, scale, s[m - 2], last);
+                s[m++] = uc;
+            }
+            while (m >= 3) {
+                const int rising = s[m - 1] > s[m - 2];
+                if (rising ? s[m - 1] >= s[m - 3] : s[m - 1] <= s[m - 3]) {
+                    s[m - 3] = s[m - 1];
+                    m -= 2;
+                } else {
+                    break;
+                }
+            }
+        }
+        const double relay = m == 1 ? f0
+            : f0 + 2.0 * (c[m - 2] + preisach_term(A, L, scale, s[m - 2], s[m - 1]));
+        y[t] = relay + offset + slope * (ut - uc);
+    }
+    *ns = m;
+}
+
+/* boucwen_fast: the Bouc-Wen oscillator of hystkit.models.boucwen.kernels.simulate: per
+ * sample n_sub classical RK4 substeps of m y'' + c y' + k y + z = u, z' = alpha v - beta |v|
+ * |z|^(nu-1) z - gamma v |z|^nu, the force linear over the sample (linear) or held. |z|^nu is
+ * |z| for nu = 1 (what fits give) and pow otherwise, chosen once out of the loop; the rest is
+ * the kernel's arithmetic. A serial dependency chain: nothing to vectorise.
+ * x[4] = (y, v, z, u_prev) one sample before u[0] (fresh: at u[0] itself, y[0] = x[0]). */
+static inline void boucwen_rhs(double y, double v, double z, double u, const double *th,
+                               double inv_m, int nu_one, double *dy, double *dv, double *dz)
+{
+    const double p = nu_one ? fabs(z) : pow(fabs(z), th[6]);
+    const double q = z >= 0.0 ? p : -p;
+    *dy = v;
+    *dv = (u - th[1] * v - th[2] * y - z) * inv_m;
+    *dz = th[3] * v - th[4] * fabs(v) * q - th[5] * v * p;
+}
+
+void boucwen_fast(const double *u, int64_t n, double *x, int64_t fresh, const double *th,
+                  double dt, int64_t n_sub, int64_t linear, double *out)
+{
+    const int nu_one = th[6] == 1.0;
+    const double inv_m = 1.0 / th[0];  /* one division per run, not eight per sample */
+    const double h = dt / n_sub;
+    double y = x[0], v = x[1], z = x[2], u_prev = x[3];
+    for (int64_t i = 0; i < n; ++i) {
+        if (i > 0 || !fresh) {
+            const double du = linear ? (u[i] - u_prev) / n_sub : 0.0;
+            for (int64_t j = 0; j < n_sub; ++j) {
+                const double u0 = u_prev + j * du, u1 = u0 + 0.5 * du, u2 = u0 + du;
+                double k1y, k1v, k1z, k2y, k2v, k2z, k3y, k3v, k3z, k4y, k4v, k4z;
+                boucwen_rhs(y, v, z, u0, th, inv_m, nu_one, &k1y, &k1v, &k1z);
+                boucwen_rhs(y + 0.5 * h * k1y, v + 0.5 * h * k1v, z + 0.5 * h * k1z, u1, th,
+                            inv_m, nu_one, &k2y, &k2v, &k2z);
+                boucwen_rhs(y + 0.5 * h * k2y, v + 0.5 * h * k2v, z + 0.5 * h * k2z, u1, th,
+                            inv_m, nu_one, &k3y, &k3v, &k3z);
+                boucwen_rhs(y + h * k3y, v + h * k3v, z + h * k3z, u2, th, inv_m, nu_one, &k4y, &k4v,
+                            &k4z);
+                y += h / 6.0 * (k1y + 2.0 * k2y + 2.0 * k3y + k4y);
+                v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+                z += h / 6.0 * (k1z + 2.0 * k2z + 2.0 * k3z + k4z);
+            }
+        }
+        out[i] = y;
+        u_prev = u[i];
+    }
+    x[0] = y, x[1] = v, x[2] = z, x[3] = u_prev;
+}

@@ -1,9 +1,9 @@
 """Forward kernels against the fastest plain C (issue 29, items 1-2): every ratio is to ``fast C``.
 
-Run:  python benchmarks/bench_kernels.py [--quick] [--before REV]   (about a minute; writes
-      benchmarks/last_run_kernels.txt; --quick: fewer rounds; --before REV: two more mPL and
-      PL columns, the bare kernel of this tree and of git revision REV, paired in the same
-      rounds)
+Run:  python benchmarks/bench_kernels.py [--quick] [--before REV] [--only FAMILIES]   (a few
+      minutes; writes benchmarks/last_run_kernels.txt; --quick: fewer rounds; --before REV: one
+      more column, the bare kernel of git revision REV, paired in the same rounds; --only
+      pi,boucwen: those families only, nothing written)
 
 Models: mPL with 1, 3 and 5 cells and PL with 2 cells, each fitted (direct mode, centring fit)
 on the virtual sensor's sine recording (seed 1): realistic parameters, e.g. the 5-cell mPL has
@@ -60,9 +60,12 @@ import numba
 import numpy as np
 from _c_build import (
     ARR,
+    BOUCWEN_ARGS,
     FAST_FLAGS,
     MPL_ARGS,
+    PI_ARGS,
     PL_ARGS,
+    PREISACH_ARGS,
     SLOW_FLAGS,
     SLOW_SOURCE,
     build_fast_reference,
@@ -71,18 +74,23 @@ from _c_build import (
 )
 
 from hystkit.compensation import fit_compensator, save_compensator
-from hystkit.models.mpl import kernels as mpl_kernels
+from hystkit.models.boucwen import divergence as boucwen_divergence
+from hystkit.models.boucwen import model as boucwen
 from hystkit.models.mpl import model as mpl
-from hystkit.models.pl import kernels as pl_kernels
 from hystkit.models.pl import model as pl
+from hystkit.models.preisach import model as preisach
 from hystkit.sensors import simulate_experiment
 
 HERE = Path(__file__).parent
-CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2))
+# each family at its default size (mPL also at 3 and 5 cells): PI 10 plays, Preisach 20 levels,
+# Bouc-Wen 2 RK4 substeps
+CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2), ("pi", 10), ("preisach", 20),
+         ("boucwen", 2))
+LABEL_WIDTH = 12
 SIZES = (8000, 100_000)
 ROUNDS = {8000: 101, 100_000: 31}
 QUICK_ROUNDS = {8000: 31, 100_000: 11}
-COLUMNS = ("fast C", "C no guard", "slow C", "simulate", "export")
+COLUMNS = ("fast C", "C no guard", "slow C", "simulate", "kernel", "export")
 # CPU time first: on a shared machine a call longer than the scheduler's slice (~2 ms here)
 # waits for the other processes, which wall time counts and CPU time does not.
 CLOCKS = {"cpu": "CPU time (thread)", "wall": "wall time"}
@@ -92,7 +100,7 @@ _EXPORT_DRIVER = r"""#include <stdint.h>
 #include "{name}.c"
 void export_run(const double *u, int64_t n, double *y)
 {{
-    static real x[1024];
+    static real x[1 << 16];  /* the Preisach state: capacity + 1 + capacity running sums */
     model_rest(x, u[0]);
     for (int64_t i = 0; i < n; ++i) y[i] = model_step(x, u[i]);
 }}
@@ -140,6 +148,12 @@ def _mpl_columns(comp, fast, slow) -> dict:
             "slow C": c_run(function(slow, "mpl_simulate", MPL_ARGS))}
 
 
+def _mpl_kernel(comp, kernels):
+    s, p = comp.structure, comp.params
+    rest = (p.i_s, p.v_t, p.w, p.v_b, mpl.knee_voltage(s, p), s.slope_cap / s.dt, s.dt)
+    return lambda u: kernels.simulate(u, np.full(s.n_cells, u[0]), *rest)[0]
+
+
 def _pl_columns(comp, fast) -> dict:
     s, p = comp.structure, comp.params
     i_t, thr, knee, power, g_lin, dt = pl.kernel_args(s, p)
@@ -154,6 +168,110 @@ def _pl_columns(comp, fast) -> dict:
         return y
 
     return {"fast C": run}
+
+
+def _pl_kernel(comp, kernels):
+    s, p = comp.structure, comp.params
+    rest = (*pl.kernel_args(s, p), p.w, p.v_b, pl.basis_breakpoints(s.n_basis),
+            np.ascontiguousarray(p.a, dtype=float))
+    return lambda u: kernels.simulate(u, np.full(s.n_cells, u[0]), *rest)[0]
+
+
+def _pi_parts(comp) -> tuple:
+    s, p = comp.structure, comp.params
+    return (np.ascontiguousarray(s.play_thresholds, dtype=float), p.w_h, p.d_s, p.w_s,
+            s.creep_gains, p.w_k, float(p.b))
+
+
+def _pi_columns(comp, fast) -> dict:
+    r, w_h, d_s, w_s, c, w_k, b = _pi_parts(comp)
+    fn = function(fast, "pi_fast", PI_ARGS)
+
+    def run(u):
+        p, z, y = np.full(r.size, u[0]), np.full(c.size, u[0]), np.empty(u.size)
+        fn(u, u.size, p, r.size, z, c.size, r, w_h, d_s, w_s, d_s.size, c, w_k, b, y)
+        return y
+
+    return {"fast C": run}
+
+
+def _pi_kernel(comp, kernels):
+    r, w_h, d_s, w_s, c, w_k, b = _pi_parts(comp)
+    return lambda u: kernels.simulate(u, np.full(r.size, u[0]), np.full(c.size, u[0]), r, w_h,
+                                      d_s, w_s, c, w_k, b)[0]
+
+
+def _preisach_parts(comp) -> tuple:
+    """Demagnetised start staircase, antisymmetric table, offset, extension slope."""
+    s, p = comp.structure, comp.params
+    table, _, poly, slope = preisach.kernel_parts(p)
+    return (preisach.demagnetised_state(s.levels - 1), np.ascontiguousarray(table[0]),
+            float(poly[0]), slope)
+
+
+def _preisach_columns(comp, fast) -> dict:
+    start, table, offset, slope = _preisach_parts(comp)
+    cap = comp.structure.capacity
+    fn = function(fast, "preisach_fast", PREISACH_ARGS)
+
+    def run(u):
+        stair, y = np.zeros(cap), np.empty(u.size)
+        stair[:start.size] = start
+        fn(u, u.size, stair, ctypes.byref(ctypes.c_int64(start.size)), cap, table,
+           table.shape[0], offset, slope, y)
+        return y
+
+    return {"fast C": run}
+
+
+def _preisach_kernel(comp, kernels):
+    """``run_tables`` and the output line the wrapper adds (offset, straight extension)."""
+    start, table, offset, slope = _preisach_parts(comp)
+    tables, cap = table[None], comp.structure.capacity
+
+    def run(u):
+        relay = kernels.run_tables(u, start, tables, cap)[0][:, 0]
+        return relay + offset + slope * (u - np.clip(u, -1.0, 1.0))
+
+    return run
+
+
+def _boucwen_parts(comp, u) -> tuple:
+    s, p = comp.structure, comp.params
+    x0 = boucwen.initial_state(s, p, u[0])
+    return (x0, p.as_array(), s.dt, s.substeps, s.input_hold == "linear",
+            boucwen_divergence.divergence_bound(s, p, x0, u))
+
+
+def _boucwen_columns(comp, fast) -> dict:
+    fn = function(fast, "boucwen_fast", BOUCWEN_ARGS)
+
+    def run(u):
+        x0, theta, dt, n_sub, linear, _ = _boucwen_parts(comp, u)
+        y = np.empty(u.size)
+        fn(u, u.size, x0, 1, theta, dt, n_sub, int(linear), y)
+        return y
+
+    return {"fast C": run}
+
+
+def _boucwen_kernel(comp, kernels):
+    def run(u):
+        x0, theta, dt, n_sub, linear, bound = _boucwen_parts(comp, u)
+        return kernels.simulate(u, x0, True, theta, dt, n_sub, linear, bound)[0][:, 0]
+
+    return run
+
+
+# family: (its model module (simulate_reference), its C columns, its bare kernel on a
+# kernels module: this tree's or a past revision's)
+FAMILY_SETUP = {
+    "mpl": (mpl, _mpl_columns, _mpl_kernel),
+    "pl": (pl, _pl_columns, _pl_kernel),
+    "pi": (importlib.import_module("hystkit.models.pi.model"), _pi_columns, _pi_kernel),
+    "preisach": (preisach, _preisach_columns, _preisach_kernel),
+    "boucwen": (boucwen, _boucwen_columns, _boucwen_kernel),
+}
 
 
 def _export_column(comp, label: str, cc: str, tmp: Path):
@@ -178,8 +296,8 @@ def _export_column(comp, label: str, cc: str, tmp: Path):
 
 
 def load_kernels_at(rev: str, tmp: Path, family: str = "mpl"):
-    """``models/<family>/kernels.py`` of git revision ``rev`` as a module of its own (mpl's and
-    pl's import only numpy and numba), for a paired before/after in one run."""
+    """``models/<family>/kernels.py`` of git revision ``rev`` as a module of its own (the timed
+    families' import only numpy and numba), for a paired before/after in one run."""
     source = f"{rev}:src/hystkit/models/{family}/kernels.py"
     text = subprocess.run(["git", "-C", str(HERE), "show", source], capture_output=True,
                           text=True, check=True).stdout
@@ -191,56 +309,36 @@ def load_kernels_at(rev: str, tmp: Path, family: str = "mpl"):
     return module
 
 
-def _kernel_columns(comp, current, before, rev: str) -> dict:
-    """The bare numba kernel (no wrapper) of this tree and of revision ``rev``."""
-    s, p = comp.structure, comp.params
-    rest = (p.i_s, p.v_t, p.w, p.v_b, mpl.knee_voltage(s, p), s.slope_cap / s.dt, s.dt)
-
-    def run(module):
-        return lambda u: module.simulate(u, np.full(s.n_cells, u[0]), *rest)[0]
-
-    return {"kernel": run(current), f"kernel@{rev}": run(before)}
-
-
-def _pl_kernel_columns(comp, current, before, rev: str) -> dict:
-    """PL's bare numba kernel (no wrapper) of this tree and of revision ``rev``."""
-    s, p = comp.structure, comp.params
-    rest = (*pl.kernel_args(s, p), p.w, p.v_b, pl.basis_breakpoints(s.n_basis),
-            np.ascontiguousarray(p.a, dtype=float))
-
-    def run(module):
-        return lambda u: module.simulate(u, np.full(s.n_cells, u[0]), *rest)[0]
-
-    return {"kernel": run(current), f"kernel@{rev}": run(before)}
-
-
-def build_cases(cc: str, tmp: Path, before_rev: str | None = None) -> list[Case]:
+def build_cases(cc: str, tmp: Path, before_rev: str | None = None,
+                only: set | None = None) -> list[Case]:
     fast = build_fast_reference(cc, tmp)
     slow = compile_shared(cc, SLOW_FLAGS, SLOW_SOURCE, tmp / "slow.so")
     fit_rec = simulate_experiment("sine", 1)
-    before = load_kernels_at(before_rev, tmp) if before_rev else None
-    pl_before = load_kernels_at(before_rev, tmp, "pl") if before_rev else None
     cases = []
     for family, size in CASES:
+        if only is not None and family not in only:
+            continue
         comp = fit_compensator(fit_rec, size, model=family, diagnose=False)
         case = Case(family, size, comp, _inputs(comp, fit_rec))
-        case.columns = _mpl_columns(comp, fast, slow) if family == "mpl" else _pl_columns(comp,
-                                                                                          fast)
+        _, c_columns, kernel = FAMILY_SETUP[family]
+        case.columns = _mpl_columns(comp, fast, slow) if family == "mpl" else c_columns(comp,
+                                                                                        fast)
         model = comp.family
         case.columns["simulate"] = (
             lambda u, m=model, s=comp.structure, p=comp.params: m.simulate(s, p, u)[0])
+        case.columns["kernel"] = kernel(comp, importlib.import_module(
+            f"hystkit.models.{family}.kernels"))
         case.columns["export"] = _export_column(comp, case.label, cc, tmp)
-        if before is not None and family == "mpl":
-            case.columns.update(_kernel_columns(comp, mpl_kernels, before, before_rev))
-        if pl_before is not None and family == "pl":
-            case.columns.update(_pl_kernel_columns(comp, pl_kernels, pl_before, before_rev))
+        if before_rev:
+            case.columns[f"kernel@{before_rev}"] = kernel(comp, load_kernels_at(before_rev, tmp,
+                                                                                family))
         cases.append(case)
     return cases
 
 
 def agreement(case: Case) -> dict:
     u = case.inputs[SIZES[0]]
-    module = mpl if case.family == "mpl" else pl
+    module = FAMILY_SETUP[case.family][0]
     ref, _ = module.simulate_reference(case.comp.structure, case.comp.params, u)
     scale = float(np.max(np.abs(ref)))
     return {name: float(np.max(np.abs(fn(u) - ref))) / scale for name, fn in case.columns.items()}
@@ -278,11 +376,14 @@ def _cpu() -> str:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer rounds")
-    parser.add_argument("--before", metavar="REV", help="add the bare mPL and PL kernels of "
-                        "this tree and of git revision REV (paired before/after)")
+    parser.add_argument("--before", metavar="REV", help="add the bare kernels of git revision "
+                        "REV (paired with this tree's)")
+    parser.add_argument("--only", metavar="FAMILIES", help="comma-separated families (e.g. "
+                        "pi,boucwen), for development; does not write last_run_kernels.txt")
     args = parser.parse_args()
+    only = set(args.only.split(",")) if args.only else None
     quick = args.quick
-    columns = [*COLUMNS, *(["kernel", f"kernel@{args.before}"] if args.before else [])]
+    columns = [*COLUMNS, *([f"kernel@{args.before}"] if args.before else [])]
     rounds = QUICK_ROUNDS if quick else ROUNDS
     cc = os.environ.get("CC", "cc")
     version = subprocess.run([cc, "--version"], capture_output=True, text=True,
@@ -305,30 +406,33 @@ def main() -> int:
     print("\n".join(lines), flush=True)
     with tempfile.TemporaryDirectory(prefix="hystkit-kernels-") as tmp:
         t0 = time.perf_counter()
-        cases = build_cases(cc, Path(tmp), args.before)
+        cases = build_cases(cc, Path(tmp), args.before, only)
         emit(f"# fits, exports and builds: {time.perf_counter() - t0:.1f} s")
         emit()
         emit("Agreement with the readable reference (simulate_reference), 8000 samples: "
              "max|y - y_ref| / max|y_ref|")
-        emit(f"{'model':<8}" + "".join(f"{c:>16}" for c in columns))
+        emit(f"{'model':<{LABEL_WIDTH}}" + "".join(f"{c:>16}" for c in columns))
         for case in cases:
             agree = agreement(case)
-            emit(f"{case.label:<8}" + "".join(
+            emit(f"{case.label:<{LABEL_WIDTH}}" + "".join(
                 f"{agree[c]:>16.1e}" if c in agree else f"{'-':>16}" for c in columns))
         for n in SIZES:
             results = [time_case(case, n, rounds[n]) for case in cases]
             for clock, clock_name in CLOCKS.items():
                 emit()
                 emit(f"{n} samples, {clock_name}: ns/sample (ratio to fast C)")
-                emit(f"{'model':<8}" + "".join(f"{c:>18}" for c in columns)
+                emit(f"{'model':<{LABEL_WIDTH}}" + "".join(f"{c:>18}" for c in columns)
                      + f"{'ns/cell fast':>14}")
                 for case, r in zip(cases, results, strict=True):
                     row = r[clock]
                     cells = "".join(f"{row[c][0]:>10.1f} ({row[c][1]:4.2f})" if c in row
                                     else f"{'-':>18}" for c in columns)
-                    emit(f"{case.label:<8}{cells}{row['fast C'][0] / case.size:>14.1f}")
+                    per_cell = (f"{row['fast C'][0] / case.size:>14.1f}"
+                                if case.family in ("mpl", "pl") else f"{'-':>14}")
+                    emit(f"{case.label:<{LABEL_WIDTH}}{cells}{per_cell}")
     emit(f"# load at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
-    (HERE / "last_run_kernels.txt").write_text("\n".join(lines) + "\n")
+    if only is None:
+        (HERE / "last_run_kernels.txt").write_text("\n".join(lines) + "\n")
     return 0
 
 
