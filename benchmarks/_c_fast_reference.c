@@ -46,7 +46,8 @@ static inline double sinh_series(double a)
  * i_s, v_t, knee[n_cells]; w[n_cells + 1]; y[n]: output. Same signature as _c_reference.c. */
 static inline void mpl_run(const double *u, int64_t n, double *x, int64_t n_cells,
                            const double *i_s, const double *v_t, const double *w, double v_b,
-                           const double *knee, double cap, double dt, double *y, int guarded)
+                           const double *knee, double cap, double dt, double *y, int guarded,
+                           const double *gc)
 {
     double inv_vt[n_cells], c2[n_cells], c0[n_cells];
     const double cap_dt = cap * dt;
@@ -61,7 +62,8 @@ static inline void mpl_run(const double *u, int64_t n, double *x, int64_t n_cell
         double acc = w[0] * ui - v_b;
         for (int64_t k = 0; k < n_cells; ++k)
             acc += w[k + 1] * x[k];
-        y[i] = acc;
+        /* mpl-g: the output resistor g(z), a cubic (eq. 5.16-5.17), Horner */
+        y[i] = gc ? gc[0] + acc * (gc[1] + acc * (gc[2] + acc * gc[3])) : acc;
         for (int64_t k = 0; k < n_cells; ++k) {
             const double v = ui - x[k];
             if (fabs(v) <= knee[k]) {
@@ -80,14 +82,61 @@ void mpl_fast(const double *u, int64_t n, double *x, int64_t n_cells, const doub
               const double *v_t, const double *w, double v_b, const double *knee, double cap,
               double dt, double *y)
 {
-    mpl_run(u, n, x, n_cells, i_s, v_t, w, v_b, knee, cap, dt, y, 1);
+    mpl_run(u, n, x, n_cells, i_s, v_t, w, v_b, knee, cap, dt, y, 1, 0);
 }
 
 void mpl_fast_unguarded(const double *u, int64_t n, double *x, int64_t n_cells,
                         const double *i_s, const double *v_t, const double *w, double v_b,
                         const double *knee, double cap, double dt, double *y)
 {
-    mpl_run(u, n, x, n_cells, i_s, v_t, w, v_b, knee, cap, dt, y, 0);
+    mpl_run(u, n, x, n_cells, i_s, v_t, w, v_b, knee, cap, dt, y, 0, 0);
+}
+
+/* mpl_g_fast: the ch. 7 compensator of hystkit.models.mpl_g.kernels.simulate: the mPL's cells
+ * (mpl_fast's loop) read out through the cubic output resistor g (gc[4]); arguments as
+ * mpl_fast, then gc. */
+void mpl_g_fast(const double *u, int64_t n, double *x, int64_t n_cells, const double *i_s,
+                const double *v_t, const double *w, double v_b, const double *knee, double cap,
+                double dt, double *y, const double *gc)
+{
+    mpl_run(u, n, x, n_cells, i_s, v_t, w, v_b, knee, cap, dt, y, 1, gc);
+}
+
+/* mpl_poly_fast: the polynomial mPL of hystkit.models.mpl_poly.kernels.simulate: cells
+ * x_k += f_k(u - x_k) dt with the cubic cell resistors f_k (fc[n_cells * 4]), continued beyond
+ * the knees (knees[n_cells * 2]: x-, x+) by straight lines of slope s when limit; output the
+ * cubic g (gc[4]) of w_0 u + sum w_k x_k - V_b. No libm call; f_k at the knees computed once
+ * per run, not per sample. (The kernel's divergence check, a compare per cell, is left out:
+ * with the limit the cells are bounded.) */
+void mpl_poly_fast(const double *u, int64_t n, double *x, int64_t n_cells, const double *fc,
+                   const double *knees, double s, int64_t limit, const double *gc,
+                   const double *w, double v_b, double dt, double *y)
+{
+    double fb_m[n_cells], fb_p[n_cells];
+    for (int64_t k = 0; k < n_cells; ++k) {
+        const double *c = fc + 4 * k, xm = knees[2 * k], xp = knees[2 * k + 1];
+        fb_m[k] = c[0] + xm * (c[1] + xm * (c[2] + xm * c[3]));
+        fb_p[k] = c[0] + xp * (c[1] + xp * (c[2] + xp * c[3]));
+    }
+    for (int64_t i = 0; i < n; ++i) {
+        const double ui = u[i];
+        double acc = w[0] * ui - v_b;
+        for (int64_t k = 0; k < n_cells; ++k)
+            acc += w[k + 1] * x[k];
+        y[i] = gc[0] + acc * (gc[1] + acc * (gc[2] + acc * gc[3]));
+        for (int64_t k = 0; k < n_cells; ++k) {
+            const double *c = fc + 4 * k, xm = knees[2 * k], xp = knees[2 * k + 1];
+            const double v = ui - x[k];
+            double f;
+            if (limit && v >= xp)
+                f = fb_p[k] + s * (v - xp);
+            else if (limit && v <= xm)
+                f = fb_m[k] + s * (v - xm);
+            else
+                f = c[0] + v * (c[1] + v * (c[2] + v * c[3]));
+            x[k] += f * dt;
+        }
+    }
 }
 
 /* i = f^-1(acc) for the increasing PWL output f = sum a_j phi_j, f(0) = 0 (eq. 2.18); the
@@ -313,4 +362,70 @@ void boucwen_fast(const double *u, int64_t n, double *x, int64_t fresh, const do
         u_prev = u[i];
     }
     x[0] = y, x[1] = v, x[2] = z, x[3] = u_prev;
+}
+
+/* chua_fast: the Chua-Stromsmoe elements of hystkit.models.chua.kernels.simulate (eq. 2.3,
+ * forward Euler): per element y_k += dt g_k(u - f_k(y_k)), output y = sum_k y_k, with the
+ * restoring function f(y) = k_inf y + (k0 - k_inf) y_s tanh(y / y_s) and the dissipation g: 0
+ * in the dead band |v| <= band, s G V_g sinh((|v| - band) / V_g) up to the knee, then the
+ * straight line of slope cap. Two libm calls per element and sample: tanh, and expm1 for the
+ * sinh, sinh(a) = (t + t / (t + 1)) / 2 with t = expm1(a), a >= 0 (no cancellation near 0, so
+ * no series guard); per-element constants (1 / y_s, 1 / V_g, the knee's line) out of the loop.
+ * x[n_el] updated in place; k0, k_inf, y_s, g, v_g, band, knee, cap [n_el]. */
+void chua_fast(const double *u, int64_t n, double *x, int64_t n_el, const double *k0,
+               const double *k_inf, const double *y_s, const double *g, const double *v_g,
+               const double *band, const double *knee, const double *cap, double dt, double *y)
+{
+    double inv_ys[n_el], dk_ys[n_el], inv_vg[n_el], gvg_dt[n_el], c0[n_el], cap_dt[n_el];
+    for (int64_t k = 0; k < n_el; ++k) {
+        inv_ys[k] = 1.0 / y_s[k];
+        dk_ys[k] = (k0[k] - k_inf[k]) * y_s[k];
+        inv_vg[k] = 1.0 / v_g[k];
+        gvg_dt[k] = g[k] * v_g[k] * dt;
+        cap_dt[k] = cap[k] * dt;
+        /* beyond the knee: s (G V_g sinh((knee - band) / V_g) + cap (|v| - knee)) dt
+         * = s c0 + cap dt v */
+        c0[k] = isinf(knee[k]) ? 0.0
+                : (g[k] * v_g[k] * sinh((knee[k] - band[k]) / v_g[k]) - cap[k] * knee[k]) * dt;
+    }
+    for (int64_t i = 0; i < n; ++i) {
+        const double ui = u[i];
+        double acc = 0.0;
+        for (int64_t k = 0; k < n_el; ++k) {
+            const double v = ui - (k_inf[k] * x[k] + dk_ys[k] * tanh(x[k] * inv_ys[k]));
+            const double a = fabs(v);
+            double step = 0.0;
+            if (a > knee[k]) {
+                step = (v > 0.0 ? c0[k] : -c0[k]) + cap_dt[k] * v;
+            } else if (a > band[k]) {
+                const double t = expm1((a - band[k]) * inv_vg[k]);
+                const double sh = 0.5 * (t + t / (t + 1.0));
+                step = v > 0.0 ? gvg_dt[k] * sh : -gvg_dt[k] * sh;
+            }
+            x[k] += step;
+            acc += x[k];
+        }
+        y[i] = acc;
+    }
+}
+
+/* bobbio_fast: the Bobbio-Marrucci chain of hystkit.models.bobbio (kernels.forces, then the
+ * output the wrapper forms): the spring forces F_2..F_N clipped from the loaded end inwards,
+ * F_k+1 = min(max(F_k+1, F_k - a_k), F_k + a_k) (eq. 2.5), y = c_1 u + sum_k c_k+1 F_k+1 + b,
+ * in one pass. x[n_f] (n_f = N - 1) updated in place; a[n_f], c[n_f + 1]. */
+void bobbio_fast(const double *u, int64_t n, double *x, int64_t n_f, const double *a,
+                 const double *c, double b, double *y)
+{
+    for (int64_t i = 0; i < n; ++i) {
+        double prev = u[i], acc = c[0] * u[i];
+        for (int64_t k = 0; k < n_f; ++k) {
+            const double lo = prev - a[k], hi = prev + a[k];
+            double f = x[k] > lo ? x[k] : lo;
+            f = f < hi ? f : hi;
+            x[k] = f;
+            prev = f;
+            acc += c[k + 1] * f;
+        }
+        y[i] = acc + b;
+    }
 }

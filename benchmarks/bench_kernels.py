@@ -60,9 +60,13 @@ import numba
 import numpy as np
 from _c_build import (
     ARR,
+    BOBBIO_ARGS,
     BOUCWEN_ARGS,
+    CHUA_ARGS,
     FAST_FLAGS,
     MPL_ARGS,
+    MPL_G_ARGS,
+    MPL_POLY_ARGS,
     PI_ARGS,
     PL_ARGS,
     PREISACH_ARGS,
@@ -74,19 +78,27 @@ from _c_build import (
 )
 
 from hystkit.compensation import fit_compensator, save_compensator
+from hystkit.models.bobbio import model as bobbio
 from hystkit.models.boucwen import divergence as boucwen_divergence
 from hystkit.models.boucwen import model as boucwen
+from hystkit.models.chua import model as chua
 from hystkit.models.mpl import model as mpl
+from hystkit.models.mpl_g import model as mpl_g
+from hystkit.models.mpl_poly import model as mpl_poly
+from hystkit.models.mpl_poly.resistors import knee_points
 from hystkit.models.pl import model as pl
 from hystkit.models.preisach import model as preisach
 from hystkit.sensors import simulate_experiment
 
 HERE = Path(__file__).parent
-# each family at its default size (mPL also at 3 and 5 cells): PI 10 plays, Preisach 20 levels,
-# Bouc-Wen 2 RK4 substeps
-CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2), ("pi", 10), ("preisach", 20),
-         ("boucwen", 2))
+# each family at its default size (mPL also at 3 and 5 cells): mpl-g, mpl-poly and Chua 1 cell,
+# PI 10 plays, Preisach 20 levels, Bouc-Wen 2 RK4 substeps, Bobbio-Marrucci 10 springs
+CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2), ("mpl-g", 1), ("mpl-poly", 1),
+         ("chua", 1), ("pi", 10), ("preisach", 20), ("boucwen", 2), ("bobbio", 10))
 LABEL_WIDTH = 12
+CELL_FAMILIES = ("mpl", "pl", "mpl-g", "mpl-poly", "chua")  # size = cells: the ns/cell column
+# kernels.py that import their package (relative imports): no --before column
+NOT_STANDALONE = ("mpl-g", "mpl-poly")
 SIZES = (8000, 100_000)
 ROUNDS = {8000: 101, 100_000: 31}
 QUICK_ROUNDS = {8000: 31, 100_000: 11}
@@ -175,6 +187,103 @@ def _pl_kernel(comp, kernels):
     rest = (*pl.kernel_args(s, p), p.w, p.v_b, pl.basis_breakpoints(s.n_basis),
             np.ascontiguousarray(p.a, dtype=float))
     return lambda u: kernels.simulate(u, np.full(s.n_cells, u[0]), *rest)[0]
+
+
+def _mpl_g_args(comp) -> tuple:
+    s, p = comp.structure, comp.params
+    return (p.i_s, p.v_t, p.w, float(p.v_b), mpl.knee_voltage(s, p), s.slope_cap / s.dt, s.dt,
+            np.ascontiguousarray(p.g, dtype=float))
+
+
+def _mpl_g_columns(comp, fast) -> dict:
+    i_s, v_t, w, v_b, knee, cap, dt, gc = _mpl_g_args(comp)
+    fn = function(fast, "mpl_g_fast", MPL_G_ARGS)
+
+    def run(u):
+        x, y = np.full(i_s.size, u[0]), np.empty(u.size)
+        fn(u, u.size, x, i_s.size, i_s, v_t, w, v_b, knee, cap, dt, y, gc)
+        return y
+
+    return {"fast C": run}
+
+
+def _mpl_g_kernel(comp, kernels):
+    i_s, v_t, w, v_b, knee, cap, dt, gc = _mpl_g_args(comp)
+    return lambda u: kernels.simulate(u, np.full(i_s.size, u[0]), gc, w, v_b, i_s, v_t, knee,
+                                      cap, dt)[0]
+
+
+def _mpl_poly_args(comp) -> tuple:
+    s, p = comp.structure, comp.params
+    return (np.ascontiguousarray(p.f, dtype=float), np.ascontiguousarray(knee_points(s, p)),
+            s.slope_cap / s.dt, bool(s.limit), np.ascontiguousarray(p.g, dtype=float), p.w,
+            float(p.v_b), s.dt)
+
+
+def _mpl_poly_columns(comp, fast) -> dict:
+    fc, knees, slope, limit, gc, w, v_b, dt = _mpl_poly_args(comp)
+    fn = function(fast, "mpl_poly_fast", MPL_POLY_ARGS)
+
+    def run(u):
+        x, y = np.full(fc.shape[0], u[0]), np.empty(u.size)
+        fn(u, u.size, x, fc.shape[0], fc, knees, slope, int(limit), gc, w, v_b, dt, y)
+        return y
+
+    return {"fast C": run}
+
+
+def _mpl_poly_kernel(comp, kernels):
+    """The kernel with the wrapper's bound when limited (inf: only non-finite states stop)."""
+    fc, knees, slope, limit, gc, w, v_b, dt = _mpl_poly_args(comp)
+    bound = np.inf if limit else 1e300
+    return lambda u: kernels.simulate(u, np.full(fc.shape[0], u[0]), fc, knees, slope, limit,
+                                      gc, w, v_b, dt, bound)[0]
+
+
+def _rest(module, comp, u) -> np.ndarray:
+    """The start of ``simulate`` with ``x0=None`` (the family's rest state at ``u[0]``)."""
+    return np.array(module.RUNS.initial(comp.structure, comp.params, None, u[0], False),
+                    dtype=float)
+
+
+def _chua_columns(comp, fast) -> dict:
+    args = chua.kernel_args(comp.structure, comp.params)
+    fn = function(fast, "chua_fast", CHUA_ARGS)
+
+    def run(u):
+        x, y = _rest(chua, comp, u), np.empty(u.size)
+        fn(u, u.size, x, x.size, *args, y)
+        return y
+
+    return {"fast C": run}
+
+
+def _chua_kernel(comp, kernels):
+    args = chua.kernel_args(comp.structure, comp.params)
+    return lambda u: kernels.simulate(u, _rest(chua, comp, u), *args)[0]
+
+
+def _bobbio_columns(comp, fast) -> dict:
+    p = comp.params
+    fn = function(fast, "bobbio_fast", BOBBIO_ARGS)
+
+    def run(u):
+        x, y = _rest(bobbio, comp, u), np.empty(u.size)
+        fn(u, u.size, x, x.size, p.friction, p.compliance, float(p.offset), y)
+        return y
+
+    return {"fast C": run}
+
+
+def _bobbio_kernel(comp, kernels):
+    """``forces`` and the output the wrapper forms from them (a matrix-vector product)."""
+    p = comp.params
+
+    def run(u):
+        f = kernels.forces(u, _rest(bobbio, comp, u), p.friction)[0]
+        return p.compliance[0] * u + f @ p.compliance[1:] + p.offset
+
+    return run
 
 
 def _pi_parts(comp) -> tuple:
@@ -268,6 +377,10 @@ def _boucwen_kernel(comp, kernels):
 FAMILY_SETUP = {
     "mpl": (mpl, _mpl_columns, _mpl_kernel),
     "pl": (pl, _pl_columns, _pl_kernel),
+    "mpl-g": (mpl_g, _mpl_g_columns, _mpl_g_kernel),
+    "mpl-poly": (mpl_poly, _mpl_poly_columns, _mpl_poly_kernel),
+    "chua": (chua, _chua_columns, _chua_kernel),
+    "bobbio": (bobbio, _bobbio_columns, _bobbio_kernel),
     "pi": (importlib.import_module("hystkit.models.pi.model"), _pi_columns, _pi_kernel),
     "preisach": (preisach, _preisach_columns, _preisach_kernel),
     "boucwen": (boucwen, _boucwen_columns, _boucwen_kernel),
@@ -326,12 +439,13 @@ def build_cases(cc: str, tmp: Path, before_rev: str | None = None,
         model = comp.family
         case.columns["simulate"] = (
             lambda u, m=model, s=comp.structure, p=comp.params: m.simulate(s, p, u)[0])
+        folder = family.replace("-", "_")
         case.columns["kernel"] = kernel(comp, importlib.import_module(
-            f"hystkit.models.{family}.kernels"))
+            f"hystkit.models.{folder}.kernels"))
         case.columns["export"] = _export_column(comp, case.label, cc, tmp)
-        if before_rev:
+        if before_rev and family not in NOT_STANDALONE:
             case.columns[f"kernel@{before_rev}"] = kernel(comp, load_kernels_at(before_rev, tmp,
-                                                                                family))
+                                                                                folder))
         cases.append(case)
     return cases
 
@@ -428,7 +542,7 @@ def main() -> int:
                     cells = "".join(f"{row[c][0]:>10.1f} ({row[c][1]:4.2f})" if c in row
                                     else f"{'-':>18}" for c in columns)
                     per_cell = (f"{row['fast C'][0] / case.size:>14.1f}"
-                                if case.family in ("mpl", "pl") else f"{'-':>14}")
+                                if case.family in CELL_FAMILIES else f"{'-':>14}")
                     emit(f"{case.label:<{LABEL_WIDTH}}{cells}{per_cell}")
     emit(f"# load at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
     if only is None:
