@@ -34,6 +34,8 @@ MPL_POLY_ARGS = [ARR, _I64, ARR, _I64, ARR, ARR, _DBL, _I64, ARR, ARR, _DBL, _DB
 CHUA_ARGS = [ARR, _I64, ARR, _I64, ARR, ARR, ARR, ARR, ARR, ARR, ARR, ARR, _DBL, ARR]
 # bobbio_fast: (u, n, x, n_forces, a (n_forces), c (n_forces + 1), b, y)
 BOBBIO_ARGS = [ARR, _I64, ARR, _I64, ARR, ARR, _DBL, ARR]
+# ladder_fast: (u, n, x, n_cells, band, g, w, v_b, dt, y)
+LADDER_ARGS = [ARR, _I64, ARR, _I64, ARR, ARR, ARR, _DBL, _DBL, ARR]
 # pi_fast: (u, n, p, n_play, z, n_creep, r, w_h, d_s, w_s, n_dz, c, w_k, b, y)
 PI_ARGS = [ARR, _I64, ARR, _I64, ARR, _I64, ARR, ARR, ARR, ARR, _I64, ARR, ARR, _DBL, ARR]
 # preisach_fast: (u, n, s, &n_s, capacity, A (L x L), L, offset, slope, y)
@@ -60,7 +62,7 @@ def function(lib: ctypes.CDLL, name: str, argtypes) -> ctypes._CFuncPtr:
 def build_fast_reference(cc: str, workdir: Path) -> ctypes.CDLL:
     """``_c_fast_reference.c`` at ``FAST_FLAGS`` (functions mpl_fast, mpl_fast_unguarded,
     pl_fast, mpl_g_fast, mpl_poly_fast, chua_fast,
-    bobbio_fast, pi_fast, preisach_fast, boucwen_fast)."""
+    bobbio_fast, ladder_fast, pi_fast, preisach_fast, boucwen_fast)."""
     return compile_shared(cc, FAST_FLAGS, FAST_SOURCE, Path(workdir) / "fast.so")
 
 

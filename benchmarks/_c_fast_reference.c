@@ -429,3 +429,33 @@ void bobbio_fast(const double *u, int64_t n, double *x, int64_t n_f, const doubl
         y[i] = acc + b;
     }
 }
+
+/* ladder_fast: the PWL ladder of hystkit.models.ladder (kernels.states, then the output the
+ * wrapper forms): y = w_0 e + sum_k w_k U_k - V_b from the present capacitor voltages, then
+ * one forward-Euler step, U_k += dt (i_k - i_k+1), i_k the dead-zone current g_k dz(U_k-1 -
+ * U_k, band_k) (U_0 = e), all currents from the old voltages. No libm call.
+ * x[n_cells] updated in place; band, g [n_cells]; w[n_cells + 1]. */
+void ladder_fast(const double *u, int64_t n, double *x, int64_t n_cells, const double *band,
+                 const double *g, const double *w, double v_b, double dt, double *y)
+{
+    for (int64_t i = 0; i < n; ++i) {
+        const double e = u[i];
+        double acc = w[0] * e - v_b;
+        for (int64_t k = 0; k < n_cells; ++k)
+            acc += w[k + 1] * x[k];
+        y[i] = acc;
+        const double v = e - x[0];
+        double i_in = v > band[0] ? g[0] * (v - band[0]) : v < -band[0] ? g[0] * (v + band[0])
+                      : 0.0;
+        for (int64_t k = 0; k < n_cells; ++k) {
+            double i_out = 0.0;  /* from the old voltages: x[k + 1] is not yet updated */
+            if (k + 1 < n_cells) {
+                const double vo = x[k] - x[k + 1];
+                i_out = vo > band[k + 1] ? g[k + 1] * (vo - band[k + 1])
+                        : vo < -band[k + 1] ? g[k + 1] * (vo + band[k + 1]) : 0.0;
+            }
+            x[k] += dt * (i_in - i_out);
+            i_in = i_out;
+        }
+    }
+}

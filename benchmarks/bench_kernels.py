@@ -64,6 +64,7 @@ from _c_build import (
     BOUCWEN_ARGS,
     CHUA_ARGS,
     FAST_FLAGS,
+    LADDER_ARGS,
     MPL_ARGS,
     MPL_G_ARGS,
     MPL_POLY_ARGS,
@@ -82,6 +83,7 @@ from hystkit.models.bobbio import model as bobbio
 from hystkit.models.boucwen import divergence as boucwen_divergence
 from hystkit.models.boucwen import model as boucwen
 from hystkit.models.chua import model as chua
+from hystkit.models.ladder import model as ladder
 from hystkit.models.mpl import model as mpl
 from hystkit.models.mpl_g import model as mpl_g
 from hystkit.models.mpl_poly import model as mpl_poly
@@ -92,11 +94,13 @@ from hystkit.sensors import simulate_experiment
 
 HERE = Path(__file__).parent
 # each family at its default size (mPL also at 3 and 5 cells): mpl-g, mpl-poly and Chua 1 cell,
-# PI 10 plays, Preisach 20 levels, Bouc-Wen 2 RK4 substeps, Bobbio-Marrucci 10 springs
+# PI 10 plays, Preisach 20 levels, Bouc-Wen 2 RK4 substeps, Bobbio-Marrucci 10 springs, the
+# ladder 2 cells
 CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2), ("mpl-g", 1), ("mpl-poly", 1),
-         ("chua", 1), ("pi", 10), ("preisach", 20), ("boucwen", 2), ("bobbio", 10))
+         ("chua", 1), ("pi", 10), ("preisach", 20), ("boucwen", 2), ("bobbio", 10),
+         ("ladder", 2))
 LABEL_WIDTH = 12
-CELL_FAMILIES = ("mpl", "pl", "mpl-g", "mpl-poly", "chua")  # size = cells: the ns/cell column
+CELL_FAMILIES = ("mpl", "pl", "mpl-g", "mpl-poly", "chua", "ladder")  # size = cells: the ns/cell column
 # kernels.py that import their package (relative imports): no --before column
 NOT_STANDALONE = ("mpl-g", "mpl-poly")
 SIZES = (8000, 100_000)
@@ -286,6 +290,34 @@ def _bobbio_kernel(comp, kernels):
     return run
 
 
+def _ladder_args(comp) -> tuple:
+    s, p = comp.structure, comp.params
+    return p.band, ladder.effective_conductance(s, p), p.w, float(p.v_b), s.dt
+
+
+def _ladder_columns(comp, fast) -> dict:
+    band, g, w, v_b, dt = _ladder_args(comp)
+    fn = function(fast, "ladder_fast", LADDER_ARGS)
+
+    def run(u):
+        x, y = _rest(ladder, comp, u), np.empty(u.size)
+        fn(u, u.size, x, x.size, band, g, w, v_b, dt, y)
+        return y
+
+    return {"fast C": run}
+
+
+def _ladder_kernel(comp, kernels):
+    """``states`` and the output the wrapper forms from them (a matrix-vector product)."""
+    band, g, w, v_b, dt = _ladder_args(comp)
+
+    def run(u):
+        s = kernels.states(u, _rest(ladder, comp, u), band, g, dt)[0]
+        return w[0] * u + s @ w[1:] - v_b
+
+    return run
+
+
 def _pi_parts(comp) -> tuple:
     s, p = comp.structure, comp.params
     return (np.ascontiguousarray(s.play_thresholds, dtype=float), p.w_h, p.d_s, p.w_s,
@@ -381,6 +413,7 @@ FAMILY_SETUP = {
     "mpl-poly": (mpl_poly, _mpl_poly_columns, _mpl_poly_kernel),
     "chua": (chua, _chua_columns, _chua_kernel),
     "bobbio": (bobbio, _bobbio_columns, _bobbio_kernel),
+    "ladder": (ladder, _ladder_columns, _ladder_kernel),
     "pi": (importlib.import_module("hystkit.models.pi.model"), _pi_columns, _pi_kernel),
     "preisach": (preisach, _preisach_columns, _preisach_kernel),
     "boucwen": (boucwen, _boucwen_columns, _boucwen_kernel),
