@@ -167,6 +167,20 @@ def run_tables(u, s0, A, capacity):
 
 
 @njit(cache=True)
+def forward(u, s0, A, weighted, poly, slope, capacity):
+    """Model output over ``u``: :func:`run_tables`, then per sample the output equation
+    (:func:`combine`) and the straight line of slope ``slope`` beyond [-1, 1], as
+    :func:`block_forward`; returns the output and the final staircase. In one compiled loop:
+    the same expression in numpy, with its temporaries, cost 5 ns/sample (8.4 -> 13.6)."""
+    relay, s_end = run_tables(u, s0, A, capacity)
+    y = np.empty(u.size)
+    for t in range(u.size):
+        u_clip = min(1.0, max(-1.0, u[t]))
+        y[t] = combine(relay[t], u_clip, weighted, poly) + slope * (u[t] - u_clip)
+    return y, s_end
+
+
+@njit(cache=True)
 def _last_index(s, start, stop, u, above):
     """Largest index ``j`` in ``start, start + 2, ... <= stop`` with ``s[j] > u`` (``above``)
     or ``s[j] < u``; -1 if none. The stored maxima fall and the minima rise along the stack
