@@ -280,8 +280,12 @@ def _bobbio_columns(comp, fast) -> dict:
 
 
 def _bobbio_kernel(comp, kernels):
-    """``forces`` and the output the wrapper forms from them (a matrix-vector product)."""
+    """``simulate`` (``forces`` and the output the wrapper formed from them, a matrix-vector
+    product, for revisions before it)."""
     p = comp.params
+    if hasattr(kernels, "simulate"):
+        return lambda u: kernels.simulate(u, _rest(bobbio, comp, u), p.friction, p.compliance,
+                                          float(p.offset))[0]
 
     def run(u):
         f = kernels.forces(u, _rest(bobbio, comp, u), p.friction)[0]
@@ -308,8 +312,11 @@ def _ladder_columns(comp, fast) -> dict:
 
 
 def _ladder_kernel(comp, kernels):
-    """``states`` and the output the wrapper forms from them (a matrix-vector product)."""
+    """``simulate`` (``states`` and the output the wrapper formed from them, a matrix-vector
+    product, for revisions before it)."""
     band, g, w, v_b, dt = _ladder_args(comp)
+    if hasattr(kernels, "simulate"):
+        return lambda u: kernels.simulate(u, _rest(ladder, comp, u), band, g, w, v_b, dt)[0]
 
     def run(u):
         s = kernels.states(u, _rest(ladder, comp, u), band, g, dt)[0]
@@ -366,9 +373,13 @@ def _preisach_columns(comp, fast) -> dict:
 
 
 def _preisach_kernel(comp, kernels):
-    """``run_tables`` and the output line the wrapper adds (offset, straight extension)."""
+    """``forward`` (``run_tables`` and the output line the wrapper added in numpy, for
+    revisions before it)."""
     start, table, offset, slope = _preisach_parts(comp)
     tables, cap = table[None], comp.structure.capacity
+    if hasattr(kernels, "forward"):
+        poly = np.array([offset])
+        return lambda u: kernels.forward(u, start, tables, False, poly, slope, cap)[0]
 
     def run(u):
         relay = kernels.run_tables(u, start, tables, cap)[0][:, 0]
