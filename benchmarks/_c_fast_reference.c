@@ -31,6 +31,27 @@
 #include <math.h>
 #include <stdint.h>
 
+/* Sizes as compile-time constants: bench_kernels.py also builds this file once per model with
+ * -DFIX_A=.. [-DFIX_B=.. -DFIX_C=..] (its "C fixed" column), each function's size arguments in
+ * order replaced by them, as a C programmer writing for one model (or hystkit export) would
+ * have them: loops fully unrolled, no trip-count tests. The ratios stay to the runtime-sized
+ * build, which takes its sizes as the numba kernels do. */
+#ifdef FIX_A
+#define FIXED_A(v) ((int64_t)(FIX_A))
+#else
+#define FIXED_A(v) (v)
+#endif
+#ifdef FIX_B
+#define FIXED_B(v) ((int64_t)(FIX_B))
+#else
+#define FIXED_B(v) (v)
+#endif
+#ifdef FIX_C
+#define FIXED_C(v) ((int64_t)(FIX_C))
+#else
+#define FIXED_C(v) (v)
+#endif
+
 /* sinh(a) for |a| < 0.5: a (1 + a^2/3! + ... + a^14/15!); the next term is < 5e-20 relative */
 static inline double sinh_series(double a)
 {
@@ -49,6 +70,7 @@ static inline void mpl_run(const double *u, int64_t n, double *x, int64_t n_cell
                            const double *knee, double cap, double dt, double *y, int guarded,
                            const double *gc)
 {
+    n_cells = FIXED_A(n_cells);
     double inv_vt[n_cells], c2[n_cells], c0[n_cells];
     const double cap_dt = cap * dt;
     for (int64_t k = 0; k < n_cells; ++k) {
@@ -112,6 +134,7 @@ void mpl_poly_fast(const double *u, int64_t n, double *x, int64_t n_cells, const
                    const double *knees, double s, int64_t limit, const double *gc,
                    const double *w, double v_b, double dt, double *y)
 {
+    n_cells = FIXED_A(n_cells);
     double fb_m[n_cells], fb_p[n_cells];
     for (int64_t k = 0; k < n_cells; ++k) {
         const double *c = fc + 4 * k, xm = knees[2 * k], xp = knees[2 * k + 1];
@@ -171,6 +194,8 @@ void pl_fast(const double *u, int64_t n, double *x, int64_t n_cells, double i_t,
              const double *w, double v_b, const double *brk, int64_t m, const double *a,
              double *y)
 {
+    n_cells = FIXED_A(n_cells);
+    m = FIXED_B(m);
     double inv_thr[n_cells], c0[n_cells];
     const double scale_dt = i_t / (power - 1.0) * dt, g_dt = g_lin * dt;
     for (int64_t k = 0; k < n_cells; ++k) {
@@ -209,6 +234,9 @@ void pi_fast(const double *u, int64_t n, double *restrict p, int64_t n_play, dou
              const double *d_s, const double *w_s, int64_t n_dz, const double *restrict c,
              const double *restrict w_k, double b, double *y)
 {
+    n_play = FIXED_A(n_play);
+    n_creep = FIXED_B(n_creep);
+    n_dz = FIXED_C(n_dz);
     double d_pos[n_dz], w_pos[n_dz], d_neg[n_dz], w_neg[n_dz], w_zero = 0.0;
     int64_t n_pos = 0, n_neg = 0;
     for (int64_t k = 0; k < n_dz; ++k) {
@@ -277,6 +305,8 @@ static inline double preisach_term(const double *A, int64_t L, double scale, dou
 void preisach_fast(const double *u, int64_t n, double *s, int64_t *ns, int64_t capacity,
                    const double *A, int64_t L, double offset, double slope, double *y)
 {
+    L = FIXED_A(L);
+    capacity = FIXED_B(capacity);
     const double scale = 0.5 * (L - 1), f0 = -A[(L - 1) * L];
     double c[capacity];
     int64_t m = *ns;
@@ -336,6 +366,7 @@ static inline void boucwen_rhs(double y, double v, double z, double u, const dou
 void boucwen_fast(const double *u, int64_t n, double *x, int64_t fresh, const double *th,
                   double dt, int64_t n_sub, int64_t linear, double *out)
 {
+    n_sub = FIXED_A(n_sub);
     const int nu_one = th[6] == 1.0;
     const double inv_m = 1.0 / th[0];  /* one division per run, not eight per sample */
     const double h = dt / n_sub;
@@ -376,6 +407,7 @@ void chua_fast(const double *u, int64_t n, double *x, int64_t n_el, const double
                const double *k_inf, const double *y_s, const double *g, const double *v_g,
                const double *band, const double *knee, const double *cap, double dt, double *y)
 {
+    n_el = FIXED_A(n_el);
     double inv_ys[n_el], dk_ys[n_el], inv_vg[n_el], gvg_dt[n_el], c0[n_el], cap_dt[n_el];
     for (int64_t k = 0; k < n_el; ++k) {
         inv_ys[k] = 1.0 / y_s[k];
@@ -416,6 +448,7 @@ void chua_fast(const double *u, int64_t n, double *x, int64_t n_el, const double
 void bobbio_fast(const double *u, int64_t n, double *x, int64_t n_f, const double *a,
                  const double *c, double b, double *y)
 {
+    n_f = FIXED_A(n_f);
     for (int64_t i = 0; i < n; ++i) {
         double prev = u[i], acc = c[0] * u[i];
         for (int64_t k = 0; k < n_f; ++k) {
@@ -438,6 +471,7 @@ void bobbio_fast(const double *u, int64_t n, double *x, int64_t n_f, const doubl
 void ladder_fast(const double *u, int64_t n, double *x, int64_t n_cells, const double *band,
                  const double *g, const double *w, double v_b, double dt, double *y)
 {
+    n_cells = FIXED_A(n_cells);
     for (int64_t i = 0; i < n; ++i) {
         const double e = u[i];
         double acc = w[0] * e - v_b;

@@ -64,6 +64,7 @@ from _c_build import (
     BOUCWEN_ARGS,
     CHUA_ARGS,
     FAST_FLAGS,
+    FAST_SOURCE,
     LADDER_ARGS,
     MPL_ARGS,
     MPL_G_ARGS,
@@ -106,7 +107,7 @@ NOT_STANDALONE = ("mpl-g", "mpl-poly")
 SIZES = (8000, 100_000)
 ROUNDS = {8000: 101, 100_000: 31}
 QUICK_ROUNDS = {8000: 31, 100_000: 11}
-COLUMNS = ("fast C", "C no guard", "slow C", "simulate", "kernel", "export")
+COLUMNS = ("fast C", "C fixed", "C no guard", "slow C", "simulate", "kernel", "export")
 # CPU time first: on a shared machine a call longer than the scheduler's slice (~2 ms here)
 # waits for the other processes, which wall time counts and CPU time does not.
 CLOCKS = {"cpu": "CPU time (thread)", "wall": "wall time"}
@@ -416,19 +417,37 @@ def _boucwen_kernel(comp, kernels):
 
 
 # family: (its model module (simulate_reference), its C columns, its bare kernel on a
-# kernels module: this tree's or a past revision's)
+# kernels module: this tree's or a past revision's, its sizes in the order of the fast C's
+# size arguments: the "C fixed" build's -DFIX_A, -DFIX_B, -DFIX_C)
 FAMILY_SETUP = {
-    "mpl": (mpl, _mpl_columns, _mpl_kernel),
-    "pl": (pl, _pl_columns, _pl_kernel),
-    "mpl-g": (mpl_g, _mpl_g_columns, _mpl_g_kernel),
-    "mpl-poly": (mpl_poly, _mpl_poly_columns, _mpl_poly_kernel),
-    "chua": (chua, _chua_columns, _chua_kernel),
-    "bobbio": (bobbio, _bobbio_columns, _bobbio_kernel),
-    "ladder": (ladder, _ladder_columns, _ladder_kernel),
-    "pi": (importlib.import_module("hystkit.models.pi.model"), _pi_columns, _pi_kernel),
-    "preisach": (preisach, _preisach_columns, _preisach_kernel),
-    "boucwen": (boucwen, _boucwen_columns, _boucwen_kernel),
+    "mpl": (mpl, _mpl_columns, _mpl_kernel, lambda comp: (comp.structure.n_cells,)),
+    "pl": (pl, _pl_columns, _pl_kernel,
+           lambda comp: (comp.structure.n_cells, np.asarray(comp.params.a).size)),
+    "mpl-g": (mpl_g, _mpl_g_columns, _mpl_g_kernel, lambda comp: (comp.params.i_s.size,)),
+    "mpl-poly": (mpl_poly, _mpl_poly_columns, _mpl_poly_kernel,
+                 lambda comp: (np.asarray(comp.params.f).shape[0],)),
+    "chua": (chua, _chua_columns, _chua_kernel, lambda comp: (comp.params.k0.size,)),
+    "bobbio": (bobbio, _bobbio_columns, _bobbio_kernel,
+               lambda comp: (comp.params.friction.size,)),
+    "ladder": (ladder, _ladder_columns, _ladder_kernel, lambda comp: (comp.params.band.size,)),
+    "pi": (importlib.import_module("hystkit.models.pi.model"), _pi_columns, _pi_kernel,
+           lambda comp: (comp.structure.n_play, comp.structure.n_creep,
+                         comp.params.d_s.size)),
+    "preisach": (preisach, _preisach_columns, _preisach_kernel,
+                 lambda comp: (comp.structure.levels, comp.structure.capacity)),
+    "boucwen": (boucwen, _boucwen_columns, _boucwen_kernel,
+                lambda comp: (comp.structure.substeps,)),
 }
+
+
+def _fixed_column(comp, family: str, label: str, cc: str, tmp: Path, slow):
+    """The fast C built with this model's sizes as compile-time constants."""
+    _, c_columns, _, sizes = FAMILY_SETUP[family]
+    defines = [f"-DFIX_{slot}={size}" for slot, size in zip("ABC", sizes(comp), strict=False)]
+    name = label.replace(" ", "_").replace("-", "_")
+    lib = compile_shared(cc, (*FAST_FLAGS, *defines), FAST_SOURCE, tmp / f"fixed_{name}.so")
+    columns = _mpl_columns(comp, lib, slow) if family == "mpl" else c_columns(comp, lib)
+    return columns["fast C"]
 
 
 def _export_column(comp, label: str, cc: str, tmp: Path):
@@ -477,9 +496,10 @@ def build_cases(cc: str, tmp: Path, before_rev: str | None = None,
             continue
         comp = fit_compensator(fit_rec, size, model=family, diagnose=False)
         case = Case(family, size, comp, _inputs(comp, fit_rec))
-        _, c_columns, kernel = FAMILY_SETUP[family]
+        _, c_columns, kernel, _ = FAMILY_SETUP[family]
         case.columns = _mpl_columns(comp, fast, slow) if family == "mpl" else c_columns(comp,
                                                                                         fast)
+        case.columns["C fixed"] = _fixed_column(comp, family, case.label, cc, tmp, slow)
         model = comp.family
         case.columns["simulate"] = (
             lambda u, m=model, s=comp.structure, p=comp.params: m.simulate(s, p, u)[0])
