@@ -38,8 +38,10 @@ BOBBIO_ARGS = [ARR, _I64, ARR, _I64, ARR, ARR, _DBL, ARR]
 LADDER_ARGS = [ARR, _I64, ARR, _I64, ARR, ARR, ARR, _DBL, _DBL, ARR]
 # pi_fast: (u, n, p, n_play, z, n_creep, r, w_h, d_s, w_s, n_dz, c, w_k, b, y)
 PI_ARGS = [ARR, _I64, ARR, _I64, ARR, _I64, ARR, ARR, ARR, ARR, _I64, ARR, ARR, _DBL, ARR]
-# preisach_fast: (u, n, s, &n_s, capacity, A (L x L), L, offset, slope, y)
-PREISACH_ARGS = [ARR, _I64, ARR, ctypes.POINTER(_I64), _I64, ARR, _I64, _DBL, _DBL, ARR]
+# preisach_fast: (u, n, s, &n_s, capacity, A (K x L x L), L, K, weighted, poly, n_poly, slope,
+# y)
+PREISACH_ARGS = [ARR, _I64, ARR, ctypes.POINTER(_I64), _I64, ARR, _I64, _I64, _I64, ARR, _I64,
+                 _DBL, ARR]
 # boucwen_fast: (u, n, x (4), fresh, theta (7), dt, n_sub, linear, y)
 BOUCWEN_ARGS = [ARR, _I64, ARR, _I64, ARR, _DBL, _I64, _I64, ARR]
 

@@ -84,6 +84,7 @@ from hystkit.models.bobbio import model as bobbio
 from hystkit.models.boucwen import divergence as boucwen_divergence
 from hystkit.models.boucwen import model as boucwen
 from hystkit.models.chua import model as chua
+from hystkit.models.gpreisach import model as gpreisach
 from hystkit.models.ladder import model as ladder
 from hystkit.models.mpl import model as mpl
 from hystkit.models.mpl_g import model as mpl_g
@@ -95,15 +96,16 @@ from hystkit.sensors import simulate_experiment
 
 HERE = Path(__file__).parent
 # each family at its default size (mPL also at 3 and 5 cells): mpl-g, mpl-poly and Chua 1 cell,
-# PI 10 plays, Preisach 20 levels, Bouc-Wen 2 RK4 substeps, Bobbio-Marrucci 10 springs, the
-# ladder 2 cells
+# PI 10 plays, Preisach 20 levels, the generalised Preisach 16 levels (two tables), Bouc-Wen 2
+# RK4 substeps, Bobbio-Marrucci 10 springs, the ladder 2 cells
 CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2), ("mpl-g", 1), ("mpl-poly", 1),
-         ("chua", 1), ("pi", 10), ("preisach", 20), ("boucwen", 2), ("bobbio", 10),
-         ("ladder", 2))
+         ("chua", 1), ("pi", 10), ("preisach", 20), ("gpreisach", 16), ("boucwen", 2),
+         ("bobbio", 10), ("ladder", 2))
 LABEL_WIDTH = 12
 CELL_FAMILIES = ("mpl", "pl", "mpl-g", "mpl-poly", "chua", "ladder")  # size = cells: the ns/cell column
 # kernels.py that import their package (relative imports): no --before column
 NOT_STANDALONE = ("mpl-g", "mpl-poly")
+KERNELS_FOLDER = {"gpreisach": "preisach"}  # the generalised model runs the classical kernels
 SIZES = (8000, 100_000)
 ROUNDS = {8000: 101, 100_000: 31}
 QUICK_ROUNDS = {8000: 31, 100_000: 11}
@@ -351,40 +353,47 @@ def _pi_kernel(comp, kernels):
 
 
 def _preisach_parts(comp) -> tuple:
-    """Demagnetised start staircase, antisymmetric table, offset, extension slope."""
+    """Demagnetised start staircase and the kernels' tables, weighted, poly, slope (the
+    classical and the generalised model alike)."""
     s, p = comp.structure, comp.params
-    table, _, poly, slope = preisach.kernel_parts(p)
-    return (preisach.demagnetised_state(s.levels - 1), np.ascontiguousarray(table[0]),
-            float(poly[0]), slope)
+    module = preisach if comp.family.name == "preisach" else gpreisach
+    tables, weighted, poly, slope = module.kernel_parts(p)
+    return (preisach.demagnetised_state(s.levels - 1), np.ascontiguousarray(tables),
+            bool(weighted), np.ascontiguousarray(poly, dtype=float), float(slope))
 
 
 def _preisach_columns(comp, fast) -> dict:
-    start, table, offset, slope = _preisach_parts(comp)
+    start, tables, weighted, poly, slope = _preisach_parts(comp)
     cap = comp.structure.capacity
     fn = function(fast, "preisach_fast", PREISACH_ARGS)
 
     def run(u):
         stair, y = np.zeros(cap), np.empty(u.size)
         stair[:start.size] = start
-        fn(u, u.size, stair, ctypes.byref(ctypes.c_int64(start.size)), cap, table,
-           table.shape[0], offset, slope, y)
+        fn(u, u.size, stair, ctypes.byref(ctypes.c_int64(start.size)), cap, tables,
+           tables.shape[1], tables.shape[0], int(weighted), poly, poly.size, slope, y)
         return y
 
     return {"fast C": run}
 
 
 def _preisach_kernel(comp, kernels):
-    """``forward`` (``run_tables`` and the output line the wrapper added in numpy, for
+    """``forward`` (``run_tables`` and the output line the wrappers added in numpy, for
     revisions before it)."""
-    start, table, offset, slope = _preisach_parts(comp)
-    tables, cap = table[None], comp.structure.capacity
+    start, tables, weighted, poly, slope = _preisach_parts(comp)
+    cap = comp.structure.capacity
     if hasattr(kernels, "forward"):
-        poly = np.array([offset])
-        return lambda u: kernels.forward(u, start, tables, False, poly, slope, cap)[0]
+        return lambda u: kernels.forward(u, start, tables, weighted, poly, slope, cap)[0]
 
     def run(u):
-        relay = kernels.run_tables(u, start, tables, cap)[0][:, 0]
-        return relay + offset + slope * (u - np.clip(u, -1.0, 1.0))
+        relay = kernels.run_tables(u, start, tables, cap)[0]
+        u_clip = np.clip(u, -1.0, 1.0)
+        if weighted:
+            w = 0.5 * (1.0 + u_clip)
+            relay = (1.0 - w) * relay[:, 0] + w * relay[:, 1]
+        else:
+            relay = relay[:, 0]
+        return relay + np.polynomial.polynomial.polyval(u_clip, poly) + slope * (u - u_clip)
 
     return run
 
@@ -434,7 +443,9 @@ FAMILY_SETUP = {
            lambda comp: (comp.structure.n_play, comp.structure.n_creep,
                          comp.params.d_s.size)),
     "preisach": (preisach, _preisach_columns, _preisach_kernel,
-                 lambda comp: (comp.structure.levels, comp.structure.capacity)),
+                 lambda comp: (comp.structure.levels, comp.structure.capacity, 1)),
+    "gpreisach": (gpreisach, _preisach_columns, _preisach_kernel,
+                  lambda comp: (comp.structure.levels, comp.structure.capacity, 2)),
     "boucwen": (boucwen, _boucwen_columns, _boucwen_kernel,
                 lambda comp: (comp.structure.substeps,)),
 }
@@ -503,7 +514,7 @@ def build_cases(cc: str, tmp: Path, before_rev: str | None = None,
         model = comp.family
         case.columns["simulate"] = (
             lambda u, m=model, s=comp.structure, p=comp.params: m.simulate(s, p, u)[0])
-        folder = family.replace("-", "_")
+        folder = KERNELS_FOLDER.get(family, family.replace("-", "_"))
         case.columns["kernel"] = kernel(comp, importlib.import_module(
             f"hystkit.models.{folder}.kernels"))
         case.columns["export"] = _export_column(comp, case.label, cc, tmp)

@@ -296,9 +296,8 @@ def kernel_parts(params: GPreisachParams) -> tuple[np.ndarray, bool, np.ndarray,
 
 def _forward(structure: GPreisachStructure, params: GPreisachParams, u: np.ndarray,
              x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    relay, x_end = kernels.run_tables(u, x, _tables(params), structure.capacity)
-    with np.errstate(over="ignore", invalid="ignore"):  # inputs near 1e308 on the extension
-        return _combine(params, relay, u), x_end
+    tables, weighted, poly, slope = kernel_parts(params)
+    return kernels.forward(u, x, tables, weighted, poly, slope, structure.capacity)
 
 
 def _inverse(structure: GPreisachStructure, params: GPreisachParams, y: np.ndarray,
