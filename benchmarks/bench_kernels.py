@@ -5,26 +5,38 @@ Run:  python benchmarks/bench_kernels.py [--quick] [--before REV] [--only FAMILI
       more column, the bare kernel of git revision REV, paired in the same rounds; --only
       pi,boucwen: those families only, nothing written)
 
-Models: mPL with 1, 3 and 5 cells and PL with 2 cells, each fitted (direct mode, centring fit)
-on the virtual sensor's sine recording (seed 1): realistic parameters, e.g. the 5-cell mPL has
-two nearly linear cells (V_T ~ 1e3). Inputs: that recording's normalised sensor (8000 samples)
-and the sine recordings of seeds 2, 3, ... normalised the same way and joined (100 000).
+Models: every registered family, each fitted (direct mode, centring fit) on the virtual
+sensor's sine recording (seed 1) at its default size (mPL also at 3 and 5 cells; ``CASES``):
+realistic parameters, e.g. the 5-cell mPL has two nearly linear cells (V_T ~ 1e3). Inputs: that
+recording's normalised sensor (8000 samples) and the sine recordings of seeds 2, 3, ...
+normalised the same way and joined (100 000).
 
 Columns, ns per sample, each built in this run and called on the same input:
 
 * ``fast C``: ``_c_fast_reference.c``, ``cc -O3 -march=native -fno-math-errno`` (no
-  -ffast-math; -fno-math-errno changes no result, only errno): one exp per
-  cell, sinh from its series below |a| = 0.5, per-cell constants out of the loop (mPL); one pow
-  per cell (PL). The yardstick;
-* ``C no guard``: the same without the series, sinh = (e - 1/e) / 2 everywhere (mPL only):
+  -ffast-math; -fno-math-errno changes no result, only errno), one function per family, sizes
+  taken at run time as the numba kernels take them: one exp per cell, sinh from its series
+  below |a| = 0.5, per-cell constants out of the loop (mPL, mpl-g); one pow per cell (PL);
+  tanh and one expm1 per element (Chua); no libm call (mpl-poly, PI, Preisach, Bobbio, ladder);
+  RK4 with 1 / m (Bouc-Wen). Its comment says what was measured for each choice. The
+  yardstick;
+* ``C fixed``: the same file built once per model with its sizes as compile-time constants
+  (``-DFIX_A=..``): loops unrolled, no trip-count tests. What a C programmer writing for one
+  model gets beyond it (0.74-0.98x);
+* ``C no guard``: the fast C without the series, sinh = (e - 1/e) / 2 everywhere (mPL only):
   what the guard costs (measured: nothing, 0.96-1.10x), and (agreement table) what it saves;
 * ``slow C``: ``_c_reference.c`` as ``bench_mpl.py`` builds it (``cc -O2``, libm's sinh, the
-  kernel's operation order; mPL only, PL has none);
-* ``simulate``: ``family.simulate`` (the numba kernel with its Python wrapper: checks, knees);
+  kernel's operation order; mPL only);
+* ``simulate``: ``family.simulate`` (the numba kernel with its Python wrapper: checks, rest
+  state, knees; a fixed cost per call, so the ratio falls from 8000 to 100k samples);
+* ``kernel``: the numba kernel alone, called as the wrapper calls it (Preisach: ``forward``;
+  Bouc-Wen: ``simulate`` with its state array);
 * ``export``: the model written by ``hystkit export --double`` (the command line, on the model
   file ``hystkit fit`` would write), its ``model_step`` called per sample from a driver that
   includes the generated C file, compiled with the fast C's flags (the compensator around it,
-  centring and flags, is ``bench_export.py``'s).
+  centring and flags, is ``bench_export.py``'s). Its sizes *and parameter values* are
+  constants of the C file, which the compiler folds: for the small linear-algebra families
+  (PI, Bobbio, ladder) it beats even ``C fixed``.
 
 Timing: rounds paired and interleaved (each round calls every column once, in turn: A B C A B
 C ...; the first call of each is untimed), the thread's CPU time (``time.thread_time``) and the
@@ -103,8 +115,6 @@ CASES = (("mpl", 1), ("mpl", 3), ("mpl", 5), ("pl", 2), ("mpl-g", 1), ("mpl-poly
          ("bobbio", 10), ("ladder", 2))
 LABEL_WIDTH = 12
 CELL_FAMILIES = ("mpl", "pl", "mpl-g", "mpl-poly", "chua", "ladder")  # size = cells: the ns/cell column
-# kernels.py that import their package (relative imports): no --before column
-NOT_STANDALONE = ("mpl-g", "mpl-poly")
 KERNELS_FOLDER = {"gpreisach": "preisach"}  # the generalised model runs the classical kernels
 SIZES = (8000, 100_000)
 ROUNDS = {8000: 101, 100_000: 31}
@@ -483,8 +493,9 @@ def _export_column(comp, label: str, cc: str, tmp: Path):
 
 
 def load_kernels_at(rev: str, tmp: Path, family: str = "mpl"):
-    """``models/<family>/kernels.py`` of git revision ``rev`` as a module of its own (the timed
-    families' import only numpy and numba), for a paired before/after in one run."""
+    """``models/<family>/kernels.py`` of git revision ``rev`` as a module of its own, for a
+    paired before/after in one run; ImportError if it imports its package (relative
+    imports)."""
     source = f"{rev}:src/hystkit/models/{family}/kernels.py"
     text = subprocess.run(["git", "-C", str(HERE), "show", source], capture_output=True,
                           text=True, check=True).stdout
@@ -518,9 +529,13 @@ def build_cases(cc: str, tmp: Path, before_rev: str | None = None,
         case.columns["kernel"] = kernel(comp, importlib.import_module(
             f"hystkit.models.{folder}.kernels"))
         case.columns["export"] = _export_column(comp, case.label, cc, tmp)
-        if before_rev and family not in NOT_STANDALONE:
-            case.columns[f"kernel@{before_rev}"] = kernel(comp, load_kernels_at(before_rev, tmp,
-                                                                                folder))
+        if before_rev:
+            try:
+                past = load_kernels_at(before_rev, tmp, folder)
+            except ImportError:  # a kernels.py that imports its package: no column
+                past = None
+            if past is not None:
+                case.columns[f"kernel@{before_rev}"] = kernel(comp, past)
         cases.append(case)
     return cases
 
