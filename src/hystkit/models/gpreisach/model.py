@@ -232,10 +232,11 @@ def output_bound(params: GPreisachParams, u_max: float) -> float:
 
 def _poly(params: GPreisachParams) -> np.ndarray:
     """Monomial coefficients of ``R(u) + y_0`` for the kernels."""
-    r = sum((c * b for c, b in zip(params.nu, reversible_basis(params.nu.size - 1))),
-            Polynomial([0.0]))
+    # on the coefficient arrays, in the order Polynomial's sum adds them (the same numbers),
+    # without its objects: every simulate builds this (40 -> ~5 us)
     coef = np.zeros(params.nu.size + 1)
-    coef[: r.coef.size] = r.coef
+    for c, b in zip(params.nu, reversible_basis(params.nu.size - 1)):
+        coef[: b.coef.size] += c * b.coef
     coef[0] += params.offset
     return coef
 
