@@ -274,9 +274,7 @@ def forces(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
 
 def _forward(structure: BobbioStructure, params: BobbioParams, u: np.ndarray,
              x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    f, x_end = kernels.forces(u, x, params.friction)
-    with np.errstate(over="ignore", invalid="ignore"):  # inputs near the float range
-        return params.compliance[0] * u + f @ params.compliance[1:] + params.offset, x_end
+    return kernels.simulate(u, x, params.friction, params.compliance, float(params.offset))
 
 
 def _inverse(structure: BobbioStructure, params: BobbioParams, y: np.ndarray,

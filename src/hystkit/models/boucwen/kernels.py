@@ -12,14 +12,15 @@ from numba import njit
 
 
 @njit(cache=True, inline="always")
-def _rhs(y, v, z, u, m, c, k, alpha, beta, gamma, nu):
-    """Right-hand side ``(dy/dt, dv/dt, dz/dt)`` of the oscillator with Bouc-Wen force ``z``."""
+def _rhs(y, v, z, u, inv_m, c, k, alpha, beta, gamma, nu):
+    """Right-hand side ``(dy/dt, dv/dt, dz/dt)`` of the oscillator with Bouc-Wen force ``z``
+    (``inv_m = 1 / m``)."""
     # |z|^nu; numba's float ** defeats the optimiser here (4x slower even when not taken), and
     # exp(nu log|z|) is exact enough and gives 0 at z = 0 for nu >= 1.
     p = abs(z) if nu == 1.0 else np.exp(nu * np.log(abs(z)))
     q = p if z >= 0.0 else -p  # |z|^(nu - 1) z, written so that z = 0 needs no 0^(nu - 1)
     dz = alpha * v - beta * abs(v) * q - gamma * v * p
-    return v, (u - c * v - k * y - z) / m, dz
+    return v, (u - c * v - k * y - z) * inv_m, dz
 
 
 @njit(cache=True, inline="always")
@@ -30,19 +31,22 @@ def advance(x, u_a, u_b, theta, h, n_sub, linear):
     ``u_a`` (zero-order hold). ``x`` is updated in place.
     """
     m, c, k, alpha, beta, gamma, nu = theta
+    # times 1 / m, not / m: eight divisions per sample on the serial RK4 chain were a third of
+    # its time (66.8 -> 48.6 ns/sample, 2 substeps); the outputs move by ~1e-14 relative
+    inv_m = 1.0 / m
     y, v, z = x[0], x[1], x[2]
     du = (u_b - u_a) / n_sub if linear else 0.0
     for j in range(n_sub):
         u0 = u_a + j * du
         u1 = u0 + 0.5 * du
         u2 = u0 + du
-        k1y, k1v, k1z = _rhs(y, v, z, u0, m, c, k, alpha, beta, gamma, nu)
+        k1y, k1v, k1z = _rhs(y, v, z, u0, inv_m, c, k, alpha, beta, gamma, nu)
         k2y, k2v, k2z = _rhs(y + 0.5 * h * k1y, v + 0.5 * h * k1v, z + 0.5 * h * k1z, u1,
-                             m, c, k, alpha, beta, gamma, nu)
+                             inv_m, c, k, alpha, beta, gamma, nu)
         k3y, k3v, k3z = _rhs(y + 0.5 * h * k2y, v + 0.5 * h * k2v, z + 0.5 * h * k2z, u1,
-                             m, c, k, alpha, beta, gamma, nu)
+                             inv_m, c, k, alpha, beta, gamma, nu)
         k4y, k4v, k4z = _rhs(y + h * k3y, v + h * k3v, z + h * k3z, u2,
-                             m, c, k, alpha, beta, gamma, nu)
+                             inv_m, c, k, alpha, beta, gamma, nu)
         y += h / 6.0 * (k1y + 2.0 * k2y + 2.0 * k3y + k4y)
         v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v)
         z += h / 6.0 * (k1z + 2.0 * k2z + 2.0 * k3z + k4z)

@@ -161,11 +161,8 @@ def _check(structure: PreisachStructure, params: PreisachParams, inverse: bool) 
 
 def _forward(structure: PreisachStructure, params: PreisachParams, u: np.ndarray,
              x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    relay, x_end = kernels.run_tables(u, x, antisymmetric(params.everett)[None],
-                                      structure.capacity)
-    u_clip = np.clip(u, -1.0, 1.0)
-    with np.errstate(over="ignore", invalid="ignore"):  # inputs near 1e308 on the extension
-        return relay[:, 0] + params.offset + _slope(params) * (u - u_clip), x_end
+    tables, weighted, poly, slope = kernel_parts(params)
+    return kernels.forward(u, x, tables, weighted, poly, slope, structure.capacity)
 
 
 def _inverse(structure: PreisachStructure, params: PreisachParams, y: np.ndarray,
