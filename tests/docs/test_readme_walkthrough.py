@@ -85,5 +85,9 @@ def test_readme_walkthrough_runs(tmp_path):
 
     # the model as a MATLAB struct: every field of the JSON model file
     m = loadmat(tmp_path / "model.mat", simplify_cells=True)
-    assert m["schema"] == "hystkit.compensator" and m["model"] == "mpl"
+    # the model the guided fit says it chose (mpl on a quiet machine; under a heavy load its
+    # time budget can skip the larger candidates and pi wins: seen once at load 7)
+    chosen = re.search(r"^chose (\S+) \(size", proc.stdout, re.MULTILINE)
+    assert chosen is not None, proc.stdout[-2000:]
+    assert m["schema"] == "hystkit.compensator" and m["model"] == chosen.group(1)
     assert m["fit"]["units"] == {"position": "mm", "sensor": "Ohm"}
