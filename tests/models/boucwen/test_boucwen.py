@@ -195,8 +195,9 @@ def test_params_round_trips_and_benchmark_notation():
     assert_allclose([p.omega0, p.zeta], [np.sqrt(1e5 / 2), 10 / (2 * np.sqrt(2e5))])
 
 
-@pytest.mark.parametrize("kwargs", [{"m": 0.0}, {"c": -1.0}, {"alpha": np.nan}, {"nu": 0.5},
-                                    {"beta": "x"}])
+# m = 5e-324 (subnormal): the kernel's 1 / m is inf, a model file with it gave NaN
+@pytest.mark.parametrize("kwargs", [{"m": 0.0}, {"m": 5e-324}, {"c": -1.0}, {"alpha": np.nan},
+                                    {"nu": 0.5}, {"beta": "x"}])
 def test_params_reject_bad_values(kwargs):
     with pytest.raises(ValueError):
         bw.BoucWenParams(**{**SOFT.to_dict(), **kwargs})

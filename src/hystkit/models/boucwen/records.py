@@ -117,6 +117,8 @@ class BoucWenParams(Record):
         for name in ("m", "c", "k", "alpha"):
             if getattr(self, name) <= 0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
+        if not np.isfinite(1.0 / self.m):  # the kernel runs on 1 / m (a subnormal m: inf)
+            raise ValueError(f"m must be at least {1 / np.finfo(float).max:.3g}, got {self.m}")
         if not 1 <= self.nu <= MAX_NU:
             raise ValueError(f"nu must lie in [1, {MAX_NU:g}], got {self.nu}")
 

@@ -54,11 +54,10 @@ def cell_gradient(v, c, xm, xp, s, limit):
     return out
 
 
-# contract: a * b + c as one fused multiply-add (one rounding instead of two), what C
-# compilers do by default; the Horner cubics are the serial chain of every sample (9.0 -> 7.2
-# ns/sample, 1 cell; the fast C 7.5). Outputs move by ~5e-16 relative
-# (tests/models/mpl_poly/test_mpl_poly_kernel_contract.py: within 1e-12 of the reference).
-@njit(cache=True, fastmath={"contract"})
+# No fastmath={"contract"} (fused multiply-add: 9.0 -> 7.2 ns/sample, 1 cell, the fast C 7.5):
+# the stream's compiled block does not fuse alike, so the stream would lose its bit-for-bit
+# check and fall back to the Python path (tests/live/test_stream_compiled.py).
+@njit(cache=True)
 def simulate(u, x0, fc, knees, s, limit, gc, w, v_b, dt, bound):
     """Forward model; returns ``(y, x_end, n_bad)``, ``n_bad`` the first sample whose state
     left ``|u_k| < bound`` (the unlimited model diverging) or -1."""
