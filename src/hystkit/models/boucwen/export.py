@@ -32,7 +32,7 @@ static void rhs(real y, real v, real z, real u, real *dy, real *dv, real *dz)
     const real q = z >= R(0.0) ? p : -p;
     *dz = alpha * v - beta * FABS(v) * q - gamma * v * p;
     *dy = v;
-    *dv = (u - c * v - k * y - z) / m;
+    *dv = (u - c * v - k * y - z) * (R(1.0) / m);  /* as the kernel: times 1 / m */
 }}
 
 static void model_rest(real *x, real value)
@@ -89,7 +89,7 @@ end
 if z >= 0.0, q = p; else, q = -p; end
 dz = alpha * v - beta * abs(v) * q - gamma * v * p;
 dy = v;
-dv = (u - c * v - k * y - z) / m;
+dv = (u - c * v - k * y - z) * (1.0 / m);  % as the kernel: times 1 / m
 end
 
 function [out, x] = model_step(B, x, u)
