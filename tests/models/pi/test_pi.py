@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from numpy.testing import assert_allclose
+from numpy.testing import assert_allclose, assert_array_equal
 
 from hystkit.compensation import evaluate, fit_compensator
 from hystkit.errors import FitDivergedError
@@ -45,7 +45,7 @@ def test_inverse_kernel_matches_invert_step():
     for y_n in y:
         e, x = pi.invert_step(STRUCT, PARAMS, x, y_n)
         ref.append(e)
-    # the kernel keeps inverse play states, the reference rebuilds them from the forward ones
+    # both form the inverse plays from the forward ones, the reference with numpy's cumsum
     assert_allclose(u_hat, ref, rtol=0, atol=1e-13)
     assert_allclose(x_end, x, rtol=0, atol=1e-13)
 
@@ -321,6 +321,43 @@ def test_block_equals_step_from_a_non_rest_state(inverse):
         assert_allclose(xn[off:off + block.n_state], x, rtol=0, atol=1e-12)
         assert np.all(np.isnan(np.r_[xn[:off], xn[off + block.n_state:]]))
         big[off:off + block.n_state] = xn[off:off + block.n_state]
+
+
+@pytest.mark.parametrize("inverse", [False, True])
+def test_block_looped_gives_the_compiled_run_bit_for_bit(inverse):
+    """What lets a stream run the PI compiled (issue 29.4): the inverse run carries the
+    forward state and forms the inverse plays from it each sample, in the block's order."""
+    u = _input(1500, seed=9)
+    run = pi.invert if inverse else pi.simulate
+    signal = pi.simulate(STRUCT, PARAMS, u)[0] if inverse else u
+    _, x0 = run(STRUCT, PARAMS, signal[:10])
+    want, want_end = run(STRUCT, PARAMS, signal[10:], x0)
+    block = pi.FAMILY.block(STRUCT, PARAMS, inverse)
+    x, xn, got = x0.copy(), np.empty(block.n_state), np.empty(signal.size - 10)
+    for k, v in enumerate(signal[10:]):
+        xn[:] = x
+        got[k] = block.step(block.body, x, xn, 0, v)
+        x, xn = xn, x
+    assert_array_equal(got, want)
+    assert_array_equal(x, want_end)
+
+
+def test_inverse_run_in_pieces_is_the_whole_run_bit_for_bit():
+    """The state between runs is the forward state the kernel carries (no conversion from
+    inverse plays), so splitting a run anywhere changes no bit. Drawn parameters 1 and 4
+    moved ~1e-16 - 2e-15 at the pieces' ends when the run kept inverse plays and converted."""
+    u = _input(1200, seed=10)
+    for seed in (1, 4):
+        params = pi.FAMILY.random_params(STRUCT, np.random.default_rng(seed))
+        y, _ = pi.simulate(STRUCT, params, u)
+        whole, x_whole = pi.invert(STRUCT, params, y)
+        head, x = pi.invert(STRUCT, params, y[:1])
+        pieces = [head]
+        for a, b in ((1, 7), (7, 500), (500, 1200)):
+            piece, x = pi.invert(STRUCT, params, y[a:b], x)
+            pieces.append(piece)
+        assert_array_equal(np.concatenate(pieces), whole)
+        assert_array_equal(x, x_whole)
 
 
 def test_inverse_block_is_refused_for_a_model_without_inverse():

@@ -69,31 +69,50 @@ def simulate(u, p0, z0, r, w_h, d_s, w_s, c, w_k, b):
     return y, p, z
 
 
+@njit(cache=True, inline="always")
+def _inverse_estimate(y, p, z, r_inv, w_inv, w, d_inv, sws_inv, c, sw_k, sb):
+    """The input estimate of one inverse sample from the present forward state ``p``, ``z``
+    (read only): ``sign * H~`` inverted by inverse plays whose states ``q_i = W_i p_i +
+    sum_{j>i} w_j p_j`` are formed from ``p`` (tail sums, no scratch), ``u = sum w'_i
+    play(v, q_i)`` with ``v`` the target of :func:`_inverse_target`."""
+    n = p.size
+    big_w = 0.0
+    for j in range(n):
+        big_w += w[j]
+    v = _inverse_target(y, z, d_inv, sws_inv, c, sw_k, sb)
+    u_hat = 0.0
+    tail = 0.0
+    for j in range(n - 1, -1, -1):  # W_j = W_n-1 - (w_j+1 + .. + w_n-1)
+        q = big_w * p[j] + tail
+        u_hat += w_inv[j] * max(v - r_inv[j], min(v + r_inv[j], q))
+        tail += w[j] * p[j]
+        big_w -= w[j]
+    return u_hat
+
+
 @njit(cache=True)
-def invert(y, q0, z0, r_inv, w_inv, d_inv, ws_inv, c, w_k, b):
+def invert(y, p0, z0, r, r_inv, w_inv, w, d_inv, sws_inv, c, sw_k, sb):
     """Inverse model (eq. 2.19 with creep): ``u = H~'[S'[y] - b - creep memory]``.
 
-    ``r_inv``/``w_inv`` are the inverse play thresholds/weights of the instantaneous operator
-    ``H + diag(c) K`` and ``q0`` its inverse play states; ``z0`` the creep states. Returns the
-    input estimate, the final states and the index of the first sample that left the finite
-    range (or -1).
+    Carries the forward state (plays ``p0``, creep ``z0``): each sample forms the inverse
+    plays of ``sign * H~`` (thresholds ``r_inv``, weights ``w_inv``, ``w = sign * w~``) from
+    the present plays (:func:`_inverse_estimate`), then moves the forward state by the
+    estimate, as :func:`block_inverse` does, so a loop of blocks (a stream) gives these bits.
+    ``sws_inv``, ``sw_k``, ``sb``: ``S^-1``'s weights, the creep weights and ``b`` times the
+    sign. Returns the input estimate, the final plays and creep states and the index of the
+    first sample that left the finite range (or -1; the states are those before it).
     """
-    q = q0.copy()
+    p = p0.copy()
     z = z0.copy()
     u = np.empty(y.size)
     bound = 1e6 * (1.0 + np.max(np.abs(y)))
     for n in range(y.size):
-        v = _inverse_target(y[n], z, d_inv, ws_inv, c, w_k, b)
-        x = 0.0
-        for i in range(r_inv.size):
-            q[i] = max(v - r_inv[i], min(v + r_inv[i], q[i]))
-            x += w_inv[i] * q[i]
+        x = _inverse_estimate(y[n], p, z, r_inv, w_inv, w, d_inv, sws_inv, c, sw_k, sb)
         if not abs(x) < bound:
-            return u, q, z, n
+            return u, p, z, n
         u[n] = x
-        for j in range(c.size):
-            z[j] += c[j] * (x - z[j])
-    return u, q, z, -1
+        _move(x, p, z, r, c)
+    return u, p, z, -1
 
 
 @njit(cache=True)
@@ -150,26 +169,13 @@ def block_forward(body, x, xn, off, u):
 
 @njit(cache=True)
 def block_inverse(body, x, xn, off, y):
-    """One sample of the inverse on the forward state (``model.invert_step``).
-
-    The inverse play states ``q_i = W_i p_i + sum_{j>i} w_j p_j`` of ``sign * H~`` are formed
-    from the present plays (tail sums, no scratch), the estimate is ``sum w'_i play(v, q_i)``
-    and then moves the forward state as :func:`block_forward` would.
-    """
+    """One sample of the inverse on the forward state (``model.invert_step``): the estimate
+    of :func:`_inverse_estimate` from the present state, which it then moves as
+    :func:`block_forward` would (the arithmetic of :func:`invert`)."""
     n, m, sb, r, _, c, sw_k, d_inv, sws_inv, i = _block_parts(body)
     r_inv, w_inv, w = body[i:i + n], body[i + n:i + 2 * n], body[i + 2 * n:i + 3 * n]
-    big_w = 0.0
-    for j in range(n):
-        big_w += w[j]
-    v = _inverse_target(y, x[off + n:off + n + m], d_inv, sws_inv, c, sw_k, sb)
-    u_hat = 0.0
-    tail = 0.0
-    for j in range(n - 1, -1, -1):  # W_j = W_n-1 - (w_j+1 + .. + w_n-1)
-        p_j = x[off + j]
-        q = big_w * p_j + tail
-        u_hat += w_inv[j] * max(v - r_inv[j], min(v + r_inv[j], q))
-        tail += w[j] * p_j
-        big_w -= w[j]
+    u_hat = _inverse_estimate(y, x[off:off + n], x[off + n:off + n + m], r_inv, w_inv, w,
+                              d_inv, sws_inv, c, sw_k, sb)
     p, z = _block_states(x, xn, off, n, m)
     _move(u_hat, p, z, r, c)
     return u_hat

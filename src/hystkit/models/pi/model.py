@@ -47,7 +47,6 @@ from .._run import Runs, family_runs
 from .._validation import check_finite_run
 from . import kernels
 from .operators import (
-    _play_states_from_inverse,
     deadzone,
     inverse_pi,
     inverse_play_states,
@@ -247,17 +246,19 @@ def _inverse(structure: PiStructure, params: PiParams, y: np.ndarray,
              x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     n = structure.n_play
     sign, w_inst, r_inv, w_inv, d_inv, ws_inv = inverse_parts(structure, params)
-    q0 = inverse_play_states(sign * w_inst, x[:n])
     # The kernel inverts sign * H~; feeding it sign * (everything on the right-hand side) is
-    # the same as negating b, the creep weights and S^-1.
-    u_hat, q, z, n_bad = kernels.invert(y, q0, x[n:].copy(), r_inv, w_inv, d_inv,
-                                        sign * ws_inv, structure.creep_gains,
-                                        sign * params.w_k, sign * params.b)
+    # the same as negating b, the creep weights and S^-1. It carries the forward state, as
+    # the family's block does, so a stream of blocks gives these bits.
+    u_hat, p, z, n_bad = kernels.invert(y, x[:n].copy(), x[n:].copy(),
+                                        np.asarray(structure.play_thresholds), r_inv, w_inv,
+                                        sign * w_inst, d_inv, sign * ws_inv,
+                                        structure.creep_gains, sign * params.w_k,
+                                        sign * params.b)
     if n_bad >= 0:
         raise FitDivergedError(
             f"the inverse model diverged at sample {n_bad} of {y.size} (|u_hat| > 1e6 times the "
             f"output range); its creep weights make the compensator unstable on this data")
-    x_end = np.concatenate([_play_states_from_inverse(sign * w_inst, q), z])
+    x_end = np.concatenate([p, z])
     return check_finite_run(u_hat, "PI", "inverse"), check_finite_run(x_end, "PI", "state")
 
 
