@@ -122,10 +122,3 @@ def inverse_play_states(w: np.ndarray, p: np.ndarray) -> np.ndarray:
     w, p = np.asarray(w, dtype=float), np.asarray(p, dtype=float)
     tail = np.concatenate([np.cumsum((w * p)[::-1])[::-1][1:], [0.0]])
     return np.cumsum(w) * p + tail
-
-
-def _play_states_from_inverse(w: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Inverse of :func:`inverse_play_states`: ``q_i - q_{i+1} = W_i (p_i - p_{i+1})``."""
-    big_w = np.cumsum(w)
-    steps = np.append(-np.diff(q) / big_w[:-1], q[-1] / big_w[-1])
-    return np.cumsum(steps[::-1])[::-1]
