@@ -1,8 +1,10 @@
-"""``hystkit stream`` of a fitted Bobbio and generalised Preisach direct compensator and a PI
-inverse runs compiled and writes ``compensate``'s numbers bit for bit (issue 29, item 4): their
-offline runs compute in their blocks' order (compiled forward passes for Bobbio and the
-generalised Preisach; the PI inverse carries the forward plays and forms its inverse plays from
-them each sample, ``models/pi/kernels.invert``), so the stream's probe accepts the block."""
+"""``hystkit stream`` of the compensators that once took the Python path (the ladder both
+ways, Bobbio and generalised Preisach direct, the PI inverse) runs compiled and writes
+``compensate``'s numbers bit for bit (issue 29, item 4): their offline runs compute in their
+blocks' order (the ladder's read-out summed in its block's order, ``models/ladder/kernels``;
+compiled forward passes for Bobbio and the generalised Preisach; the PI inverse carries the
+forward plays and forms its inverse plays from them each sample, ``models/pi/kernels.invert``),
+so the stream's probe accepts the block."""
 
 from __future__ import annotations
 
@@ -19,10 +21,11 @@ from hystkit.compensation import load_compensator
 from hystkit.live import Stream
 
 from ..cli_support import run_cli
-from .test_stream_command_ladder import ROWS, _exact
 
+ROWS = 600
 # (model, mode, size): small models, fitted in a few seconds on 600 samples
-FITTED = [("bobbio", "direct", 4), ("gpreisach", "direct", 6), ("pi", "inverse", 4)]
+FITTED = [("ladder", "direct", 3), ("ladder", "inverse", 3), ("bobbio", "direct", 4),
+          ("gpreisach", "direct", 6), ("pi", "inverse", 4)]
 
 
 @pytest.fixture(scope="module", params=FITTED, ids=lambda c: f"{c[0]}-{c[1]}")
@@ -60,3 +63,10 @@ def test_the_family_streams_compiled_with_the_bits_of_compensate(fitted, capsys)
     for name in compared:
         assert np.all(np.isfinite(written[name]))
         assert_array_equal(streamed[name].to_numpy(), written[name].to_numpy(), err_msg=name)
+
+
+def _exact(source) -> pd.DataFrame:
+    """A CSV's columns, the numbers parsed by Python's ``float`` (correctly rounded: the bits
+    that were written with ``repr``)."""
+    frame = pd.read_csv(source, dtype=str)
+    return frame.apply(lambda column: column.map(float))
