@@ -50,6 +50,9 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 FAMILIES = (("mpl", 1), ("mpl", 3), ("mpl-poly", 3), ("pi", 10), ("preisach", 20),
             ("ladder", 3))
+# table 3 only (bench_export.py shares FAMILIES): the compensators that ran the Python path
+# before issue 29.4 was finished, by (family, size, mode); an inverse row is NAME_SIZE_inverse
+MORE_ROWS = (("bobbio", 10, "direct"), ("gpreisach", 10, "direct"), ("pi", 10, "inverse"))
 CHUNK = 64
 SMALL = 10
 
@@ -85,11 +88,16 @@ def python_latency(comp, sensor, *, repeats: int = 5, chunk: int = CHUNK) -> dic
             chunks.append((clock() - t0) / chunk)
         runs["process_chunk_us"].append(float(np.median(chunks)) * 1e6)
         u = comp.normalised_sensor(sensor).tolist()
-        x = comp.family.rest_state(comp.structure, comp.params, u[0])
+        # an inverse compensator runs its model's inverse step (from the state its inverse
+        # reaches after the first sample: a timing loop, any reachable state does)
+        inverse = getattr(comp, "mode", "direct") == "inverse"
+        step = comp.family.invert_step if inverse else comp.family.step
+        x = (comp.family.rest_state(comp.structure, comp.params, u[0]) if not inverse else
+             comp.family.invert(comp.structure, comp.params, np.asarray(u[:1]))[1])
         loop = np.empty(len(u))
         for k, v in enumerate(u):
             t0 = clock()
-            _, x = comp.family.step(comp.structure, comp.params, x, v)
+            _, x = step(comp.structure, comp.params, x, v)
             loop[k] = clock() - t0
         runs["python_loop_us"].append(float(np.median(loop)) * 1e6)
     return {key: statistics.median(values) for key, values in runs.items()}
@@ -133,11 +141,12 @@ def _make_models(folder: Path, names: list[str] | None = None, command: bool = T
     train = simulate_experiment("sine", 1)
     models = folder / "models"
     models.mkdir()
-    for name, size in FAMILIES:
-        if names and f"{name}_{size}" not in names:
+    for name, size, mode in [(*row, "direct") for row in FAMILIES] + list(MORE_ROWS):
+        label = f"{name}_{size}" + ("_inverse" if mode == "inverse" else "")
+        if names and label not in names:
             continue
-        comp = fit_compensator(train, size, model=name, diagnose=False)
-        save_compensator(comp, models / f"{name}_{size}.json")
+        comp = fit_compensator(train, size, model=name, mode=mode, diagnose=False)
+        save_compensator(comp, models / f"{label}.json")
     if not command:
         return
     write_recording(train, folder / "train.csv")
@@ -398,8 +407,8 @@ def _table3_only(args, variants, models: Path) -> list[str]:
 
 
 def _latency_table(names: list[str], runs) -> list[str]:
-    lines = ["", ("Table 3. in-process, µs per sample (2000 samples of the decay run; direct "
-                  "compensators fitted on the sine run): Stream.step p50 / p99, "
+    lines = ["", ("Table 3. in-process, µs per sample (2000 samples of the decay run; "
+                  "compensators fitted on the sine run, direct unless _inverse): Stream.step p50 / p99, "
                   "Stream.process on chunks of 64, a plain-Python loop over the family's step"),
               (f"  {'model':<22} {'variant':<7} {'compiled':>8} {'step p50':>9} "
               f"{'step p99':>9} {'process/64':>11} {'python loop':>12} {'step / loop':>12}")]
