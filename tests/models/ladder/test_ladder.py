@@ -183,25 +183,6 @@ def test_block_equals_step_from_a_non_rest_state(inverse, drive):
     assert np.ptp(x_ref[:, 2]) > 0.2  # the last section conducts now and then
 
 
-@pytest.mark.parametrize("inverse", [False, True])
-def test_block_looped_gives_the_compiled_run_bit_for_bit(inverse):
-    """What lets a stream run the ladder compiled (issue 29.4): the block, sample by sample,
-    sums the read-out in the compiled run's order (``w_0 u - V_b``, then ``+ w_k U_k``)."""
-    u = _input(1500)
-    run = ladder.invert if inverse else ladder.simulate
-    signal = ladder.simulate(STRUCT3, PARAMS3, u)[0] if inverse else u
-    _, x0 = run(STRUCT3, PARAMS3, signal[:10])
-    want, want_end = run(STRUCT3, PARAMS3, signal[10:], x0)
-    blk = FAMILY.block(STRUCT3, PARAMS3, inverse)
-    x, xn, got = x0.copy(), np.empty(3), np.empty(signal.size - 10)
-    for k, v in enumerate(signal[10:]):
-        xn[:] = x
-        got[k] = blk.step(blk.body, x, xn, 0, v)
-        x, xn = xn, x
-    assert_array_equal(got, want)
-    assert_array_equal(x, want_end)
-
-
 def test_forward_output_is_linear_in_the_states_to_rounding():
     """The fit solves for ``w`` and ``V_b`` with ``w_0 u + states @ w - V_b``; the run sums the
     same terms in another order."""

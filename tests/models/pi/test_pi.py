@@ -323,25 +323,6 @@ def test_block_equals_step_from_a_non_rest_state(inverse):
         big[off:off + block.n_state] = xn[off:off + block.n_state]
 
 
-@pytest.mark.parametrize("inverse", [False, True])
-def test_block_looped_gives_the_compiled_run_bit_for_bit(inverse):
-    """What lets a stream run the PI compiled (issue 29.4): the inverse run carries the
-    forward state and forms the inverse plays from it each sample, in the block's order."""
-    u = _input(1500, seed=9)
-    run = pi.invert if inverse else pi.simulate
-    signal = pi.simulate(STRUCT, PARAMS, u)[0] if inverse else u
-    _, x0 = run(STRUCT, PARAMS, signal[:10])
-    want, want_end = run(STRUCT, PARAMS, signal[10:], x0)
-    block = pi.FAMILY.block(STRUCT, PARAMS, inverse)
-    x, xn, got = x0.copy(), np.empty(block.n_state), np.empty(signal.size - 10)
-    for k, v in enumerate(signal[10:]):
-        xn[:] = x
-        got[k] = block.step(block.body, x, xn, 0, v)
-        x, xn = xn, x
-    assert_array_equal(got, want)
-    assert_array_equal(x, want_end)
-
-
 def test_inverse_run_in_pieces_is_the_whole_run_bit_for_bit():
     """The state between runs is the forward state the kernel carries (no conversion from
     inverse plays), so splitting a run anywhere changes no bit. Drawn parameters 1 and 4
