@@ -51,6 +51,9 @@ class _Entry:
 
 
 _found: dict[str, _Entry] | None = None
+# Families looked up by name before discovery (``_own_folder``), kept so that the next lookup
+# (``Compensator.family``, asked per call) is a dict read, not a module search (~40 us).
+_own: dict[str, _Entry | None] = {}
 
 
 def _check(family: object, origin: str) -> Family:
@@ -96,8 +99,16 @@ def _own_folder(name: str) -> _Entry | None:
     """The family `name` from its own folder (``mpl-g``: ``mpl_g``) before any discovery, or
     None. Discovery gives a folder's family precedence over plugins, so this is the family it
     would find."""
+    if _found is not None:
+        return None
+    if name not in _own:
+        _own[name] = _search_own_folder(name)
+    return _own[name]
+
+
+def _search_own_folder(name: str) -> _Entry | None:
     folder = name.replace("-", "_")
-    if _found is not None or not folder.isidentifier() or folder.startswith("_"):
+    if not folder.isidentifier() or folder.startswith("_"):
         return None
     spec = importlib.util.find_spec(f"{_PACKAGE}.{folder}")
     if spec is None or spec.submodule_search_locations is None:  # not a sub-package
