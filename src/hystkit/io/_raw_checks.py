@@ -11,6 +11,7 @@ from collections.abc import Callable
 import numpy as np
 from numba import njit
 
+from hystkit._kernel_inputs import read_only
 from hystkit.errors import InputError
 
 from ._raw_format import MAX_VOLTAGE
@@ -25,6 +26,7 @@ Fail = Callable[..., InputError]
 def check_values(values: np.ndarray, column: str, start: int, fail: Fail, *,
                  n_samples: int | None, from_csv: bool) -> None:
     """Refuse a missing, infinite or (outside ``time``) out-of-range value of one chunk."""
+    values = read_only(values)
     i = _first_nonfinite(values)
     if i < 0 and column != "time":
         j = _first_beyond(values, MAX_VOLTAGE)
@@ -45,7 +47,7 @@ def check_values(values: np.ndarray, column: str, start: int, fail: Fail, *,
 def check_time_steps(t: np.ndarray, t_prev: float | None, start: int, fs: float,
                      fail: Fail) -> float:
     """Refuse a time step off 1/fs (across chunk borders via `t_prev`); the chunk's last time."""
-    i = _first_bad_step(t, np.nan if t_prev is None else t_prev, fs, MAX_STEP_DEVIATION)
+    i = _first_bad_step(read_only(t), np.nan if t_prev is None else t_prev, fs, MAX_STEP_DEVIATION)
     if i >= 0:
         previous = float(t[i - 1] if i else t_prev)
         step = float(t[i]) - previous  # Python floats: a huge step is inf, not a warning

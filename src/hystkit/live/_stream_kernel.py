@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._closure_cache import compile_closure
+from .._kernel_inputs import read_only
 from ..compensation import (
     MAX_NORMALISED,
     BandState,
@@ -170,6 +171,7 @@ class Engine:
         self.mem = np.zeros(N_MEM)
         self.consts = _constants(path)
         self._one = np.zeros(1)
+        self._one_read = read_only(self._one)  # what the kernel reads: `run`'s type
         self._one_out = np.zeros((5, 1))
 
     def load(self, state) -> None:
@@ -193,14 +195,14 @@ class Engine:
         ``out`` (estimate, lower, upper, sensor and estimate outside as 0/1) and how many were
         taken; the state advances over those."""
         out = np.zeros((5, sensor.size))
-        taken = self.run_kernel(sensor, self.consts, self.body, self.x, self.xn, self.mem, out)
+        taken = self.run_kernel(read_only(sensor), self.consts, self.body, self.x, self.xn, self.mem, out)
         return out, taken
 
     def step(self, value: float) -> list[float] | None:
         """One sample: its column of ``out`` as a list, None if refused (state unchanged)."""
         self._one[0] = value
         out = self._one_out
-        if not self.run_kernel(self._one, self.consts, self.body, self.x, self.xn, self.mem,
+        if not self.run_kernel(self._one_read, self.consts, self.body, self.x, self.xn, self.mem,
                                out):
             return None
         return out[:, 0].tolist()

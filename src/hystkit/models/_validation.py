@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from hystkit._kernel_inputs import read_only
 from hystkit.errors import FitDivergedError
 
 __all__ = [
@@ -108,7 +109,8 @@ def frozen_shaped(values, shape: tuple[int, ...] | None, name: str) -> np.ndarra
 
 
 def check_signal(u, name: str) -> np.ndarray:
-    """``u`` as a contiguous, non-empty, finite 1-D float array.
+    """``u`` as a contiguous, non-empty, finite 1-D float array, read-only (the kernels that
+    read it then see one array type, :func:`hystkit._kernel_inputs.read_only`).
 
     Raises
     ------
@@ -121,7 +123,7 @@ def check_signal(u, name: str) -> np.ndarray:
         raise ValueError(f"{name} must be a non-empty 1-D array, got shape {u.shape}")
     if not np.all(np.isfinite(u)):
         raise ValueError(f"{name} contains NaN or inf at index {int(np.argmin(np.isfinite(u)))}")
-    return u
+    return read_only(u)
 
 
 def broadcast_state(x0, n: int, layout: str | None = None) -> np.ndarray:

@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .._kernel_inputs import read_only
+
 __all__ = ["bridge_kernel", "bridge_resistance", "bridge_voltage", "clipped_channels",
            "first_invalid_bridge_sample", "gauge_symmetry", "relative_change"]
 
@@ -217,7 +219,8 @@ def bridge_kernel(v1: np.ndarray, v2: np.ndarray, r_bridge: float, v_supply: flo
         Updated statistics.
     """
     if v0 is None:
-        return _bridge_both(v1, v2, np.array([float(v_supply)]), 0, float(r_bridge), ext)
+        return _bridge_both(read_only(v1), read_only(v2), read_only(np.array([float(v_supply)])),
+                            0, float(r_bridge), ext)
     if np.shape(v0) != np.shape(v1):
         raise ValueError(f"v0 has shape {np.shape(v0)}, the bridge voltages {np.shape(v1)}")
-    return _bridge_both(v1, v2, v0, 1, float(r_bridge), ext)
+    return _bridge_both(read_only(v1), read_only(v2), read_only(v0), 1, float(r_bridge), ext)

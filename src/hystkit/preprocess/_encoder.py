@@ -31,6 +31,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numba import njit
 
+from .._kernel_inputs import read_only
 from ._quadrature import DEFAULT_STATES, PHASE, parse_states
 
 __all__ = ["EncoderSettings", "EncoderState", "decode", "decode_flush", "decode_reference",
@@ -182,7 +183,7 @@ def decode_step(settings: EncoderSettings, state: EncoderState,
     ints = np.array([getattr(state, f) for f in _INT_FIELDS], dtype=np.int64)
     floats = np.concatenate([state.levels, state.sums, state.n_firm])
     counts, ints, floats = _decode_kernel(
-        np.ascontiguousarray(x, dtype=np.float64), np.asarray(settings.states, dtype=np.int64),
+        read_only(np.ascontiguousarray(x, dtype=np.float64)), np.asarray(settings.states, dtype=np.int64),
         PHASE, ints, floats, settings.dwell, settings.track_block, settings.track_gain,
         settings.illegal == "continue")
     new = replace(state, levels=floats[0:4].copy(), sums=floats[4:8].copy(),

@@ -25,6 +25,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from ..._kernel_inputs import read_only
 from ...identification import FitResult, NormalEquations, check_fit_data, fit_multistart
 from ...identification._constrained import constrain_fit
 from . import kernels
@@ -250,7 +251,9 @@ def fit_mpl(u: np.ndarray, y: np.ndarray, structure: mpl.MplStructure, *,
         cells = theta[: 2 * n].reshape(n, 2)
         v_t = np.exp(cells[:, 1])
         resistors = SimpleNamespace(i_s=0.5 * np.exp(cells[:, 0]) * v_t, v_t=v_t)
-        return (resistors.i_s, v_t, np.ascontiguousarray(theta[2 * n: 3 * n + 1]),
+        # read-only, as MplParams' arrays: one specialisation of the kernels for fit and model
+        return (read_only(resistors.i_s), read_only(v_t),
+                read_only(np.ascontiguousarray(theta[2 * n: 3 * n + 1])),
                 float(theta[3 * n + 1]), mpl.knee_voltage(structure, resistors), cap,
                 structure.dt)
 

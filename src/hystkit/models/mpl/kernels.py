@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..._kernel_inputs import read_only
 from .cell_kernels import (
     cell_constants,
     cell_increment,
@@ -308,8 +309,8 @@ def theta_normal_equations(u, y_target, x0, theta, slope_cap, dt):
     resistors, knee = theta_cells(theta, slope_cap, dt)
     n_cells = knee.size
     w = theta[2 * n_cells: 3 * n_cells + 1]
-    resistors.flags.writeable = w.flags.writeable = False  # views: theta stays writeable
-    return normal_equations(u, y_target, x0, resistors[0], resistors[1], w,
+    return normal_equations(u, y_target, x0, read_only(resistors[0]), read_only(resistors[1]),
+                            read_only(w),
                             theta[3 * n_cells + 1], knee, slope_cap / dt, dt)
 
 
