@@ -215,8 +215,14 @@ def test_compensator_on_the_virtual_sensor():
 # --- the family protocol: loop blocks, rest states, at(dt), records, linearisation ---------
 
 FAMILY = get_family("bobbio")
-# a state the chain reaches (eq. 2.5 holds with F_1 = 0.1), piston 1 off its threshold
-X_MEMORY = bobbio.simulate(STRUCT, PARAMS, _ramps(0.0, 1.5, -0.6, 0.2, 0.1))[1]
+
+
+def _x_memory() -> np.ndarray:
+    """A state the chain reaches (eq. 2.5 holds with F_1 = 0.1), piston 1 off its threshold
+    (run when a test asks: at import, every xdist worker compiled the kernel while collecting)."""
+    return bobbio.simulate(STRUCT, PARAMS, _ramps(0.0, 1.5, -0.6, 0.2, 0.1))[1]
+
+
 # eq. 2.5 strictly inside for F_1 = 0.1: no piston on its threshold, the step is smooth here
 X_INSIDE = np.array([0.12, 0.05, -0.1, 0.0])
 
@@ -224,7 +230,7 @@ X_INSIDE = np.array([0.12, 0.05, -0.1, 0.0])
 @pytest.mark.parametrize("inverse", [False, True])
 def test_block_equals_step_from_a_non_rest_state(inverse, drive):
     rng = np.random.default_rng(4)
-    x0 = X_MEMORY
+    x0 = _x_memory()
     signal = np.cumsum(0.15 * rng.standard_normal(400))
     if inverse:
         signal = bobbio.simulate(STRUCT, PARAMS, signal, x0=x0)[0] + 0.01 * rng.standard_normal(400)
