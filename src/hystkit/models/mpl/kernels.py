@@ -46,17 +46,24 @@ def input_for(w, v_b, x, z):
 
 
 # the cell's arithmetic lives in cell_kernels.py; its names stay importable from here
-__all__ = ["NORMAL_BLOCK", "block_forward", "block_inverse", "cell_constants",
-           "cell_increment", "cell_sensitivity_step", "constants", "current", "fold_block",
-           "input_for", "invert", "knee_constants", "mirror_upper", "normal_equations", "readout",
-           "simulate",
+__all__ = ["NORMAL_BLOCK", "advance_cells", "advance_with_sensitivities",
+           "block_forward", "block_inverse", "cell_constants", "cell_increment",
+           "cell_sensitivity_step", "constants", "current", "fold_block", "input_for", "invert",
+           "knee_constants", "mirror_upper", "normal_equations", "readout", "simulate",
            "simulate_with_jacobian", "sinh_cosh", "sinh_series", "straight_offset",
            "theta_cells", "theta_normal_equations"]
 
 
+@njit(cache=True, inline="always")
+def advance_cells(x, drive, inv_vt, two_i_s_dt, knee, c0, cap_dt):
+    """One Euler step of every cell driven by ``drive`` (eq. 5.6), in place: the update of the
+    runs of mpl and mpl-g, forward and inverse."""
+    for k in range(x.size):
+        x[k] += cell_increment(drive - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
+
+
 @njit(cache=True)
 def simulate(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
-    n_cells = x0.size
     x = x0.copy()
     y = np.empty(u.size)
     inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
@@ -64,8 +71,7 @@ def simulate(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
     for n in range(u.size):
         u_n = u[n]
         y[n] = readout(w, v_b, x, u_n)
-        for k in range(n_cells):
-            x[k] += cell_increment(u_n - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
+        advance_cells(x, u_n, inv_vt, two_i_s_dt, knee, c0, cap_dt)
     return y, x
 
 
@@ -75,7 +81,6 @@ def invert(y, x0, i_s, v_t, w, v_b, knee, cap, dt):
 
     Returns the index of the first sample that left the finite range, or -1.
     """
-    n_cells = x0.size
     x = x0.copy()
     u_hat = np.empty(y.size)
     bound = 1e6 * (1.0 + np.max(np.abs(y)))
@@ -86,8 +91,7 @@ def invert(y, x0, i_s, v_t, w, v_b, knee, cap, dt):
         if not abs(e) < bound:
             return u_hat, x, n
         u_hat[n] = e
-        for k in range(n_cells):
-            x[k] += cell_increment(e - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
+        advance_cells(x, e, inv_vt, two_i_s_dt, knee, c0, cap_dt)
     return u_hat, x, -1
 
 
@@ -126,17 +130,32 @@ def knee_constants(i_s, v_t, knee, cap):
     return two_i_s, g, f_knee, dvt_knee
 
 
+@njit(cache=True, inline="always")
+def advance_with_sensitivities(x, sens_g, sens_vt, drive, inv_vt, two_i_s_dt, two_i_s, g, knee,
+                               c0, f_knee, dvt_knee, cap, cap_dt, dt):
+    """:func:`advance_cells` (bit for bit: :func:`cell_sensitivity_step`) with each cell's
+    sensitivities to ``log G_k`` and ``log V_Tk`` carried along, in place: the passes of the
+    mpl and mpl-g fits."""
+    for k in range(x.size):
+        step, d_log_g, d_log_vt, slope = cell_sensitivity_step(
+            drive - x[k], inv_vt[k], two_i_s_dt[k], two_i_s[k], g[k], knee[k], c0[k],
+            f_knee[k], dvt_knee[k], cap, cap_dt)
+        sens_g[k] += (d_log_g - slope * sens_g[k]) * dt
+        sens_vt[k] += (d_log_vt - slope * sens_vt[k]) * dt
+        x[k] += step
+
+
 @njit(cache=True)
 def simulate_with_jacobian(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
     """Forward model output (:func:`simulate`'s, bit for bit) and its exact Jacobian by forward
-    sensitivities (:func:`cell_sensitivity_step`).
+    sensitivities (:func:`advance_with_sensitivities`).
 
     Columns follow ``MplParams.to_vector``: per cell ``log G_k`` and ``log V_Tk``
     (``G = 2 I_S / V_T``), then ``w_0 .. w_N`` and ``V_b``.
     """
     n_cells = x0.size
     x = x0.copy()
-    sens = np.zeros((n_cells, 2))
+    sens_g, sens_vt = np.zeros(n_cells), np.zeros(n_cells)
     y = np.empty(u.size)
     jac = np.empty((u.size, 3 * n_cells + 2))
     inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
@@ -146,19 +165,14 @@ def simulate_with_jacobian(u, x0, i_s, v_t, w, v_b, knee, cap, dt):
         acc = w[0] * u[n] - v_b
         for k in range(n_cells):
             acc += w[k + 1] * x[k]
-            jac[n, 2 * k] = w[k + 1] * sens[k, 0]
-            jac[n, 2 * k + 1] = w[k + 1] * sens[k, 1]
+            jac[n, 2 * k] = w[k + 1] * sens_g[k]
+            jac[n, 2 * k + 1] = w[k + 1] * sens_vt[k]
             jac[n, 2 * n_cells + 1 + k] = x[k]
         y[n] = acc
         jac[n, 2 * n_cells] = u[n]
         jac[n, 3 * n_cells + 1] = -1.0
-        for k in range(n_cells):
-            step, d_log_g, d_log_vt, slope = cell_sensitivity_step(
-                u[n] - x[k], inv_vt[k], two_i_s_dt[k], two_i_s[k], g[k], knee[k], c0[k],
-                f_knee[k], dvt_knee[k], cap, cap_dt)
-            sens[k, 0] += (d_log_g - slope * sens[k, 0]) * dt
-            sens[k, 1] += (d_log_vt - slope * sens[k, 1]) * dt
-            x[k] += step
+        advance_with_sensitivities(x, sens_g, sens_vt, u[n], inv_vt, two_i_s_dt, two_i_s, g, knee,
+                                   c0, f_knee, dvt_knee, cap, cap_dt, dt)
     return y, jac
 
 
@@ -237,7 +251,7 @@ def normal_equations(u, y_target, x0, i_s, v_t, w, v_b, knee, cap, dt):
     The same forward sensitivities and column order as :func:`simulate_with_jacobian`, but
     the Jacobian rows are folded into the (p x p) and (p,) sums block by block as they are
     formed, so memory is independent of ``u.size``. The state and the outputs are
-    :func:`simulate`'s, bit for bit (:func:`cell_sensitivity_step`), so ``sum(r^2)`` is the
+    :func:`simulate`'s, bit for bit (:func:`advance_with_sensitivities`), so ``sum(r^2)`` is the
     sequential sum of the squared residuals of :func:`simulate`.
     """
     n_cells = x0.size
@@ -269,13 +283,8 @@ def normal_equations(u, y_target, x0, i_s, v_t, w, v_b, knee, cap, dt):
         if m == NORMAL_BLOCK or n == u.size - 1:
             fold_block(cols, res, m, jtj, jtr)
             m = 0
-        for k in range(n_cells):
-            step, d_log_g, d_log_vt, slope = cell_sensitivity_step(
-                u[n] - x[k], inv_vt[k], two_i_s_dt[k], two_i_s[k], g[k], knee[k], c0[k],
-                f_knee[k], dvt_knee[k], cap, cap_dt)
-            sens_g[k] += (d_log_g - slope * sens_g[k]) * dt
-            sens_vt[k] += (d_log_vt - slope * sens_vt[k]) * dt
-            x[k] += step
+        advance_with_sensitivities(x, sens_g, sens_vt, u[n], inv_vt, two_i_s_dt, two_i_s, g, knee,
+                                   c0, f_knee, dvt_knee, cap, cap_dt, dt)
     return sse, mirror_upper(jtj), jtr
 
 

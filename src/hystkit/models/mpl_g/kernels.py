@@ -12,15 +12,15 @@ import numpy as np
 from numba import njit
 
 from ..mpl.kernels import (
+    advance_cells,
+    advance_with_sensitivities,
     block_cells,
-    cell_increment,
-    cell_sensitivity_step,
     constants,
     input_for,
     knee_constants,
     readout,
 )
-from ..mpl_poly.kernels import branch_input, solve_output
+from ..mpl_poly.kernels import branch_input, output_columns, solve_output
 
 
 @njit(cache=True, inline="always")
@@ -33,15 +33,13 @@ def _output(gc, z):
 @njit(cache=True)
 def simulate(u, x0, gc, w, v_b, i_s, v_t, knee, cap, dt):
     """Forward model; returns ``(y, x_end)``."""
-    n_cells = x0.size
     x = x0.copy()
     y = np.empty(u.size)
     inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
     cap_dt = cap * dt
     for n in range(u.size):
         y[n], _ = _output(gc, readout(w, v_b, x, u[n]))
-        for k in range(n_cells):
-            x[k] += cell_increment(u[n] - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
+        advance_cells(x, u[n], inv_vt, two_i_s_dt, knee, c0, cap_dt)
     return y, x
 
 
@@ -51,11 +49,11 @@ def simulate_with_jacobian(u, x0, gc, w, v_b, i_s, v_t, knee, cap, dt):
 
     Columns follow ``MplGParams.to_vector``: per cell ``log G_k``, ``log V_Tk``, then
     ``g_0..g_3``, ``w_0..w_N``, ``V_b``. The cells' sensitivities are the mPL's (see
-    ``mpl.kernels.simulate_with_jacobian``); the output multiplies them by ``g'(z)``.
+    ``mpl.kernels.advance_with_sensitivities``); the output multiplies them by ``g'(z)``.
     """
     n_cells = x0.size
     x = x0.copy()
-    sens = np.zeros((n_cells, 2))
+    sens_g, sens_vt = np.zeros(n_cells), np.zeros(n_cells)
     y = np.empty(u.size)
     jac = np.empty((u.size, 3 * n_cells + 6))
     col_g, col_w, col_vb = 2 * n_cells, 2 * n_cells + 4, 3 * n_cells + 5
@@ -65,23 +63,14 @@ def simulate_with_jacobian(u, x0, gc, w, v_b, i_s, v_t, knee, cap, dt):
     for n in range(u.size):
         z = readout(w, v_b, x, u[n])
         y[n], dg = _output(gc, z)
-        zj = 1.0
-        for j in range(4):
-            jac[n, col_g + j] = zj
-            zj *= z
-        jac[n, col_w] = dg * u[n]
-        jac[n, col_vb] = -dg
+        output_columns(jac, n, col_g, col_w, col_vb, z, dg, u[n])
         for k in range(n_cells):
-            jac[n, 2 * k] = dg * w[k + 1] * sens[k, 0]
-            jac[n, 2 * k + 1] = dg * w[k + 1] * sens[k, 1]
+            jac[n, 2 * k] = dg * w[k + 1] * sens_g[k]
+            jac[n, 2 * k + 1] = dg * w[k + 1] * sens_vt[k]
             jac[n, col_w + 1 + k] = dg * x[k]
-        for k in range(n_cells):  # the state as simulate's, bit for bit
-            step, d_log_g, d_log_vt, slope = cell_sensitivity_step(
-                u[n] - x[k], inv_vt[k], two_i_s_dt[k], two_i_s[k], g[k], knee[k], c0[k],
-                f_knee[k], dvt_knee[k], cap, cap_dt)
-            sens[k, 0] += (d_log_g - slope * sens[k, 0]) * dt
-            sens[k, 1] += (d_log_vt - slope * sens[k, 1]) * dt
-            x[k] += step
+        # the state as simulate's, bit for bit
+        advance_with_sensitivities(x, sens_g, sens_vt, u[n], inv_vt, two_i_s_dt, two_i_s, g, knee,
+                                   c0, f_knee, dvt_knee, cap, cap_dt, dt)
     return y, jac
 
 
@@ -91,7 +80,6 @@ def invert(y, x0, gc, lo, hi, sign, centre, w, v_b, i_s, v_t, knee, cap, dt, bou
     present state, then the state update (fig. 5.12). Returns ``(e_hat, x_end, n_bad, why)``:
     ``why`` 1 when ``y`` is outside the branch's range, 2 when ``|e| >= bound``; ``n_bad = -1``
     when all went well."""
-    n_cells = x0.size
     x = x0.copy()
     e_hat = np.empty(y.size)
     inv_vt, two_i_s_dt, c0 = constants(i_s, v_t, knee, cap, dt)
@@ -101,8 +89,7 @@ def invert(y, x0, gc, lo, hi, sign, centre, w, v_b, i_s, v_t, knee, cap, dt, bou
         if why:
             return e_hat, x, n, why
         e_hat[n] = e
-        for k in range(n_cells):
-            x[k] += cell_increment(e - x[k], inv_vt[k], two_i_s_dt[k], knee[k], c0[k], cap_dt)
+        advance_cells(x, e, inv_vt, two_i_s_dt, knee, c0, cap_dt)
     return e_hat, x, -1, 0
 
 

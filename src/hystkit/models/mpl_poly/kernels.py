@@ -75,6 +75,19 @@ def simulate(u, x0, fc, knees, s, limit, gc, w, v_b, dt, bound):
 
 
 @njit(cache=True, inline="always")
+def output_columns(jac, n, col_g, col_w, col_vb, z, dg, u_n):
+    """Row ``n`` of the Jacobian of ``y = g(z)``, ``z = w_0 u + sum w_k x_k - V_b``: the
+    output resistor's coefficients ``g_0..g_3`` (``1, z, z^2, z^3``), ``w_0`` and ``V_b``;
+    the cells' and ``w_1..w_N``'s columns are the caller's (mpl-poly and mpl-g)."""
+    zj = 1.0
+    for j in range(4):
+        jac[n, col_g + j] = zj
+        zj *= z
+    jac[n, col_w] = dg * u_n
+    jac[n, col_vb] = -dg
+
+
+@njit(cache=True, inline="always")
 def _advance_with_sensitivities(u_n, x, sens, fc, knees, s, limit, dt, bound):
     """The cells' Euler update driven by ``u_n`` with their parameter sensitivities (rows of
     ``sens``, the order of :func:`cell_gradient`); False as soon as a cell leaves
@@ -109,12 +122,7 @@ def simulate_with_jacobian(u, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt, bo
     for n in range(u.size):
         z = readout(w, v_b, x, u[n])
         y[n], dg = _cubic(gc[0], gc[1], gc[2], gc[3], z)
-        zj = 1.0
-        for j in range(4):
-            jac[n, col_g + j] = zj
-            zj *= z
-        jac[n, col_w] = dg * u[n]
-        jac[n, col_vb] = -dg
+        output_columns(jac, n, col_g, col_w, col_vb, z, dg, u[n])
         for k in range(n_cells):
             jac[n, col_w + 1 + k] = dg * x[k]
             for j in range(4):
@@ -144,15 +152,11 @@ def normal_equations(u, y_target, x0, sens0, fc, knees, s, limit, gc, w, v_b, dt
     sse = 0.0
     m = 0
     col_g, col_w, col_vb = 4 * n_cells, 4 * n_cells + 4, 5 * n_cells + 5
+    rows = cols.T  # the block's Jacobian rows, as output_columns writes them
     for n in range(u.size):
         z = readout(w, v_b, x, u[n])
         y, dg = _cubic(gc[0], gc[1], gc[2], gc[3], z)
-        zj = 1.0
-        for j in range(4):
-            cols[col_g + j, m] = zj
-            zj *= z
-        cols[col_w, m] = dg * u[n]
-        cols[col_vb, m] = -dg
+        output_columns(rows, m, col_g, col_w, col_vb, z, dg, u[n])
         for k in range(n_cells):
             cols[col_w + 1 + k, m] = dg * x[k]
             for j in range(4):
