@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 
 from .._capabilities import ALL_LOSSES, Capabilities
+from .._euler_cap import at_same_limit
 from .._protocol import Block, Family
 from . import INFO, box, kernels
 from . import model as chua
@@ -43,9 +42,7 @@ class ChuaFamily(Family):
         ``max(slope_cap, 1)``: at a coarser step that needs more, the Euler step stays monotone
         (stable, no overshoot) and the absolute limit falls instead, so the fastest part of
         ``g`` becomes slower than fitted."""
-        dt = float(dt)
-        cap = min(structure.slope_cap * dt / structure.dt, max(structure.slope_cap, 1.0))
-        return dataclasses.replace(structure, dt=dt, slope_cap=cap)
+        return at_same_limit(structure, dt)
 
     def block(self, structure, params, inverse=False):
         *per_element, dt = chua.kernel_args(structure, params)

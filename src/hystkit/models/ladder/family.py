@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 
 from ...errors import FitDivergedError
 from .._capabilities import ALL_LOSSES, Capabilities
+from .._euler_cap import at_same_limit
 from .._protocol import Block, Family
 from . import INFO, box, kernels
 from . import model as ladder
@@ -48,9 +47,7 @@ class LadderFamily(Family):
         saturates at ``max(slope_cap, 1)``: at a coarser step that needs more, the Euler step
         stays monotone and the limit falls instead, so the fastest sections lag more than
         fitted."""
-        dt = float(dt)
-        cap = min(structure.slope_cap * dt / structure.dt, max(structure.slope_cap, 1.0))
-        return dataclasses.replace(structure, dt=dt, slope_cap=cap)
+        return at_same_limit(structure, dt)
 
     def block(self, structure, params, inverse=False):
         if inverse and params.w[0] == 0:
