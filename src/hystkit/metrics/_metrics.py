@@ -7,7 +7,17 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from .._docfill import docfiller
 from ._reversals import REVERSAL_DEADBAND, confirmed_reversals
+
+# The Parameters section of the normalised errors of eq. 5.11 (the docstrings' %(normalised_pair)s).
+METRIC_ENTRIES = {"normalised_pair": """Parameters
+----------
+y_true, y_pred : array_like, shape (n,)
+    Measured and predicted signal, same unit, n >= 2.
+scale : float, optional
+    Normalisation of eq. 5.10 in the unit of the signals; default ``max|y_true|``."""}
+fill_metric_doc = docfiller(METRIC_ENTRIES.__getitem__)
 
 # Kaiser beta of MATLAB's ``sinad``: its side lobes (~ -350 dB) sit below double
 # precision, so no leakage escapes the main lobes of the DC and the fundamental.
@@ -83,15 +93,11 @@ def r2(y_true: npt.ArrayLike, y_pred: npt.ArrayLike) -> float:
     return 1.0 - ss_res / ss_tot
 
 
+@fill_metric_doc
 def e_rms_pct(y_true: npt.ArrayLike, y_pred: npt.ArrayLike, scale: float | None = None) -> float:
     """Normalised RMS error in percent of `scale`, eq. 5.11.
 
-    Parameters
-    ----------
-    y_true, y_pred : array_like, shape (n,)
-        Measured and predicted signal, same unit, n >= 2.
-    scale : float, optional
-        Normalisation of eq. 5.10 in the unit of the signals; default ``max|y_true|``.
+    %(normalised_pair)s
 
     Returns
     -------
@@ -102,15 +108,11 @@ def e_rms_pct(y_true: npt.ArrayLike, y_pred: npt.ArrayLike, scale: float | None 
     return 100.0 * math.sqrt(float(np.mean(d**2)))  # eq. 5.11
 
 
+@fill_metric_doc
 def e_max_pct(y_true: npt.ArrayLike, y_pred: npt.ArrayLike, scale: float | None = None) -> float:
     """Normalised maximum absolute error in percent of `scale`, eq. 5.11.
 
-    Parameters
-    ----------
-    y_true, y_pred : array_like, shape (n,)
-        Measured and predicted signal, same unit, n >= 2.
-    scale : float, optional
-        Normalisation of eq. 5.10 in the unit of the signals; default ``max|y_true|``.
+    %(normalised_pair)s
 
     Returns
     -------

@@ -8,13 +8,17 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
-from .._docs import docfiller
+from .._docs import ENTRIES, docfiller
 from .records import (
     MplPolyParams,
     MplPolyStructure,
 )
 
-fill_doc = docfiller("MplPolyStructure", "MplPolyParams")
+# The Parameters section of the output resistor's functions of its voltage (g and g').
+_ENTRIES = {"output_voltage": "Parameters\n----------\n" + ENTRIES["params"] + """
+z : numpy.ndarray
+    Voltage across the output resistor."""}
+fill_doc = docfiller("MplPolyStructure", "MplPolyParams", entries=_ENTRIES)
 
 
 @fill_doc
@@ -83,11 +87,7 @@ def resistor_slope(structure: MplPolyStructure, params: MplPolyParams,
 def output_current(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
     """Output resistor current ``g(z)`` (eq. 5.17).
 
-    Parameters
-    ----------
-    %(params)s
-    z : numpy.ndarray
-        Voltage across the output resistor.
+    %(output_voltage)s
 
     Returns
     -------
@@ -101,11 +101,7 @@ def output_current(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
 def output_slope(params: MplPolyParams, z: np.ndarray) -> np.ndarray:
     """Output resistor slope ``g'(z)`` (``g'_0`` of eq. 5.19).
 
-    Parameters
-    ----------
-    %(params)s
-    z : numpy.ndarray
-        Voltage across the output resistor.
+    %(output_voltage)s
 
     Returns
     -------

@@ -41,7 +41,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import FitDivergedError
-from .._docs import docfiller
+from .._docs import ENTRIES, docfiller
 from .._run import Runs, family_runs
 from .._validation import check_signal
 from . import kernels
@@ -57,7 +57,11 @@ from .records import (
     output_bound,
 )
 
-fill_doc = docfiller("PlStructure", "PlParams", state="x_capacitors")
+# The Parameters section of the output resistor's functions of its current (f and f').
+_ENTRIES = {"output_current": "Parameters\n----------\n" + ENTRIES["params"] + """
+i : numpy.ndarray
+    Output current."""}
+fill_doc = docfiller("PlStructure", "PlParams", state="x_capacitors", entries=_ENTRIES)
 
 __all__ = [
     "A_RANGE",
@@ -127,11 +131,7 @@ def resistor_slope(structure: PlStructure, params: PlParams, v: np.ndarray) -> n
 def output_resistor(params: PlParams, i: np.ndarray) -> np.ndarray:
     """``u = f(i) = sum_j a_j phi_j(i)`` (eq. 2.17), shape of ``i``.
 
-    Parameters
-    ----------
-    %(params)s
-    i : numpy.ndarray
-        Output current.
+    %(output_current)s
 
     Returns
     -------
@@ -176,11 +176,7 @@ def output_resistor_slope(params: PlParams, i: np.ndarray) -> np.ndarray:
     """``f'(i)``: the slope ``a_j`` of the segment holding ``i`` (the left one at a breakpoint
     inside, as the outermost segments extend to infinity).
 
-    Parameters
-    ----------
-    %(params)s
-    i : numpy.ndarray
-        Output current.
+    %(output_current)s
 
     Returns
     -------
