@@ -37,6 +37,10 @@ params : {Params}
 ENTRIES = {
     # the records every model function takes first
     "structure": RECORDS,
+    # the whole Parameters section of a function of the records alone
+    "records_parameters": """Parameters
+----------
+""" + RECORDS,
     "params": """params : {Params}
     The model's parameters.""",
     # rest_state(structure, params, value, inverse)

@@ -78,9 +78,7 @@ __all__ = [
 def limits(structure: ChuaStructure, params: ChuaParams) -> tuple[np.ndarray, np.ndarray]:
     """Per element: the cap on ``g'`` and the knee ``|v|`` beyond which ``g`` is straight.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------
@@ -266,9 +264,7 @@ def rest_state(structure: ChuaStructure, params: ChuaParams, value: float,
 def kernel_args(structure: ChuaStructure, params: ChuaParams) -> tuple:
     """The compiled kernels' parameter arguments, in their order.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------

@@ -199,9 +199,7 @@ def conductance_limit(structure: LadderStructure) -> float:
 def effective_conductance(structure: LadderStructure, params: LadderParams) -> np.ndarray:
     """``G_k`` limited to :func:`conductance_limit`, what the Euler step uses.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------

@@ -208,9 +208,7 @@ def knee_voltage(structure: MplStructure, params: MplParams) -> np.ndarray:
     ``+inf`` without the limit (``structure.limit`` false: the sinh everywhere). A structure
     without a ``limit`` field (the mpl-g family's) is limited.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------

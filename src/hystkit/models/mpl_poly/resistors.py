@@ -28,9 +28,7 @@ def knee_points(structure: MplPolyStructure, params: MplPolyParams) -> np.ndarra
     ``s = slope_cap / dt``. With ``c3 > 0`` ``f'`` is an upward parabola, so ``f' > s`` exactly
     outside the knees; when it never drops to ``s`` both knees sit at its vertex.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------

@@ -31,9 +31,7 @@ def equilibria(structure: MplPolyStructure, params: MplPolyParams) -> list[np.nd
 
     At rest ``u_k = e - v*``: the rest voltage does not depend on the input.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------
@@ -63,9 +61,7 @@ def check_rest(structure: MplPolyStructure, params: MplPolyParams) -> None:
     ``dt`` (:func:`equilibria`) lies within ``REST_MAX``: the straight continuations can move
     a cell's rest point far beyond its cubic's roots (a steep cubic, a small ``slope_cap``).
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Raises
     ------
@@ -115,9 +111,7 @@ def rest_voltages(structure: MplPolyStructure, params: MplPolyParams) -> np.ndar
     tie): unlike "nearest to 0" this does not depend on how the cell voltage is offset, so
     equivalent parameters (``fit.canonical``) start in the same state.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------
@@ -146,9 +140,7 @@ def output_branch(structure: MplPolyStructure,
     where there are none). Defined this way it is the same branch for all equivalent parameters
     (``fit.canonical``).
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------
@@ -204,9 +196,7 @@ def inverse_branch(structure: MplPolyStructure,
     where the inverse's Newton search starts widening its bracket (the arguments of
     ``kernels.solve_output``). Raises as :func:`output_branch`.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------

@@ -78,9 +78,7 @@ __all__ = ["MAX_CREEP", "MAX_DEADZONES", "MAX_PLAYS", "MAX_VALUE", "InverseParts
 def instantaneous_weights(structure: PiStructure, params: PiParams) -> np.ndarray:
     """Play weights of ``H~ = H + kappa x``, the operator one sample of ``H + K`` applies.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------
@@ -120,9 +118,7 @@ def inverse_parts(structure: PiStructure, params: PiParams) -> InverseParts:
     """The inverse operators: polarity ``sign`` of ``H~`` (the polarity lives in ``H``, ``S``
     increases), its weights ``w_inst``, the inverse plays of ``sign * H~`` and ``S^-1``.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------
@@ -271,9 +267,7 @@ def not_invertible_reason(structure: PiStructure, params: PiParams) -> str:
     from ``d = 0`` outwards (an increasing ``S``), all at least ``INVERSE_MIN_SLOPE`` (1e-6) in
     magnitude so that the inverse's slopes stay below 1e6 (the fit's are below 100).
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------

@@ -263,9 +263,7 @@ def _check(structure: PlStructure, params: PlParams, inverse: bool) -> None:
 def kernel_args(structure: PlStructure, params: PlParams) -> tuple:
     """``(I_T, thresholds, knees, p, G, dt)``: the cell arguments of the compiled kernels.
 
-    Parameters
-    ----------
-    %(structure)s
+    %(records_parameters)s
 
     Returns
     -------
