@@ -37,6 +37,11 @@ params : {Params}
 ENTRIES = {
     # the records every model function takes first
     "structure": RECORDS,
+    # the whole Parameters section of a function of the structure alone
+    "structure_parameters": """Parameters
+----------
+structure : {Structure}
+    The model's structure.""",
     # the whole Parameters section of a function of the records alone
     "records_parameters": """Parameters
 ----------
@@ -69,6 +74,11 @@ inverse : bool, default False
     The branch's bounds (``+-inf`` where unbounded).
 sign : float
     Sign of ``g'`` on it.""",
+    # the Raises section of the functions that find the branch around the rest point
+    "no_branch": """Raises
+------
+FitDivergedError
+    If ``g'(z_rest) = 0`` (no monotone branch through the operating point).""",
     "u_max": """u_max : float
     Largest input magnitude.""",
     "rng": """rng : numpy.random.Generator
@@ -87,7 +97,10 @@ accept : callable, optional
     A candidate counts only if ``accept(params)``; ``accept_reason`` says why others failed.
 accept_reason : str, optional
     Why candidates were rejected, for the message.""",
-    "best_start": """FitResult
+    # the Returns section of a multistart fit
+    "best_start": """Returns
+-------
+FitResult
     The best start's fit.""",
     # the fits that solve one linear least-squares problem (no robust loss)
     "linear_loss": """loss, f_scale : str, float

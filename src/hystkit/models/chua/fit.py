@@ -112,8 +112,6 @@ def fit_chua(u: np.ndarray, y: np.ndarray, structure: chua.ChuaStructure, *,
         The cost minimised: the SSE by default, or a robust loss and/or per-sample weights
         (one per sample of ``y``); see :func:`hystkit.identification.fit_multistart`.
 
-    Returns
-    -------
     %(best_start)s
 
     Raises

@@ -32,7 +32,7 @@ from .box import (
     random_params,
 )
 
-fill_doc = docfiller()
+fill_doc = docfiller("ladder.LadderStructure")
 
 __all__ = ["default_starts", "fit_ladder", "random_params"]
 
@@ -62,14 +62,12 @@ def _theta_limits(n_cells: int) -> tuple[list[str | None], list[str | None]]:
     return lower, upper
 
 
+@fill_doc
 def default_starts(structure: ladder.LadderStructure) -> list[np.ndarray]:
     """Deterministic starts ``[E_1, log G_1, ..]``: bands growing along the ladder (0, 0.05 or
     0.2 of the range per cell) and conductances near the limit or 10 and 100 times slower.
 
-    Parameters
-    ----------
-    structure : ladder.LadderStructure
-        The model's structure.
+    %(structure_parameters)s
 
     Returns
     -------
@@ -119,8 +117,6 @@ def fit_ladder(u: np.ndarray, y: np.ndarray, structure: ladder.LadderStructure, 
         projected weights and bias minimise the same cost
         (:func:`hystkit.identification.robust_linear_fit`).
 
-    Returns
-    -------
     %(best_start)s
 
     Raises

@@ -179,13 +179,11 @@ def output_bound(params: LadderParams, u_max: float) -> float:
     return float(np.abs(params.w).sum() * u_max + abs(params.v_b))
 
 
+@fill_doc
 def conductance_limit(structure: LadderStructure) -> float:
     """Largest effective ``G`` [1/s]: two conducting resistors at a node reach ``slope_cap``.
 
-    Parameters
-    ----------
-    structure : LadderStructure
-        The model's structure.
+    %(structure_parameters)s
 
     Returns
     -------

@@ -7,7 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._docs import docfiller
 from . import model as mpl
+
+fill_doc = docfiller("MplStructure")
 
 __all__ = ["LOG_G_MIN", "LOG_G_UNLIMITED", "LOG_VT_BOUNDS", "W_BOUND", "fit_box", "random_params",
            "theta_names"]
@@ -29,6 +32,7 @@ def theta_names(n_cells: int) -> list[str]:
     return [*cells, *(f"w[{k}]" for k in range(n_cells + 1)), "v_b"]
 
 
+@fill_doc
 def fit_box(structure: mpl.MplStructure) -> tuple[np.ndarray, np.ndarray]:
     """The fit's bounds in optimiser coordinates (:meth:`MplParams.to_vector`).
 
@@ -36,10 +40,7 @@ def fit_box(structure: mpl.MplStructure) -> tuple[np.ndarray, np.ndarray]:
     limit, ``[log 1e-8, log 1e8]``; ``log V_T,k`` in ``[log 1e-3, log 1e3]``; ``w_k`` and
     ``V_b`` in ``[-100, 100]``.
 
-    Parameters
-    ----------
-    structure : MplStructure
-        The model's structure.
+    %(structure_parameters)s
 
     Returns
     -------

@@ -47,7 +47,7 @@ from .slopes import (
     slope_matrix,
 )
 
-fill_doc = docfiller()
+fill_doc = docfiller("MplGStructure")
 
 __all__ = ["MONOTONE_RANGE", "WEIGHT_SUM_FLOOR", "bernstein_slopes", "canonical", "fit_box",
            "fit_mpl_g", "output_from_slopes", "random_params", "start_theta", "theta_names"]
@@ -78,15 +78,13 @@ def theta_names(n_cells: int) -> list[str]:
             *(f"w[{k}]" for k in range(1, n_cells + 1))]
 
 
+@fill_doc
 def fit_box(structure: mpl_g.MplGStructure) -> tuple[np.ndarray, np.ndarray]:
     """The fit's bounds on its coordinates (:func:`theta_names`): the mPL's cell box, ``g_0``
     in ``[-1e3, 1e3]``, the logs of the Bernstein slopes in ``[log 1e-6, log 1e3]``,
     ``w_1..w_N`` in ``[-100, 100]``.
 
-    Parameters
-    ----------
-    structure : MplGStructure
-        The model's structure.
+    %(structure_parameters)s
 
     Returns
     -------

@@ -179,10 +179,7 @@ def output_branch(params: MplGParams) -> tuple[float, float, float]:
     -------
     %(branch)s
 
-    Raises
-    ------
-    FitDivergedError
-        If ``g'(z_rest) = 0`` (no monotone branch through the operating point).
+    %(no_branch)s
     """
     return branch_around(params, -params.v_b)
 

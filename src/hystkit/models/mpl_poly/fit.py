@@ -32,7 +32,7 @@ from . import kernels
 from . import model as mpl_poly
 from .presets import PAPER_9_2_TABLE_I, paper_9_2_params
 
-fill_doc = docfiller()
+fill_doc = docfiller("mpl_poly.MplPolyStructure")
 
 __all__ = ["canonical", "default_starts", "fit_box", "fit_mpl_poly", "random_params",
            "theta_names"]
@@ -58,15 +58,13 @@ def theta_names(n_cells: int) -> list[str]:
             "v_b"]
 
 
+@fill_doc
 def fit_box(structure: mpl_poly.MplPolyStructure) -> tuple[np.ndarray, np.ndarray]:
     """The fit's bounds in optimiser coordinates (:meth:`MplPolyParams.to_vector`):
     ``c_k0..c_k2`` and ``g`` in ``[-1e3, 1e3]``, ``log c_k3`` in ``[log 1e-6, log 1e4]``,
     ``w`` and ``V_b`` in ``[-100, 100]``.
 
-    Parameters
-    ----------
-    structure : mpl_poly.MplPolyStructure
-        The model's structure.
+    %(structure_parameters)s
 
     Returns
     -------
@@ -137,6 +135,7 @@ def _table_i_start(n_cells: int) -> mpl_poly.MplPolyParams:
                                   w=np.r_[p.w, np.zeros(n_cells - 1)], v_b=p.v_b)
 
 
+@fill_doc
 def default_starts(structure: mpl_poly.MplPolyStructure) -> list[np.ndarray]:
     """Deterministic cell resistors ``f_k`` (shape (N, 4) each) for the linear-output starts.
 
@@ -145,10 +144,7 @@ def default_starts(structure: mpl_poly.MplPolyStructure) -> list[np.ndarray]:
     strongly (``V = 0.2``, the document's ``V_T`` start) and a mildly (``V = 2``) non-linear
     shape, for data normalised to max |.| = 1 (eq. 5.10).
 
-    Parameters
-    ----------
-    structure : mpl_poly.MplPolyStructure
-        The model's structure.
+    %(structure_parameters)s
 
     Returns
     -------
@@ -240,8 +236,6 @@ def fit_mpl_poly(u: np.ndarray, y: np.ndarray, structure: mpl_poly.MplPolyStruct
         patternsearch from table I: the preset ``paper-9.2-table-i``); clipped into
         :func:`fit_box`.
 
-    Returns
-    -------
     %(best_start)s
 
     Raises

@@ -146,10 +146,7 @@ def output_branch(structure: MplPolyStructure,
     -------
     %(branch)s
 
-    Raises
-    ------
-    FitDivergedError
-        If ``g'(z_rest) = 0`` (no monotone branch through the operating point).
+    %(no_branch)s
     """
     z_rest = -params.w[1:] @ rest_voltages(structure, params) - params.v_b
     return branch_around(params, z_rest)

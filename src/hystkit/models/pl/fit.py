@@ -37,7 +37,7 @@ from .box import (
     random_params,
 )
 
-fill_doc = docfiller()
+fill_doc = docfiller("pl.PlStructure")
 
 __all__ = ["THETA_NAMES", "default_starts", "fit_pl", "random_params", "solve_weights"]
 
@@ -100,15 +100,13 @@ def solve_weights(structure: pl.PlStructure, x: np.ndarray, u: np.ndarray,
     return coef[:m], coef[m:-1], float(coef[-1])
 
 
+@fill_doc
 def default_starts(structure: pl.PlStructure) -> list[np.ndarray]:
     """Starts ``[log I_T, log V_T]``: a coarse grid of the two, thresholds spanning 0.2 to 2 of
     the normalised range (``N V_T``) and cell-1 creep time constants ``V_T / I_T`` of 0.3, 3
     and 30 s (12 starts; the cost has several basins in these two coordinates).
 
-    Parameters
-    ----------
-    structure : pl.PlStructure
-        The model's structure.
+    %(structure_parameters)s
 
     Returns
     -------
@@ -150,8 +148,6 @@ def fit_pl(u: np.ndarray, y: np.ndarray, structure: pl.PlStructure, *,
         loss acts on ``I_T``, ``V_T`` only: the projected ``a``, ``w``, ``V_b`` stay the
         voltage-side least-squares fit, with its rows weighted by `weights`.
 
-    Returns
-    -------
     %(best_start)s
 
     Raises
