@@ -41,8 +41,21 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from .._docfill import docfiller
+
 __all__ = ["FAR_MARGIN", "MAX_OUTSIDE", "MIN_EXPLAINED", "MIN_USABLE", "USE_STATUSES",
            "pooled_verdict", "use_verdict", "verdict"]
+
+# What the verdicts of scores take and return (%(where)s, %(as_verdict)s).
+VERDICT_ENTRIES = {
+    "where": """where : str
+    What the scores are of, for the message.""",
+    "as_verdict": """Returns
+-------
+tuple of str
+    As :func:`verdict`.""",
+}
+fill_verdict_doc = docfiller(VERDICT_ENTRIES.__getitem__)
 
 # Below this R² the estimate is no better than reporting a constant in any useful sense.
 MIN_EXPLAINED = 0.1
@@ -113,6 +126,7 @@ def verdict(r2_model: float | None, r2_line: float | None, where: str,
     return "ok", f"{where} R² {r2_model:.4f} (straight line {line})"
 
 
+@fill_verdict_doc
 def use_verdict(scores: dict, where: str) -> tuple[str, str]:
     """:func:`verdict` of a compensator on one recording from :func:`~._evaluate.evaluate`'s
     deployable scores, which carry the counts of sensor samples and estimates far outside
@@ -122,17 +136,14 @@ def use_verdict(scores: dict, where: str) -> tuple[str, str]:
     ----------
     scores : dict
         ``evaluate(compensator, recording)``.
-    where : str
-        What the scores are of, for the message.
+    %(where)s
 
-    Returns
-    -------
-    tuple of str
-        As :func:`verdict`.
+    %(as_verdict)s
     """
     return pooled_verdict([scores], where)
 
 
+@fill_verdict_doc
 def pooled_verdict(scores: Sequence[dict], where: str) -> tuple[str, str]:
     """:func:`verdict` of one compensator on several recordings (``batch``'s validation runs):
     the mean deployable R² of each, the far-outside shares pooled over all samples.
@@ -142,13 +153,9 @@ def pooled_verdict(scores: Sequence[dict], where: str) -> tuple[str, str]:
     scores : sequence of dict
         :func:`~._evaluate.evaluate`'s scores of each recording (``n_sensor_far_outside``,
         ``n_estimate_far_outside``: None where the model file does not know its ranges).
-    where : str
-        What the scores are of, for the message.
+    %(where)s
 
-    Returns
-    -------
-    tuple of str
-        As :func:`verdict`.
+    %(as_verdict)s
     """
     return verdict(_mean(scores, "r2"), _mean(scores, "linear_r2"), where,
                    _pooled_share(scores, "n_sensor_far_outside"),

@@ -15,12 +15,24 @@ import control
 import numpy as np
 from scipy.optimize import brentq
 
+from .._docfill import docfiller
 from ._blocks import PID, TS, DisturbanceObserver, Plant, plant_matrices
 from ._linearise import classify_poles, open_loop, slowest_cell, static_sign_flips
 from ._loop import ControlLoop, LoopState
 from ._loop_margins import LoopMargins
 
 __all__ = ["DOB_CANDIDATES_HZ", "bode_data", "design_dob", "loop_margins", "tune_pid"]
+
+# The loop and operating point the analyses take (the docstrings' %(operating_point)s).
+ANALYSIS_ENTRIES = {
+    "operating_point": """Parameters
+----------
+loop : ControlLoop
+    The loop to analyse.
+state : LoopState, optional
+    Operating point; default :func:`rest_state` at ``r = 0``.""",
+}
+fill_analysis_doc = docfiller(ANALYSIS_ENTRIES.__getitem__)
 
 
 def _grid(ts: float, f_min: float = 1e-3, n: int = 4000) -> np.ndarray:
@@ -47,6 +59,7 @@ def _gain_margin(h, f: np.ndarray, resp: np.ndarray,
     return None, None
 
 
+@fill_analysis_doc
 def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargins:
     """Margins of :func:`open_loop` and closed-loop stability of the linearised loop.
 
@@ -64,12 +77,7 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
     (plant and integrator) make its polynomial method fall back to a grid that returns
     spurious low-frequency crossings.
 
-    Parameters
-    ----------
-    loop : ControlLoop
-        The loop to analyse.
-    state : LoopState, optional
-        Operating point; default :func:`rest_state` at ``r = 0``.
+    %(operating_point)s
 
     Returns
     -------
@@ -107,6 +115,7 @@ def loop_margins(loop: ControlLoop, state: LoopState | None = None) -> LoopMargi
                        slow_cell_s=None if slow is None else slow[1])
 
 
+@fill_analysis_doc
 def bode_data(loop: ControlLoop, state: LoopState | None = None,
               f: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Frequency [Hz], magnitude [dB] and unwrapped phase [deg] of :func:`open_loop`.
@@ -115,12 +124,7 @@ def bode_data(loop: ControlLoop, state: LoopState | None = None,
     unwrapped phase is shifted by whole turns so that it lies in (-360, 0] where ``|L|`` is
     closest to 1 (the crossover reads as ``-180 + phase margin``).
 
-    Parameters
-    ----------
-    loop : ControlLoop
-        The loop to analyse.
-    state : LoopState, optional
-        Operating point; default :func:`rest_state` at ``r = 0``.
+    %(operating_point)s
     f : numpy.ndarray, optional
         Frequencies [Hz]; default the grid above.
 

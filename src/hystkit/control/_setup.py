@@ -19,6 +19,7 @@ import time
 from dataclasses import dataclass, field, replace
 
 from .. import control as package
+from .._docfill import docfiller
 from ..compensation import Compensator
 from ..io import Recording
 from ._blocks import PID, DisturbanceObserver, Plant
@@ -29,6 +30,15 @@ from ._names import MASS
 from ._sensor_blocks import SensorBlock, SensorModels, compensator_block, sensor_block
 
 __all__ = ["LoopError", "LoopSetup", "SetupResult", "sensor_from", "setup_loop"]
+
+# The Parameters section of the functions of a loop's definition (%(setup_parameters)s).
+SETUP_ENTRIES = {
+    "setup_parameters": """Parameters
+----------
+setup : LoopSetup
+    The loop's definition.""",
+}
+fill_setup_doc = docfiller(SETUP_ENTRIES.__getitem__)
 
 TABLE_II = "table-ii-"
 
@@ -133,13 +143,11 @@ class SetupResult:
     fit_seconds: float
 
 
+@fill_setup_doc
 def sensor_from(setup: LoopSetup) -> SensorBlock | None:
     """``S_r`` as the setup names it; None for one fitted on the virtual sensor or a recording.
 
-    Parameters
-    ----------
-    setup : LoopSetup
-        The loop's definition.
+    %(setup_parameters)s
 
     Returns
     -------
@@ -172,14 +180,12 @@ def _block(make, compensator: Compensator, name: str, part: str) -> SensorBlock:
         raise LoopError(part, str(exc)) from None
 
 
+@fill_setup_doc
 def setup_loop(setup: LoopSetup) -> SetupResult:
     """The loop of `setup`: its sensor models fitted (or read from the disk cache), model
     files in their slots, the PID tuned and the DOB designed when asked.
 
-    Parameters
-    ----------
-    setup : LoopSetup
-        The loop's definition.
+    %(setup_parameters)s
 
     Returns
     -------

@@ -11,11 +11,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._docfill import docfiller
 from . import _kernel
 from ._blocks import plant_matrices
 from ._loop import ControlLoop, LoopState, rest_state
 
 __all__ = ["LoopResponse", "simulate_loop", "simulate_loop_reference"]
+
+# What both loop runs take and raise (the docstrings' %(input_noise)s, %(bad_run)s).
+RUN_ENTRIES = {
+    "input_noise": """d_in : array, optional
+    Input force disturbance [N].
+noise : array, optional
+    Additive sensor noise [sensor units].""",
+    "bad_run": """Raises
+------
+ValueError
+    If `r` is empty, not 1-D or not finite, a disturbance is not shaped like `r`, or
+    `state` does not match the loop's blocks.""",
+}
+fill_run_doc = docfiller(RUN_ENTRIES.__getitem__)
 
 
 @dataclass(frozen=True, eq=False)
@@ -161,6 +176,7 @@ def _response(loop, r, t0, out, x_end, n_done, reason, seconds,
         compile_seconds=compile_seconds)
 
 
+@fill_run_doc
 def simulate_loop(loop: ControlLoop, r: np.ndarray, *, state: LoopState | None = None,
                   t0: float = 0.0, d_out: np.ndarray | None = None,
                   d_in: np.ndarray | None = None,
@@ -179,10 +195,7 @@ def simulate_loop(loop: ControlLoop, r: np.ndarray, *, state: LoopState | None =
     d_out : array, optional
         Output disturbance [m] added to the plant position (sec. 7.3.2); the sensor sees it and
         it counts in the plant error.
-    d_in : array, optional
-        Input force disturbance [N].
-    noise : array, optional
-        Additive sensor noise [sensor units].
+    %(input_noise)s
 
     Returns
     -------
@@ -190,11 +203,7 @@ def simulate_loop(loop: ControlLoop, r: np.ndarray, *, state: LoopState | None =
         ``bounded`` is False if a value left the finite range or ``|y| > loop.y_limit``;
         the signals then stop before that step.
 
-    Raises
-    ------
-    ValueError
-        If `r` is empty, not 1-D or not finite, a disturbance is not shaped like `r`, or
-        `state` does not match the loop's blocks.
+    %(bad_run)s
     """
     r, (d_out, d_in, noise), state = _prepare(loop, r, state, d_out, d_in, noise)
     args = (r, d_out, d_in, noise, state.to_vector(), *loop.kernel_arguments())
@@ -205,6 +214,7 @@ def simulate_loop(loop: ControlLoop, r: np.ndarray, *, state: LoopState | None =
     return _response(loop, r, t0, out, x_end, n_done, reason, seconds, compile_seconds)
 
 
+@fill_run_doc
 def simulate_loop_reference(loop: ControlLoop, r: np.ndarray, *,
                             state: LoopState | None = None, t0: float = 0.0,
                             d_out: np.ndarray | None = None, d_in: np.ndarray | None = None,
@@ -223,21 +233,14 @@ def simulate_loop_reference(loop: ControlLoop, r: np.ndarray, *,
         Time of the first sample [s] (only labels ``t``).
     d_out : array, optional
         Output disturbance [m] added to the plant position.
-    d_in : array, optional
-        Input force disturbance [N].
-    noise : array, optional
-        Additive sensor noise [sensor units].
+    %(input_noise)s
 
     Returns
     -------
     LoopResponse
         As :func:`simulate_loop`'s (``compile_seconds`` is 0).
 
-    Raises
-    ------
-    ValueError
-        If `r` is empty, not 1-D or not finite, a disturbance is not shaped like `r`, or
-        `state` does not match the loop's blocks.
+    %(bad_run)s
     """
     r, (d_out, d_in, noise), state = _prepare(loop, r, state, d_out, d_in, noise)
     ts, p = loop.ts, loop.pid

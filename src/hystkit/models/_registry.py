@@ -23,11 +23,21 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from importlib.metadata import entry_points
 
+from .._docfill import docfiller
 from ..errors import InputError
 from ._protocol import Family, FamilyInfo
 
 __all__ = ["FAMILIES", "FAMILY_INFO", "family_info", "family_of", "get_family", "register",
            "unregister"]
+
+# The Parameters section of the look-ups by family name (%(family_name)s).
+REGISTRY_ENTRIES = {
+    "family_name": """Parameters
+----------
+name : str
+    Family name (``"mpl"``, ``"preisach"``, ...).""",
+}
+fill_registry_doc = docfiller(REGISTRY_ENTRIES.__getitem__)
 
 _PACKAGE = __name__.rpartition(".")[0]
 
@@ -163,14 +173,12 @@ def unregister(name: str) -> None:
     _entries().pop(name, None)
 
 
+@fill_registry_doc
 def get_family(name: str) -> Family:
     """The registered family ``name`` (its ``family.py`` imported on first use); InputError
     listing the known ones otherwise.
 
-    Parameters
-    ----------
-    name : str
-        Family name (``"mpl"``, ``"preisach"``, ...).
+    %(family_name)s
 
     Returns
     -------
@@ -185,13 +193,11 @@ def get_family(name: str) -> Family:
     return _entry(name).load()
 
 
+@fill_registry_doc
 def family_info(name: str) -> FamilyInfo:
     """What the registry knows of family ``name`` without loading its code.
 
-    Parameters
-    ----------
-    name : str
-        Family name (``"mpl"``, ``"preisach"``, ...).
+    %(family_name)s
 
     Returns
     -------

@@ -14,7 +14,7 @@ import dataclasses
 import numpy as np
 
 from ..io import Recording
-from ._virtual import VirtualSensor, simulate_experiment
+from ._virtual import VirtualSensor, fill_experiment_doc, simulate_experiment
 
 __all__ = ["gain_ramp", "occasional_references", "simulate_drifting_experiment",
            "with_gain_drift"]
@@ -71,16 +71,14 @@ def with_gain_drift(recording: Recording, drift: float = 0.10) -> Recording:
                                source=f"{recording.source}, gain drift {drift:+.0%}")
 
 
+@fill_experiment_doc
 def simulate_drifting_experiment(name: str, seed: int = 0, drift: float = 0.10,
                                  sensor: VirtualSensor | None = None) -> Recording:
     """:func:`~hystkit.sensors.simulate_experiment` with a sensor gain drift of ``drift``.
 
     Parameters
     ----------
-    name : str
-        Excitation (sine, decay, chirp, noise).
-    seed : int
-        Seeds the noise, the temperature drift and, for ``noise``, the trajectory.
+    %(experiment)s
     drift : float
         Relative gain change over the run [-].
     sensor : VirtualSensor, optional

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from .._docfill import docfiller
 from ..io import Recording
 from ..preprocess import downsample, lowpass_zero_phase
 from ..signals import excitation
@@ -45,6 +46,15 @@ from ._physics import (
 )
 
 __all__ = ["VirtualSensor", "simulate_experiment"]
+
+# What the simulated experiments take (%(experiment)s).
+EXPERIMENT_ENTRIES = {
+    "experiment": """name : str
+    Excitation (sine, decay, chirp, noise).
+seed : int
+    Seeds the noise, the temperature drift and, for ``noise``, the trajectory.""",
+}
+fill_experiment_doc = docfiller(EXPERIMENT_ENTRIES.__getitem__)
 
 
 @dataclass(frozen=True)
@@ -179,6 +189,7 @@ class VirtualSensor:
                          source=source)
 
 
+@fill_experiment_doc
 def simulate_experiment(name: str, seed: int = 0,
                         sensor: VirtualSensor | None = None) -> Recording:
     """One recording of the document's experiment ``name`` (sine, decay, chirp, noise).
@@ -188,10 +199,7 @@ def simulate_experiment(name: str, seed: int = 0,
 
     Parameters
     ----------
-    name : str
-        Excitation (sine, decay, chirp, noise).
-    seed : int
-        Seeds the noise, the temperature drift and, for ``noise``, the trajectory.
+    %(experiment)s
     sensor : VirtualSensor, optional
         The simulated sensor; the defaults when None.
 

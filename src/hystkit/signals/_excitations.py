@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._docfill import docfiller
+
 __all__ = [
     "EXPERIMENTS",
     "Experiment",
@@ -17,27 +19,37 @@ __all__ = [
     "sine",
 ]
 
+# What the excitations of time take and return (%(t)s, %(amplitude)s, %(position)s).
+EXCITATION_ENTRIES = {
+    "t": """t : numpy.ndarray
+    Times [s].""",
+    "amplitude": """amplitude : float, default 3.0
+    Amplitude [mm].""",
+    "position": """Returns
+-------
+numpy.ndarray
+    Position [mm], same shape as `t`.""",
+}
+fill_excitation_doc = docfiller(EXCITATION_ENTRIES.__getitem__)
 
+
+@fill_excitation_doc
 def sine(t: np.ndarray, frequency: float = 0.5, amplitude: float = 3.0) -> np.ndarray:
     """``amplitude * sin(2 pi f t)`` [mm]; the sine experiment is 0.5 Hz, 3 mm (eq. 9.14).
 
     Parameters
     ----------
-    t : numpy.ndarray
-        Times [s].
+    %(t)s
     frequency : float, default 0.5
         Frequency [Hz].
-    amplitude : float, default 3.0
-        Amplitude [mm].
+    %(amplitude)s
 
-    Returns
-    -------
-    numpy.ndarray
-        Position [mm], same shape as `t`.
+    %(position)s
     """
     return amplitude * np.sin(2 * np.pi * frequency * np.asarray(t, dtype=float))
 
 
+@fill_excitation_doc
 def decaying_sine(t: np.ndarray, frequency: float = 0.5, start_amplitude: float = 2.0,
                   end_amplitude: float = 0.1, duration: float = 200.0) -> np.ndarray:
     """Sine whose amplitude falls exponentially from ``start`` to ``end`` over ``duration`` [mm].
@@ -47,8 +59,7 @@ def decaying_sine(t: np.ndarray, frequency: float = 0.5, start_amplitude: float 
 
     Parameters
     ----------
-    t : numpy.ndarray
-        Times [s].
+    %(t)s
     frequency : float, default 0.5
         Frequency [Hz].
     start_amplitude, end_amplitude : float, default 2.0 and 0.1
@@ -56,35 +67,28 @@ def decaying_sine(t: np.ndarray, frequency: float = 0.5, start_amplitude: float 
     duration : float, default 200.0
         Time [s] over which the amplitude falls from start to end.
 
-    Returns
-    -------
-    numpy.ndarray
-        Position [mm], same shape as `t`.
+    %(position)s
     """
     t = np.asarray(t, dtype=float)
     envelope = start_amplitude * (end_amplitude / start_amplitude) ** (t / duration)
     return envelope * np.sin(2 * np.pi * frequency * t)
 
 
+@fill_excitation_doc
 def exponential_chirp(t: np.ndarray, f0: float = 0.1, f1: float = 3.0, duration: float = 100.0,
                       amplitude: float = 3.0) -> np.ndarray:
     """Sine sweep whose frequency rises exponentially from ``f0`` to ``f1`` over ``duration``.
 
     Parameters
     ----------
-    t : numpy.ndarray
-        Times [s].
+    %(t)s
     f0, f1 : float, default 0.1 and 3.0
         Start and end frequency [Hz].
     duration : float, default 100.0
         Time [s] at which the frequency reaches `f1`.
-    amplitude : float, default 3.0
-        Amplitude [mm].
+    %(amplitude)s
 
-    Returns
-    -------
-    numpy.ndarray
-        Position [mm], same shape as `t`.
+    %(position)s
     """
     from scipy import signal  # here, not at the top: listing the experiments stays light
 
@@ -109,6 +113,7 @@ def _fir_lowpass(fs: float, cutoff_3db: float, numtaps: int) -> np.ndarray:
     return signal.firwin(numtaps, fc, fs=fs)
 
 
+@fill_excitation_doc
 def filtered_noise(t: np.ndarray, seed: int, cutoff: float = 4.0, order: int = 500,
                    amplitude: float = 3.0) -> np.ndarray:
     """Gaussian noise through an ``order``-th order FIR low-pass (-3 dB at ``cutoff``) [mm].
@@ -129,10 +134,7 @@ def filtered_noise(t: np.ndarray, seed: int, cutoff: float = 4.0, order: int = 5
     amplitude : float, default 3.0
         Largest absolute value [mm].
 
-    Returns
-    -------
-    numpy.ndarray
-        Position [mm], same shape as `t`.
+    %(position)s
     """
     from scipy import signal  # here: as in exponential_chirp
 

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
+from .._docfill import docfiller
 from ..compensation import (
     Compensator,
     center_label,
@@ -31,6 +32,15 @@ from ._html import Section, definition_list, figure_png, note, paragraph, png_bl
 
 __all__ = ["FIGURE_DPI", "ReportContent", "compensator_sections", "fit_section", "model_report",
            "named_parameters", "score_section"]
+
+# What the builders of a report page return (%(report_content)s).
+REPORT_ENTRIES = {
+    "report_content": """Returns
+-------
+ReportContent
+    The page's title, sections and figures.""",
+}
+fill_report_doc = docfiller(REPORT_ENTRIES.__getitem__)
 
 # (evaluate key, column heading, format)
 _SCORES = (("r2", "R²", ".4f"), ("e_rms_pct", "e_rms %", ".3f"), ("e_max_pct", "e_max %", ".3f"),
@@ -282,6 +292,7 @@ def compensator_sections(comp: Compensator, recordings: Mapping[str, Recording],
     return content
 
 
+@fill_report_doc
 def model_report(model_path: Path, recordings: Mapping[str, Recording], *,
                  sensor_label: str = DEFAULT_SENSOR_LABEL) -> ReportContent:
     """The page of a model file (read with :func:`~hystkit.compensation.load_compensator`,
@@ -296,10 +307,7 @@ def model_report(model_path: Path, recordings: Mapping[str, Recording], *,
     sensor_label : str, default "sensor"
         The sensor axis' label in the loop figure.
 
-    Returns
-    -------
-    ReportContent
-        The page's title, sections and figures.
+    %(report_content)s
 
     Raises
     ------

@@ -20,7 +20,7 @@ from ._figures import DEFAULT_SENSOR_LABEL
 from ._html import render_page
 from ._report_control import control_report
 from ._report_folders import folder_kind, folder_report
-from ._report_model import ReportContent, model_report
+from ._report_model import ReportContent, fill_report_doc, model_report
 
 __all__ = ["FIGURE_FORMATS", "build_report", "figure_paths", "sensor_label", "write_report"]
 
@@ -37,6 +37,7 @@ def sensor_label(options: ReadOptions | None, recordings: Sequence[Recording] = 
     return f"{name} [{unit}]" if unit else name
 
 
+@fill_report_doc
 def build_report(inputs: Sequence[str | os.PathLike[str]], *,
                  options: ReadOptions | Callable[[Path], ReadOptions] | None = None,
                  ) -> ReportContent:
@@ -52,10 +53,7 @@ def build_report(inputs: Sequence[str | os.PathLike[str]], *,
         each recording's settings file beside it when it has one (``my.toml`` for ``my.csv``,
         :func:`~hystkit.io.options_for`), as the command line reads it.
 
-    Returns
-    -------
-    ReportContent
-        The page's title, sections and figures.
+    %(report_content)s
 
     Raises
     ------

@@ -17,7 +17,12 @@ from .._validation import (
     check_structure_size,
 )
 
-fill_doc = docfiller(params="PreisachParams")
+# The Parameters section of the functions of the Everett nodes alone (%(everett_nodes)s).
+_ENTRIES = {"everett_nodes": """Parameters
+----------
+e : numpy.ndarray, shape (L, L)
+    Everett nodes (lower triangle)."""}
+fill_doc = docfiller(params="PreisachParams", entries=_ENTRIES)
 
 # Limits. The fit's design matrix holds n_samples x L (L - 1) / 2 floats: at L = 128 and 8000
 # samples 0.5 GB (measured: 1.5 GB peak, 2.5 min); L = 512 would need 8.4 GB. A run holds one
@@ -123,13 +128,11 @@ def everett_from_masses(masses: np.ndarray) -> np.ndarray:
     return np.tril(e, -1)
 
 
+@fill_doc
 def masses_from_everett(e: np.ndarray) -> np.ndarray:
     """Inverse of :func:`everett_from_masses`: mixed second differences of ``E``.
 
-    Parameters
-    ----------
-    e : numpy.ndarray, shape (L, L)
-        Everett nodes (lower triangle).
+    %(everett_nodes)s
 
     Returns
     -------
@@ -141,13 +144,11 @@ def masses_from_everett(e: np.ndarray) -> np.ndarray:
     return np.tril(m)
 
 
+@fill_doc
 def antisymmetric(e: np.ndarray) -> np.ndarray:
     """``E - E^T``: the extension the bilinear interpolation runs on (zero diagonal).
 
-    Parameters
-    ----------
-    e : numpy.ndarray, shape (L, L)
-        Everett nodes (lower triangle).
+    %(everett_nodes)s
 
     Returns
     -------
