@@ -43,11 +43,16 @@ __all__ = ["MM", "SensorBlock", "SensorModels", "compensator_block", "forward_bl
 
 MM = 1e-3  # recordings hold position in mm; the loop works in metres
 
-# What every builder of a sensor block returns (the docstrings' %(sensor_block)s).
-SENSOR_BLOCK_ENTRIES = {"sensor_block": """Returns
+# What the builders of a sensor block take and return (%(compensator)s, %(sensor_block)s).
+SENSOR_BLOCK_ENTRIES = {
+    "sensor_block": """Returns
 -------
 SensorBlock
-    Position [m] in, sensor signal out."""}
+    Position [m] in, sensor signal out.""",
+    # the model file the compensator and sensor blocks run
+    "compensator": """compensator : Compensator
+    A fitted compensator (a model file).""",
+}
 fill_sensor_doc = docfiller(SENSOR_BLOCK_ENTRIES.__getitem__)
 
 
@@ -241,6 +246,7 @@ def _file_info(compensator: Compensator, direction: str) -> dict:
     return info
 
 
+@fill_sensor_doc
 def compensator_block(compensator: Compensator, *, name: str = "compensator") -> SensorBlock:
     """The compensator as a loop block: sensor signal in, position estimate [m] out.
 
@@ -249,8 +255,7 @@ def compensator_block(compensator: Compensator, *, name: str = "compensator") ->
 
     Parameters
     ----------
-    compensator : Compensator
-        A fitted compensator (a model file).
+    %(compensator)s
     name : str, default "compensator"
         Block name.
 
@@ -276,8 +281,7 @@ def sensor_block(compensator: Compensator, *, name: str = "S_r") -> SensorBlock:
 
     Parameters
     ----------
-    compensator : Compensator
-        A fitted compensator (a model file).
+    %(compensator)s
     name : str, default "S_r"
         Block name.
 
