@@ -94,13 +94,14 @@ while h_b < 0
 end
 if g1 ~= 0, z = (i - g0) / g1; else, z = NaN; end
 if ~(a < z && z < b), z = 0.5 * (a + b); end
+g2_2 = 2.0 * g2; g3_3 = 3.0 * g3;
 for it = 1:200
-    gz = g0 + z * (g1 + z * (g2 + z * g3));
-    dg = g1 + z * (2.0 * g2 + 3.0 * g3 * z);
-    h = sign_ * (gz - i);
+    r = (g0 + z * (g1 + z * (g2 + z * g3))) - i;
+    dg = g1 + z * (g2_2 + g3_3 * z);
+    h = sign_ * r;
     if h == 0, break; end
     if h < 0, a = z; else, b = z; end
-    if dg ~= 0, z_new = z - (gz - i) / dg; else, z_new = NaN; end
+    if dg ~= 0, z_new = z - r / dg; else, z_new = NaN; end
     if ~(a < z_new && z_new < b), z_new = 0.5 * (a + b); end
     if abs(z_new - z) <= 4e-16 * (1.0 + abs(z)) || b - a <= 4e-16 * (1.0 + abs(z))
         z = z_new;
