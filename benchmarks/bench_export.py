@@ -2,6 +2,7 @@
 
 Run:  python benchmarks/bench_export.py [--quick]     (writes benchmarks/last_run_export.txt)
       python benchmarks/bench_export.py --octave [--before REV] [--rounds N] [--samples N]
+            [--families NAME ...] [--out FILE]
             (the Octave table alone; appends a dated section to benchmarks/last_run_export.txt)
 
 Compensators are fitted (direct mode, centring fit) on the virtual sensor's sine run, as in
@@ -250,8 +251,14 @@ def _octave_main(args: argparse.Namespace) -> None:
     version = subprocess.run(["octave", "--version"], check=True, capture_output=True,
                              text=True).stdout.splitlines()[0]
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
+    git = ["git", "-C", str(HERE.parent)]
+    head_rev = subprocess.run([*git, "rev-parse", "--short", "HEAD"], check=True,
+                              capture_output=True, text=True).stdout.strip()
+    dirty = subprocess.run([*git, "status", "--porcelain", "src"], check=True,
+                           capture_output=True, text=True).stdout.strip()
+    after = f"this tree, HEAD {head_rev}{' + uncommitted src' if dirty else ''}"
     head = [(f"## {datetime.date.today()}: Octave table ({version}; --before {args.before}, "
-             f"after = this tree)"),
+             f"after = {after})"),
             (f"# {platform.processor() or platform.machine()}, {os.cpu_count()} cores, load "
              f"{load}; {args.samples} samples of the noise run (seed 2), {args.rounds} rounds "
              f"alternating A B / B A in one Octave process; cpu µs per sample, medians; ratio: "
