@@ -101,9 +101,10 @@ for it = 1:200
     h = sign_ * r;
     if h == 0, break; end
     if h < 0, a = z; else, b = z; end
-    if dg ~= 0, z_new = z - r / dg; else, z_new = NaN; end
+    z_new = z - r / dg;  % dg = 0 gives +-Inf (r is not 0): outside (a, b), as NaN would be
     if ~(a < z_new && z_new < b), z_new = 0.5 * (a + b); end
-    if abs(z_new - z) <= 4e-16 * (1.0 + abs(z)) || b - a <= 4e-16 * (1.0 + abs(z))
+    near = 4e-16 * (1.0 + abs(z));
+    if abs(z_new - z) <= near || b - a <= near
         z = z_new;
         break;
     end
