@@ -4,6 +4,7 @@ translation, as subfunctions.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from textwrap import indent
 
@@ -25,9 +26,10 @@ def m_model(plan, lit: Callable[[float], str]) -> str:
     f0 = "; ".join(str(i_a + (k * levels + levels - 1) * levels) for k in range(n_tab))
     consts = {"@CAP@": str(cap), "@LEV@": str(levels), "@K@": str(n_tab),
               "@IA@": str(i_a), "@RT@": lit(REST_TOL), "@SCALE@": lit(0.5 * (levels - 1)),
-              "@KL@": f"[{tables}]" if n_tab > 1 else tables, "@F0@": f"[{f0}]",
-              "@COMBINE@": _combine(plan.body[3] != 0, n_tab, n_poly)}
-    code = _M_COMMON + (_M_INVERSE if plan.inverse else _M_FORWARD)
+              "@KL@": f"[{tables}]" if n_tab > 1 else tables, "@F0@": f"[{f0}]"}
+    combine = _combine(plan.body[3] != 0, n_tab, [lit(v) for v in plan.body[7:7 + n_poly]])
+    code = re.sub(r"^( *)@COMBINE@", lambda found: indent(combine, found.group(1)),
+                  _M_COMMON + (_M_INVERSE if plan.inverse else _M_FORWARD), flags=re.MULTILINE)
     for key, value in consts.items():
         code = code.replace(key, value)
     return f"""function x = model_rest(B, value)
@@ -41,25 +43,38 @@ end
 """.replace("@CAP@", str(cap)).replace("@K@", str(n_tab)) + code
 
 
-def _combine(weighted: bool, n_tab: int, n_poly: int) -> str:
+def _combine(weighted: bool, n_tab: int, poly: list[str]) -> str:
     """``y = combine(acc, u)`` (kernels.combine): the weight interpolated between tables 0 and
-    1 if weighted, plus the polynomial in u by Horner from ``r = 0`` (the body says which)."""
+    1 if weighted, plus the polynomial in u (coefficients ``poly``, literals) by Horner from
+    ``r = 0`` (the body says which)."""
     parts = (f"w = 0.5 * (1.0 + u);\ny = (1.0 - w) * acc(1) + w * acc({min(2, n_tab)});\n"
              if weighted else "y = acc(1);\n")
     horner = "0.0"
-    for i in range(n_poly - 1, -1, -1):
-        horner = f"{horner} * u + B({8 + i})" if horner == "0.0" else f"({horner}) * u + B({8 + i})"
+    for i, coefficient in enumerate(reversed(poly)):
+        horner = f"0.0 * u + {coefficient}" if i == 0 else f"({horner}) * u + {coefficient}"
     return parts + f"y = y + ({horner});\n"
 
 
-def _everett(a: str, b: str) -> str:
-    """``E`` = E_k(a, b) of every table k (a column), bilinear in A_k (kernels._everett)."""
-    return f"""xa = ({a} + 1.0) * @SCALE@; xb = ({b} + 1.0) * @SCALE@;
-ia = min(fix(xa), @LEV@ - 2); ib = min(fix(xb), @LEV@ - 2);
-sa = xa - ia; sb = xb - ib;
-i0 = @IA@ + (@KL@ + ia) * @LEV@ + ib;
+def _everett(a: str, b: str, a_at: str = "", b_at: str = "") -> str:
+    """``E`` = E_k(a, b) of every table k (a column), bilinear in A_k (kernels._everett). An
+    argument that is the staircase's ``s(j)`` (``a_at`` or ``b_at`` = j) takes its grid cell
+    from ``is_(j)``, ``ss(j)``, computed once a step by the same operations (:data:`_GRID`)."""
+    grid_a = (f"ia = is_({a_at}); sa = ss({a_at});\n" if a_at else
+              f"xa = ({a} + 1.0) * @SCALE@; ia = min(fix(xa), @LEV@ - 2); sa = xa - ia;\n")
+    grid_b = (f"ib = is_({b_at}); sb = ss({b_at});\n" if b_at else
+              f"xb = ({b} + 1.0) * @SCALE@; ib = min(fix(xb), @LEV@ - 2); sb = xb - ib;\n")
+    return grid_a + grid_b + """i0 = @IA@ + (@KL@ + ia) * @LEV@ + ib;
 E = ((1.0 - sa) * ((1.0 - sb) * B(i0) + sb * B(i0 + 1)) ...
      + sa * ((1.0 - sb) * B(i0 + @LEV@) + sb * B(i0 + @LEV@ + 1)));
+"""
+
+
+# What the branch output reads of the staircase s, once a step: its entries above the first
+# (s_1, s_3, ...) and below (s_0, s_2, ...) as candidates, each entry's grid cell and offset,
+# -A_k(L - 1, 0)
+_GRID = """s_up = s(2:2:n - 1); s_down = s(1:2:n - 1);
+xs = (s + 1.0) * @SCALE@; is_ = min(fix(xs), @LEV@ - 2); ss = xs - is_;
+f0 = -B(@F0@);
 """
 
 
@@ -144,25 +159,25 @@ end
 # The maxima on the staircase fall and its minima rise (wiping-out), so the ones above (below) u
 # are a prefix and their count gives the last one, as kernels._last_index's binary search does.
 _BRANCH = f"""if u >= s(n)
-    i = 2 * sum(s(2:2:n - 1) > u);
-{indent(_everett("u", "s(i + 1)"), "    ")}    if i > 0
-        acc = -B(@F0@) + 2.0 * (R(:, i + 1) + E);
+    i = 2 * sum(s_up > u);
+{indent(_everett("u", "", b_at="i + 1"), "    ")}    if i > 0
+        acc = f0 + 2.0 * (R(:, i + 1) + E);
     else
-        acc = -B(@F0@) + 2.0 * (0.0 + E);
+        acc = f0 + 2.0 * (0.0 + E);
     end
 else
-    i = 2 * sum(s(1:2:n - 1) < u) - 2;
+    i = 2 * sum(s_down < u) - 2;
     if i < 0
-        acc = -B(@F0@);
+        acc = f0;
     else
-{indent(_everett("s(i + 2)", "u"), "        ")}        acc = -B(@F0@) + 2.0 * (R(:, i + 2) - E);
+{indent(_everett("", "u", a_at="i + 2"), "        ")}        acc = f0 + 2.0 * (R(:, i + 2) - E);
     end
 end
 @COMBINE@"""
 
 _M_INVERSE = f"""
 function y = branch_output(B, u, s, n, R)
-{_BRANCH}end
+{_GRID}{_BRANCH}end
 
 function [u_hat, x] = model_step(B, x, target)
 slope = B(5); tol = B(6);
@@ -172,7 +187,7 @@ R = reshape(x(2 + @CAP@:1 + @CAP@ + (n - 1) * @K@), @K@, n - 1);
 if n >= 2
     R(:, n) = R(:, n - 1) + term(B, s(n - 1), s(n));
 end
-last = s(n);
+{_GRID}last = s(n);
 lo = 0.0; hi = 0.0; y_lo = 0.0; y_hi = 0.0; u_hat = last;
 y_now = branch_output(B, last, s, n, R);
 if abs(target - y_now) <= @RT@ * max(1.0, abs(y_now))
