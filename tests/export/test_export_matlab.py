@@ -15,16 +15,18 @@ from hystkit.export import make_plan, matlab_files
 from .export_support import CENTRINGS, MODE_CASES, need
 
 N_BLOCK = 300  # samples run through NAME_block (one Octave call per sample: slow)
-# The Preisach inverses bisect ~40 times a sample: 80 s per 8000 samples in Octave. Its tare
+# The Preisach inverses bisect ~40 times a sample: 1.0-1.3 ms a sample in Octave (3-4.8 ms
+# before issue 28.5; benchmarks/bench_export.py --octave), ~9 s per 8000 samples. Its tare
 # and track runs are checked on the first 1000 samples (causal: the estimate's prefix), which
 # hold the whole tare window and the tracker's start; fit on the first 2000 of the 8000 noise
-# samples (the C export runs all 8000 through the same bisection, tests/export/test_export_c.py;
-# the whole run here took 75-111 s per case, the suite's slowest tests).
+# samples (the C export runs all 8000 through the same bisection, tests/export/test_export_c.py).
+# Kept so after 28.5 made the MATLAB 3-3.7x faster: the saving goes to the suite's time.
 N_SAMPLES = {(family, "inverse", center): 1000 for family in ("preisach", "gpreisach")
              for center in ("tare", "track")}
 N_SAMPLES.update({(family, "inverse", "fit"): 2000 for family in ("preisach", "gpreisach")})
-# The Chua inverse bisects twice a sample (~100 evaluations of every element): its MATLAB run
-# (an addition beyond the issue's families) is checked on the first 1500 samples.
+# The Chua inverse bisects once or twice a sample (~50-100 evaluations of every element, ~1 ms
+# a sample in Octave, 7.7 ms before issue 28.5): its MATLAB run (an addition beyond the issue's
+# families) is checked on the first 1500 samples.
 N_SAMPLES.update({("chua", "inverse", center): 1500 for center in CENTRINGS})
 
 

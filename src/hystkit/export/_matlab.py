@@ -18,6 +18,8 @@ The arithmetic repeats :meth:`Compensator.estimate` in the same order as the C e
 
 from __future__ import annotations
 
+from textwrap import indent
+
 import numpy as np
 
 from ._comments import comment_text
@@ -60,31 +62,36 @@ def _constants(plan: ExportPlan) -> dict[str, str]:
     return {k: lit(v) for k, v in plan.constants.items()}
 
 
-def _centring(plan: ExportPlan) -> str:
+def _normalise(plan: ExportPlan, st: str, sensor: str = "sensor", s: str = "s") -> str:
+    """Code setting ``s`` from ``sensor``, the centring's state in ``{st}sum_z`` etc. (``st.``
+    in the function below; the chunk's loop keeps it in plain variables, ``st`` empty)."""
     c = _constants(plan)
     if plan.center in ("fit", "none"):
         offset = c["SENSOR_OFFSET"]
         level = ""
     else:
-        offset = f"(({c['SENSOR_OFFSET']} + st.level) - {c['SENSOR_REFERENCE']})"
+        offset = f"(({c['SENSOR_OFFSET']} + {st}level) - {c['SENSOR_REFERENCE']})"
         if plan.center == "tare":
-            level = f"""if st.n_seen < {int(plan.constants['N_TARE'])}
-    st.sum_z = st.sum_z + sensor;
-    st.n_seen = st.n_seen + 1;
-    st.level = st.sum_z / st.n_seen;
+            level = f"""if {st}n_seen < {int(plan.constants['N_TARE'])}
+    {st}sum_z = {st}sum_z + {sensor};
+    {st}n_seen = {st}n_seen + 1;
+    {st}level = {st}sum_z / {st}n_seen;
 end
 """
         else:
-            level = f"""num = st.sum_z + {c['TRACK_A']} * sensor;
-den = st.weight_z + {c['TRACK_A']} * 1.0;
-st.sum_z = sensor * 0.0 - num * {c['TRACK_A1']};
-st.weight_z = 0.0 - den * {c['TRACK_A1']};
-st.level = num / den;
+            level = f"""num = {st}sum_z + {c['TRACK_A']} * {sensor};
+den = {st}weight_z + {c['TRACK_A']} * 1.0;
+{st}sum_z = {sensor} * 0.0 - num * {c['TRACK_A1']};
+{st}weight_z = 0.0 - den * {c['TRACK_A1']};
+{st}level = num / den;
 """
+    return f"{level}{s} = ({c['POLARITY']} * ({sensor} - {offset})) / {c['SENSOR_SCALE']};\n"
+
+
+def _centring(plan: ExportPlan) -> str:
     return f"""function [s, st] = normalised(st, sensor)
 % the model's input: offset removed, flipped by the polarity, scaled (eq. 5.10)
-{level}s = ({c['POLARITY']} * (sensor - {offset})) / {c['SENSOR_SCALE']};
-end
+{_normalise(plan, "st.")}end
 """
 
 
@@ -154,17 +161,34 @@ end
 """
 
 
+_CENTRING_STATE = ("level", "sum_z", "weight_z", "n_seen")
+
+
 def _chunk(plan: ExportPlan) -> str:
+    """``NAME.m``. Octave interprets every statement and call, so only what carries state runs
+    per sample: the model step (a call), a drifting centring and the band (in the loop); a
+    fixed centring, the estimate and the flags are array operations on the whole chunk, the
+    same arithmetic per sample."""
     n, c = plan.name, _constants(plan)
     if plan.band is None:
-        outputs, doc, start, step, sub = "[estimate, state, flags]", "", "", "", ""
+        outputs, doc, start, step, sub, band = "[estimate, state, flags]", "", "", "", "", ""
     else:
         outputs = "[estimate, state, flags, lower, upper]"
         doc = (f"% lower, upper: the prediction band [mm] of each estimate at nominal level "
                f"{plan.band['LEVEL']:g}; its\n% features are carried in state.\n")
-        start = "lower = zeros(size(sensor));\nupper = zeros(size(sensor));\n"
-        step = "    [h, state] = band_half(state, s);\n"
+        start = "h = zeros(size(sensor));\n"
+        step = "    [h(i), state] = band_half(state, s);\n"
         sub = "\n" + _band(plan)
+        band = "lower = estimate - h;\nupper = estimate + h;\n"
+    if plan.center in ("fit", "none"):  # s depends on the sample alone
+        before = _normalise(plan, "", "sensor", "u")
+        per_sample = "    s = u(i);\n"
+        load = save = ""
+    else:
+        before = "u = zeros(size(sensor));\n"
+        per_sample = indent(_normalise(plan, "", "sensor(i)"), "    ") + "    u(i) = s;\n"
+        load = "".join(f"{f} = state.{f}; " for f in _CENTRING_STATE)[:-1] + "\n"
+        save = "".join(f"state.{f} = {f}; " for f in _CENTRING_STATE)[:-1] + "\n"
     return _comment(plan, f"{n}.m") + f"""function {outputs} = {n}(sensor, state)
 % [estimate, state, flags] = {n}(sensor, state): position estimates [mm] for a chunk of sensor
 % samples. state omitted or [] starts at rest at sensor(1) ({n}_init); pass the returned state
@@ -174,24 +198,18 @@ def _chunk(plan: ExportPlan) -> str:
     state = {n}_init(sensor(1));
 end
 B = body();
-estimate = zeros(size(sensor));
-flags = zeros(size(sensor));
+p = zeros(size(sensor));
 {start}x = state.x;
-for i = 1:numel(sensor)
-    [s, state] = normalised(state, sensor(i));
-{step}    [p, x] = model_step(B, x, s);
-    e = p * {c['POSITION_SCALE']} + {c['POSITION_OFFSET']};
-    f = 0;
-    if s < {c['SENSOR_LOW']} || s > {c['SENSOR_HIGH']}, f = f + 1; end
-    if e < {c['ESTIMATE_LOW']} || e > {c['ESTIMATE_HIGH']}, f = f + 2; end
-    if ~(abs(p) <= {c['MAX_NORMALISED']}) || ~isfinite(e), f = f + 4; end
-    estimate(i) = e;
-    flags(i) = f;
-{"    lower(i) = e - h;" + chr(10) + "    upper(i) = e + h;" + chr(10) if plan.band else ""}end
-state.x = x;
+{load}{before}for i = 1:numel(sensor)
+{per_sample}{step}    [p(i), x] = model_step(B, x, s);
 end
+state.x = x;
+{save}estimate = p * {c['POSITION_SCALE']} + {c['POSITION_OFFSET']};
+flags = (u < {c['SENSOR_LOW']} | u > {c['SENSOR_HIGH']}) ...
+        + 2 * (estimate < {c['ESTIMATE_LOW']} | estimate > {c['ESTIMATE_HIGH']}) ...
+        + 4 * (~(abs(p) <= {c['MAX_NORMALISED']}) | ~isfinite(estimate));
+{band}end
 {sub}
-{_centring(plan)}
 {_body(plan)}
 {plan.translation.m_model(plan, lit)}"""
 

@@ -42,7 +42,7 @@ C_KEYWORDS = frozenset(
 # subfunctions every export defines (a family's own are its Translation.m_functions).
 _MATLAB_TAKEN = frozenset([
     "abs", "sinh", "cosh", "exp", "log", "tanh", "asinh", "max", "min", "fix", "round", "sum",
-    "zeros", "ones", "numel", "isempty", "isfinite", "struct", "end",
+    "zeros", "ones", "numel", "isempty", "isfinite", "struct", "end", "any", "cumsum", "reshape",
     "body", "normalised", "model_step", "model_rest", "model_load", "band_half",
     # NAME_step of the C side would clash with its static model_step
     "model"])

@@ -68,37 +68,43 @@ end
 
 """
 
+# cubic(g, z) written out as g0 + z (g1 + z (g2 + z g3)): a call per Newton step costs more than
+# the arithmetic in Octave, which interprets each one
 M_SOLVE = """function [z, ok] = solve_output(B, i)
-g = B(10:13); lo = B(6); hi = B(7); sign_ = B(8); centre = B(9);
+g0 = B(10); g1 = B(11); g2 = B(12); g3 = B(13);
+lo = B(6); hi = B(7); sign_ = B(8); centre = B(9);
 z = NaN; ok = false;
 width = 1.0;
 if isfinite(lo), a = lo; else, a = centre - width; end
-h_a = sign_ * (cubic(g, a) - i);
+h_a = sign_ * ((g0 + a * (g1 + a * (g2 + a * g3))) - i);
 while h_a > 0
     if isfinite(lo) || width > 1e15, return; end
     width = width * 2.0;
     a = centre - width;
-    h_a = sign_ * (cubic(g, a) - i);
+    h_a = sign_ * ((g0 + a * (g1 + a * (g2 + a * g3))) - i);
 end
 width = 1.0;
 if isfinite(hi), b = hi; else, b = centre + width; end
-h_b = sign_ * (cubic(g, b) - i);
+h_b = sign_ * ((g0 + b * (g1 + b * (g2 + b * g3))) - i);
 while h_b < 0
     if isfinite(hi) || width > 1e15, return; end
     width = width * 2.0;
     b = centre + width;
-    h_b = sign_ * (cubic(g, b) - i);
+    h_b = sign_ * ((g0 + b * (g1 + b * (g2 + b * g3))) - i);
 end
-if g(2) ~= 0, z = (i - g(1)) / g(2); else, z = NaN; end
+if g1 ~= 0, z = (i - g0) / g1; else, z = NaN; end
 if ~(a < z && z < b), z = 0.5 * (a + b); end
+g2_2 = 2.0 * g2; g3_3 = 3.0 * g3;
 for it = 1:200
-    [gz, dg] = cubic(g, z);
-    h = sign_ * (gz - i);
+    r = (g0 + z * (g1 + z * (g2 + z * g3))) - i;
+    dg = g1 + z * (g2_2 + g3_3 * z);
+    h = sign_ * r;
     if h == 0, break; end
     if h < 0, a = z; else, b = z; end
-    if dg ~= 0, z_new = z - (gz - i) / dg; else, z_new = NaN; end
+    z_new = z - r / dg;  % dg = 0 gives +-Inf (r is not 0): outside (a, b), as NaN would be
     if ~(a < z_new && z_new < b), z_new = 0.5 * (a + b); end
-    if abs(z_new - z) <= 4e-16 * (1.0 + abs(z)) || b - a <= 4e-16 * (1.0 + abs(z))
+    near = 4e-16 * (1.0 + abs(z));
+    if abs(z_new - z) <= near || b - a <= near
         z = z_new;
         break;
     end

@@ -7,6 +7,7 @@ Body: ``[m, c, k, alpha, beta, gamma, nu, dt, substeps, linear]``; state ``(y, v
 from __future__ import annotations
 
 from collections.abc import Callable
+from textwrap import indent
 
 from .._protocol import Translation
 
@@ -71,39 +72,39 @@ static real model_step(real *x, real u)
 """
 
 
+def _m_rhs(k: int, y: str, v: str, z: str, u: str) -> str:
+    """The Bouc-Wen right-hand side at (y, v, z, u) into kKy, kKv, kKz (the kernel's ``rhs``,
+    written out: Octave would spend more on the call than on the arithmetic)."""
+    return f"""yy = {y}; vv = {v}; zz = {z};
+if nu == 1.0, p = abs(zz); else, p = exp(nu * log(abs(zz))); end
+if zz >= 0.0, q = p; else, q = -p; end
+k{k}z = alpha * vv - beta * abs(vv) * q - gamma * vv * p;
+k{k}y = vv;
+k{k}v = ({u} - c * vv - k_ * yy - zz) * (1.0 / m);  % as the kernel: times 1 / m
+"""
+
+
 def m_model(plan, lit: Callable[[float], str]) -> str:
     e = plan.extra
     rest = (f"y0 = value / {lit(e['K0'])};\nx = [y0; 0.0; {lit(e['ALPHA'])} * y0; value];"
             if e["EQUILIBRIUM"] else "x = [0.0; 0.0; 0.0; value];")
+    stages = (_m_rhs(1, "y", "v", "z", "u0")
+              + _m_rhs(2, "y + 0.5 * h * k1y", "v + 0.5 * h * k1v", "z + 0.5 * h * k1z", "u1")
+              + _m_rhs(3, "y + 0.5 * h * k2y", "v + 0.5 * h * k2v", "z + 0.5 * h * k2z", "u1")
+              + _m_rhs(4, "y + h * k3y", "v + h * k3v", "z + h * k3z", "u2"))
     return f"""function x = model_rest(B, value)
 {rest}
 end
 
-function [dy, dv, dz] = rhs(B, y, v, z, u)
-m = B(1); c = B(2); k = B(3); alpha = B(4); beta = B(5); gamma = B(6); nu = B(7);
-if nu == 1.0
-    p = abs(z);
-else
-    p = exp(nu * log(abs(z)));
-end
-if z >= 0.0, q = p; else, q = -p; end
-dz = alpha * v - beta * abs(v) * q - gamma * v * p;
-dy = v;
-dv = (u - c * v - k * y - z) * (1.0 / m);  % as the kernel: times 1 / m
-end
-
 function [out, x] = model_step(B, x, u)
+m = B(1); c = B(2); k_ = B(3); alpha = B(4); beta = B(5); gamma = B(6); nu = B(7);
 n_sub = fix(B(9));
 h = B(8) / n_sub; u_a = x(4);
 if B(10) ~= 0, du = (u - u_a) / n_sub; else, du = 0.0; end
 y = x(1); v = x(2); z = x(3);
 for j = 0:n_sub - 1
     u0 = u_a + j * du; u1 = u0 + 0.5 * du; u2 = u0 + du;
-    [k1y, k1v, k1z] = rhs(B, y, v, z, u0);
-    [k2y, k2v, k2z] = rhs(B, y + 0.5 * h * k1y, v + 0.5 * h * k1v, z + 0.5 * h * k1z, u1);
-    [k3y, k3v, k3z] = rhs(B, y + 0.5 * h * k2y, v + 0.5 * h * k2v, z + 0.5 * h * k2z, u1);
-    [k4y, k4v, k4z] = rhs(B, y + h * k3y, v + h * k3v, z + h * k3z, u2);
-    y = y + h / 6.0 * (k1y + 2.0 * k2y + 2.0 * k3y + k4y);
+{indent(stages, "    ")}    y = y + h / 6.0 * (k1y + 2.0 * k2y + 2.0 * k3y + k4y);
     v = v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
     z = z + h / 6.0 * (k1z + 2.0 * k2z + 2.0 * k3z + k4z);
 end
@@ -117,6 +118,5 @@ end
 TRANSLATION = Translation(
     c_model=c_model,
     m_model=m_model,
-    m_functions=("rhs",),
     extra=extra,
     inverse=False)

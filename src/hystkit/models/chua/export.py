@@ -170,134 +170,145 @@ static real model_step(real *x, real y)
 """
 
 
-def m_model(plan, lit: Callable[[float], str]) -> str:
-    e = plan.extra
-    value = "rest_input(B, value)" if plan.inverse else "value"
-    step = (_M_INVERSE.replace("@MAXK@", lit(e["MAX_K"])).replace("@MAXS@",
-                                                                   lit(e["MAX_SPREAD"]))
-            .replace("@RT@", lit(REST_TOL)) if plan.inverse else _M_FORWARD)
-    return f"""function x = model_rest(B, value)
-u = {value};
-n = round(B(1));
-x = zeros(n, 1);
-for k = 1:n
-    x(k) = restoring_inverse(B, u, k);
+# MATLAB works on all elements at once (column vectors): Octave interprets every statement
+# and call, so a bisection step is two array statements instead of a call per element and
+# parameter. Each element's arithmetic is the scalar C's, operation for operation (s * g * v_g
+# * sinh(t) equals s * ((g * v_g) * sinh(t) + 0) for s = +-1), so the numbers are the same.
+
+def _m_params(n: int) -> str:
+    names = ("k0", "k_inf", "y_s", "g", "v_g", "band", "knee", "cap")
+    slices = "\n".join(f"{name} = B({3 + i * n}:{2 + (i + 1) * n});"
+                       for i, name in enumerate(names))
+    return f"""function [k0, k_inf, y_s, gv, v_g, band, knee, cap, gk] = params(B)
+% every element's parameters (body [N, dt, k0, k_inf, y_s, g, v_g, delta, knee, cap]), gv = g
+% v_g and gk, the dissipation at the knee
+{slices}
+gv = g .* v_g;
+gk = gv .* sinh((knee - band) ./ v_g);
 end
+"""
+
+
+# g_k(v_k) of every element, a = |v|: 0 in the dead band, the sinh up to the knee, then the
+# straight line (kernels._dissipation; knee >= band; a NaN v gives NaN, as there)
+_M_DISSIPATION = ("(2.0 * (v > 0) - 1.0) .* (gv .* sinh((min(max(a, band), knee) - band) ./ v_g)"
+                  " + cap .* ((a - knee) .* (a > knee)))")
+
+_M_COMMON = """function f = restoring(y, k0, k_inf, y_s)
+f = k_inf .* y + (k0 - k_inf) .* y_s .* tanh(y ./ y_s);
 end
 
-function v = P(B, i, k)
-v = B(3 + i * round(B(1)) + k - 1);
-end
-
-function f = restoring(B, y, k)
-f = P(B, 1, k) * y + (P(B, 0, k) - P(B, 1, k)) * P(B, 2, k) * tanh(y / P(B, 2, k));
-end
-
-function y = restoring_inverse(B, u, k)
-spread = abs(P(B, 0, k) - P(B, 1, k)) * P(B, 2, k);
-lo = (u - spread) / P(B, 1, k); hi = (u + spread) / P(B, 1, k);
-while hi - lo > 1e-16 * (1.0 + abs(lo) + abs(hi))
+function y = restoring_inverse(u, k0, k_inf, y_s)
+% f_k^-1(u) of every element, each its own bisection (kernels.restoring_inverse)
+spread = abs(k0 - k_inf) .* y_s;
+lo = (u - spread) ./ k_inf; hi = (u + spread) ./ k_inf;
+go = hi - lo > 1e-16 * (1.0 + abs(lo) + abs(hi));
+while any(go)
     mid = 0.5 * (lo + hi);
-    if mid <= lo || mid >= hi, break; end
-    if restoring(B, mid, k) >= u, hi = mid; else, lo = mid; end
+    go = go & ~(mid <= lo | mid >= hi);
+    up = go & (restoring(mid, k0, k_inf, y_s) >= u);
+    down = go & ~up;
+    hi(up) = mid(up);
+    lo(down) = mid(down);
+    go = go & (hi - lo > 1e-16 * (1.0 + abs(lo) + abs(hi)));
 end
 y = 0.5 * (lo + hi);
 end
 
-function d = dissipation(B, v, k)
-g = P(B, 3, k); v_g = P(B, 4, k); band = P(B, 5, k); knee = P(B, 6, k); cap = P(B, 7, k);
+function d = dissipation(v, gv, v_g, band, knee, cap)
 a = abs(v);
-if a <= band
-    d = 0.0;
-    return;
+d = @DISSIPATION@;
 end
-if v > 0, s = 1.0; else, s = -1.0; end
-if a <= knee
-    d = s * g * v_g * sinh((a - band) / v_g);
-else
-    d = s * (g * v_g * sinh((knee - band) / v_g) + cap * (a - knee));
+"""
+
+
+def m_model(plan, lit: Callable[[float], str]) -> str:
+    e = plan.extra
+    value = "rest_input(value, k0, k_inf, y_s)" if plan.inverse else "value"
+    step = (_M_INVERSE.replace("@MAXK@", lit(e["MAX_K"])).replace("@MAXS@",
+                                                                   lit(e["MAX_SPREAD"]))
+            .replace("@RT@", lit(REST_TOL)) if plan.inverse else _M_FORWARD)
+    return (f"""function x = model_rest(B, value)
+[k0, k_inf, y_s] = params(B);
+x = restoring_inverse({value}, k0, k_inf, y_s);
 end
-end
-{step}"""
+
+{_m_params(int(plan.body[0]))}
+""" + _M_COMMON + step).replace("@DISSIPATION@", _M_DISSIPATION)
 
 
 _M_FORWARD = """
 function [acc, x] = model_step(B, x, u)
-acc = 0.0;
-for k = 1:round(B(1))
-    v = u - restoring(B, x(k), k);
-    x(k) = x(k) + B(2) * dissipation(B, v, k);
-    acc = acc + x(k);
-end
+[k0, k_inf, y_s, gv, v_g, band, knee, cap] = params(B);
+x = x + B(2) * dissipation(u - restoring(x, k0, k_inf, y_s), gv, v_g, band, knee, cap);
+acc = sum(x);
 end
 """
 
+# The two bisections (first u with rate >= r, last with rate <= r) take the same steps until
+# a rate equals r: without such a tie the second one's end is the first one's lower end.
 _M_INVERSE = """
-function u = rest_input(B, y0)
-n = round(B(1));
+function u = rest_input(y0, k0, k_inf, y_s)
+n = numel(k0);
 span = (abs(y0) + 1.0) * @MAXK@ + @MAXS@;
 lo = -span * n; hi = span * n;
 while hi - lo > 1e-16 * (1.0 + abs(lo) + abs(hi))
     mid = 0.5 * (lo + hi);
     if mid <= lo || mid >= hi, break; end
-    total = 0.0;
-    for k = 1:n
-        total = total + restoring_inverse(B, mid, k);
-    end
-    if total >= y0, hi = mid; else, lo = mid; end
+    if sum(restoring_inverse(mid, k0, k_inf, y_s)) >= y0, hi = mid; else, lo = mid; end
 end
 u = 0.5 * (lo + hi);
 end
 
-function v = dissipation_inverse(B, r, k, upper)
-g = P(B, 3, k); v_g = P(B, 4, k); band = P(B, 5, k); knee = P(B, 6, k); cap = P(B, 7, k);
+function v = dissipation_inverse(r, gv, v_g, band, knee, cap, gk, upper)
+% the smallest (upper false) or largest v_k with g_k(v_k) = r, every element
 if r == 0
     if upper, v = band; else, v = -band; end
     return;
 end
 if r > 0, s = 1.0; else, s = -1.0; end
 a = abs(r);
-g_knee = g * v_g * sinh((knee - band) / v_g);
-if a <= g_knee
-    v = s * (band + v_g * asinh(a / (g * v_g)));
-else
-    v = s * (knee + (a - g_knee) / cap);
-end
+v = s * (band + v_g .* asinh(a ./ gv));
+far = ~(a <= gk);
+v(far) = s * (knee(far) + (a - gk(far)) ./ cap(far));
 end
 
 function [e, x] = model_step(B, x, y)
-n = round(B(1)); dt = B(2);
-fx = zeros(n, 1); total = 0.0; scale = 0.0;
-for k = 1:n
-    fx(k) = restoring(B, x(k), k);
-    total = total + x(k);
-    scale = scale + abs(x(k));
-end
-if abs(y - total) <= @RT@ * max([1.0, abs(y), scale]), y = total; end
+[k0, k_inf, y_s, gv, v_g, band, knee, cap, gk] = params(B);
+n = numel(x); dt = B(2);
+fx = restoring(x, k0, k_inf, y_s);
+total = sum(x);
+if abs(y - total) <= @RT@ * max([1.0, abs(y), sum(abs(x))]), y = total; end
 r = (y - total) / dt;
-lo = Inf; hi = -Inf;
-for k = 1:n
-    lo = min(lo, fx(k) + dissipation_inverse(B, r / n, k, false));
-    hi = max(hi, fx(k) + dissipation_inverse(B, r / n, k, true));
-end
+lo = min(fx + dissipation_inverse(r / n, gv, v_g, band, knee, cap, gk, false));
+hi = max(fx + dissipation_inverse(r / n, gv, v_g, band, knee, cap, gk, true));
 ends = [0.0, 0.0];
+tie = false;
 for side = 0:1
-    a = lo; b = hi;
-    while b - a > 1e-14 * (1.0 + abs(a) + abs(b))
-        m = 0.5 * (a + b);
-        if m <= a || m >= b, break; end
-        rate = 0.0;
-        for k = 1:n
-            rate = rate + dissipation(B, m - fx(k), k);
-        end
-        if rate > r || (side == 0 && rate == r), b = m; else, a = m; end
+    if side == 1 && ~tie
+        ends(2) = a_;
+        break;
     end
-    if side == 0, ends(1) = b; else, ends(2) = a; end
+    a_ = lo; b_ = hi;
+    while b_ - a_ > 1e-14 * (1.0 + abs(a_) + abs(b_))
+        m = 0.5 * (a_ + b_);
+        if m <= a_ || m >= b_, break; end
+        v = m - fx;
+        a = abs(v);
+        rate = sum(@DISSIPATION@);
+        if rate > r
+            b_ = m;
+        elseif rate == r
+            tie = true;
+            if side == 0, b_ = m; else, a_ = m; end
+        else
+            a_ = m;
+        end
+    end
+    if side == 0, ends(1) = b_; else, ends(2) = a_; end
 end
 e = 0.5 * (ends(1) + ends(2));
-for k = 1:n
-    x(k) = x(k) + dt * dissipation(B, e - fx(k), k);
-end
+x = x + dt * dissipation(e - fx, gv, v_g, band, knee, cap);
 end
 """
 
@@ -306,6 +317,6 @@ end
 TRANSLATION = Translation(
     c_model=c_model,
     m_model=m_model,
-    m_functions=("P", "dissipation", "dissipation_inverse", "rest_input", "restoring",
+    m_functions=("dissipation", "dissipation_inverse", "params", "rest_input", "restoring",
                  "restoring_inverse"),
     extra=extra)

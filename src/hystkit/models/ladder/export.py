@@ -56,8 +56,11 @@ static real model_step(real *x, real u)
 
 def m_model(plan, lit: Callable[[float], str]) -> str:
     w_sum = plan.extra["W_SUM"]
+    n = int(plan.body[0])
     rest = ("value" if not plan.inverse else
             f"(value + B(2)) / {lit(w_sum)}" if w_sum != 0 else "0.0")
+    # every dead zone at once (Octave interprets each call): zone 1 between the drive and
+    # cell 1, zone k + 1 between cells k and k + 1, all from the states before the step
     return f"""function x = model_rest(B, value)
 x = ({rest}) * ones(round(B(1)), 1);
 end
@@ -66,26 +69,16 @@ function [out, x] = model_step(B, x, u)
 n = round(B(1));
 iw = 4 + 2 * n;
 {m_linear_readout(plan.inverse)}
-i_in = dead_zone(B, drive - x(1), 1, n);
-for k = 1:n
-    i_out = 0.0;
-    if k < n
-        i_out = dead_zone(B, x(k) - x(k + 1), k + 1, n);
-    end
-    x(k) = x(k) + B(3) * (i_in - i_out);
-    i_in = i_out;
-end
+i = dead_zone([drive - x(1); x(1:{n - 1}) - x(2:{n})], B(4:{3 + n}), B({4 + n}:{3 + 2 * n}));
+x = x + B(3) * (i - [i(2:{n}); 0.0]);
 end
 
-function i = dead_zone(B, v, k, n)
-band = B(3 + k); g = B(3 + n + k);
-if v > band
-    i = g * (v - band);
-elseif v < -band
-    i = g * (v + band);
-else
-    i = 0.0;
-end
+function i = dead_zone(v, band, g)
+i = zeros(size(v));
+up = v > band;
+i(up) = g(up) .* (v(up) - band(up));
+down = ~up & v < -band;
+i(down) = g(down) .* (v(down) + band(down));
 end
 """
 

@@ -101,19 +101,21 @@ static real model_step(real *x, real u)
 """
 
 
-# The limited sinh resistor (eq. 5.1 with eq. 5.29) in MATLAB: f from v, i_s, v_t, knee, cap
-# (mpl-g's cells use it too).
-M_SINH_CURRENT = """if abs(v) <= knee
-    f = 2.0 * i_s * sinh(v / v_t);
-else
-    s = -1.0; if v > 0, s = 1.0; end
-    f = s * 2.0 * i_s * sinh(knee / v_t) + cap * (v - s * knee);
+# The limited sinh resistor (eq. 5.1 with eq. 5.29) in MATLAB: f of every cell at once (column
+# vectors v, i_s, v_t, knee; cap a number), each cell's arithmetic the C's (mpl-g's cells use it
+# too). Octave interprets each statement and call: array operations, not a call per cell.
+M_SINH_CURRENT = """f = 2.0 * i_s .* sinh(v ./ v_t);
+far = ~(abs(v) <= knee);
+if any(far)
+    s = 2.0 * (v(far) > 0) - 1.0;
+    f(far) = s .* 2.0 .* i_s(far) .* sinh(knee(far) ./ v_t(far)) + cap * (v(far) - s .* knee(far));
 end
 """
 
 
 def m_model(plan, lit: Callable[[float], str]) -> str:
     w_sum = plan.extra["W_SUM"]
+    n = int(plan.body[0])
     rest = ("v = value;" if not plan.inverse else
             f"v = (value + B(2)) / {lit(w_sum)};" if w_sum != 0 else "v = 0.0;")
     return f"""function x = model_rest(B, value)
@@ -125,13 +127,11 @@ function [out, x] = model_step(B, x, u)
 n = round(B(1));
 iw = 5 + 3 * n;
 {m_linear_readout(plan.inverse)}
-for k = 1:n
-    x(k) = x(k) + mpl_current(B, drive - x(k), k, n) * B(4);
-end
+x = x + mpl_current(drive - x, B(5:{4 + n}), B({5 + n}:{4 + 2 * n}), B({5 + 2 * n}:{4 + 3 * n}), ...
+                    B(3)) * B(4);
 end
 
-function f = mpl_current(B, v, k, n)
-i_s = B(4 + k); v_t = B(4 + n + k); knee = B(4 + 2 * n + k); cap = B(3);
+function f = mpl_current(v, i_s, v_t, knee, cap)
 {M_SINH_CURRENT}end
 """
 

@@ -11,7 +11,6 @@ w (n + 1)]``.
 from __future__ import annotations
 
 from collections.abc import Callable
-from textwrap import indent
 
 from .._cubic_output_code import C_FORWARD, C_INVERSE, C_SOLVE, M_CUBIC, M_SOLVE, m_step
 from .._protocol import Translation
@@ -62,6 +61,7 @@ static void model_rest(real *x, real value)
 
 def m_model(plan, lit: Callable[[float], str]) -> str:
     w_sum = plan.extra["W_SUM"]
+    n = int(plan.body[0])
     if not plan.inverse:
         rest = "e0 = value;"
     elif w_sum != 0:
@@ -75,12 +75,10 @@ x = e0 * ones(round(B(1)), 1);
 end
 
 {M_CUBIC}function x = cells(B, x, drive)
-n = round(B(1)); ic = 13;
-for k = 1:n
-    v = drive - x(k);
-    i_s = B(ic + k); v_t = B(ic + n + k); knee = B(ic + 2 * n + k); cap = B(3);
-{indent(M_SINH_CURRENT, "    ")}    x(k) = x(k) + f * B(4);
-end
+v = drive - x;
+i_s = B({_IC + 1}:{_IC + n}); v_t = B({_IC + n + 1}:{_IC + 2 * n});
+knee = B({_IC + 2 * n + 1}:{_IC + 3 * n}); cap = B(3);
+{M_SINH_CURRENT}x = x + f * B(4);
 end
 
 {M_SOLVE if plan.inverse else ""}{m_step(plan.inverse, 3)}"""

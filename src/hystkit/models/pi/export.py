@@ -126,85 +126,71 @@ static real model_step(real *x, real y)
 
 
 def m_model(plan, lit: Callable[[float], str]) -> str:
+    """MATLAB on every play and creep state at once (Octave interprets each statement and
+    call): the body's index ranges are written in, the sums taken in the C's order (``sum``
+    and ``cumsum`` add left to right from the first term; x - a is x + -a)."""
+    n, m, k = (int(v) for v in plan.body[:3])
     e = plan.extra
 
     def col(values):
         return "[" + ", ".join(lit(v) for v in np.asarray(values, float).ravel()) + "]"
 
+    i_r, i_c = 4, 4 + 2 * n
+    i_d = i_c + 2 * m
+    i_rinv = i_d + 2 * k
+    spans = {"@P@": f"1:{n}", "@Z@": f"{n + 1}:{n + m}", "@R@": f"{i_r + 1}:{i_r + n}",
+             "@WH@": f"{i_r + n + 1}:{i_r + 2 * n}", "@C@": f"{i_c + 1}:{i_c + m}",
+             "@WK@": f"{i_c + m + 1}:{i_c + 2 * m}", "@D@": f"{i_d + 1}:{i_d + k}",
+             "@WD@": f"{i_d + k + 1}:{i_d + 2 * k}",
+             "@RINV@": f"{i_rinv + n}:-1:{i_rinv + 1}",
+             "@WINV@": f"{i_rinv + 2 * n}:-1:{i_rinv + n + 1}",
+             "@W@": f"{i_rinv + 2 * n + 1}:{i_rinv + 3 * n}", "@N@": str(n)}
     rest = (f"u = (superposition(value, {col(e['D_INV'])}, {col(e['WS_INV'])}) - "
             f"{lit(e['B'])}) / {lit(e['GAIN'])};" if plan.inverse else "u = value;")
-    step = _M_INVERSE if plan.inverse else _M_FORWARD
-    return f"""function x = model_rest(B, value)
+    code = f"""function x = model_rest(B, value)
 {rest}
-x = u * ones(round(B(1)) + round(B(2)), 1);
-end
-
-function [n, m, k, ir, iwh, ic, iwk, id, iwd] = layout(B)
-n = round(B(1)); m = round(B(2)); k = round(B(3));
-ir = 4; iwh = ir + n; ic = ir + 2 * n; iwk = ic + m; id = ic + 2 * m; iwd = id + k;
+x = u * ones({n + m}, 1);
 end
 
 function acc = superposition(v, d, w)
-acc = 0.0;
-for j = 1:numel(d)
-    if d(j) > 0
-        acc = acc + w(j) * max(v - d(j), 0.0);
-    elseif d(j) < 0
-        acc = acc + w(j) * min(v - d(j), 0.0);
-    else
-        acc = acc + w(j) * v;
-    end
-end
+% the one-sided dead zones d weighted by w, summed in order
+t = w * v;
+up = d > 0;
+t(up) = w(up) .* max(v - d(up), 0.0);
+down = d < 0;
+t(down) = w(down) .* min(v - d(down), 0.0);
+acc = sum(t);
 end
 
 function x = move(B, x, u)
-[n, m, k, ir, iwh, ic] = layout(B);
-for i = 1:n
-    x(i) = max(u - B(ir + i), min(u + B(ir + i), x(i)));
+x(@P@) = max(u - B(@R@), min(u + B(@R@), x(@P@)));
+x(@Z@) = x(@Z@) + B(@C@) .* (u - x(@Z@));
 end
-for i = 1:m
-    x(n + i) = x(n + i) + B(ic + i) * (u - x(n + i));
-end
-end
-{step}"""
+{_M_INVERSE if plan.inverse else _M_FORWARD}"""
+    for key, value in spans.items():
+        code = code.replace(key, value)
+    return code
 
 
 _M_FORWARD = """
 function [y, x] = model_step(B, x, u)
-[n, m, k, ir, iwh, ic, iwk, id, iwd] = layout(B);
 x = move(B, x, u);
-v = B(4);
-for i = 1:n
-    v = v + B(iwh + i) * x(i);
-end
-for i = 1:m
-    v = v + B(iwk + i) * x(n + i);
-end
-y = superposition(v, B(id + 1:id + k), B(iwd + 1:iwd + k));
+v = sum([B(4); B(@WH@) .* x(@P@); B(@WK@) .* x(@Z@)]);
+y = superposition(v, B(@D@), B(@WD@));
 end
 """
 
+# The plays from the last to the first: big_w = sum w minus the ones done, tail the sum of
+# w_j p_j done (eq. 2.19)
 _M_INVERSE = """
 function [u_hat, x] = model_step(B, x, y)
-[n, m, k, ir, iwh, ic, iwk, id, iwd] = layout(B);
-irinv = id + 2 * k; iwinv = irinv + n; iw = iwinv + n;
-big_w = 0.0;
-for j = 1:n
-    big_w = big_w + B(iw + j);
-end
-v = superposition(y, B(id + 1:id + k), B(iwd + 1:iwd + k)) - B(4);
-for j = 1:m
-    v = v - B(iwk + j) * (1.0 - B(ic + j)) * x(n + j);
-end
-u_hat = 0.0;
-tail = 0.0;
-for j = n:-1:1
-    p_j = x(j);
-    q = big_w * p_j + tail;
-    u_hat = u_hat + B(iwinv + j) * max(v - B(irinv + j), min(v + B(irinv + j), q));
-    tail = tail + B(iw + j) * p_j;
-    big_w = big_w - B(iw + j);
-end
+w = B(@W@);
+v = sum([superposition(y, B(@D@), B(@WD@)) - B(4); -(B(@WK@) .* (1.0 - B(@C@)) .* x(@Z@))]);
+p = x(@N@:-1:1);
+big_w = cumsum([sum(w); -w(@N@:-1:2)]);
+tail = cumsum([0.0; w(@N@:-1:2) .* p(1:end - 1)]);
+q = big_w .* p + tail;
+u_hat = sum(B(@WINV@) .* max(v - B(@RINV@), min(v + B(@RINV@), q)));
 x = move(B, x, u_hat);
 end
 """
@@ -214,5 +200,5 @@ end
 TRANSLATION = Translation(
     c_model=c_model,
     m_model=m_model,
-    m_functions=("layout", "move", "superposition"),
+    m_functions=("move", "superposition"),
     extra=extra)

@@ -127,52 +127,46 @@ static real model_step(real *x, real y)
 
 
 def m_model(plan, lit: Callable[[float], str]) -> str:
+    """MATLAB on every cell and segment at once (Octave interprets each statement and call):
+    the body's layout written in at export, sums in the C's order (``sum`` adds left to right
+    from the first term; x - a is x + -a)."""
     w_sum = plan.extra["W_SUM"]
+    n, m = int(plan.body[0]), int(plan.body[1])
+    i_w = 8 + 2 * n
+    i_b = i_w + n + 1
+    i_s = i_b + m + 1
     rest = ("v = value;" if not plan.inverse else
             f"v = (f_of(B, value) + B(7)) / {lit(w_sum)};" if w_sum != 0 else "v = 0.0;")
     step = _M_INVERSE if plan.inverse else _M_FORWARD
-    return f"""function x = model_rest(B, value)
+    code = f"""function x = model_rest(B, value)
 {rest}
 x = v * ones(round(B(1)), 1);
 end
 
-function [n, m, iw, ib, is_] = layout(B)
-n = round(B(1)); m = round(B(2));
-iw = 8 + 2 * n; ib = iw + n + 1; is_ = ib + m + 1;
-end
-
-function f = current(B, v, k)
-n = round(B(1));
-i_t = B(3); power = B(4); g_lin = B(5); thr = B(7 + k); knee = B(7 + n + k);
-a = abs(v);
-if v >= 0, s = 1.0; else, s = -1.0; end
-scale = i_t / (power - 1.0);
-if a <= knee
-    f = s * scale * (a / thr) ^ power;
-else
-    f = s * (scale * (knee / thr) ^ power + g_lin * (a - knee));
-end
-end
-
 function x = cells(B, x, drive)
-for k = 1:round(B(1))
-    x(k) = x(k) + current(B, drive - x(k), k) * B(6);
+% every cell's current (power law up to the knee, then straight), the Euler step
+v = drive - x;
+thr = B(8:@N7@); knee = B(@N8@:@N2_7@); power = B(4);
+a = abs(v);
+s = 2.0 * (v >= 0) - 1.0;
+scale = B(3) / (power - 1.0);
+f = s .* scale .* (a ./ thr) .^ power;
+far = ~(a <= knee);
+if any(far)
+    f(far) = s(far) .* (scale * (knee(far) ./ thr(far)) .^ power + B(5) * (a(far) - knee(far)));
 end
+x = x + f * B(6);
 end
 
 function total = f_of(B, i)
-[n, m, iw, ib, is_] = layout(B);
-total = 0.0;
-for j = 1:m
-    if j == 1, lo = -Inf; else, lo = B(ib + j - 1); end
-    if j == m, hi = Inf; else, hi = B(ib + j); end
-    total = total + B(is_ + j - 1) * (min(max(i, lo), hi) - min(max(0.0, lo), hi));
-end
+% the segments j = 1 .. m between the breakpoints (open at both ends)
+lo = [-Inf; B(@IB1@:@IBM@)]; hi = [B(@IB1@:@IBM@); Inf];
+total = sum(B(@IS@:@ISM@) .* (min(max(i, lo), hi) - min(max(0.0, lo), hi)));
 end
 
 function i = f_inverse(B, u)
-[n, m, iw, ib, is_] = layout(B);
-brk = B(ib:ib + m); a = B(is_:is_ + m - 1);
+m = @M@;
+brk = B(@IB@:@IBE@); a = B(@IS@:@ISM@);
 j = 1;
 while j < m && brk(j + 1) <= 0
     j = j + 1;
@@ -194,28 +188,25 @@ end
 i = i_left + (u - f_left) / a(j);
 end
 {step}"""
+    spans = {"@N7@": str(7 + n), "@N8@": str(8 + n), "@N2_7@": str(7 + 2 * n),
+             "@IB1@": str(i_b + 1), "@IBM@": str(i_b + m - 1), "@IBE@": str(i_b + m),
+             "@IB@": str(i_b), "@IS@": str(i_s), "@ISM@": str(i_s + m - 1), "@M@": str(m),
+             "@IW@": str(i_w), "@IWN@": f"{i_w + 1}:{i_w + n}"}
+    for key, value in spans.items():
+        code = code.replace(key, value)
+    return code
 
 
 _M_FORWARD = """
 function [y, x] = model_step(B, x, u)
-[n, m, iw] = layout(B);
-acc = B(iw) * u - B(7);
-for k = 1:n
-    acc = acc + B(iw + k) * x(k);
-end
-y = f_inverse(B, acc);
+y = f_inverse(B, sum([B(@IW@) * u - B(7); B(@IWN@) .* x]));
 x = cells(B, x, u);
 end
 """
 
 _M_INVERSE = """
 function [e, x] = model_step(B, x, y)
-[n, m, iw] = layout(B);
-acc = f_of(B, y) + B(7);
-for k = 1:n
-    acc = acc - B(iw + k) * x(k);
-end
-e = acc / B(iw);
+e = sum([f_of(B, y) + B(7); -(B(@IWN@) .* x)]) / B(@IW@);
 x = cells(B, x, e);
 end
 """
@@ -225,5 +216,5 @@ end
 TRANSLATION = Translation(
     c_model=c_model,
     m_model=m_model,
-    m_functions=("cells", "current", "f_inverse", "f_of", "layout"),
+    m_functions=("cells", "f_inverse", "f_of"),
     extra=extra)

@@ -40,8 +40,7 @@ def state_size(plan) -> int:
 TRANSLATION = Translation(
     c_model=c_model,
     m_model=m_model,
-    m_functions=("A", "branch_output", "combine", "everett", "last_index", "load_sums",
-                 "make_room", "running_sum", "term", "update"),
+    m_functions=("branch_output", "everett", "load_sums", "make_room", "term", "update"),
     extra=extra,
     state_size=state_size,
     m_load=M_LOAD)
