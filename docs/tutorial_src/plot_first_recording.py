@@ -26,16 +26,20 @@ what it printed.
 # Setting up
 # ----------
 # A fresh folder to work in, ``work``, and ``hystkit``, a helper that runs one command line
-# there (``python -m hystkit`` is the ``hystkit`` program) and prints its output.
+# there and prints its output. It calls :func:`hystkit.cli.main`, what the ``hystkit``
+# program runs, in this Python process (one start of Python for the whole page instead of
+# one per command; the output is the program's).
 
+import contextlib
+import io
 import shlex
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
 import matplotlib.pyplot as plt
 import pandas as pd
+
+from hystkit.cli import main
 
 work = Path(tempfile.mkdtemp(prefix="hystkit-tutorial-"))
 
@@ -43,12 +47,13 @@ work = Path(tempfile.mkdtemp(prefix="hystkit-tutorial-"))
 def hystkit(command: str) -> None:
     """Run ``hystkit COMMAND`` in ``work``, print its output; stop if it fails."""
     print(f"$ hystkit {command}")
-    argv = [sys.executable, "-m", "hystkit", *shlex.split(command)]
-    proc = subprocess.run(argv, cwd=work, stdout=subprocess.PIPE,
-                          stderr=subprocess.STDOUT, text=True, check=False)
-    print(proc.stdout, end="")
-    if proc.returncode != 0:
-        raise RuntimeError(f"exit code {proc.returncode}: {proc.stdout}")
+    output = io.StringIO()
+    with (contextlib.chdir(work), contextlib.redirect_stdout(output),
+          contextlib.redirect_stderr(output)):
+        code = main(shlex.split(command))
+    print(output.getvalue(), end="")
+    if code != 0:
+        raise RuntimeError(f"exit code {code}: {output.getvalue()}")
 
 
 # %%
