@@ -59,6 +59,7 @@ autosummary_generate = True
 autosummary_generate_overwrite = True
 autosummary_imported_members = True  # the packages export what their private modules define
 autodoc_typehints = "none"  # the numpydoc sections give every type, with shape and unit
+autodoc_use_type_comments = False  # hystkit has no type comments; looking for them parses sources
 autodoc_member_order = "bysource"
 autodoc_default_options = {"exclude-members": "__init__, __new__"}
 numpydoc_show_class_members = False  # the class template documents the members itself
@@ -96,3 +97,4 @@ html_theme_options = {
     "footer_end": ["sphinx-version"],
 }
 html_show_sourcelink = False
+html_copy_source = False  # no page links its source (above); the search reads the pages
