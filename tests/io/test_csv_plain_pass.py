@@ -122,9 +122,9 @@ def test_a_fit_of_a_clean_csv_loads_neither_pandas_nor_scipy_optimize(tmp_path):
     u = np.sin(2 * np.pi * 0.5 * t)
     rec = Recording(time=t, position=3 * u, sensor=u + 0.01 * rng.standard_normal(t.size))
     path = write_recording(rec, tmp_path / "rec.csv")
-    # the plain fit loads neither; the prediction band's fold fits weight the samples (zero on
-    # the held-out pieces), which goes through scipy's trf: pandas stays out either way
-    for options, loaded in ((["--no-band"], ["False", "False"]), ([], ["False", "True"])):
+    # neither the plain fit nor the prediction band's fold fits, which weight the samples (zero
+    # on the held-out pieces) and run on the same solver, load them
+    for options, loaded in ((["--no-band"], ["False", "False"]), ([], ["False", "False"])):
         model = tmp_path / f"m{len(options)}.json"
         code = ("import sys; from hystkit.cli import main; "
                 f"code = main(['fit', {str(path)!r}, '--model', 'mpl', '--out', {str(model)!r}, "

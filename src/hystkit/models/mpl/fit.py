@@ -98,7 +98,10 @@ def _projected_search(normal_equations: Callable[[np.ndarray], NormalEquations],
                              "screen_nfev": min(options["screen_nfev"], PROJECTED_SCREEN),
                              "n_polish": min(options["n_polish"], PROJECTED_POLISH)})
     theta = projected.full(best.theta)
-    return SimpleNamespace(theta=theta, runs=best.n_evaluations + projected.extra,
+    # runs: the solver's evaluations (the second pass of a near-exact one, and the pass for a
+    # point a worker evaluated, are not counted: they happen in whichever process ran it, and
+    # a fit split over workers counts the same as a serial one)
+    return SimpleNamespace(theta=theta, runs=best.n_evaluations,
                            seconds=best.seconds)
 
 # A cell whose rate G at the floor moves it by less than this share of its drive over the whole

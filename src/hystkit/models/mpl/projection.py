@@ -74,14 +74,12 @@ class Projection:
         self._low, self._high = lin_lower, lin_upper
         self._unit = np.r_[0.0, np.ones(n_cells), 0.0]
         self._linear: dict[bytes, np.ndarray] = {}
-        self.extra = 0  # runs outside the solver: repeated passes, points a worker evaluated
 
     def __call__(self, cells: np.ndarray) -> NormalEquations:
         cost, hess, grad, linear, probe_cost = self._project(cells, self._unit)
         if cost < CANCELLATION * probe_cost and np.all(linear[1: self._n + 1] != 0):
             # a near-exact fit: its cost, found as the probe's minus the projection, has lost
             # its digits; a pass at the best weights gives it (and its derivatives) again
-            self.extra += 1
             cost, hess, grad, linear, _ = self._project(cells, linear)
         self._linear[cells.tobytes()] = linear
         return NormalEquations(COST_SCALE * cost, COST_SCALE * hess, COST_SCALE * grad)
@@ -119,8 +117,7 @@ class Projection:
     def full(self, cells: np.ndarray) -> np.ndarray:
         """The whole optimiser vector at `cells`: with its best linear parameters."""
         key = np.asarray(cells, float).tobytes()
-        if key not in self._linear:
-            self.extra += 1
+        if key not in self._linear:  # a point a worker evaluated: run once more here
             self(np.asarray(cells, float))
         return np.r_[cells, self._linear[key]]
 
