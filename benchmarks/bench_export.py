@@ -336,7 +336,12 @@ def main() -> None:
             print(row, flush=True)
     lines.append(f"# load at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
     print(lines[-1])
-    (HERE / "last_run_export.txt").write_text("\n".join(lines) + "\n")
+    # this table replaces the file's first one; the Octave sections (--octave) appended
+    # after it stay
+    out = HERE / "last_run_export.txt"
+    old = out.read_text() if out.exists() else ""
+    octave_sections = old[old.index("\n## "):] if "\n## " in old else ""
+    out.write_text("\n".join(lines) + "\n" + octave_sections)
 
 
 if __name__ == "__main__":
