@@ -6,14 +6,11 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
-import subprocess
 from html.parser import HTMLParser
 from pathlib import Path
 
 import numpy as np
 import pytest
-from matplotlib.image import imread
 
 from hystkit.compensation import evaluate, fit_compensator, load_compensator, save_compensator
 from hystkit.io import write_recording
@@ -22,9 +19,7 @@ from hystkit.studies import build_report, write_report
 from hystkit.studies._html import Section, render_page, table
 from hystkit.studies._report_model import named_parameters
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-needs_chromium = pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (CI "
-                                                             "installs the Debian package)")
+from .screenshots import n_close, n_colours, needs_chromium, screenshot
 
 
 class PageParser(HTMLParser):
@@ -81,31 +76,15 @@ def external_references(page: str) -> list[str]:
     return [r for r in refs if not r.startswith(("data:", "#"))]
 
 
-# Every render is cut off from the network: a proxy on a closed port, no name resolution, and
-# the browser's own background traffic (updates, accounts) switched off.
-_OFFLINE = ("--proxy-server=127.0.0.1:9", "--host-resolver-rules=MAP * ~NOTFOUND",
-            "--disable-background-networking", "--disable-component-update", "--disable-sync",
-            "--no-first-run", "--disable-default-apps")
-
-
-def render(page: Path, shot: Path, *flags: str) -> np.ndarray:
-    """Screenshot of `page` in headless Chromium (1280 px wide), as an RGB float array."""
-    subprocess.run([CHROMIUM, "--headless=new", "--no-sandbox", "--disable-gpu",
-                    "--hide-scrollbars", "--window-size=1280,4000", f"--screenshot={shot}",
-                    *_OFFLINE, *flags, page.resolve().as_uri()],
-                   check=True, capture_output=True, timeout=120)
-    return imread(shot)[..., :3]
-
-
 def render_logged(page: Path, tmp_path: Path) -> tuple[np.ndarray, list[str]]:
-    """One Chromium run of `page`: its screenshot (as :func:`render`) and the URLs the page
-    itself asked for meanwhile, from Chromium's net log.
+    """One Chromium run of `page`: its screenshot (1280 x 4000 px, RGB pixels) and the URLs
+    the page itself asked for meanwhile, from Chromium's net log.
 
     The page's requests carry its (opaque, file://) origin as initiator, "null"; the browser's
     own background requests say "not an origin". Data URIs never reach the network stack.
     """
     log = tmp_path / f"{page.stem}-net.json"
-    shot = render(page, tmp_path / f"{page.stem}-shot.png", f"--log-net-log={log}")
+    shot = screenshot(page, tmp_path / f"{page.stem}-shot.png", 4000, f"--log-net-log={log}")
     events = json.loads(log.read_text(encoding="utf-8"))
     names = {v: k for k, v in events["constants"]["logEventTypes"].items()}
     return shot, [e["params"]["url"] for e in events["events"]
@@ -223,17 +202,16 @@ def test_tables_escape_their_text() -> None:
 
 @needs_chromium
 def test_chromium_renders_the_page_with_its_figures(rendered: tuple) -> None:
-    shot, _ = rendered
-    pixels = np.round(shot * 255).astype(np.uint8).reshape(-1, 3)
-    n_colours = np.unique(pixels, axis=0).shape[0]
-    assert n_colours > 2000, n_colours  # text alone gives a few hundred grey levels
+    pixels, _ = rendered
+    colours = n_colours(pixels)
+    assert colours > 2000, colours  # text alone gives a few hundred grey levels
     non_white = np.mean(np.any(pixels < 250, axis=1))
     assert non_white > 0.05, non_white
     # the figures' traces: tab:orange (the model), tab:purple (the sensor loop); text and
     # table borders are grey, so these pixels come from the embedded images only
     for rgb in ((255, 127, 14), (148, 103, 189)):
-        close = np.all(np.abs(pixels.astype(int) - rgb) <= 12, axis=1)
-        assert close.sum() > 2000, (rgb, close.sum())
+        close = n_close(pixels, rgb)
+        assert close > 2000, (rgb, close)
 
 
 @needs_chromium

@@ -6,19 +6,15 @@ from __future__ import annotations
 import base64
 import json
 import re
-import shutil
-import subprocess
 from html.parser import HTMLParser
 from pathlib import Path
 
-import numpy as np
 import pytest
-from matplotlib.image import imread
 
 from hystkit.studies import DEMO_FILES, run_demo
 from hystkit.studies._demo import REPORT_DEMO_FILES
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+from .screenshots import n_close, n_colours, needs_chromium, screenshot
 
 
 class Page(HTMLParser):
@@ -87,16 +83,10 @@ def test_demo_page_embeds_the_figure_files_and_nothing_else(demo: Path) -> None:
     assert embedded == [(demo / n).read_bytes() for n in ("loops.png", "time_series.png")]
 
 
-@pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (CI installs it)")
+@needs_chromium
 def test_chromium_renders_the_demo_page(demo: Path, tmp_path: Path) -> None:
     shot = tmp_path / "demo.png"
-    subprocess.run([CHROMIUM, "--headless=new", "--no-sandbox", "--disable-gpu",
-                    "--hide-scrollbars", "--window-size=1280,5000", f"--screenshot={shot}",
-                    "--proxy-server=127.0.0.1:9", "--host-resolver-rules=MAP * ~NOTFOUND",
-                    "--disable-background-networking", "--disable-component-update",
-                    (demo / "report.html").resolve().as_uri()],
-                   check=True, capture_output=True, timeout=120)
-    pixels = np.round(imread(shot)[..., :3] * 255).astype(np.uint8).reshape(-1, 3)
-    assert np.unique(pixels, axis=0).shape[0] > 2000
+    pixels = screenshot(demo / "report.html", shot, 5000)
+    assert n_colours(pixels) > 2000
     for rgb in ((255, 127, 14), (148, 103, 189)):  # mPL traces, sensor loops
-        assert np.all(np.abs(pixels.astype(int) - rgb) <= 12, axis=1).sum() > 2000, rgb
+        assert n_close(pixels, rgb) > 2000, rgb

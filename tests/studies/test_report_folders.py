@@ -8,13 +8,10 @@ import base64
 import json
 import re
 import shutil
-import subprocess
 from html.parser import HTMLParser
 from pathlib import Path
 
-import numpy as np
 import pytest
-from matplotlib.image import imread
 
 from hystkit.cli import cmd_select, main
 from hystkit.errors import InputError
@@ -24,7 +21,8 @@ from hystkit.studies import Candidate, build_report, write_report
 from hystkit.studies._report_control import stability_verdict
 from hystkit.studies._report_folders import folder_kind, plot_unexplained
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+from .screenshots import n_close, n_colours, needs_chromium, screenshot
+
 N_SHORT = 2400  # 60 s at 40 Hz: enough for every fold of select, quick to fit
 
 
@@ -184,19 +182,14 @@ def test_a_damaged_result_file_is_one_error_naming_the_folder(
         build_report([broken])
 
 
-@pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (CI installs it)")
+@needs_chromium
 def test_chromium_renders_the_folders_page(page: Path, tmp_path: Path) -> None:
     shot = tmp_path / "folders.png"
-    subprocess.run([CHROMIUM, "--headless=new", "--no-sandbox", "--disable-gpu",
-                    "--hide-scrollbars", "--window-size=1280,6000", f"--screenshot={shot}",
-                    "--proxy-server=127.0.0.1:9", "--host-resolver-rules=MAP * ~NOTFOUND",
-                    "--disable-background-networking", "--disable-component-update",
-                    page.resolve().as_uri()], check=True, capture_output=True, timeout=120)
-    pixels = np.round(imread(shot)[..., :3] * 255).astype(np.uint8).reshape(-1, 3)
-    assert np.unique(pixels, axis=0).shape[0] > 2000
+    pixels = screenshot(page, shot, 6000)
+    assert n_colours(pixels) > 2000
     # viridis cells of the generalisation matrix and the Bode plot's blue trace
     for rgb in ((31, 119, 180),):
-        assert np.all(np.abs(pixels.astype(int) - rgb) <= 12, axis=1).sum() > 2000
+        assert n_close(pixels, rgb) > 2000
 
 
 def test_a_loop_unstable_only_over_days_is_a_note_not_a_failure() -> None:
