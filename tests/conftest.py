@@ -14,11 +14,13 @@ spread the rest finer, but pytest-xdist 3.8 does not group under pytest 9 (it re
 from __future__ import annotations
 
 import inspect
+import os
 import types
 from functools import cache
 from pathlib import Path
 
 import pytest
+from threadpoolctl import threadpool_limits
 
 TESTS = Path(__file__).resolve().parent
 
@@ -87,3 +89,13 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     # otherwise start last and run alone at the end (--no-loadscope-reorder keeps this order).
     slow_files = {i.path for i in items if i.get_closest_marker("slow")}
     items.sort(key=lambda i: i.path not in slow_files)  # stable: the files keep their order
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    # Under pytest-xdist each worker keeps one BLAS thread, as scikit-learn's conftest does:
+    # with OpenBLAS's default of one thread per core, two workers on two cores run four
+    # threads that spin against each other (a 191 x 191 SVD took 35-41 ms of CPU instead of
+    # 8-18 ms, a QR of 8200 x 192 164-179 ms instead of 40-43 ms, on this 2-core machine
+    # under load). The `hystkit` program sets one BLAS thread itself (cli/_main.py).
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        threadpool_limits(limits=1, user_api="blas")  # kept for the worker's whole run
