@@ -18,6 +18,8 @@ __all__ = ["any_chunk", "plain_chunk", "rows", "run_chunk"]
 
 # What a line of two plain numbers holds (anything else: the line-by-line path)
 _NOT_PLAIN = str.maketrans("", "", "0123456789.eE+-,\n")
+# Samples checked and compensated per compiled call on the line-by-line path
+_WINDOW = 512
 
 
 def run_chunk(stream: Stream, chunk: str, reading: Reading, tally: Tally,
@@ -96,8 +98,11 @@ def any_chunk(stream: Stream, chunk: list[str], reading: Reading, tally: Tally,
     lines: list[str] = []
     i = 0
     while i < len(samples):
+        # a window at a time (a split run equals the whole run): after a refused sample only
+        # the rest of its window is checked again, not the rest of the chunk (quadratic)
+        window = range(i, min(i + _WINDOW, len(samples)))
         kept, problems, previous = [], [], reading.previous
-        for j in range(i, len(samples)):
+        for j in window:
             problem = reading.step_problem(samples[j][1], previous, dt)
             if problem is not None:
                 problems.append((j, problem))
@@ -106,7 +111,7 @@ def any_chunk(stream: Stream, chunk: list[str], reading: Reading, tally: Tally,
                 previous = samples[j][1]
         out = stream.step_many([samples[j][2] for j in kept])
         taken = out.estimate.size
-        stop = kept[taken] if taken < len(kept) else len(samples)  # the refused sample
+        stop = kept[taken] if taken < len(kept) else window[-1]  # the refused or last sample
         for j, problem in problems:
             if j <= stop:  # (after a refused sample they are checked again)
                 tally.add(problem, samples[j][3])
