@@ -95,3 +95,25 @@ def test_an_unreachable_scheduler_is_one_error(monkeypatch):
     with pytest.raises(HystkitError, match=r"--scheduler tcp://127.0.0.1:9: cannot connect"), \
             open_executor(scheduler="tcp://127.0.0.1:9"):
         pass
+
+
+def test_closing_after_finished_maps_stops_no_worker(monkeypatch):
+    """Workers that wait for work leave on the pool's own signal: stopping one inside the call
+    queue's lock would leave the lock taken and the shutdown waiting on the other worker."""
+    import multiprocessing.process
+
+    from hystkit.parallel._forked import ForkedExecutor
+
+    stopped = []
+    terminate = multiprocessing.process.BaseProcess.terminate
+    monkeypatch.setattr(multiprocessing.process.BaseProcess, "terminate",
+                        lambda self: (stopped.append(self.pid), terminate(self)))
+    executor = ForkedExecutor(2)
+    assert executor.map(pow, [2, 3, 4], shared={"exp": 2}) == [4, 9, 16]
+    executor.close()
+    assert stopped == []
+    # a piece still running when the executor closes (an error elsewhere, a signal) is stopped
+    executor = ForkedExecutor(2)
+    executor._pool.submit(time.sleep, 60)
+    executor.close()
+    assert stopped

@@ -104,8 +104,14 @@ class ForkedExecutor:
                                  optimize_graph=False, callbacks=callbacks))
 
     def close(self) -> None:
-        """End the workers; a piece still running (after an error or a signal) is stopped."""
-        for process in list(getattr(self._pool, "_processes", {}).values()):
-            if process.is_alive():
-                process.terminate()
+        """End the workers; a piece still running (after an error or a signal) is stopped.
+
+        After maps that finished, the workers leave on the pool's own signal. Stopping them
+        instead could stop one that waits for work, inside the call queue's lock: the lock
+        stays taken and the shutdown waits for ever on the other worker (a ``generalize``
+        hung so once, at load ~9)."""
+        if getattr(self._pool, "_pending_work_items", None):
+            for process in list(getattr(self._pool, "_processes", {}).values()):
+                if process.is_alive():
+                    process.terminate()
         self._pool.shutdown(wait=True, cancel_futures=True)
