@@ -46,10 +46,10 @@ def _locked(path: Path):
             fcntl.flock(lock, fcntl.LOCK_UN)
 
 
-def _shared_folder(tmp_path_factory, worker_id: str) -> Path | None:
+def _shared_folder(tmp_path_factory) -> Path | None:
     """The run's folder the xdist workers share (the parent of each worker's own temporary
     folder belongs to this run only); None without workers or without file locks."""
-    if worker_id == "master" or fcntl is None:
+    if not os.environ.get("PYTEST_XDIST_WORKER") or fcntl is None:
         return None
     folder = tmp_path_factory.getbasetemp().parent / "export-compensators"
     folder.mkdir(exist_ok=True)
@@ -73,11 +73,11 @@ def _built_once(folder: Path | None, key: tuple[str, str, str],
 
 
 @pytest.fixture(scope="session")
-def compensators(recordings, tmp_path_factory, worker_id):
+def compensators(recordings, tmp_path_factory):
     """(label, mode, center) -> Compensator, built on first use in this run."""
     cache: dict = {}
     train, val = recordings
-    folder = _shared_folder(tmp_path_factory, worker_id)
+    folder = _shared_folder(tmp_path_factory)
 
     def get(label: str, mode: str, center: str) -> Compensator:
         key = (label, mode, center)
