@@ -19,8 +19,8 @@ from collections.abc import Iterator, Sequence
 from typing import Any
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
+from .._blas import one_blas_thread
 from ..models import Family
 from ._diagnostics import (
     error_steps,
@@ -68,7 +68,7 @@ def chunked_standard_errors(family: Family, structure: Any, params: Any,
     r_factor, sse, n = np.zeros((0, steps.size)), 0.0, 0
     # one BLAS thread for the QR folds and the SVD (tall, narrow or small: a QR of 8200 x 192
     # took 164-179 ms of CPU on OpenBLAS's two threads against 40-43 ms on one, under load)
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         for u, target in zip(inputs, targets, strict=True):
             for r0, jac in _jacobian_chunks(family, structure, shifted, steps, u, target, rows):
                 sse += float(r0 @ r0)

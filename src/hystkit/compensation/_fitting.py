@@ -18,8 +18,8 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
+from .._blas import one_blas_thread
 from ..errors import FitDivergedError, HystkitError, InputError
 from ..identification import FitResult, objective
 from ..io import Recording
@@ -89,7 +89,7 @@ def _polish_jointly(run: Callable, structure: Any, params: Any, inputs: list[np.
 
     # one BLAS thread, as the family fits: trf's SVD of the tall, narrow Jacobian (16000 x 9)
     # took 19.6 ms on OpenBLAS's two threads against 2.0 ms on one, on a busy 2-core machine
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         sol = least_squares(residual, theta0, method="trf", x_scale="jac", loss=loss,
                             f_scale=f_scale, max_nfev=100)
     start_cost = 0.5 * objective(residual(theta0), loss, f_scale)

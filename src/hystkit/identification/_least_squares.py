@@ -20,7 +20,6 @@ families' compiled normal equations have no weights). Weighted fits are the fold
 
 from __future__ import annotations
 
-import functools
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -28,8 +27,8 @@ from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
-from threadpoolctl import ThreadpoolController
 
+from .._blas import one_blas_thread
 from ..errors import FitDivergedError
 from ..parallel import Executor, current_executor
 from ._clock import FitTimer
@@ -336,7 +335,7 @@ class _StartSolver:
     def __call__(self, theta0: np.ndarray, budget: int, resume: Any = None) -> SimpleNamespace:
         # BLAS threads do not pay on (n x n_params) problems, and under load they cost 10-30x
         # (benchmarks/README.md).
-        with _blas_controller().limit(limits=1, user_api="blas"):
+        with one_blas_thread():
             if self.solver != "trf":
                 # lm may stop on a bound, the margin keeps it inside as trf and tr stay
                 shrink = self.margin if self.solver == "lm" else 0.0
@@ -475,9 +474,3 @@ def _per_coordinate(values: Sequence | None, n: int, what: str) -> tuple | None:
         raise ValueError(f"{what} must have one entry per coordinate ({n}), got {len(values)}")
     return values
 
-
-@functools.cache
-def _blas_controller() -> ThreadpoolController:
-    """One controller per process: finding the loaded BLAS libraries reads /proc/self/maps
-    (~20 ms), which per solve cost more than a short fit's model runs."""
-    return ThreadpoolController()

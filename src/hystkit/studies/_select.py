@@ -14,8 +14,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
-from threadpoolctl import threadpool_limits
 
+from .._blas import one_blas_thread
 from ..compensation import (
     DEFAULT_CENTER,
     EXTRAPOLATION_NOTE,
@@ -223,7 +223,7 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
             # refit's standard errors take QR factors of chunks of (~1000 x n_params) rows,
             # too small for threads, and idle OpenBLAS threads spin (measured: the Preisach
             # refit 0.4 s with one thread, 0.8-3.4 s with two on a busy 2-core machine).
-            with threadpool_limits(limits=1, user_api="blas"):
+            with one_blas_thread():
                 comp = fit_compensator(list(recordings), row["size"], model=row["model"],
                                        mode=row["mode"], center=row["center"], **options)
         except FAMILY_FAILURES as exc:
@@ -235,7 +235,7 @@ def select_model(recordings: Sequence[Recording], cands: Sequence[Candidate], *,
                                   f"{comp.fit_info['status_message']}")
             continue
         # the winner's band, from the same folds it was validated on
-        with threadpool_limits(limits=1, user_api="blas"):
+        with one_blas_thread():
             comp = with_band(comp, list(recordings), row["size"], options)
         out["winner"], out["compensator"] = row, comp
         return out

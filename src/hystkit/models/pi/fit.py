@@ -38,8 +38,8 @@ from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import lsq_linear
-from threadpoolctl import threadpool_limits
 
+from ..._blas import one_blas_thread
 from ...errors import FitDivergedError
 from ...identification import FitResult, FitTimer, check_weights, require_linear_loss
 from . import kernels
@@ -185,7 +185,7 @@ def fit_pi(u: np.ndarray, y: np.ndarray, structure: pi.PiStructure, *,
     a_aug = np.vstack([a, lam * np.eye(a.shape[1])])
     t_aug = np.concatenate([centre, lam * neutral])
     # BLAS threads do not pay on (n x ~30) problems and cost a lot under load.
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         sol = lsq_linear(a_aug, t_aug, bounds=(lower, np.inf), method="bvls")
     if not np.all(np.isfinite(sol.x)):
         raise FitDivergedError(f"the fit failed: the linear solver returned non-finite "

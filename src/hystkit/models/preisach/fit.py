@@ -34,8 +34,8 @@ import numpy as np
 from scipy.interpolate import LinearNDInterpolator
 from scipy.linalg import LinAlgError, LinAlgWarning
 from scipy.optimize import lsq_linear, nnls
-from threadpoolctl import threadpool_limits
 
+from ..._blas import one_blas_thread
 from ...errors import FitDivergedError
 from ...identification import (
     FitResult,
@@ -195,7 +195,7 @@ def solve_regularised(a: np.ndarray, y: np.ndarray, penalty: np.ndarray,
     message : str
     success : bool
     """
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         stacked = np.vstack([np.column_stack([a, y]),
                              np.column_stack([penalty, np.zeros(penalty.shape[0])])])
         r = np.linalg.qr(stacked, mode="r")
