@@ -5,22 +5,37 @@ hystkit's default local executor, two worker processes forked from the test proc
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterator
 
 import pytest
 
 from hystkit.io import Recording
 from hystkit.sensors import simulate_experiment
 
+# The cluster opens at the first test that asks for it and closes when this worker's next test
+# is outside tests/parallel, not at the session's end: idle, its scheduler and two workers took
+# ~0.07 s of CPU a second (2026-11-29), ~14 s over the ~200 s of other files a worker then ran.
+# (A package-scoped fixture would need tests/parallel/__init__.py, which renames the test
+# modules to ``parallel.*``; the cluster's workers then fail to import the pieces they run.)
+_CLUSTER: dict = {}
 
-@pytest.fixture(scope="session")
-def cluster_address() -> Iterator[str]:
-    distributed = pytest.importorskip("distributed")
-    from hystkit.parallel._dask import NO_DASHBOARD
 
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  silence_logs=logging.CRITICAL, **NO_DASHBOARD) as cluster:
-        yield cluster.scheduler_address
+@pytest.fixture
+def cluster_address() -> str:
+    if "cluster" not in _CLUSTER:
+        distributed = pytest.importorskip("distributed")
+        from hystkit.parallel._dask import NO_DASHBOARD
+
+        _CLUSTER["cluster"] = distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, silence_logs=logging.CRITICAL,
+            **NO_DASHBOARD)
+    return _CLUSTER["cluster"].scheduler_address
+
+
+def pytest_runtest_teardown(item, nextitem):
+    if nextitem is None or nextitem.path.parent != item.path.parent:
+        cluster = _CLUSTER.pop("cluster", None)
+        if cluster is not None:
+            cluster.close()
 
 
 @pytest.fixture(scope="session")
