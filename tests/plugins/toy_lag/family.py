@@ -72,10 +72,11 @@ class LagFamily(Family):
         u, y = check_fit_data(u, y)
         best = None
         for rate in RATES:
-            lag = self.simulate(structure, LagParams(rate, 0.0, 1.0), u)[0]
-            coef = np.linalg.lstsq(np.column_stack([u, lag, np.ones_like(u)]), y, rcond=None)[0]
+            lag = self.simulate(structure, LagParams(rate, 0.0, 1.0), u)[0]  # the state x
+            columns = np.column_stack([u, lag, np.ones_like(u)])
+            coef = np.linalg.lstsq(columns, y, rcond=None)[0]
             params = LagParams(rate, *coef)
-            cost = float(np.sum((self.simulate(structure, params, u)[0] - y) ** 2))
+            cost = float(np.sum((columns @ coef - y) ** 2))  # the model's output is columns @ coef
             if best is None or cost < best[0]:
                 best = (cost, params)
         return FitResult(structure=structure, params=best[1], cost=best[0],
