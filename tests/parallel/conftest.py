@@ -31,6 +31,7 @@ def cluster_address() -> str:
     return _CLUSTER["cluster"].scheduler_address
 
 
+@pytest.hookimpl(trylast=True)  # after the test's own fixtures (a client of the cluster) end
 def pytest_runtest_teardown(item, nextitem):
     if nextitem is None or nextitem.path.parent != item.path.parent:
         cluster = _CLUSTER.pop("cluster", None)
